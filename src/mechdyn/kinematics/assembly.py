@@ -1,0 +1,277 @@
+"""Position analysis: solve Phi(x) = 0, g(x) = q for the body poses x.
+
+Newton's method from the previous solution keeps the assembly branch by
+continuity; the initial assembly from the sketch uses a least-squares solve.
+Failures name the joints that stay open and by how much; near-singular
+Jacobians (dead and toggle positions) are reported with the coordinates that
+lose control and the joints whose equations become dependent.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from ..errors import AssemblyError, SingularPositionError
+from ..model import ConstraintLayout, Model
+from .constraints import coordinates, jacobian, residual, system
+
+__all__ = ["solve_position", "assemble", "joint_residuals", "singularity", "rank_report",
+           "branch_sign", "SINGULAR_RCOND"]
+
+#: ratio sigma_min / sigma_max of the scaled Jacobian below which a position is singular
+SINGULAR_RCOND = 1e-9
+
+
+def _scale(model: Model) -> np.ndarray:
+    """Column scaling: lengths as they are, rotations times the length scale."""
+    s = np.ones(model.n_x)
+    s[2::3] = model.length_scale
+    return s
+
+
+def _fmt_len(v: float) -> str:
+    v = abs(float(v))
+    if v >= 1e-3:
+        return f"{v * 1e3:.4g} mm"
+    if v >= 1e-6:
+        return f"{v * 1e6:.4g} um"
+    return f"{v:.3g} m"
+
+
+def joint_residuals(model: Model, x, layout: ConstraintLayout | None = None) -> dict:
+    """Norm of each joint's residual at one pose, largest first (m; rad for angle rows)."""
+    lay = layout or model.layout()
+    r = residual(model, x, lay)
+    res = {n: float(np.linalg.norm(r[rows])) for n, rows in lay.rows.items()}
+    return dict(sorted(res.items(), key=lambda kv: -kv[1]))
+
+
+def solve_position(model: Model, q, x_guess, *, layout: ConstraintLayout | None = None,
+                   tol: float | None = None, max_iter: int = 30, t: float | None = None,
+                   check_singular: bool = True) -> np.ndarray:
+    """Newton solve of [Phi(x); g(x) - q] = 0 from ``x_guess`` (batched).
+
+    Parameters
+    ----------
+    model : Model
+    q : array_like, shape (..., n_q)
+        Generalized coordinates (rad or m).
+    x_guess : array_like, shape (..., n_x)
+        Start, usually the previous solution (which keeps the assembly branch).
+    tol : float, optional
+        Residual tolerance, default ``1e-13 * length_scale`` (m).
+    t : float, optional
+        Time, only for the error message.
+
+    Returns
+    -------
+    x : ndarray, shape (..., n_x)
+
+    Raises
+    ------
+    AssemblyError
+        No convergence; the message names the joints that stay open.
+    SingularPositionError
+        The Jacobian is singular at the solution (dead or toggle position).
+    """
+    lay = layout or model.layout()
+    q = np.asarray(q, dtype=float)
+    x = np.array(x_guess, dtype=float, copy=True)
+    if tol is None:
+        tol = 1e-13 * max(model.length_scale, 1e-3)
+    batch = np.broadcast_shapes(q.shape[:-1], x.shape[:-1])
+    x = np.broadcast_to(x, batch + (model.n_x,)).copy()
+    prev = np.full(batch, np.inf)
+    done = np.zeros(batch, dtype=bool)
+    for _ in range(max_iter):
+        F, J = system(model, x, q, lay)
+        err = np.max(np.abs(F), axis=-1) if F.shape[-1] else np.zeros(batch)
+        # converged, or stagnating at round-off level
+        done = (err <= tol) | ((err >= 0.5 * prev) & (err <= 1e3 * tol))
+        if np.all(done):
+            break
+        prev = np.where(done, prev, err)
+        if J.shape[-1] == J.shape[-2]:
+            try:
+                dx = np.linalg.solve(J, F[..., None])[..., 0]
+            except np.linalg.LinAlgError:
+                dx = _lstsq(J, F)
+        else:
+            dx = _lstsq(J, F)
+        if not np.all(np.isfinite(dx)):
+            dx = _lstsq(J, F)
+        x = x - np.where(done[..., None], 0.0, dx)
+    else:
+        F, J = system(model, x, q, lay)
+        err = np.max(np.abs(F), axis=-1)
+        done = err <= 1e3 * tol
+    if not np.all(done):
+        bad = np.unravel_index(np.argmax(~done), batch) if batch else ()
+        xb, qb = x[bad], q[bad] if q.ndim > 1 else q
+        raise _assembly_error(model, qb, xb, lay, t)
+    if check_singular:
+        _check_singular(model, x, q, lay, t)
+    return x
+
+
+def _lstsq(J, F):
+    return (np.linalg.pinv(J) @ F[..., None])[..., 0]
+
+
+def _assembly_error(model, q, x_start, lay, t):
+    """Find the closest configuration by least squares and say which joints stay open."""
+    q = np.asarray(q, float)
+    w = 1e3  # the coordinates are honoured much more strongly than the joints
+
+    def fun(x):
+        F, _ = system(model, x, q, lay)
+        F[lay.n_rows:] *= w
+        return F
+
+    def jac(x):
+        _, J = system(model, x, q, lay)
+        J[lay.n_rows:] *= w
+        return J
+
+    x = x_start if np.all(np.isfinite(x_start)) else model.x_sketch
+    try:
+        sol = least_squares(fun, x, jac=jac, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15)
+        x = sol.x
+    except Exception:  # noqa: BLE001 - keep the Newton iterate for the report
+        pass
+    res = joint_residuals(model, x, lay)
+    open_ = {n: v for n, v in res.items() if v > 1e-9 * max(model.length_scale, 1e-3)}
+    if not open_:
+        open_ = dict(list(res.items())[:2])
+    gap = sum(v for n, v in open_.items() if model.joint_kind(n) == "revolute")
+    parts = ", ".join(f"{n!r}: {_fmt_len(v)}" for n, v in open_.items())
+    qs = ", ".join(f"{n} = {v:.6g}" for n, v in zip(model.coordinate_names, np.atleast_1d(q),
+                                                    strict=False))
+    msg = (f"the mechanism cannot be assembled at {qs}: the loop through joints "
+           f"{', '.join(repr(n) for n in open_)} does not close by about {_fmt_len(gap)} "
+           f"(closest gaps: {parts}); a link is too short or too long for this position")
+    return AssemblyError(msg, t=t, q=q, residuals=open_)
+
+
+def singularity(model: Model, x, layout: ConstraintLayout | None = None) -> dict:
+    """Singular-value report of the scaled position Jacobian [Phi_x; g_x] at one pose.
+
+    Returns
+    -------
+    dict with ``rcond`` (sigma_min / sigma_max), ``sigma_min``, ``coordinates``
+    (coordinates whose equations carry the left null vector: they lose control)
+    and ``joints`` (joints whose equations become dependent).
+    """
+    lay = layout or model.layout()
+    _, J = system(model, x, np.zeros(model.n_q), lay)
+    Js = J * _scale(model)
+    u, s, _ = np.linalg.svd(Js)
+    y = u[:, -1]
+    share = y**2
+    coords = [model.coordinate_names[c] for c in range(model.n_q)
+              if share[lay.n_rows + c] > 1e-3]
+    joints = sorted({lay.row_joint[r] for r in range(lay.n_rows) if share[r] > 1e-3})
+    return {"rcond": float(s[-1] / s[0]) if s[0] > 0 else 0.0, "sigma_min": float(s[-1]),
+            "coordinates": coords, "joints": joints}
+
+
+def _check_singular(model, x, q, lay, t):
+    if model.n_x == 0:
+        return
+    _, J = system(model, x, q, lay)
+    Js = J * _scale(model)
+    if Js.shape[-1] != Js.shape[-2]:
+        return
+    s = np.linalg.svd(Js, compute_uv=False)
+    rc = s[..., -1] / s[..., 0]
+    if np.any(rc < SINGULAR_RCOND):
+        k = np.unravel_index(np.argmin(rc), rc.shape) if rc.ndim else ()
+        xb = x[k]
+        qb = q[k] if q.ndim > 1 else q
+        rep = singularity(model, xb, lay)
+        raise SingularPositionError(
+            f"dead or toggle position: the constraint Jacobian is singular "
+            f"(sigma_min/sigma_max = {rep['rcond']:.2e}); coordinate(s) "
+            f"{', '.join(rep['coordinates']) or '-'} lose control, joints "
+            f"{', '.join(rep['joints']) or '-'} become dependent",
+            t=t, q=qb, sigma_min=rep["sigma_min"], coordinates=rep["coordinates"],
+            joints=rep["joints"])
+
+
+def branch_sign(model: Model, x, layout: ConstraintLayout | None = None) -> np.ndarray:
+    """Sign of det [Phi_x; g_x] (batched): it changes only through a singular position,
+    so a change between two solves means the assembly branch was left."""
+    lay = layout or model.layout()
+    _, J = system(model, x, np.zeros(np.shape(x)[:-1] + (model.n_q,)), lay)
+    if J.shape[-1] != J.shape[-2]:
+        return np.ones(np.shape(x)[:-1])
+    return np.sign(np.linalg.det(J * _scale(model)))
+
+
+def assemble(model: Model, q=None, *, x_guess=None, layout=None, t=None) -> np.ndarray:
+    """Assemble the mechanism from the sketch (or ``x_guess``) at coordinates ``q``.
+
+    With ``q`` None the coordinates are measured on the sketch.  A least-squares
+    solve pulls the sketch onto the constraints (choosing the branch nearest to
+    the sketch), then Newton polishes.
+    """
+    lay = layout or model.layout()
+    x = np.array(model.x_sketch if x_guess is None else x_guess, dtype=float)
+    if q is None:
+        q = coordinates(model, x)
+    q = np.asarray(q, dtype=float)
+    if model.n_x == 0:
+        return x
+    try:
+        return solve_position(model, q, x, layout=lay, t=t, check_singular=False, max_iter=8)
+    except AssemblyError:
+        pass
+
+    def fun(xx):
+        F, _ = system(model, xx, q, lay)
+        return F
+
+    def jac(xx):
+        _, J = system(model, xx, q, lay)
+        return J
+
+    sol = least_squares(fun, x, jac=jac, method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                        x_scale=_scale(model) / model.length_scale, max_nfev=2000)
+    return solve_position(model, q, sol.x, layout=lay, t=t, check_singular=False)
+
+
+def rank_report(model: Model, x, layout=None) -> dict:
+    """Ranks at a pose: constraint rank, redundant joints, dependent coordinates."""
+    lay = layout or model.layout()
+    sc = _scale(model)
+    P = jacobian(model, x, lay) * sc
+    G = np.concatenate([P, np.zeros((0, model.n_x))])
+    from .constraints import coordinates_jacobian
+
+    Gq = coordinates_jacobian(model, x) * sc
+    tol_rel = 1e-9
+    rank_phi = _rank(P, tol_rel)
+    redundant = []
+    if rank_phi < lay.n_rows:
+        # rows that are linear combinations of the others: left null space of Phi_x
+        u, s, _ = np.linalg.svd(P)
+        smax = s[0] if s.size else 1.0
+        null = u[:, int(np.sum(s > tol_rel * smax)):]
+        weight = np.sum(null**2, axis=1)
+        redundant = sorted({lay.row_joint[r] for r in range(lay.n_rows) if weight[r] > 1e-6})
+    full = np.concatenate([G, Gq])
+    dep = []
+    if model.n_q and _rank(full, tol_rel) < rank_phi + model.n_q:
+        for c in range(model.n_q):
+            others = np.concatenate([P, np.delete(Gq, c, axis=0)])
+            if _rank(np.concatenate([others, Gq[c:c + 1]]), tol_rel) == _rank(others, tol_rel):
+                dep.append(model.coordinate_names[c])
+    return {"rank_phi": rank_phi, "redundant_joints": redundant, "dependent_coordinates": dep}
+
+
+def _rank(A, tol_rel):
+    if A.size == 0:
+        return 0
+    s = np.linalg.svd(A, compute_uv=False)
+    return int(np.sum(s > tol_rel * s[0])) if s[0] > 0 else 0

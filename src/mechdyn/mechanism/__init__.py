@@ -1,0 +1,9 @@
+"""Mechanism description: frozen elements in SI units, no time, no solver."""
+
+from .body import GROUND, Body, Ground
+from .coordinate import COORDINATE_KINDS, Coordinate
+from .joint import Joint, Lock, Prismatic, Revolute
+from .mechanism import Mechanism
+
+__all__ = ["GROUND", "Body", "Ground", "Coordinate", "COORDINATE_KINDS", "Joint", "Revolute",
+           "Prismatic", "Lock", "Mechanism"]

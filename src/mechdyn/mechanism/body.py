@@ -1,0 +1,105 @@
+"""Rigid bodies of a planar mechanism.
+
+A body has its own frame: ``points`` and ``com`` are given in that frame, in m.
+Its ``pose`` is where the frame sits in the initial *sketch* of the mechanism
+(x, y in m, theta in rad); the sketch chooses the assembly branch, which is then
+kept by continuity.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from types import MappingProxyType
+
+import numpy as np
+
+__all__ = ["Body", "Ground", "GROUND"]
+
+GROUND = "ground"
+
+
+def _vec2(value, what: str) -> tuple[float, float]:
+    try:
+        arr = np.asarray(value, dtype=float).reshape(-1)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{what} must be a pair of numbers (x, y), got {value!r}") from exc
+    if arr.shape != (2,):
+        raise ValueError(f"{what} must be a pair of numbers (x, y), got {value!r}")
+    return float(arr[0]), float(arr[1])
+
+
+@dataclass(frozen=True)
+class Body:
+    """A rigid link.
+
+    Parameters
+    ----------
+    name : str
+        Unique name of the body.
+    mass : float
+        Mass in kg (zero is allowed: massless links).
+    inertia : float
+        Moment of inertia about the centre of mass, kg m^2 (zero is allowed).
+    com : (float, float)
+        Centre of mass in the body frame, m.
+    points : mapping of str to (float, float)
+        Named points in the body frame, m.
+    pose : (float, float, float)
+        Position (m) and angle (rad) of the body frame in the initial sketch.
+    """
+
+    name: str
+    mass: float = 0.0
+    inertia: float = 0.0
+    com: tuple[float, float] = (0.0, 0.0)
+    points: dict = field(default_factory=dict)
+    pose: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        object.__setattr__(self, "com", _vec2(self.com, f"body {self.name!r}: com"))
+        pts = {str(k): _vec2(v, f"body {self.name!r}: point {k!r}")
+               for k, v in dict(self.points).items()}
+        object.__setattr__(self, "points", MappingProxyType(pts))
+        pose = np.asarray(self.pose, dtype=float).reshape(-1)
+        if pose.shape != (3,):
+            raise ValueError(f"body {self.name!r}: pose must be (x, y, theta), got {self.pose!r}")
+        object.__setattr__(self, "pose", tuple(float(v) for v in pose))
+        object.__setattr__(self, "mass", float(self.mass))
+        object.__setattr__(self, "inertia", float(self.inertia))
+
+    @property
+    def is_ground(self) -> bool:
+        """True for the fixed frame."""
+        return False
+
+    def point(self, name: str) -> tuple[float, float]:
+        """Coordinates of a named point in the body frame (``"com"`` is the centre of mass)."""
+        if name == "com":
+            return self.com
+        return self.points[name]
+
+    def point_names(self) -> list[str]:
+        """Names of the points of this body, ``"com"`` included."""
+        return ["com", *self.points]
+
+    def sketch_point(self, name: str) -> tuple[float, float]:
+        """Where a named point is in the initial sketch (ground frame), m."""
+        sx, sy = self.point(name)
+        x, y, th = self.pose
+        c, s = np.cos(th), np.sin(th)
+        return (x + c * sx - s * sy, y + s * sx + c * sy)
+
+
+@dataclass(frozen=True)
+class Ground(Body):
+    """The fixed frame. Its frame is the ground (world) frame; it has no mass."""
+
+    name: str = GROUND
+
+    def __post_init__(self):
+        super().__post_init__()
+        object.__setattr__(self, "pose", (0.0, 0.0, 0.0))
+
+    @property
+    def is_ground(self) -> bool:
+        return True

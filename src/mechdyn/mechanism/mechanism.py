@@ -1,0 +1,248 @@
+"""The mechanism: bodies, joints, coordinates, loads and drives, as plain data.
+
+``Mechanism`` is a builder: add elements, then call :meth:`Mechanism.validate`
+(which reports every problem at once) or :meth:`Mechanism.compile`, which
+validates and returns the constant :class:`mechdyn.model.Model` that every
+analysis uses.  Nothing here knows about solvers or time.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ModelError, did_you_mean
+from .body import GROUND, Body, Ground
+from .coordinate import COORDINATE_KINDS, Coordinate
+from .joint import Joint, Lock, Prismatic, Revolute
+
+__all__ = ["Mechanism"]
+
+
+@dataclass
+class Mechanism:
+    """A planar mechanism described by its elements.
+
+    Parameters
+    ----------
+    name : str
+        A title used in reports.
+    gravity : (float, float)
+        Gravitational acceleration vector in the ground frame, m/s^2
+        (default (0, -9.81): y is up).
+    description : str
+        Free text kept with the model (shown by ``mechdyn examples``).
+
+    Examples
+    --------
+    >>> m = Mechanism("pendulum")
+    >>> _ = m.add_body("bar", mass=2.0, inertia=0.05, com=(0.5, 0.0))
+    >>> _ = m.add_revolute("O", "ground", "bar")
+    >>> _ = m.add_coordinate("theta", kind="angle", body="bar")
+    >>> m.dof
+    1
+    """
+
+    name: str = "mechanism"
+    gravity: tuple[float, float] = (0.0, -9.81)
+    description: str = ""
+    ground: Ground = field(default_factory=Ground)
+    bodies: dict[str, Body] = field(default_factory=dict)
+    joints: dict[str, Joint] = field(default_factory=dict)
+    coordinates: dict[str, Coordinate] = field(default_factory=dict)
+    loads: list = field(default_factory=list)
+    drives: list = field(default_factory=list)
+    #: optional extra elements (switches, contacts, process loads ...) by kind
+    extras: dict[str, list] = field(default_factory=dict)
+
+    # ------------------------------------------------------------------ building
+    def add(self, element):
+        """Add a body, ground, joint, coordinate, load or drive; returns it."""
+        if isinstance(element, Ground):
+            self.ground = element
+        elif isinstance(element, Body):
+            self._check_new(element.name)
+            self.bodies[element.name] = element
+        elif isinstance(element, Joint):
+            self._check_new(element.name)
+            self.joints[element.name] = element
+        elif isinstance(element, Coordinate):
+            if element.name in self.coordinates:
+                raise ModelError(f"coordinate {element.name!r} is defined twice")
+            self.coordinates[element.name] = element
+        elif getattr(element, "is_drive", False):
+            self.drives.append(element)
+        else:
+            self.loads.append(element)
+        return element
+
+    def _check_new(self, name: str):
+        if name == GROUND or name in self.bodies or name in self.joints:
+            raise ModelError(f"name {name!r} is already used by another body or joint")
+
+    def add_ground(self, points=None) -> Ground:
+        """Set the named points of the fixed frame (ground frame coordinates, m)."""
+        return self.add(Ground(points=dict(points or {})))
+
+    def add_body(self, name: str, **kwargs) -> Body:
+        """Add a :class:`Body`; keyword arguments as for ``Body``."""
+        return self.add(Body(name, **kwargs))
+
+    def add_revolute(self, name, parent, child, parent_point=(0.0, 0.0),
+                     child_point=(0.0, 0.0)) -> Revolute:
+        """Add a :class:`Revolute` joint (pin) between two bodies."""
+        return self.add(Revolute(name, parent, child, parent_point, child_point))
+
+    def add_prismatic(self, name, parent, child, parent_point=(0.0, 0.0), axis=(1.0, 0.0),
+                      child_point=(0.0, 0.0), angle=None) -> Prismatic:
+        """Add a :class:`Prismatic` joint: ``child`` slides along a line of ``parent``."""
+        return self.add(Prismatic(name, parent, child, parent_point, tuple(axis),
+                                  child_point, angle))
+
+    def add_lock(self, name, parent, child, engaged=True, offset=None) -> Lock:
+        """Add a switchable weld (:class:`Lock`) between two bodies."""
+        return self.add(Lock(name, parent, child, engaged, offset))
+
+    def add_coordinate(self, name, kind="angle", body=None, joint=None,
+                       offset=0.0) -> Coordinate:
+        """Declare a generalized coordinate (see :class:`Coordinate`)."""
+        return self.add(Coordinate(name, kind, body, joint, float(offset)))
+
+    # ------------------------------------------------------------------ queries
+    def body(self, name: str) -> Body:
+        """The body (or the ground) of that name; a clear error lists valid names."""
+        if name == GROUND or name == self.ground.name:
+            return self.ground
+        try:
+            return self.bodies[name]
+        except KeyError:
+            raise ModelError(did_you_mean(name, [GROUND, *self.bodies], "body")) from None
+
+    @property
+    def all_bodies(self) -> dict[str, Body]:
+        """Ground first, then the moving bodies."""
+        return {GROUND: self.ground, **self.bodies}
+
+    @property
+    def n_equations(self) -> int:
+        """Number of constraint equations with the initially engaged locks."""
+        return sum(j.n_equations for j in self.joints.values()
+                   if not (isinstance(j, Lock) and not j.engaged))
+
+    @property
+    def dof(self) -> int:
+        """Degrees of freedom by Gruebler's count, 3 n_bodies - equations."""
+        return 3 * len(self.bodies) - self.n_equations
+
+    # ------------------------------------------------------------------ checks
+    def problems(self) -> list[str]:
+        """Every problem of the description that can be found without solving."""
+        out: list[str] = []
+        names = [GROUND, *self.bodies]
+        for b in self.bodies.values():
+            if not np.isfinite(b.mass) or b.mass < 0:
+                out.append(f"body {b.name!r}: mass must be >= 0 kg, got {b.mass!r}")
+            if not np.isfinite(b.inertia) or b.inertia < 0:
+                out.append(f"body {b.name!r}: inertia must be >= 0 kg*m^2, got {b.inertia!r}")
+            for k, v in [("com", b.com), *b.points.items()]:
+                if not np.all(np.isfinite(v)):
+                    out.append(f"body {b.name!r}: point {k!r} is not finite: {v!r}")
+        g = np.asarray(self.gravity, dtype=float)
+        if g.shape != (2,) or not np.all(np.isfinite(g)):
+            out.append(f"gravity must be a finite vector (gx, gy) in m/s^2, got {self.gravity!r}")
+
+        for j in self.joints.values():
+            where = f"{type(j).__name__.lower()} joint {j.name!r}"
+            for role, bname in (("parent", j.parent), ("child", j.child)):
+                if bname not in names:
+                    out.append(f"{where}: {role}: " + did_you_mean(bname, names, "body"))
+            if j.parent == j.child:
+                out.append(f"{where}: parent and child are the same body {j.parent!r}")
+            for role, bname, ref in self._point_refs(j):
+                if bname in names and isinstance(ref, str):
+                    body = self.body(bname)
+                    if ref not in body.point_names():
+                        out.append(f"{where}: {role}: unknown point {ref!r} of body "
+                                   f"{bname!r}; valid point names: "
+                                   + ", ".join(repr(p) for p in body.point_names()))
+            if isinstance(j, Prismatic):
+                ax = np.asarray(j.axis, dtype=float)
+                if ax.shape != (2,) or not np.all(np.isfinite(ax)) or np.hypot(*ax) == 0:
+                    out.append(f"{where}: axis must be a non-zero direction (x, y), "
+                               f"got {j.axis!r}")
+
+        for c in self.coordinates.values():
+            where = f"coordinate {c.name!r}"
+            if c.kind not in COORDINATE_KINDS:
+                out.append(f"{where}: unknown kind {c.kind!r}; valid kinds: "
+                           + ", ".join(repr(k) for k in COORDINATE_KINDS))
+                continue
+            if c.kind == "angle":
+                if c.body is None:
+                    out.append(f"{where}: kind 'angle' needs a body")
+                elif c.body not in self.bodies:
+                    out.append(f"{where}: body: " + did_you_mean(c.body, self.bodies, "body"))
+            else:
+                want = Revolute if c.kind == "relative_angle" else Prismatic
+                if c.joint is None:
+                    out.append(f"{where}: kind {c.kind!r} needs a joint")
+                elif c.joint not in self.joints:
+                    out.append(f"{where}: joint: " + did_you_mean(c.joint, self.joints, "joint"))
+                elif not isinstance(self.joints[c.joint], want):
+                    valid = [n for n, jj in self.joints.items() if isinstance(jj, want)]
+                    out.append(f"{where}: kind {c.kind!r} needs a {want.__name__.lower()} "
+                               f"joint, but {c.joint!r} is a "
+                               f"{type(self.joints[c.joint]).__name__.lower()}; "
+                               f"{want.__name__.lower()} joints: "
+                               + (", ".join(repr(v) for v in valid) or "(none)"))
+        if not self.bodies:
+            out.append("the mechanism has no moving bodies")
+        if not self.coordinates:
+            out.append("no generalized coordinates are declared")
+        elif self.bodies and self.dof != len(self.coordinates):
+            out.append(
+                f"degrees of freedom by Gruebler's count: 3 x {len(self.bodies)} bodies - "
+                f"{self.n_equations} equations = {self.dof}, but {len(self.coordinates)} "
+                f"coordinate(s) are declared ({', '.join(self.coordinates)})")
+        return out
+
+    @staticmethod
+    def _point_refs(j: Joint):
+        if isinstance(j, (Revolute, Prismatic)):
+            yield "parent_point", j.parent, j.parent_point
+            yield "child_point", j.child, j.child_point
+
+    def validate(self) -> Mechanism:
+        """Check the whole description and raise one :class:`ModelError` listing all problems.
+
+        Besides the checks that need no solving (names, masses, DOF count), the
+        sketch is assembled and the coordinates are checked to be independent.
+        Returns the mechanism itself so calls can be chained.
+        """
+        self.compile()
+        return self
+
+    def compile(self):
+        """Validate and build the constant :class:`mechdyn.model.Model`."""
+        from ..model import Model
+
+        probs = self.problems()
+        if self.bodies and self.coordinates and probs and any(
+                p.startswith("degrees of freedom") for p in probs):
+            # A Gruebler mismatch may be a redundant constraint set; decide by rank below.
+            rest = [p for p in probs if not p.startswith("degrees of freedom")]
+            if rest:
+                raise ModelError(probs)
+            model = Model(self)
+            model.check_rank(gruebler_message=probs[-1])
+            return model
+        if probs:
+            raise ModelError(probs)
+        model = Model(self)
+        model.check_rank()
+        return model
+
+    def __repr__(self) -> str:
+        return (f"Mechanism({self.name!r}: {len(self.bodies)} bodies, {len(self.joints)} joints, "
+                f"coordinates {list(self.coordinates)})")

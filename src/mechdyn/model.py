@@ -1,0 +1,309 @@
+"""The compiled, constant model: index layout and parameter arrays.
+
+The state of a mechanism with ``n_bodies`` moving bodies is the absolute
+coordinate vector ``x`` of length ``n_x = 3 n_bodies``, ordered
+``(x_0, y_0, theta_0, x_1, ...)`` in the order the bodies were added.  The
+ground is not part of ``x``; in the index arrays below it has index
+``n_bodies`` and pose (0, 0, 0).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import ModelError, did_you_mean
+from .mechanism.body import GROUND
+from .mechanism.joint import Lock, Prismatic, Revolute
+
+__all__ = ["Model", "RevoluteRows", "PrismaticRows", "LockRows"]
+
+COORD_ANGLE, COORD_RELATIVE, COORD_TRAVEL = 0, 1, 2
+_KIND_CODE = {"angle": COORD_ANGLE, "relative_angle": COORD_RELATIVE, "travel": COORD_TRAVEL}
+
+
+@dataclass(frozen=True)
+class RevoluteRows:
+    """Arrays of all revolute joints: bodies ``i`` (parent), ``j`` (child), points."""
+
+    names: tuple[str, ...]
+    i: np.ndarray
+    j: np.ndarray
+    si: np.ndarray  # (n, 2) parent point, parent frame
+    sj: np.ndarray  # (n, 2) child point, child frame
+
+
+@dataclass(frozen=True)
+class PrismaticRows:
+    """Arrays of all prismatic joints (child ``j`` slides on a line of parent ``i``)."""
+
+    names: tuple[str, ...]
+    i: np.ndarray
+    j: np.ndarray
+    si: np.ndarray  # (n, 2) point of the line, parent frame
+    ui: np.ndarray  # (n, 2) unit axis, parent frame
+    sj: np.ndarray  # (n, 2) child point
+    angle: np.ndarray  # (n,) theta_j - theta_i held
+
+
+@dataclass(frozen=True)
+class LockRows:
+    """Arrays of all locks (welds): child frame origin held at ``c`` in the parent frame."""
+
+    names: tuple[str, ...]
+    i: np.ndarray
+    j: np.ndarray
+    c: np.ndarray  # (n, 2)
+    angle: np.ndarray  # (n,)
+    engaged: np.ndarray  # (n,) bool, initial mode
+
+
+class Model:
+    """Compiled form of a :class:`~mechdyn.mechanism.Mechanism`.
+
+    Attributes
+    ----------
+    mechanism : Mechanism
+        The description it was compiled from.
+    body_names, joint_names, coordinate_names : tuple of str
+    n_bodies, n_x, n_q : int
+    mass, inertia : ndarray, shape (n_bodies,)
+        kg and kg m^2 (about the centre of mass).
+    com : ndarray, shape (n_bodies, 2)
+        Centres of mass in the body frames, m.
+    mass_diag : ndarray, shape (n_x,)
+        Diagonal of the mass matrix of the body frames' origins... see ``mass_matrix``.
+    x_sketch : ndarray, shape (n_x,)
+        The sketch poses, which choose the assembly branch.
+    length_scale : float
+        A characteristic length (m) used to scale tolerances and rotations.
+    """
+
+    def __init__(self, mechanism):
+        self.mechanism = mechanism
+        bodies = list(mechanism.bodies.values())
+        self.body_names = tuple(b.name for b in bodies)
+        self.n_bodies = nb = len(bodies)
+        self.n_x = 3 * nb
+        self._bindex = {n: k for k, n in enumerate(self.body_names)}
+        self._bindex[GROUND] = nb
+        self._bodies = {**mechanism.all_bodies}
+
+        self.mass = np.array([b.mass for b in bodies], dtype=float)
+        self.inertia = np.array([b.inertia for b in bodies], dtype=float)
+        self.com = np.array([b.com for b in bodies], dtype=float).reshape(nb, 2)
+        self.gravity = np.asarray(mechanism.gravity, dtype=float)
+        self.x_sketch = np.array([v for b in bodies for v in b.pose], dtype=float)
+
+        revs = [j for j in mechanism.joints.values() if isinstance(j, Revolute)]
+        pris = [j for j in mechanism.joints.values() if isinstance(j, Prismatic)]
+        locks = [j for j in mechanism.joints.values() if isinstance(j, Lock)]
+        self.rev = RevoluteRows(
+            tuple(j.name for j in revs),
+            np.array([self._bindex[j.parent] for j in revs], dtype=int),
+            np.array([self._bindex[j.child] for j in revs], dtype=int),
+            np.array([self._point(j.parent, j.parent_point) for j in revs]).reshape(-1, 2),
+            np.array([self._point(j.child, j.child_point) for j in revs]).reshape(-1, 2),
+        )
+        ui = np.array([np.asarray(j.axis, float) / np.hypot(*j.axis) for j in pris]).reshape(-1, 2)
+        self.pri = PrismaticRows(
+            tuple(j.name for j in pris),
+            np.array([self._bindex[j.parent] for j in pris], dtype=int),
+            np.array([self._bindex[j.child] for j in pris], dtype=int),
+            np.array([self._point(j.parent, j.parent_point) for j in pris]).reshape(-1, 2),
+            ui,
+            np.array([self._point(j.child, j.child_point) for j in pris]).reshape(-1, 2),
+            np.array([self._sketch_angle(j) if j.angle is None else j.angle for j in pris],
+                     dtype=float),
+        )
+        lock_c, lock_a = [], []
+        for j in locks:
+            off = self._sketch_offset(j) if j.offset is None else j.offset
+            lock_c.append(off[:2])
+            lock_a.append(off[2])
+        self.lock = LockRows(
+            tuple(j.name for j in locks),
+            np.array([self._bindex[j.parent] for j in locks], dtype=int),
+            np.array([self._bindex[j.child] for j in locks], dtype=int),
+            np.array(lock_c, dtype=float).reshape(-1, 2),
+            np.array(lock_a, dtype=float),
+            np.array([j.engaged for j in locks], dtype=bool),
+        )
+        self.joint_names = tuple(mechanism.joints)
+        self._jkind = {n: type(j).__name__.lower() for n, j in mechanism.joints.items()}
+
+        coords = list(mechanism.coordinates.values())
+        self.coordinate_names = tuple(c.name for c in coords)
+        self.n_q = len(coords)
+        self.coord_kind = np.array([_KIND_CODE[c.kind] for c in coords], dtype=int)
+        self.coord_is_angle = np.array([c.is_angle for c in coords], dtype=bool)
+        self.coord_offset = np.array([c.offset for c in coords], dtype=float)
+        # body for 'angle'; joint index into rev / pri tables otherwise
+        cb, cj = [], []
+        for c in coords:
+            if c.kind == "angle":
+                cb.append(self._bindex[c.body])
+                cj.append(-1)
+            elif c.kind == "relative_angle":
+                cb.append(-1)
+                cj.append(self.rev.names.index(c.joint))
+            else:
+                cb.append(-1)
+                cj.append(self.pri.names.index(c.joint))
+        self.coord_body = np.array(cb, dtype=int)
+        self.coord_joint = np.array(cj, dtype=int)
+
+        pts = [np.hypot(*p) for b in mechanism.all_bodies.values()
+               for p in [b.com, *b.points.values()]]
+        pts += list(np.abs(self.x_sketch[0::3])) + list(np.abs(self.x_sketch[1::3]))
+        scale = max([p for p in pts if np.isfinite(p)] + [0.0])
+        self.length_scale = scale if scale > 0 else 1.0
+
+        self.mass_diag = np.repeat(self.mass, 3).reshape(nb, 3)
+        self.mass_diag[:, 2] = self.inertia  # body frame = ... see mass_matrix
+        self.mass_diag = self.mass_diag.reshape(-1)
+        self.initial_mode = self.mode_of(self.lock.engaged)
+        self._layouts: dict = {}
+
+    # ------------------------------------------------------------------ lookups
+    def _point(self, body: str, ref) -> tuple[float, float]:
+        if isinstance(ref, str):
+            return self._bodies[body].point(ref)
+        return (float(ref[0]), float(ref[1]))
+
+    def _sketch_angle(self, j) -> float:
+        return self._bodies[j.child].pose[2] - self._bodies[j.parent].pose[2]
+
+    def _sketch_offset(self, j):
+        pi = np.asarray(self._bodies[j.parent].pose)
+        pj = np.asarray(self._bodies[j.child].pose)
+        c, s = np.cos(pi[2]), np.sin(pi[2])
+        d = pj[:2] - pi[:2]
+        return (c * d[0] + s * d[1], -s * d[0] + c * d[1], pj[2] - pi[2])
+
+    def body_index(self, name: str) -> int:
+        """Index of a moving body in ``x`` (ground: ``n_bodies``); clear error if unknown."""
+        try:
+            return self._bindex[name]
+        except KeyError:
+            raise ModelError(did_you_mean(name, self._bindex, "body")) from None
+
+    def point_local(self, body: str, point) -> np.ndarray:
+        """Body-frame coordinates of a named point (or pass-through of (x, y)), m."""
+        self.body_index(body)
+        if isinstance(point, str):
+            b = self._bodies[body]
+            if point not in b.point_names():
+                raise ModelError(f"unknown point {point!r} of body {body!r}; valid point names: "
+                                 + ", ".join(repr(p) for p in b.point_names()))
+        return np.asarray(self._point(body, point), dtype=float)
+
+    def named_points(self) -> list[tuple[str, str]]:
+        """(body, point) of every named point of the moving bodies, centres of mass included."""
+        return [(b, p) for b in self.body_names for p in self._bodies[b].point_names()]
+
+    def joint_kind(self, name: str) -> str:
+        """'revolute', 'prismatic' or 'lock'."""
+        try:
+            return self._jkind[name]
+        except KeyError:
+            raise ModelError(did_you_mean(name, self._jkind, "joint")) from None
+
+    def coordinate_index(self, name: str) -> int:
+        """Index of a generalized coordinate; clear error listing valid names."""
+        try:
+            return self.coordinate_names.index(name)
+        except ValueError:
+            raise ModelError(did_you_mean(name, self.coordinate_names, "coordinate")) from None
+
+    # ------------------------------------------------------------------ modes
+    def mode_of(self, engaged) -> frozenset:
+        """The mode (frozenset of engaged lock names) for a boolean array over ``lock.names``."""
+        return frozenset(n for n, e in zip(self.lock.names, np.asarray(engaged, bool), strict=True)
+                         if e)
+
+    def layout(self, mode=None) -> ConstraintLayout:
+        """Row layout of the constraint equations in a mode (cached)."""
+        mode = self.initial_mode if mode is None else frozenset(mode)
+        lay = self._layouts.get(mode)
+        if lay is None:
+            unknown = set(mode) - set(self.lock.names)
+            if unknown:
+                raise ModelError(did_you_mean(sorted(unknown)[0], self.lock.names, "lock"))
+            lay = ConstraintLayout(self, mode)
+            self._layouts[mode] = lay
+        return lay
+
+    # ------------------------------------------------------------------ mass
+    def mass_matrix(self) -> np.ndarray:
+        """Diagonal of the mass matrix in centre-of-mass coordinates, shape (n_x,).
+
+        The kinetic energy is T = 1/2 sum (m v_c^2 + J_c omega^2); dynamics
+        works with the velocities of the centres of mass (see ``dynamics``).
+        """
+        return self.mass_diag.copy()
+
+    # ------------------------------------------------------------------ checks
+    def check_rank(self, gruebler_message: str | None = None):
+        """Assemble the sketch and check the coordinates and constraints by rank.
+
+        Raises
+        ------
+        ModelError
+            If the coordinates are not independent, if the DOF count does not match
+            and the constraints are not merely redundant, or if the sketch cannot be
+            assembled.
+        """
+        from .kinematics.assembly import assemble, rank_report
+
+        try:
+            x0 = assemble(self)
+        except Exception as exc:  # an AssemblyError carries its own message
+            raise ModelError(f"the initial sketch cannot be assembled: {exc}") from exc
+        self.x0 = x0
+        rep = rank_report(self, x0)
+        self.redundant = rep["redundant_joints"]
+        problems = []
+        if rep["dependent_coordinates"]:
+            problems.append(
+                "coordinates are not independent at the sketch position: "
+                + ", ".join(repr(c) for c in rep["dependent_coordinates"])
+                + " can be expressed by the others (choose coordinates that each move a "
+                "different part of the mechanism)")
+        dof_rank = self.n_x - rep["rank_phi"]
+        if dof_rank != self.n_q:
+            problems.append(
+                f"the mechanism has {dof_rank} degree(s) of freedom at the sketch position "
+                f"(rank of the constraint Jacobian {rep['rank_phi']}), but {self.n_q} "
+                f"coordinate(s) are declared")
+        elif gruebler_message is not None and not self.redundant:
+            problems.append(gruebler_message)
+        if problems:
+            raise ModelError(problems)
+
+
+class ConstraintLayout:
+    """Which rows of Phi belong to which joint, for one mode."""
+
+    def __init__(self, model: Model, mode: frozenset):
+        self.mode = mode
+        rows: dict[str, np.ndarray] = {}
+        k = 0
+        for n in model.rev.names:
+            rows[n] = np.arange(k, k + 2)
+            k += 2
+        for n in model.pri.names:
+            rows[n] = np.arange(k, k + 2)
+            k += 2
+        active = np.array([n in mode for n in model.lock.names], dtype=bool)
+        for n, a in zip(model.lock.names, active, strict=True):
+            if a:
+                rows[n] = np.arange(k, k + 3)
+                k += 3
+        self.lock_active = active
+        self.rows = rows
+        self.n_rows = k
+        self.row_joint = np.empty(k, dtype=object)
+        for n, r in rows.items():
+            self.row_joint[r] = n
