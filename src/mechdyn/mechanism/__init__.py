@@ -2,8 +2,11 @@
 
 from .body import GROUND, Body, Ground
 from .coordinate import COORDINATE_KINDS, Coordinate
+from .drive import Drive, TorqueSpeedCurve
 from .joint import Joint, Lock, Prismatic, Revolute
+from .load import Force, RotarySpring, Spring, Table, Torque, pulse
 from .mechanism import Mechanism
 
 __all__ = ["GROUND", "Body", "Ground", "Coordinate", "COORDINATE_KINDS", "Joint", "Revolute",
-           "Prismatic", "Lock", "Mechanism"]
+           "Prismatic", "Lock", "Mechanism", "Drive",
+           "TorqueSpeedCurve", "Force", "RotarySpring", "Spring", "Table", "Torque", "pulse"]

@@ -236,11 +236,18 @@ class Mechanism:
                 raise ModelError(probs)
             model = Model(self)
             model.check_rank(gruebler_message=probs[-1])
-            return model
+            return self._check_loads(model)
         if probs:
             raise ModelError(probs)
         model = Model(self)
         model.check_rank()
+        return self._check_loads(model)
+
+    @staticmethod
+    def _check_loads(model):
+        from ..dynamics.forces import force_model
+
+        force_model(model)  # raises one ModelError listing every bad load or drive
         return model
 
     def __repr__(self) -> str:
