@@ -1,0 +1,24 @@
+"""``mechdyn examples``: list the bundled model files."""
+
+from __future__ import annotations
+
+
+def register(sub) -> None:
+    p = sub.add_parser("examples", help="list the bundled example models",
+                       description="List the bundled example models (use a name wherever a "
+                                   "MODEL.toml is expected).")
+    p.add_argument("--path", metavar="NAME", help="print the file path of one example")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from ..examples import list_examples, path
+
+    if args.path:
+        print(path(args.path))
+        return 0
+    items = list_examples()
+    width = max(len(n) for n, _ in items)
+    for name, text in items:
+        print(f"{name:<{width}}  {text}")
+    return 0
