@@ -260,7 +260,10 @@ class Model:
         try:
             x0 = assemble(self)
         except Exception as exc:  # an AssemblyError carries its own message
-            raise ModelError(f"the initial sketch cannot be assembled: {exc}") from exc
+            probs = [f"the initial sketch cannot be assembled: {exc}"]
+            if gruebler_message is not None:
+                probs.insert(0, gruebler_message)
+            raise ModelError(probs) from exc
         self.x0 = x0
         rep = rank_report(self, x0)
         self.redundant = rep["redundant_joints"]

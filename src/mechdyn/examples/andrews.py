@@ -1,0 +1,259 @@
+"""Andrews' squeezing mechanism (the "seven-body mechanism") built in Python.
+
+The data and the reference solution are those of the Test Set for IVP Solvers
+(F. Mazzia, C. Magherini, *Test Set for Initial Value Problem Solvers*,
+release 2.4, University of Bari, 2008, problem ``andrews``), which takes the
+problem from E. Hairer, G. Wanner, *Solving Ordinary Differential Equations
+II*, 2nd ed., Springer 1996, section VII.7 ("Multibody systems", the
+seven-body mechanism of Schiehlen / Manning and Andrews).
+
+The Test Set describes the mechanism by seven angles q = (beta, Theta, gamma,
+Phi, delta, Omega, epsilon), some of them *relative* (Theta, Phi, Omega).
+mechdyn uses the absolute pose of each body; the body frames here are chosen
+so that the body angles are simple sums of the Test Set's angles:
+
+==========  ======  ===========================  =====================================
+body        origin  frame angle                  points (body frame)
+==========  ======  ===========================  =====================================
+crank (1)   O       beta                         F = (rr, 0), com = (ra, 0)
+rod (2)     F       beta + Theta                 E = (-d, 0), com = (-da, 0)
+triangle(3) B       gamma                        E = (0, -ss), D = (sd, -sc), com = (sb, -sa)
+link4 (4)   G       Phi + delta                  E = (0, -e), com = (0, -(e - ea))
+link5 (5)   A       delta                        G = (zt, 0), com = (ta, tb)
+link6 (6)   H       Omega + epsilon              E = (zf, 0), com = (zf - fa, 0)
+link7 (7)   A       epsilon                      H = (0, -u), com = (ub, -ua)
+==========  ======  ===========================  =====================================
+
+The ground points are O = (0, 0), A = (xa, ya), B = (xb, yb), C = (xc, yc).
+Rod 2, triangle 3, link 4 and link 6 meet at E (three revolutes: rod-triangle,
+triangle-link4, triangle-link6).  A spring (c0, free length l0) pulls D on the
+triangle towards C on the ground; the torque ``mom`` drives the crank; there
+is no gravity.
+
+Links 5 and 7 only turn about the fixed point A, so the Test Set's equations
+contain only the *distances* of their centres of mass from A,
+sqrt(ta^2 + tb^2) and sqrt(ua^2 + ub^2).  Their directions are not given
+there; here (ta, tb) and (ua, ub) are taken as "along the link, then to its
+left", which is an assumption that changes nothing in the dynamics.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+import numpy as np
+
+from ..mechanism import Mechanism, Spring, Torque
+
+__all__ = ["PARAMS", "Q0", "ANGLE_NAMES", "REFERENCE_T003", "REFERENCE_T003_RATES", "build",
+           "test_set_angles", "test_set_mass_matrix", "sketch_poses"]
+
+#: Test Set parameters, SI (kg, kg m^2, m, N/m, N m)
+PARAMS: dict[str, float] = {
+    "m1": 0.04325, "m2": 0.00365, "m3": 0.02373, "m4": 0.00706,
+    "m5": 0.07050, "m6": 0.00706, "m7": 0.05498,
+    "I1": 2.194e-6, "I2": 4.410e-7, "I3": 5.255e-6, "I4": 5.667e-7,
+    "I5": 1.169e-5, "I6": 5.667e-7, "I7": 1.912e-5,
+    "xa": -0.06934, "ya": -0.00227, "xb": -0.03635, "yb": 0.03273,
+    "xc": 0.014, "yc": 0.072,
+    "d": 0.028, "da": 0.0115, "e": 0.02, "ea": 0.01421, "rr": 0.007, "ra": 0.00092,
+    "ss": 0.035, "sa": 0.01874, "sb": 0.01043, "sc": 0.018, "sd": 0.02,
+    "ta": 0.02308, "tb": 0.00916, "u": 0.04, "ua": 0.01228, "ub": 0.00449,
+    "zf": 0.02, "zt": 0.04, "fa": 0.01421,
+    "c0": 4530.0, "l0": 0.07785, "mom": 0.033,
+}
+
+#: order of the Test Set's angles
+ANGLE_NAMES = ("beta", "Theta", "gamma", "Phi", "delta", "Omega", "epsilon")
+
+#: consistent initial angles of the Test Set, rad
+Q0: dict[str, float] = {
+    "beta": -0.0617138900142764496358948458001,
+    "Theta": 0.0,
+    "gamma": 0.455279819163070380255912382449,
+    "Phi": 0.222668390165885884674473185609,
+    "delta": 0.487364979543842550225598953530,
+    "Omega": -0.222668390165885884674473185609,
+    "epsilon": 1.23054744454982119249735015568,
+}
+
+#: the Test Set's reference solution at t = 0.03 s (angles, rad), started at rest from Q0
+REFERENCE_T003: dict[str, float] = {
+    "beta": 15.81077119629904,
+    "Theta": -15.75637105984298,
+    "gamma": 0.04082224013073101,
+    "Phi": -0.5347301163226948,
+    "delta": 0.5244099658805304,
+    "Omega": 0.5347301163226948,
+    "epsilon": 1.048080741042263,
+}
+
+#: ... and the rates of the first two angles at t = 0.03 s, rad/s
+REFERENCE_T003_RATES: dict[str, float] = {
+    "beta": 1139.920302151208,
+    "Theta": -1424.379294994111,
+}
+
+_BODIES = ("crank", "rod", "triangle", "link4", "link5", "link6", "link7")
+
+
+def sketch_poses(angles: Mapping[str, float] | None = None) -> dict[str, tuple[float, ...]]:
+    """Body poses (x, y, theta) in m and rad for given Test Set angles (default ``Q0``).
+
+    The poses follow the open tree of the Test Set's kinematics (crank, rod,
+    triangle, link5 -> link4, link7 -> link6); they close at E only for
+    consistent angles.
+    """
+    p = PARAMS
+    a = dict(Q0 if angles is None else angles)
+    be, th, ga, ph, de, om, ep = (a[n] for n in ANGLE_NAMES)
+    F = (p["rr"] * math.cos(be), p["rr"] * math.sin(be))
+    G = (p["xa"] + p["zt"] * math.cos(de), p["ya"] + p["zt"] * math.sin(de))
+    H = (p["xa"] + p["u"] * math.sin(ep), p["ya"] - p["u"] * math.cos(ep))
+    return {
+        "crank": (0.0, 0.0, be),
+        "rod": (F[0], F[1], be + th),
+        "triangle": (p["xb"], p["yb"], ga),
+        "link4": (G[0], G[1], ph + de),
+        "link5": (p["xa"], p["ya"], de),
+        "link6": (H[0], H[1], om + ep),
+        "link7": (p["xa"], p["ya"], ep),
+    }
+
+
+def build(*, loads: bool = True) -> Mechanism:
+    """Andrews' squeezing mechanism as a :class:`~mechdyn.mechanism.Mechanism`.
+
+    Parameters
+    ----------
+    loads : bool
+        Add the spring (D-C) and the driving torque on the crank.
+
+    Returns
+    -------
+    Mechanism
+        Seven bodies, ten revolutes, one coordinate ``beta`` (absolute crank
+        angle, rad), sketched at the Test Set's consistent angles ``Q0``; no
+        gravity.  ``extras["initial"]`` holds beta = Q0["beta"] and rate 0.
+    """
+    p = PARAMS
+    poses = sketch_poses()
+    m = Mechanism("Andrews' squeezing mechanism", gravity=(0.0, 0.0),
+                  description="Andrews' squeezer, seven bodies, Test Set for IVP solvers "
+                              "(problem 'andrews'), coordinate beta.")
+    m.add_ground({"O": (0.0, 0.0), "A": (p["xa"], p["ya"]), "B": (p["xb"], p["yb"]),
+                  "C": (p["xc"], p["yc"])})
+    m.add_body("crank", mass=p["m1"], inertia=p["I1"], com=(p["ra"], 0.0),
+               points={"F": (p["rr"], 0.0)}, pose=poses["crank"])
+    m.add_body("rod", mass=p["m2"], inertia=p["I2"], com=(-p["da"], 0.0),
+               points={"F": (0.0, 0.0), "E": (-p["d"], 0.0)}, pose=poses["rod"])
+    m.add_body("triangle", mass=p["m3"], inertia=p["I3"], com=(p["sb"], -p["sa"]),
+               points={"B": (0.0, 0.0), "E": (0.0, -p["ss"]), "D": (p["sd"], -p["sc"])},
+               pose=poses["triangle"])
+    m.add_body("link4", mass=p["m4"], inertia=p["I4"], com=(0.0, -(p["e"] - p["ea"])),
+               points={"G": (0.0, 0.0), "E": (0.0, -p["e"])}, pose=poses["link4"])
+    m.add_body("link5", mass=p["m5"], inertia=p["I5"], com=(p["ta"], p["tb"]),
+               points={"A": (0.0, 0.0), "G": (p["zt"], 0.0)}, pose=poses["link5"])
+    m.add_body("link6", mass=p["m6"], inertia=p["I6"], com=(p["zf"] - p["fa"], 0.0),
+               points={"H": (0.0, 0.0), "E": (p["zf"], 0.0)}, pose=poses["link6"])
+    m.add_body("link7", mass=p["m7"], inertia=p["I7"], com=(p["ub"], -p["ua"]),
+               points={"A": (0.0, 0.0), "H": (0.0, -p["u"])}, pose=poses["link7"])
+    m.add_revolute("O", "ground", "crank", "O", (0.0, 0.0))
+    m.add_revolute("F", "crank", "rod", "F", "F")
+    m.add_revolute("B", "ground", "triangle", "B", "B")
+    m.add_revolute("A5", "ground", "link5", "A", "A")
+    m.add_revolute("G", "link5", "link4", "G", "G")
+    m.add_revolute("A7", "ground", "link7", "A", "A")
+    m.add_revolute("H", "link7", "link6", "H", "H")
+    m.add_revolute("E_rod", "triangle", "rod", "E", "E")
+    m.add_revolute("E_link4", "triangle", "link4", "E", "E")
+    m.add_revolute("E_link6", "triangle", "link6", "E", "E")
+    m.add_coordinate("beta", kind="angle", body="crank")
+    if loads:
+        m.add(Spring("spring", "triangle", "D", "ground", "C", stiffness=p["c0"],
+                     free_length=p["l0"]))
+        m.add(Torque("drive", "crank", p["mom"], reaction_body="ground"))
+    m.extras["initial"] = {"q": {"beta": Q0["beta"]}, "qdot": {"beta": 0.0}}
+    return m
+
+
+def test_set_angles(model, x) -> dict[str, np.ndarray | float]:
+    """The Test Set's seven angles from mechdyn body poses.
+
+    Parameters
+    ----------
+    model : mechdyn.model.Model
+        A compiled model of this mechanism (``build().compile()`` or the
+        ``andrews_squeezer.toml`` example).
+    x : array_like, shape (..., n_x)
+        Body poses.
+
+    Returns
+    -------
+    dict
+        ``beta, Theta, gamma, Phi, delta, Omega, epsilon`` in rad (arrays of the
+        leading shape of ``x``).  The relative angles are plain differences of
+        the body angles, so they follow the body angles without wrapping.
+    """
+    x = np.asarray(x, dtype=float)
+    th = {b: x[..., 3 * model.body_index(b) + 2] for b in _BODIES}
+    out = {
+        "beta": th["crank"],
+        "Theta": th["rod"] - th["crank"],
+        "gamma": th["triangle"],
+        "Phi": th["link4"] - th["link5"],
+        "delta": th["link5"],
+        "Omega": th["link6"] - th["link7"],
+        "epsilon": th["link7"],
+    }
+    if x.ndim == 1:
+        return {k: float(v) for k, v in out.items()}
+    return out
+
+
+def test_set_mass_matrix(angles: Mapping[str, float] | np.ndarray) -> np.ndarray:
+    """The Test Set's mass matrix M(q) of the seven angles (andrews.f), shape (7, 7), SI.
+
+    Parameters
+    ----------
+    angles : mapping or array_like, shape (7,)
+        ``beta, Theta, gamma, Phi, delta, Omega, epsilon`` in rad (by name or in
+        that order).
+
+    Returns
+    -------
+    ndarray, shape (7, 7)
+        kg m^2; the kinetic energy is T = 1/2 qdot^T M qdot.
+    """
+    if isinstance(angles, Mapping):
+        q = [float(angles[n]) for n in ANGLE_NAMES]
+    else:
+        q = [float(v) for v in np.asarray(angles, dtype=float).reshape(7)]
+    _, th, _, ph, _, om, _ = q
+    p = PARAMS
+    m1, m2, m3, m4, m5, m6, m7 = (p[f"m{k}"] for k in range(1, 8))
+    i1, i2, i3, i4, i5, i6, i7 = (p[f"I{k}"] for k in range(1, 8))
+    rr, ra, da = p["rr"], p["ra"], p["da"]
+    e_ea = p["e"] - p["ea"]
+    zf_fa = p["zf"] - p["fa"]
+    zt, u = p["zt"], p["u"]
+    M = np.zeros((7, 7))
+    M[0, 0] = m1 * ra**2 + m2 * (rr**2 - 2 * da * rr * math.cos(th) + da**2) + i1 + i2
+    M[1, 0] = M[0, 1] = m2 * (da**2 - da * rr * math.cos(th)) + i2
+    M[1, 1] = m2 * da**2 + i2
+    M[2, 2] = m3 * (p["sa"] ** 2 + p["sb"] ** 2) + i3
+    M[3, 3] = m4 * e_ea**2 + i4
+    M[4, 3] = M[3, 4] = m4 * (e_ea**2 + zt * e_ea * math.sin(ph)) + i4
+    M[4, 4] = (m4 * (zt**2 + 2 * zt * e_ea * math.sin(ph) + e_ea**2)
+               + m5 * (p["ta"] ** 2 + p["tb"] ** 2) + i4 + i5)
+    M[5, 5] = m6 * zf_fa**2 + i6
+    M[6, 5] = M[5, 6] = m6 * (zf_fa**2 - u * zf_fa * math.sin(om)) + i6
+    M[6, 6] = (m6 * (zf_fa**2 - 2 * u * zf_fa * math.sin(om) + u**2)
+               + m7 * (p["ua"] ** 2 + p["ub"] ** 2) + i6 + i7)
+    return M
+
+
+# these are not tests: keep pytest from collecting them when imported into a test module
+test_set_angles.__test__ = False
+test_set_mass_matrix.__test__ = False

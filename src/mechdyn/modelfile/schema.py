@@ -1,0 +1,187 @@
+"""The JSON schema of the model file and the translation of its errors into plain words.
+
+The schema (``schema.json`` beside this module) checks the *structure* of a model
+file: which tables and keys exist, which are required, and the TOML type of each
+value.  Units and physical sense (``"-2 kg"`` for a mass) are checked by the
+loader.  Every schema error becomes one message that cites the file, the table
+and the key, e.g. ``press.toml: [bodies.rod]: missing key 'mass' (mass, e.g. "4.6 kg")``.
+"""
+
+from __future__ import annotations
+
+import difflib
+import json
+from collections.abc import Sequence
+from functools import lru_cache
+from importlib import resources
+from typing import Any
+
+__all__ = ["schema", "schema_problems", "locate", "toml_type"]
+
+#: top-level tables whose sub-tables are named elements ([bodies.NAME], ...)
+_NAMED_SECTIONS = ("bodies", "joints", "coordinates")
+#: top-level arrays of tables ([[loads]], ...)
+_ARRAY_SECTIONS = ("loads", "drives")
+
+
+@lru_cache(maxsize=1)
+def schema() -> dict:
+    """The JSON schema of the model file (a dict, loaded once from ``schema.json``)."""
+    text = resources.files(__package__).joinpath("schema.json").read_text(encoding="utf-8")
+    return json.loads(text)
+
+
+@lru_cache(maxsize=1)
+def _validator():
+    from jsonschema import Draft202012Validator
+
+    return Draft202012Validator(schema())
+
+
+def toml_type(value: Any) -> str:
+    """How a value is called in TOML words (for messages)."""
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, int):
+        return "an integer"
+    if isinstance(value, float):
+        return "a float"
+    if isinstance(value, str):
+        return "a string"
+    if isinstance(value, dict):
+        return "a table"
+    if isinstance(value, list):
+        return "an array"
+    return type(value).__name__
+
+
+def _show(value: Any) -> str:
+    """Short text of a value for a message."""
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k} = ..." for k in list(value)[:4]) + (
+            ", ...}" if len(value) > 4 else "}")
+    text = repr(value) if not isinstance(value, bool) else str(value).lower()
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def locate(fname: str, path: Sequence, doc: Any = None) -> str:
+    """Where a value sits, as ``"file: [table.sub] key"``.
+
+    Parameters
+    ----------
+    fname : str
+        File name shown first.
+    path : sequence of str or int
+        Keys and array indices from the top of the document.
+    doc : dict, optional
+        The document, to show the ``name`` of a ``[[loads]]`` entry.
+    """
+    path = list(path)
+    if not path:
+        return fname
+    head = path[0]
+    if head in _ARRAY_SECTIONS and len(path) >= 2 and isinstance(path[1], int):
+        label = f"[[{head}]] #{path[1] + 1}"
+        try:
+            name = doc[head][path[1]].get("name")
+        except (TypeError, KeyError, IndexError, AttributeError):
+            name = None
+        if isinstance(name, str):
+            label += f" {name!r}"
+        rest = path[2:]
+    else:
+        depth = 1
+        if head in _NAMED_SECTIONS and len(path) >= 2:
+            depth = 2
+            if head == "bodies" and len(path) >= 4 and path[2] == "points":
+                depth = 3
+        elif head == "ground" and len(path) >= 3 and path[1] == "points":
+            depth = 2
+        label = "[" + ".".join(str(p) for p in path[:depth]) + "]"
+        rest = path[depth:]
+    key = ""
+    for p in rest:
+        if isinstance(p, int):
+            key += f"[{p}]"
+        else:
+            key += ("." if key else "") + str(p)
+    return f"{fname}: {label}" + (f" {key}" if key else "")
+
+
+def _property_hint(sch: dict, key: str) -> str:
+    prop = sch.get("properties", {}).get(key)
+    if isinstance(prop, dict) and prop.get("description"):
+        return f" ({prop['description']})"
+    return ""
+
+
+def _valid_keys(sch: dict) -> list[str]:
+    return [k for k in sch.get("properties", {})]
+
+
+def _message(err, fname: str, doc: Any) -> str:
+    path = list(err.absolute_path)
+    where = locate(fname, path, doc)
+    v = err.validator
+    inst = err.instance
+    if v == "required":
+        missing = [k for k in err.validator_value if not (isinstance(inst, dict) and k in inst)]
+        key = missing[0] if missing else "?"
+        what = "table" if not path else "key"
+        return f"{where}: missing {what} {key!r}{_property_hint(err.schema, key)}"
+    if v == "additionalProperties":
+        valid = _valid_keys(err.schema)
+        extra = [k for k in inst if k not in valid] if isinstance(inst, dict) else []
+        what = "table" if not path else "key"
+        names = ", ".join(repr(k) for k in extra) or "?"
+        close = [m for k in extra for m in difflib.get_close_matches(str(k), valid, n=1)]
+        hint = f" (did you mean {', '.join(repr(c) for c in close)}?)" if close else ""
+        return (f"{where}: unknown {what} {names}{hint}; valid {what}s: "
+                + (", ".join(repr(k) for k in valid) or "(none)"))
+    if v == "type":
+        want = err.validator_value
+        want = [want] if isinstance(want, str) else list(want)
+        words = {"string": "a string", "number": "a number", "integer": "an integer",
+                 "object": "a table", "array": "an array", "boolean": "true or false"}
+        expected = " or ".join(words.get(w, w) for w in want)
+        return f"{where}: {_show(inst)}: wrong type: expected {expected}, got {toml_type(inst)}"
+    if v == "enum":
+        opts = ", ".join(repr(o) for o in err.validator_value)
+        return f"{where}: {_show(inst)}: must be one of {opts}"
+    if v in ("minItems", "maxItems"):
+        n = err.validator_value
+        if "minItems" in err.schema and err.schema.get("minItems") == err.schema.get("maxItems"):
+            need = f"exactly {n}"
+        else:
+            need = f"at least {n}" if v == "minItems" else f"at most {n}"
+        return (f"{where}: {_show(inst)}: expected {need} components, got "
+                f"{len(inst) if isinstance(inst, list) else '?'}")
+    if v == "minProperties":
+        section = path[-1] if path else "model"
+        return f"{where}: at least one entry is needed in [{section}]"
+    if v == "pattern":
+        return (f"{where}: name {inst!r} is not allowed: use letters, digits, '_' and '-', "
+                "starting with a letter or '_'")
+    return f"{where}: {_show(inst)}: {err.message}"
+
+
+def schema_problems(doc: Any, fname: str) -> tuple[list[str], list[tuple]]:
+    """Check a parsed TOML document against the schema.
+
+    Returns
+    -------
+    messages : list of str
+        One message per problem, in document order, duplicates removed.
+    paths : list of tuple
+        The path of each problem (to skip the broken elements when building).
+    """
+    msgs: list[str] = []
+    paths: list[tuple] = []
+    errors = sorted(_validator().iter_errors(doc),
+                    key=lambda e: [str(p) for p in e.absolute_path])
+    for err in errors:
+        m = _message(err, fname, doc)
+        if m not in msgs:
+            msgs.append(m)
+            paths.append(tuple(err.absolute_path))
+    return msgs, paths

@@ -1,0 +1,296 @@
+"""Physical quantities at the edge of mechdyn: text such as ``"15 mm"`` to SI floats.
+
+pint is used here (and in ``modelfile/`` and the command line) only; everything
+inside mechdyn works with plain floats and arrays in SI units.
+
+Rules
+-----
+* A string with a unit is converted to the SI unit of the expected *kind*
+  (``"15 mm"`` as a length gives ``0.015``; ``"-64.1 deg"`` as an angle gives
+  ``-1.11876...``).  A unit of the wrong dimension raises :class:`UnitError`
+  naming where the value came from, the value, the expected dimension and an
+  example.
+* A bare number (``0.015``, or a string without a unit such as ``"0.015"``) is
+  taken as already being in SI units.  **This includes angles and angular
+  speeds**: a bare ``1.2`` for an angle means 1.2 rad, not 1.2 deg, and a bare
+  ``43.5`` for an angular velocity means 43.5 rad/s.  Write ``"1.2 deg"`` or
+  ``"100 rpm"`` to use other units.
+* Angles are dimensionless to pint, so ``"10 Hz"`` would silently become
+  ``10 rad/s``.  To prevent this, angle-like kinds (``angle``,
+  ``angular_velocity``, ``angular_acceleration``) demand an angle unit
+  (``rad``, ``deg``, ``turn``, ``rpm``, ...) whenever a unit is given, and the
+  non-angular kinds refuse angle units.  ``frequency`` accepts both ``"50 Hz"``
+  and ``"3000 rpm"`` (= 50 Hz).
+* ``"%"`` (or ``percent``) is accepted for ``dimensionless``/``ratio``.
+
+Examples
+--------
+>>> parse_quantity("15 mm", "length", where="demo")
+0.015
+>>> round(parse_quantity("100 rpm", "angular_velocity", where="demo"), 6)
+10.471976
+>>> parse_quantity("1.5 kW", "power", where="demo")
+1500.0
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from .errors import UnitError
+
+__all__ = ["KINDS", "Kind", "parse_quantity", "parse_vector", "format_quantity", "registry"]
+
+
+@dataclass(frozen=True)
+class Kind:
+    """A kind of quantity: its SI unit, a human name and an example."""
+
+    si: str
+    name: str
+    example: str
+    #: power of radian the unit must carry: 1 for angle-like kinds, 0 for the others;
+    #: ``None``: any power of radian is accepted (rotational stiffness "N*m" or "N*m/rad")
+    angle_power: int | None = 0
+
+
+#: every kind of quantity the model file and the command line understand
+KINDS: dict[str, Kind] = {
+    "length": Kind("m", "length (m)", '"15 mm"'),
+    "angle": Kind("rad", "angle (rad)", '"-64.1 deg"', 1),
+    "mass": Kind("kg", "mass (kg)", '"4.6 kg"'),
+    "inertia": Kind("kg*m^2", "moment of inertia (kg*m^2)", '"0.034 kg*m^2"'),
+    "angular_velocity": Kind("rad/s", "angular velocity (rad/s)", '"43.5 rad/s" or "100 rpm"', 1),
+    "angular_acceleration": Kind("rad/s^2", "angular acceleration (rad/s^2)", '"10 rad/s^2"', 1),
+    "velocity": Kind("m/s", "velocity (m/s)", '"0.5 m/s"'),
+    "acceleration": Kind("m/s^2", "acceleration (m/s^2)", '"-9.81 m/s^2"'),
+    "force": Kind("N", "force (N)", '"250 N" or "1.2 kN"'),
+    "torque": Kind("N*m", "torque (N*m)", '"0.033 N*m"'),
+    "stiffness": Kind("N/m", "stiffness (N/m)", '"4530 N/m" or "4.53 N/mm"'),
+    "damping": Kind("N*s/m", "damping coefficient (N*s/m)", '"20 N*s/m"'),
+    "rotational_stiffness": Kind("N*m/rad", "rotational stiffness (N*m/rad)", '"12 N*m/rad"',
+                                 None),
+    "rotational_damping": Kind("N*m*s/rad", "rotational damping (N*m*s/rad)",
+                               '"0.05 N*m*s/rad"', None),
+    "time": Kind("s", "time (s)", '"0.05 s" or "20 ms"'),
+    "power": Kind("W", "power (W)", '"1.5 kW"'),
+    "energy": Kind("J", "energy (J)", '"12 J"'),
+    "dimensionless": Kind("", "dimensionless number", '"0.3" or "30 %"'),
+    "frequency": Kind("Hz", "frequency (Hz)", '"50 Hz" or "3000 rpm"', None),
+}
+KINDS["ratio"] = KINDS["dimensionless"]
+
+_REGISTRY = None
+
+
+def registry():
+    """The one shared pint ``UnitRegistry`` of mechdyn (built on first use: it is slow)."""
+    global _REGISTRY
+    if _REGISTRY is None:
+        import pint
+
+        ureg = pint.UnitRegistry()
+        ureg.define("rev = turn")
+        _REGISTRY = ureg
+    return _REGISTRY
+
+
+def _kind(kind: str) -> Kind:
+    try:
+        return KINDS[kind]
+    except KeyError:
+        raise ValueError(f"unknown quantity kind {kind!r}; valid kinds: "
+                         + ", ".join(sorted(KINDS))) from None
+
+
+def _problem(where: str, value: Any, kind: Kind, why: str) -> UnitError:
+    shown = f"{value!r}" if isinstance(value, str) else f"{value}"
+    prefix = f"{where}: " if where else ""
+    article = "an" if kind.name[0] in "aeiou" else "a"
+    return UnitError(f"{prefix}{shown}: {why}; expected {article} {kind.name}, "
+                     f"e.g. {kind.example}")
+
+
+def parse_quantity(value: Any, kind: str, *, where: str = "") -> float:
+    """Convert a quantity to a float in the SI unit of ``kind``.
+
+    Parameters
+    ----------
+    value : str or float or int
+        ``"15 mm"``, ``"-64.1 deg"``, ``"0.034 kg*m^2"``, ``"100 rpm"``, ``"1.5 kW"``,
+        ``"30 %"``, or a bare number, which is taken as SI (angles: rad; angular
+        speeds: rad/s).
+    kind : str
+        One of :data:`KINDS` (``"length"``, ``"angle"``, ``"mass"``, ...).
+    where : str
+        Where the value came from, for the error message (e.g.
+        ``"press.toml: [bodies.rod] mass"``).
+
+    Returns
+    -------
+    float
+        The value in the SI unit of the kind (``KINDS[kind].si``).
+
+    Raises
+    ------
+    UnitError
+        The text cannot be parsed, the unit has the wrong dimension, or the value
+        is not finite.
+    """
+    k = _kind(kind)
+    if isinstance(value, bool) or not isinstance(value, (str, int, float)):
+        raise _problem(where, value, k, f"not a number or a quantity string "
+                       f"(got {type(value).__name__})")
+    if isinstance(value, (int, float)):
+        out = float(value)
+        if not math.isfinite(out):
+            raise _problem(where, value, k, "not a finite number")
+        return out
+    text = value.strip()
+    if not text:
+        raise _problem(where, value, k, "empty text")
+    if any(c in text for c in ",;()[]{}"):
+        raise _problem(where, value, k, "one quantity expected (no commas or brackets)")
+    ureg = registry()
+    import pint
+
+    try:
+        q = ureg.Quantity(text)
+    except Exception as exc:  # noqa: BLE001 - pint's parser raises many kinds; report them all
+        why = str(exc).strip() or "malformed expression"
+        if isinstance(exc, pint.errors.UndefinedUnitError):
+            why = f"unknown unit ({why})"
+        raise _problem(where, value, k, f"cannot be read as a quantity: {why}") from None
+    if not isinstance(q, ureg.Quantity):  # pint returns plain numbers for "2*3"
+        q = ureg.Quantity(q)
+    if not isinstance(q.magnitude, (int, float)):
+        raise _problem(where, value, k, "cannot be read as a single quantity")
+    if not q._units:  # a bare number in a string: SI
+        out = float(q.magnitude)
+    else:
+        root = q.to_root_units()
+        rad_power = dict(root._units).get("radian", 0)
+        target = ureg.Unit(k.si) if k.si else ureg.dimensionless
+        if root.dimensionality != target.dimensionality:
+            dim = _dimension_text(root)
+            raise _problem(where, value, k, f"the unit {q.units:~} is a {dim}")
+        if k.angle_power == 1 and rad_power != 1:
+            raise _problem(where, value, k,
+                           f"the unit {q.units:~} has no angle unit (use rad, deg, turn or rpm; "
+                           "a frequency in Hz is not an angular velocity)")
+        if k.angle_power == 0 and rad_power != 0:
+            raise _problem(where, value, k, f"the unit {q.units:~} carries an angle unit")
+        if kind == "frequency" and rad_power == 1:
+            out = float(root.magnitude) / (2.0 * math.pi)
+        elif kind == "frequency" and rad_power not in (0, 1):
+            raise _problem(where, value, k, f"the unit {q.units:~} is not a frequency")
+        else:
+            out = float(q.to(target).magnitude) if k.si else float(q.to("").magnitude)
+    if not math.isfinite(out):
+        raise _problem(where, value, k, "not a finite value")
+    return out
+
+
+def _dimension_text(q) -> str:
+    """'length unit', 'mass unit', ... for a root-unit quantity, else its dimensionality."""
+    ureg = registry()
+    for k in KINDS.values():
+        if k.si and k.angle_power != 1 and ureg.Unit(k.si).dimensionality == q.dimensionality:
+            return f"{k.name.split(' (')[0]} unit"
+    return f"unit of dimension {q.dimensionality}"
+
+
+_VECTOR_RE = re.compile(r"^\s*\((?P<body>[^()]*)\)\s*(?P<unit>.*?)\s*$")
+
+
+def parse_vector(value: Any, kind: str | Sequence[str], where: str = "",
+                 *, size: int | None = None) -> tuple[float, ...]:
+    """Convert a vector of quantities to a tuple of SI floats.
+
+    Parameters
+    ----------
+    value : sequence or str
+        A list such as ``["10 mm", "0 mm"]`` or ``[0.01, 0]``, or one string
+        ``"(10, 0) mm"`` (one unit for all components) or ``"(10 mm, 0 mm, 30 deg)"``.
+    kind : str or sequence of str
+        The kind of every component, or one kind per component (e.g.
+        ``("length", "length", "angle")`` for a pose).
+    where : str
+        Where the value came from, for the error message.
+    size : int, optional
+        Number of components; default ``len(kind)`` for a sequence of kinds, else 2.
+
+    Returns
+    -------
+    tuple of float, length ``size``
+
+    Raises
+    ------
+    UnitError
+        Wrong number of components, or any component as in :func:`parse_quantity`.
+    """
+    kinds = [kind] if isinstance(kind, str) else list(kind)
+    n = size if size is not None else (len(kinds) if not isinstance(kind, str) else 2)
+    if isinstance(kind, str):
+        kinds = [kind] * n
+    names = ", ".join(dict.fromkeys(KINDS[k].name for k in kinds))
+    example = "[" + ", ".join(KINDS[k].example.split(" or ")[0] for k in kinds) + "]"
+    prefix = f"{where}: " if where else ""
+    if isinstance(value, str):
+        m = _VECTOR_RE.match(value)
+        if m is None:
+            raise UnitError(f"{prefix}{value!r}: cannot be read as a vector; write {example} "
+                            f"or \"(x, y) unit\" ({names})")
+        parts = [p.strip() for p in m.group("body").split(",")]
+        unit = m.group("unit")
+        items: list[Any] = [f"{p} {unit}".strip() for p in parts]
+    elif isinstance(value, (list, tuple)):
+        items = list(value)
+    else:
+        raise UnitError(f"{prefix}{value!r}: expected a list of {n} components, e.g. {example} "
+                        f"({names})")
+    if len(items) != n:
+        raise UnitError(f"{prefix}{value!r}: expected {n} components, got {len(items)}; "
+                        f"e.g. {example}")
+    return tuple(parse_quantity(v, k, where=f"{where}[{i}]" if where else f"[{i}]")
+                 for i, (v, k) in enumerate(zip(items, kinds, strict=True)))
+
+
+def format_quantity(value: float, kind: str, unit: str | None = None, *,
+                    digits: int = 6) -> str:
+    """Format an SI value for display, e.g. ``format_quantity(0.015, "length", "mm")``
+    gives ``"15 mm"``.
+
+    Parameters
+    ----------
+    value : float
+        The value in the SI unit of ``kind``.
+    kind : str
+        One of :data:`KINDS`.
+    unit : str, optional
+        Display unit (``"mm"``, ``"deg"``, ``"rpm"``, ``"kN"``, ...); default the SI unit.
+    digits : int
+        Significant digits.
+
+    Returns
+    -------
+    str
+    """
+    k = _kind(kind)
+    if unit is None or unit == k.si:
+        return f"{value:.{digits}g} {k.si}".rstrip()
+    ureg = registry()
+    q = ureg.Quantity(float(value), k.si if k.si else "")
+    try:
+        if kind == "frequency" and dict(ureg.Unit(unit).dimensionality) == {"[time]": -1} and \
+                dict(ureg.get_root_units(unit)[1]._units).get("radian", 0) == 1:
+            out = ureg.Quantity(float(value) * 2 * math.pi, "rad/s").to(unit)
+        else:
+            out = q.to(unit)
+    except Exception as exc:  # noqa: BLE001 - turn pint's error into a clear one
+        raise UnitError(f"cannot show a {k.name} in {unit!r}: {exc}") from None
+    return f"{float(out.magnitude):.{digits}g} {unit}"
