@@ -1,10 +1,21 @@
 """Kinematic analysis in absolute coordinates with exact Jacobians."""
 
-from .analogs import (accelerations, acceleration_bias, finite_difference_analogs, velocities,
-                      velocity_analogs)
+from .analogs import (
+                      acceleration_bias,
+                      accelerations,
+                      finite_difference_analogs,
+                      velocities,
+                      velocity_analogs,
+)
 from .assembly import assemble, branch_sign, joint_residuals, singularity, solve_position
-from .constraints import (coordinates, jacobian, point_acceleration, point_position,
-                          point_velocity, residual)
+from .constraints import (
+                      coordinates,
+                      jacobian,
+                      point_acceleration,
+                      point_position,
+                      point_velocity,
+                      residual,
+)
 
 __all__ = ["accelerations", "acceleration_bias", "finite_difference_analogs", "velocities",
            "velocity_analogs", "assemble", "branch_sign", "joint_residuals", "singularity",

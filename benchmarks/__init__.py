@@ -1,0 +1,1 @@
+"""Benchmarks of mechdyn: ``python -m benchmarks`` (or ``make bench``) runs them all."""

@@ -1,0 +1,757 @@
+"""Motors and transmissions: mechanical characteristics M(omega) for drives.
+
+Every class here is frozen data in SI units with one method the dynamics calls,
+``torque_at(omega)`` (N m at the shaft speed ``omega``, rad/s; scalars give a
+float, arrays an array), and ``extra_inertia()`` (kg m^2), the moment of
+inertia the drive adds to the coordinate it drives (rotor, gears: reduced to
+the driven shaft).  A drive on a coordinate is ``Drive(name, coordinate,
+torque=<one of these>)`` (see :mod:`mechdyn.mechanism.drive`).
+
+Classes
+-------
+InductionMotor
+    Squirrel-cage induction motor from catalogue data, by Kloss's formula
+    ``M = 2 M_k / (s/s_k + s_k/s)`` or by the extended Kloss formula with the
+    stator-resistance term ``a``,
+    ``M = 2 M_k (1 + a s_k) / (s/s_k + s_k/s + 2 a s_k)``, fitted so that it
+    passes through the rated, the breakdown and the starting torque.
+DCMotor
+    Separately excited DC motor: linear characteristic.
+ConstantSpeedDrive
+    An ideal drive holding a speed (kinematic driving, kinetostatics).
+TabulatedMotor
+    A characteristic M(omega) from a table.
+GearStage
+    A gear (or belt) stage of ratio ``i = omega_motor / omega_driven`` with
+    efficiency and inertias between a motor and the driven coordinate.
+
+:func:`drive_from_table` builds a :class:`~mechdyn.mechanism.drive.Drive` from a
+model-file ``[[drives]]`` table (see ``docs/reduction-and-drives.md``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ModelError
+from .drive import Drive
+
+__all__ = ["InductionMotor", "DCMotor", "ConstantSpeedDrive", "TabulatedMotor", "GearStage",
+           "kloss_critical_slip", "fit_extended_kloss", "drive_from_table",
+           "extra_inertia_by_coordinate", "DRIVE_TYPES", "CHARACTERISTICS"]
+
+#: forms of the induction-motor characteristic
+CHARACTERISTICS = ("kloss", "extended")
+
+
+def _out(value):
+    """float for a scalar result, ndarray otherwise."""
+    arr = np.asarray(value, dtype=float)
+    return float(arr) if arr.ndim == 0 else arr
+
+
+def _finite(x) -> bool:
+    try:
+        return bool(np.isfinite(float(x)))
+    except (TypeError, ValueError):
+        return False
+
+
+def _raise(where: str, problems: list[str]):
+    if problems:
+        raise ModelError([f"{where}: {p}" for p in problems])
+
+
+def _torque_through_gear(m_motor, omega_driven, ratio, efficiency):
+    """Driven-side torque of a stage: losses always oppose the power flow."""
+    m = np.asarray(m_motor, dtype=float)
+    forward = m * np.asarray(omega_driven, dtype=float) >= 0.0  # power flows motor -> machine
+    return np.where(forward, efficiency * ratio * m, ratio * m / efficiency)
+
+
+# ---------------------------------------------------------------------- induction motor
+def kloss_critical_slip(rated_slip: float, breakdown_ratio: float) -> float:
+    """Critical slip of Kloss's formula through the rated point.
+
+    From ``M_n / M_k = 2 / (s_n/s_k + s_k/s_n)`` with ``lambda = M_k / M_n``:
+    ``s_k = s_n (lambda + sqrt(lambda^2 - 1))`` (the root above ``s_n``).
+
+    Parameters
+    ----------
+    rated_slip : float
+        s_n, in (0, 1).
+    breakdown_ratio : float
+        lambda = M_k / M_n, > 1.
+    """
+    lam = float(breakdown_ratio)
+    return float(rated_slip) * (lam + math.sqrt(lam * lam - 1.0))
+
+
+def _extended_q(slip, torque_ratio, sk):
+    """q = a s_k that puts the extended curve through (slip, torque_ratio * M_k)."""
+    f = slip / sk + sk / slip
+    return (torque_ratio * f / 2.0 - 1.0) / (1.0 - torque_ratio)
+
+
+def fit_extended_kloss(rated_slip: float, breakdown_ratio: float,
+                       starting_ratio: float) -> tuple[float, float]:
+    """Fit the extended Kloss formula to the rated, breakdown and starting torques.
+
+    Solves for ``s_k`` and ``a`` in
+    ``M(s) = 2 M_k (1 + a s_k) / (s/s_k + s_k/s + 2 a s_k)`` so that
+    ``M(s_n) = M_n``, ``M(1) = M_start``; its maximum is ``M_k`` at ``s = s_k``
+    for any ``a`` with ``1 + a s_k > 0``.
+
+    Parameters
+    ----------
+    rated_slip : float
+        s_n, in (0, 1).
+    breakdown_ratio, starting_ratio : float
+        M_k / M_n (> 1) and M_start / M_n (0 < ... < breakdown_ratio).
+
+    Returns
+    -------
+    (s_k, a) : tuple of float
+        Critical slip (dimensionless) and the stator-resistance term a.
+
+    Raises
+    ------
+    ModelError
+        When no curve of this form passes through the three points (the message
+        says why); Kloss's formula (``characteristic = "kloss"``) still fits the
+        rated and breakdown points.
+    """
+    from scipy.optimize import brentq
+
+    sn, lam, mst = float(rated_slip), float(breakdown_ratio), float(starting_ratio)
+    mu_n, mu_s = 1.0 / lam, mst / lam
+
+    def h(sk):
+        return _extended_q(sn, mu_n, sk) - _extended_q(1.0, mu_s, sk)
+
+    grid = np.geomspace(sn * (1 + 1e-9), 1.0 - 1e-9, 4001)
+    vals = np.array([h(s) for s in grid])
+    roots = []
+    for k in np.flatnonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0):
+        sk = brentq(h, grid[k], grid[k + 1], xtol=1e-15, rtol=1e-14)
+        q = _extended_q(sn, mu_n, sk)
+        if q > -1.0 + 1e-12:
+            roots.append((sk, q / sk))
+    if not roots:
+        sk_k = kloss_critical_slip(sn, lam)
+        m1 = 2 * lam / (1.0 / sk_k + sk_k)
+        raise ModelError(
+            f"no extended Kloss curve M = 2 M_k (1 + a s_k)/(s/s_k + s_k/s + 2 a s_k) passes "
+            f"through the rated torque at slip {sn:.4g}, the breakdown torque "
+            f"{lam:.4g} M_n and the starting torque {mst:.4g} M_n with 1 + a s_k > 0 and "
+            f"s_n < s_k < 1 (Kloss's formula gives M_start = {m1:.4g} M_n); use "
+            f"characteristic = 'kloss' or check the catalogue data")
+    # several admissible roots are not expected; take the one closest to Kloss's s_k
+    sk_k = kloss_critical_slip(sn, lam)
+    sk, a = min(roots, key=lambda r: abs(r[0] - sk_k))
+    return float(sk), float(a)
+
+
+@dataclass(frozen=True)
+class InductionMotor:
+    """A squirrel-cage induction motor from catalogue data.
+
+    Parameters
+    ----------
+    name : str
+        Designation, e.g. ``"4A80B4U3"``.
+    rated_power : float
+        P_n, W (shaft output at rated load).
+    synchronous_speed : float
+        omega_0, rad/s (1500 rpm = 157.08 rad/s).
+    rated_slip : float, optional
+        s_n = (omega_0 - omega_n) / omega_0, in (0, 1).  Give this or ``rated_speed``.
+    rated_speed : float, optional
+        omega_n, rad/s, below ``synchronous_speed``.
+    breakdown_ratio : float
+        M_k / M_n (> 1): breakdown (maximum) torque over rated torque.
+    starting_ratio : float, optional
+        M_start / M_n: torque at standstill (s = 1) over rated torque; needed for
+        ``characteristic="extended"``.
+    rotor_inertia : float
+        Moment of inertia of the rotor, kg m^2 (>= 0).
+    characteristic : {"kloss", "extended"}
+        Kloss's formula (through the rated and breakdown torques) or the extended
+        formula with the stator-resistance term (also through the starting torque).
+    source : str
+        Where the data come from (free text, kept in reports).
+
+    Attributes
+    ----------
+    rated_torque : float
+        M_n = P_n / omega_n, N m.
+    breakdown_torque : float
+        M_k, N m.
+    critical_slip : float
+        s_k of the chosen form.
+    a : float
+        Stator-resistance term of the extended form (0 for Kloss's formula).
+
+    Examples
+    --------
+    >>> import math
+    >>> m = InductionMotor("4A80B4U3", rated_power=1500.0,
+    ...                    synchronous_speed=1500 * math.pi / 30, rated_slip=0.058,
+    ...                    breakdown_ratio=2.2, starting_ratio=2.0)
+    >>> round(m.torque_at(m.rated_speed) / m.rated_torque, 12)
+    1.0
+    """
+
+    name: str
+    rated_power: float
+    synchronous_speed: float
+    rated_slip: float | None = None
+    rated_speed: float | None = None
+    breakdown_ratio: float = 2.0
+    starting_ratio: float | None = None
+    rotor_inertia: float = 0.0
+    characteristic: str = "kloss"
+    source: str = ""
+    rated_torque: float = field(init=False, repr=False, default=0.0)
+    breakdown_torque: float = field(init=False, repr=False, default=0.0)
+    critical_slip: float = field(init=False, repr=False, default=0.0)
+    a: float = field(init=False, repr=False, default=0.0)
+
+    def __post_init__(self):
+        where = f"induction motor {self.name!r}"
+        p: list[str] = []
+        if not _finite(self.rated_power) or self.rated_power <= 0:
+            p.append(f"rated_power must be > 0 W, got {self.rated_power!r}")
+        if not _finite(self.synchronous_speed) or self.synchronous_speed <= 0:
+            p.append(f"synchronous_speed must be > 0 rad/s, got {self.synchronous_speed!r}")
+        if (self.rated_slip is None) == (self.rated_speed is None):
+            p.append("give exactly one of rated_slip and rated_speed "
+                     f"(got rated_slip={self.rated_slip!r}, rated_speed={self.rated_speed!r})")
+        if self.rated_slip is not None and (not _finite(self.rated_slip)
+                                            or not 0.0 < self.rated_slip < 1.0):
+            p.append(f"rated_slip must lie in (0, 1), got {self.rated_slip!r}")
+        if self.rated_speed is not None:
+            if not _finite(self.rated_speed) or self.rated_speed <= 0:
+                p.append(f"rated_speed must be > 0 rad/s, got {self.rated_speed!r}")
+            elif _finite(self.synchronous_speed) and self.rated_speed >= self.synchronous_speed:
+                p.append(f"rated_speed {self.rated_speed:.6g} rad/s must be below the "
+                         f"synchronous_speed {self.synchronous_speed:.6g} rad/s (a motor "
+                         f"runs with positive slip)")
+        if not _finite(self.breakdown_ratio) or self.breakdown_ratio <= 1.0:
+            p.append(f"breakdown_ratio (M_k/M_n) must be > 1: the breakdown torque cannot be "
+                     f"below the rated torque; got {self.breakdown_ratio!r}")
+        if self.starting_ratio is not None:
+            if not _finite(self.starting_ratio) or self.starting_ratio <= 0:
+                p.append(f"starting_ratio (M_start/M_n) must be > 0, got "
+                         f"{self.starting_ratio!r}")
+            elif _finite(self.breakdown_ratio) and self.starting_ratio >= self.breakdown_ratio:
+                p.append(f"starting_ratio {self.starting_ratio!r} must be below "
+                         f"breakdown_ratio {self.breakdown_ratio!r} (the breakdown torque is "
+                         f"the maximum of the characteristic)")
+        if not _finite(self.rotor_inertia) or self.rotor_inertia < 0:
+            p.append(f"rotor_inertia must be >= 0 kg*m^2, got {self.rotor_inertia!r}")
+        if self.characteristic not in CHARACTERISTICS:
+            p.append(f"characteristic must be one of {', '.join(map(repr, CHARACTERISTICS))}, "
+                     f"got {self.characteristic!r}")
+        elif self.characteristic == "extended" and self.starting_ratio is None:
+            p.append("characteristic 'extended' needs starting_ratio (M_start/M_n)")
+        _raise(where, p)
+
+        w0 = float(self.synchronous_speed)
+        if self.rated_slip is None:
+            sn = (w0 - float(self.rated_speed)) / w0
+            object.__setattr__(self, "rated_slip", sn)
+        else:
+            sn = float(self.rated_slip)
+            object.__setattr__(self, "rated_speed", w0 * (1.0 - sn))
+        for name in ("rated_power", "synchronous_speed", "breakdown_ratio", "rotor_inertia"):
+            object.__setattr__(self, name, float(getattr(self, name)))
+        if self.starting_ratio is not None:
+            object.__setattr__(self, "starting_ratio", float(self.starting_ratio))
+        mn = self.rated_power / self.rated_speed
+        object.__setattr__(self, "rated_torque", mn)
+        object.__setattr__(self, "breakdown_torque", self.breakdown_ratio * mn)
+        if self.characteristic == "kloss":
+            sk, a = kloss_critical_slip(sn, self.breakdown_ratio), 0.0
+        else:
+            try:
+                sk, a = fit_extended_kloss(sn, self.breakdown_ratio, self.starting_ratio)
+            except ModelError as exc:
+                raise ModelError(f"{where}: {exc}") from None
+        object.__setattr__(self, "critical_slip", float(sk))
+        object.__setattr__(self, "a", float(a))
+
+    # ------------------------------------------------------------------ curve
+    @property
+    def critical_speed(self) -> float:
+        """Speed at the breakdown torque, omega_0 (1 - s_k), rad/s."""
+        return self.synchronous_speed * (1.0 - self.critical_slip)
+
+    @property
+    def starting_torque(self) -> float:
+        """Torque of the model at standstill (s = 1), N m."""
+        return self.torque_at_slip(1.0)
+
+    def slip(self, omega):
+        """Slip s = (omega_0 - omega) / omega_0 at shaft speed ``omega`` (rad/s)."""
+        if isinstance(omega, float):
+            return (self.synchronous_speed - omega) / self.synchronous_speed
+        return _out((self.synchronous_speed - np.asarray(omega, float)) / self.synchronous_speed)
+
+    def torque_at_slip(self, s):
+        """Electromagnetic torque at slip ``s`` (N m), written without the pole at s = 0:
+        ``M = 2 M_k (1 + a s_k) s s_k / (s^2 + s_k^2 + 2 a s_k^2 s)``."""
+        sk, a = self.critical_slip, self.a
+        if isinstance(s, float):  # fast path for the integrators' scalar calls
+            return (2.0 * self.breakdown_torque * (1.0 + a * sk) * s * sk
+                    / (s * s + sk * sk + 2.0 * a * sk * sk * s))
+        s = np.asarray(s, dtype=float)
+        num = 2.0 * self.breakdown_torque * (1.0 + a * sk) * s * sk
+        den = s * s + sk * sk + 2.0 * a * sk * sk * s
+        return _out(num / den)
+
+    def torque_at(self, omega):
+        """Shaft torque (N m) at shaft speed ``omega`` (rad/s); scalar or array."""
+        return self.torque_at_slip(self.slip(omega))
+
+    def extra_inertia(self) -> float:
+        """Rotor inertia added to the driven coordinate, kg m^2 (direct drive)."""
+        return self.rotor_inertia
+
+    def describe(self) -> str:
+        """One-line summary with the fitted constants."""
+        rpm = 30.0 / math.pi
+        return (f"{self.name}: P_n = {self.rated_power / 1e3:.4g} kW, n_0 = "
+                f"{self.synchronous_speed * rpm:.5g} rpm, n_n = {self.rated_speed * rpm:.5g} rpm "
+                f"(s_n = {self.rated_slip:.4g}), M_n = {self.rated_torque:.4g} N m, M_k = "
+                f"{self.breakdown_torque:.4g} N m at s_k = {self.critical_slip:.4g}, "
+                f"M_start = {self.starting_torque:.4g} N m, a = {self.a:.4g} "
+                f"({self.characteristic}), J_rotor = {self.rotor_inertia:.4g} kg m^2")
+
+
+# ---------------------------------------------------------------------- DC motor
+@dataclass(frozen=True)
+class DCMotor:
+    """A separately excited DC motor: ``M = M_stall (1 - omega / omega_0)``.
+
+    Parameters
+    ----------
+    name : str
+    no_load_speed : float
+        omega_0 > 0, rad/s (torque zero).
+    stall_torque : float
+        M_stall > 0, N m (torque at standstill).
+    rotor_inertia : float
+        kg m^2, >= 0.
+    source : str
+    """
+
+    name: str
+    no_load_speed: float
+    stall_torque: float
+    rotor_inertia: float = 0.0
+    source: str = ""
+
+    def __post_init__(self):
+        p = []
+        if not _finite(self.no_load_speed) or self.no_load_speed <= 0:
+            p.append(f"no_load_speed must be > 0 rad/s, got {self.no_load_speed!r}")
+        if not _finite(self.stall_torque) or self.stall_torque <= 0:
+            p.append(f"stall_torque must be > 0 N*m, got {self.stall_torque!r}")
+        if not _finite(self.rotor_inertia) or self.rotor_inertia < 0:
+            p.append(f"rotor_inertia must be >= 0 kg*m^2, got {self.rotor_inertia!r}")
+        _raise(f"DC motor {self.name!r}", p)
+
+    @classmethod
+    def from_rated(cls, name: str, rated_power: float, rated_speed: float,
+                   no_load_speed: float, rotor_inertia: float = 0.0,
+                   source: str = "") -> DCMotor:
+        """From the rated point (P_n W, omega_n rad/s) and the no-load speed (rad/s)."""
+        p = []
+        if not _finite(rated_power) or rated_power <= 0:
+            p.append(f"rated_power must be > 0 W, got {rated_power!r}")
+        if not _finite(rated_speed) or rated_speed <= 0:
+            p.append(f"rated_speed must be > 0 rad/s, got {rated_speed!r}")
+        elif _finite(no_load_speed) and rated_speed >= no_load_speed:
+            p.append(f"rated_speed {rated_speed!r} rad/s must be below no_load_speed "
+                     f"{no_load_speed!r} rad/s")
+        _raise(f"DC motor {name!r}", p)
+        mn = rated_power / rated_speed
+        return cls(name, float(no_load_speed), mn / (1.0 - rated_speed / no_load_speed),
+                   rotor_inertia, source)
+
+    def torque_at(self, omega):
+        """Shaft torque (N m) at shaft speed ``omega`` (rad/s)."""
+        return _out(self.stall_torque * (1.0 - np.asarray(omega, float) / self.no_load_speed))
+
+    def extra_inertia(self) -> float:
+        """Rotor inertia added to the driven coordinate, kg m^2."""
+        return float(self.rotor_inertia)
+
+
+# ---------------------------------------------------------------------- ideal drive
+@dataclass(frozen=True)
+class ConstantSpeedDrive:
+    """An ideal drive holding the coordinate at a constant speed.
+
+    For kinetostatics (the crank turns at ``speed``; the driving torque is the
+    unknown the analysis finds) and for ideal drives in simulation.  In forward
+    dynamics a perfectly rigid speed is a constraint, not a torque: give
+    ``stiffness`` (N m s/rad) to model it as a stiff speed governor
+    ``M = stiffness (speed - omega)``; without it ``torque_at`` raises.
+
+    Parameters
+    ----------
+    name : str
+    speed : float
+        rad/s (m/s on a travel coordinate).
+    stiffness : float, optional
+        N m s/rad, > 0.
+    """
+
+    name: str
+    speed: float
+    stiffness: float | None = None
+
+    def __post_init__(self):
+        p = []
+        if not _finite(self.speed):
+            p.append(f"speed must be a finite number in rad/s, got {self.speed!r}")
+        if self.stiffness is not None and (not _finite(self.stiffness) or self.stiffness <= 0):
+            p.append(f"stiffness must be > 0 N*m*s/rad, got {self.stiffness!r}")
+        _raise(f"constant-speed drive {self.name!r}", p)
+
+    def torque_at(self, omega):
+        """``stiffness (speed - omega)``, N m; raises without a stiffness."""
+        if self.stiffness is None:
+            raise ModelError(
+                f"constant-speed drive {self.name!r}: an ideal constant speed has no torque "
+                f"characteristic; use it for kinetostatics (prescribed motion), or give "
+                f"'stiffness' (N*m*s/rad) to model a stiff speed governor in dynamics")
+        return _out(self.stiffness * (self.speed - np.asarray(omega, float)))
+
+    def extra_inertia(self) -> float:
+        """No inertia is added, kg m^2."""
+        return 0.0
+
+
+# ---------------------------------------------------------------------- table
+@dataclass(frozen=True)
+class TabulatedMotor:
+    """A mechanical characteristic M(omega) from a table, linearly interpolated.
+
+    Parameters
+    ----------
+    name : str
+    omega : sequence of float
+        Shaft speeds, rad/s, strictly increasing (at least two).
+    torque : sequence of float
+        Torques at those speeds, N m.
+    rotor_inertia : float
+        kg m^2, >= 0.
+    extrapolate : bool
+        Linear extrapolation outside the table (default); False holds the end values.
+    source : str
+    """
+
+    name: str
+    omega: tuple
+    torque: tuple
+    rotor_inertia: float = 0.0
+    extrapolate: bool = True
+    source: str = ""
+
+    def __post_init__(self):
+        w = np.asarray(self.omega, dtype=float).reshape(-1)
+        m = np.asarray(self.torque, dtype=float).reshape(-1)
+        p = []
+        if w.size < 2 or w.size != m.size:
+            p.append(f"omega and torque need the same length >= 2, got {w.size} and {m.size}")
+        elif not np.all(np.diff(w) > 0):
+            p.append("omega must increase strictly")
+        if not (np.all(np.isfinite(w)) and np.all(np.isfinite(m))):
+            p.append("omega and torque must be finite")
+        if not _finite(self.rotor_inertia) or self.rotor_inertia < 0:
+            p.append(f"rotor_inertia must be >= 0 kg*m^2, got {self.rotor_inertia!r}")
+        _raise(f"tabulated motor {self.name!r}", p)
+        object.__setattr__(self, "omega", tuple(w))
+        object.__setattr__(self, "torque", tuple(m))
+
+    def torque_at(self, omega):
+        """Interpolated torque (N m) at shaft speed ``omega`` (rad/s)."""
+        w = np.asarray(self.omega)
+        m = np.asarray(self.torque)
+        om = np.asarray(omega, dtype=float)
+        out = np.interp(om, w, m)
+        if self.extrapolate:
+            lo = (m[1] - m[0]) / (w[1] - w[0])
+            hi = (m[-1] - m[-2]) / (w[-1] - w[-2])
+            out = np.where(om < w[0], m[0] + lo * (om - w[0]), out)
+            out = np.where(om > w[-1], m[-1] + hi * (om - w[-1]), out)
+        return _out(out)
+
+    def extra_inertia(self) -> float:
+        """Rotor inertia, kg m^2."""
+        return float(self.rotor_inertia)
+
+
+# ---------------------------------------------------------------------- gear stage
+@dataclass(frozen=True)
+class GearStage:
+    """A speed-reducing stage between a motor and the driven coordinate.
+
+    ``ratio`` i = omega_motor / omega_driven.  The driven-side torque is
+    ``eta i M_motor(i omega)`` while the motor drives the machine, and
+    ``i M_motor / eta`` when power flows back (the losses always oppose the
+    power flow).  The rotating parts add the reduced inertia
+    ``(J_motor + J_input) i^2 + J_output`` to the driven coordinate.
+
+    Parameters
+    ----------
+    motor : object with ``torque_at(omega)`` (and optionally ``extra_inertia()``)
+        The motor (or another stage).
+    ratio : float
+        i > 0.
+    efficiency : float
+        eta in (0, 1].
+    input_inertia, output_inertia : float
+        Inertia of the gear parts on the motor shaft and on the driven shaft,
+        kg m^2 (pulleys, pinion, gear wheel, couplings).
+    name : str
+    """
+
+    motor: object
+    ratio: float
+    efficiency: float = 1.0
+    input_inertia: float = 0.0
+    output_inertia: float = 0.0
+    name: str = "gear"
+
+    def __post_init__(self):
+        p = []
+        if not hasattr(self.motor, "torque_at"):
+            p.append(f"motor must have a method torque_at(omega), got {type(self.motor)!r}")
+        if not _finite(self.ratio) or self.ratio <= 0:
+            p.append(f"ratio (omega_motor/omega_driven) must be > 0, got {self.ratio!r}")
+        if not _finite(self.efficiency) or not 0.0 < self.efficiency <= 1.0:
+            p.append(f"efficiency must lie in (0, 1], got {self.efficiency!r}")
+        for fld in ("input_inertia", "output_inertia"):
+            v = getattr(self, fld)
+            if not _finite(v) or v < 0:
+                p.append(f"{fld} must be >= 0 kg*m^2, got {v!r}")
+        _raise(f"gear stage {self.name!r}", p)
+        for fld in ("ratio", "efficiency", "input_inertia", "output_inertia"):
+            object.__setattr__(self, fld, float(getattr(self, fld)))
+
+    def motor_speed(self, omega):
+        """Motor shaft speed (rad/s) at driven speed ``omega`` (rad/s)."""
+        if isinstance(omega, float):
+            return self.ratio * omega
+        return _out(self.ratio * np.asarray(omega, float))
+
+    def motor_torque(self, omega):
+        """Motor torque (N m) at driven speed ``omega`` (rad/s)."""
+        return self.motor.torque_at(self.motor_speed(omega))
+
+    def torque_at(self, omega):
+        """Torque on the driven coordinate (N m) at its speed ``omega`` (rad/s)."""
+        m = self.motor_torque(omega)
+        if isinstance(omega, float) and isinstance(m, float):
+            eta, i = self.efficiency, self.ratio
+            return eta * i * m if m * omega >= 0.0 else i * m / eta
+        return _out(_torque_through_gear(m, omega, self.ratio, self.efficiency))
+
+    def extra_inertia(self) -> float:
+        """``(J_motor + J_input) i^2 + J_output``, kg m^2, on the driven coordinate."""
+        jm = float(self.motor.extra_inertia()) if hasattr(self.motor, "extra_inertia") else 0.0
+        return (jm + self.input_inertia) * self.ratio**2 + self.output_inertia
+
+
+def extra_inertia_by_coordinate(mechanism) -> dict[str, float]:
+    """Inertia the drives add to their coordinates, kg m^2 (kg on travels).
+
+    The hook for the dynamics: ``A[k, k] += extra[name_k]``.  Drives whose
+    torque has no ``extra_inertia()`` add nothing.
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+
+    Returns
+    -------
+    dict
+        Coordinate name -> added inertia (only coordinates with a non-zero value).
+    """
+    out: dict[str, float] = {}
+    for dr in mechanism.drives:
+        fn = getattr(dr.torque, "extra_inertia", None)
+        if fn is None:
+            continue
+        j = float(fn())
+        if j:
+            out[dr.coordinate] = out.get(dr.coordinate, 0.0) + j
+    return out
+
+
+# ---------------------------------------------------------------------- model file
+#: drive types of the model file and the keys each accepts (besides name, coordinate, type)
+DRIVE_TYPES: dict[str, tuple[str, ...]] = {
+    "induction_motor": ("catalogue", "rated_power", "synchronous_speed", "rated_speed",
+                        "rated_slip", "breakdown_ratio", "starting_ratio", "rotor_inertia",
+                        "characteristic", "source"),
+    "dc_motor": ("no_load_speed", "stall_torque", "rated_power", "rated_speed",
+                 "rotor_inertia", "source"),
+    "constant_speed": ("speed", "stiffness"),
+    "torque_speed": ("omega", "torque", "rotor_inertia", "extrapolate", "source"),
+}
+_GEAR_KEYS = ("gear_ratio", "efficiency", "gear_input_inertia", "gear_output_inertia")
+_COMMON_KEYS = ("name", "coordinate", "type", "description")
+
+
+def _q(table, key, kind, where, default=None):
+    from ..units import parse_quantity
+
+    if key not in table:
+        return default
+    return parse_quantity(table[key], kind, where=f"{where}: {key}")
+
+
+def drive_from_table(table: Mapping, where: str = "drives") -> Drive:
+    """Build a :class:`Drive` from a model-file ``[[drives]]`` table with a ``type``.
+
+    Parameters
+    ----------
+    table : mapping
+        The TOML table, values as written (quantities as strings with units,
+        e.g. ``"1.5 kW"``, ``"1500 rpm"``; bare numbers are SI).
+    where : str
+        Location for messages, e.g. ``"press.toml: drives[0]"``.
+
+    Returns
+    -------
+    Drive
+        Its ``torque`` is the motor, wrapped in a :class:`GearStage` when
+        ``gear_ratio`` is given.
+
+    Raises
+    ------
+    ModelError
+        Naming the key at fault; unknown keys and types list the valid ones.
+
+    Examples
+    --------
+    The source paper's press drive (motor 4A80B4U3 through a 3.4 : 1 stage)::
+
+        [[drives]]
+        name = "motor"
+        coordinate = "phi"
+        type = "induction_motor"
+        catalogue = "4A80B4U3"
+        characteristic = "extended"
+        gear_ratio = 3.4
+        efficiency = 0.95
+    """
+    from ..errors import did_you_mean
+
+    t = dict(table)
+    kind = t.get("type")
+    if kind not in DRIVE_TYPES:
+        raise ModelError(f"{where}: type: " + did_you_mean(str(kind), DRIVE_TYPES, "drive type"))
+    name = str(t.get("name", kind))
+    problems = []
+    if "coordinate" not in t:
+        problems.append(f"{where}: coordinate: missing (the driven generalized coordinate)")
+    allowed = set(_COMMON_KEYS) | set(DRIVE_TYPES[kind]) | set(_GEAR_KEYS)
+    for key in t:
+        if key not in allowed:
+            problems.append(f"{where}: " + did_you_mean(key, sorted(allowed),
+                                                        f"key of a {kind!r} drive"))
+    if problems:
+        raise ModelError(problems)
+
+    if kind == "induction_motor":
+        motor = _induction_from_table(t, name, where)
+    elif kind == "dc_motor":
+        jr = _q(t, "rotor_inertia", "inertia", where, 0.0)
+        w0 = _q(t, "no_load_speed", "angular_velocity", where)
+        if w0 is None:
+            raise ModelError(f"{where}: no_load_speed: missing (rad/s, e.g. \"3000 rpm\")")
+        if "stall_torque" in t:
+            motor = DCMotor(name, w0, _q(t, "stall_torque", "torque", where), jr,
+                            str(t.get("source", "")))
+        else:
+            pn = _q(t, "rated_power", "power", where)
+            wn = _q(t, "rated_speed", "angular_velocity", where)
+            if pn is None or wn is None:
+                raise ModelError(f"{where}: give stall_torque, or rated_power and rated_speed")
+            motor = DCMotor.from_rated(name, pn, wn, w0, jr, str(t.get("source", "")))
+    elif kind == "constant_speed":
+        sp = _q(t, "speed", "angular_velocity", where)
+        if sp is None:
+            raise ModelError(f"{where}: speed: missing (e.g. \"43.5 rad/s\")")
+        motor = ConstantSpeedDrive(name, sp, _q(t, "stiffness", "rotational_damping", where))
+    else:
+        om, tq = t.get("omega"), t.get("torque")
+        if not isinstance(om, list) or not isinstance(tq, list):
+            raise ModelError(f"{where}: omega and torque must be lists of quantities")
+        from ..units import parse_quantity
+
+        w = [parse_quantity(v, "angular_velocity", where=f"{where}: omega[{k}]")
+             for k, v in enumerate(om)]
+        m = [parse_quantity(v, "torque", where=f"{where}: torque[{k}]")
+             for k, v in enumerate(tq)]
+        motor = TabulatedMotor(name, tuple(w), tuple(m), _q(t, "rotor_inertia", "inertia",
+                                                           where, 0.0),
+                               bool(t.get("extrapolate", True)), str(t.get("source", "")))
+    try:
+        torque = motor
+        if "gear_ratio" in t or any(k in t for k in _GEAR_KEYS):
+            if "gear_ratio" not in t:
+                raise ModelError(f"{where}: gear_ratio: missing (the efficiency and gear "
+                                 f"inertias need a gear ratio omega_motor/omega_driven)")
+            torque = GearStage(motor, _q(t, "gear_ratio", "ratio", where),
+                               _q(t, "efficiency", "ratio", where, 1.0),
+                               _q(t, "gear_input_inertia", "inertia", where, 0.0),
+                               _q(t, "gear_output_inertia", "inertia", where, 0.0),
+                               name=f"{name} gear")
+    except ModelError as exc:
+        raise ModelError([p if p.startswith(where) else f"{where}: {p}"
+                          for p in exc.problems]) from None
+    return Drive(name, str(t["coordinate"]), torque)
+
+
+def _induction_from_table(t, name, where) -> InductionMotor:
+    from .catalogue import catalogue_entry
+
+    data: dict = {}
+    source = str(t.get("source", ""))
+    if "catalogue" in t:
+        entry = catalogue_entry(str(t["catalogue"]))
+        data = entry.motor_kwargs()
+        name = str(t.get("name", entry.designation))
+        source = source or entry.source_text()
+    spec = {"rated_power": "power", "synchronous_speed": "angular_velocity",
+            "rated_speed": "angular_velocity", "rated_slip": "ratio",
+            "breakdown_ratio": "ratio", "starting_ratio": "ratio", "rotor_inertia": "inertia"}
+    for key, kind in spec.items():
+        if key in t:
+            data[key] = _q(t, key, kind, where)
+    if "rated_speed" in t and "rated_slip" not in t:
+        data.pop("rated_slip", None)  # the file's rated speed replaces the catalogue slip
+    elif "rated_slip" in t and "rated_speed" not in t:
+        data.pop("rated_speed", None)
+    missing = [k for k in ("rated_power", "synchronous_speed", "breakdown_ratio") if k not in data]
+    if "rated_speed" not in data and "rated_slip" not in data:
+        missing.append("rated_speed (or rated_slip)")
+    if missing:
+        raise ModelError(f"{where}: missing {', '.join(missing)} (or name a motor with "
+                         f"catalogue = \"4A80B4U3\")")
+    data["characteristic"] = str(t.get("characteristic", "kloss"))
+    try:
+        return InductionMotor(name, source=source, **data)
+    except ModelError as exc:
+        raise ModelError([f"{where}: {p}" for p in exc.problems]) from None

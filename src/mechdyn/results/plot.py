@@ -1,0 +1,146 @@
+"""Plots of result records, written to PNG files.
+
+One function per kind of record (``plot_<record>``), and :func:`plot`, which
+picks the function for a record.  Figures are drawn with matplotlib's Agg
+canvas directly, so nothing here needs a screen or changes pyplot's backend.
+
+Add a record kind by writing ``plot_<kind>(record, path, ...) -> Path`` below
+and an entry in ``PLOTTERS``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ModelError
+
+__all__ = ["plot", "plot_kinematic_sweep", "PLOTTERS"]
+
+
+def _figure(n_rows: int, width: float = 8.0, height: float = 2.6):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(width, height * n_rows), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(n_rows, 1, sharex=True, squeeze=False)[:, 0]
+    return fig, axes
+
+
+def _save(fig, path, dpi) -> Path:
+    path = Path(path)
+    if path.parent and not path.parent.exists():
+        path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=dpi)
+    return path
+
+
+# ---------------------------------------------------------------- kinematic sweep
+def _parse_points(model, points) -> list[tuple[str, object]]:
+    out = []
+    for p in points:
+        if isinstance(p, str):
+            body, sep, name = p.partition(".")
+            if not sep:
+                raise ModelError(f"point {p!r}: write it as BODY.POINT (e.g. 'rod.B' or "
+                                 "'rod.com')")
+            p = (body, name)
+        body, name = p
+        model.point_local(body, name)  # a clear error for unknown names
+        out.append((body, name, _label(body, name)))
+    return out
+
+
+def _default_points(model) -> list[tuple[str, object, str]]:
+    """The sliders' guided points, else the named points of the last body."""
+    mech = model.mechanism
+    out = []
+    for jn in model.pri.names:
+        j = mech.joints[jn]
+        if j.child != "ground":
+            out.append((j.child, j.child_point, f"{j.child} on {jn!r}"))
+    if out:
+        return out
+    body = model.body_names[-1]
+    names = [p for p in mech.bodies[body].points] or ["com"]
+    return [(body, p, _label(body, p)) for p in names]
+
+
+def _label(body, name) -> str:
+    if isinstance(name, str):
+        return f"{body}.{name}"
+    return f"{body}({name[0]:.4g}, {name[1]:.4g})"
+
+
+def plot_kinematic_sweep(sweep, path, points: Iterable | None = None, *,
+                         title: str | None = None, dpi: int = 120) -> Path:
+    """Position, velocity and acceleration of points against the swept coordinate.
+
+    Parameters
+    ----------
+    sweep : KinematicSweep
+    path : str or Path
+        PNG file to write.
+    points : iterable of "BODY.POINT" or (body, point), optional
+        Default: the guided point of every slider, else the named points of the
+        last body.  Components that stay constant over the sweep are left out.
+    title : str, optional
+    dpi : int
+
+    Returns
+    -------
+    Path
+    """
+    model = sweep.model
+    pts = _parse_points(model, points) if points is not None else _default_points(model)
+    angle = sweep.over_is_angle
+    xs = np.rad2deg(sweep.values) if angle else sweep.values * 1e3
+    fig, axes = _figure(3)
+    scale = model.length_scale
+    rows = [("position", "m", 0), ("velocity", "m/s", 1), ("acceleration", "m/s²", 2)]
+    for body, name, label in pts:
+        data = sweep.point(body, name)
+        for c, comp in enumerate("xy"):
+            if len(sweep) == 0 or np.ptp(data[0][:, c]) <= 1e-12 * scale:
+                continue  # a constant component (e.g. y of a horizontal slider)
+            for ax, (_, _, k) in zip(axes, rows, strict=True):
+                ax.plot(xs, data[k][:, c], label=f"{comp} of {label}")
+    for ax, (what, unit, _) in zip(axes, rows, strict=True):
+        ax.set_ylabel(f"{what} ({unit})")
+        ax.grid(True, alpha=0.3)
+        ax.axhline(0.0, color="0.6", lw=0.6)
+        if ax.lines[1:]:
+            ax.legend(fontsize="small", loc="best")
+    axes[-1].set_xlabel(f"{sweep.over} ({'deg' if angle else 'mm'})")
+    k = sweep.over_index
+    rate = float(sweep.qdot[0, k]) if len(sweep) else 1.0
+    rate_txt = (f"{rate:.6g} rad/s ({rate * 30 / np.pi:.6g} rpm)" if angle
+                else f"{rate:.6g} m/s")
+    name = model.mechanism.name
+    fig.suptitle(title or f"{name}: kinematics at constant {sweep.over}-rate {rate_txt}")
+    if sweep.status != "success" and len(sweep):
+        for ax in axes:
+            ax.axvline(xs[-1], color="tab:red", ls="--", lw=1.0)
+        axes[0].annotate("dead position", (xs[-1], 0.98), xycoords=("data", "axes fraction"),
+                         color="tab:red", ha="right", va="top", fontsize="small")
+    return _save(fig, path, dpi)
+
+
+#: record class name -> plotting function
+PLOTTERS: dict[str, Callable] = {
+    "KinematicSweep": plot_kinematic_sweep,
+}
+
+
+def plot(record, path, **kwargs) -> Path:
+    """Plot any result record with the function registered for its kind (PNG)."""
+    kind = type(record).__name__
+    try:
+        fn = PLOTTERS[kind]
+    except KeyError:
+        raise TypeError(f"no plot for records of kind {kind!r}; kinds with plots: "
+                        + ", ".join(sorted(PLOTTERS))) from None
+    return fn(record, path, **kwargs)

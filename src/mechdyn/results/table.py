@@ -1,0 +1,104 @@
+"""Result records to CSV tables.
+
+Every record has ``to_dataframe()`` whose column names end with their SI unit
+(``phi_deg``, ``vx_rod_B_m_s``, ``M_drive_Nm``; the scheme is in
+``docs/notation.md``).  :func:`write_csv` writes that table with a short header
+of ``#`` comment lines: what the record is, its status, and the unit of every
+column in words.  :func:`read_csv` reads it back.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+__all__ = ["write_csv", "read_csv", "unit_of_column", "UNIT_SUFFIXES"]
+
+#: column-name suffix -> unit, longest suffixes first when matching
+UNIT_SUFFIXES: dict[str, str] = {
+    "_rad_s2": "rad/s^2",
+    "_rad_s": "rad/s",
+    "_rad_m": "rad/m",
+    "_rad": "rad",
+    "_deg_s": "deg/s",
+    "_deg": "deg",
+    "_rpm": "rpm",
+    "_m_s2": "m/s^2",
+    "_m_s": "m/s",
+    "_m_m": "m/m",
+    "_m": "m",
+    "_mm": "mm",
+    "_Nm": "N*m",
+    "_N": "N",
+    "_kg_m2": "kg*m^2",
+    "_kg": "kg",
+    "_J": "J",
+    "_W": "W",
+    "_Hz": "Hz",
+    "_s": "s",
+    "_1": "1",
+}
+
+
+def unit_of_column(name: str) -> str:
+    """Unit named by a column's suffix (``"vx_rod_B_m_s"`` -> ``"m/s"``); ``""`` if none."""
+    for suffix in sorted(UNIT_SUFFIXES, key=len, reverse=True):
+        if name.endswith(suffix):
+            return UNIT_SUFFIXES[suffix]
+    return ""
+
+
+def _describe(record) -> list[str]:
+    kind = type(record).__name__
+    model = getattr(record, "model", None)
+    mech = getattr(model, "mechanism", None)
+    lines = [f"mechdyn {kind}" + (f" of {mech.name!r}" if mech is not None else "")]
+    over = getattr(record, "over", None)
+    if over is not None:
+        lines.append(f"swept coordinate: {over}")
+    status = getattr(record, "status", None)
+    if status is not None:
+        lines.append(f"status: {status}")
+    message = getattr(record, "message", "")
+    if message:
+        lines.append("message: " + " ".join(str(message).split()))
+    lines.append("column names end with their SI unit (see docs/notation.md); "
+                 "analogs are per rad (angle coordinates) or per m (travels)")
+    return lines
+
+
+def write_csv(record, path, *, float_format: str = "%.12g") -> Path:
+    """Write a result record's table to CSV with a commented header of units.
+
+    Parameters
+    ----------
+    record
+        Any result record with ``to_dataframe()`` (e.g. :class:`~mechdyn.kinematics.
+        sweep.KinematicSweep`).
+    path : str or Path
+        Output file; its folder is created if needed.
+    float_format : str
+        printf-style format of the numbers (default 12 significant digits).
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    path = Path(path)
+    df = record.to_dataframe()
+    lines = _describe(record)
+    lines.append("units: " + ", ".join(f"{c} [{unit_of_column(c) or '-'}]" for c in df.columns))
+    if path.parent and not path.parent.exists():
+        path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w", encoding="utf-8", newline="") as fh:
+        for line in lines:
+            fh.write(f"# {line}\n")
+        df.to_csv(fh, index=False, float_format=float_format, lineterminator="\n")
+    return path
+
+
+def read_csv(path):
+    """Read a table written by :func:`write_csv` into a pandas DataFrame."""
+    import pandas as pd
+
+    return pd.read_csv(path, comment="#")
