@@ -1,13 +1,68 @@
-"""mechdyn: kinematics, dynamics and kinetostatics of planar mechanisms."""
+"""mechdyn: kinematics, dynamics and kinetostatics of planar mechanisms.
 
-from .errors import (AssemblyError, BranchJumpError, IntegrationError, LockupError, MechdynError,
-                     ModelError, SingularPositionError, UnitError)
-from .mechanism import Body, Coordinate, Ground, Lock, Mechanism, Prismatic, Revolute
+The public names are re-exported here; see ``docs/`` for the notation, the
+model-file format and tutorials.
+"""
+
+from . import examples, units
+from .dynamics.kinetostatics import Kinetostatics, kinetostatics
+from .dynamics.reduction import (
+                                 FlywheelSizing,
+                                 Reduction,
+                                 SteadyCycle,
+                                 reduce_model,
+                                 run_reduced,
+                                 size_flywheel,
+                                 startup,
+                                 steady_state,
+)
+from .errors import (
+                                 AssemblyError,
+                                 BranchJumpError,
+                                 IntegrationError,
+                                 LockupError,
+                                 MechdynError,
+                                 ModelError,
+                                 SingularPositionError,
+                                 UnitError,
+)
+from .kinematics.sweep import KinematicPoint, KinematicSweep, SweepSummary, analyze, sweep
+from .mechanism import (
+                                 Body,
+                                 Coordinate,
+                                 Drive,
+                                 Force,
+                                 Ground,
+                                 Lock,
+                                 Mechanism,
+                                 Prismatic,
+                                 Revolute,
+                                 RotarySpring,
+                                 Spring,
+                                 Table,
+                                 Torque,
+                                 TorqueSpeedCurve,
+                                 pulse,
+)
+from .mechanism.motors import ConstantSpeedDrive, DCMotor, GearStage, InductionMotor
 from .model import Model
+from .modelfile import load, loads
 from .state import State
 
 __version__ = "0.1.0"
 
-__all__ = ["AssemblyError", "BranchJumpError", "IntegrationError", "LockupError",
-           "MechdynError", "ModelError", "SingularPositionError", "UnitError", "Body",
-           "Coordinate", "Ground", "Lock", "Mechanism", "Prismatic", "Revolute", "Model", "State"]
+__all__ = [
+    # description
+    "Mechanism", "Body", "Ground", "Revolute", "Prismatic", "Lock", "Coordinate", "Spring",
+    "RotarySpring", "Force", "Torque", "Table", "pulse", "Drive", "TorqueSpeedCurve",
+    "InductionMotor", "DCMotor", "ConstantSpeedDrive", "GearStage", "Model", "State",
+    "load", "loads", "examples", "units",
+    # analyses and their records
+    "sweep", "analyze", "KinematicSweep", "KinematicPoint", "SweepSummary",
+    "kinetostatics", "Kinetostatics",
+    "reduce_model", "Reduction", "run_reduced", "steady_state", "SteadyCycle", "size_flywheel",
+    "FlywheelSizing", "startup",
+    # errors
+    "MechdynError", "ModelError", "UnitError", "AssemblyError", "SingularPositionError",
+    "BranchJumpError", "LockupError", "IntegrationError",
+]

@@ -4,8 +4,14 @@ import numpy as np
 import pytest
 
 from mechdyn import Mechanism
-from mechdyn.kinematics.constraints import (coordinates, coordinates_gamma,
-                                            coordinates_jacobian, gamma, jacobian, residual)
+from mechdyn.kinematics.constraints import (
+    coordinates,
+    coordinates_gamma,
+    coordinates_jacobian,
+    gamma,
+    jacobian,
+    residual,
+)
 
 
 def every_joint_mechanism():

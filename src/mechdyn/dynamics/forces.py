@@ -13,10 +13,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
+from ..kinematics.constraints import extend
 from ..mechanism.drive import Drive
 from ..mechanism.load import Force, RotarySpring, Spring, Table, Torque
 from ..model import Model
-from ..kinematics.constraints import extend
 
 __all__ = ["LoadContext", "ForceModel", "force_model"]
 
@@ -117,7 +117,7 @@ class ForceModel:
         X = extend(m, x)
         V = extend(m, xdot)
         nb = m.n_bodies
-        for (name, i, si, j, sj, k, L0, c, pre) in self.springs:
+        for (name, i, si, j, sj, k, L0, c, pre) in self.springs:  # noqa: B007
             ai, aj = _rot(X[i, 2], si), _rot(X[j, 2], sj)
             d = X[j, :2] + aj - X[i, :2] - ai
             L = np.hypot(d[0], d[1])
@@ -209,7 +209,6 @@ class ForceModel:
     def nonconservative_power(self, t, x, xdot, q, qdot) -> float:
         """Power (W) of every force that is not gravity or spring stiffness:
         dampers, applied forces and torques, and drives."""
-        m = self.model
         F, Qd = self.applied(t, x, xdot, q, qdot)
         Fc = self.conservative(x)
         return float((F - Fc) @ xdot + Qd @ qdot)

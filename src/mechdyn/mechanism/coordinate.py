@@ -9,7 +9,8 @@ __all__ = ["Coordinate", "COORDINATE_KINDS"]
 #: kind -> what it measures
 COORDINATE_KINDS = {
     "angle": "absolute angle of a body, rad (theta_body + offset)",
-    "relative_angle": "relative angle of a revolute joint, rad (theta_child - theta_parent + offset)",
+    "relative_angle": "relative angle of a revolute joint, rad "
+                      "(theta_child - theta_parent + offset)",
     "travel": "travel of a prismatic joint along its axis, m (from the axis point, + offset)",
 }
 
