@@ -117,7 +117,7 @@ class ForceModel:
         X = extend(m, x)
         V = extend(m, xdot)
         nb = m.n_bodies
-        for (name, i, si, j, sj, k, L0, c, pre) in self.springs:  # noqa: B007
+        for (name, i, si, j, sj, k, L0, c, pre) in self.springs:
             ai, aj = _rot(X[i, 2], si), _rot(X[j, 2], sj)
             d = X[j, :2] + aj - X[i, :2] - ai
             L = np.hypot(d[0], d[1])
@@ -129,7 +129,7 @@ class ForceModel:
             f = k * (L - L0) + c * (e @ vd) + pre
             self._apply(F, i, ai, f * e, nb)
             self._apply(F, j, aj, -f * e, nb)
-        for (name, i, j, k, a0, c, pre) in self.rotary:
+        for (_name, i, j, k, a0, c, pre) in self.rotary:
             rel = X[j, 2] - X[i, 2]
             w = V[j, 2] - V[i, 2]
             tq = -(k * (rel - a0) + c * w + pre)

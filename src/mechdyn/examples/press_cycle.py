@@ -11,42 +11,52 @@ contact.
 The cycle, as the paper describes it:
 
 1. **idle** - preloaded springs hold the ram up against its upper stop
-   (x_C = 25.5 mm); the crank turns and the rocker swings: the machine is a
+   (x_C = 28 mm); the crank turns and the rocker swings: the machine is a
    crank-rocker four-bar on the ram (2 DOF phi, psi; with the stop closed 1).
 2. **engaging** - the cylinder pushes the piston down; it closes the 0.5 mm
-   gap onto the ram (an impact) and pushes the ram 2 mm down, to the piston's
-   lower stop (x_C = 23.5 mm).
+   gap onto the ram (an impact) and pushes the ram 4 mm down, to the piston's
+   lower stop (x_C = 24 mm).
 3. **locking** - with the ram down, the rocker's swing now reaches the ram
    axis (psi = 0, before the crank's top dead centre); there it locks onto the
    ram (a plastic impact).  The machine is a 1-DOF slider-crank: the ram
-   rises 1.5 mm to top dead centre, leaves the piston and does its 30 mm work
-   stroke with a punch load in the last 3 mm.
+   rises to top dead centre (25 mm), leaves the piston and does its 30 mm
+   work stroke with a punch load in the last 3 mm.
 4. **release** - the cylinder is switched off during the stroke (the piston
    returns); when the ram comes back up through x_C = 23.0 mm the lock
    releases (no jump); the return torque of the second cylinder turns the
    rocker back and the springs return the ram to its upper stop (an impact
    with restitution 0.2, bounces, then it rests there): idle again.
 
+
+
 Values the paper does not give, chosen here (SI):
 
-* **ram springs**: stiffness 2e5 N/m, 4 kN push at the upper stop.  They
-  must hold the ram (100 kg, 981 N) plus the idle linkage forces (about
-  1-2 kN at 43.5 rad/s) against the stop, yet stay soft over the 30 mm
-  stroke (+6 kN).  Damping 2000 N s/m (a few % of critical).
-* **upper stop** at x_C = 25.5 mm: 0.5 mm beyond the change-point distance
+* **ram springs**: a preloaded spring pack pushing the ram up with 70 kN at
+  the upper stop (stiffness 2e5 N/m), whose seat lands on the frame after
+  6 mm of travel (the push then falls to zero over 2 mm), so that it holds
+  the ram in idle but does not load the 30 mm work stroke.  The preload is
+  set by the idle linkage: with the paper's masses at 43.5 rad/s the rocker
+  and rod pull the ram down by up to 59 kN near the crank's top dead centre
+  (computed with the ram held: ``x_stop_up`` = 28 mm); the paper gives no
+  value.
+* **upper stop** at x_C = 28 mm: 3 mm beyond the change-point distance
   l2 + l3 - l1 = 25 mm, so idle is a proper crank-rocker whose rocker never
-  reaches the ram axis (it swings between -15.4 and -127 deg) - it can only
-  lock after the ram is pushed down; restitution 0.2 (steel on a damped stop).
-* **piston**: 5 kg, stroke 2.5 mm (0.5 mm gap + 2 mm push: the paper's
-  "1-2 mm"), return spring 300 N; **cylinder force** 7 kN (beats the 4.4 kN
-  of the springs minus the ram weight, with margin for the linkage forces).
+  reaches the ram axis (it swings between -37 and -127 deg) - it can only
+  lock after the ram is pushed below 25 mm; restitution 0.2 (steel on a
+  damped stop).  Closer to 25 mm the idle linkage forces grow without bound
+  (534 kN at 25.5 mm), which is why the paper's "1-2 mm" became 4 mm here.
+* **piston**: 5 kg, stroke 4.5 mm (0.5 mm gap + 4 mm push, down to
+  x_C = 24 mm), return spring 300 N; **cylinder force** 85 kN (beats the
+  70.8 kN of the springs minus the ram's weight, with margin for the linkage
+  forces that push the ram up).
 * **locking**: rocker-to-ram relative angle held (a CoordinateLock on joint
   C) when psi rises through 0 with the ram below 24 mm and the piston down.
 * **return torque** of the second cylinder on the rocker: 20 N m towards
   negative psi while |psi| < 2 deg (inactive in idle, absorbed by the lock
   while locked, it picks the idle branch of the rocker at release).
-* **flywheel**: 1.5 kg m^2 added to the crank (a press stores its stroke
-  energy in a flywheel; the paper's crank alone, 0.034 kg m^2, would stall).
+* **flywheel**: 5 kg m^2 added to the crank (a press stores its stroke
+  energy in a flywheel; the paper's crank alone, 0.034 kg m^2, would stall
+  against the spring pack and the punch).
 * **motor**: a linear torque-speed characteristic at the crank standing for
   the 4A80B4U3 induction motor through its reduction: 0 N m at the
   synchronous 46.2 rad/s, 34.5 N m at the nominal 43.5 rad/s (1.5 kW),
@@ -72,9 +82,9 @@ __all__ = ["build", "run", "PARAMETERS", "command_times"]
 PARAMETERS = dict(
     l1=0.015, l2=0.040, l3=0.030,
     m1=4.6, m2=20.0, m3=18.0, m4=100.0, m5=5.0,
-    J1=0.034, J2=0.036, J3=0.0441, J_flywheel=1.5,
+    J1=0.034, J2=0.036, J3=0.0441, J_flywheel=5.0,
     x_stop_up=0.028, piston_gap=0.0005, piston_stroke=0.0045,
-    k_ram=2e5, push_ram=70000.0, c_ram=2e4, e_stop=0.2,
+    k_ram=2e5, push_ram=70000.0, spring_travel=0.006, e_stop=0.2,
     k_piston=1e4, pull_piston=300.0, F_cylinder=85000.0,
     M_return=20.0, psi_return=np.deg2rad(2.0),
     x_lock_below=0.0245, x_release=0.0235,
@@ -160,10 +170,11 @@ def build(cycles: int = 2, **overrides) -> Mechanism:
     m.add_coordinate("p", kind="travel", joint="cylinder")
 
     # loads
-    L_ram = xs + 0.2
-    m.add(Spring("ram_springs", "ground", "spring_base", "slider", (0.0, 0.0),
-                 stiffness=p["k_ram"], free_length=L_ram + p["push_ram"] / p["k_ram"],
-                 damping=p["c_ram"]))
+    tr = p["spring_travel"]
+    push = p["push_ram"]
+    m.add(Force("ram_springs", "slider", (0.0, 0.0),
+                Table((xs - tr - 0.002, xs - tr, xs), (0.0, push - p["k_ram"] * tr, push),
+                      "slider.com.x"), direction=(1.0, 0.0)))
     L_pis = 0.2 - x_piston_up
     m.add(Spring("piston_return", "ground", "piston_anchor", "piston", (0.0, 0.0),
                  stiffness=p["k_piston"], free_length=L_pis - p["pull_piston"] / p["k_piston"]))
