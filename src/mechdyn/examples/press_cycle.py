@@ -76,7 +76,7 @@ from ..mechanism.contact import Contact, Stop
 from ..mechanism.drive import Drive
 from ..mechanism.switch import CoordinateLock, Switch, add_element
 
-__all__ = ["build", "run", "PARAMETERS", "command_times"]
+__all__ = ["build", "run", "PARAMETERS", "command_times", "load_model_file"]
 
 #: every chosen value, SI (see the module docstring for the reasons)
 PARAMETERS = dict(
@@ -94,7 +94,7 @@ PARAMETERS = dict(
 )
 
 
-def command_times(cycles: int = 2, first: float = 0.10, period: float = 0.45,
+def command_times(cycles: int = 2, first: float = 0.10, period: float = 0.4265,
                   duration: float = 0.12) -> list[tuple[float, float]]:
     """(on, off) times of the engaging cylinder, s: one stroke per ``period``."""
     return [(first + k * period, first + k * period + duration) for k in range(cycles)]
@@ -232,3 +232,33 @@ def run(cycles: int = 2, t_end: float | None = None, **options):
     options.setdefault("rtol", 1e-9)
     options.setdefault("dt_out", 5e-4)
     return simulate_events(mech, t_end, **options)
+
+
+def load_model_file(path=None):
+    """The press from its model file ``press_cycle.toml`` (variable-structure tables
+    read by :func:`mechdyn.modelfile.switches.parse_switches`).
+
+    Works whether or not the model-file loader already knows the tables
+    ``[[stops]]``, ``[[contacts]]``, ``[[coordinate_locks]]`` and ``[[switches]]``.
+    """
+    from pathlib import Path
+
+    from ..errors import ModelError
+    from ..modelfile.loader import build as build_doc
+    from ..modelfile.loader import read_document
+    from ..modelfile.switches import TABLES, parse_switches
+
+    path = Path(path) if path is not None else Path(__file__).with_name("press_cycle.toml")
+    doc = read_document(path.read_text(encoding="utf-8"), str(path))
+    if any(t in doc for t in TABLES):
+        rest = {k: v for k, v in doc.items() if k not in TABLES}
+        try:
+            mech = build_doc(doc, str(path))
+        except ModelError:
+            mech = build_doc(rest, str(path))
+        if not any(mech.extras.get(k) for k in TABLES):
+            probs = parse_switches(doc, mech, str(path))
+            if probs:
+                raise ModelError(probs)
+        return mech
+    return build_doc(doc, str(path))

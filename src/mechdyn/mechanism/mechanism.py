@@ -71,6 +71,8 @@ class Mechanism:
             if element.name in self.coordinates:
                 raise ModelError(f"coordinate {element.name!r} is defined twice")
             self.coordinates[element.name] = element
+        elif getattr(element, "extra_kind", None):
+            self.extras.setdefault(element.extra_kind, []).append(element)
         elif getattr(element, "is_drive", False):
             self.drives.append(element)
         else:

@@ -42,6 +42,8 @@ from ..mechanism import (
 )
 from ..units import parse_quantity, parse_vector
 from .schema import locate, schema_problems
+from .switches import TABLES as SWITCH_TABLES
+from .switches import parse_switches
 
 __all__ = ["load", "loads", "build", "read_document"]
 
@@ -353,6 +355,9 @@ class _Builder:
                     continue
                 names.add(el.name)
                 mech.add(el)
+        if any(k in self.doc for k in SWITCH_TABLES):
+            for p in parse_switches(self.doc, mech, self.fname):
+                self.problem(p)
         return mech
 
     # ------------------------------------------------------------ bodies

@@ -1,0 +1,336 @@
+"""Unilateral contacts: complementarity problems for contact forces and impulses.
+
+Following the cyclic-automata document (seed 4), the forces lambda of the
+touching unilateral constraints (stops and point-on-line contacts) solve
+
+    a = (G + C) lambda + r >= 0,   lambda >= 0,   lambda^T a = 0
+
+with a the gap accelerations, G = W A^-1 W^T the contact (Delassus) matrix of
+the constraint Jacobian W in the current coordinates, A the generalized mass
+matrix, C the diagonal compliance (regularization) matrix and r the gap
+accelerations without contact forces.  For symmetric G + C (no sliding
+friction) this is the bound-constrained quadratic programme
+
+    minimize 1/2 lambda^T (G + C) lambda + r^T lambda,  lambda >= 0,
+
+whose optimality conditions are exactly the complementarity conditions; it is
+solved with :func:`scipy.optimize.nnls` on a square-root factor of G + C.  A
+sliding contact's friction makes G non-symmetric (no QP exists and no SciPy
+routine solves a general LCP); those small problems are solved by enumerating
+active sets, which is exact and cheap for the few contacts of a mechanism.
+
+The same solver handles impacts at the velocity level (impulses instead of
+forces, Newton's restitution law instead of a >= 0).
+
+``resolve_mode`` decides, at a switching instant, which touching constraints
+stay closed and whether frictional contacts stick or slip.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import nnls
+
+from ..errors import MechdynError
+from .modes import ModeSystem, Row, SwitchedModel
+
+__all__ = ["ContactError", "solve_lcp", "LCPResult", "resolve_mode", "constrained_inverse",
+           "row_terms"]
+
+
+class ContactError(MechdynError):
+    """No contact force distribution satisfies the complementarity conditions."""
+
+    def __init__(self, message, *, t=None):
+        self.t = t
+        super().__init__(message + (f" (at t = {t:.9g} s)" if t is not None else ""))
+
+
+@dataclass
+class LCPResult:
+    """Solution of an LCP w = H z + r, z >= 0, w >= 0, z^T w = 0.
+
+    Attributes
+    ----------
+    z, w : ndarray, shape (m,)
+    method : str
+        ``"nnls"`` or ``"enumeration"``.
+    residual : float
+        Largest violation of the conditions, scaled.
+    """
+
+    z: np.ndarray
+    w: np.ndarray
+    method: str
+    residual: float
+
+
+def _lcp_residual(H, r, z):
+    w = H @ z + r
+    scale = max(np.max(np.abs(r)) if r.size else 0.0, 1e-300)
+    hs = max(np.max(np.abs(H)) if H.size else 0.0, 1e-300)
+    zs = z * hs
+    viol = max(float(np.max(-np.minimum(w, 0.0), initial=0.0)),
+               float(np.max(-np.minimum(zs, 0.0), initial=0.0)),
+               float(np.max(np.minimum(np.abs(w), np.abs(zs)), initial=0.0)))
+    return w, viol / scale
+
+
+def solve_lcp(H, r, *, tol: float = 1e-9) -> LCPResult:
+    """Solve the linear complementarity problem w = H z + r >= 0, z >= 0, z^T w = 0.
+
+    Parameters
+    ----------
+    H : array_like, shape (m, m)
+        Positive semidefinite (symmetric) or a P-matrix (non-symmetric, small m).
+    r : array_like, shape (m,)
+    tol : float
+        Accepted relative violation of the conditions.
+
+    Returns
+    -------
+    LCPResult
+
+    Raises
+    ------
+    ContactError
+        No solution was found (e.g. the contact configuration is jammed).
+    """
+    H = np.atleast_2d(np.asarray(H, float))
+    r = np.asarray(r, float).reshape(-1)
+    m = r.size
+    if m == 0:
+        return LCPResult(np.zeros(0), np.zeros(0), "empty", 0.0)
+    if np.all(r >= 0):
+        return LCPResult(np.zeros(m), r.copy(), "trivial", 0.0)
+    sym = np.allclose(H, H.T, rtol=1e-10, atol=1e-12 * max(np.max(np.abs(H)), 1e-300))
+    if sym:
+        Hs = 0.5 * (H + H.T)
+        s, V = np.linalg.eigh(Hs)
+        smax = max(float(s[-1]), 1e-300)
+        s = np.maximum(s, 1e-13 * smax)
+        # 1/2 z^T H z + r^T z = 1/2 |S^1/2 V^T z + S^-1/2 V^T r|^2 + const
+        Lt = np.sqrt(s)[:, None] * V.T
+        y = (V.T @ r) / np.sqrt(s)
+        z, _ = nnls(Lt, -y, maxiter=50 * m)
+        w, res = _lcp_residual(H, r, z)
+        if res <= tol:
+            return LCPResult(z, w, "nnls", res)
+    best = None
+    if m <= 12:
+        for k in range(m + 1):
+            for act in itertools.combinations(range(m), k):
+                z = np.zeros(m)
+                if act:
+                    a = list(act)
+                    try:
+                        z[a] = np.linalg.solve(H[np.ix_(a, a)], -r[a])
+                    except np.linalg.LinAlgError:
+                        z[a] = np.linalg.lstsq(H[np.ix_(a, a)], -r[a], rcond=None)[0]
+                w, res = _lcp_residual(H, r, z)
+                if best is None or res < best[2]:
+                    best = (z, w, res)
+                if res <= tol:
+                    return LCPResult(z, w, "enumeration", res)
+    if best is not None and best[2] <= 1e3 * tol:
+        return LCPResult(best[0], best[1], "enumeration", best[2])
+    raise ContactError("the contact problem has no solution (no set of compressive contact "
+                       "forces keeps every gap from closing further)")
+
+
+def constrained_inverse(A, C_eq):
+    """Z = N (N^T A N)^-1 N^T with N a basis of the null space of ``C_eq``.
+
+    With the equality rows C_eq qddot = 0 enforced, qddot = Z f solves
+    A qddot = f + C_eq^T mu.  Shape (n, n).
+    """
+    n = A.shape[0]
+    if C_eq.shape[0] == 0:
+        N = np.eye(n)
+    else:
+        _, s, vt = np.linalg.svd(C_eq)
+        rank = int(np.sum(s > 1e-10 * max(s[0] if s.size else 0.0, 1e-300)))
+        N = vt[rank:].T
+    if N.shape[1] == 0:
+        return np.zeros((n, n))
+    K = N.T @ A @ N
+    return N @ np.linalg.solve(K, N.T)
+
+
+def row_terms(ms: ModeSystem, rows: list[Row], x, xdot, B, b, nb):
+    """For rows in a mode's coordinates: C (m, n_i) with rate = C qdot_I, the
+    acceleration offset d (m,) with accel = C qddot_I + d, and the force
+    directions W (m, n_i) including sliding friction."""
+    from ..kinematics.constraints import extend
+
+    X, V = extend(ms.model, x), extend(ms.model, xdot)
+    C, W, d = [], [], []
+    for r in rows:
+        g = r.sign * r.measure.grad(X, nb)
+        C.append(g @ B)
+        d.append(g @ b + r.sign * r.measure.quad(X, V))
+        gw = g.copy()
+        if r.slip:
+            gw = gw - r.mu * r.slip * r.tangent.grad(X, nb)
+        W.append(gw @ B)
+    n = B.shape[1]
+    return (np.array(C).reshape(-1, n), np.array(W).reshape(-1, n), np.array(d, float))
+
+
+def touching(sm: SwitchedModel, ms: ModeSystem, x, *, gap_tol: float) -> list[str]:
+    """Unilateral tokens whose gap is within ``gap_tol`` (m, or rad for angle stops)."""
+    from ..kinematics.constraints import extend
+
+    X = extend(sm.model, x)
+    out = []
+    for n, (st, meas) in sm.stops.items():
+        v = meas.value(X)
+        L = 1.0 if meas.is_angle else 1.0
+        if st.lower is not None and v - st.lower <= gap_tol * L:
+            out.append(f"{n}@lower")
+        if st.upper is not None and st.upper - v <= gap_tol * L:
+            out.append(f"{n}@upper")
+    for n, (_ct, gap, _) in sm.contacts.items():
+        if gap.value(X) <= gap_tol:
+            out.append(f"{n}@contact")
+    return out
+
+
+def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates,
+                 *, slip_velocity_tol: float, force_tol: float, forced_open=(),
+                 forced_slip: dict | None = None, forced_stick=()):
+    """Decide which touching constraints are closed, and stick or slip, at a state.
+
+    Parameters
+    ----------
+    sm : SwitchedModel
+    t : float
+    x, xdot : ndarray, shape (n_x,)
+        A pose and velocity consistent with the locks; the candidates' gaps
+        and gap rates are (nearly) zero.
+    locks : frozenset of str
+        The engaged locks (bilateral).
+    targets : dict
+        Held values of the locks; updated with the stick positions chosen.
+    candidates : iterable of str
+        Unilateral tokens (``"stop@lower"``, contact names) that may close.
+    slip_velocity_tol : float
+        Below this tangential speed (m/s) a frictional contact may stick.
+    force_tol : float
+        Forces below it (N) count as zero.
+    forced_open : iterable of str
+        Tokens whose force just fell to zero: kept open unless their gap would
+        then accelerate into penetration.
+    forced_slip : dict, optional
+        {contact: +1/-1}: contacts that must slip in that direction (they
+        just broke away from sticking).
+    forced_stick : iterable of str
+        Contacts whose slip velocity just vanished: they are tried sticking first.
+
+    Returns
+    -------
+    mode : frozenset of str
+    lam : dict
+        Normal force of each closed token (N, or N m for angle stops).
+
+    Raises
+    ------
+    ContactError
+    """
+    from ..kinematics.constraints import extend
+
+    locks = frozenset(locks)
+    cand = sorted(set(candidates))
+    if not cand:
+        return locks, {}
+    forced_open = set(forced_open)
+    forced_slip = dict(forced_slip or {})
+    base = ModeSystem(sm, locks, targets, x)
+    terms = base.terms(t, x, xdot)
+    B, b, A, f = terms["B"], terms["b"], terms["A"], terms["f"]
+    X, V = extend(sm.model, x), extend(sm.model, xdot)
+    # friction state of each candidate contact
+    fric = {}
+    for tok in cand:
+        c = tok[:-8] if tok.endswith("@contact") else None
+        if c is not None and sm.contacts[c][0].friction > 0:
+            if c in forced_slip:
+                fric[c] = "slip+" if forced_slip[c] > 0 else "slip-"
+                continue
+            vt = sm.contacts[c][2].rate(X, V, sm.nb)
+            if abs(vt) <= slip_velocity_tol or c in forced_stick:
+                fric[c] = "stick"
+            else:
+                fric[c] = "slip+" if vt > 0 else "slip-"
+    active = [c for c in cand if c not in forced_open]
+    for _ in range(4 * len(cand) + 4):
+        toks = frozenset(active) | frozenset(f"{c}:{s}" for c, s in fric.items()
+                                             if f"{c}@contact" in active)
+        stick_targets = dict(targets)
+        for c in [a[:-8] for a in active if a.endswith("@contact")]:
+            if fric.get(c) == "stick":
+                stick_targets[f"{c}:stick"] = sm.contacts[c][2].value(X)
+        rows = sm.rows(toks, stick_targets)
+        eq = [r for r in rows if r.kind == "stick"]
+        uni = [r for r in rows if r.unilateral]
+        Ce, _, de = row_terms(base, eq, x, xdot, B, b, sm.nb)
+        Cu, Wu, du = row_terms(base, uni, x, xdot, B, b, sm.nb)
+        # equality rows: A qdd = f + Ce^T mu + Wu^T lam ; Ce qdd + de = 0
+        n = A.shape[0]
+        ne = Ce.shape[0]
+        K = np.block([[A, -Ce.T], [Ce, np.zeros((ne, ne))]])
+        Kinv = np.linalg.pinv(K) if K.size else np.zeros((0, 0))
+        base_sol = Kinv @ np.concatenate([f, -de]) if K.size else np.zeros(0)
+        resp = Kinv[:, :n] @ Wu.T if K.size else np.zeros((0, len(uni)))
+        H = Cu @ resp[:n]
+        r = Cu @ base_sol[:n] + du
+        comp = np.array([r_.compliance for r_ in uni], float)
+        H = H + np.diag(comp)
+        sol = solve_lcp(H, r)
+        lam = sol.z
+        acc = sol.w
+        mu_e = base_sol[n:] + resp[n:] @ lam if ne else np.zeros(0)
+        changed = False
+        # drop rows without force (they separate or just touch)
+        keep = [u.label for u, l_ in zip(uni, lam, strict=True) if l_ > force_tol]
+        if set(keep) != set(active):
+            active = keep
+            changed = True
+        # friction: sticking force within the cone?
+        lam_n = {u.element: l_ for u, l_ in zip(uni, lam, strict=True) if u.kind == "contact"}
+        for r_, m_ in zip(eq, mu_e, strict=True):
+            c = r_.element
+            mu = sm.contacts[c][0].friction
+            if f"{c}@contact" in active and \
+                    abs(m_) > mu * lam_n.get(c, 0.0) * (1 + 1e-12) + force_tol:
+                fric[c] = "slip-" if m_ > 0 else "slip+"
+                changed = True
+        if not changed:
+            # released tokens must not accelerate into penetration
+            reopen = []
+            if forced_open:
+                trial = sm.rows(frozenset(forced_open & set(cand)), targets)
+                Ct, _, dt_ = row_terms(base, [r_ for r_ in trial if r_.unilateral], x, xdot, B,
+                                       b, sm.nb)
+                qdd = base_sol[:n] + resp[:n] @ lam
+                at = Ct @ qdd + dt_
+                for r_, a_ in zip([r_ for r_ in trial if r_.unilateral], at, strict=True):
+                    if a_ < -1e-6 * max(1.0, float(np.max(np.abs(acc)) if acc.size else 1.0)):
+                        reopen.append(r_.label)
+            if reopen:
+                forced_open -= set(reopen)
+                active = sorted(set(active) | set(reopen))
+                continue
+            mode = locks | frozenset(active) | frozenset(
+                f"{c}:{s}" for c, s in fric.items() if f"{c}@contact" in active)
+            for c in [a[:-8] for a in active if a.endswith("@contact")]:
+                if fric.get(c) == "stick":
+                    targets[f"{c}:stick"] = sm.contacts[c][2].value(X)
+            forces = {u.label: float(l_) for u, l_ in zip(uni, lam, strict=True)
+                      if u.label in active}
+            return mode, forces
+    raise ContactError("the contact and friction states do not settle (stick/slip cycling)",
+                       t=t)

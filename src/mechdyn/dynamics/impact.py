@@ -1,0 +1,245 @@
+"""What happens at a switch: impacts when constraints engage, none when they release.
+
+When a lock engages, or a stop or contact closes, with a velocity that the new
+constraint does not allow, the velocities jump.  The impact is computed in the
+generalized coordinates q of the structure *before* the switch (its bilateral
+part, after any releases), where the generalized mass matrix is A = B^T M B and
+the new constraint rows are C = Phi_new,x B:
+
+* plastic (locks, and stops/contacts with e = 0): generalized momentum is
+  conserved up to the impulses of the new rows,
+
+      [A  -C^T] [qdot+]   [A qdot-]
+      [C    0 ] [ P   ] = [   0   ]
+
+  (P the impulses of the new rows; the brief's form with -P);
+* unilateral rows with Newton's restitution e: the impulses P >= 0 and the
+  rows' velocities after the impact v+ >= e max(0, -v-) are complementary
+  (v+ = -e v- on every row that receives an impulse), a velocity-level LCP
+  solved by :func:`mechdyn.dynamics.contact.solve_lcp`.
+
+The kinetic energy lost is T- - T+; for a plastic impact it equals
+1/2 (qdot- - qdot+)^T A (qdot- - qdot+).  The impulse of every joint, lock,
+stop and contact (including the pins that carry the impact through) comes from
+M (xdot+ - xdot-) = Phi_x^T Lambda over all rows of the new mode.  Friction is
+not active during the instant of an impact (frictionless impact law).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .contact import constrained_inverse, row_terms, solve_lcp
+from .modes import ModeSystem, SwitchedModel, mass_matrix_x
+
+__all__ = ["ImpactResult", "impact", "element_forces", "frame_forces"]
+
+
+@dataclass
+class ImpactResult:
+    """The outcome of an impact.
+
+    Attributes
+    ----------
+    xdot_plus : ndarray, shape (n_x,)
+        Body velocities after the impact.
+    energy_before, energy_after, energy_lost : float
+        Kinetic energies (J) and their difference (J, >= 0).
+    impulses : dict
+        Impulse of each row (N s, or N m s for angular rows) by row label;
+        joint rows are labelled ``"O.x"``, ``"O.y"``, ....
+    element_impulses : dict
+        For each joint or lock, the impulse (Px, Py, L) on its child body from
+        its parent (N s, N s, N m s about the child frame origin); for each
+        stop or contact, the normal impulse (N s).
+    velocity_before, velocity_after : dict
+        Rate of each new row (m/s or rad/s) before and after the impact.
+    """
+
+    xdot_plus: np.ndarray
+    energy_before: float
+    energy_after: float
+    energy_lost: float
+    impulses: dict = field(default_factory=dict)
+    element_impulses: dict = field(default_factory=dict)
+    velocity_before: dict = field(default_factory=dict)
+    velocity_after: dict = field(default_factory=dict)
+
+
+def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets: dict,
+           unilateral=(), *, restitution: dict | None = None, small_velocity: float = 0.0,
+           t=None) -> ImpactResult:
+    """Velocities after locks engage and/or unilateral constraints close at pose ``x``.
+
+    Parameters
+    ----------
+    sm : SwitchedModel
+    x : ndarray, shape (n_x,)
+        The pose at the switch (satisfies every row involved).
+    xdot_minus : ndarray, shape (n_x,)
+        Velocities before, consistent with ``locks_before``.
+    locks_before : frozenset of str
+        Locks engaged before (after the releases of the same instant).
+    locks_after : frozenset of str
+        Locks engaged after (``locks_before`` plus the ones engaging).
+    targets : dict
+        Held values of the locks (the engaging ones captured at ``x``).
+    unilateral : iterable of str
+        Touching stop sides and contacts (closed before, or closing now).
+    restitution : dict, optional
+        Coefficient e per unilateral token (default: the element's own).
+    small_velocity : float
+        Approach speeds below it (m/s, or rad/s for angle stops) are treated as
+        plastic (e = 0), which ends bouncing sequences in finite time.
+
+    Returns
+    -------
+    ImpactResult
+    """
+    model = sm.model
+    xdot_minus = np.asarray(xdot_minus, float)
+    base = ModeSystem(sm, frozenset(locks_before), targets, x)
+    B, _ = base.velocity_analogs(x)
+    M, _ = mass_matrix_x(model, x)
+    A = B.T @ M @ B
+    G = base._coord_jac(x)[base.coords]
+    qd_minus = G @ xdot_minus
+    new_locks = frozenset(locks_after) - frozenset(locks_before)
+    rows_b = sm.rows(new_locks, targets) if new_locks else []
+    uni_tokens = sorted(set(unilateral))
+    rows_u = [r for r in sm.rows(frozenset(uni_tokens), targets) if r.unilateral]
+    zero_b = np.zeros_like(B[:, 0]) if B.shape[1] else np.zeros(model.n_x)
+    Cb, _, _ = row_terms(base, rows_b, x, xdot_minus, B, zero_b, sm.nb)
+    Cu, _, _ = row_terms(base, rows_u, x, xdot_minus, B, zero_b, sm.nb)
+    Z = constrained_inverse(A, Cb)
+    p_minus = A @ qd_minus
+    v_minus = Cu @ qd_minus
+    v0 = Cu @ Z @ p_minus
+    Hm = Cu @ Z @ Cu.T
+    e = np.zeros(len(rows_u))
+    for k, r in enumerate(rows_u):
+        tok = r.label
+        if restitution and tok in restitution:
+            e[k] = restitution[tok]
+        elif r.kind == "stop":
+            e[k] = sm.stops[r.element][0].restitution
+        else:
+            e[k] = sm.contacts[r.element][0].restitution
+        if -v_minus[k] <= small_velocity:
+            e[k] = 0.0
+    target = e * np.maximum(-v_minus, 0.0)
+    sol = solve_lcp(Hm, v0 - target)
+    P_u = sol.z
+    qd_plus = Z @ (p_minus + Cu.T @ P_u)
+    xdot_plus = B @ qd_plus
+    T0 = 0.5 * float(xdot_minus @ M @ xdot_minus)
+    T1 = 0.5 * float(xdot_plus @ M @ xdot_plus)
+    res = ImpactResult(xdot_plus, T0, T1, T0 - T1)
+    # impulses of every row of the mode after the impact
+    after = ModeSystem(sm, frozenset(locks_after) | frozenset(uni_tokens), targets, x)
+    R = after.row_jacobian(x)
+    dp = M @ (xdot_plus - xdot_minus)
+    Lam = np.linalg.lstsq(R.T, dp, rcond=None)[0] if R.size else np.zeros(0)
+    labels = after.row_labels()
+    res.impulses = dict(zip(labels, (float(v) for v in Lam), strict=True))
+    res.element_impulses = element_forces(after, x, Lam)
+    for r, vm, vp in zip(rows_b + rows_u, np.concatenate([Cb @ qd_minus, v_minus]),
+                         np.concatenate([Cb @ qd_plus, Cu @ qd_plus]), strict=True):
+        res.velocity_before[r.label] = float(vm)
+        res.velocity_after[r.label] = float(vp)
+    return res
+
+
+def element_forces(ms: ModeSystem, x, lam) -> dict:
+    """Per element: (Fx, Fy, M) on its child body from the rows' multipliers (joints,
+    weld locks), or the scalar multiplier (coordinate locks: N m or N; stops and
+    contacts: the normal force); pass impulses to get impulses.
+
+    The joint convention is that of ``mechdyn``'s reactions: the force on the child
+    from the parent, at the child frame origin for the moment, ground frame.
+    """
+    model = ms.model
+    R = ms.row_jacobian(x)
+    elements = ms.row_elements()
+    out: dict = {}
+    nb = model.n_bodies
+    for el in dict.fromkeys(elements):
+        idx = [k for k, e in enumerate(elements) if e == el]
+        kind = _element_kind(ms, el)
+        if kind in ("stop", "contact", "stick") or el in ms.sm.coord_locks:
+            # normal multiplier (the first row of the element); stick adds tangential
+            out[el] = float(lam[idx[0]])
+            continue
+        child = _child_index(ms, el)
+        gen = R[idx].T @ lam[idx]
+        if child is None or child >= nb:
+            out[el] = np.zeros(3)
+        else:
+            out[el] = gen[3 * child:3 * child + 3].copy()
+    return out
+
+
+def _element_kind(ms: ModeSystem, el: str) -> str:
+    for r in ms.rows:
+        if r.element == el:
+            return r.kind
+    return "joint"
+
+
+def _child_index(ms: ModeSystem, el: str):
+    mech = ms.model.mechanism
+    if el in mech.joints:
+        return ms.model.body_index(mech.joints[el].child)
+    return None
+
+
+def frame_forces(ms: ModeSystem, x, lam) -> dict:
+    """Forces (Fx, Fy) the mechanism exerts on the frame through each ground joint,
+    lock, stop or contact attached to the ground, N; key ``"total"`` sums them."""
+    model = ms.model
+    R = ms.row_jacobian(x)
+    elements = ms.row_elements()
+    nb = model.n_bodies
+    mech = model.mechanism
+    out: dict = {}
+    total = np.zeros(2)
+    for el in dict.fromkeys(elements):
+        idx = [k for k, e in enumerate(elements) if e == el]
+        gen = R[idx].T @ lam[idx]  # constraint force on each moving body
+        on_bodies = gen.reshape(nb, 3)[:, :2]
+        if el in mech.joints:
+            j = mech.joints[el]
+            grounded = "ground" in (j.parent, j.child)
+        else:
+            grounded = _touches_ground(ms, el)
+        if not grounded:
+            continue
+        f = -on_bodies.sum(axis=0)  # Newton's third law: the frame gets the opposite
+        out[el] = f
+        total = total + f
+    out["total"] = total
+    return out
+
+
+def _touches_ground(ms: ModeSystem, el: str) -> bool:
+    sm = ms.sm
+    mech = ms.model.mechanism
+    if el in sm.contacts:
+        ct = sm.contacts[el][0]
+        return "ground" in (ct.body, ct.line_body)
+    if el in sm.welds:
+        j = mech.joints[el]
+        return "ground" in (j.parent, j.child)
+    meas = None
+    if el in sm.stops:
+        meas = sm.stops[el][1]
+    elif el in sm.coord_locks:
+        meas = sm.coord_locks[el][1]
+    if meas is None:
+        return False
+    nb = ms.model.n_bodies
+    bodies = [getattr(meas, a) for a in ("b", "i", "j", "b1", "b2") if hasattr(meas, a)]
+    return any(b == nb for b in bodies)
+

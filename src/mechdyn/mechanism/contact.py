@@ -1,0 +1,128 @@
+"""Unilateral constraints: coordinate stops and point-on-line contacts.
+
+A unilateral constraint has a *gap* g(x) >= 0 and a force lambda >= 0 that
+pushes to open the gap; force and gap obey complementarity (lambda g = 0).
+Whether it is closed is part of the mode (``State.mode``), never a change of
+the mechanism: a closed stop on side ``lower`` appears as ``"name@lower"``,
+a closed contact as ``"name@contact"`` (with ``"name:stick"``, ``"name:slip+"`` or
+``"name:slip-"`` for its friction state when it has friction).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Stop", "Contact"]
+
+
+def _check_fraction(value, what):
+    v = float(value)
+    if not (0.0 <= v <= 1.0):
+        raise ValueError(f"{what}: restitution must be in [0, 1], got {value!r}")
+    return v
+
+
+@dataclass(frozen=True)
+class Stop:
+    """Limits on a measured quantity, e.g. the travel of a slider or a joint angle.
+
+    Parameters
+    ----------
+    name : str
+    variable : str
+        The limited quantity: a declared coordinate, ``"joint:NAME"`` (relative
+        angle or travel), ``"angle:BODY"`` or ``"body.point.x|y"``; see
+        :mod:`mechdyn.mechanism.switch`.
+    lower, upper : float or None
+        The limits, rad or m (None: no limit on that side).
+    restitution : float
+        Newton's coefficient of restitution e in [0, 1] (0: plastic, the stop
+        stays closed after the impact).
+    """
+
+    name: str
+    variable: str
+    lower: float | None = None
+    upper: float | None = None
+    restitution: float = 0.0
+    extra_kind = "stops"
+
+    def __post_init__(self):
+        object.__setattr__(self, "restitution",
+                           _check_fraction(self.restitution, f"stop {self.name!r}"))
+        for side in ("lower", "upper"):
+            v = getattr(self, side)
+            if v is not None:
+                object.__setattr__(self, side, float(v))
+        if self.lower is None and self.upper is None:
+            raise ValueError(f"stop {self.name!r}: give a lower or an upper limit (or both)")
+        if self.lower is not None and self.upper is not None and self.lower >= self.upper:
+            raise ValueError(f"stop {self.name!r}: lower limit {self.lower!r} must be below the "
+                             f"upper limit {self.upper!r}")
+
+    def sides(self) -> list[str]:
+        """The limited sides, ``"lower"`` and/or ``"upper"``."""
+        return [s for s in ("lower", "upper") if getattr(self, s) is not None]
+
+
+@dataclass(frozen=True)
+class Contact:
+    """A point of one body against a line of another (gap >= 0), optionally with friction.
+
+    The gap is ``n . (p - a)``: ``p`` the contact point, ``a`` the line point,
+    ``n`` the unit normal obtained by turning ``line_direction`` by +90 deg
+    (the free side is to the left of the direction).  The tangent is the line
+    direction; the slip velocity is the tangential velocity of ``p`` relative to
+    the line body.
+
+    Parameters
+    ----------
+    name : str
+    body : str
+        The body carrying the contact point.
+    point : str or (float, float)
+        The contact point, named or in the body frame (m).
+    line_body : str
+        The body carrying the line (``"ground"`` for the frame).
+    line_point : str or (float, float)
+        A point of the line in ``line_body``'s frame, m.
+    line_direction : (float, float)
+        Direction of the line in ``line_body``'s frame.
+    friction : float
+        Coulomb coefficient mu >= 0 (same for sticking and sliding).
+    restitution : float
+        Newton's coefficient e in [0, 1] for impacts on closing.
+    compliance : float
+        Contact compliance c >= 0, (m/s^2)/N: added to the diagonal of the
+        contact (Delassus) matrix, G + C, so that statically indeterminate
+        contact sets get unique forces (the cyclic-automata document's
+        influence-coefficient matrix C, taken diagonal).  Within a mode the
+        forces of redundant contacts are shared in inverse proportion to it.
+    """
+
+    name: str
+    body: str
+    point: object
+    line_body: str
+    line_point: object = (0.0, 0.0)
+    line_direction: tuple = (1.0, 0.0)
+    friction: float = 0.0
+    restitution: float = 0.0
+    compliance: float = 0.0
+    extra_kind = "contacts"
+
+    def __post_init__(self):
+        d = np.asarray(self.line_direction, dtype=float).reshape(-1)
+        if d.shape != (2,) or not np.all(np.isfinite(d)) or np.hypot(*d) == 0:
+            raise ValueError(f"contact {self.name!r}: line_direction must be a non-zero (x, y), "
+                             f"got {self.line_direction!r}")
+        object.__setattr__(self, "line_direction", tuple(d / np.hypot(*d)))
+        object.__setattr__(self, "restitution",
+                           _check_fraction(self.restitution, f"contact {self.name!r}"))
+        for fld in ("friction", "compliance"):
+            v = float(getattr(self, fld))
+            if not (np.isfinite(v) and v >= 0):
+                raise ValueError(f"contact {self.name!r}: {fld} must be >= 0, got {v!r}")
+            object.__setattr__(self, fld, v)

@@ -1,0 +1,863 @@
+"""The event loop of variable-structure mechanisms: locks, stops, contacts, switches.
+
+The motion is integrated piecewise, one *mode* (set of active switchable
+constraints, ``State.mode``) at a time:
+
+1. in a mode, the independent coordinates q_I (a subset of the declared
+   coordinates) are integrated with SciPy's DOP853 (rtol 1e-10 by default);
+   positions are re-solved from q_I at every evaluation, so every constraint
+   of the mode holds to round-off;
+2. after every accepted step the event functions are evaluated; a sign change
+   is located to machine precision by Brent's method on the step's dense
+   output.  Events: switch conditions (a variable crossing a value in a
+   direction, command times), gaps of open stops and contacts closing, forces
+   of closed ones falling to zero, sticking contacts reaching the friction
+   cone, slipping contacts coming to rest;
+3. at an event the switch is applied: releases (no jump), engagements and
+   closures (an impact: :func:`mechdyn.dynamics.impact.impact`, plastic or
+   with restitution), then :func:`mechdyn.dynamics.contact.resolve_mode`
+   decides by complementarity which touching constraints stay closed and
+   whether they stick or slip; the independent coordinates of the new mode
+   are chosen, and the integration restarts from the consistent state.
+
+All declared coordinates are recorded in every mode (dependent ones measured
+on the pose), so one :class:`~mechdyn.results.trajectory.Trajectory` covers
+the whole run; its ``events`` list holds a :class:`SwitchEvent` per switch.
+Per-sample mode, constraint forces and forces on the frame are in
+``trajectory.stats["variable_structure"]`` (see :func:`simulate_events`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.integrate import DOP853, RK45
+from scipy.optimize import brentq
+
+from .dynamics.contact import ContactError, resolve_mode, touching
+from .dynamics.impact import element_forces, frame_forces, impact
+from .dynamics.modes import (
+    ModeSystem,
+    SwitchedModel,
+    TimeMeasure,
+    mode_friction,
+    mode_locks,
+    mode_unilateral,
+)
+from .errors import (
+    AssemblyError,
+    LockupError,
+    MechdynError,
+    ModelError,
+    SingularPositionError,
+    did_you_mean,
+)
+from .kinematics.constraints import extend
+from .model import Model
+from .results.trajectory import Trajectory
+
+__all__ = ["simulate_events", "SwitchEvent", "format_events", "needs_event_loop"]
+
+
+@dataclass
+class SwitchEvent:
+    """One switching instant of a variable-structure run.
+
+    Attributes
+    ----------
+    t : float
+        Time, s (located to machine precision on the dense output).
+    kind : str
+        ``"engage"``, ``"release"`` (a switch acted on a lock), ``"impact"``
+        (a stop or contact closed with a velocity jump), ``"close"``,
+        ``"separate"`` (a closed stop or contact opened), ``"slip"``,
+        ``"stick"``, ``"ignored"`` (a switch whose guard failed or whose
+        action changed nothing).
+    element : str
+        The switch, lock, stop (``"name@side"``) or contact concerned.
+    mode_before, mode_after : frozenset of str
+    q_before, qdot_before, q_after, qdot_after : ndarray, shape (n_q,)
+        Declared coordinates and rates just before and just after.
+    energy_lost : float
+        Kinetic energy dissipated by the impact, J (0 without a jump).
+    impulses : dict
+        Impulse of every element: (Px, Py, L) on a joint's or lock's child
+        body (N s, N m s), normal impulse of stops and contacts (N s).
+    message : str
+    """
+
+    t: float
+    kind: str
+    element: str
+    mode_before: frozenset
+    mode_after: frozenset
+    q_before: np.ndarray
+    qdot_before: np.ndarray
+    q_after: np.ndarray
+    qdot_after: np.ndarray
+    energy_lost: float = 0.0
+    impulses: dict = field(default_factory=dict)
+    message: str = ""
+
+    @property
+    def name(self) -> str:
+        """``kind:element`` (for listings that expect an event name)."""
+        return f"{self.kind}:{self.element}"
+
+    @property
+    def q(self) -> np.ndarray:
+        return self.q_after
+
+    @property
+    def qdot(self) -> np.ndarray:
+        return self.qdot_after
+
+
+def needs_event_loop(model: Model) -> bool:
+    """True if the mechanism has switches, stops, contacts or coordinate locks."""
+    ex = model.mechanism.extras or {}
+    return any(ex.get(k) for k in ("switches", "stops", "contacts", "coordinate_locks"))
+
+
+def format_events(events, coordinate_names=None, *, limit: int | None = None) -> str:
+    """A text table of the switching events of a run (for ``mechdyn simulate``).
+
+    Parameters
+    ----------
+    events : list of SwitchEvent
+    coordinate_names : sequence of str, optional
+        Adds the coordinates after each event.
+    limit : int, optional
+        Show at most this many (the first ``limit - 1`` and the last).
+    """
+    evs = [e for e in events if isinstance(e, SwitchEvent)]
+    if not evs:
+        return "no switching events"
+    lines = [f"{len(evs)} switching event(s):",
+             f"{'t [s]':>14}  {'kind':<9} {'element':<18} {'lost [J]':>10}  mode after"]
+    shown = list(enumerate(evs))
+    if limit is not None and len(evs) > limit:
+        shown = shown[:max(limit - 1, 1)] + [(None, None)] + shown[-1:]
+    for k, e in shown:
+        if e is None:
+            lines.append(f"{'...':>14}  ({len(evs) - limit} more)")
+            continue
+        mode = ", ".join(sorted(e.mode_after)) or "-"
+        line = f"{e.t:14.9f}  {e.kind:<9} {e.element:<18} {e.energy_lost:10.4g}  {mode}"
+        if coordinate_names is not None:
+            line += "   " + ", ".join(f"{n}={v:.6g}" for n, v in
+                                      zip(coordinate_names, e.q_after, strict=False))
+        lines.append(line)
+        del k
+    return "\n".join(lines)
+
+
+# ============================================================================ helpers
+class _Stop(Exception):
+    def __init__(self, status, message):
+        self.status, self.message = status, message
+        super().__init__(message)
+
+
+@dataclass
+class _EventFn:
+    kind: str  # switch, gap, force, cone, slip, time
+    key: str  # element / token
+    fn: object  # (t, ev) -> float
+    hard: float  # fire at once below -hard
+    data: object = None
+    armed: bool = False
+    arm: float = 0.0  # after firing, re-arm only above this value
+    fresh: bool = False
+
+
+def _initial(model: Model, q0, qdot0):
+    ex = model.mechanism.extras or {}
+    init = ex.get("initial", {}) if isinstance(ex, Mapping) else {}
+    x0 = getattr(model, "x0", model.x_sketch)
+    from .kinematics.constraints import coordinates
+
+    q = np.array(coordinates(model, x0), float)
+    qd = np.zeros(model.n_q)
+    for given, out, what in ((init.get("q"), q, "initial q"), (init.get("qdot"), qd,
+                                                                 "initial qdot"),
+                             (q0, q, "q0"), (qdot0, qd, "qdot0")):
+        if given is None:
+            continue
+        if isinstance(given, Mapping):
+            for n, v in given.items():
+                if n not in model.coordinate_names:
+                    raise ModelError(f"{what}: " + did_you_mean(n, model.coordinate_names,
+                                                                "coordinate"))
+                out[model.coordinate_index(n)] = float(v)
+        else:
+            arr = np.asarray(given, float).reshape(-1)
+            if arr.shape != (model.n_q,):
+                raise ModelError(f"{what} must have {model.n_q} values "
+                                 f"({', '.join(model.coordinate_names)}), got {arr.size}")
+            out[:] = arr
+    return q, qd, np.array(x0, float)
+
+
+# ============================================================================ main
+def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: float = 0.0,
+                    mode=None, rtol: float = 1e-10, atol: float | None = None,
+                    max_step: float | None = None, dt_out: float | None = None,
+                    t_eval=None, method: str = "DOP853", max_events: int = 100000,
+                    small_velocity: float | None = None, gap_tol: float | None = None,
+                    zeno_time: float | None = None,
+                    max_wall_time: float | None = None) -> Trajectory:
+    """Simulate a variable-structure mechanism through all its switches.
+
+    Parameters
+    ----------
+    mech_or_model : Mechanism or Model
+        With ``extras`` ``switches``, ``stops``, ``contacts``, ``coordinate_locks``
+        (and/or weld :class:`~mechdyn.mechanism.joint.Lock` joints).
+    t_end : float
+        End time, s.
+    q0, qdot0 : array_like (n_q,) or mapping {name: value}, optional
+        Initial declared coordinates and rates (default: the model file's
+        ``initial`` table, then the sketch at rest).  Coordinates that are
+        dependent in the initial mode are re-measured.
+    t0 : float
+        Start time, s.
+    mode : iterable of str, optional
+        Engaged locks at the start (default: as declared by the elements).
+        Stops and contacts found touching are closed automatically.
+    rtol, atol : float
+        Integrator tolerances (atol default rtol x 1e-2 in SI units).
+    max_step : float, optional
+        Largest step, s.
+    dt_out : float, optional
+        Output sampling interval, s (default (t_end - t0) / 500).  Samples are
+        also stored just before and just after every event.
+    t_eval : array_like, optional
+        Explicit output times (instead of ``dt_out``).
+    method : {"DOP853", "RK45"}
+        SciPy integrator used within a mode.
+    max_events : int
+        Stop (status ``"too-many-events"``) after this many switching instants.
+    small_velocity : float, optional
+        Approach speeds below this are absorbed plastically (m/s; default
+        1e-6 x length scale / s), which ends bouncing in finite time.
+    gap_tol : float, optional
+        Distance (m) at which a stop or contact counts as touching (default
+        1e-9 x length scale); it is also the penetration tolerance.
+    zeno_time : float, optional
+        A stop or contact that impacts again within this time (s; default
+        1e-4 x (t_end - t0)) is absorbed plastically: a bouncing sequence with
+        e < 1 has infinitely many impacts in finite time, and this ends it
+        where the bounces become shorter than ``zeno_time``.
+    max_wall_time : float, optional
+        Stop (status ``"timeout"``) after this many seconds of computing.
+
+    Returns
+    -------
+    Trajectory
+        ``t``, ``q``, ``qdot``, ``qddot`` (all declared coordinates), ``x``,
+        ``xdot``; ``events`` (list of :class:`SwitchEvent`); ``status``
+        (``"success"``, ``"assembly-failed"``, ``"singular-position"``,
+        ``"no-contact-solution"``, ``"lockup"``, ``"too-many-events"``,
+        ``"failed"``) and ``message``; ``energy`` (kinetic, potential,
+        work_nc, balance = T + U - W_nc + impact losses, residual); and
+        ``stats["variable_structure"]``: ``mode`` (list of frozensets per
+        sample), ``frame_force`` (n, 2) N, ``forces`` {element: (n,) or (n, 3)},
+        ``modes`` (distinct modes in order), ``penetration`` (largest, m).
+    """
+    wall0 = time.perf_counter()
+    model = mech_or_model if isinstance(mech_or_model, Model) else mech_or_model.compile()
+    sm = SwitchedModel(model)
+    L = model.length_scale
+    t_end = float(t_end)
+    t0 = float(t0)
+    if not t_end > t0:
+        raise ModelError(f"t_end must be after t0 = {t0} s, got {t_end}")
+    if atol is None:
+        atol = rtol * 1e-2
+    if small_velocity is None:
+        small_velocity = 1e-6 * L
+    if gap_tol is None:
+        gap_tol = 1e-9 * L
+    if zeno_time is None:
+        zeno_time = 1e-4 * (t_end - t0)
+    last_impact: dict = {}
+    if t_eval is None:
+        dt = dt_out if dt_out is not None else (t_end - t0) / 500.0
+        n = int(math.floor((t_end - t0) / dt + 1e-9))
+        t_eval = t0 + dt * np.arange(n + 1)
+        if t_eval[-1] < t_end - 1e-12 * max(1.0, abs(t_end)):
+            t_eval = np.append(t_eval, t_end)
+    t_eval = np.asarray(t_eval, float)
+    weight = float(np.sum(model.mass) * max(np.hypot(*model.gravity), 1.0))
+    force_scale = max(weight, 1.0)
+    solver_cls = {"DOP853": DOP853, "RK45": RK45}.get(method.upper())
+    if solver_cls is None:
+        raise ModelError(f"method must be 'DOP853' or 'RK45', got {method!r}")
+
+    # ---------------------------------------------------------------- records
+    rec = dict(t=[], q=[], qd=[], qdd=[], x=[], xd=[], mode=[], frame=[], forces=[], T=[],
+               U=[], W=[], res=[], lost=[])
+    events: list[SwitchEvent] = []
+    stats = dict(steps=0, rejected=0, evaluations=0, integrator=f"scipy-{method.upper()}",
+                 formulation="variable-structure (reduced, exact constraints)", backend="numpy",
+                 rtol=rtol, atol=atol, segments=0)
+    lost_total = 0.0
+    penetration = 0.0
+
+    def store(t, ms, ev, w):
+        fr = frame_forces(ms, ev.x, ev.lam)
+        rec["t"].append(t)
+        rec["q"].append(ev.q)
+        rec["qd"].append(ev.qdot)
+        rec["qdd"].append(ev.qddot)
+        rec["x"].append(ev.x)
+        rec["xd"].append(ev.xdot)
+        rec["mode"].append(ms.mode)
+        rec["frame"].append(fr["total"])
+        rec["forces"].append(element_forces(ms, ev.x, ev.lam))
+        rec["T"].append(ms.kinetic_energy(ev.x, ev.xdot))
+        rec["U"].append(sm.fm.potential_energy(ev.x))
+        rec["W"].append(w)
+        rec["res"].append(ms.residual_norm(ev.x))
+        rec["lost"].append(lost_total)
+
+    # ---------------------------------------------------------------- initial state
+    status, message = "success", ""
+    q_init, qd_init, x_guess = _initial(model, q0, qdot0)
+    targets: dict = {}
+    locks = sm.initial_locks() if mode is None else frozenset(mode)
+    unknown = [n for n in locks if n not in sm.lock_names]
+    if unknown:
+        raise ModelError("mode: " + did_you_mean(unknown[0], sm.lock_names, "lock"))
+    t = t0
+    w_nc = 0.0
+    try:
+        free = ModeSystem(sm, frozenset(), targets, x_guess)
+        x = free.solve_position(q_init[free.coords], x_guess, t=t)
+        for n in locks:
+            sm.capture_target(n, x, targets)
+        ms = ModeSystem(sm, locks, targets, x)
+        x = ms.solve_position(q_init[ms.coords], x, t=t)
+        # rates: given for the independent coordinates of the mode with every
+        # touching stop and contact closed (the rest are dependent there)
+        touch0 = touching(sm, ms, x, gap_tol=gap_tol)
+        ms_t = ModeSystem(sm, locks | frozenset(touch0), targets, x) if touch0 else ms
+        B, _ = ms_t.velocity_analogs(x)
+        xd = B @ qd_init[ms_t.coords]
+        X = extend(model, x)
+        for n, (st, meas) in sm.stops.items():
+            v = meas.value(X)
+            tol = gap_tol if not meas.is_angle else gap_tol / L
+            if (st.lower is not None and v < st.lower - tol) or (
+                    st.upper is not None and v > st.upper + tol):
+                raise ModelError(f"stop {n!r}: the initial state violates its limits "
+                                 f"({meas.label} = {v:.9g}, lower {st.lower}, upper {st.upper})")
+        for n, (_ct, gap, _) in sm.contacts.items():
+            if gap.value(X) < -gap_tol:
+                raise ModelError(f"contact {n!r}: the initial state penetrates by "
+                                 f"{-gap.value(X):.3g} m")
+        ms, x, xd, _ = _switch(sm, t, ms, x, xd, targets, events, fired=[],
+                               small_velocity=small_velocity, gap_tol=gap_tol,
+                               force_scale=force_scale, initial=True)
+    except (MechdynError, np.linalg.LinAlgError) as exc:
+        if isinstance(exc, ModelError):
+            raise
+        return _finish(model, rec, events, stats, wall0, *_status_of(exc), sm)
+
+    qi, qdi = ms.independent(x, xd)
+    just_fired: set = set()
+    next_out = 0
+    fired_once: set = set()
+    n_events = 0
+    last_event_t, repeat = None, 0
+    while t < t_end:
+        stats["segments"] += 1
+        state_cache = {}
+
+        def evaluate(tt, y, ms=ms, cache=state_cache):
+            n_i = ms.n_i
+            qi_, qdi_ = y[:n_i], y[n_i:2 * n_i]
+            key = (tt, y.tobytes())
+            if key in cache:
+                return cache[key]
+            ev = ms.evaluate(tt, qi_, qdi_)
+            cache.clear()
+            cache[key] = ev
+            return ev
+
+        def rhs(tt, y, ms=ms):
+            stats["evaluations"] += 1
+            ev = evaluate(tt, y)
+            n_i = ms.n_i
+            p = float((ev.F - sm.fm.conservative(ev.x)) @ ev.xdot)
+            p += _friction_power(ms, ev)
+            return np.concatenate([y[n_i:2 * n_i], ev.qddot[ms.coords], [p]])
+
+        y0 = np.concatenate([qi, qdi, [w_nc]])
+        efns = _event_functions(sm, ms, t, fired_once, force_scale, gap_tol, L)
+        for e in efns:
+            e.fresh = (e.kind, e.key) in just_fired
+        try:
+            ev0 = evaluate(t, y0)
+            if not rec["t"] or rec["t"][-1] != t or rec["mode"][-1] != ms.mode:
+                store(t, ms, ev0, w_nc)
+            for e in efns:
+                g0 = e.fn(t, ev0)
+                e.armed = g0 > 0 and not e.fresh
+            first = None if not just_fired else 1e-7 * (t_end - t0)
+            solver = solver_cls(rhs, t, y0, t_end, rtol=rtol, first_step=first,
+                                atol=_atol(ms, atol, L), max_step=max_step or np.inf)
+            hit = None
+            while solver.status == "running":
+                msg = solver.step()
+                if solver.status == "failed":
+                    raise _Stop("failed", f"the integrator failed at t = {solver.t:.9g} s: "
+                                f"{msg}")
+                stats["steps"] += 1
+                t_old, t_new = solver.t_old, solver.t
+                dense = solver.dense_output()
+                ev_new = evaluate(t_new, solver.y)
+                gs = [e.fn(t_new, ev_new) for e in efns]
+                cands = []
+                for e, g in zip(efns, gs, strict=True):
+                    if (e.armed and g <= 0) or g < -e.hard:
+                        cands.append(e)
+                if cands:
+                    def gfun(s, e, dense=dense):
+                        return e.fn(s, evaluate(s, dense(s)))
+
+                    roots = []
+                    for e in cands:
+                        a_val = gfun(t_old, e)
+                        t_a = t_old
+                        if a_val <= 0:
+                            # started at (or just below) zero: look for the positive
+                            # excursion inside the step before the crossing
+                            h_ = t_new - t_old
+                            probes = np.concatenate([t_old + h_ * 2.0 ** -np.arange(30, 0, -1),
+                                                     np.linspace(t_old, t_new, 33)[1:-1]])
+                            for s_ in np.unique(probes):
+                                if gfun(s_, e) > 0:
+                                    t_a, a_val = s_, 1.0
+                                    break
+                        if a_val > 0:
+                            ts = brentq(gfun, t_a, t_new, args=(e,), xtol=1e-15,
+                                        rtol=4 * np.finfo(float).eps, maxiter=200)
+                            # take the side where the event has happened
+                            if gfun(ts, e) > 0:
+                                ts = min(np.nextafter(ts, np.inf), t_new)
+                        else:
+                            ts = t_old
+                        roots.append((ts, e))
+                    roots.sort(key=lambda r: r[0])
+                    t_hit = roots[0][0]
+                    tol_sim = 1e-12 * max(1.0, abs(t_hit))
+                    hit = (t_hit, [e for ts, e in roots if ts <= t_hit + tol_sim], dense)
+                    t_new = t_hit
+                # output samples
+                while next_out < t_eval.size and t_eval[next_out] <= t_new:
+                    to = t_eval[next_out]
+                    if to > t_old or (to == t_old and (not rec["t"] or rec["t"][-1] < to)):
+                        yo = dense(to) if to < solver.t else solver.y
+                        evo = evaluate(to, yo)
+                        store(to, ms, evo, float(yo[-1]))
+                        penetration = max(penetration, _penetration(sm, evo.x, ms))
+                    next_out += 1
+                if hit is not None:
+                    break
+                for e, g in zip(efns, gs, strict=True):
+                    if g > 0 and (not e.fresh or g > e.arm):
+                        e.armed = True
+                if max_wall_time is not None and time.perf_counter() - wall0 > max_wall_time:
+                    raise _Stop("timeout", f"stopped after {max_wall_time} s of computing at "
+                                f"t = {t_new:.9g} s")
+            if hit is None:
+                t = t_end
+                break
+            # ------------------------------------------------------------ switch
+            t_hit, fired, dense = hit
+            y_hit = dense(t_hit)
+            ev_hit = evaluate(t_hit, y_hit)
+            w_nc = float(y_hit[-1])
+            if not rec["t"] or rec["t"][-1] != t_hit:
+                store(t_hit, ms, ev_hit, w_nc)
+            penetration = max(penetration, _penetration(sm, ev_hit.x, ms))
+            n_before = len(events)
+            plastic = {k for k, tl in last_impact.items() if t_hit - tl <= zeno_time}
+            ms_new, x, xd, lost = _switch(sm, t_hit, ms, ev_hit.x, ev_hit.xdot, targets, events,
+                                          fired=fired, small_velocity=small_velocity,
+                                          gap_tol=gap_tol, force_scale=force_scale,
+                                          plastic=plastic)
+            for ev_ in events[n_before:]:
+                if ev_.kind == "impact":
+                    last_impact[ev_.element] = t_hit
+            for e in fired:
+                if e.kind == "switch" and e.data[0].once and len(events) > n_before \
+                        and any(ev.kind in ("engage", "release") and ev.element == e.key
+                                for ev in events[n_before:]):
+                    fired_once.add(e.key)
+                if e.kind == "time":
+                    fired_once.add((e.key, e.data[1]))
+            lost_total += lost
+            n_events += 1
+            if last_event_t is not None and t_hit - last_event_t <= 1e-12 * max(1, abs(t_hit)):
+                repeat += 1
+                if repeat > 50:
+                    raise _Stop("too-many-events", f"switching does not settle at t = "
+                                f"{t_hit:.9g} s (more than 50 events at the same instant)")
+            else:
+                repeat = 0
+            last_event_t = t_hit
+            if n_events >= max_events:
+                raise _Stop("too-many-events", f"stopped after {max_events} switching events "
+                            f"at t = {t_hit:.9g} s")
+            just_fired = {(e.kind, e.key) for e in fired}
+            ms = ms_new
+            t = t_hit
+            qi, qdi = ms.independent(x, xd)
+            ev_after = ms.evaluate_x(t, x, xd)
+            store(t, ms, ev_after, w_nc)
+        except _Stop as exc:
+            status, message = exc.status, exc.message
+            break
+        except (MechdynError, np.linalg.LinAlgError, ValueError) as exc:
+            status, message = _status_of(exc)
+            break
+    stats["penetration"] = penetration
+    return _finish(model, rec, events, stats, wall0, status, message, sm)
+
+
+def _friction_power(ms: ModeSystem, ev) -> float:
+    p = 0.0
+    if not any(r.slip for r in ms.rows):
+        return 0.0
+    X, V = extend(ms.model, ev.x), extend(ms.model, ev.xdot)
+    for k, r in enumerate(ms.rows):
+        if r.slip:
+            vt = r.tangent.rate(X, V, ms.sm.nb)
+            p += -r.mu * r.slip * ev.lam[ms.n_base + k] * vt
+    return p
+
+
+def _atol(ms, atol, L):
+    n = ms.n_i
+    names = ms.coord_names
+    model = ms.model
+    sc = np.array([1.0 if model.coord_is_angle[model.coordinate_index(c)] else L for c in names])
+    return np.concatenate([atol * sc, atol * sc * 10, [atol * 1e3]]) if n else \
+        np.array([atol * 1e3])
+
+
+def _penetration(sm: SwitchedModel, x, ms) -> float:
+    X = extend(sm.model, x)
+    worst = 0.0
+    for _n, (st, meas) in sm.stops.items():
+        if meas.is_angle:
+            continue
+        v = meas.value(X)
+        if st.lower is not None:
+            worst = max(worst, st.lower - v)
+        if st.upper is not None:
+            worst = max(worst, v - st.upper)
+    for _n, (_ct, gap, _) in sm.contacts.items():
+        worst = max(worst, -gap.value(X))
+    return worst
+
+
+def _status_of(exc):
+    if isinstance(exc, SingularPositionError):
+        return "singular-position", str(exc)
+    if isinstance(exc, AssemblyError):
+        return "assembly-failed", str(exc)
+    if isinstance(exc, ContactError):
+        return "no-contact-solution", str(exc)
+    if isinstance(exc, LockupError):
+        return "lockup", str(exc)
+    if isinstance(exc, np.linalg.LinAlgError):
+        return "failed", f"singular system: {exc}"
+    return "failed", str(exc)
+
+
+# ============================================================================ events
+def _event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_scale, gap_tol,
+                     L) -> list[_EventFn]:
+    out: list[_EventFn] = []
+    nb = sm.nb
+    model = sm.model
+    locks = mode_locks(ms.mode)
+
+    def value_of(meas, tt, ev):
+        if isinstance(meas, TimeMeasure):
+            return tt
+        X = extend(model, ev.x)
+        if meas.needs_velocity:
+            return meas.value(X, extend(model, ev.xdot))
+        return meas.value(X)
+
+    for sw, meas, _guards in sm.switches:
+        if sw.name in fired_once:
+            continue
+        if sw.action == "engage" and sw.target in locks:
+            continue
+        if sw.action == "release" and sw.target not in locks:
+            continue
+        if sw.is_scheduled:
+            nxt = [tc for tc in sw.times if tc > t or (tc == t and (sw.name, tc) not in
+                                                       fired_once)]
+            nxt = [tc for tc in nxt if (sw.name, tc) not in fired_once]
+            if nxt:
+                tc = nxt[0]
+                out.append(_EventFn("time", sw.name, lambda tt, ev, tc=tc: tc - tt, 0.0,
+                                    (sw, tc)))
+            continue
+        hard = np.inf
+        for d in ((1, -1) if sw.direction == 0 else (sw.direction,)):
+            if d > 0:
+                def fn(tt, ev, m=meas, v=sw.value):
+                    return (v - value_of(m, tt, ev))
+            else:
+                def fn(tt, ev, m=meas, v=sw.value):
+                    return (value_of(m, tt, ev) - v)
+            scale = 1.0 if isinstance(meas, TimeMeasure) or meas.is_angle else L
+            out.append(_EventFn("switch", sw.name, fn, hard, (sw, d),
+                                arm=1e-11 * (abs(sw.value) + scale)))
+    closed = set(mode_unilateral(ms.mode))
+    # open stops and contacts: gaps
+    for n, (st, meas) in sm.stops.items():
+        for side in st.sides():
+            tok = f"{n}@{side}"
+            if tok in closed:
+                continue
+            lim = getattr(st, side)
+            sgn = 1.0 if side == "lower" else -1.0
+            tol = gap_tol / L if meas.is_angle else gap_tol
+            out.append(_EventFn("gap", tok,
+                                lambda tt, ev, m=meas, lim=lim, s=sgn:
+                                s * (m.value(extend(model, ev.x)) - lim), tol, arm=1e-3 * tol))
+    for n, (_ct, gap, _) in sm.contacts.items():
+        if f"{n}@contact" in closed:
+            continue
+        out.append(_EventFn("gap", f"{n}@contact",
+                            lambda tt, ev, m=gap: m.value(extend(model, ev.x)),
+                            gap_tol, arm=1e-3 * gap_tol))
+    # closed ones: forces
+    fr = mode_friction(ms.mode)
+    for k, r in enumerate(ms.rows):
+        idx = ms.n_base + k
+        if r.unilateral:
+            tok = r.label
+            out.append(_EventFn("force", tok, lambda tt, ev, i=idx: ev.lam[i],
+                                1e-7 * force_scale, arm=1e-10 * force_scale))
+    for c, s in fr.items():
+        ct = sm.contacts[c][0]
+        kn = [ms.n_base + k for k, r in enumerate(ms.rows) if r.element == c
+              and r.kind == "contact"][0]
+        if s == "stick":
+            kt = [ms.n_base + k for k, r in enumerate(ms.rows) if r.element == c
+                  and r.kind == "stick"][0]
+            out.append(_EventFn("cone", c, lambda tt, ev, kn=kn, kt=kt, mu=ct.friction:
+                                mu * ev.lam[kn] - abs(ev.lam[kt]), 1e-7 * force_scale,
+                                arm=1e-10 * force_scale))
+        else:
+            sg = 1.0 if s == "slip+" else -1.0
+            slip = sm.contacts[c][2]
+            out.append(_EventFn("slip", c, lambda tt, ev, m=slip, sg=sg:
+                                sg * m.rate(extend(model, ev.x), extend(model, ev.xdot), nb),
+                                np.inf, arm=1e-12 * L))
+    return out
+
+
+def _guard_ok(sm, guards, t, x, xd) -> bool:
+    model = sm.model
+    X, V = extend(model, x), extend(model, xd)
+    for meas, op, val in guards:
+        if isinstance(meas, TimeMeasure):
+            v = t
+        elif meas.needs_velocity:
+            v = meas.value(X, V)
+        else:
+            v = meas.value(X)
+        ok = {"<": v < val, "<=": v <= val, ">": v > val, ">=": v >= val}[op]
+        if not ok:
+            return False
+    return True
+
+
+def _switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *, fired,
+            small_velocity, gap_tol, force_scale, initial=False, plastic=()):
+    """Apply the fired events at (t, x, xd); returns (new ModeSystem, x, xdot, energy lost)."""
+    mode_before = ms.mode
+    q_b = ms.coordinates(x)
+    qd_b = ms._coord_jac(x) @ xd
+    locks = set(mode_locks(mode_before))
+    engage, release = [], []
+    forced_open, forced_slip, forced_stick = set(), {}, set()
+    notes = []
+    for e in fired:
+        if e.kind in ("switch", "time"):
+            sw = e.data[0]
+            guards = [g for s_, _m, g in sm.switches if s_ is sw][0]
+            if not _guard_ok(sm, guards, t, x, xd):
+                notes.append(("ignored", sw.name, "guard not met"))
+                continue
+            act = sw.action
+            if act == "toggle":
+                act = "release" if sw.target in locks else "engage"
+            if act == "engage" and sw.target not in locks:
+                engage.append((sw.target, sw.name))
+            elif act == "release" and sw.target in locks:
+                release.append((sw.target, sw.name))
+            else:
+                notes.append(("ignored", sw.name, f"{sw.target} already {act}d"))
+        elif e.kind == "force":
+            forced_open.add(e.key)
+        elif e.kind == "cone":
+            kt = [ms.n_base + k for k, r in enumerate(ms.rows) if r.element == e.key
+                  and r.kind == "stick"][0]
+            ev = ms.evaluate_x(t, x, xd)
+            forced_slip[e.key] = -1 if ev.lam[kt] > 0 else 1
+        elif e.kind == "slip":
+            forced_stick.add(e.key)
+    for n, _ in release:
+        locks.discard(n)
+        targets.pop(n, None)
+    locks_before = frozenset(locks)
+    for n, _ in engage:
+        sm.capture_target(n, x, targets)
+        locks.add(n)
+    frees = [f for n, _ in engage for f in sm.lock_frees(n)]
+    locks = frozenset(locks)
+    # touching unilateral constraints (closed ones have zero gap by construction)
+    touch = set(touching(sm, ms, x, gap_tol=gap_tol)) | set(mode_unilateral(mode_before))
+    lost = 0.0
+    imp = None
+    xd_plus = xd
+    need_impact = bool(set(locks) - set(locks_before))
+    if not need_impact and touch:
+        # any touching constraint approaching?
+        free = ModeSystem(sm, locks, targets, x)
+        for r in [r for r in sm.rows(frozenset(touch), targets) if r.unilateral]:
+            X, V = extend(sm.model, x), extend(sm.model, xd)
+            v = r.sign * r.measure.rate(X, V, sm.nb)
+            if v < 0.0:
+                need_impact = True
+                break
+        del free
+    if need_impact:
+        imp = impact(sm, x, xd, locks_before, locks, targets, touch,
+                     restitution={k: 0.0 for k in plastic},
+                     small_velocity=small_velocity, t=t)
+        xd_plus = imp.xdot_plus
+        lost = imp.energy_lost
+    # candidates: touching and not separating
+    X, V = extend(sm.model, x), extend(sm.model, xd_plus)
+    cand = []
+    vtol = max(small_velocity * 1e-3, 1e-9 * float(np.max(np.abs(xd_plus), initial=0.0)))
+    for r in [r for r in sm.rows(frozenset(touch), targets) if r.unilateral]:
+        tok = r.label
+        v = r.sign * r.measure.rate(X, V, sm.nb)
+        if v <= vtol:
+            cand.append(tok)
+    vscale = max(float(np.max(np.abs(xd_plus), initial=0.0)), small_velocity)
+    mode_after, forces = resolve_mode(
+        sm, t, x, xd_plus, locks, targets, cand, slip_velocity_tol=1e-9 * vscale + 1e-12,
+        force_tol=1e-10 * force_scale, forced_open=forced_open, forced_slip=forced_slip,
+        forced_stick=forced_stick)
+    prefer = ms.coord_names
+    ms_new = ModeSystem(sm, mode_after, targets, x, prefer=prefer, avoid=frees)
+    # an engaging lock must hold the pose it engages at (no position jump)
+    tol_pos = 1e-8 * sm.model.length_scale
+    bad = {lab: float(v) for lab, v, el in zip(ms_new.row_labels(), ms_new.row_values(x),
+                                               ms_new.row_elements(), strict=True)
+           if el in dict(engage) and abs(v) > tol_pos}
+    if bad:
+        raise AssemblyError(
+            "engaging " + ", ".join(repr(n) for n, _ in engage) + " would need a position "
+            "jump: the held value differs from the pose at the switch ("
+            + ", ".join(f"{k} off by {v:.3g}" for k, v in bad.items()) + ")",
+            t=t, q=q_b, residuals=bad)
+    # project onto the new mode's constraints (removes round-off of the located crossing)
+    qi = ms_new.coordinates(x)[ms_new.coords]
+    x_new = ms_new.solve_position(qi, x, t=t)
+    B, _ = ms_new.velocity_analogs(x_new)
+    G = ms_new._coord_jac(x_new)[ms_new.coords]
+    xd_new = B @ (G @ xd_plus)
+    q_a = ms_new.coordinates(x_new)
+    qd_a = ms_new._coord_jac(x_new) @ xd_new
+    if initial and mode_after == mode_before and not engage:
+        return ms_new, x_new, xd_new, lost
+
+    def add(kind, element, msg="", lost_=0.0, impulses=None):
+        events.append(SwitchEvent(t, kind, element, mode_before, frozenset(mode_after),
+                                  q_b, qd_b, q_a, qd_a, lost_, dict(impulses or {}), msg))
+
+    impulses = imp.element_impulses if imp is not None else {}
+    for n, swn in release:
+        add("release", n, f"switch {swn!r} released lock {n!r}")
+    for n, swn in engage:
+        add("engage", n, f"switch {swn!r} engaged lock {n!r}", lost, impulses)
+    closed_before = set(mode_unilateral(mode_before))
+    closed_after = set(mode_unilateral(mode_after))
+    for tok in sorted(closed_after - closed_before):
+        kind = "impact" if imp is not None and not engage else "close"
+        add(kind, tok, "", lost if not engage else 0.0, impulses)
+    for tok in sorted(closed_before - closed_after):
+        bounced = imp is not None and tok in touch
+        add("impact" if bounced and tok not in closed_after else "separate", tok,
+            "rebound" if bounced else "force fell to zero", lost if bounced and not engage
+            else 0.0, impulses if bounced else None)
+    for tok in sorted(touch - closed_before - closed_after):
+        if imp is not None and not engage and tok not in forced_open:
+            add("impact", tok, "rebound", lost, impulses)
+    fb, fa = mode_friction(mode_before), mode_friction(mode_after)
+    for c in sorted(set(fb) | set(fa)):
+        if fb.get(c) != fa.get(c) and c in fa and f"{c}@contact" in closed_before:
+            add("stick" if fa[c] == "stick" else "slip", c, fa[c])
+    for kind, name, msg in notes:
+        add(kind, name, msg)
+    if len(events) == 0 or events[-1].t != t:
+        if mode_after != mode_before:
+            add("switch", ",".join(sorted(set(mode_after) ^ set(mode_before))))
+    return ms_new, x_new, xd_new, lost
+
+
+# ============================================================================ output
+def _finish(model, rec, events, stats, wall0, status, message, sm) -> Trajectory:
+    n_q, n_x = model.n_q, model.n_x
+    arr = (lambda k, w: np.array(rec[k], float).reshape(-1, w))  # noqa: E731
+    t = np.array(rec["t"], float)
+    modes = []
+    for m in rec["mode"]:
+        if m not in modes:
+            modes.append(m)
+    forces: dict = {}
+    for k, fd in enumerate(rec["forces"]):
+        for el, v in fd.items():
+            forces.setdefault(el, [None] * len(rec["forces"]))[k] = v
+    forces_arr = {}
+    for el, lst in forces.items():
+        shape = next(np.shape(v) for v in lst if v is not None)
+        forces_arr[el] = np.array([np.full(shape, 0.0) if v is None else v for v in lst],
+                                  float)
+    T, U, W = (np.array(rec[k], float) for k in ("T", "U", "W"))
+    lostc = np.array(rec["lost"], float)
+    stats = dict(stats)
+    stats["wall_time_s"] = time.perf_counter() - wall0
+    stats["variable_structure"] = dict(
+        mode=list(rec["mode"]), modes=modes,
+        mode_index=np.array([modes.index(m) for m in rec["mode"]], int),
+        frame_force=arr("frame", 2), forces=forces_arr, impact_losses=lostc,
+        penetration=stats.get("penetration", 0.0))
+    energy = dict(kinetic=T, potential=U, work_nc=W, balance=T + U - W + lostc,
+                  residual=np.array(rec["res"], float))
+    return Trajectory(t, arr("q", n_q), arr("qd", n_q), arr("qdd", n_q), arr("x", n_x),
+                      arr("xd", n_x), status=status, message=message, events=list(events),
+                      stats=stats, energy=energy, coordinate_names=model.coordinate_names,
+                      body_names=model.body_names,
+                      coordinate_is_angle=tuple(bool(v) for v in model.coord_is_angle),
+                      model=model)
