@@ -1,0 +1,244 @@
+"""The integrator contract: advance q'' = f(t, q, q') and report each step.
+
+An integrator holds *settings only*.  :meth:`Integrator.integrate` is a
+generator: it yields one :class:`Step` per accepted step, each carrying the new
+state, the acceleration there and a dense interpolant over the step, and keeps
+counters in :attr:`Integrator.stats`.  It knows nothing of bodies; the caller
+(``mechdyn.simulate``) re-solves positions, stores samples and stops when it
+wants to.
+
+The right-hand side ``f(t, q, qdot)`` returns ``qddot`` (shape (n,)), or, when
+the integration carries ``n_w`` extra *quadrature* states ``w`` with
+``w' = p(t, q, qdot)`` (e.g. the work of non-conservative forces), the pair
+``(qddot, p)``.
+
+How to write a new integrator:
+
+1. subclass :class:`Integrator`, set ``name``, ``order`` and ``adaptive``;
+2. validate every setting in ``__init__`` and raise ``ValueError`` naming it;
+3. implement ``_steps(rhs, t0, q0, qdot0, w0, t_end)`` yielding :class:`Step`,
+   calling ``rhs`` (which counts evaluations) and incrementing
+   ``self.stats.steps`` / ``self.stats.rejected``.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import MechdynError
+
+__all__ = ["Integrator", "IntegratorStats", "Step", "hermite_dense", "check_positive",
+           "IntegratorOptionError", "fixed_grid"]
+
+
+class IntegratorOptionError(MechdynError, ValueError):
+    """A bad integrator option (the message names the option and the value)."""
+
+
+def check_positive(name: str, value, *, integer: bool = False, allow_none: bool = False):
+    """Validate a positive (integer) option; raise :class:`IntegratorOptionError` naming it."""
+    if value is None and allow_none:
+        return None
+    kind = "a positive integer" if integer else "a positive number"
+    try:
+        v = int(value) if integer else float(value)
+    except (TypeError, ValueError):
+        raise IntegratorOptionError(f"`{name}` must be {kind}, got {value!r}") from None
+    if integer and (isinstance(value, bool) or v != value):
+        raise IntegratorOptionError(f"`{name}` must be {kind}, got {value!r}")
+    if not (math.isfinite(v) and v > 0):
+        raise IntegratorOptionError(f"`{name}` must be {kind}, got {value!r}")
+    return v
+
+
+@dataclass
+class IntegratorStats:
+    """Counters of one integration.
+
+    Attributes
+    ----------
+    steps : int
+        Accepted steps.
+    rejected : int
+        Rejected steps (adaptive integrators).
+    evaluations : int
+        Right-hand-side evaluations f(t, q, qdot).
+    """
+
+    steps: int = 0
+    rejected: int = 0
+    evaluations: int = 0
+
+    def as_dict(self) -> dict:
+        return {"steps": self.steps, "rejected": self.rejected,
+                "evaluations": self.evaluations}
+
+
+@dataclass
+class Step:
+    """One accepted step from ``t_old`` to ``t``.
+
+    Attributes
+    ----------
+    t_old, t : float
+        Start and end of the step, s.
+    q, qdot, qddot : ndarray, shape (n,)
+        State and acceleration at ``t``.
+    w : ndarray, shape (n_w,)
+        Quadrature states at ``t``.
+    dense : callable
+        ``dense(s)`` for ``t_old <= s <= t`` returns ``(q, qdot, w)`` at ``s``.
+    """
+
+    t_old: float
+    t: float
+    q: np.ndarray
+    qdot: np.ndarray
+    qddot: np.ndarray
+    w: np.ndarray
+    dense: Callable = field(repr=False)
+
+
+def hermite_dense(t0, q0, v0, a0, w0, p0, t1, q1, v1, a1, w1, p1):
+    """Quintic Hermite interpolant of q (from q, q', q'' at both ends) and cubic of w.
+
+    Returns a callable ``dense(s) -> (q, qdot, w)`` valid on [t0, t1]; local
+    error O(h^6) in q, O(h^5) in qdot.
+    """
+    h = t1 - t0
+    q0, v0, a0, q1, v1, a1 = (np.asarray(v, float) for v in (q0, v0, a0, q1, v1, a1))
+    w0, p0, w1, p1 = (np.asarray(v, float) for v in (w0, p0, w1, p1))
+
+    def dense(s):
+        if h == 0:
+            return q1.copy(), v1.copy(), w1.copy()
+        u = (s - t0) / h
+        u2, u3 = u * u, u * u * u
+        u4, u5 = u3 * u, u3 * u2
+        h00 = 1 - 10 * u3 + 15 * u4 - 6 * u5
+        h10 = u - 6 * u3 + 8 * u4 - 3 * u5
+        h20 = 0.5 * (u2 - 3 * u3 + 3 * u4 - u5)
+        h01 = 10 * u3 - 15 * u4 + 6 * u5
+        h11 = -4 * u3 + 7 * u4 - 3 * u5
+        h21 = 0.5 * (u3 - 2 * u4 + u5)
+        d00 = (-30 * u2 + 60 * u3 - 30 * u4) / h
+        d10 = 1 - 18 * u2 + 32 * u3 - 15 * u4
+        d20 = 0.5 * h * (2 * u - 9 * u2 + 12 * u3 - 5 * u4)
+        d01 = -d00
+        d11 = -12 * u2 + 28 * u3 - 15 * u4
+        d21 = 0.5 * h * (3 * u2 - 8 * u3 + 5 * u4)
+        q = h00 * q0 + h * h10 * v0 + h * h * h20 * a0 + h01 * q1 + h * h11 * v1 \
+            + h * h * h21 * a1
+        v = d00 * q0 + d10 * v0 + d20 * a0 + d01 * q1 + d11 * v1 + d21 * a1
+        # cubic Hermite for the quadrature states
+        c00 = 1 - 3 * u2 + 2 * u3
+        c10 = u - 2 * u2 + u3
+        c01 = 3 * u2 - 2 * u3
+        c11 = -u2 + u3
+        w = c00 * w0 + h * c10 * p0 + c01 * w1 + h * c11 * p1
+        return q, v, w
+
+    return dense
+
+
+class Integrator(ABC):
+    """Base class of the integrators of q'' = f(t, q, q').
+
+    Subclasses hold settings only; :meth:`integrate` yields :class:`Step`
+    records and fills :attr:`stats`.
+    """
+
+    #: short name used by ``simulate(integrator=...)`` and the CLI
+    name: str = "?"
+    #: global order of accuracy
+    order: int = 0
+    #: whether the step size is chosen from an error estimate
+    adaptive: bool = False
+
+    def __init__(self):
+        self.stats = IntegratorStats()
+
+    def settings(self) -> dict:
+        """The settings of this integrator (for the run's stats)."""
+        return {}
+
+    def integrate(self, f: Callable, t0: float, q0, qdot0, t_end: float, *,
+                  w0=None, first_order: Callable | None = None) -> Iterator[Step]:
+        """Integrate from ``t0`` to ``t_end``, yielding every accepted step.
+
+        Parameters
+        ----------
+        f : callable
+            ``f(t, q, qdot) -> qddot`` or, with ``w0``, ``-> (qddot, p)``.
+        t0, t_end : float
+            Start and end times, s (``t_end >= t0``).
+        q0, qdot0 : array_like, shape (n,)
+            Initial coordinates and rates.
+        w0 : array_like, shape (n_w,), optional
+            Initial quadrature states (integrated as w' = p).
+        first_order : callable, optional
+            The same right-hand side as ``fun(t, y) -> y'`` for y = (q, q', w); an
+            integrator that works on first-order systems may call it directly
+            (it saves the Python glue of unpacking per evaluation).
+
+        Yields
+        ------
+        Step
+        """
+        t0 = float(t0)
+        try:
+            t_end = float(t_end)
+        except (TypeError, ValueError):
+            raise IntegratorOptionError(f"`t_end` must be a number, got {t_end!r}") from None
+        if not math.isfinite(t_end) or t_end < t0:
+            raise IntegratorOptionError(
+                f"`t_end` must be finite and >= t0 = {t0:g} s, got {t_end!r}")
+        q0 = np.array(q0, dtype=float).reshape(-1)
+        qdot0 = np.array(qdot0, dtype=float).reshape(-1)
+        if qdot0.shape != q0.shape:
+            raise IntegratorOptionError(f"`qdot0` must have the shape of `q0` {q0.shape}, "
+                                        f"got {qdot0.shape}")
+        has_w = w0 is not None
+        w0 = np.zeros(0) if w0 is None else np.array(w0, dtype=float).reshape(-1)
+        self.stats = IntegratorStats()
+        stats = self.stats
+
+        def rhs(t, q, qdot):
+            stats.evaluations += 1
+            out = f(t, q, qdot)
+            if has_w:
+                a, p = out
+                return np.asarray(a, float), np.asarray(p, float).reshape(-1)
+            return np.asarray(out, float), np.zeros(0)
+
+        return self._steps(rhs, t0, q0, qdot0, w0, t_end, first_order)
+
+    @abstractmethod
+    def _steps(self, rhs, t0, q0, qdot0, w0, t_end, first_order=None) -> Iterator[Step]:
+        """Yield the accepted steps (``rhs`` always returns ``(qddot, p)``)."""
+
+    def __repr__(self) -> str:
+        s = ", ".join(f"{k}={v!r}" for k, v in self.settings().items())
+        return f"{type(self).__name__}({s})"
+
+
+def fixed_grid(t0: float, t_end: float, steps: int | None, dt: float | None,
+               default_steps: int = 100) -> np.ndarray:
+    """Step end points of a fixed-step integration: ``steps`` equal steps, or steps of
+    ``dt`` (the last one shortened to land on ``t_end``)."""
+    if steps is not None and dt is not None:
+        raise IntegratorOptionError("give either `steps` or `dt`, not both")
+    if t_end == t0:
+        return np.array([t0])
+    if dt is not None:
+        n = max(1, int(math.ceil((t_end - t0) / dt - 1e-9)))
+        grid = t0 + dt * np.arange(n + 1)
+        grid[-1] = t_end
+        return grid
+    n = default_steps if steps is None else steps
+    return np.linspace(t0, t_end, n + 1)

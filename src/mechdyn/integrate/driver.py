@@ -1,0 +1,187 @@
+"""Choosing an integrator by name, and a small driver for plain ODEs.
+
+``make_integrator("wilson", steps=40)`` builds an integrator from its name and
+options (unknown names and misplaced options give errors naming them);
+:func:`solve` runs one over [t0, t_end] with output times and events, the
+integrate-level analogue of ``scipy.integrate.solve_ivp`` for q'' = f(t, q, q').
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .base import Integrator, IntegratorOptionError
+from .events import as_events, locate_events
+from .runge_kutta import RungeKutta4
+from .scipy_ivp import SCIPY_METHODS, ScipyIntegrator
+from .wilson import Wilson
+
+__all__ = ["INTEGRATORS", "make_integrator", "solve", "Solution", "sample_times"]
+
+#: valid integrator names
+INTEGRATORS = ("wilson", "rk4", *SCIPY_METHODS)
+_FIXED_OPTIONS = ("steps", "dt")
+_WILSON_OPTIONS = ("iterations", "tol", "theta")
+_ADAPTIVE_OPTIONS = ("first_step", "max_step")
+
+
+def make_integrator(name: str | Integrator = "dop853", *, steps: int | None = None,
+                    dt: float | None = None, rtol: float = 1e-9, atol=None,
+                    **options) -> Integrator:
+    """An integrator from its name and options.
+
+    Parameters
+    ----------
+    name : str or Integrator
+        One of :data:`INTEGRATORS` (case-insensitive), or an integrator instance
+        (returned as is; then no other option may be given).
+    steps, dt
+        Number of steps or step size (s) of the fixed-step integrators ``wilson``, ``rk4``.
+    rtol, atol
+        Tolerances of the adaptive (SciPy) integrators; ignored by fixed-step ones.
+    **options
+        ``iterations``, ``tol``, ``theta`` for ``wilson``; ``first_step``, ``max_step``
+        for the adaptive ones.
+
+    Raises
+    ------
+    IntegratorOptionError
+        Unknown name (the valid ones are listed), an option the integrator does not
+        take, or a bad value.
+    """
+    if isinstance(name, Integrator):
+        extra = [k for k, v in {"steps": steps, "dt": dt, **options}.items() if v is not None]
+        if extra:
+            raise IntegratorOptionError(
+                f"options {', '.join(extra)} cannot be combined with an integrator instance "
+                f"({name!r}); set them on the instance")
+        return name
+    if not isinstance(name, str) or name.lower() not in INTEGRATORS:
+        raise IntegratorOptionError(
+            f"unknown integrator {name!r}; valid integrator names: {', '.join(INTEGRATORS)}")
+    key = name.lower()
+    options = {k: v for k, v in options.items() if v is not None}
+    if key in ("wilson", "rk4"):
+        allowed = _WILSON_OPTIONS if key == "wilson" else ()
+        bad = [k for k in options if k not in allowed]
+        if bad:
+            raise IntegratorOptionError(
+                f"integrator {key!r} does not take option(s) {', '.join(bad)}"
+                + (f"; its options: steps, dt, {', '.join(allowed)}" if allowed
+                   else "; its options: steps, dt"))
+        if key == "wilson":
+            return Wilson(steps, dt, **options)
+        return RungeKutta4(steps, dt)
+    given = [k for k, v in (("steps", steps), ("dt", dt)) if v is not None]
+    bad = given + [k for k in options if k not in _ADAPTIVE_OPTIONS]
+    if bad:
+        raise IntegratorOptionError(
+            f"integrator {key!r} is adaptive and does not take option(s) {', '.join(bad)}; "
+            f"its options: rtol, atol, {', '.join(_ADAPTIVE_OPTIONS)} (fixed-step "
+            f"integrators taking steps/dt: wilson, rk4)")
+    return ScipyIntegrator(key, rtol, atol, **options)
+
+
+@dataclass
+class Solution:
+    """Result of :func:`solve`: samples (time-major), events, counters, status."""
+
+    t: np.ndarray
+    q: np.ndarray
+    qdot: np.ndarray
+    qddot: np.ndarray
+    w: np.ndarray
+    events: list = field(default_factory=list)
+    stats: dict = field(default_factory=dict)
+    status: str = "success"
+
+
+def sample_times(t0: float, t_end: float, t_eval) -> np.ndarray | None:
+    """Validate output times: sorted, within [t0, t_end]."""
+    if t_eval is None:
+        return None
+    te = np.asarray(t_eval, dtype=float).reshape(-1)
+    if np.any(np.diff(te) < 0):
+        raise IntegratorOptionError("`t_eval` must be sorted increasingly")
+    if te.size and (te[0] < t0 - 1e-12 * max(1.0, abs(t0)) or te[-1] > t_end * (1 + 1e-12)
+                    + 1e-15):
+        raise IntegratorOptionError(f"`t_eval` must lie within [{t0:g}, {t_end:g}] s")
+    return te
+
+
+def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end: float, *,
+          t_eval=None, events=None, w0=None, **options) -> Solution:
+    """Integrate q'' = f(t, q, q') and collect samples (every step, or at ``t_eval``).
+
+    Parameters
+    ----------
+    integrator : Integrator or str
+    f : callable
+        ``f(t, q, qdot) -> qddot`` (or ``(qddot, p)`` with ``w0``).
+    t_eval : array_like, optional
+        Output times (interpolated with the dense output); default every step.
+    events : callable or list, optional
+        Event functions ``g(t, q, qdot)`` (see :mod:`mechdyn.integrate.events`).
+    **options
+        Passed to :func:`make_integrator` when ``integrator`` is a name.
+    """
+    integ = make_integrator(integrator, **options)
+    ev = as_events(events)
+    te = sample_times(t0, t_end, t_eval)
+    q0 = np.asarray(q0, float).reshape(-1)
+    v0 = np.asarray(qdot0, float).reshape(-1)
+    wz = np.zeros(0) if w0 is None else np.asarray(w0, float).reshape(-1)
+    out_t, out_q, out_v, out_a, out_w = [], [], [], [], []
+
+    def acc(t, q, v):
+        r = f(t, q, v)
+        return np.asarray(r[0] if w0 is not None else r, float)
+
+    def push(t, q, v, w, a=None):
+        out_t.append(t)
+        out_q.append(np.array(q))
+        out_v.append(np.array(v))
+        out_w.append(np.array(w))
+        out_a.append(np.array(acc(t, q, v) if a is None else a))
+
+    steps = integ.integrate(f, t0, q0, v0, t_end, w0=w0)
+    k_eval = 0
+    if te is None:
+        push(t0, q0, v0, wz)
+    else:
+        while k_eval < te.size and te[k_eval] <= t0:
+            push(t0, q0, v0, wz)
+            k_eval += 1
+    g_old = np.array([e(t0, q0, v0) for e in ev])
+    records = []
+    status = "success"
+    for step in steps:
+        t_stop = step.t
+        terminal = False
+        if ev:
+            rec, g_old, terminal = locate_events(ev, g_old, step)
+            records.extend(rec)
+            if terminal:
+                t_stop = rec[-1].t
+        if te is None:
+            if terminal:
+                q, v, w = step.dense(t_stop)
+                push(t_stop, q, v, w)
+            else:
+                push(step.t, step.q, step.qdot, step.w, step.qddot)
+        else:
+            while k_eval < te.size and te[k_eval] <= t_stop:
+                q, v, w = step.dense(te[k_eval])
+                push(te[k_eval], q, v, w)
+                k_eval += 1
+        if terminal:
+            status = "event"
+            break
+    n = q0.size
+    return Solution(np.array(out_t), np.array(out_q).reshape(-1, n),
+                    np.array(out_v).reshape(-1, n), np.array(out_a).reshape(-1, n),
+                    np.array(out_w).reshape(len(out_t), -1), records,
+                    {"integrator": integ.name, **integ.stats.as_dict()}, status)

@@ -1,0 +1,136 @@
+"""SciPy's initial-value solvers (the methods of ``scipy.integrate.solve_ivp``).
+
+``solve_ivp`` drives an ``OdeSolver`` class (DOP853, RK45, Radau, LSODA, ...) in
+a loop; here the same classes are stepped one by one, so that ``simulate`` can
+re-solve positions, check the state and keep everything computed so far when a
+run stops.  Dense output comes from the solver's own interpolant; events are
+located on it (see :mod:`mechdyn.integrate.events`).
+
+The second-order system is integrated as y = (q, q', w), y' = (q', q'', p).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+import scipy.integrate as si
+
+from ..errors import IntegrationError
+from .base import Integrator, IntegratorOptionError, Step, check_positive
+
+__all__ = ["ScipyIntegrator", "SCIPY_METHODS"]
+
+#: our name -> scipy OdeSolver class name
+SCIPY_METHODS = {"dop853": "DOP853", "rk45": "RK45", "rk23": "RK23", "radau": "Radau",
+                 "bdf": "BDF", "lsoda": "LSODA"}
+_FSAL = {"DOP853", "RK45", "RK23"}  # solver.f holds f(t_new, y_new) after a step
+
+
+class ScipyIntegrator(Integrator):
+    """An adaptive SciPy solver.
+
+    Parameters
+    ----------
+    method : {"dop853", "rk45", "rk23", "radau", "bdf", "lsoda"}
+        The solver (case-insensitive; SciPy's spelling ``"DOP853"`` works too).
+    rtol : float
+        Relative tolerance (> 0), default 1e-9.
+    atol : float or array_like
+        Absolute tolerance, SI units of each state component (> 0); a scalar, or an
+        array of length 2 n + n_w over (q, q', w).  Default ``1e-3 rtol``.
+    first_step, max_step : float, optional
+        Initial and largest step sizes, s.
+    """
+
+    adaptive = True
+
+    def __init__(self, method: str = "dop853", rtol: float = 1e-9, atol=None, *,
+                 first_step: float | None = None, max_step: float | None = None):
+        super().__init__()
+        key = str(method).lower()
+        if key not in SCIPY_METHODS:
+            raise IntegratorOptionError(
+                f"unknown scipy method {method!r}; valid: {', '.join(SCIPY_METHODS)}")
+        self.method = SCIPY_METHODS[key]
+        self.name = key
+        self.order = {"DOP853": 8, "RK45": 5, "RK23": 3, "Radau": 5, "BDF": 5,
+                      "LSODA": 12}[self.method]
+        self.rtol = check_positive("rtol", rtol)
+        if atol is None:
+            atol = 1e-3 * self.rtol
+        at = np.asarray(atol, dtype=float)
+        if not np.all(np.isfinite(at)) or np.any(at <= 0):
+            raise IntegratorOptionError(f"`atol` must be positive, got {atol!r}")
+        self.atol = float(at) if at.ndim == 0 else at
+        self.first_step = check_positive("first_step", first_step, allow_none=True)
+        self.max_step = check_positive("max_step", max_step, allow_none=True)
+
+    def settings(self) -> dict:
+        return {"method": self.method, "rtol": self.rtol, "atol": self.atol,
+                "first_step": self.first_step, "max_step": self.max_step}
+
+    def _steps(self, rhs, t0, q0, qdot0, w0, t_end, first_order=None) -> Iterator[Step]:
+        n, nw = q0.size, w0.size
+        if t_end == t0:
+            return
+        stats = self.stats
+
+        def wrapped(t, y):
+            a, p = rhs(t, y[:n], y[n:2 * n])
+            out = np.empty(2 * n + nw)
+            out[:n] = y[n:2 * n]
+            out[n:2 * n] = a
+            out[2 * n:] = p
+            return out
+
+        fun = wrapped if first_order is None else first_order
+        y0 = np.concatenate([q0, qdot0, w0])
+        atol = self.atol
+        if np.ndim(atol) and np.size(atol) != y0.size:
+            raise IntegratorOptionError(
+                f"`atol` has {np.size(atol)} components but the state (q, q', w) has "
+                f"{y0.size}")
+        kw = {"rtol": self.rtol, "atol": atol}
+        if self.first_step is not None:
+            kw["first_step"] = self.first_step
+        if self.max_step is not None:
+            kw["max_step"] = self.max_step
+        cls = getattr(si, self.method)
+        solver = cls(fun, t0, y0, t_end, vectorized=False, **kw)
+        fsal = self.method in _FSAL
+        base_count = stats.evaluations
+        while solver.status == "running":
+            t_old = solver.t
+            message = solver.step()
+            if solver.status == "failed":
+                raise IntegrationError(f"{self.method} failed: {message}", t=solver.t,
+                                       q=solver.y[:n])
+            stats.steps += 1
+            y = solver.y
+            if fsal:
+                a = solver.f[n:2 * n].copy()
+            else:
+                a, _ = rhs(solver.t, y[:n], y[n:2 * n])
+                base_count += 1
+            if first_order is not None:
+                stats.evaluations = base_count + solver.nfev
+            yield Step(t_old, float(solver.t), y[:n].copy(), y[n:2 * n].copy(), a,
+                       y[2 * n:].copy(), _LazyDense(solver, n))
+            if first_order is not None:
+                stats.evaluations = base_count + solver.nfev
+
+
+class _LazyDense:
+    """The solver's interpolant of the last step, built on first use (DOP853 spends
+    three extra evaluations on it).  Valid until the solver takes its next step."""
+
+    def __init__(self, solver, n):
+        self.solver, self.n, self.sol = solver, n, None
+
+    def __call__(self, s):
+        if self.sol is None:
+            self.sol = self.solver.dense_output()
+        y = self.sol(s)
+        n = self.n
+        return y[:n], y[n:2 * n], y[2 * n:]

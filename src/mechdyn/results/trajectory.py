@@ -1,0 +1,198 @@
+"""The record of a dynamic simulation: :class:`Trajectory`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["Trajectory"]
+
+#: statuses of a run that reached its end (or a terminal event)
+SUCCESS_STATUSES = ("success", "event")
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """Samples of a simulated motion, time-major.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+        Times, s.
+    q, qdot, qddot : ndarray, shape (n, n_q)
+        Generalized coordinates (rad or m), rates and accelerations.
+    x : ndarray, shape (n, n_x)
+        Body poses (x, y in m, theta in rad per body, in ``body_names`` order).
+    xdot : ndarray, shape (n, n_x)
+        Body frame velocities (m/s, rad/s).
+    status : str
+        ``"success"``, ``"event"`` (a terminal event ended the run), or why the run
+        stopped early: ``"singular-position"``, ``"assembly-failed"``,
+        ``"singular-mass-matrix"``, ``"non-finite"``, ``"failed"``.
+    message : str
+        What happened, with the time and the coordinates when the run stopped early.
+    events : list of EventRecord
+        Occurrences of the requested events, in time order.
+    stats : dict
+        ``steps``, ``rejected``, ``evaluations`` (right-hand sides), ``wall_time_s``,
+        ``integrator``, ``formulation``, ``backend`` and the integrator's settings.
+    energy : dict or None
+        Arrays of shape (n,): ``kinetic`` T, ``potential`` U, ``work_nc`` (work of
+        the non-conservative forces since t0: drives, applied forces and torques,
+        dampers), all in J; ``balance`` = T + U - W_nc (constant for exact
+        dynamics); ``residual``, the largest constraint residual (m or rad).
+    coordinate_names, body_names : tuple of str
+    coordinate_is_angle : tuple of bool
+    model : Model or None
+        The compiled model (for point positions in :meth:`to_dataframe`).
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    qdot: np.ndarray
+    qddot: np.ndarray
+    x: np.ndarray
+    xdot: np.ndarray
+    status: str = "success"
+    message: str = ""
+    events: list = field(default_factory=list)
+    stats: dict = field(default_factory=dict)
+    energy: dict | None = None
+    coordinate_names: tuple = ()
+    body_names: tuple = ()
+    coordinate_is_angle: tuple = ()
+    model: object = field(default=None, repr=False, compare=False)
+
+    @property
+    def success(self) -> bool:
+        """True when the run reached ``t_end`` (or a terminal event)."""
+        return self.status in SUCCESS_STATUSES
+
+    @property
+    def n_samples(self) -> int:
+        return int(self.t.shape[0])
+
+    def coordinate(self, name: str) -> np.ndarray:
+        """Samples (n,) of one coordinate (rad or m)."""
+        return self.q[:, self._ci(name)]
+
+    def rate(self, name: str) -> np.ndarray:
+        """Samples (n,) of one coordinate's rate."""
+        return self.qdot[:, self._ci(name)]
+
+    def acceleration(self, name: str) -> np.ndarray:
+        """Samples (n,) of one coordinate's acceleration."""
+        return self.qddot[:, self._ci(name)]
+
+    def _ci(self, name):
+        from ..errors import ModelError, did_you_mean
+
+        try:
+            return self.coordinate_names.index(name)
+        except ValueError:
+            raise ModelError(did_you_mean(name, self.coordinate_names, "coordinate")) from None
+
+    def energy_drift(self) -> float:
+        """Largest |balance - balance[0]| over the run, J (NaN without energy)."""
+        if not self.energy or self.t.size == 0:
+            return float("nan")
+        b = self.energy["balance"]
+        return float(np.max(np.abs(b - b[0])))
+
+    def summary(self) -> str:
+        """Multi-line text: status, counters and the energy balance."""
+        lines = [f"status: {self.status}" + (f" - {self.message}" if self.message else "")]
+        s = self.stats
+        if s:
+            lines.append(
+                f"integrator {s.get('integrator')} ({s.get('formulation')}, backend "
+                f"{s.get('backend')}): {s.get('steps')} steps, {s.get('evaluations')} "
+                f"evaluations, wall time {s.get('wall_time_s', float('nan')):.4g} s")
+        if self.t.size:
+            lines.append(f"samples: {self.t.size}, t = {self.t[0]:.6g} .. {self.t[-1]:.6g} s")
+        if self.energy and self.t.size:
+            e = self.energy
+            lines.append(
+                f"energy at the end: T = {e['kinetic'][-1]:.9g} J, U = {e['potential'][-1]:.9g}"
+                f" J, W_nc = {e['work_nc'][-1]:.9g} J; balance T + U - W_nc drifts by "
+                f"{self.energy_drift():.3e} J; largest constraint residual "
+                f"{np.max(e['residual']):.3e}")
+        return "\n".join(lines)
+
+    # ------------------------------------------------------------------ tables
+    def to_dataframe(self, points: bool = False, energy: bool = True, bodies: bool = True,
+                     degrees: bool = True):
+        """A pandas DataFrame, one row per sample, columns with unit suffixes.
+
+        Parameters
+        ----------
+        points : bool
+            Add position, velocity and acceleration of every named body point
+            (``x_rod_B_m``, ``vx_rod_B_m_s``, ``ax_rod_B_m_s2`` ...).
+        energy : bool
+            Add ``T_J``, ``U_J``, ``W_nc_J``, ``E_balance_J`` and ``residual``.
+        bodies : bool
+            Add the body frame poses and velocities (``x_rod_m``, ``theta_rod_rad``,
+            ``omega_rod_rad_s`` ...).
+        degrees : bool
+            Add ``<angle>_deg`` columns next to the radians.
+        """
+        import pandas as pd
+
+        cols: dict[str, np.ndarray] = {"t_s": self.t}
+        for k, name in enumerate(self.coordinate_names):
+            ang = self.coordinate_is_angle[k] if self.coordinate_is_angle else True
+            u, ud, udd = ("rad", "rad_s", "rad_s2") if ang else ("m", "m_s", "m_s2")
+            cols[f"{name}_{u}"] = self.q[:, k]
+            if ang and degrees:
+                cols[f"{name}_deg"] = np.rad2deg(self.q[:, k])
+            cols[f"{name}_dot_{ud}"] = self.qdot[:, k]
+            cols[f"{name}_ddot_{udd}"] = self.qddot[:, k]
+        if bodies:
+            for b, name in enumerate(self.body_names):
+                cols[f"x_{name}_m"] = self.x[:, 3 * b]
+                cols[f"y_{name}_m"] = self.x[:, 3 * b + 1]
+                cols[f"theta_{name}_rad"] = self.x[:, 3 * b + 2]
+                cols[f"vx_{name}_m_s"] = self.xdot[:, 3 * b]
+                cols[f"vy_{name}_m_s"] = self.xdot[:, 3 * b + 1]
+                cols[f"omega_{name}_rad_s"] = self.xdot[:, 3 * b + 2]
+        if points and self.model is not None and self.t.size:
+            cols.update(self._point_columns())
+        if energy and self.energy:
+            e = self.energy
+            cols["T_J"] = e["kinetic"]
+            cols["U_J"] = e["potential"]
+            cols["W_nc_J"] = e["work_nc"]
+            cols["E_balance_J"] = e["balance"]
+            cols["residual"] = e["residual"]
+        return pd.DataFrame(cols)
+
+    def xddot(self) -> np.ndarray:
+        """Body frame accelerations xddot = B q'' + b, shape (n, n_x) (needs ``model``)."""
+        from ..kinematics.analogs import accelerations
+
+        return accelerations(self.model, self.x, self.xdot, self.qddot,
+                             layout=self._layout())
+
+    def _layout(self):
+        mode = self.stats.get("mode")
+        return self.model.layout(mode)
+
+    def _point_columns(self) -> dict:
+        from ..kinematics.constraints import point_acceleration, point_position, point_velocity
+
+        m = self.model
+        xdd = self.xddot()
+        out = {}
+        for body, pt in m.named_points():
+            r = point_position(m, self.x, body, pt)
+            v = point_velocity(m, self.x, self.xdot, body, pt)
+            a = point_acceleration(m, self.x, self.xdot, xdd, body, pt)
+            for k, ax in enumerate("xy"):
+                out[f"{ax}_{body}_{pt}_m"] = r[:, k]
+            for k, ax in enumerate("xy"):
+                out[f"v{ax}_{body}_{pt}_m_s"] = v[:, k]
+            for k, ax in enumerate("xy"):
+                out[f"a{ax}_{body}_{pt}_m_s2"] = a[:, k]
+        return out

@@ -1,0 +1,456 @@
+"""Forward dynamics: integrate the equations of motion and record a :class:`Trajectory`.
+
+``simulate`` composes :mod:`mechdyn.dynamics.lagrange` (the right-hand side
+q'' = A^-1 (Q - c), positions re-solved from q at every evaluation) with an
+integrator of :mod:`mechdyn.integrate`.  After every accepted step the positions
+are re-solved from q and checked for a dead position; q, q' and q'' are
+checked finite.  A run that cannot go on (dead or toggle position, a mechanism
+that cannot be assembled, a singular mass matrix, a failing integrator) ends
+with its ``status`` and a ``message`` naming the time, the coordinates and the
+joints concerned, and returns everything computed so far.
+
+The work of the non-conservative forces is integrated with the motion, as an
+extra state w' = P_nc, so that the energy balance T + U - W_nc = const holds
+to the integrator's tolerance.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from collections.abc import Mapping
+
+import numpy as np
+
+from .dynamics.lagrange import FORMULATIONS, EquationsOfMotion, kinetic_energy, potential_energy
+from .errors import (
+    AssemblyError,
+    IntegrationError,
+    MechdynError,
+    ModelError,
+    SingularPositionError,
+    did_you_mean,
+)
+from .integrate.base import IntegratorOptionError
+from .integrate.driver import make_integrator, sample_times
+from .integrate.events import as_events, locate_events
+from .kinematics.analogs import velocity_analogs
+from .kinematics.assembly import singularity, solve_position
+from .kinematics.constraints import coordinates, residual
+from .model import Model
+from .results.trajectory import Trajectory
+
+__all__ = ["simulate", "initial_state"]
+
+#: sigma_min / sigma_max of the scaled position Jacobian below which a stop is
+#: reported as a dead position
+DEAD_RCOND = 1e-4
+#: runs predicted longer than this (s of wall time) show a progress bar (progress=None)
+PROGRESS_AFTER = 2.0
+
+
+def _as_model(mech_or_model) -> Model:
+    if isinstance(mech_or_model, Model):
+        return mech_or_model
+    if hasattr(mech_or_model, "compile"):
+        return mech_or_model.compile()
+    raise TypeError(f"expected a Mechanism or a Model, got {type(mech_or_model).__name__}")
+
+
+def _values(model: Model, given, base: np.ndarray, what: str) -> np.ndarray:
+    """Coordinates from an array (n_q,) or a mapping {name: value} over ``base``."""
+    out = np.array(base, dtype=float)
+    if given is None:
+        return out
+    if isinstance(given, Mapping):
+        for name, v in given.items():
+            if name not in model.coordinate_names:
+                raise ModelError(f"{what}: " + did_you_mean(name, model.coordinate_names,
+                                                            "coordinate"))
+            out[model.coordinate_index(name)] = float(v)
+        return out
+    arr = np.asarray(given, dtype=float).reshape(-1)
+    if arr.shape != (model.n_q,):
+        names = ", ".join(model.coordinate_names)
+        raise ModelError(f"{what} must have {model.n_q} values ({names}), got {arr.size}")
+    return arr
+
+
+def _continue_to(model: Model, q_from, x_from, q_to, layout) -> np.ndarray:
+    """Newton continuation from a solved pose to new coordinates (keeps the branch)."""
+    q_from = np.asarray(q_from, float)
+    dq = np.asarray(q_to, float) - q_from
+    size = np.where(model.coord_is_angle, np.abs(dq) / 0.05,
+                    np.abs(dq) / (0.05 * model.length_scale))
+    n = max(1, int(math.ceil(float(np.max(size, initial=0.0)))))
+    x = np.array(x_from, float)
+    for k in range(1, n + 1):
+        x = solve_position(model, q_from + dq * (k / n), x, layout=layout, check_singular=False)
+    return x
+
+
+def initial_state(model: Model, q0=None, qdot0=None, *, mode=None):
+    """Initial (q, qdot, x): arguments, else ``mechanism.extras["initial"]``, else the sketch.
+
+    Parameters
+    ----------
+    q0, qdot0 : array_like (n_q,) or mapping {coordinate name: value}, optional
+        Values given override those of the model file; missing ones come from the
+        model file's ``initial`` table, then from the sketch (rates: zero).
+
+    Returns
+    -------
+    q, qdot : ndarray, shape (n_q,)
+    x : ndarray, shape (n_x,)
+        The assembled pose at q, reached by continuation from the sketch.
+    """
+    layout = model.layout(mode)
+    x_sk = getattr(model, "x0", None)
+    if x_sk is None:
+        from .kinematics.assembly import assemble
+
+        x_sk = assemble(model, layout=layout)
+    q_sk = coordinates(model, x_sk)
+    init = {}
+    extras = getattr(model.mechanism, "extras", None) or {}
+    if isinstance(extras, Mapping):
+        init = extras.get("initial", {}) or {}
+    q = _values(model, init.get("q"), q_sk, "initial q")
+    qd = _values(model, init.get("qdot"), np.zeros(model.n_q), "initial qdot")
+    q = _values(model, q0, q, "q0")
+    qd = _values(model, qdot0, qd, "qdot0")
+    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd))):
+        raise ModelError(f"the initial state must be finite, got q = {q}, qdot = {qd}")
+    x = _continue_to(model, q_sk, x_sk, q, layout)
+    return q, qd, x
+
+
+class _Progress:
+    """A tqdm bar over simulated time, shown at once (True), never (False) or once
+    the run has taken longer than PROGRESS_AFTER seconds (None)."""
+
+    def __init__(self, mode, t0, t_end):
+        self.mode, self.t0, self.t_end = mode, t0, t_end
+        self.bar = None
+        self.start = time.perf_counter()
+        self.shown = t0
+        if mode is True:
+            self._open()
+
+    def _open(self):
+        try:
+            from tqdm import tqdm
+        except ImportError:  # pragma: no cover - tqdm is a dependency
+            self.mode = False
+            return
+        self.bar = tqdm(total=self.t_end - self.t0, unit="s", file=sys.stderr,
+                        desc="simulate", bar_format="{l_bar}{bar}| {n:.4g}/{total:.4g} s "
+                        "[{elapsed}<{remaining}]")
+
+    def update(self, t):
+        if self.bar is None and self.mode is None and \
+                time.perf_counter() - self.start > PROGRESS_AFTER:
+            self._open()
+            if self.bar is not None:
+                self.bar.update(self.shown - self.t0)
+        if self.bar is not None:
+            self.bar.update(t - self.shown)
+        self.shown = t
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+
+
+def _fmt_q(model, q):
+    return ", ".join(f"{n} = {v:.9g}" + (" rad" if a else " m")
+                     for n, v, a in zip(model.coordinate_names, np.atleast_1d(q),
+                                        model.coord_is_angle, strict=True))
+
+
+def _diagnose(eom: EquationsOfMotion, exc: Exception, t_good: float, q_good, x_good):
+    """Status and message of a run that stopped with ``exc`` after the state at ``t_good``."""
+    model, lay = eom.model, eom.layout
+    if isinstance(exc, SingularPositionError):
+        return "singular-position", str(exc)
+    if isinstance(exc, AssemblyError) and exc.q is not None and q_good is not None:
+        # The solve failed between an assemblable q_good and q_bad: the segment leaves the
+        # assembly region, whose boundary is a singular position. Bisect for it.
+        q_bad = np.asarray(exc.q, float)
+        t_bad = exc.t if exc.t is not None else t_good
+        lo, hi, x_lo = 0.0, 1.0, np.array(x_good, float)
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            try:
+                x_lo = solve_position(model, q_good + mid * (q_bad - q_good), x_lo, layout=lay,
+                                      check_singular=False)
+                lo = mid
+            except AssemblyError:
+                hi = mid
+            if hi - lo < 1e-13:
+                break
+        q_edge = q_good + lo * (q_bad - q_good)
+        rep = singularity(model, x_lo, lay)
+        t_edge = t_good + lo * (t_bad - t_good)
+        if rep["rcond"] < DEAD_RCOND:
+            return "singular-position", (
+                f"dead position reached near t = {t_edge:.9g} s at {_fmt_q(model, q_edge)}: "
+                f"the mechanism cannot move past it (sigma_min/sigma_max of the constraint "
+                f"Jacobian {rep['rcond']:.2e}); coordinate(s) "
+                f"{', '.join(rep['coordinates']) or '-'} lose control, joints "
+                f"{', '.join(rep['joints']) or '-'} become dependent")
+        return "assembly-failed", f"position solve failed at t = {t_bad:.9g} s: {exc}"
+    if x_good is not None:
+        rep = singularity(model, x_good, lay)
+        if rep["rcond"] < DEAD_RCOND:
+            return "singular-position", (
+                f"dead position near t = {t_good:.9g} s at {_fmt_q(model, q_good)}: "
+                f"sigma_min/sigma_max = {rep['rcond']:.2e}; coordinate(s) "
+                f"{', '.join(rep['coordinates']) or '-'} lose control, joints "
+                f"{', '.join(rep['joints']) or '-'} become dependent ({exc})")
+    if isinstance(exc, AssemblyError):
+        return "assembly-failed", str(exc)
+    if isinstance(exc, IntegrationError) and "mass matrix" in str(exc):
+        return "singular-mass-matrix", str(exc)
+    if isinstance(exc, FloatingPointError | ArithmeticError):
+        return "non-finite", f"non-finite values after t = {t_good:.9g} s: {exc}"
+    return "failed", str(exc)
+
+
+def _turning_point_check(eom: EquationsOfMotion, step, qd_old, x_good):
+    """A coordinate whose rate changes sign during the step may turn back at a dead
+    position (there the rate of the driving coordinate vanishes and the mechanism would
+    have to change assembly branch to go on): locate the turn on the dense output and
+    test the position there.  Returns (status, message) or None."""
+    from scipy.optimize import brentq
+
+    model, lay = eom.model, eom.layout
+    for k in np.flatnonzero(np.sign(qd_old) * np.sign(step.qdot) < 0):
+        try:
+            tk = brentq(lambda s, k=k: step.dense(s)[1][k], step.t_old, step.t, xtol=1e-14,
+                        rtol=4 * np.finfo(float).eps)
+        except ValueError:
+            continue
+        qk = step.dense(tk)[0]
+        try:
+            xk = solve_position(model, qk, x_good, layout=lay, check_singular=False)
+        except AssemblyError:
+            xk = None
+        rep = singularity(model, xk, lay) if xk is not None else None
+        if rep is None or rep["rcond"] < DEAD_RCOND:
+            name = model.coordinate_names[k]
+            if rep is None:
+                rep = singularity(model, x_good, lay)
+            return "singular-position", (
+                f"dead position reached near t = {tk:.9g} s at {_fmt_q(model, qk)}: "
+                f"{name} turns back where the constraint Jacobian is singular "
+                f"(sigma_min/sigma_max {rep['rcond']:.2e}); coordinate(s) "
+                f"{', '.join(rep['coordinates']) or '-'} lose control, joints "
+                f"{', '.join(rep['joints']) or '-'} become dependent; going on would need "
+                f"the other assembly branch")
+    return None
+
+
+def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | None = None,
+             dt: float | None = None, rtol: float = 1e-9, atol=None, q0=None, qdot0=None,
+             t_eval=None, formulation: str = "exact", d=None, progress: bool | None = None,
+             events=None, t0: float = 0.0, mode=None, backend: str = "auto",
+             iterations: int | None = None, tol: float | None = None,
+             theta: float | None = None, first_step: float | None = None,
+             max_step: float | None = None) -> Trajectory:
+    """Simulate the motion of a mechanism under its loads and drives.
+
+    Parameters
+    ----------
+    mech_or_model : Mechanism or Model
+    t_end : float
+        End time, s (>= ``t0``).
+    integrator : str or Integrator
+        ``"dop853"`` (default), ``"rk45"``, ``"rk23"``, ``"radau"``, ``"bdf"``,
+        ``"lsoda"`` (adaptive, SciPy), ``"rk4"`` or ``"wilson"`` (fixed step; the
+        source paper's linear-acceleration method).
+    steps, dt
+        Number of steps or step size (s) of the fixed-step integrators.
+    rtol, atol
+        Tolerances of the adaptive integrators (atol default ``1e-3 rtol``, SI units
+        of q, q' and of the work W_nc in J).
+    q0, qdot0 : array_like (n_q,) or mapping {name: value}, optional
+        Initial state; default from the model file's ``initial`` table, then the
+        sketch with zero rates.
+    t_eval : array_like, optional
+        Output times (from the dense output); default every accepted step.
+    formulation : {"exact", "analogs"}
+        Exact analogs (default) or the source paper's finite-difference analogs.
+    d : float or array_like, optional
+        Virtual displacement of ``formulation="analogs"`` (rad / m), default 0.1 deg.
+    progress : bool or None
+        Progress bar on stderr: always, never, or (None) once a run takes > 2 s.
+    events : callable or list, optional
+        Event functions ``g(t, q, qdot)`` (see :class:`mechdyn.integrate.Event`);
+        occurrences are recorded in ``Trajectory.events``.
+    t0 : float
+        Start time, s.
+    mode : iterable of str, optional
+        Engaged locks (default: the model's initial mode).
+    backend : {"auto", "numpy", "numba"}
+        Evaluation of the right-hand side (see :class:`EquationsOfMotion`).
+    iterations, tol, theta
+        Corrector passes, corrector tolerance and Wilson's theta (``wilson`` only).
+    first_step, max_step
+        Step-size bounds of the adaptive integrators, s.
+
+    Returns
+    -------
+    Trajectory
+        Also when the run stopped early: then ``status`` and ``message`` say why and
+        where, and the samples computed so far are kept.
+
+    Raises
+    ------
+    IntegratorOptionError, ModelError
+        Bad options (unknown integrator or formulation, steps <= 0, theta < 1.37 but
+        != 1, rtol <= 0, t_end < t0 ...), or an initial state that cannot be
+        assembled.
+    """
+    wall0 = time.perf_counter()
+    model = _as_model(mech_or_model)
+    try:
+        t0 = float(t0)
+        t_end_f = float(t_end)
+    except (TypeError, ValueError):
+        raise IntegratorOptionError(f"`t_end` must be a time in s, got {t_end!r}") from None
+    if not math.isfinite(t_end_f) or t_end_f < t0 or t_end_f < 0:
+        raise IntegratorOptionError(f"`t_end` must be finite and >= t0 = {t0:g} s, "
+                                    f"got {t_end!r}")
+    if formulation not in FORMULATIONS:
+        raise IntegratorOptionError(f"unknown formulation {formulation!r}; valid formulations: "
+                                    + ", ".join(FORMULATIONS))
+    integ = make_integrator(integrator, steps=steps, dt=dt, rtol=rtol, atol=atol,
+                            iterations=iterations, tol=tol, theta=theta,
+                            first_step=first_step, max_step=max_step)
+    te = sample_times(t0, t_end_f, t_eval)
+    ev = as_events(events)
+
+    q_init, qd_init, x_init = initial_state(model, q0, qdot0, mode=mode)
+    t_compile = time.perf_counter()
+    eom = EquationsOfMotion(model, formulation, d=d, mode=mode, x0=x_init, backend=backend)
+    t_compile = time.perf_counter() - t_compile
+    # the initial position must be regular and the equations solvable there
+    x_init = eom.positions(q_init, t0, check_singular=True)
+    a_init = eom.qddot(t0, q_init, qd_init)
+    eval0 = eom.total_evaluations
+
+    T, Q, QD, QDD, X, W = [], [], [], [], [], []
+
+    def record(t, q, qd, qdd, x, w):
+        T.append(t)
+        Q.append(np.array(q, float))
+        QD.append(np.array(qd, float))
+        QDD.append(np.array(qdd, float))
+        X.append(np.array(x, float))
+        W.append(float(w[0]) if len(w) else 0.0)
+
+    k_eval = 0
+    if te is None:
+        record(t0, q_init, qd_init, a_init, x_init, [0.0])
+    else:
+        while k_eval < te.size and te[k_eval] <= t0:
+            record(t0, q_init, qd_init, a_init, x_init, [0.0])
+            k_eval += 1
+
+    status, message = "success", ""
+    records: list = []
+    g_old = np.array([e(t0, q_init, qd_init) for e in ev])
+    bar = _Progress(progress, t0, t_end_f)
+    t_good, q_good, x_good, qd_good = t0, q_init, x_init, qd_init
+    steps_iter = integ.integrate(eom.rhs, t0, q_init, qd_init, t_end_f, w0=np.zeros(1),
+                                 first_order=eom.first_order_function())
+    try:
+        with np.errstate(over="raise", invalid="raise", divide="raise"):
+            for step in steps_iter:
+                if not (np.all(np.isfinite(step.q)) and np.all(np.isfinite(step.qdot))
+                        and np.all(np.isfinite(step.qddot))):
+                    status = "non-finite"
+                    message = (f"non-finite state at t = {step.t:.9g} s after "
+                               f"{_fmt_q(model, q_good)} at t = {t_good:.9g} s")
+                    break
+                turn = _turning_point_check(eom, step, qd_good, x_good)
+                if turn is not None:
+                    status, message = turn
+                    break
+                t_stop, terminal = step.t, False
+                if ev:
+                    rec, g_old, terminal = locate_events(ev, g_old, step)
+                    records.extend(rec)
+                    if terminal:
+                        t_stop = rec[-1].t
+                # positions at the step end, re-solved from q and checked for a dead position
+                x_end = eom.positions(step.q, step.t, check_singular=True)
+                if te is None:
+                    if terminal:
+                        q, v, w = step.dense(t_stop)
+                        x = eom.positions(q, t_stop)
+                        record(t_stop, q, v, eom.qddot(t_stop, q, v), x, w)
+                    else:
+                        record(step.t, step.q, step.qdot, step.qddot, x_end, step.w)
+                else:
+                    while k_eval < te.size and te[k_eval] <= t_stop:
+                        ts = te[k_eval]
+                        if ts == step.t:
+                            record(ts, step.q, step.qdot, step.qddot, x_end, step.w)
+                        else:
+                            q, v, w = step.dense(ts)
+                            x = eom.positions(q, ts)
+                            record(ts, q, v, eom.qddot(ts, q, v), x, w)
+                        k_eval += 1
+                    eom.positions(step.q, step.t)  # continue from the step end
+                t_good, q_good, x_good, qd_good = step.t, step.q, x_end, step.qdot
+                bar.update(step.t)
+                if terminal:
+                    status = "event"
+                    message = f"terminal event {records[-1].name!r} at t = {t_stop:.9g} s"
+                    break
+    except (MechdynError, FloatingPointError, ArithmeticError, np.linalg.LinAlgError) as exc:
+        if isinstance(exc, ModelError) and not isinstance(exc, IntegratorOptionError):
+            bar.close()
+            raise
+        status, message = _diagnose(eom, exc, t_good, q_good, x_good)
+    finally:
+        bar.close()
+        steps_iter.close() if hasattr(steps_iter, "close") else None
+
+    n_q, n_x = model.n_q, model.n_x
+    t_arr = np.array(T, float)
+    q_arr = np.array(Q, float).reshape(-1, n_q)
+    qd_arr = np.array(QD, float).reshape(-1, n_q)
+    qdd_arr = np.array(QDD, float).reshape(-1, n_q)
+    x_arr = np.array(X, float).reshape(-1, n_x)
+    lay = eom.layout
+    if t_arr.size:
+        B = velocity_analogs(model, x_arr, lay)
+        xd_arr = (B @ qd_arr[..., None])[..., 0]
+        # bodies, plus rotors and gears of the drives reduced to their coordinates
+        Tk = kinetic_energy(model, x_arr, xd_arr) + 0.5 * (qd_arr**2) @ eom.extra_inertia
+        U = potential_energy(model, x_arr)
+        Wn = np.array(W, float)
+        r = residual(model, x_arr, lay)
+        res = np.max(np.abs(r), axis=-1) if r.shape[-1] else np.zeros(t_arr.size)
+        energy = {"kinetic": Tk, "potential": U, "work_nc": Wn, "balance": Tk + U - Wn,
+                  "residual": res}
+    else:
+        xd_arr = np.zeros((0, n_x))
+        energy = None
+    wall = time.perf_counter() - wall0
+    stats = {"integrator": integ.name, "formulation": formulation, "backend": eom.backend,
+             **integ.stats.as_dict(), "evaluations": eom.total_evaluations - eval0,
+             "integrator_evaluations": integ.stats.evaluations, "wall_time_s": wall,
+             "setup_time_s": t_compile, "settings": integ.settings(),
+             "mode": sorted(lay.mode)}
+    if eom.kernel is not None:
+        stats["compile_time_s"] = eom.kernel.compile_time
+    elif eom.backend_note:
+        stats["backend_note"] = eom.backend_note
+    return Trajectory(t_arr, q_arr, qd_arr, qdd_arr, x_arr, xd_arr, status, message, records,
+                      stats, energy, tuple(model.coordinate_names), tuple(model.body_names),
+                      tuple(bool(v) for v in model.coord_is_angle), model)
