@@ -326,6 +326,18 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
     if formulation not in FORMULATIONS:
         raise IntegratorOptionError(f"unknown formulation {formulation!r}; valid formulations: "
                                     + ", ".join(FORMULATIONS))
+    from .simulate_events import needs_event_loop, simulate_events
+
+    if needs_event_loop(model):
+        # switches, stops, contacts: the event loop integrates mode by mode
+        name = integrator if isinstance(integrator, str) else type(integrator).__name__
+        if name.lower() not in ("dop853", "rk45"):
+            raise IntegratorOptionError(
+                f"integrator {name!r} is not available for a variable-structure mechanism "
+                "(switches, stops or contacts): use 'dop853' or 'rk45'")
+        return simulate_events(model, t_end_f, q0=q0, qdot0=qdot0, t0=t0, mode=mode,
+                               rtol=rtol, atol=atol, max_step=max_step, t_eval=t_eval,
+                               method=name.upper())
     integ = make_integrator(integrator, steps=steps, dt=dt, rtol=rtol, atol=atol,
                             iterations=iterations, tol=tol, theta=theta,
                             first_step=first_step, max_step=max_step)

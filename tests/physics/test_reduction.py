@@ -301,9 +301,6 @@ def test_reduced_run_with_fixed_step_integrators(integrator, options):
     np.testing.assert_allclose(run.omega, ref.omega, rtol=tol)
 
 
-@pytest.mark.xfail(reason="needs the dynamics hook A[k, k] += drive.torque.extra_inertia() "
-                          "(rotor and gear inertia of motors.GearStage) in dynamics/lagrange.py",
-                   strict=False)
 def test_full_simulation_includes_rotor_inertia_through_the_gear():
     simulate = pytest.importorskip("mechdyn.simulate").simulate
     from mechdyn.mechanism.motors import drive_from_table

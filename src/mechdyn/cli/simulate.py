@@ -127,6 +127,10 @@ def run(args) -> int:
                     backend=args.backend, theta=args.theta,
                     iterations=args.iterations if fixed else None)
     print(traj.summary())
+    if traj.events:
+        from ..simulate_events import format_events
+
+        print(format_events(traj.events, traj.coordinate_names, limit=40))
     if traj.t.size:
         last = ", ".join(
             f"{n} = {np.rad2deg(v):.9g} deg" if a else f"{n} = {v * 1e3:.9g} mm"
@@ -136,6 +140,10 @@ def run(args) -> int:
     if args.output:
         traj.to_dataframe(points=args.points).to_csv(args.output, index=False)
         print(f"wrote {args.output} ({traj.t.size} rows)")
+        if traj.events:
+            ev_path = _events_path(args.output)
+            _events_table(traj).to_csv(ev_path, index=False)
+            print(f"wrote {ev_path} ({len(traj.events)} events)")
     if args.plot:
         from ..results.plot_dynamics import plot_trajectory
 
@@ -145,3 +153,30 @@ def run(args) -> int:
         print(f"mechdyn simulate: stopped early: {traj.status}: {traj.message}", file=sys.stderr)
         return 1
     return 0
+
+
+def _events_path(output: str):
+    from pathlib import Path
+
+    p = Path(output)
+    return p.with_name(p.stem + "_events.csv")
+
+
+def _events_table(traj):
+    """One row per switching event: time, kind, element, modes, coordinates, energy lost."""
+    import numpy as np
+    import pandas as pd
+
+    rows = []
+    for ev in traj.events:
+        row = {"t_s": getattr(ev, "t", np.nan), "kind": getattr(ev, "kind", type(ev).__name__),
+               "element": getattr(ev, "element", getattr(ev, "name", "")),
+               "mode_before": " ".join(sorted(getattr(ev, "mode_before", ()) or ())),
+               "mode_after": " ".join(sorted(getattr(ev, "mode_after", ()) or ())),
+               "energy_lost_J": getattr(ev, "energy_lost", 0.0)}
+        qa = getattr(ev, "q_after", None)
+        if qa is not None:
+            for n, v in zip(traj.coordinate_names, np.atleast_1d(qa), strict=False):
+                row[f"{n}_after"] = v
+        rows.append(row)
+    return pd.DataFrame(rows)
