@@ -17,7 +17,7 @@ from .errors import ModelError, did_you_mean
 from .mechanism.body import GROUND
 from .mechanism.joint import Lock, Prismatic, Revolute
 
-__all__ = ["Model", "RevoluteRows", "PrismaticRows", "LockRows"]
+__all__ = ["Model", "RevoluteRows", "PrismaticRows", "LockRows", "as_model"]
 
 COORD_ANGLE, COORD_RELATIVE, COORD_TRAVEL = 0, 1, 2
 _KIND_CODE = {"angle": COORD_ANGLE, "relative_angle": COORD_RELATIVE, "travel": COORD_TRAVEL}
@@ -310,3 +310,12 @@ class ConstraintLayout:
         self.row_joint = np.empty(k, dtype=object)
         for n, r in rows.items():
             self.row_joint[r] = n
+
+
+def as_model(mech_or_model) -> Model:
+    """The compiled :class:`Model` of a Mechanism (compiled and validated here) or a Model."""
+    if isinstance(mech_or_model, Model):
+        return mech_or_model
+    if hasattr(mech_or_model, "compile"):
+        return mech_or_model.compile()
+    raise TypeError(f"expected a Mechanism or a Model, got {type(mech_or_model).__name__}")

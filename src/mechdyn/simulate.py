@@ -38,7 +38,7 @@ from .integrate.events import as_events, locate_events
 from .kinematics.analogs import velocity_analogs
 from .kinematics.assembly import singularity, solve_position
 from .kinematics.constraints import coordinates, residual
-from .model import Model
+from .model import Model, as_model
 from .results.trajectory import Trajectory
 
 __all__ = ["simulate", "initial_state"]
@@ -50,12 +50,6 @@ DEAD_RCOND = 1e-4
 PROGRESS_AFTER = 2.0
 
 
-def _as_model(mech_or_model) -> Model:
-    if isinstance(mech_or_model, Model):
-        return mech_or_model
-    if hasattr(mech_or_model, "compile"):
-        return mech_or_model.compile()
-    raise TypeError(f"expected a Mechanism or a Model, got {type(mech_or_model).__name__}")
 
 
 def _values(model: Model, given, base: np.ndarray, what: str) -> np.ndarray:
@@ -314,7 +308,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
         assembled.
     """
     wall0 = time.perf_counter()
-    model = _as_model(mech_or_model)
+    model = as_model(mech_or_model)
     try:
         t0 = float(t0)
         t_end_f = float(t_end)

@@ -65,7 +65,7 @@ from ..kinematics.constraints import (
 )
 from ..mechanism.drive import TorqueSpeedCurve
 from ..mechanism.load import Table
-from ..model import COORD_TRAVEL, ConstraintLayout, Model
+from ..model import COORD_TRAVEL, ConstraintLayout, Model, as_model
 from .forces import LoadContext, evaluate, force_model
 
 __all__ = ["Kinetostatics", "kinetostatics", "inertia_forces", "frame_mass_matrix",
@@ -103,12 +103,6 @@ def _col_scale(model: Model) -> np.ndarray:
     return s
 
 
-def _as_model(mech_or_model) -> Model:
-    if isinstance(mech_or_model, Model):
-        return mech_or_model
-    if hasattr(mech_or_model, "compile"):
-        return mech_or_model.compile()
-    raise TypeError(f"expected a Mechanism or a Model, got {type(mech_or_model).__name__}")
 
 
 # ================================================================ inertia
@@ -1132,7 +1126,7 @@ def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
     0.981
     """
     t_start = time.perf_counter()
-    model = _as_model(mech_or_model)
+    model = as_model(mech_or_model)
     fm = force_model(model)
     if model_drives not in ("replace", "load"):
         raise ValueError(f"model_drives must be 'replace' or 'load', got {model_drives!r}")
@@ -1459,7 +1453,7 @@ def dead_centres(mech_or_model, body: str, point, *, coordinate: str = "y",
     """
     from scipy.optimize import minimize_scalar
 
-    model = _as_model(mech_or_model)
+    model = as_model(mech_or_model)
     lay = model.layout(mode)
     x_start = getattr(model, "x0", model.x_sketch)
     over_idx = [model.coordinate_index(over)] if over else []

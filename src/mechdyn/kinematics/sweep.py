@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError, SingularPositionError, did_you_mean
-from ..model import Model
+from ..model import Model, as_model
 from ._sweep_kernel import Kernel
 from .assembly import assemble, singularity
 from .constraints import coordinates, point_acceleration, point_position, point_velocity
@@ -773,13 +773,6 @@ def _refine_dead_centre(sw: KinematicSweep, jname: str, i: int) -> tuple[float, 
 
 
 # ====================================================================== analyses
-def _as_model(mech_or_model) -> Model:
-    if isinstance(mech_or_model, Model):
-        return mech_or_model
-    compile_ = getattr(mech_or_model, "compile", None)
-    if compile_ is None:
-        raise TypeError(f"expected a Mechanism or a Model, got {type(mech_or_model).__name__}")
-    return compile_()
 
 
 def initial_coordinates(model: Model, x0=None) -> np.ndarray:
@@ -910,7 +903,7 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
         The mechanism cannot be assembled at the start of the sweep.
     """
     t_start = time.perf_counter()
-    model = _as_model(mech_or_model)
+    model = as_model(mech_or_model)
     if model.n_q == 0:
         raise ModelError("the mechanism has no coordinates to sweep")
     if over is None:
@@ -1104,7 +1097,7 @@ def analyze(mech_or_model, q, qdot, qddot=None, x_guess=None, *, mode=None) -> K
     -------
     KinematicPoint
     """
-    model = _as_model(mech_or_model)
+    model = as_model(mech_or_model)
     lay = model.layout(mode)
     kern = _kernel(model, lay)
     q = np.asarray(q, float).reshape(model.n_q)
