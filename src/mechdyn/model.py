@@ -164,6 +164,11 @@ class Model:
         self.mass_diag[:, 2] = self.inertia  # body frame = ... see mass_matrix
         self.mass_diag = self.mass_diag.reshape(-1)
         self.initial_mode = self.mode_of(self.lock.engaged)
+        #: declared assembly modes: (AssemblyMode, ((body index, local point) for P, Q, R))
+        self.assembly_modes = [
+            (am, tuple((self._bindex[b], np.asarray(self._point(b, ref), dtype=float))
+                       for b, ref in am.points))
+            for am in mechanism.extras.get("assembly", [])]
         self._layouts: dict = {}
 
     # ------------------------------------------------------------------ lookups

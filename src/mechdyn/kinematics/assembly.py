@@ -14,10 +14,10 @@ from scipy.optimize import least_squares
 
 from ..errors import AssemblyError, SingularPositionError
 from ..model import ConstraintLayout, Model
-from .constraints import coordinates, jacobian, residual, system
+from .constraints import coordinates, extend, jacobian, residual, system
 
 __all__ = ["solve_position", "assemble", "joint_residuals", "singularity", "rank_report",
-           "branch_sign", "SINGULAR_RCOND"]
+           "branch_sign", "turn_signs", "SINGULAR_RCOND"]
 
 #: ratio sigma_min / sigma_max of the scaled Jacobian below which a position is singular
 SINGULAR_RCOND = 1e-9
@@ -209,7 +209,102 @@ def branch_sign(model: Model, x, layout: ConstraintLayout | None = None) -> np.n
     return np.sign(np.linalg.det(J * _scale(model)))
 
 
+def _world(X, b, s):
+    c, sn = np.cos(X[..., b, 2]), np.sin(X[..., b, 2])
+    return X[..., b, :2] + np.stack([c * s[0] - sn * s[1], sn * s[0] + c * s[1]], axis=-1)
+
+
+def turn_signs(model: Model, x) -> dict:
+    """Turn P -> Q -> R of every declared assembly mode at pose(s) ``x``.
+
+    Returns
+    -------
+    dict
+        name -> +1 (left, counter-clockwise), -1 (right) or 0 (straight: a toggle
+        position), an array for a batch of poses.
+    """
+    X = extend(model, x)
+    out = {}
+    for am, ((bp, sp), (bq, sq), (br, sr)) in model.assembly_modes:
+        P, Q, R = _world(X, bp, sp), _world(X, bq, sq), _world(X, br, sr)
+        a, b = Q - P, R - Q
+        out[am.name] = np.sign(a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0])
+    return out
+
+
+def _wrong_modes(model: Model, x) -> list:
+    signs = turn_signs(model, x)
+    return [am for am, _ in model.assembly_modes if signs[am.name] != am.sign]
+
+
+def _mirror_guess(model: Model, x, am, pts) -> np.ndarray:
+    """Sketch with the bodies that meet at Q mirrored across the line P-R
+    (each body refitted as a rigid body to its mirrored points)."""
+    X = extend(model, x)
+    (bp, sp), (bq, sq), (br, sr) = pts
+    P, Q, R = _world(X, bp, sp), _world(X, bq, sq), _world(X, br, sr)
+    d = R - P
+    n = np.hypot(*d)
+    if n == 0:
+        return np.asarray(x, float)
+    d = d / n
+    xg = np.array(x, dtype=float)
+    tol = 1e-6 * model.length_scale
+    for k, name in enumerate(model.body_names):
+        body = model.mechanism.bodies[name]
+        local = np.array([body.point(p) for p in body.point_names()] + [(0.0, 0.0)])
+        world = np.array([_world(X, k, s) for s in local])
+        if not np.any(np.hypot(*(world - Q).T) < tol) or k in (bp, br):
+            continue
+        rel = world - P
+        mirrored = P + 2 * np.outer(rel @ d, d) - rel
+        # rigid fit (rotation only): angle from the centred cross-covariance
+        lc, mc = local - local.mean(0), mirrored - mirrored.mean(0)
+        th = np.arctan2(np.sum(lc[:, 0] * mc[:, 1] - lc[:, 1] * mc[:, 0]),
+                        np.sum(lc[:, 0] * mc[:, 0] + lc[:, 1] * mc[:, 1]))
+        c, s = np.cos(th), np.sin(th)
+        origin = mirrored.mean(0) - np.array([c * local.mean(0)[0] - s * local.mean(0)[1],
+                                              s * local.mean(0)[0] + c * local.mean(0)[1]])
+        # keep the angle on the branch of the sketch angle (no 2 pi jumps)
+        th = xg[3 * k + 2] + np.angle(np.exp(1j * (th - xg[3 * k + 2])))
+        xg[3 * k:3 * k + 3] = (origin[0], origin[1], th)
+    return xg
+
+
 def assemble(model: Model, q=None, *, x_guess=None, layout=None, t=None) -> np.ndarray:
+    """Assemble the mechanism at coordinates ``q`` in the declared assembly modes.
+
+    See :func:`_assemble_near` for the solve; when the mechanism declares
+    assembly modes (:class:`~mechdyn.mechanism.assembly_mode.AssemblyMode`) and the
+    sketch lands on the other branch of a loop, the bodies meeting at that loop's
+    point Q are mirrored and the mechanism re-assembled from there.
+
+    Raises
+    ------
+    AssemblyError
+        If the declared mode cannot be reached.
+    """
+    if q is None:
+        q = coordinates(model, model.x_sketch if x_guess is None else np.asarray(x_guess, float))
+    x = _assemble_near(model, q, x_guess=x_guess, layout=layout, t=t)
+    for _ in range(len(model.assembly_modes)):
+        wrong = _wrong_modes(model, x)
+        if not wrong:
+            return x
+        am = wrong[0]
+        pts = dict((a.name, p) for a, p in model.assembly_modes)[am.name]
+        x = _assemble_near(model, q, x_guess=_mirror_guess(model, x, am, pts), layout=layout,
+                           t=t)
+    wrong = _wrong_modes(model, x)
+    if wrong:
+        names = ", ".join(f"{am.name!r} (declared {am.turn!r})" for am in wrong)
+        raise AssemblyError(
+            f"the declared assembly mode(s) {names} could not be reached from the sketch; "
+            "draw the sketch in the declared mode or check the points P, Q, R", t=t, q=q)
+    return x
+
+
+def _assemble_near(model: Model, q=None, *, x_guess=None, layout=None, t=None) -> np.ndarray:
     """Assemble the mechanism from the sketch (or ``x_guess``) at coordinates ``q``.
 
     With ``q`` None the coordinates are measured on the sketch.  A least-squares

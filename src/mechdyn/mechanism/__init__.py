@@ -1,5 +1,6 @@
 """Mechanism description: frozen elements in SI units, no time, no solver."""
 
+from .assembly_mode import AssemblyMode
 from .body import GROUND, Body, Ground
 from .coordinate import COORDINATE_KINDS, Coordinate
 from .drive import Drive, TorqueSpeedCurve
@@ -7,6 +8,6 @@ from .joint import Joint, Lock, Prismatic, Revolute
 from .load import Force, RotarySpring, Spring, Table, Torque, pulse
 from .mechanism import Mechanism
 
-__all__ = ["GROUND", "Body", "Ground", "Coordinate", "COORDINATE_KINDS", "Joint", "Revolute",
-           "Prismatic", "Lock", "Mechanism", "Drive",
-           "TorqueSpeedCurve", "Force", "RotarySpring", "Spring", "Table", "Torque", "pulse"]
+__all__ = ["AssemblyMode", "GROUND", "Body", "Ground", "Coordinate", "COORDINATE_KINDS", "Joint",
+           "Revolute", "Prismatic", "Lock", "Mechanism", "Drive", "TorqueSpeedCurve", "Force",
+           "RotarySpring", "Spring", "Table", "Torque", "pulse"]

@@ -106,6 +106,16 @@ class Mechanism:
         """Add a switchable weld (:class:`Lock`) between two bodies."""
         return self.add(Lock(name, parent, child, engaged, offset))
 
+    def add_assembly_mode(self, name, p, q, r, turn="left"):
+        """Declare the assembly branch of a loop: the turn P -> Q -> R at Q.
+
+        ``p``, ``q``, ``r`` are (body, point) pairs; ``turn`` is "left" or "right"
+        (see :class:`~mechdyn.mechanism.assembly_mode.AssemblyMode`).
+        """
+        from .assembly_mode import AssemblyMode
+
+        return self.add(AssemblyMode(name, (tuple(p), tuple(q), tuple(r)), turn))
+
     def add_coordinate(self, name, kind="angle", body=None, joint=None,
                        offset=0.0) -> Coordinate:
         """Declare a generalized coordinate (see :class:`Coordinate`)."""
@@ -198,6 +208,15 @@ class Mechanism:
                                f"{type(self.joints[c.joint]).__name__.lower()}; "
                                f"{want.__name__.lower()} joints: "
                                + (", ".join(repr(v) for v in valid) or "(none)"))
+        for am in self.extras.get("assembly", []):
+            for role, (bname, ref) in zip("PQR", am.points, strict=True):
+                where = f"assembly mode {am.name!r}: point {role}"
+                if bname not in names:
+                    out.append(f"{where}: " + did_you_mean(bname, names, "body"))
+                elif isinstance(ref, str) and ref not in self.body(bname).point_names():
+                    out.append(f"{where}: unknown point {ref!r} of body {bname!r}; valid "
+                               "point names: " + ", ".join(
+                                   repr(p) for p in self.body(bname).point_names()))
         if not self.bodies:
             out.append("the mechanism has no moving bodies")
         if not self.coordinates:

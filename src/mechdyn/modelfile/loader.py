@@ -355,10 +355,29 @@ class _Builder:
                     continue
                 names.add(el.name)
                 mech.add(el)
+        for k, spec in enumerate(self.section("assembly", list)):
+            if isinstance(spec, dict) and not self.broken("assembly", k):
+                self.assembly_mode(mech, k, spec)
         if any(k in self.doc for k in SWITCH_TABLES):
             for p in parse_switches(self.doc, mech, self.fname):
                 self.problem(p)
         return mech
+
+    # ------------------------------------------------------------ assembly modes
+    def assembly_mode(self, mech: Mechanism, k: int, spec: dict) -> None:
+        """An [[assembly]] entry: points "body.point" P, Q, R and the turn at Q."""
+        pts = []
+        for i, text in enumerate(spec.get("points", [])):
+            body, _, point = str(text).partition(".")
+            if not point:
+                self.problem(f"{self.where('assembly', k, 'points', i)}: {text!r}: write a "
+                             "point as \"body.point\", e.g. \"rod.B\"")
+                return
+            pts.append((body, point))
+        if len(pts) != 3 or "turn" not in spec:
+            return
+        name = spec.get("name") or f"{pts[1][0]}.{pts[1][1]}"
+        mech.add_assembly_mode(name, *pts, turn=spec["turn"])
 
     # ------------------------------------------------------------ bodies
     def body(self, bname: str, spec: dict) -> Body:
