@@ -331,7 +331,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
                 "(switches, stops or contacts): use 'dop853' or 'rk45'")
         return simulate_events(model, t_end_f, q0=q0, qdot0=qdot0, t0=t0, mode=mode,
                                rtol=rtol, atol=atol, max_step=max_step, t_eval=t_eval,
-                               method=name.upper())
+                               method=name.upper(), progress=progress)
     integ = make_integrator(integrator, steps=steps, dt=dt, rtol=rtol, atol=atol,
                             iterations=iterations, tol=tol, theta=theta,
                             first_step=first_step, max_step=max_step)

@@ -210,7 +210,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                     t_eval=None, method: str = "DOP853", max_events: int = 100000,
                     small_velocity: float | None = None, gap_tol: float | None = None,
                     zeno_time: float | None = None,
-                    max_wall_time: float | None = None) -> Trajectory:
+                    max_wall_time: float | None = None,
+                    progress: bool | None = None) -> Trajectory:
     """Simulate a variable-structure mechanism through all its switches.
 
     Parameters
@@ -255,6 +256,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         where the bounces become shorter than ``zeno_time``.
     max_wall_time : float, optional
         Stop (status ``"timeout"``) after this many seconds of computing.
+    progress : bool or None
+        Progress bar on stderr: always, never, or (None) once a run takes > 2 s.
 
     Returns
     -------
@@ -375,6 +378,9 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     fired_once: set = set()
     n_events = 0
     last_event_t, repeat = None, 0
+    from .simulate import _Progress
+
+    bar = _Progress(progress, t0, t_end)
     while t < t_end:
         stats["segments"] += 1
         state_cache = {}
@@ -420,6 +426,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                                 f"{msg}")
                 stats["steps"] += 1
                 t_old, t_new = solver.t_old, solver.t
+                bar.update(t_new)
                 dense = solver.dense_output()
                 ev_new = evaluate(t_new, solver.y)
                 gs = [e.fn(t_new, ev_new) for e in efns]
@@ -529,6 +536,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             status, message = _status_of(exc)
             break
     stats["penetration"] = penetration
+    bar.close()
     return _finish(model, rec, events, stats, wall0, status, message, sm)
 
 
