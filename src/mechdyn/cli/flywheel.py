@@ -59,7 +59,9 @@ def register(sub) -> None:
 
 def run(args) -> int:
     """Run ``mechdyn flywheel``; returns the exit code."""
-    from ..dynamics.reduction import ReducedMachine, reduce_model, size_flywheel
+    from ..dynamics.flywheel import size_flywheel
+    from ..dynamics.reduced_machine import ReducedMachine
+    from ..dynamics.reduction import reduce_model
     from ..errors import ModelError
     from ..units import parse_quantity
 

@@ -57,7 +57,7 @@ def prepare_model(args):
                              parse_quantity(parts[1], "length", where="--engage y"),
                              parse_quantity(parts[2], "angle", where="--engage theta"))
     if engage or args.drop:
-        from ..dynamics.reduction import mode_mechanism
+        from ..dynamics.reduced_machine import mode_mechanism
 
         mech = mode_mechanism(mech, engage=engage, offsets=offsets, drop=args.drop)
     if args.motor is None and (args.gear_ratio is not None or args.efficiency is not None):

@@ -74,7 +74,7 @@ def plot_reduction(red, path, *, title: str | None = None, dpi: int = 120) -> Pa
 
 def plot_steady_cycle(cycle, path, *, title: str | None = None, dpi: int = 120) -> Path:
     """Speed and reduced torque over one steady cycle (a
-    :class:`~mechdyn.dynamics.reduction.SteadyCycle`)."""
+    :class:`~mechdyn.dynamics.flywheel.SteadyCycle`)."""
     x = np.degrees(cycle.phi)
     fig, ax = _figure(2)
     ax[0].plot(x, cycle.omega)
@@ -92,7 +92,7 @@ def plot_steady_cycle(cycle, path, *, title: str | None = None, dpi: int = 120) 
 
 
 def plot_startup(res, path, *, title: str | None = None, dpi: int = 120) -> Path:
-    """Speed and torques of a start-up (a :class:`~mechdyn.dynamics.reduction.StartupResult`)."""
+    """Speed and torques of a start-up (a :class:`~mechdyn.dynamics.startup.StartupResult`)."""
     run = res.run
     fig, ax = _figure(2)
     ax[0].plot(run.t, run.omega)

@@ -1,0 +1,560 @@
+"""The periodic steady motion of a reduced machine and flywheel sizing.
+
+Public names
+------------
+SteadyCycle, steady_state
+    The periodic steady motion (shooting on omega at phi0) and its coefficient
+    of speed fluctuation.
+FlywheelSizing, size_flywheel
+    Flywheel sizing by the energy method (basic and refined), confirmed or
+    corrected by simulating the steady cycle.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import IntegrationError, LockupError, ModelError
+from .reduced_machine import ReducedMachine, _frozen
+
+__all__ = ["SteadyCycle", "steady_state", "FlywheelSizing", "size_flywheel", "FLYWHEEL_METHODS"]
+
+
+# ============================================================================ steady cycle
+@dataclass(frozen=True)
+class SteadyCycle:
+    """One cycle of the periodic steady motion of a reduced machine.
+
+    Attributes
+    ----------
+    phi, t, omega, epsilon, J, M : ndarray, shape (n,)
+        Position (rad, from ``phi0`` over one period), time from the cycle start
+        (s), speed (rad/s), acceleration (rad/s^2), total inertia (kg m^2) and
+        reduced torque (N m) on one cycle.
+    omega_max, omega_min : float
+        Extreme speeds, rad/s.
+    omega_mean : float
+        (omega_max + omega_min) / 2, rad/s: the mean of the coefficient of
+        speed fluctuation and of the energy method.
+    omega_avg : float
+        True average speed, period / cycle time, rad/s.
+    delta : float
+        Coefficient of speed fluctuation (omega_max - omega_min) / omega_mean.
+    cycle_time : float
+        s.
+    phi_at_max, phi_at_min : float
+        Where the extremes occur, rad.
+    """
+
+    phi: np.ndarray
+    t: np.ndarray
+    omega: np.ndarray
+    epsilon: np.ndarray
+    J: np.ndarray
+    M: np.ndarray
+    omega_max: float
+    omega_min: float
+    omega_mean: float
+    omega_avg: float
+    delta: float
+    cycle_time: float
+    phi_at_max: float
+    phi_at_min: float
+    extra_inertia: float = 0.0
+    status: str = "success"
+    message: str = ""
+    events: tuple = ()
+    stats: dict = field(default_factory=dict)
+
+    @property
+    def delta_avg(self) -> float:
+        """(omega_max - omega_min) / omega_avg, with the true average speed."""
+        return (self.omega_max - self.omega_min) / self.omega_avg
+
+    def to_dataframe(self):
+        """Columns ``phi_deg, t_s, omega_rad_s, epsilon_rad_s2, J_total_kgm2, M_red_Nm``."""
+        import pandas as pd
+
+        return pd.DataFrame({"phi_deg": np.degrees(self.phi), "t_s": self.t,
+                             "omega_rad_s": self.omega, "epsilon_rad_s2": self.epsilon,
+                             "J_total_kgm2": self.J, "M_red_Nm": self.M})
+
+
+class _Cycle:
+    """One cycle integrated in the position with classical RK4 on a fixed grid.
+
+    State (E, t) with E = J omega^2 / 2: dE/dphi = M_red(t, phi, omega),
+    dt/dphi = 1/omega.  A fixed grid makes the cycle map omega0 -> omega_end a
+    smooth deterministic function (shooting finds its fixed point exactly) and
+    copes with loads that jump (punch windows); its error is O(h^4).
+    """
+
+    def __init__(self, machine: ReducedMachine, phi0: float, steps: int):
+        self.m = machine
+        self.phi0 = float(phi0)
+        self.steps = int(steps)
+        self.phi = self.phi0 + np.linspace(0.0, machine.period, self.steps + 1)
+        self.h = machine.period / self.steps
+        self.evaluations = 0
+
+    def _f(self, p, e, t, e_floor):
+        self.evaluations += 1
+        j = self.m.inertia(p)[0]
+        if e <= e_floor:
+            raise LockupError(
+                f"the machine stalls during the cycle at phi = {math.degrees(p):.4g} deg "
+                f"(its speed drops to zero): the driving torque cannot carry the load through "
+                f"the cycle at this speed; use startup() or start faster", q=[p])
+        w = math.sqrt(2.0 * e / j)
+        return self.m.torque(t, p, w), 1.0 / w
+
+    def run(self, omega0: float, t0: float = 0.0, record: bool = False):
+        """Integrate one cycle from speed ``omega0``; returns (omega_end, t_end, record)."""
+        if not (math.isfinite(omega0) and omega0 > 0):
+            raise IntegrationError(f"cycle start speed must be > 0 rad/s, got {omega0!r}")
+        m, h, ph = self.m, self.h, self.phi
+        e = 0.5 * m.inertia(ph[0])[0] * omega0 * omega0
+        floor = 1e-10 * e
+        t = float(t0)
+        f = self._f
+        if record:
+            E = np.empty(self.steps + 1)
+            T = np.empty(self.steps + 1)
+            M = np.empty(self.steps + 1)
+        for k in range(self.steps):
+            p = ph[k]
+            m1, r1 = f(p, e, t, floor)
+            if record:
+                E[k], T[k], M[k] = e, t, m1
+            m2, r2 = f(p + 0.5 * h, e + 0.5 * h * m1, t + 0.5 * h * r1, floor)
+            m3, r3 = f(p + 0.5 * h, e + 0.5 * h * m2, t + 0.5 * h * r2, floor)
+            m4, r4 = f(ph[k + 1], e + h * m3, t + h * r3, floor)
+            e += h * (m1 + 2.0 * m2 + 2.0 * m3 + m4) / 6.0
+            t += h * (r1 + 2.0 * r2 + 2.0 * r3 + r4) / 6.0
+        mend, _ = f(ph[-1], e, t, floor)
+        w1 = math.sqrt(2.0 * e / m.inertia(ph[-1])[0])
+        rec = None
+        if record:
+            E[-1], T[-1], M[-1] = e, t, mend
+            rec = (E, T, M)
+        return w1, t, rec
+
+
+def _omega_of(machine, phi, E):
+    J = machine.inertia_along(phi)
+    return np.sqrt(2.0 * np.maximum(E, 0.0) / J), J
+
+
+def steady_state(machine: ReducedMachine, *, omega_guess: float | None = None,
+                 omega_mean: float | None = None, phi0: float = 0.0, t0: float = 0.0,
+                 steps: int = 720, tol: float = 1e-10, max_iter: int = 60) -> SteadyCycle:
+    """The periodic steady motion: shooting on the speed at ``phi0``.
+
+    One cycle is integrated in the position (``dE/dphi = M_red`` with the kinetic
+    energy ``E = J omega^2 / 2``, and ``dt/dphi = 1/omega``; classical RK4 with
+    ``steps`` equal steps) and the speed at ``phi0`` is found for which it
+    returns after one period, ``omega(phi0 + period) = omega(phi0)`` (a few
+    fixed-point cycles, then the secant method).
+
+    Parameters
+    ----------
+    machine : ReducedMachine
+        Its torque must be periodic in phi (and may depend on omega and t).
+    omega_guess : float, optional
+        Start of the iteration, rad/s (default the drive's nominal speed, else
+        the speed at which the mean torque over a cycle vanishes).
+    omega_mean : float, optional
+        For machines whose torque does not depend on the speed (a constant
+        driving torque): the steady motions form a family, and this picks the
+        one with (omega_max + omega_min)/2 = omega_mean (rad/s).  The cycle must
+        then be balanced (zero net work), else no steady motion exists.
+    phi0 : float
+        Position where the cycle starts, rad.
+    t0 : float
+        Time at the cycle start, s (for time-dependent loads).
+    steps : int
+        RK4 steps per cycle (the cycle's samples are the steps' ends).
+    tol : float
+        Relative tolerance on the periodicity, |omega_end - omega_0| / omega_0.
+    max_iter : int
+
+    Returns
+    -------
+    SteadyCycle
+
+    Raises
+    ------
+    LockupError
+        The machine stalls within a cycle.
+    IntegrationError
+        No periodic motion was found (the message gives the change of speed over
+        a cycle).
+    """
+    from scipy.optimize import brentq
+
+    if int(steps) < 8:
+        raise ModelError(f"steps must be at least 8, got {steps!r}")
+    cyc = _Cycle(machine, phi0, steps)
+    iters = 0
+
+    def g(w0):
+        nonlocal iters
+        iters += 1
+        w1, _, _ = cyc.run(w0, t0)
+        return w1 - w0, w1
+
+    if omega_mean is not None:
+        target = float(omega_mean)
+        if not target > 0:
+            raise ModelError(f"omega_mean must be > 0 rad/s, got {omega_mean!r}")
+
+        def mean_err(w0):
+            _, _, (E, _, _) = cyc.run(w0, t0, record=True)
+            om, _ = _omega_of(machine, cyc.phi, E)
+            return 0.5 * (om.max() + om.min()) - target
+
+        lo = hi = target
+        flo = mean_err(lo)
+        if flo == 0:
+            w0 = lo
+        else:
+            step = 1.05 if flo < 0 else 1 / 1.05
+            for _ in range(200):
+                hi = hi * step
+                try:
+                    fhi = mean_err(hi)
+                except LockupError:
+                    continue
+                if np.sign(fhi) != np.sign(flo):
+                    break
+            else:
+                raise IntegrationError(f"no cycle with mean speed {target:.6g} rad/s found")
+            w0 = brentq(mean_err, min(lo, hi), max(lo, hi), xtol=1e-13 * target,
+                        rtol=4 * np.finfo(float).eps)
+        err, _ = g(w0)
+        if abs(err) > max(tol, 1e-8) * w0:
+            raise IntegrationError(
+                f"the machine has no steady motion at mean speed {target:.6g} rad/s: over one "
+                f"cycle its speed changes by {err:.6g} rad/s (the work of the driving torque "
+                f"does not balance the load); balance the mean torque or use a speed-dependent "
+                f"drive")
+        return _finish(machine, cyc, w0, t0, iters)
+
+    w0 = omega_guess if omega_guess is not None else machine.nominal_speed
+    if w0 is None:
+        w0 = _balance_speed(machine, t0, phi0)
+    if not w0 > 0:
+        raise ModelError(f"omega_guess must be > 0 rad/s, got {w0!r}")
+    w0 = float(w0)
+    # a few fixed-point cycles (the motor's slope makes the map contracting) ...
+    for _ in range(3):
+        err, w1 = g(w0)
+        if abs(err) <= tol * w0:
+            return _finish(machine, cyc, w0, t0, iters)
+        w0 = w1
+    # ... then the secant method on g(omega0) = omega_end - omega0
+    wa = w0
+    ea, _ = g(wa)
+    wb = wa * (1.0 + 1e-3)
+    eb, _ = g(wb)
+    for _ in range(max_iter):
+        if abs(eb) <= tol * wb:
+            return _finish(machine, cyc, wb, t0, iters)
+        if eb == ea:
+            break
+        wc = wb - eb * (wb - wa) / (eb - ea)
+        if not wc > 0:
+            wc = 0.5 * wb
+        wa, ea = wb, eb
+        wb = wc
+        eb, _ = g(wb)
+    raise IntegrationError(
+        f"no periodic steady motion found after {iters} cycles (last omega0 = {wb:.6g} rad/s, "
+        f"change over a cycle {eb:.3g} rad/s); a machine with a speed-independent drive needs "
+        f"omega_mean=..., and the mean driving torque must balance the load")
+
+
+def _balance_speed(machine: ReducedMachine, t0: float, phi0: float) -> float:
+    """Speed (rad/s) at which the torque averaged over a cycle at constant speed vanishes."""
+    from scipy.optimize import brentq
+
+    ph = phi0 + np.linspace(0.0, machine.period, 73)[:-1]
+
+    def mean_torque(w):
+        return float(np.mean([machine.torque(t0, p, w) for p in ph]))
+
+    ws = np.geomspace(1e-2, 1e5, 71)
+    vals = np.array([mean_torque(w) for w in ws])
+    tol = 1e-9 * max(float(np.max(np.abs(vals))), 1e-300)
+    for k in range(len(ws) - 1):
+        if vals[k] > tol and vals[k + 1] <= tol:
+            lo, hi = ws[k], ws[k + 1]
+            if vals[k + 1] < -tol:
+                return brentq(mean_torque, lo, hi, rtol=1e-10)
+            for _ in range(80):  # the torque vanishes from some speed on: its first zero
+                mid = 0.5 * (lo + hi)
+                if mean_torque(mid) > tol:
+                    lo = mid
+                else:
+                    hi = mid
+            return hi
+    raise ModelError("steady_state needs omega_guess (rad/s): no speed between 0.01 and 1e5 "
+                     "rad/s balances the mean torque over a cycle")
+
+
+def _finish(machine, cyc: _Cycle, w0, t0, iters) -> SteadyCycle:
+    from scipy.optimize import minimize_scalar
+
+    _, t1, (E, T, M) = cyc.run(w0, t0, record=True)
+    ph = cyc.phi
+    om, J = _omega_of(machine, ph, E)
+    dJ = np.array([machine.inertia(p)[1] for p in ph])
+    eps = (M - 0.5 * dJ * om**2) / J
+    h = cyc.h
+
+    # refine the extremes between the samples: cubic Hermite of E (dE/dphi = M)
+    def speed(p, k):
+        u = (p - ph[k]) / h
+        h00, h10 = 2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u
+        h01, h11 = -2 * u**3 + 3 * u**2, u**3 - u**2
+        e = h00 * E[k] + h10 * h * M[k] + h01 * E[k + 1] + h11 * h * M[k + 1]
+        return math.sqrt(2.0 * max(e, 0.0) / machine.inertia(p)[0])
+
+    ext = []
+    for k0, sign in ((int(np.argmax(om)), -1.0), (int(np.argmin(om)), 1.0)):
+        best = (sign * om[k0], ph[k0])
+        for k in (k0 - 1, k0):
+            if 0 <= k < cyc.steps:
+                r = minimize_scalar(lambda p, k=k, s=sign: s * speed(p, k),
+                                    bounds=(ph[k], ph[k + 1]), method="bounded",
+                                    options={"xatol": 1e-12})
+                best = min(best, (float(r.fun), float(r.x)))
+        ext.append((sign * best[0], best[1]))
+    (wmax, pmax), (wmin, pmin) = ext
+    wmean = 0.5 * (wmax + wmin)
+    T_cyc = t1 - t0
+    return SteadyCycle(
+        phi=_frozen(ph), t=_frozen(T - t0), omega=_frozen(om), epsilon=_frozen(eps),
+        J=_frozen(J), M=_frozen(M), omega_max=float(wmax), omega_min=float(wmin),
+        omega_mean=float(wmean), omega_avg=float(machine.period / T_cyc),
+        delta=float((wmax - wmin) / wmean), cycle_time=float(T_cyc), phi_at_max=float(pmax),
+        phi_at_min=float(pmin), extra_inertia=machine.extra_inertia,
+        stats={"cycles_integrated": iters + 1, "evaluations": cyc.evaluations,
+               "omega0": float(w0), "steps": cyc.steps})
+
+
+# ============================================================================ flywheel
+@dataclass(frozen=True)
+class FlywheelSizing:
+    """A flywheel for a target coefficient of speed fluctuation.
+
+    Attributes
+    ----------
+    delta_target : float
+    omega_mean : float
+        Mean speed of the link of reduction, rad/s.
+    delta_E_max : float
+        Largest swing of the work of the reduced torque over a cycle, J
+        (``max W - min W`` with the torque at omega_mean, balanced).
+    delta_E_refined : float
+        The same for the work minus the kinetic energy of the variable part of
+        J_red at omega_mean, J (refined energy method).
+    J_red_mean, J_red_min, J_red_max : float
+        Of the machine without the flywheel (drive inertia included), kg m^2.
+    J_fly_energy : float
+        ``delta_E_max / (delta omega_mean^2) - J_red_mean``, kg m^2 (basic energy method).
+    J_fly_refined : float
+        ``delta_E_refined / (delta omega_mean^2) - J_red_mean``, kg m^2.
+    J_fly : float
+        The recommended flywheel on the link of reduction (method ``method``),
+        kg m^2; 0 when the machine already meets the target.
+    J_fly_motor : float or None
+        The same on the motor shaft through the gear, ``J_fly / i^2``, kg m^2.
+    gear_ratio : float or None
+    delta_simulated : float or None
+        Coefficient of fluctuation of the steady cycle with ``J_fly`` added.
+    delta_without : float or None
+        Of the steady cycle without a flywheel.
+    method : str
+    cycle : SteadyCycle or None
+        The steady cycle with the flywheel.
+    """
+
+    delta_target: float
+    omega_mean: float
+    delta_E_max: float
+    delta_E_refined: float
+    J_red_mean: float
+    J_red_min: float
+    J_red_max: float
+    J_fly_energy: float
+    J_fly_refined: float
+    J_fly: float
+    J_fly_motor: float | None
+    gear_ratio: float | None
+    delta_simulated: float | None
+    delta_without: float | None
+    method: str
+    cycle: SteadyCycle | None = None
+    status: str = "success"
+    message: str = ""
+    events: tuple = ()
+    stats: dict = field(default_factory=dict)
+
+    def to_dataframe(self):
+        """One row of the sizing figures with unit-suffixed columns."""
+        import pandas as pd
+
+        return pd.DataFrame([{
+            "delta_target": self.delta_target, "omega_mean_rad_s": self.omega_mean,
+            "delta_E_max_J": self.delta_E_max, "delta_E_refined_J": self.delta_E_refined,
+            "J_red_mean_kgm2": self.J_red_mean, "J_fly_energy_kgm2": self.J_fly_energy,
+            "J_fly_refined_kgm2": self.J_fly_refined, "J_fly_kgm2": self.J_fly,
+            "J_fly_motor_kgm2": self.J_fly_motor, "gear_ratio": self.gear_ratio,
+            "delta_simulated": self.delta_simulated, "delta_without": self.delta_without,
+            "method": self.method}])
+
+
+FLYWHEEL_METHODS = ("energy", "refined", "simulation")
+
+
+def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | None = None,
+                  omega_guess: float | None = None, gear_ratio: float | None = None,
+                  method: str = "refined", confirm: bool = True, phi0: float = 0.0,
+                  t: float = 0.0, points: int = 2001, rtol: float = 1e-3) -> FlywheelSizing:
+    """Size a flywheel for a coefficient of speed fluctuation ``delta``.
+
+    Energy method: with the work ``W(phi) = int (M_red at omega_mean) dphi`` of one
+    cycle (its mean torque removed so the cycle balances), the kinetic energy
+    swings by ``Delta E_max = max W - min W``; as ``(J/2)(omega_max^2 -
+    omega_min^2) = J delta omega_mean^2`` with ``omega_mean = (omega_max +
+    omega_min)/2``, the constant inertia needed is ``Delta E_max / (delta
+    omega_mean^2)``, exact for a constant J and a torque of the position only.
+    The basic form then subtracts the mean reduced inertia; the refined form
+    subtracts from W the kinetic energy of the variable part of J_red,
+    ``(J_red - J_red_mean) omega_mean^2 / 2``, before taking the swing.
+    ``method="simulation"`` starts from the refined value and corrects it
+    (secant) until the simulated steady cycle meets ``delta`` within ``rtol``.
+
+    Parameters
+    ----------
+    machine : ReducedMachine
+    delta : float
+        Target (omega_max - omega_min)/omega_mean, in (0, 2).
+    omega_mean : float, optional
+        Mean speed, rad/s; default from the steady cycle without a flywheel
+        (needs a speed-dependent drive).
+    omega_guess : float, optional
+        Start of the steady-state iteration, rad/s.
+    gear_ratio : float, optional
+        i = omega_motor / omega_link, to report the flywheel on the motor shaft
+        (``J_fly / i^2``); default the machine's gear stage ratio if any.
+    method : {"energy", "refined", "simulation"}
+    confirm : bool
+        Simulate the steady cycle with the flywheel and report its delta.
+    phi0 : float
+        Cycle start, rad.
+    t : float
+        Time at which the torque is evaluated for the energy method, s.
+    points : int
+        Positions for the work integral.
+    rtol : float
+        Relative tolerance on delta for ``method="simulation"``.
+
+    Returns
+    -------
+    FlywheelSizing
+    """
+    from scipy.integrate import cumulative_simpson
+
+    if not (isinstance(delta, (int, float)) and 0 < delta < 2):
+        raise ModelError(f"delta (coefficient of speed fluctuation) must lie in (0, 2), "
+                         f"got {delta!r}")
+    if method not in FLYWHEEL_METHODS:
+        raise ModelError(f"method must be one of {', '.join(map(repr, FLYWHEEL_METHODS))}, "
+                         f"got {method!r}")
+    dependent = machine.speed_dependent(t)
+    if omega_mean is None:
+        if not dependent:
+            raise ModelError("the reduced torque does not depend on the speed, so the machine "
+                             "does not choose its steady speed: give omega_mean")
+        base = steady_state(machine, omega_guess=omega_guess, phi0=phi0)
+        omega_mean = base.omega_mean
+    elif dependent:
+        base = steady_state(machine, omega_guess=omega_mean, phi0=phi0)
+    else:
+        base = steady_state(machine, omega_mean=omega_mean, phi0=phi0)
+    wm = float(omega_mean)
+    if not wm > 0:
+        raise ModelError(f"omega_mean must be > 0 rad/s, got {omega_mean!r}")
+    if gear_ratio is None:
+        gear_ratio = getattr(machine.drive, "ratio", None)
+    ph = phi0 + np.linspace(0.0, machine.period, int(points))
+    M = np.array([machine.torque(t, p, wm) for p in ph])
+    J = machine.inertia_along(ph)
+    imbalance = float(np.mean(M[:-1]))  # mean torque over the cycle (uniform grid)
+    Mb = M - imbalance
+    W = cumulative_simpson(Mb, x=ph, initial=0.0)
+    W -= (W[-1] / machine.period) * (ph - ph[0])  # remove the residual quadrature drift
+    dE = float(W.max() - W.min())
+    jm = float(np.mean(J[:-1]))
+    E2 = (J - jm) * wm * wm / 2.0
+    WI = W - E2
+    dE_ref = float(WI.max() - WI.min())
+    need = 1.0 / (delta * wm * wm)
+    j_basic = dE * need - jm
+    j_ref = dE_ref * need - jm
+    j_fly = j_basic if method == "energy" else j_ref
+    msgs = []
+    if abs(imbalance) > 0.02 * max(1e-300, float(np.max(np.abs(M)))):
+        msgs.append(f"the mean torque at omega_mean is {imbalance:.4g} N m (the cycle is not "
+                    f"balanced at this speed); it was removed for the energy method")
+    if j_fly < 0:
+        msgs.append(f"the machine's own inertia meets delta = {delta:g} (the estimate is "
+                    f"{j_fly:.4g} kg m^2): no flywheel is needed")
+        j_fly = 0.0
+    cycle = None
+    d_sim = None
+    kw = {"omega_guess": wm} if dependent else {"omega_mean": wm}
+
+    def dsim(jf):
+        c = steady_state(machine.with_extra_inertia(jf), phi0=phi0, **kw)
+        return c.delta, c
+
+    if method == "simulation":
+        # 1/delta is nearly linear in the total inertia: secant on 1/delta - 1/target
+        ja = max(j_fly, 0.0)
+        da, cycle = dsim(ja)
+        jb, db = ja, da
+        if abs(da / delta - 1.0) > rtol:
+            jb = max(ja + (ja + jm) * (da / delta - 1.0), 0.0)
+            db, cycle = dsim(jb)
+            for _ in range(30):
+                if abs(db / delta - 1.0) <= rtol or db == da:
+                    break
+                jc = jb + (1 / delta - 1 / db) * (jb - ja) / (1 / db - 1 / da)
+                ja, da = jb, db
+                jb = max(jc, 0.0)
+                db, cycle = dsim(jb)
+                if jb == 0.0 and db < delta:
+                    break
+        j_fly, d_sim = jb, db
+    elif confirm:
+        d_sim, cycle = dsim(j_fly)
+    if d_sim is not None and abs(d_sim / delta - 1.0) > 0.05 and j_fly > 0:
+        msgs.append(f"the simulated delta {d_sim:.4g} differs from the target by "
+                    f"{100 * (d_sim / delta - 1):.1f} %: the energy method's assumptions "
+                    f"(torque independent of the speed, small fluctuation) do not hold well; "
+                    f"use method='simulation'")
+    d0 = base.delta
+    j_motor = None if gear_ratio is None else j_fly / float(gear_ratio) ** 2
+    return FlywheelSizing(
+        delta_target=float(delta), omega_mean=wm, delta_E_max=dE, delta_E_refined=dE_ref,
+        J_red_mean=jm, J_red_min=float(J.min()), J_red_max=float(J.max()),
+        J_fly_energy=float(j_basic), J_fly_refined=float(j_ref), J_fly=float(j_fly),
+        J_fly_motor=j_motor, gear_ratio=None if gear_ratio is None else float(gear_ratio),
+        delta_simulated=d_sim, delta_without=d0, method=method, cycle=cycle,
+        message="; ".join(msgs), stats={"mean_torque_removed_Nm": imbalance})

@@ -1,0 +1,639 @@
+"""The reduced 1-DOF machine and its equation of motion (lecture notes eq. 7.12).
+
+``J(phi) domega/dt + 1/2 omega^2 dJ/dphi = M_red(phi, omega, t)`` with
+``J = J_red + J_extra`` (rotor and gears reduced to the link, flywheel).  Since
+``d(J omega^2 / 2) / dphi = M_red``, the *energy form* ``J omega^2 / 2 =
+J_0 omega_0^2 / 2 + integral M_red dphi`` holds when M_red depends on the
+position only.
+
+Public names
+------------
+ReducedMachine, Member, MemberLoad
+    The reduced machine: from a model, from a :class:`~mechdyn.dynamics.reduction.Reduction`
+    table, from a transmission of velocity ratios (belt drives, gear trains), or
+    from plain functions.
+ReducedRun, run_reduced, energy_speed
+    Time integration of the reduced equation (with :mod:`mechdyn.integrate`) and
+    the energy form.
+mode_mechanism
+    A variable-structure mechanism in one mode (locks engaged, frozen
+    coordinates dropped), e.g. the press in its 1-DOF working mode.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..errors import IntegrationError, ModelError, did_you_mean
+from ..model import Model
+from .reduced_kinematics import _ModelEvaluator
+
+if TYPE_CHECKING:
+    from .reduction import Reduction
+
+__all__ = ["ReducedMachine", "Member", "MemberLoad", "ReducedRun", "run_reduced",
+           "energy_speed", "mode_mechanism"]
+
+TWO_PI = 2.0 * math.pi
+
+
+def _frozen(a) -> np.ndarray:
+    a = np.array(a, dtype=float, copy=True)
+    a.setflags(write=False)
+    return a
+
+
+def _extra_inertia(value) -> float:
+    """``value`` as an added inertia, kg m^2 (checked finite and >= 0)."""
+    j = float(value)
+    if not math.isfinite(j) or j < 0:
+        raise ModelError(f"extra_inertia must be >= 0 kg*m^2, got {value!r}")
+    return j
+
+
+def _drive_torque(drive, omega) -> float:
+    """Torque of a drive at ``omega`` (its ``torque_at``), N m; 0 without a drive."""
+    return 0.0 if drive is None else float(drive.torque_at(omega))
+
+
+# ============================================================================ the machine
+@dataclass(frozen=True)
+class Member:
+    """A moving member of a transmission, given by its velocity ratio to the input.
+
+    Parameters
+    ----------
+    name : str
+    inertia : float
+        Moment of inertia about its axis (kg m^2) for ``kind="rotation"``, mass
+        (kg) for ``kind="translation"``.
+    ratio : float or callable
+        ``omega_i / omega`` (rotation) or ``v_i / omega`` (translation, m/rad):
+        a constant, or a function of the input position phi.
+    ratio_derivative : float or callable, optional
+        d(ratio)/dphi; default 0 for a constant ratio, a central difference for
+        a callable.
+    kind : {"rotation", "translation"}
+    """
+
+    name: str
+    inertia: float
+    ratio: float | Callable = 1.0
+    ratio_derivative: float | Callable | None = None
+    kind: str = "rotation"
+
+    def __post_init__(self):
+        if self.kind not in ("rotation", "translation"):
+            raise ModelError(f"member {self.name!r}: kind must be 'rotation' or "
+                             f"'translation', got {self.kind!r}")
+        if not math.isfinite(float(self.inertia)) or float(self.inertia) < 0:
+            unit = "kg*m^2" if self.kind == "rotation" else "kg"
+            raise ModelError(f"member {self.name!r}: inertia must be >= 0 {unit}, "
+                             f"got {self.inertia!r}")
+
+
+@dataclass(frozen=True)
+class MemberLoad:
+    """A torque (or force) on a member, reduced by equal power.
+
+    Parameters
+    ----------
+    name : str
+    value : float or callable
+        N m (or N) in the member's positive direction of motion; a constant or
+        ``value(t, phi, omega) -> float`` of the input's position and speed.
+    ratio : float or callable
+        The member's velocity ratio to the input (as in :class:`Member`).
+    """
+
+    name: str
+    value: float | Callable = 0.0
+    ratio: float | Callable = 1.0
+
+
+def _ratio(r, phi):
+    return float(r(phi)) if callable(r) else float(r)
+
+
+def _dratio(m: Member, phi, h=1e-6):
+    if m.ratio_derivative is not None:
+        return _ratio(m.ratio_derivative, phi)
+    if not callable(m.ratio):
+        return 0.0
+    return (_ratio(m.ratio, phi + h) - _ratio(m.ratio, phi - h)) / (2 * h)
+
+
+class ReducedMachine:
+    """A one-degree-of-freedom machine reduced to one link.
+
+    Equation of motion: ``J(phi) phi'' + 1/2 J'(phi) phi'^2 = M(t, phi, phi')``
+    with ``J = J_red(phi) + extra_inertia``.
+
+    Parameters
+    ----------
+    inertia : callable
+        ``inertia(phi) -> (J_red, dJ_red/dphi)``, kg m^2 and kg m^2/rad.
+    torque : callable
+        ``torque(t, phi, omega) -> M_red``, N m (forces and drives).
+    extra_inertia : float
+        Constant inertia added on the link (rotor through the gear, flywheel), kg m^2.
+    drive : object, optional
+        The drive on the link (an object with ``torque_at``; a
+        :class:`~mechdyn.mechanism.motors.GearStage` also gives the motor-side
+        torque in :func:`~mechdyn.dynamics.startup.startup`).  Informational: its
+        torque must already be part of ``torque``.
+    period : float
+        Angle of one cycle, rad (2 pi for a crank).
+    name : str
+    coordinate : str
+        Name of the coordinate of the link of reduction (for reports).
+    nominal_speed : float, optional
+        A speed near the working point, rad/s (start of the steady-state search);
+        default from the drive (rated speed through the gear).
+
+    Build one with :meth:`from_model`, :meth:`from_reduction`,
+    :meth:`from_transmission` or :meth:`constant`.
+    """
+
+    def __init__(self, inertia: Callable, torque: Callable, *, extra_inertia: float = 0.0,
+                 drive=None, period: float = TWO_PI, name: str = "machine",
+                 coordinate: str = "phi", nominal_speed: float | None = None):
+        ej = _extra_inertia(extra_inertia)
+        if not (math.isfinite(float(period)) and period > 0):
+            raise ModelError(f"period must be > 0 rad, got {period!r}")
+        self._inertia = inertia
+        self._torque = torque
+        self.extra_inertia = ej
+        self.drive = drive
+        self.period = float(period)
+        self.name = name
+        self.coordinate = coordinate
+        self.nominal_speed = nominal_speed if nominal_speed is not None else _nominal(drive)
+
+    # ------------------------------------------------------------------ evaluation
+    def inertia(self, phi: float) -> tuple[float, float]:
+        """(J, dJ/dphi) of the whole machine (extra inertia included), kg m^2 and kg m^2/rad."""
+        j, dj = self._inertia(float(phi))
+        return float(j) + self.extra_inertia, float(dj)
+
+    def inertia_along(self, phi) -> np.ndarray:
+        """J of the whole machine at each of the positions ``phi`` (in order), kg m^2."""
+        return np.array([self.inertia(p)[0] for p in phi])
+
+    def torque(self, t: float, phi: float, omega: float) -> float:
+        """Reduced torque of forces and drives, N m."""
+        return float(self._torque(float(t), float(phi), float(omega)))
+
+    def acceleration(self, t: float, phi: float, omega: float) -> float:
+        """phi'' = (M - 1/2 J' omega^2) / J, rad/s^2."""
+        j, dj = self.inertia(phi)
+        if not j > 0:
+            raise IntegrationError(f"reduced inertia J = {j:.6g} kg*m^2 is not positive",
+                                   t=t, q=[phi])
+        return (self.torque(t, phi, omega) - 0.5 * dj * omega * omega) / j
+
+    def rhs(self, t, q, qdot):
+        """The right-hand side q'' = f(t, q, q') for :mod:`mechdyn.integrate`."""
+        return np.array([self.acceleration(t, q[0], qdot[0])])
+
+    def drive_torque(self, omega: float) -> float:
+        """Torque of the drive on the link (N m), 0 without a drive."""
+        return _drive_torque(self.drive, omega)
+
+    def motor_torque(self, omega: float) -> float | None:
+        """Motor-side torque (N m) when the drive is a gear stage, else the drive torque."""
+        if self.drive is None:
+            return None
+        fn = getattr(self.drive, "motor_torque", None)
+        return float(fn(omega)) if fn is not None else self.drive_torque(omega)
+
+    def speed_dependent(self, t: float = 0.0) -> bool:
+        """Whether the reduced torque changes with the speed (a motor, a damper)."""
+        for p in np.linspace(0.0, self.period, 7)[:-1]:
+            a = self.torque(t, p, 10.0)
+            b = self.torque(t, p, 20.0)
+            if abs(a - b) > 1e-9 * max(1.0, abs(a)):
+                return True
+        return False
+
+    def with_extra_inertia(self, added: float) -> ReducedMachine:
+        """A copy with ``added`` kg m^2 more on the link (a flywheel)."""
+        new = object.__new__(type(self))
+        new.__dict__.update(self.__dict__)
+        new.extra_inertia = self.extra_inertia + float(added)
+        return new
+
+    # ------------------------------------------------------------------ constructors
+    @classmethod
+    def from_model(cls, model: Model, *, coordinate: str | None = None,
+                   extra_inertia: float | None = None, mode=None, x0=None,
+                   period: float | None = None) -> ReducedMachine:
+        """The exact reduced machine of a 1-DOF model.
+
+        Every evaluation solves the position (continued from the last one, so
+        the assembly branch is kept), the exact analogs and the generalized
+        force of all loads and drives; ``extra_inertia`` defaults to the
+        drives' rotor and gear inertia.
+        """
+        ev = _ModelEvaluator(model, coordinate, mode=mode, x0=x0)
+        if extra_inertia is None:
+            extra_inertia = ev.drive_inertia()
+        drive = _single_drive(model, ev.coordinate)
+        if period is None:
+            period = TWO_PI if ev.is_angle else 1.0
+        m = cls(ev.inertia, ev.torque, extra_inertia=extra_inertia, drive=drive, period=period,
+                name=model.mechanism.name, coordinate=ev.coordinate)
+        m.evaluator = ev
+        return m
+
+    @classmethod
+    def from_reduction(cls, red: Reduction, model: Model | None = None, *,
+                       extra_inertia: float | None = None, drive=None) -> ReducedMachine:
+        """A fast machine interpolating a one-cycle
+        :class:`~mechdyn.dynamics.reduction.Reduction` table.
+
+        J_red is a periodic cubic spline (its derivative the spline's), the
+        applied-force torque M_forces is interpolated linearly (punch loads are
+        discontinuous) and periodically; the drive torque is evaluated live from
+        ``drive`` (default: the model's drive on the coordinate), so the table's
+        M_drive is not used.  Valid when the loads depend on the position only.
+        """
+        from scipy.interpolate import CubicSpline
+
+        if red.link is not None:
+            raise ModelError("from_reduction: reduce to the coordinate (link=None) to build a "
+                             "machine")
+        phi = np.asarray(red.phi)
+        period = phi[-1] - phi[0]
+        if not period > 0 or not np.all(np.diff(phi) > 0):
+            raise ModelError("from_reduction: the table must cover one cycle with increasing "
+                             "positions (first and last position one period apart)")
+        jj = np.array(red.J_red, dtype=float)
+        jj[-1] = jj[0]
+        spline = CubicSpline(phi, jj, bc_type="periodic")
+        coef = spline.c.T.tolist()  # per interval: c3, c2, c1, c0 in powers of (u - phi_i)
+        xs = phi.tolist()
+        mf = np.array(red.M_forces, dtype=float).tolist()
+        n_int = len(xs) - 1
+        phi0 = xs[0]
+        h = period / n_int
+        uniform = bool(np.allclose(np.diff(phi), h, rtol=1e-12, atol=0.0))
+        if drive is None and model is not None:
+            drive = _speed_drive(model, red.coordinate)
+
+        def locate(p):
+            u = phi0 + (p - phi0) % period
+            if uniform:
+                i = int((u - phi0) / h)
+            else:
+                i = bisect.bisect_right(xs, u) - 1
+            return u, min(max(i, 0), n_int - 1)
+
+        def inertia(p):
+            u, i = locate(p)
+            d = u - xs[i]
+            c3, c2, c1, c0 = coef[i]
+            return ((c3 * d + c2) * d + c1) * d + c0, (3.0 * c3 * d + 2.0 * c2) * d + c1
+
+        def torque(t, p, w):
+            u, i = locate(p)
+            r = (u - xs[i]) / (xs[i + 1] - xs[i])
+            m = mf[i] + r * (mf[i + 1] - mf[i])
+            return m + _drive_torque(drive, w)
+
+        if extra_inertia is None:
+            extra_inertia = float(red.stats.get("extra_inertia_coordinate", 0.0))
+        return cls(inertia, torque, extra_inertia=extra_inertia, drive=drive, period=period,
+                   coordinate=red.coordinate)
+
+    @classmethod
+    def from_transmission(cls, members: Sequence[Member], loads: Sequence[MemberLoad] = (),
+                          drive=None, *, period: float = TWO_PI,
+                          name: str = "transmission") -> ReducedMachine:
+        """A machine given by the velocity ratios of its members (lecture notes §6).
+
+        ``J_red = sum I_i r_i^2``, ``dJ_red/dphi = 2 sum I_i r_i r_i'``,
+        ``M_red = sum M_j r_j + drive.torque_at(omega)``.  This is the honest way
+        to reduce a belt drive or a gear train: mechdyn has no belt or gear-mesh
+        joint, but their velocity ratios are exactly what the reduction needs.
+
+        Parameters
+        ----------
+        members : sequence of Member
+        loads : sequence of MemberLoad
+        drive : object with ``torque_at(omega)``, optional
+            A motor on the input (its ``extra_inertia()`` is added).
+        """
+        members = list(members)
+        loads = list(loads)
+        names = [m.name for m in members]
+        if len(set(names)) != len(names):
+            raise ModelError(f"transmission: member names must be unique, got {names}")
+
+        def inertia(p):
+            j = sum(m.inertia * _ratio(m.ratio, p) ** 2 for m in members)
+            dj = sum(2.0 * m.inertia * _ratio(m.ratio, p) * _dratio(m, p) for m in members)
+            return j, dj
+
+        def torque(t, p, w):
+            tot = 0.0
+            for ld in loads:
+                v = ld.value(t, p, w) if callable(ld.value) else ld.value
+                tot += float(v) * _ratio(ld.ratio, p)
+            return tot + _drive_torque(drive, w)
+
+        extra = float(drive.extra_inertia()) if hasattr(drive, "extra_inertia") else 0.0
+        return cls(inertia, torque, extra_inertia=extra, drive=drive, period=period, name=name)
+
+    @classmethod
+    def constant(cls, inertia: float, torque: Callable | float, *, drive=None,
+                 period: float = TWO_PI, name: str = "machine") -> ReducedMachine:
+        """A machine of constant inertia (kg m^2) and torque ``torque(t, phi, omega)`` (N m)
+        or a constant; a ``drive`` adds its ``torque_at(omega)``."""
+        if not inertia > 0:
+            raise ModelError(f"inertia must be > 0 kg*m^2, got {inertia!r}")
+        j = float(inertia)
+
+        def tq(t, p, w):
+            v = torque(t, p, w) if callable(torque) else torque
+            return float(v) + _drive_torque(drive, w)
+
+        return cls(lambda p: (j, 0.0), tq, drive=drive, period=period, name=name)
+
+
+def _single_drive(model: Model, coordinate: str):
+    """The drive object on the coordinate (for reports), None if none or not a motor."""
+    objs = [d.torque for d in model.mechanism.drives if d.coordinate == coordinate]
+    objs = [o for o in objs if hasattr(o, "torque_at")]
+    return objs[0] if len(objs) == 1 else None
+
+
+class _SpeedDrives:
+    """The drives on one coordinate as one ``torque_at(omega)`` (constants, characteristics)."""
+
+    def __init__(self, parts):
+        self.parts = list(parts)
+
+    def torque_at(self, omega):
+        tot = 0.0
+        for p in self.parts:
+            if hasattr(p, "torque_at"):
+                tot += float(p.torque_at(omega))
+            elif callable(p):
+                tot += float(p(omega))
+            else:
+                tot += float(p)
+        return tot
+
+
+def _speed_drive(model: Model, coordinate: str):
+    """The drives of a coordinate as a function of its speed only (None without drives)."""
+    from ..mechanism.drive import TorqueSpeedCurve
+    from ..mechanism.load import Table
+
+    parts = []
+    for d in model.mechanism.drives:
+        if d.coordinate != coordinate:
+            continue
+        tq = d.torque
+        if hasattr(tq, "torque_at") or isinstance(tq, TorqueSpeedCurve):
+            parts.append(tq)
+        elif isinstance(tq, Table) or callable(tq):
+            raise ModelError(f"drive {d.name!r}: its torque depends on more than the speed of "
+                             f"{coordinate!r}; use the exact machine "
+                             f"(ReducedMachine.from_model, or --exact on the command line)")
+        else:
+            parts.append(float(tq))
+    if not parts:
+        return None
+    if len(parts) == 1 and hasattr(parts[0], "torque_at"):
+        return parts[0]
+    return _SpeedDrives(parts)
+
+
+def _nominal(drive) -> float | None:
+    """A speed at which a drive runs near its rated point, rad/s (None if unknown)."""
+    if drive is None:
+        return None
+    ratio = 1.0
+    d = drive
+    while hasattr(d, "ratio") and hasattr(d, "motor"):
+        ratio *= d.ratio
+        d = d.motor
+    for attr in ("rated_speed", "speed"):
+        v = getattr(d, attr, None)
+        if v is not None:
+            return float(v) / ratio
+    v = getattr(d, "no_load_speed", None)
+    if v is not None:
+        return 0.5 * float(v) / ratio
+    return None
+
+
+# ============================================================================ time runs
+@dataclass(frozen=True)
+class ReducedRun:
+    """A time history of the reduced machine.
+
+    Attributes
+    ----------
+    t, phi, omega, epsilon : ndarray, shape (n,)
+        Time (s), position (rad), speed (rad/s), acceleration (rad/s^2).
+    J, M, M_drive : ndarray, shape (n,)
+        Total reduced inertia (kg m^2), reduced torque and drive torque (N m).
+    M_motor : ndarray or None
+        Motor-side torque through a gear stage, N m.
+    """
+
+    t: np.ndarray
+    phi: np.ndarray
+    omega: np.ndarray
+    epsilon: np.ndarray
+    J: np.ndarray
+    M: np.ndarray
+    M_drive: np.ndarray
+    M_motor: np.ndarray | None = None
+    status: str = "success"
+    message: str = ""
+    events: tuple = ()
+    stats: dict = field(default_factory=dict)
+
+    def to_dataframe(self):
+        """Columns ``t_s, phi_deg, omega_rad_s, epsilon_rad_s2, J_kgm2, M_red_Nm, ...``."""
+        import pandas as pd
+
+        cols = {"t_s": self.t, "phi_deg": np.degrees(self.phi), "phi_rad": self.phi,
+                "omega_rad_s": self.omega, "epsilon_rad_s2": self.epsilon,
+                "J_total_kgm2": self.J, "M_red_Nm": self.M, "M_drive_Nm": self.M_drive}
+        if self.M_motor is not None:
+            cols["M_motor_Nm"] = self.M_motor
+        return pd.DataFrame(cols)
+
+
+def _history(machine: ReducedMachine, t, phi, omega, **kw) -> ReducedRun:
+    n = t.size
+    J = np.empty(n)
+    M = np.empty(n)
+    eps = np.empty(n)
+    md = np.empty(n)
+    mm = np.empty(n) if machine.drive is not None else None
+    for i in range(n):
+        j, dj = machine.inertia(phi[i])
+        J[i] = j
+        M[i] = machine.torque(t[i], phi[i], omega[i])
+        eps[i] = (M[i] - 0.5 * dj * omega[i] ** 2) / j
+        md[i] = machine.drive_torque(omega[i])
+        if mm is not None:
+            mm[i] = machine.motor_torque(omega[i])
+    return ReducedRun(_frozen(t), _frozen(phi), _frozen(omega), _frozen(eps), _frozen(J),
+                      _frozen(M), _frozen(md), None if mm is None else _frozen(mm), **kw)
+
+
+def run_reduced(machine: ReducedMachine, t_end: float, *, phi0: float = 0.0,
+                omega0: float = 0.0, t0: float = 0.0, integrator: str = "dop853",
+                t_eval=None, events=None, **options) -> ReducedRun:
+    """Integrate the reduced equation of motion in time.
+
+    Parameters
+    ----------
+    machine : ReducedMachine
+    t_end : float
+        End time, s.
+    phi0, omega0 : float
+        Initial position (rad) and speed (rad/s).
+    t0 : float
+        Start time, s.
+    integrator : str
+        A name of :data:`mechdyn.integrate.INTEGRATORS` (``"wilson"``, ``"rk4"``,
+        ``"dop853"``, ...).
+    t_eval : array_like, optional
+        Output times (default every step).
+    events : optional
+        Event functions ``g(t, q, qdot)`` (see :mod:`mechdyn.integrate.events`).
+    **options
+        Integrator options (``steps``/``dt`` for fixed-step ones; ``rtol``, ``atol``,
+        ``max_step`` for the adaptive ones).
+
+    Returns
+    -------
+    ReducedRun
+    """
+    from ..integrate import solve
+
+    sol = solve(integrator, machine.rhs, t0, [phi0], [omega0], t_end, t_eval=t_eval,
+                events=events, **options)
+    return _history(machine, sol.t, sol.q[:, 0], sol.qdot[:, 0],
+                    status="success" if sol.status == "success" else sol.status,
+                    events=tuple(sol.events), stats=dict(sol.stats))
+
+
+def energy_speed(machine: ReducedMachine, phi, *, phi0: float = 0.0, omega0: float,
+                 t: float = 0.0, rtol: float = 1e-11) -> np.ndarray:
+    """Speed from the energy form ``J omega^2/2 = J_0 omega_0^2/2 + int M dphi``.
+
+    Valid when the reduced torque depends on the position only: it is evaluated
+    at time ``t`` and speed ``omega0``.
+
+    Parameters
+    ----------
+    phi : array_like, shape (n,)
+        Positions, rad (any order, on either side of ``phi0``).
+    phi0, omega0 : float
+        Reference position (rad) and speed there (rad/s).
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        omega(phi), rad/s; NaN where the kinetic energy would be negative (the
+        machine cannot reach that position).
+    """
+    from scipy.integrate import solve_ivp
+
+    phi = np.asarray(phi, dtype=float).reshape(-1)
+    j0, _ = machine.inertia(phi0)
+    out = np.empty_like(phi)
+    for sign in (1.0, -1.0):
+        sel = (phi >= phi0) if sign > 0 else (phi < phi0)
+        if not np.any(sel):
+            continue
+        target = phi[sel]
+        end = target.max() if sign > 0 else target.min()
+        if end == phi0:
+            w = np.zeros(target.size)
+        else:
+            sol = solve_ivp(lambda p, y: [machine.torque(t, p, omega0)], (phi0, end), [0.0],
+                            method="DOP853", rtol=rtol, atol=1e-12 * max(1.0, j0 * omega0**2),
+                            dense_output=True)
+            w = sol.sol(target)[0]
+        jt = machine.inertia_along(target)
+        e2 = j0 * omega0**2 + 2.0 * w
+        with np.errstate(invalid="ignore"):
+            out[sel] = np.where(e2 >= 0, np.sqrt(np.maximum(e2, 0) / jt), np.nan)
+    return out
+
+
+# ============================================================================ modes
+def mode_mechanism(mechanism, *, engage: Sequence[str] = (), offsets: dict | None = None,
+                   drop: Sequence[str] = ()):
+    """A copy of a mechanism with locks engaged and the coordinates they freeze removed.
+
+    The reduction method needs one degree of freedom; a variable-structure
+    machine has it in some modes only (the clutchless press in its working mode:
+    rocker locked onto the slider).  This builds that mode as a mechanism of its
+    own.
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+    engage : sequence of str
+        Locks to engage.
+    offsets : dict, optional
+        Lock name -> pose (x m, y m, theta rad) of the child frame in the parent
+        frame held by the lock; default the lock's own offset (or the sketch).
+    drop : sequence of str
+        Coordinates to remove (those the engaged locks freeze).
+
+    Returns
+    -------
+    Mechanism
+        The original is not changed; initial values of dropped coordinates are
+        removed from ``extras["initial"]``.
+    """
+    import dataclasses
+
+    from ..mechanism.joint import Lock
+
+    offsets = dict(offsets or {})
+    joints = dict(mechanism.joints)
+    probs = []
+    for name in engage:
+        j = joints.get(name)
+        if not isinstance(j, Lock):
+            locks = [n for n, jj in joints.items() if isinstance(jj, Lock)]
+            probs.append(did_you_mean(name, locks, "lock"))
+            continue
+        off = offsets.pop(name, j.offset)
+        joints[name] = dataclasses.replace(j, engaged=True,
+                                           offset=None if off is None else tuple(map(float, off)))
+    for name in offsets:
+        probs.append(f"offsets: lock {name!r} is not in engage")
+    coords = {k: v for k, v in mechanism.coordinates.items() if k not in set(drop)}
+    for name in drop:
+        if name not in mechanism.coordinates:
+            probs.append(did_you_mean(name, mechanism.coordinates, "coordinate"))
+    if probs:
+        raise ModelError(probs)
+    extras = dict(mechanism.extras)
+    init = extras.get("initial")
+    if isinstance(init, dict):
+        extras["initial"] = {k: {c: v for c, v in dict(d or {}).items() if c in coords}
+                             for k, d in init.items()}
+    return dataclasses.replace(mechanism, joints=joints, coordinates=coords,
+                               loads=list(mechanism.loads), drives=list(mechanism.drives),
+                               extras=extras)
