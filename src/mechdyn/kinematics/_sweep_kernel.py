@@ -28,6 +28,7 @@ from scipy.sparse import csr_array
 from scipy.sparse.csgraph import connected_components, maximum_bipartite_matching
 
 from ..model import COORD_ANGLE, COORD_RELATIVE, COORD_TRAVEL, ConstraintLayout, Model
+from .assembly import _scale
 
 __all__ = ["Kernel"]
 
@@ -246,9 +247,7 @@ class Kernel:
         self.n_q = model.n_q
         self.n_eq = layout.n_rows + model.n_q
         self.square = self.n_eq == self.n_x
-        scale = np.ones(self.n_x)
-        scale[2::3] = model.length_scale
-        self.col_scale = scale
+        self.col_scale = _scale(model)
 
         rv, pr, lk = model.rev, model.pri, model.lock
         act = layout.lock_active

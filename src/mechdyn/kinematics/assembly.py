@@ -30,6 +30,11 @@ def _scale(model: Model) -> np.ndarray:
     return s
 
 
+def _position_tol(model: Model) -> float:
+    """Default residual tolerance of the position solve: 1e-13 x the length scale, m."""
+    return 1e-13 * max(model.length_scale, 1e-3)
+
+
 def _fmt_len(v: float) -> str:
     v = abs(float(v))
     if v >= 1e-3:
@@ -79,7 +84,7 @@ def solve_position(model: Model, q, x_guess, *, layout: ConstraintLayout | None 
     q = np.asarray(q, dtype=float)
     x = np.array(x_guess, dtype=float, copy=True)
     if tol is None:
-        tol = 1e-13 * max(model.length_scale, 1e-3)
+        tol = _position_tol(model)
     batch = np.broadcast_shapes(q.shape[:-1], x.shape[:-1])
     x = np.broadcast_to(x, batch + (model.n_x,)).copy()
     prev = np.full(batch, np.inf)

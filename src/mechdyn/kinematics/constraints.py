@@ -299,3 +299,10 @@ def point_acceleration(model: Model, x, xdot, xddot, body: str, point) -> np.nda
     X, V, W = extend(model, x), extend(model, xdot), extend(model, xddot)
     a = _rot(X[..., k, 2][..., None], s[None, :])[..., 0, :]
     return W[..., k, :2] + W[..., k, 2][..., None] * _perp(a) - (V[..., k, 2] ** 2)[..., None] * a
+
+
+def _point_kinematics(model: Model, x, xdot, xddot, body: str, point):
+    """Position (m), velocity (m/s) and acceleration (m/s^2) of a body point, (..., 2) each."""
+    return (point_position(model, x, body, point),
+            point_velocity(model, x, xdot, body, point),
+            point_acceleration(model, x, xdot, xddot, body, point))

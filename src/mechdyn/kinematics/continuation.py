@@ -1,0 +1,235 @@
+"""Numerical continuation along one coordinate: the building blocks of the sweep.
+
+Newton's method on a batch of positions (:func:`_newton`, :func:`_polish`) and on
+one position (:func:`_newton1`), the solved positions of the continuation
+(:class:`_Node`: pose, velocity analogs, second derivative along the swept
+coordinate and branch sign), their quintic Hermite predictor (:func:`_hermite5`,
+:func:`_predict`), the sequential step-halving march (:func:`_march`), the choice
+of the anchors it visits (:func:`_anchor_indices`) and the per-model cache of the
+evaluation kernel (:func:`_kernel`).  The analyses that use them are in
+:mod:`mechdyn.kinematics.sweep`; the dead-centre refinement of
+:mod:`mechdyn.kinematics.figures` reuses :func:`_newton1` and :func:`_node`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model import Model
+from ._sweep_kernel import Kernel
+
+#: Newton iterations allowed per step of the continuation / per batched polish
+_MAX_NEWTON = 10
+
+
+@dataclass
+class _Node:
+    """One solved position of the continuation: pose, analogs, second derivative, sign."""
+
+    q: np.ndarray  # (n_q,)
+    x: np.ndarray  # (n_x,)
+    B: np.ndarray  # (n_x, n_q)
+    H: np.ndarray  # (n_x,) d2x/dq_k^2 of the swept coordinate
+    sign: float
+
+
+def _newton(kern: Kernel, x, q, tol, max_iter=_MAX_NEWTON):
+    """Newton on a batch from ``x``; returns x, converged (N,), last F and J (at x)."""
+    x = x.copy()
+    F, J = kern.system(x, q)
+    err = np.max(np.abs(F), axis=1)
+    prev = np.full(x.shape[0], np.inf)
+    ok = err <= tol
+    active = ~ok
+    it = 0
+    while active.any() and it < max_iter:
+        it += 1
+        idx = np.flatnonzero(active)
+        dx = kern.solve(J[idx], F[idx, :, None])[..., 0]
+        xi = x[idx] - dx
+        bad = ~np.all(np.isfinite(xi), axis=1)
+        xi[bad] = x[idx][bad]
+        x[idx] = xi
+        Fi, Ji = kern.system(xi, q[idx])
+        F[idx], J[idx] = Fi, Ji
+        e = np.max(np.abs(Fi), axis=1)
+        # converged, or stagnating at round-off level
+        ok[idx] = ~bad & ((e <= tol) | ((e >= 0.5 * prev[idx]) & (e <= 1e3 * tol)))
+        diverged = bad | ~np.isfinite(e) | (e > 1e3 * np.maximum(err[idx], tol))
+        prev[idx] = e
+        active[idx] = ~ok[idx] & ~diverged
+    return x, ok, F, J
+
+
+def _newton1(kern: Kernel, x, q, tol, max_iter=_MAX_NEWTON):
+    """Newton for one position; returns x, converged, J at x and its LU factors."""
+    F, J = kern.system1(x, q)
+    err = float(np.max(np.abs(F))) if F.size else 0.0
+    first, prev = err, np.inf
+    for _ in range(max_iter):
+        if err <= tol:
+            break
+        fac = kern.factor1(J, want_sign=False)
+        dx = kern.solve1(J, fac, F)
+        xn = x - dx
+        if not np.all(np.isfinite(xn)):
+            return x, False, J, None
+        x = xn
+        F, J = kern.system1(x, q)
+        prev, err = err, float(np.max(np.abs(F)))
+        if not np.isfinite(err) or err > 1e3 * max(first, tol):
+            return x, False, J, None
+        if err >= 0.5 * prev and err <= 1e3 * tol:  # stagnating at round-off level
+            break
+    ok = err <= 1e3 * tol
+    return x, ok, J, kern.factor1(J) if ok else None
+
+
+def _polish(kern: Kernel, xp, Q, tol):
+    """Newton from accurate predictions ``xp`` (N, n_x): one batched step, then more
+    iterations only where needed.  Returns x, F and J at x, and the converged mask."""
+    F, J = kern.system(xp, Q)
+    X = xp - kern.apply(J, kern.factor(J, want_sign=False), F[..., None])[..., 0]
+    F, J = kern.system(X, Q)
+    ok = np.max(np.abs(F), axis=1) <= tol
+    if not ok.all():
+        idx = np.flatnonzero(~ok)
+        x2, ok2, F2, J2 = _newton(kern, X[idx], Q[idx], tol, max_iter=4)
+        X[idx], F[idx], J[idx], ok[idx] = x2, F2, J2, ok2
+    return X, F, J, ok
+
+
+def _node(kern: Kernel, x, q, k: int, J=None, fac=None) -> _Node:
+    """Analogs, second derivative along coordinate ``k`` and branch sign at a solved pose."""
+    if J is None:
+        _, J = kern.system1(x, q)
+        fac = kern.factor1(J)
+    B = kern.solve1(J, fac, kern.rhs_unit(1)[0])
+    H = kern.solve1(J, fac, kern.gamma1(x, B[:, k]))
+    sign = fac[2] if fac is not None else 1.0
+    return _Node(q.copy(), x.copy(), B, H, sign)
+
+
+@dataclass
+class _Stop:
+    """Where the continuation could not go on."""
+
+    node: _Node  # last solved position
+    q_try: np.ndarray  # the coordinates it could not reach
+    reason: str
+
+
+def _scaled_norm(kern, dx):
+    return float(np.max(np.abs(dx * kern.col_scale)))
+
+
+def _predict(prev: _Node | None, node: _Node, k: int, h: float) -> np.ndarray:
+    """Pose predicted at q_k + h: quintic Hermite through the last two nodes, extrapolated
+    (error O(h^6)); a second-order Taylor step when there is no usable previous node."""
+    if prev is not None:
+        hp = node.q[k] - prev.q[k]
+        if hp != 0 and abs(h) <= 2 * abs(hp):
+            t = 1.0 + h / hp  # a float: the basis is then computed in plain Python
+            return _hermite5(t, hp, prev.x, prev.B[:, k], prev.H, node.x, node.B[:, k], node.H)
+    return node.x + node.B[:, k] * h + 0.5 * node.H * h * h
+
+
+def _march(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, tol,
+           counter: dict, prev: _Node | None = None):
+    """Sequential continuation through ``targets`` (values of coordinate k).
+
+    Returns the list of nodes reached (one per target) and a :class:`_Stop` or None.
+    """
+    node = start
+    out: list[_Node] = []
+    h_try = max_step
+    L = kern.model.length_scale
+    for target in targets:
+        while node.q[k] != target:
+            remaining = target - node.q[k]
+            qn = node.q.copy()
+            if abs(remaining) <= h_try * (1 + 1e-6):
+                qn[k] = target
+            else:
+                qn[k] = node.q[k] + np.sign(remaining) * h_try
+            h = qn[k] - node.q[k]
+            xp = _predict(prev, node, k, h)
+            counter["coarse_steps"] = counter.get("coarse_steps", 0) + 1
+            x, ok, J, fac = _newton1(kern, xp, qn, tol)
+            accepted = False
+            reason = "Newton's method does not converge"
+            if ok:
+                nn = _node(kern, x, qn, k, J=J, fac=fac)
+                step = _scaled_norm(kern, nn.x - node.x)
+                corr = _scaled_norm(kern, nn.x - xp)
+                if nn.sign != node.sign:
+                    reason = "the sign of det [Phi_x; g_x] changes (the branch would be left)"
+                elif corr > 0.25 * step + 1e-9 * L:
+                    reason = "the corrector moves far from the predictor"
+                else:
+                    accepted = True
+            if not accepted:
+                counter["rejected_steps"] = counter.get("rejected_steps", 0) + 1
+                h_try = abs(h) / 2
+                prev = None  # fall back to the Taylor predictor near trouble
+                if h_try < min_step:
+                    return out, _Stop(node, qn, reason)
+                continue
+            prev, node = node, nn
+            h_try = min(2 * h_try, max_step)
+        out.append(node)
+    return out, None
+
+
+def _hermite5(t, h, x0, d0, a0, x1, d1, a1):
+    """Quintic Hermite interpolation on t in [0, 1] over an interval of length h.
+
+    x0, d0, a0 (value, first, second derivative at t=0) etc. are (N, n_x) arrays, t (N, 1).
+    """
+    t2 = t * t
+    t3 = t2 * t
+    t4 = t3 * t
+    t5 = t4 * t
+    h0 = 1 - 10 * t3 + 15 * t4 - 6 * t5
+    h1 = t - 6 * t3 + 8 * t4 - 3 * t5
+    h2 = 0.5 * (t2 - 3 * t3 + 3 * t4 - t5)
+    h3 = 0.5 * (t3 - 2 * t4 + t5)
+    h4 = -4 * t3 + 7 * t4 - 3 * t5
+    h5 = 10 * t3 - 15 * t4 + 6 * t5
+    return (h0 * x0 + h1 * h * d0 + h2 * h * h * a0 + h3 * h * h * a1 + h4 * h * d1
+            + h5 * x1)
+
+
+
+def _anchor_indices(values, max_step) -> np.ndarray:
+    """Indices of the values solved sequentially: the first, the last, every turning
+    point of the sequence, and enough in between that consecutive anchors are at most
+    ``max_step`` apart (or neighbours, if the values themselves are further apart)."""
+    n = len(values)
+    if n <= 2:
+        return np.arange(n)
+    d = np.diff(values)
+    path = np.concatenate([[0.0], np.cumsum(np.abs(d))])
+    turning = np.flatnonzero(d[:-1] * d[1:] < 0) + 1
+    ends = [0, *turning.tolist(), n - 1]
+    anchors = [0]
+    reach = max_step * (1 + 1e-9)
+    for a, b in zip(ends[:-1], ends[1:], strict=True):
+        i = a
+        while i < b:
+            j = int(np.searchsorted(path, path[i] + reach, side="right")) - 1
+            i = min(max(j, i + 1), b)
+            anchors.append(i)
+    return np.array(anchors, dtype=int)
+
+
+def _kernel(model: Model, layout) -> Kernel:
+    """The evaluation kernel of a model in a mode, cached on the model itself (so that
+    it goes away with the model)."""
+    per = model.__dict__.setdefault("_sweep_kernels", {})
+    kern = per.get(layout.mode)
+    if kern is None:
+        kern = per[layout.mode] = Kernel(model, layout)
+    return kern
