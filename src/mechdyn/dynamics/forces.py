@@ -1,35 +1,83 @@
 """Applied forces in absolute coordinates, their generalized forces and potentials.
 
-``applied_forces`` returns the force vector F (n_x,) conjugate to the body
+``ForceModel.loads`` returns the force vector F (..., n_x) conjugate to the body
 poses x: for each body the force (N) and the moment about the body-frame origin
-(N m).  The generalized forces are then Q = B^T F + Q_drive by virtual work,
-exact.  Drives act on their coordinate directly (Q_drive).
+(N m).  It works on one pose (x of shape (n_x,)) or on a batch (leading
+dimensions, as in :mod:`mechdyn.kinematics.constraints`), so forward dynamics
+(one state per call) and kinetostatics (a whole cycle per call) evaluate the
+loads with the same code.  The generalized forces are then Q = B^T F + Q_drive
+by virtual work, exact.  Drives act on their coordinate directly (Q_drive).
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
-from ..kinematics.constraints import extend
+from ..kinematics.constraints import (
+    _perp,
+    coordinates_jacobian,
+    extend,
+    point_position,
+    point_velocity,
+)
 from ..mechanism.drive import Drive
 from ..mechanism.load import Force, RotarySpring, Spring, Table, Torque
 from ..model import Model
 
-__all__ = ["LoadContext", "ForceModel", "force_model"]
+__all__ = ["LoadContext", "ForceModel", "force_model", "evaluate", "applied_forces",
+           "com_arms"]
+
+
+# ====================================================================== geometry
+def rotate(th, s) -> np.ndarray:
+    """A(th) s for angles th, shape (...,), and one body-frame vector s (2,) -> (..., 2)."""
+    c, sn = np.cos(th), np.sin(th)
+    out = np.empty(np.shape(th) + (2,))
+    out[..., 0] = c * s[0] - sn * s[1]
+    out[..., 1] = sn * s[0] + c * s[1]
+    return out
+
+
+def cross(a, b) -> np.ndarray:
+    """z component of a x b for planar vectors (..., 2) -> (...)."""
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def com_arms(model: Model, x) -> np.ndarray:
+    """A_k c_k: centres of mass relative to the frame origins in the ground frame,
+    shape (..., n_bodies, 2), m."""
+    th = np.asarray(x)[..., 2::3]
+    c, s = np.cos(th), np.sin(th)
+    cx, cy = model.com[:, 0], model.com[:, 1]
+    out = np.empty(th.shape + (2,))
+    out[..., 0] = c * cx - s * cy
+    out[..., 1] = s * cx + c * cy
+    return out
+
+
+# ====================================================================== values
+def _scalar_or_array(v):
+    return float(v) if np.ndim(v) == 0 else v
 
 
 class LoadContext:
     """What a load's value may depend on, handed to callables and tables.
 
+    One position (``t`` a float, ``q`` of shape (n_q,) ...) or a batch of
+    positions (leading dimensions ``(...)`` on every attribute); the methods
+    return floats for one position and arrays of shape ``(...)`` for a batch.
+
     Attributes
     ----------
-    t : float
+    t : float or ndarray, shape (...)
         Time, s.
-    q, qdot : ndarray, shape (n_q,)
-    x, xdot : ndarray, shape (n_x,)
+    q, qdot : ndarray, shape (..., n_q)
+    x, xdot : ndarray, shape (..., n_x)
         Body poses and their rates.
     """
 
@@ -38,30 +86,38 @@ class LoadContext:
     def __init__(self, model: Model, t, q, qdot, x, xdot):
         self.model, self.t, self.q, self.qdot, self.x, self.xdot = model, t, q, qdot, x, xdot
 
-    def coord(self, name: str) -> float:
-        """Value of a generalized coordinate (rad or m)."""
-        return float(self.q[self.model.coordinate_index(name)])
+    @property
+    def shape(self) -> tuple:
+        """The batch shape, ``()`` for one position."""
+        return np.shape(self.t)
 
-    def rate(self, name: str) -> float:
+    def at(self, k: tuple) -> LoadContext:
+        """The context of one position ``k`` (an index into :attr:`shape`) of a batch."""
+        if not k:
+            return self
+        return LoadContext(self.model, float(self.t[k]), self.q[k], self.qdot[k], self.x[k],
+                           self.xdot[k])
+
+    def coord(self, name: str):
+        """Value of a generalized coordinate (rad or m)."""
+        return _scalar_or_array(self.q[..., self.model.coordinate_index(name)])
+
+    def rate(self, name: str):
         """Rate of a generalized coordinate (rad/s or m/s)."""
-        return float(self.qdot[self.model.coordinate_index(name)])
+        return _scalar_or_array(self.qdot[..., self.model.coordinate_index(name)])
 
     def point(self, body: str, point) -> np.ndarray:
-        """Position (2,) of a body point, m."""
-        from ..kinematics.constraints import point_position
-
+        """Position (..., 2) of a body point, m."""
         return point_position(self.model, self.x, body, point)
 
     def velocity(self, body: str, point) -> np.ndarray:
-        """Velocity (2,) of a body point, m/s."""
-        from ..kinematics.constraints import point_velocity
-
+        """Velocity (..., 2) of a body point, m/s."""
         return point_velocity(self.model, self.x, self.xdot, body, point)
 
-    def variable(self, name: str) -> float:
+    def variable(self, name: str):
         """A named variable: 't', a coordinate, '<coordinate>_dot', 'body.point.x|y'."""
         if name == "t":
-            return float(self.t)
+            return _scalar_or_array(self.t)
         if name in self.model.coordinate_names:
             return self.coord(name)
         if name.endswith("_dot") and name[:-4] in self.model.coordinate_names:
@@ -69,28 +125,60 @@ class LoadContext:
         parts = name.split(".")
         if len(parts) == 3 and parts[2] in ("x", "y"):
             p = self.point(parts[0], parts[1])
-            return float(p[0] if parts[2] == "x" else p[1])
+            return _scalar_or_array(p[..., 0] if parts[2] == "x" else p[..., 1])
         raise ModelError(f"unknown table variable {name!r}; use 't', a coordinate "
                          f"({', '.join(self.model.coordinate_names)}), '<coordinate>_dot' or "
                          f"'body.point.x' / 'body.point.y'")
 
 
-def evaluate(value, ctx: LoadContext, where: str = "load") -> float:
-    """Evaluate a load value (constant, Table or callable of a LoadContext)."""
-    if isinstance(value, Table):
-        return value(ctx.variable(value.variable))
-    if callable(value):
-        out = float(value(ctx))
-    else:
-        out = float(value)
-    if not np.isfinite(out):
-        raise ModelError(f"{where}: value is not finite ({out!r}) at t = {ctx.t:.6g} s")
+def _each(fn, shape: tuple):
+    """fn(k) for every position k of a batch shape: a float for (), else an array."""
+    if not shape:
+        return fn(())
+    out = np.empty(shape)
+    for k in np.ndindex(shape):
+        out[k] = fn(k)
     return out
 
 
-def _rot(th, s):
-    c, sn = np.cos(th), np.sin(th)
-    return np.array([c * s[0] - sn * s[1], sn * s[0] + c * s[1]])
+def evaluate(value, ctx: LoadContext, where: str = "load"):
+    """Evaluate a load value (constant, Table or callable of a LoadContext).
+
+    Returns a float for one position, an array of shape ``ctx.shape`` for a
+    batch.  Callables marked ``vectorized`` get the batch context whole; others
+    are called once per position.
+    """
+    if isinstance(value, Table):
+        return value(ctx.variable(value.variable))
+    shape = ctx.shape
+    if not callable(value):
+        out = float(value)
+        if shape:
+            return np.full(shape, out)
+    elif getattr(value, "vectorized", False) and shape:
+        out = np.broadcast_to(np.asarray(value(ctx), dtype=float), shape).copy()
+    else:
+        out = _each(lambda k: float(value(ctx.at(k))), shape)
+    if math.isfinite(out) if not shape else np.isfinite(out).all():
+        return out
+    k = int(np.argmax(~np.isfinite(np.ravel(out))))
+    raise ModelError(f"{where}: value is not finite ({float(np.ravel(out)[k])!r}) at "
+                         f"t = {np.ravel(np.broadcast_to(ctx.t, shape))[k]:.6g} s")
+    return out
+
+
+# ====================================================================== the loads
+def _apply(F, b, arm, f):
+    """Add force f (..., 2) at arm (..., 2) from the origin of body slot b to F (..., nb+1, 3)."""
+    F[..., b, :2] += f
+    F[..., b, 2] += cross(arm, f)
+
+
+def _spring_geometry(X, i, si, j, sj):
+    """Arms of the two spring ends, the vector P1 -> P2 and its length."""
+    ai, aj = rotate(X[..., i, 2], si), rotate(X[..., j, 2], sj)
+    d = X[..., j, :2] + aj - X[..., i, :2] - ai
+    return ai, aj, d, np.hypot(d[..., 0], d[..., 1])
 
 
 @dataclass
@@ -105,135 +193,197 @@ class ForceModel:
     torques: list
     drives: list
 
-    # ----------------------------------------------------------------- forces
-    def applied(self, t, x, xdot, q, qdot) -> tuple[np.ndarray, np.ndarray]:
-        """Applied forces F (n_x,) on the body poses and drive forces Q_drive (n_q,)."""
+    def __post_init__(self):
         m = self.model
-        F = np.zeros(m.n_x)
-        self.add_gravity(F, x)
-        ctx = None
-        if self.springs or self.rotary or self.forces or self.torques or self.drives:
-            ctx = LoadContext(m, t, q, qdot, x, xdot)
-        X = extend(m, x)
-        V = extend(m, xdot)
+        has = bool(np.any(m.gravity)) and bool(np.any(m.mass))
+        #: the weights (n_bodies, 2), N, or None without gravity
+        self._weights = m.mass[:, None] * m.gravity if has else None
+
+    # ----------------------------------------------------------------- forces
+    def loads(self, t, x, xdot, q, qdot, *, skip_drives: Sequence[int] = (),
+              reacting_loads: Sequence[str] = (), conservative: bool = False):
+        """Applied loads at one pose or a batch of poses.
+
+        Parameters
+        ----------
+        t : float or array_like, shape (...)
+        x, xdot : array_like, shape (..., n_x)
+        q, qdot : array_like, shape (..., n_q)
+        skip_drives : sequence of int
+            Coordinates whose ``Drive`` elements are left out.
+        reacting_loads : sequence of str
+            Names of ``Force`` loads whose reaction the frame carries.
+        conservative : bool
+            Gravity and spring stiffness/preload alone (``t``, ``xdot``, ``q``
+            and ``qdot`` are then not used).
+
+        Returns
+        -------
+        F : ndarray, shape (..., n_x)
+            Forces (N) and moments about the body-frame origins (N m) on the
+            moving bodies; drives are not included (see ``Qd``).
+        ground : ndarray, shape (..., 3)
+            Force (N) and moment about the ground origin (N m) that the load
+            elements attached to the frame put on it (spring ends, torque
+            reactions, reacting forces).
+        Qd : ndarray, shape (..., n_q)
+            The drive torques/forces on the coordinates.
+        """
+        m = self.model
+        x = np.asarray(x, dtype=float)
+        batch = x.shape[:-1]
         nb = m.n_bodies
+        X = extend(m, x)
+        F = np.zeros(batch + (nb + 1, 3))
+        if self._weights is not None:
+            _add_weights(self._weights, m, F[..., :nb, :], x)
+        V = None if conservative else extend(m, xdot)
         for (name, i, si, j, sj, k, L0, c, pre) in self.springs:
-            ai, aj = _rot(X[i, 2], si), _rot(X[j, 2], sj)
-            d = X[j, :2] + aj - X[i, :2] - ai
-            L = np.hypot(d[0], d[1])
-            if L < 1e-300:
+            ai, aj, d, L = _spring_geometry(X, i, si, j, sj)
+            if (L < 1e-300).any():
                 raise ModelError(f"spring {name!r}: its two points coincide; direction undefined")
-            e = d / L
-            vd = (V[j, :2] + V[j, 2] * np.array([-aj[1], aj[0]])
-                  - V[i, :2] - V[i, 2] * np.array([-ai[1], ai[0]]))
-            f = k * (L - L0) + c * (e @ vd) + pre
-            self._apply(F, i, ai, f * e, nb)
-            self._apply(F, j, aj, -f * e, nb)
+            e = d / L[..., None]
+            f = k * (L - L0)
+            if V is not None and c != 0.0:
+                vd = (V[..., j, :2] + V[..., j, 2, None] * _perp(aj)
+                      - V[..., i, :2] - V[..., i, 2, None] * _perp(ai))
+                f = f + c * np.sum(e * vd, axis=-1)
+            f = (f + pre)[..., None] * e
+            _apply(F, i, ai, f)
+            _apply(F, j, aj, -f)
         for (_name, i, j, k, a0, c, pre) in self.rotary:
-            rel = X[j, 2] - X[i, 2]
-            w = V[j, 2] - V[i, 2]
-            tq = -(k * (rel - a0) + c * w + pre)
-            if j < nb:
-                F[3 * j + 2] += tq
-            if i < nb:
-                F[3 * i + 2] -= tq
-        for (ld, b, s) in self.forces:
-            mag = evaluate(ld.magnitude, ctx, f"force {ld.name!r}")
-            d = np.asarray(ld.direction)
-            if ld.frame == "body":
-                d = _rot(X[b, 2], d)
-            self._apply(F, b, _rot(X[b, 2], s), mag * d, nb)
-        for (ld, b, r) in self.torques:
-            tq = evaluate(ld.magnitude, ctx, f"torque {ld.name!r}")
-            if b < nb:
-                F[3 * b + 2] += tq
-            if r is not None and r < nb:
-                F[3 * r + 2] -= tq
-        Qd = np.zeros(m.n_q)
-        for (dr, k) in self.drives:
-            Qd[k] += self.drive_torque(dr, ctx, k)
+            tq = k * (X[..., j, 2] - X[..., i, 2] - a0)
+            if V is not None and c != 0.0:
+                tq = tq + c * (V[..., j, 2] - V[..., i, 2])
+            tq = -(tq + pre)
+            F[..., j, 2] += tq
+            F[..., i, 2] -= tq
+        Qd = np.zeros(batch + (m.n_q,))
+        if not conservative and (self.forces or self.torques or self.drives):
+            if batch and np.shape(t) != batch:  # one time for a batch of poses
+                t = np.broadcast_to(np.asarray(t, dtype=float), batch)
+            ctx = LoadContext(m, t, q, qdot, x, xdot)
+            reacting = set(reacting_loads)
+            for (ld, b, s) in self.forces:
+                mag = evaluate(ld.magnitude, ctx, f"force {ld.name!r}")
+                d = np.asarray(ld.direction, dtype=float)
+                arm = rotate(X[..., b, 2], s)
+                if ld.frame == "body":
+                    d = rotate(X[..., b, 2], d)
+                f = np.asarray(mag)[..., None] * d
+                _apply(F, b, arm, f)
+                if ld.name in reacting:
+                    # the frame takes the reaction along the same line of action
+                    _apply(F, nb, X[..., b, :2] + arm, -f)
+            for (ld, b, r) in self.torques:
+                tq = evaluate(ld.magnitude, ctx, f"torque {ld.name!r}")
+                F[..., b, 2] += tq
+                if r is not None:
+                    F[..., r, 2] -= tq
+            skip = set(int(k) for k in skip_drives)
+            for (dr, k) in self.drives:
+                if k not in skip:
+                    Qd[..., k] += self.drive_torque(dr, ctx, k)
+        return F[..., :nb, :].reshape(batch + (m.n_x,)), F[..., nb, :], Qd
+
+    def applied(self, t, x, xdot, q, qdot) -> tuple[np.ndarray, np.ndarray]:
+        """Applied forces F (..., n_x) on the body poses and drive forces Q_drive (..., n_q)."""
+        F, _, Qd = self.loads(t, x, xdot, q, qdot)
         return F, Qd
 
-    def drive_torque(self, dr: Drive, ctx: LoadContext, k: int) -> float:
-        """Torque (N m) or force (N) of one drive on its coordinate."""
+    def drive_torque(self, dr: Drive, ctx: LoadContext, k: int):
+        """Torque (N m) or force (N) of one drive on its coordinate (float, or an array
+        of shape ``ctx.shape`` for a batch)."""
         tq = dr.torque
+        w = np.asarray(ctx.qdot)[..., k]
         if hasattr(tq, "torque_at"):  # motor characteristics of mechanism.drive extensions
-            return float(tq.torque_at(ctx.qdot[k]))
-        if not isinstance(tq, Table) and not callable(tq):
-            return float(tq)
+            return _each(lambda i: float(tq.torque_at(w[i])), ctx.shape)
         if hasattr(tq, "omega"):  # TorqueSpeedCurve
-            return tq(ctx.qdot[k])
+            return tq(w[()])
         return evaluate(tq, ctx, f"drive {dr.name!r}")
 
-    @staticmethod
-    def _apply(F, b, arm, f, nb):
-        if b < nb:
-            F[3 * b] += f[0]
-            F[3 * b + 1] += f[1]
-            F[3 * b + 2] += arm[0] * f[1] - arm[1] * f[0]
-
     def add_gravity(self, F, x):
-        """Add the weight of every body at its centre of mass to F (in place)."""
+        """Add the weight of every body at its centre of mass to F (..., n_x) (in place)."""
         m = self.model
-        if not np.any(m.gravity) or not np.any(m.mass):
-            return F
-        th = x[2::3]
-        c, s = np.cos(th), np.sin(th)
-        ax = c * m.com[:, 0] - s * m.com[:, 1]
-        ay = s * m.com[:, 0] + c * m.com[:, 1]
-        fx, fy = m.mass * m.gravity[0], m.mass * m.gravity[1]
-        F[0::3] += fx
-        F[1::3] += fy
-        F[2::3] += ax * fy - ay * fx
+        if self._weights is not None:
+            _add_weights(self._weights, m, np.asarray(F).reshape(np.shape(x)[:-1]
+                                                                 + (m.n_bodies, 3)), x)
         return F
 
     # ----------------------------------------------------------------- energy
-    def potential_energy(self, x) -> float:
-        """Potential energy of gravity and springs (J); zero at the origin / free length."""
+    def potential_energy(self, x):
+        """Potential energy of gravity and springs (J), shape (...); zero at the origin
+        / free length."""
         m = self.model
+        x = np.asarray(x, dtype=float)
         X = extend(m, x)
-        th = X[:-1, 2]
-        c, s = np.cos(th), np.sin(th)
-        rc = X[:-1, :2] + np.stack([c * m.com[:, 0] - s * m.com[:, 1],
-                                    s * m.com[:, 0] + c * m.com[:, 1]], axis=-1)
-        U = -float(np.sum(m.mass * (rc @ m.gravity)))
+        rc = X[..., :-1, :2] + com_arms(m, x)
+        U = -np.sum(m.mass * (rc @ m.gravity), axis=-1)
         for (_, i, si, j, sj, k, L0, _c, pre) in self.springs:
-            d = X[j, :2] + _rot(X[j, 2], sj) - X[i, :2] - _rot(X[i, 2], si)
-            L = np.hypot(d[0], d[1])
-            U += 0.5 * k * (L - L0) ** 2 + pre * L
+            L = _spring_geometry(X, i, si, j, sj)[3]
+            U = U + 0.5 * k * (L - L0) ** 2 + pre * L
         for (_, i, j, k, a0, _c, pre) in self.rotary:
-            rel = X[j, 2] - X[i, 2]
-            U += 0.5 * k * (rel - a0) ** 2 + pre * rel
+            rel = X[..., j, 2] - X[..., i, 2]
+            U = U + 0.5 * k * (rel - a0) ** 2 + pre * rel
         return U
 
-    def nonconservative_power(self, t, x, xdot, q, qdot) -> float:
+    def nonconservative_power(self, t, x, xdot, q, qdot, *, applied=None):
         """Power (W) of every force that is not gravity or spring stiffness:
-        dampers, applied forces and torques, and drives."""
-        F, Qd = self.applied(t, x, xdot, q, qdot)
-        Fc = self.conservative(x)
-        return float((F - Fc) @ xdot + Qd @ qdot)
+        dampers, applied forces and torques, and drives; shape (...).
+
+        ``applied`` = (F, Q_drive) from :meth:`applied` at the same state
+        saves evaluating the loads again."""
+        F, Qd = self.applied(t, x, xdot, q, qdot) if applied is None else applied
+        P = np.sum((F - self.conservative(x)) * xdot, axis=-1)
+        return _scalar_or_array(P + np.sum(Qd * np.asarray(qdot), axis=-1))
 
     def conservative(self, x) -> np.ndarray:
-        """Forces of gravity and spring stiffness/preload alone, (n_x,)."""
-        m = self.model
-        F = np.zeros(m.n_x)
-        self.add_gravity(F, x)
-        X = extend(m, x)
-        nb = m.n_bodies
-        for (_, i, si, j, sj, k, L0, _c, pre) in self.springs:
-            ai, aj = _rot(X[i, 2], si), _rot(X[j, 2], sj)
-            d = X[j, :2] + aj - X[i, :2] - ai
-            L = np.hypot(d[0], d[1])
-            f = k * (L - L0) + pre
-            self._apply(F, i, ai, f * d / L, nb)
-            self._apply(F, j, aj, -f * d / L, nb)
-        for (_, i, j, k, a0, _c, pre) in self.rotary:
-            tq = -(k * (X[j, 2] - X[i, 2] - a0) + pre)
-            if j < nb:
-                F[3 * j + 2] += tq
-            if i < nb:
-                F[3 * i + 2] -= tq
-        return F
+        """Forces of gravity and spring stiffness/preload alone, (..., n_x)."""
+        return self.loads(None, x, None, None, None, conservative=True)[0]
+
+
+def _add_weights(w, model: Model, Fb, x):
+    """Add the weights w (n_bodies, 2) at the centres of mass to the body forces
+    Fb (..., n_bodies, 3), in place."""
+    Fb[..., :2] += w
+    Fb[..., 2] += cross(com_arms(model, x), w)
+
+
+def applied_forces(model: Model, t, x, xdot, q, qdot, *, skip_drives: Sequence[int] = (),
+                   reacting_loads: Sequence[str] = ()):
+    """Applied forces for a batch of positions, drives included on the body poses.
+
+    Parameters
+    ----------
+    t : array_like, shape (n,)
+    x, xdot : array_like, shape (n, n_x)
+    q, qdot : array_like, shape (n, n_q)
+    skip_drives : sequence of int
+        Coordinates whose ``Drive`` elements are left out (replaced by a prescribed motion).
+    reacting_loads : sequence of str
+        Names of ``Force`` loads whose reaction the frame carries.
+
+    Returns
+    -------
+    F : ndarray, shape (n, n_x)
+        Forces (N) and moments about the body-frame origins (N m) on the moving
+        bodies, drives on coordinates included (as ``g_x^T Q_drive``).
+    ground : ndarray, shape (n, 3)
+        Force (N) and moment about the ground origin (N m) that the load
+        elements attached to the frame put on it (spring ends, torque
+        reactions, reacting forces); drives are not included here.
+    Qd : ndarray, shape (n, n_q)
+        The drive torques/forces that were applied, per coordinate.
+    """
+    fm = force_model(model)
+    t = np.asarray(t, dtype=float).reshape(-1)
+    x = np.asarray(x, dtype=float)
+    F, ground, Qd = fm.loads(t, x, np.asarray(xdot, dtype=float), np.asarray(q, dtype=float),
+                             np.asarray(qdot, dtype=float), skip_drives=skip_drives,
+                             reacting_loads=reacting_loads)
+    if np.any(Qd):
+        F = F + np.einsum("nq,nqx->nx", Qd, coordinates_jacobian(model, x))
+    return F, ground, Qd
 
 
 def force_model(model: Model) -> ForceModel:

@@ -44,7 +44,7 @@ from ..kinematics.analogs import acceleration_bias, default_displacement
 from ..kinematics.assembly import solve_position
 from ..kinematics.constraints import coordinates_jacobian, extend, jacobian, residual
 from ..model import Model
-from .forces import force_model
+from .forces import com_arms, force_model
 
 __all__ = ["EquationsOfMotion", "Terms", "FORMULATIONS", "equations_of_motion", "drive_inertia",
            "com_analogs", "kinetic_energy", "potential_energy", "mass_matrix"]
@@ -95,15 +95,6 @@ class Terms:
     power_nc: float
 
 
-def _com_arms(model: Model, x):
-    """A_k c_k: centres of mass relative to the frame origins in the ground frame,
-    shape (..., n_bodies, 2)."""
-    th = np.asarray(x)[..., 2::3]
-    c, s = np.cos(th), np.sin(th)
-    cx, cy = model.com[:, 0], model.com[:, 1]
-    return np.stack([c * cx - s * cy, s * cx + c * cy], axis=-1)
-
-
 def com_analogs(model: Model, x, B, b=None, xdot=None):
     """Centre-of-mass analogs B_c = T(x) B and bias b_c = T(x) b - omega^2 A c.
 
@@ -120,7 +111,7 @@ def com_analogs(model: Model, x, B, b=None, xdot=None):
         Rows (vx_c, vy_c, omega) per body.
     bc : ndarray, shape (..., n_x) or None
     """
-    arm = _com_arms(model, x)
+    arm = com_arms(model, x)
     B = np.asarray(B, float)
     nb = model.n_bodies
     Bk = B.reshape(B.shape[:-2] + (nb, 3, B.shape[-1]))
@@ -149,7 +140,7 @@ def mass_matrix(model: Model, x, B) -> np.ndarray:
 def kinetic_energy(model: Model, x, xdot) -> np.ndarray:
     """T = 1/2 sum (m v_c^2 + J_c omega^2), J, shape (...)."""
     xdot = np.asarray(xdot, float)
-    arm = _com_arms(model, x)
+    arm = com_arms(model, x)
     w = xdot[..., 2::3]
     vx = xdot[..., 0::3] - w * arm[..., 1]
     vy = xdot[..., 1::3] + w * arm[..., 0]
@@ -158,23 +149,7 @@ def kinetic_energy(model: Model, x, xdot) -> np.ndarray:
 
 def potential_energy(model: Model, x) -> np.ndarray:
     """Potential energy of gravity and springs, J, shape (...) (batched over poses)."""
-    fm = force_model(model)
-    x = np.asarray(x, float)
-    X = extend(model, x)
-    arm = _com_arms(model, x)
-    rc = X[..., :-1, :2] + arm
-    U = -np.sum(model.mass * (rc @ model.gravity), axis=-1)
-    for (_, i, si, j, sj, k, L0, _c, pre) in fm.springs:
-        ci, sni = np.cos(X[..., i, 2]), np.sin(X[..., i, 2])
-        cj, snj = np.cos(X[..., j, 2]), np.sin(X[..., j, 2])
-        dx = (X[..., j, 0] + cj * sj[0] - snj * sj[1]) - (X[..., i, 0] + ci * si[0] - sni * si[1])
-        dy = (X[..., j, 1] + snj * sj[0] + cj * sj[1]) - (X[..., i, 1] + sni * si[0] + ci * si[1])
-        L = np.hypot(dx, dy)
-        U = U + 0.5 * k * (L - L0) ** 2 + pre * L
-    for (_, i, j, k, a0, _c, pre) in fm.rotary:
-        rel = X[..., j, 2] - X[..., i, 2]
-        U = U + 0.5 * k * (rel - a0) ** 2 + pre * rel
-    return U
+    return force_model(model).potential_energy(x)
 
 
 def drive_inertia(model: Model) -> np.ndarray:
@@ -385,8 +360,7 @@ class EquationsOfMotion:
         return np.linalg.solve(L.T, y)
 
     def _power(self, F, Qd, x, xdot, qdot) -> float:
-        Fc = self.forces.conservative(x)
-        return float((F - Fc) @ xdot + Qd @ qdot)
+        return self.forces.nonconservative_power(None, x, xdot, None, qdot, applied=(F, Qd))
 
     def _exact(self, t, q, qdot) -> Terms:
         model, lay = self.model, self.layout
@@ -422,7 +396,7 @@ class EquationsOfMotion:
 
         def analog_mass(xs):
             """A from the poses of the partial systems xs (..., 2n, n_x)."""
-            rc = extend(model, xs)[..., :-1, :2] + _com_arms(model, xs)  # (..., 2n, nb, 2)
+            rc = extend(model, xs)[..., :-1, :2] + com_arms(model, xs)  # (..., 2n, nb, 2)
             th = xs[..., 2::3]
             vc = (rc[..., :n, :, :] - rc[..., n:, :, :]) / (2 * d[:, None, None])  # (..,n,nb,2)
             w = (th[..., :n, :] - th[..., n:, :]) / (2 * d[:, None])  # (..., n, nb)

@@ -38,8 +38,10 @@ class TorqueSpeedCurve:
         object.__setattr__(self, "omega", tuple(w))
         object.__setattr__(self, "torque", tuple(m))
 
-    def __call__(self, omega: float) -> float:
-        return float(np.interp(omega, self.omega, self.torque))
+    def __call__(self, omega):
+        """Torque (N m) at ``omega`` (a float, or an array of the shape of an array ``omega``)."""
+        y = np.interp(omega, self.omega, self.torque)
+        return float(y) if np.ndim(y) == 0 else y
 
 
 @dataclass(frozen=True)

@@ -50,10 +50,13 @@ class Table:
         object.__setattr__(self, "x", tuple(x))
         object.__setattr__(self, "y", tuple(y))
 
-    def __call__(self, s: float) -> float:
-        if self.outside is not None and (s < self.x[0] or s > self.x[-1]):
-            return float(self.outside)
-        return float(np.interp(s, self.x, self.y))
+    def __call__(self, s):
+        """The value at ``s`` (a float, or an array of the shape of an array ``s``)."""
+        s = np.asarray(s, dtype=float)
+        y = np.interp(s, self.x, self.y)
+        if self.outside is not None:
+            y = np.where((s < self.x[0]) | (s > self.x[-1]), self.outside, y)
+        return float(y) if y.ndim == 0 else y
 
 
 Value = float | Table | Callable

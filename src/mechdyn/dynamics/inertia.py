@@ -1,0 +1,61 @@
+"""Inertia forces of the body frames: the frame mass matrix M_x and the inertia
+forces ``M_x xddot`` plus the centripetal terms, batched over poses."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..kinematics.constraints import _perp
+from ..model import Model
+from .forces import com_arms, cross
+
+__all__ = ["frame_mass_matrix", "inertia_forces"]
+
+
+def frame_mass_matrix(model: Model, x) -> np.ndarray:
+    """Mass matrix M_x of the body-frame coordinates, shape (..., n_x, n_x).
+
+    With the centre of mass at ``a = A(theta) com`` from the frame origin, the
+    kinetic energy ``1/2 m |v + omega perp(a)|^2 + 1/2 J_c omega^2`` gives, per
+    body, the block ``[[m, 0, -m a_y], [0, m, m a_x], [-m a_y, m a_x, J_c + m |a|^2]]``
+    (kg, kg m, kg m^2).  The inertia forces are ``M_x xddot`` plus the
+    centripetal force ``-m omega^2 a`` (see :func:`inertia_forces`).
+    """
+    x = np.asarray(x, dtype=float)
+    nb = model.n_bodies
+    a = com_arms(model, x)
+    m = model.mass
+    M = np.zeros(x.shape[:-1] + (model.n_x, model.n_x))
+    for b in range(nb):
+        k = 3 * b
+        M[..., k, k] = m[b]
+        M[..., k + 1, k + 1] = m[b]
+        M[..., k, k + 2] = M[..., k + 2, k] = -m[b] * a[..., b, 1]
+        M[..., k + 1, k + 2] = M[..., k + 2, k + 1] = m[b] * a[..., b, 0]
+        M[..., k + 2, k + 2] = model.inertia[b] + m[b] * (a[..., b, 0] ** 2 + a[..., b, 1] ** 2)
+    return M
+
+
+def inertia_forces(model: Model, x, xdot, xddot) -> np.ndarray:
+    """Inertia forces conjugate to the body-frame poses, shape (..., n_x).
+
+    Per body: ``m a_c`` (N) and ``J_c alpha + a x (m a_c)`` (N m, about the
+    frame origin), with ``a_c = rddot + alpha perp(a) - omega^2 a`` the
+    acceleration of the centre of mass.  Equals ``M_x xddot - m omega^2 a``.
+
+    Parameters
+    ----------
+    x, xdot, xddot : array_like, shape (..., n_x)
+        Poses (m, rad), their rates and accelerations.
+    """
+    x = np.asarray(x, dtype=float)
+    nb = model.n_bodies
+    batch = x.shape[:-1]
+    V = np.asarray(xdot, dtype=float).reshape(batch + (nb, 3))
+    W = np.asarray(xddot, dtype=float).reshape(batch + (nb, 3))
+    a = com_arms(model, x)
+    ac = W[..., :2] + W[..., 2, None] * _perp(a) - (V[..., 2] ** 2)[..., None] * a
+    f = model.mass[:, None] * ac
+    mom = model.inertia * W[..., 2] + cross(a, f)
+    return np.concatenate([f, mom[..., None]], axis=-1).reshape(batch + (model.n_x,))
+

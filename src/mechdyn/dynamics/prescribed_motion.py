@@ -1,0 +1,316 @@
+"""Poses, velocities and accelerations of a mechanism whose driven coordinates follow
+a prescribed motion (batched over positions), the choice of the driven coordinates,
+and the dead centres of a crank's turn.
+
+The driving constraints ``g_d(x) - q_d = 0`` are appended to the joint constraints
+``Phi(x) = 0``; the poses are found by continuation (branch kept by the sign of the
+scaled Jacobian's determinant), the rates from ``[Phi_x; g_d,x] xdot = [0; qdot_d]``
+and the accelerations from the same matrix with the exact right-hand side gamma.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import AssemblyError, ModelError, SingularPositionError
+from ..kinematics.assembly import joint_residuals
+from ..kinematics.constraints import (
+    coordinates,
+    coordinates_gamma,
+    coordinates_jacobian,
+    gamma,
+    jacobian,
+    point_position,
+    residual,
+)
+from ..model import ConstraintLayout, Model, as_model
+
+__all__ = ["dead_centres"]
+
+#: relative singular value below which constraint equations count as dependent
+REDUNDANT_RCOND = 1e-9
+
+
+def _col_scale(model: Model) -> np.ndarray:
+    s = np.ones(model.n_x)
+    s[2::3] = model.length_scale
+    return s
+
+
+def _kin_system(model, lay, didx, x, qd):
+    Phi = residual(model, x, lay)
+    g = coordinates(model, x)[..., didx]
+    F = np.concatenate([Phi, g - qd], axis=-1)
+    J = np.concatenate([jacobian(model, x, lay), coordinates_jacobian(model, x)[..., didx, :]],
+                       axis=-2)
+    return F, J
+
+
+def _lin_solve(J, F):
+    """Solve J dx = F (batched), least squares / minimum norm when not square or singular."""
+    if J.shape[-1] == J.shape[-2]:
+        try:
+            dx = np.linalg.solve(J, F[..., None])[..., 0]
+            if np.all(np.isfinite(dx)):
+                return dx
+        except np.linalg.LinAlgError:
+            pass
+    return (np.linalg.pinv(J, rcond=1e-12) @ F[..., None])[..., 0]
+
+
+class _Positions:
+    """Position, velocity and acceleration analysis with a subset of driven coordinates."""
+
+    def __init__(self, model: Model, lay: ConstraintLayout, didx: np.ndarray):
+        self.model, self.lay, self.didx = model, lay, didx
+        self.tol = 1e-12 * max(model.length_scale, 1e-3)
+        self.scale = _col_scale(model)
+        self.iterations = 0
+        self.branch_changes: list = []
+
+    def jac(self, x):
+        """[Phi_x; g_d,x] at x, shape (..., n_rows + n_d, n_x)."""
+        return _kin_system(self.model, self.lay, self.didx, x,
+                           np.zeros(np.shape(x)[:-1] + (len(self.didx),)))[1]
+
+    def newton(self, qd, x, max_iter=30):
+        """Newton iterations (batched); returns x, converged flags, and J at x."""
+        x = np.array(x, dtype=float, copy=True)
+        for _ in range(max_iter):
+            F, J = _kin_system(self.model, self.lay, self.didx, x, qd)
+            err = np.max(np.abs(F), axis=-1) if F.shape[-1] else np.zeros(F.shape[:-1])
+            done = err <= self.tol
+            if np.all(done):
+                return x, done, J
+            self.iterations += 1
+            dx = _lin_solve(J, F)
+            if not np.all(np.isfinite(dx)):
+                break
+            x = x - np.where(done[..., None], 0.0, dx)
+        F, J = _kin_system(self.model, self.lay, self.didx, x, qd)
+        err = np.max(np.abs(F), axis=-1)
+        return x, err <= 1e3 * self.tol, J
+
+    def analogs(self, J):
+        """dx/dq_d from the Jacobian J, shape (..., n_x, n_d)."""
+        rhs = np.zeros(J.shape[:-2] + (J.shape[-2], len(self.didx)))
+        rhs[..., self.lay.n_rows:, :] = np.eye(len(self.didx))
+        if J.shape[-1] == J.shape[-2]:
+            try:
+                return np.linalg.solve(J, rhs)
+            except np.linalg.LinAlgError:
+                pass
+        return np.linalg.pinv(J, rcond=1e-12) @ rhs
+
+    def det_sign(self, J):
+        """Sign of det of the scaled J (ones when J is not square)."""
+        if J.shape[-1] != J.shape[-2]:
+            return np.ones(J.shape[:-2])
+        return np.sign(np.linalg.det(J * self.scale))
+
+    def first(self, qd, x_start):
+        """The first pose: continuation from the assembled start pose keeps its branch."""
+        q_s = coordinates(self.model, x_start)[self.didx]
+        F, _ = _kin_system(self.model, self.lay, self.didx, x_start, q_s)
+        if np.max(np.abs(F), initial=0.0) <= 1e3 * self.tol:
+            try:
+                return self.step(q_s, x_start, qd)[0]
+            except (AssemblyError, SingularPositionError):
+                pass
+        x, ok, _ = self.newton(qd, x_start, max_iter=60)
+        if ok:
+            return x
+        from scipy.optimize import least_squares
+
+        def fun(xx):
+            return _kin_system(self.model, self.lay, self.didx, xx, qd)[0]
+
+        def jac(xx):
+            return _kin_system(self.model, self.lay, self.didx, xx, qd)[1]
+
+        sol = least_squares(fun, x_start, jac=jac, method="trf", xtol=1e-15, ftol=1e-15,
+                            gtol=1e-15, x_scale=self.scale / self.model.length_scale,
+                            max_nfev=2000)
+        x, ok, _ = self.newton(qd, sol.x)
+        if not ok:
+            raise self._error(qd, x)
+        return x
+
+    def _error(self, qd, x, t=None):
+        res = joint_residuals(self.model, x, self.lay)
+        names = [self.model.coordinate_names[k] for k in self.didx]
+        if max(res.values(), default=0.0) < 1e-6 * self.model.length_scale:
+            return SingularPositionError(
+                "the position solve stalls near a dead, toggle or change point: the driven "
+                "coordinate(s) " + ", ".join(names) + " lose control of the mechanism there "
+                "(largest joint residual " + f"{max(res.values()):.3g}); analyse up to that "
+                "position or choose another driven coordinate", t=t, q=qd,
+                coordinates=names, joints=list(res))
+        open_ = {n: v for n, v in res.items() if v > 1e-9 * max(self.model.length_scale, 1e-3)}
+        qs = ", ".join(f"{n} = {v:.6g}" for n, v in zip(names, np.atleast_1d(qd), strict=True))
+        parts = ", ".join(f"{n!r}: {v:.3g}" for n, v in open_.items()) or "none"
+        return AssemblyError(f"the mechanism cannot be assembled at {qs}; joints that stay "
+                             f"open (residual, m or rad): {parts}", t=t, q=qd,
+                             residuals=open_)
+
+    def step(self, qd_from, x_from, qd_to, J_from=None, depth=0):
+        """Solve at qd_to continuing from a solved pose, halving the step on failure.
+
+        Returns the pose and the Jacobian there."""
+        L = self.model.length_scale
+        if J_from is None:
+            J_from = self.jac(x_from)
+        dx = self.analogs(J_from) @ (qd_to - qd_from)
+        # near a singular position the analogs blow up: then start from x_from itself
+        pred = x_from + dx if np.max(np.abs(dx * self.scale)) <= 0.5 * L else x_from
+        x, ok, J = self.newton(qd_to, pred)
+        if ok:
+            # a link turning by more than ~1 rad in one step means the solve jumped
+            jump = np.max(np.abs((x - x_from) * self.scale)) > L
+            same = self.det_sign(J) == self.det_sign(J_from)
+            if (same and not jump) or depth > 10:
+                if not same or jump:
+                    self.branch_changes.append(np.array(qd_to, dtype=float))
+                return x, J
+        if depth > 14:
+            raise self._error(qd_to, x)
+        mid = 0.5 * (qd_from + qd_to)
+        xm, Jm = self.step(qd_from, x_from, mid, J_from, depth + 1)
+        return self.step(mid, xm, qd_to, Jm, depth + 1)
+
+    def solve(self, qd, x_start, x_guess=None):
+        """Poses for all rows of qd (n, n_d), by continuation from x_start.
+
+        Sequential continuation on about 100 anchor positions, then one batched
+        Newton solve for all the others from the anchors' first-order predictions
+        (with a branch check, falling back to continuation where it fails)."""
+        n = qd.shape[0]
+        if x_guess is not None:
+            x, ok, _ = self.newton(qd, x_guess)
+            if np.all(ok):
+                return x
+        x = np.empty((n, self.model.n_x))
+        x[0] = self.first(qd[0], x_start if x_guess is None else x_guess[0])
+        if n == 1:
+            return x
+        stride = max(1, n // 100)
+        anchors = list(range(0, n, stride))
+        if anchors[-1] != n - 1:
+            anchors.append(n - 1)
+        Ja = np.empty((len(anchors),) + self.jac(x[0]).shape)
+        Ja[0] = self.jac(x[0])
+        for i, (a0, a1) in enumerate(zip(anchors[:-1], anchors[1:], strict=True)):
+            x[a1], Ja[i + 1] = self.step(qd[a0], x[a0], qd[a1], Ja[i])
+        rest = np.setdiff1d(np.arange(n), anchors)
+        if rest.size:
+            base = np.searchsorted(anchors, rest, side="right") - 1
+            a = np.asarray(anchors)[base]
+            B = self.analogs(Ja[base])
+            pred = x[a] + (B @ (qd[rest] - qd[a])[..., None])[..., 0]
+            xr, ok, Jr = self.newton(qd[rest], pred)
+            ok &= self.det_sign(Jr) == self.det_sign(Ja[base])
+            x[rest] = xr
+            for k in rest[~ok]:
+                x[k] = self.step(qd[k - 1], x[k - 1], qd[k])[0]
+        return x
+
+    def motion(self, x, qd_dot, qd_ddot):
+        """Velocities and accelerations of the poses for driven rates (batched)."""
+        m, lay = self.model, self.lay
+        _, J = _kin_system(m, lay, self.didx, x, np.zeros(x.shape[:-1] + (len(self.didx),)))
+        rhs = np.zeros(x.shape[:-1] + (J.shape[-2],))
+        rhs[..., lay.n_rows:] = qd_dot
+        xdot = _lin_solve(J, rhs)
+        gam = np.concatenate([gamma(m, x, xdot, lay),
+                              coordinates_gamma(m, x, xdot)[..., self.didx] + qd_ddot], axis=-1)
+        xddot = _lin_solve(J, gam)
+        return xdot, xddot
+
+
+def _independent_subset(model, lay, x0, first: list[int]) -> list[int]:
+    """Extend ``first`` with coordinates that add rank, up to the DOF of the layout."""
+    sc = _col_scale(model)
+    P = jacobian(model, x0, lay) * sc
+    G = coordinates_jacobian(model, x0) * sc
+
+    def rank(A):
+        if A.size == 0:
+            return 0
+        s = np.linalg.svd(A, compute_uv=False)
+        return int(np.sum(s > REDUNDANT_RCOND * s[0])) if s[0] > 0 else 0
+
+    r_phi = rank(P)
+    dof = model.n_x - r_phi
+    chosen: list[int] = []
+    for k in first:
+        if rank(np.concatenate([P, G[chosen + [k]]])) == r_phi + len(chosen) + 1:
+            chosen.append(k)
+        else:
+            raise ModelError(
+                f"coordinate {model.coordinate_names[k]!r} cannot be driven in mode "
+                f"{sorted(lay.mode)}: it is fixed by the other driven coordinates and the "
+                f"constraints ({dof} degree(s) of freedom)")
+    for k in range(model.n_q):
+        if len(chosen) >= dof:
+            break
+        if k in chosen:
+            continue
+        if rank(np.concatenate([P, G[chosen + [k]]])) == r_phi + len(chosen) + 1:
+            chosen.append(k)
+    if len(chosen) < dof:
+        raise ModelError(f"the mechanism has {dof} degrees of freedom in mode "
+                         f"{sorted(lay.mode)}, but only {len(chosen)} coordinates can be driven")
+    return chosen
+
+
+def dead_centres(mech_or_model, body: str, point, *, coordinate: str = "y",
+                 over: str | None = None, mode=None, n: int = 720) -> dict:
+    """Extreme positions of a point over one turn of a crank coordinate.
+
+    Parameters
+    ----------
+    body, point :
+        The watched point (e.g. the slider's ``"F"``).
+    coordinate : {"x", "y"}
+        Which ground coordinate of the point.
+    over : str, optional
+        The crank coordinate (default the first independent coordinate).
+    n : int
+        Samples of the turn before refinement.
+
+    Returns
+    -------
+    dict
+        ``{"min": (angle_rad, value_m), "max": (angle_rad, value_m)}`` with the
+        angle in [0, 2 pi) and the extreme refined to about 1e-10 rad.
+    """
+    from scipy.optimize import minimize_scalar
+
+    model = as_model(mech_or_model)
+    lay = model.layout(mode)
+    x_start = getattr(model, "x0", model.x_sketch)
+    over_idx = [model.coordinate_index(over)] if over else []
+    didx = np.asarray(_independent_subset(model, lay, x_start, over_idx), dtype=int)
+    held = coordinates(model, x_start)[didx[1:]]
+    pos = _Positions(model, lay, didx)
+    ang = np.linspace(0.0, 2 * np.pi, n + 1)
+    qd = np.concatenate([ang[:, None], np.broadcast_to(held, (n + 1, held.size))], axis=1)
+    xs = pos.solve(qd, np.asarray(x_start, float))
+    k = 0 if coordinate == "x" else 1
+    c = point_position(model, xs, body, point)[:, k]
+    out = {}
+    for key, sgn in (("min", 1.0), ("max", -1.0)):
+        i = int(np.argmin(sgn * c[:-1]))
+        xi = xs[i]
+
+        def f(a, xi=xi, sgn=sgn):
+            qq = np.concatenate([[a], held])
+            xa, _, _ = pos.newton(qq, xi)
+            return sgn * point_position(model, xa, body, point)[k]
+
+        h = ang[1] - ang[0]
+        res = minimize_scalar(f, bracket=(ang[i] - h, ang[i], ang[i] + h),
+                              options={"xtol": 1e-12})
+        a = float(np.mod(res.x, 2 * np.pi))
+        out[key] = (a, float(sgn * res.fun))
+    return out

@@ -1,0 +1,234 @@
+"""Joint reactions and driving torques of a prescribed motion: the batched solve for
+the Lagrange multipliers, the reactions in the ground and the joint frames, the loads
+the frame receives, and the redundancy check.
+
+With the poses, rates and accelerations known, one linear system per position
+(batched over all positions at once)::
+
+    -Phi_x^T lambda + g_d,x^T tau = I(x, xdot, xddot) - F(t, x, xdot)
+
+gives the multipliers ``lambda`` and the driving torques ``tau``; the sign
+conventions are those of :mod:`mechdyn.dynamics.kinetostatics`.
+"""
+
+from __future__ import annotations
+
+import warnings as _warnings
+
+import numpy as np
+
+from ..kinematics.assembly import SINGULAR_RCOND
+from ..kinematics.constraints import _perp, coordinates_jacobian, extend, jacobian
+from ..model import COORD_TRAVEL, ConstraintLayout, Model
+from .forces import applied_forces, cross, rotate
+from .inertia import inertia_forces
+from .prescribed_motion import REDUNDANT_RCOND, _col_scale
+
+__all__ = ["KinetostaticsWarning"]
+
+#: rcond of the scaled inverse-dynamics matrix below which a position is reported
+#: as close to singular (a warning; the solve is still exact)
+NEAR_SINGULAR_RCOND = 1e-6
+
+
+class KinetostaticsWarning(UserWarning):
+    """Redundant constraints or singular positions in a kinetostatic analysis."""
+
+
+#: names of the equations of each joint kind (for the redundancy message)
+_ROW_LABELS = {"revolute": ("x", "y"), "prismatic": ("normal", "angle"),
+               "lock": ("x", "y", "angle")}
+
+
+def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
+    """Number of dependent joint equations, the joints involved and row labels."""
+    if lay.n_rows == 0:
+        return 0, [], []
+    sc = _col_scale(model)
+    x = np.asarray(x, dtype=float).reshape(-1, model.n_x)
+    if x.shape[0] > 64:  # redundancy is structural: a sample of the positions suffices
+        x = x[np.unique(np.linspace(0, x.shape[0] - 1, 64).astype(int))]
+    P = jacobian(model, x, lay) * sc
+    s = np.linalg.svd(P, compute_uv=False)
+    r = np.sum(s > REDUNDANT_RCOND * s[..., :1], axis=-1)
+    if s.shape[-1] < lay.n_rows:  # more equations than unknowns
+        r = np.minimum(r, s.shape[-1])
+    n_red = int(lay.n_rows - r.min())
+    if n_red == 0:
+        return 0, [], []
+    k = int(np.argmin(r))
+    u = np.linalg.svd(P[k])[0]
+    null = u[:, int(r[k]):]
+    weight = np.sum(null**2, axis=1)
+    rows = [i for i in range(lay.n_rows) if weight[i] > 1e-6]
+    joints = sorted({str(lay.row_joint[i]) for i in rows})
+    labels = []
+    for i in rows:
+        j = str(lay.row_joint[i])
+        pos = int(np.flatnonzero(lay.rows[j] == i)[0])
+        labels.append(f"{j} ({_ROW_LABELS[model.joint_kind(j)][pos]})")
+    return n_red, joints, labels
+
+
+def _joint_geometry(model: Model, lay: ConstraintLayout):
+    """Per active joint: kind, parent index, child index, child-frame point, parent axis."""
+    out = {}
+    for k, nme in enumerate(model.rev.names):
+        out[nme] = ("revolute", int(model.rev.i[k]), int(model.rev.j[k]), model.rev.sj[k], None)
+    for k, nme in enumerate(model.pri.names):
+        out[nme] = ("prismatic", int(model.pri.i[k]), int(model.pri.j[k]), model.pri.sj[k],
+                    model.pri.ui[k])
+    for k, nme in enumerate(model.lock.names):
+        if lay.lock_active[k]:
+            out[nme] = ("lock", int(model.lock.i[k]), int(model.lock.j[k]), np.zeros(2), None)
+    return {n: out[n] for n in model.joint_names if n in out}
+
+
+def _net_on_ground(model: Model, x, D) -> np.ndarray:
+    """Minus the net force and moment about the ground origin of body forces D (n, n_x).
+
+    For a force element between the frame and the moving bodies, this is what
+    the frame receives (action and reaction).
+    """
+    n = D.shape[0]
+    Db = D.reshape(n, model.n_bodies, 3)
+    r = np.asarray(x, float).reshape(n, model.n_bodies, 3)[..., :2]
+    f = Db[..., :2].sum(axis=1)
+    m = (Db[..., 2] + cross(r, Db[..., :2])).sum(axis=1)
+    return -np.concatenate([f, m[:, None]], axis=-1)
+
+
+def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qdot, *,
+             skip, reacting, point) -> dict:
+    """The batched inverse-dynamics solve and the reaction bookkeeping."""
+    n = t.shape[0]
+    nb = model.n_bodies
+    L = model.length_scale
+    n_d = len(didx)
+    warn: list[str] = []
+    F, F_ground, Qd_loads = applied_forces(model, t, x, xdot, q, qdot, skip_drives=skip,
+                                           reacting_loads=reacting)
+    Ix = inertia_forces(model, x, xdot, xddot)
+    P = jacobian(model, x, lay)  # (n, rows, n_x)
+    G = coordinates_jacobian(model, x)  # (n, n_q, n_x)
+    Gd = G[:, didx, :]
+    A = np.concatenate([-P, Gd], axis=1).transpose(0, 2, 1)  # (n, n_x, rows + n_d)
+    rhs = Ix - F
+    # balance units: moment equations / L; moment-like unknowns scaled by L
+    rs = np.ones(model.n_x)
+    rs[2::3] = 1.0 / L
+    cs = np.ones(lay.n_rows + n_d)
+    for j, rows in lay.rows.items():
+        kind = model.joint_kind(j)
+        if kind == "prismatic":
+            cs[rows[1]] = L
+        elif kind == "lock":
+            cs[rows[2]] = L
+    for i, k in enumerate(didx):
+        if model.coord_kind[k] != COORD_TRAVEL:
+            cs[lay.n_rows + i] = L
+    As = A * rs[:, None] * cs[None, :]
+    bs = rhs * rs
+    n_red, red_joints, red_labels = _redundancy(model, lay, x)
+    sv = np.linalg.svd(As, compute_uv=False)
+    rank_need = lay.n_rows + n_d - n_red
+    smax = sv[:, 0]
+    s_need = sv[:, rank_need - 1] if rank_need > 0 else smax
+    rcond = s_need / np.where(smax > 0, smax, 1.0)
+    singular = rcond < SINGULAR_RCOND
+    if n_red == 0 and As.shape[1] == As.shape[2] and not singular.any():
+        z = np.linalg.solve(As, bs[..., None])[..., 0]
+    else:
+        z = (np.linalg.pinv(As, rcond=1e-10) @ bs[..., None])[..., 0]
+    resid = np.einsum("nij,nj->ni", As, z) - bs
+    scale_f = np.maximum(np.max(np.abs(bs), axis=-1), 1e-300)
+    bad = np.max(np.abs(resid), axis=-1) > 1e-6 * np.maximum(
+        scale_f, np.max(np.abs(As), axis=(1, 2)) * np.max(np.abs(z), axis=-1))
+    singular |= bad
+    z = z * cs
+    lam = z[:, :lay.n_rows]
+    tau = z[:, lay.n_rows:]
+    status = "ok"
+    redundant: list[str] = []
+    if n_red:
+        status = "redundant"
+        redundant = red_joints
+        warn.append(f"{n_red} redundant joint equation(s): the equations "
+                    + ", ".join(red_labels) + " are linearly dependent, so the reactions of "
+                    "joints " + ", ".join(repr(j) for j in red_joints) + " are not unique; "
+                    "the minimum-norm solution is reported (forces in N, moments in N m "
+                    f"divided by the length scale {L:.4g} m)")
+    if singular.any():
+        status = "singular"
+        ks = np.flatnonzero(singular)
+        warn.append(f"{ks.size} singular position(s) (first at index {ks[0]}, t = "
+                    f"{t[ks[0]]:.6g} s): the driven coordinates do not control the "
+                    f"mechanism there; reactions there are least-squares values")
+    near = (rcond < NEAR_SINGULAR_RCOND) & ~singular
+    if near.any():
+        k = int(np.argmin(np.where(near, rcond, np.inf)))
+        warn.append(f"{int(near.sum())} position(s) close to a singular position (smallest "
+                    f"rcond {rcond[k]:.2e} at index {k}, t = {t[k]:.6g} s): reactions and "
+                    f"driving torques there are large and sensitive to the geometry")
+    for w in warn:
+        _warnings.warn(w, KinetostaticsWarning, stacklevel=3)
+
+    # ------------------------------------------------ joint reactions
+    X = extend(model, x)
+    C = -P * lam[:, :, None]  # row contributions to generalized forces (n, rows, n_x)
+    geo = _joint_geometry(model, lay)
+    reactions, moments, jframe, jpoints, kinds = {}, {}, {}, {}, {}
+    frame_loads: dict[str, np.ndarray] = {}
+    for name, (kind, i, j, sj, ui) in geo.items():
+        rows = lay.rows[name]
+        Cj = C[:, rows, :].sum(axis=1).reshape(n, nb, 3)
+        Pt = X[:, j, :2] + rotate(X[:, j, 2], sj)  # joint point (ground frame)
+        if j < nb:
+            f = Cj[:, j, :2]
+            m_o = Cj[:, j, 2]
+            mP = m_o - cross(Pt - X[:, j, :2], f)
+        else:  # child is the ground: use the parent's share (action = -reaction)
+            fi = Cj[:, i, :2]
+            mi = Cj[:, i, 2] - cross(Pt - X[:, i, :2], fi)
+            f, mP = -fi, -mi
+        reactions[name] = f
+        moments[name] = mP if kind != "revolute" else np.zeros(n)
+        jpoints[name] = Pt
+        kinds[name] = kind
+        thi = X[:, i, 2]
+        if kind == "prismatic":
+            u = rotate(thi, ui)
+            nrm = _perp(u)
+            jframe[name] = np.stack([np.sum(f * u, -1), np.sum(f * nrm, -1)], axis=-1)
+        else:
+            e1 = np.stack([np.cos(thi), np.sin(thi)], axis=-1)
+            jframe[name] = np.stack([np.sum(f * e1, -1), np.sum(f * _perp(e1), -1)], axis=-1)
+        if i == nb or j == nb:
+            sgn = 1.0 if j == nb else -1.0  # what the frame receives
+            ff, mm = sgn * f, sgn * mP
+            frame_loads[name] = np.concatenate(
+                [ff, (mm + cross(Pt - point, ff))[:, None]], axis=-1)
+
+    # ------------------------------------------------ drives' stator and ground-attached loads
+    D = np.einsum("nd,ndx->nx", tau, Gd) + np.einsum("nq,nqx->nx", Qd_loads, G)
+    dr = _net_on_ground(model, x, D)
+    dr[:, 2] -= cross(np.broadcast_to(point, (n, 2)), dr[:, :2])
+    frame_loads["drives"] = dr
+    lg = F_ground.copy()
+    lg[:, 2] -= cross(np.broadcast_to(point, (n, 2)), lg[:, :2])
+    frame_loads["loads"] = lg
+    tot = sum(frame_loads.values())
+    # ------------------------------------------------ power balance (self-check)
+    p_in = np.einsum("nd,nd->n", tau, qdot[:, didx]) + np.einsum("nx,nx->n", F, xdot)
+    p_kin = np.einsum("nx,nx->n", Ix, xdot)
+    p_scale = max(float(np.max(np.abs(p_kin))), float(np.max(np.abs(p_in))),
+                  float(np.max(np.abs(F * xdot))), 1e-300)
+    stats = {"power_balance_rel": float(np.max(np.abs(p_in - p_kin)) / p_scale),
+             "rcond_min": float(np.min(rcond)), "redundant_equations": n_red,
+             "singular_positions": int(singular.sum())}
+    return {"reactions": reactions, "moments": moments, "joint_frame": jframe,
+            "joint_points": jpoints, "kinds": kinds, "frame_loads": frame_loads,
+            "frame_force": tot[:, :2].copy(), "frame_moment": tot[:, 2].copy(), "tau": tau,
+            "lam": lam, "status": status, "warnings": warn, "redundant": redundant,
+            "stats": stats}
+

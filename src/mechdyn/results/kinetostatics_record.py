@@ -1,0 +1,369 @@
+"""The record of a kinetostatic analysis: :class:`Kinetostatics` (tables, summary,
+harmonics of the frame loads).  Computed by :func:`mechdyn.dynamics.kinetostatics.kinetostatics`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ModelError, did_you_mean
+from ..model import Model
+
+__all__ = ["Kinetostatics"]
+
+
+@dataclass(frozen=True, repr=False)
+class Kinetostatics:
+    """Result of a kinetostatic (inverse-dynamics) analysis over ``n`` positions.
+
+    Attributes
+    ----------
+    over : str
+        The coordinate that labels the positions (the crank angle, usually).
+    t : ndarray, shape (n,)
+        Time, s (zeros for a static analysis).
+    values : ndarray, shape (n,)
+        Values of ``over`` (rad or m).
+    q, qdot, qddot : ndarray, shape (n, n_q)
+        All generalized coordinates and their rates, measured on the poses.
+    x, xdot, xddot : ndarray, shape (n, n_x)
+        Body-frame poses, velocities and accelerations.
+    driven : tuple of str
+        Coordinates whose motion is prescribed (each has a driving torque/force).
+    reactions : dict str -> ndarray, shape (n, 2)
+        Per joint, the force ON THE CHILD FROM THE PARENT at the joint point, in
+        the ground frame, N.
+    moments : dict str -> ndarray, shape (n,)
+        Per joint, the moment on the child about the joint point, N m (zero for
+        revolutes).
+    joint_frame : dict str -> ndarray, shape (n, 2)
+        The reaction in the joint frame: prismatic (tangential along the axis,
+        normal = axis turned +90 deg); revolute and lock: components along the
+        parent body's x and y axes.
+    joint_points : dict str -> ndarray, shape (n, 2)
+        Where each reaction acts (ground frame), m.
+    driving : dict str -> ndarray, shape (n,)
+        Torque (N m) or force (N) the drive must apply to each driven coordinate.
+    power : dict str -> ndarray, shape (n,)
+        Driving power ``driving * qdot`` per driven coordinate, W.
+    frame_force : ndarray, shape (n, 2)
+        Sum of all forces the frame receives (shaking force), N.
+    frame_moment : ndarray, shape (n,)
+        Sum of the moments the frame receives about ``frame_point`` (shaking
+        moment), N m.
+    frame_point : ndarray, shape (2,)
+        The point of the frame moments, m.
+    frame_loads : dict str -> ndarray, shape (n, 3)
+        Per contributor (every joint to the ground by name, ``"drives"`` for
+        the stator reactions, ``"loads"`` for spring/torque ends): force x, y
+        (N) and moment about ``frame_point`` (N m) that the frame receives.
+    multipliers : ndarray, shape (n, n_rows)
+        Lagrange multipliers of the joint equations (layout row order).
+    joint_kinds : dict str -> str
+        "revolute", "prismatic" or "lock" for each reported joint.
+    mode : frozenset of str
+        Engaged locks.
+    redundant_joints : tuple of str
+        Joints whose equations are linearly dependent (their reactions are not
+        unique; the minimum-norm solution is reported).
+    status : str
+        "ok", "redundant" (non-unique reactions) or "singular" (positions where
+        the driven coordinates lose control of the mechanism).
+    message : str
+    warnings : tuple of str
+    stats : dict
+        Run figures: positions, seconds, Newton iterations, power-balance
+        residual (relative), smallest rcond, ...
+    """
+
+    over: str
+    t: np.ndarray
+    values: np.ndarray
+    q: np.ndarray
+    qdot: np.ndarray
+    qddot: np.ndarray
+    x: np.ndarray
+    xdot: np.ndarray
+    xddot: np.ndarray
+    coordinate_names: tuple
+    driven: tuple
+    reactions: dict
+    moments: dict
+    joint_frame: dict
+    joint_points: dict
+    driving: dict
+    power: dict
+    frame_force: np.ndarray
+    frame_moment: np.ndarray
+    frame_point: np.ndarray
+    frame_loads: dict
+    multipliers: np.ndarray
+    joint_kinds: dict
+    mode: frozenset
+    redundant_joints: tuple
+    status: str
+    message: str
+    warnings: tuple
+    stats: dict
+    model: Model | None = field(default=None, compare=False)
+
+    def __repr__(self) -> str:
+        return (f"Kinetostatics(status={self.status!r}, {len(self.t)} positions over "
+                f"{self.over!r}, driven={list(self.driven)}, joints={list(self.reactions)})")
+
+    # ------------------------------------------------------------ helpers
+    @property
+    def n(self) -> int:
+        """Number of positions."""
+        return int(self.t.shape[0])
+
+    @property
+    def over_is_angle(self) -> bool:
+        """True when ``over`` is an angle coordinate."""
+        k = self.coordinate_names.index(self.over)
+        return self._is_angle(k)
+
+    def _is_angle(self, k: int) -> bool:
+        if self.model is not None:
+            return bool(self.model.coord_is_angle[k])
+        return True
+
+    def _label(self, name: str) -> tuple[str, float]:
+        """Column of a coordinate value and the factor from SI."""
+        k = self.coordinate_names.index(name)
+        return (f"{name}_deg", np.rad2deg(1.0)) if self._is_angle(k) else (f"{name}_m", 1.0)
+
+    def _drive_unit(self, name: str) -> tuple[str, str]:
+        k = self.coordinate_names.index(name)
+        return ("M", "Nm") if self._is_angle(k) else ("F", "N")
+
+    def force_magnitude(self, joint: str) -> np.ndarray:
+        """Resultant |R| of a joint reaction, N, shape (n,)."""
+        R = self._reaction(joint)
+        return np.hypot(R[:, 0], R[:, 1])
+
+    def force_angle(self, joint: str) -> np.ndarray:
+        """Direction angle of a joint reaction in the ground frame, rad (-pi, pi], shape (n,)."""
+        R = self._reaction(joint)
+        return np.arctan2(R[:, 1], R[:, 0])
+
+    def _reaction(self, joint: str) -> np.ndarray:
+        try:
+            return self.reactions[joint]
+        except KeyError:
+            raise ModelError(did_you_mean(joint, self.reactions, "joint")) from None
+
+    @property
+    def driving_total_power(self) -> np.ndarray:
+        """Sum of the driving powers, W, shape (n,)."""
+        out = np.zeros(self.n)
+        for p in self.power.values():
+            out = out + p
+        return out
+
+    # ------------------------------------------------------------ tables
+    def to_dataframe(self):
+        """One row per position, unit-suffixed columns.
+
+        Columns: ``t_s``; per coordinate ``<c>_deg`` (or ``<c>_m``),
+        ``<c>_dot_rad_s``, ``<c>_ddot_rad_s2`` (or m/s, m/s^2); per driven
+        coordinate ``M_drive_<c>_Nm`` (``F_drive_<c>_N`` for a travel) and
+        ``P_drive_<c>_W``; per joint ``Fx_<J>_N``, ``Fy_<J>_N``, ``F_<J>_N``,
+        ``angle_F_<J>_deg``, for prismatic joints ``Ft_<J>_N``, ``Fn_<J>_N`` and
+        ``M_<J>_Nm``, for locks ``M_<J>_Nm``; per joint to the ground
+        ``Fx_frame_<J>_N``, ``Fy_frame_<J>_N``, ``M_frame_<J>_Nm``; and the
+        totals ``Fx_frame_N``, ``Fy_frame_N``, ``F_frame_N``, ``M_frame_Nm``.
+        """
+        import pandas as pd
+
+        cols: dict[str, np.ndarray] = {"t_s": self.t}
+        for k, c in enumerate(self.coordinate_names):
+            if self._is_angle(k):
+                cols[f"{c}_deg"] = np.rad2deg(self.q[:, k])
+                cols[f"{c}_dot_rad_s"] = self.qdot[:, k]
+                cols[f"{c}_ddot_rad_s2"] = self.qddot[:, k]
+            else:
+                cols[f"{c}_m"] = self.q[:, k]
+                cols[f"{c}_dot_m_s"] = self.qdot[:, k]
+                cols[f"{c}_ddot_m_s2"] = self.qddot[:, k]
+        for c in self.driven:
+            sym, unit = self._drive_unit(c)
+            cols[f"{sym}_drive_{c}_{unit}"] = self.driving[c]
+            cols[f"P_drive_{c}_W"] = self.power[c]
+        for j, R in self.reactions.items():
+            cols[f"Fx_{j}_N"] = R[:, 0]
+            cols[f"Fy_{j}_N"] = R[:, 1]
+            cols[f"F_{j}_N"] = np.hypot(R[:, 0], R[:, 1])
+            cols[f"angle_F_{j}_deg"] = np.rad2deg(np.arctan2(R[:, 1], R[:, 0]))
+            kind = self.joint_kinds[j]
+            if kind == "prismatic":
+                cols[f"Ft_{j}_N"] = self.joint_frame[j][:, 0]
+                cols[f"Fn_{j}_N"] = self.joint_frame[j][:, 1]
+            if kind in ("prismatic", "lock"):
+                cols[f"M_{j}_Nm"] = self.moments[j]
+        for j, L in self.frame_loads.items():
+            if j in self.reactions:
+                cols[f"Fx_frame_{j}_N"] = L[:, 0]
+                cols[f"Fy_frame_{j}_N"] = L[:, 1]
+                cols[f"M_frame_{j}_Nm"] = L[:, 2]
+        cols["Fx_frame_N"] = self.frame_force[:, 0]
+        cols["Fy_frame_N"] = self.frame_force[:, 1]
+        cols["F_frame_N"] = np.hypot(self.frame_force[:, 0], self.frame_force[:, 1])
+        cols["M_frame_Nm"] = self.frame_moment
+        return pd.DataFrame(cols)
+
+    # ------------------------------------------------------------ summaries
+    def _where(self, k: int) -> str:
+        lab, f = self._label(self.over)
+        unit = "deg" if lab.endswith("_deg") else "m"
+        return f"{self.over} = {self.values[k] * f:.4g} {unit}"
+
+    def rms(self, series) -> float:
+        """RMS of a series over the positions, weighted by time when time advances
+        (trapezoidal rule), else by position count."""
+        y = np.asarray(series, dtype=float)
+        t = self.t
+        if y.size < 2:
+            return float(np.sqrt(np.mean(y**2)))
+        if np.all(np.diff(t) > 0):
+            return float(np.sqrt(np.trapezoid(y**2, t) / (t[-1] - t[0])))
+        v = self.values
+        if np.all(np.diff(v) > 0) or np.all(np.diff(v) < 0):
+            return float(np.sqrt(np.trapezoid(y**2, v) / (v[-1] - v[0])))
+        return float(np.sqrt(np.mean(y**2)))
+
+    def peaks(self) -> dict:
+        """The figures of :meth:`summary` as a dict (SI units; positions in ``over``'s unit)."""
+        out: dict = {"driving": {}, "joints": {}, "frame": {}}
+        for c in self.driven:
+            m = self.driving[c]
+            ka, kmx, kmn = int(np.argmax(np.abs(m))), int(np.argmax(m)), int(np.argmin(m))
+            out["driving"][c] = {
+                "peak_abs": float(m[ka]), "peak_abs_at": float(self.values[ka]),
+                "max": float(m[kmx]), "max_at": float(self.values[kmx]),
+                "min": float(m[kmn]), "min_at": float(self.values[kmn]),
+                "rms": self.rms(m), "mean": float(np.mean(m)),
+                "peak_power": float(np.max(np.abs(self.power[c]))),
+            }
+        for j in self.reactions:
+            F = self.force_magnitude(j)
+            k = int(np.argmax(F))
+            out["joints"][j] = {"peak": float(F[k]), "peak_at": float(self.values[k]),
+                                "rms": self.rms(F)}
+            if self.joint_kinds[j] != "revolute":
+                M = self.moments[j]
+                km = int(np.argmax(np.abs(M)))
+                out["joints"][j].update(peak_moment=float(M[km]),
+                                        peak_moment_at=float(self.values[km]))
+        Ff = np.hypot(self.frame_force[:, 0], self.frame_force[:, 1])
+        k, km = int(np.argmax(Ff)), int(np.argmax(np.abs(self.frame_moment)))
+        out["frame"] = {
+            "force_peak": float(Ff[k]), "force_peak_at": float(self.values[k]),
+            "Fx_min": float(self.frame_force[:, 0].min()),
+            "Fx_max": float(self.frame_force[:, 0].max()),
+            "Fy_min": float(self.frame_force[:, 1].min()),
+            "Fy_max": float(self.frame_force[:, 1].max()),
+            "moment_peak": float(self.frame_moment[km]),
+            "moment_peak_at": float(self.values[km]),
+            "M_min": float(self.frame_moment.min()), "M_max": float(self.frame_moment.max()),
+        }
+        return out
+
+    def summary(self) -> str:
+        """Peak and RMS driving torque (motor sizing), peak force per joint and where,
+        shaking force and moment extremes; warnings last."""
+        p = self.peaks()
+        lab, f = self._label(self.over)
+        unit = "deg" if lab.endswith("_deg") else "m"
+        lines = [f"kinetostatics over {self.over}: {self.n} positions, "
+                 f"{self.over} from {self.values[0] * f:.4g} to {self.values[-1] * f:.4g} "
+                 f"{unit}; status {self.status}"]
+        for c, d in p["driving"].items():
+            sym, u = self._drive_unit(c)
+            u = "N m" if u == "Nm" else u
+            lines.append(
+                f"  drive {c}: peak {d['peak_abs']:.6g} {u} at {self.over} = "
+                f"{d['peak_abs_at'] * f:.4g} {unit}; max {d['max']:.6g} {u} at "
+                f"{d['max_at'] * f:.4g} {unit}; min {d['min']:.6g} {u} at "
+                f"{d['min_at'] * f:.4g} {unit}; RMS {d['rms']:.6g} {u}; mean "
+                f"{d['mean']:.6g} {u}; peak power {d['peak_power']:.6g} W")
+        for j, d in p["joints"].items():
+            s = (f"  joint {j} ({self.joint_kinds[j]}): peak force {d['peak']:.6g} N at "
+                 f"{self.over} = {d['peak_at'] * f:.4g} {unit}")
+            if "peak_moment" in d:
+                s += (f"; peak moment {d['peak_moment']:.6g} N m at "
+                      f"{d['peak_moment_at'] * f:.4g} {unit}")
+            lines.append(s)
+        fr = p["frame"]
+        lines.append(
+            f"  frame: shaking force peak {fr['force_peak']:.6g} N at {self.over} = "
+            f"{fr['force_peak_at'] * f:.4g} {unit} (Fx {fr['Fx_min']:.6g}..{fr['Fx_max']:.6g} N,"
+            f" Fy {fr['Fy_min']:.6g}..{fr['Fy_max']:.6g} N); shaking moment about "
+            f"({self.frame_point[0]:.4g}, {self.frame_point[1]:.4g}) m: "
+            f"{fr['M_min']:.6g}..{fr['M_max']:.6g} N m")
+        for w in self.warnings:
+            lines.append(f"  warning: {w}")
+        return "\n".join(lines)
+
+    def harmonics(self, n_orders: int | None = None):
+        """Harmonics of the shaking force and moment per order of the ``over`` cycle.
+
+        The positions must sample one full turn of an angle coordinate
+        uniformly (an end point equal to the start point modulo 2 pi is
+        dropped); at constant speed this is the Fourier series in time, order k
+        at ``k`` times the crank frequency.
+
+        Parameters
+        ----------
+        n_orders : int, optional
+            Highest order returned (default: all, up to the Nyquist order).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``order``, ``f_Hz`` (k times the mean crank frequency; NaN
+            for a static analysis), and amplitude and phase of ``Fx_frame_N``,
+            ``Fy_frame_N``, ``M_frame_Nm`` (columns ``<name>`` for the
+            amplitude, ``<name>_phase_deg``) in the cosine series
+            ``y = sum_k A_k cos(k |phi - phi_0| + phase_k)`` (angle travelled
+            from the first position); order 0 is the (signed) mean.
+
+        Raises
+        ------
+        ValueError
+            If the samples are not one uniformly sampled turn.
+        """
+        import pandas as pd
+
+        v = np.asarray(self.values, dtype=float)
+        if not self.over_is_angle:
+            raise ValueError(f"harmonics need an angle coordinate; {self.over!r} is a travel")
+        n = v.size
+        if n >= 2 and np.isclose(abs(v[-1] - v[0]), 2 * np.pi, rtol=1e-9, atol=1e-12):
+            n -= 1  # the end point repeats the start point
+        step = 2 * np.pi / n if n else np.nan
+        if n < 4 or not np.allclose(np.abs(np.diff(v)), step, rtol=1e-6, atol=1e-12):
+            raise ValueError(
+                f"harmonics need one full turn of {self.over!r} sampled uniformly "
+                f"(e.g. values = linspace(0, 2 pi, 361)); got {v.size} positions from "
+                f"{np.rad2deg(v[0]):.6g} to {np.rad2deg(v[-1]):.6g} deg")
+        series = {"Fx_frame_N": self.frame_force[:n, 0], "Fy_frame_N": self.frame_force[:n, 1],
+                  "M_frame_Nm": self.frame_moment[:n]}
+        kmax = n // 2 if n_orders is None else min(int(n_orders), n // 2)
+        orders = np.arange(kmax + 1)
+        tt = self.t
+        period = (tt[n] - tt[0]) if n < tt.size else (tt[n - 1] - tt[0]) * n / (n - 1)
+        freq = orders / period if period > 0 else orders * np.nan
+        cols: dict = {"order": orders, "f_Hz": freq}
+        for name, y in series.items():
+            Y = np.fft.rfft(y)[: kmax + 1] / n
+            amp = 2 * np.abs(Y)
+            ph = np.angle(Y)
+            amp[0], ph[0] = Y[0].real, 0.0
+            if n % 2 == 0 and kmax == n // 2:
+                amp[-1] = np.abs(Y[-1])
+            cols[name] = amp
+            cols[f"{name}_phase_deg"] = np.rad2deg(ph)
+        return pd.DataFrame(cols)
+
