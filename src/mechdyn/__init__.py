@@ -44,9 +44,15 @@ from .mechanism import (
                                  TorqueSpeedCurve,
                                  pulse,
 )
+from .mechanism.assembly_mode import AssemblyMode
+from .mechanism.contact import Contact, Stop
 from .mechanism.motors import ConstantSpeedDrive, DCMotor, GearStage, InductionMotor
+from .mechanism.switch import CoordinateLock, Switch
 from .model import Model
 from .modelfile import load, loads
+from .results.trajectory import Trajectory
+from .simulate import simulate
+from .simulate_events import SwitchEvent, format_events
 from .state import State
 
 __version__ = "0.1.0"
@@ -56,9 +62,11 @@ __all__ = [
     "Mechanism", "Body", "Ground", "Revolute", "Prismatic", "Lock", "Coordinate", "Spring",
     "RotarySpring", "Force", "Torque", "Table", "pulse", "Drive", "TorqueSpeedCurve",
     "InductionMotor", "DCMotor", "ConstantSpeedDrive", "GearStage", "Model", "State",
+    "AssemblyMode", "CoordinateLock", "Switch", "Stop", "Contact",
     "load", "loads", "examples", "units",
     # analyses and their records
     "sweep", "analyze", "KinematicSweep", "KinematicPoint", "SweepSummary",
+    "simulate", "Trajectory", "SwitchEvent", "format_events",
     "kinetostatics", "Kinetostatics",
     "reduce_model", "Reduction", "run_reduced", "steady_state", "SteadyCycle", "size_flywheel",
     "FlywheelSizing", "startup",
