@@ -73,7 +73,8 @@ class Model:
     com : ndarray, shape (n_bodies, 2)
         Centres of mass in the body frames, m.
     mass_diag : ndarray, shape (n_x,)
-        Diagonal of the mass matrix of the body frames' origins... see ``mass_matrix``.
+        (m, m, J_c) per body: the diagonal mass matrix in centre-of-mass coordinates
+        (kg, kg, kg m^2); dynamics maps the body-frame analogs to the centres of mass.
     x_sketch : ndarray, shape (n_x,)
         The sketch poses, which choose the assembly branch.
     length_scale : float
@@ -161,7 +162,7 @@ class Model:
         self.length_scale = scale if scale > 0 else 1.0
 
         self.mass_diag = np.repeat(self.mass, 3).reshape(nb, 3)
-        self.mass_diag[:, 2] = self.inertia  # body frame = ... see mass_matrix
+        self.mass_diag[:, 2] = self.inertia
         self.mass_diag = self.mass_diag.reshape(-1)
         self.initial_mode = self.mode_of(self.lock.engaged)
         #: declared assembly modes: (AssemblyMode, ((body index, local point) for P, Q, R))
@@ -239,15 +240,6 @@ class Model:
             lay = ConstraintLayout(self, mode)
             self._layouts[mode] = lay
         return lay
-
-    # ------------------------------------------------------------------ mass
-    def mass_matrix(self) -> np.ndarray:
-        """Diagonal of the mass matrix in centre-of-mass coordinates, shape (n_x,).
-
-        The kinetic energy is T = 1/2 sum (m v_c^2 + J_c omega^2); dynamics
-        works with the velocities of the centres of mass (see ``dynamics``).
-        """
-        return self.mass_diag.copy()
 
     # ------------------------------------------------------------------ checks
     def check_rank(self, gruebler_message: str | None = None):
