@@ -17,7 +17,7 @@ __all__ = ["main", "SUBCOMMAND_MODULES"]
 
 #: modules of this package that define subcommands, in the order of ``mechdyn --help``
 SUBCOMMAND_MODULES = ("demo", "examples", "kinematics", "simulate", "kinetostatics", "reduce",
-                      "flywheel")
+                      "flywheel", "animate", "report")
 
 
 def build_parser() -> argparse.ArgumentParser:

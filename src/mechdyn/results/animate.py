@@ -1,0 +1,596 @@
+"""Animations and still frames of a mechanism's motion (GIF, MP4, PNG).
+
+:func:`animate` draws every frame of a record that carries body poses ``x``
+(shape (n, n_x)) and its compiled ``model`` -- a
+:class:`~mechdyn.kinematics.records.KinematicSweep`, a
+:class:`~mechdyn.results.trajectory.Trajectory` or a
+:class:`~mechdyn.results.kinetostatics_record.Kinetostatics` -- and writes a GIF
+(with Pillow, as matplotlib's ``PillowWriter`` does) or an MP4 (only when ffmpeg is installed).
+:func:`snapshot` writes one frame as a PNG.
+
+What is drawn (the coordinates of every frame come from :func:`frame_geometry`,
+which the tests compare with :func:`mechdyn.kinematics.constraints.point_position`):
+
+* every moving body as the polygon (three or more points) or the bar (two points)
+  through its named points and the points of its joints; a slider block (a small
+  rectangle along the guide) for a body guided by a prismatic joint that has only
+  one point; a small disc for any other body with one point;
+* revolute joints as small open circles, locks as small squares;
+* the ground points of joints as hatched triangles (anchors);
+* prismatic guides as lines along their axis, spanning the travel of the slider
+  over the motion (they move with their parent body when it is not the ground);
+* optionally the path of one point (``trace``) -- faint for the whole motion,
+  solid up to the current frame;
+* the time (a trajectory) or the swept coordinate's value (a sweep) in the corner.
+
+The axis limits are fixed from the whole motion and the aspect ratio is equal.
+Figures are drawn on matplotlib's Agg canvas; pyplot is not used.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import MechdynError, ModelError
+
+__all__ = ["animate", "snapshot", "frame_geometry", "frame_indices", "check_animation_path",
+           "MechanismDrawing"]
+
+#: largest number of frames drawn by default
+MAX_FRAMES = 200
+
+_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown",
+           "tab:pink", "tab:olive", "tab:cyan", "tab:gray")
+
+
+def _rot(theta: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Rotate body-frame points ``s`` (k, 2) by angles ``theta`` (n,) -> (n, k, 2)."""
+    c, sn = np.cos(theta)[:, None], np.sin(theta)[:, None]
+    return np.stack([c * s[None, :, 0] - sn * s[None, :, 1],
+                     sn * s[None, :, 0] + c * s[None, :, 1]], axis=-1)
+
+
+def _as_point(model, body: str, ref) -> np.ndarray:
+    if isinstance(ref, str):
+        return np.asarray(model._point(body, ref), dtype=float)
+    return np.asarray(ref, dtype=float).reshape(2)
+
+
+def _unique(points: list[np.ndarray], tol: float) -> list[np.ndarray]:
+    out: list[np.ndarray] = []
+    for p in points:
+        if all(np.hypot(*(p - q)) > tol for q in out):
+            out.append(p)
+    return out
+
+
+def _outline(points: list[np.ndarray]) -> np.ndarray:
+    """Order three or more body-frame points around their centroid (a simple polygon)."""
+    P = np.array(points)
+    c = P.mean(axis=0)
+    ang = np.arctan2(P[:, 1] - c[1], P[:, 0] - c[0])
+    return P[np.argsort(ang)]
+
+
+@dataclass(frozen=True)
+class MechanismDrawing:
+    """What to draw of a model, in body-frame coordinates (built once per record).
+
+    Attributes
+    ----------
+    bodies : dict str -> (ndarray (k, 2), str)
+        Outline of each moving body in its frame, m, and its style: ``"polygon"``
+        (closed), ``"bar"`` (open polyline), ``"block"`` (closed slider block) or
+        ``"disc"`` (one point).
+    revolutes, locks : dict str -> (str, ndarray (2,))
+        Child body and the joint point in the child frame (a lock: the child
+        frame origin), m.
+    anchors : dict str -> ndarray (2,)
+        Ground points of joints to the ground, ground frame, m (by joint name).
+    guides : dict str -> (str, ndarray (2, 2))
+        Parent body (or ``"ground"``) and the guide segment's two ends in the
+        parent frame, m.
+    size : float
+        Drawing size of joint circles, blocks and anchors, m.
+    """
+
+    bodies: dict
+    revolutes: dict
+    locks: dict
+    anchors: dict
+    guides: dict
+    size: float
+
+
+def _drawing(model, x: np.ndarray) -> MechanismDrawing:
+    """Build the :class:`MechanismDrawing` of a model for poses ``x`` (n, n_x)."""
+    mech = model.mechanism
+    ground = "ground"
+    tol = 1e-9 * model.length_scale
+    pts: dict[str, list[np.ndarray]] = {b: [] for b in model.body_names}
+    for b in model.body_names:
+        pts[b] += [np.asarray(p, dtype=float) for p in mech.bodies[b].points.values()]
+    revolutes, locks, anchors, guides = {}, {}, {}, {}
+    guided: dict[str, tuple[np.ndarray, float]] = {}
+    for name, j in mech.joints.items():
+        kind = model.joint_kind(name)
+        if kind == "lock":
+            locks[name] = (j.child, np.zeros(2)) if j.child != ground else (j.parent, np.zeros(2))
+            continue
+        pp = _as_point(model, j.parent, j.parent_point)
+        cp = _as_point(model, j.child, j.child_point)
+        if j.parent != ground:
+            pts[j.parent].append(pp)
+        if j.child != ground:
+            pts[j.child].append(cp)
+        if kind == "revolute":
+            if j.child != ground:
+                revolutes[name] = (j.child, cp)
+            else:
+                revolutes[name] = (j.parent, pp)
+            if ground in (j.parent, j.child):
+                anchors[name] = pp if j.parent == ground else cp
+        else:  # prismatic: a guide line on the parent, a block on the child
+            k = model.pri.names.index(name)
+            u = model.pri.ui[k]
+            if j.child != ground:
+                a = -model.pri.angle[k]
+                ca, sa = np.cos(a), np.sin(a)
+                guided[j.child] = (np.array([ca * u[0] - sa * u[1], sa * u[0] + ca * u[1]]), 0.0)
+            guides[name] = (j.parent, pp, u, j.child, cp)
+
+    span = _extent(model, x, pts)
+    size = 0.035 * span
+    bodies = {}
+    for b in model.body_names:
+        p = _unique(pts[b], tol)
+        if len(p) >= 3:
+            bodies[b] = (_outline(p), "polygon")
+        elif len(p) == 2:
+            bodies[b] = (np.array(p), "bar")
+        else:
+            c = p[0] if p else np.asarray(model.com[model.body_index(b)], dtype=float)
+            if b in guided:
+                u = guided[b][0]
+                n = np.array([-u[1], u[0]])
+                w, h = 1.6 * size, 0.9 * size
+                block = np.array([c + w * u + h * n, c - w * u + h * n,
+                                  c - w * u - h * n, c + w * u - h * n])
+                bodies[b] = (block, "block")
+            else:
+                bodies[b] = (c[None, :], "disc")
+    # guide segments: the travel range of the child point over the motion, plus margins
+    out_guides = {}
+    for name, (parent, pp, u, child, cp) in guides.items():
+        if child == ground or parent == child:
+            continue
+        r_c = _world(model, x, child, cp[None, :])[:, 0]
+        r_o = _world(model, x, parent, pp[None, :])[:, 0]
+        if parent == ground:
+            u_w = np.broadcast_to(u, r_c.shape)
+        else:
+            th = x[:, 3 * model.body_index(parent) + 2]
+            u_w = _rot(th, u[None, :])[:, 0]
+        s = np.einsum("ij,ij->i", r_c - r_o, u_w)
+        lo, hi = float(np.min(s)), float(np.max(s))
+        m = max(2.5 * size, 0.1 * (hi - lo))
+        out_guides[name] = (parent, np.array([pp + (lo - m) * u, pp + (hi + m) * u]))
+    return MechanismDrawing(bodies, revolutes, locks, anchors, out_guides, size)
+
+
+def _world(model, x: np.ndarray, body: str, local: np.ndarray) -> np.ndarray:
+    """Ground-frame positions (n, k, 2) of body-frame points ``local`` (k, 2) over ``x``."""
+    if body == "ground":
+        return np.broadcast_to(local[None], (x.shape[0],) + local.shape)
+    k = model.body_index(body)
+    return x[:, None, 3 * k:3 * k + 2] + _rot(x[:, 3 * k + 2], local)
+
+
+def _extent(model, x: np.ndarray, pts: dict) -> float:
+    """Size of the region swept by all points over the motion, m."""
+    allp = []
+    for b, p in pts.items():
+        if p:
+            allp.append(_world(model, x, b, np.array(p)).reshape(-1, 2))
+        k = model.body_index(b)
+        allp.append(x[:, 3 * k:3 * k + 2])
+    P = np.concatenate(allp) if allp else np.zeros((1, 2))
+    span = float(np.max(np.ptp(P, axis=0)))
+    return span if span > 0 else model.length_scale
+
+
+def _trace_spec(model, trace) -> tuple[str, object] | None:
+    if trace is None:
+        return None
+    if isinstance(trace, str):
+        body, sep, point = trace.partition(".")
+        if not sep or not point:
+            raise ModelError(f"trace {trace!r}: write it as BODY.POINT (e.g. 'rod.B')")
+        trace = (body, point)
+    body, point = trace
+    model.point_local(body, point)  # clear error for unknown names
+    return body, point
+
+
+def _record_parts(record):
+    """(model, x (n, n_x), labels (n,) of the corner text, name)."""
+    model = getattr(record, "model", None)
+    x = getattr(record, "x", None)
+    if model is None or x is None:
+        raise ModelError(f"cannot animate a {type(record).__name__}: it needs body poses 'x' "
+                         "and its compiled 'model' (a KinematicSweep, Trajectory or "
+                         "Kinetostatics)")
+    x = np.atleast_2d(np.asarray(x, dtype=float))
+    if x.shape[0] == 0:
+        raise ModelError(f"the {type(record).__name__} has no positions to draw "
+                         f"(status {getattr(record, 'status', '?')!r})")
+    return model, x
+
+
+def _labels(record, idx: np.ndarray) -> list[str]:
+    over = getattr(record, "over", None)
+    t = getattr(record, "t", None)
+    if over is not None and getattr(record, "values", None) is not None:
+        v = np.asarray(record.values)[idx]
+        if record.over_is_angle:
+            return [f"{over} = {np.rad2deg(a):8.2f} deg" for a in v]
+        return [f"{over} = {a * 1e3:8.3f} mm" for a in v]
+    if t is not None:
+        tt = np.asarray(t)[idx]
+        span = float(np.ptp(np.asarray(t))) if np.size(t) else 0.0
+        if 0 < span < 1.0:
+            return [f"t = {a * 1e3:9.3f} ms" for a in tt]
+        return [f"t = {a:9.4f} s" for a in tt]
+    return [f"frame {i}" for i in idx]
+
+
+def frame_indices(record, frames: int | None = None) -> np.ndarray:
+    """Indices of the samples drawn: at most ``frames`` (default ``min(n, 200)``).
+
+    For a record with increasing times (a trajectory) the frames are equally spaced
+    in time (the sample nearest to each frame time); otherwise equally spaced in
+    index.  The first and the last sample are always drawn.
+    """
+    _, x = _record_parts(record)
+    n = x.shape[0]
+    m = min(n, MAX_FRAMES) if frames is None else int(frames)
+    if m < 1:
+        raise ModelError(f"frames must be at least 1, got {frames}")
+    m = min(m, n)
+    t = getattr(record, "t", None)
+    if t is not None and np.size(t) == n and n > 1 and np.all(np.diff(t) >= 0) and t[-1] > t[0]:
+        t = np.asarray(t, dtype=float)
+        goal = np.linspace(t[0], t[-1], m)
+        idx = np.clip(np.searchsorted(t, goal), 0, n - 1)
+        prev = np.clip(idx - 1, 0, n - 1)
+        idx = np.where(np.abs(t[prev] - goal) < np.abs(t[idx] - goal), prev, idx)
+    else:
+        idx = np.round(np.linspace(0, n - 1, m)).astype(int)
+    return np.unique(idx)
+
+
+def frame_geometry(record, index=None, *, trace=None) -> dict:
+    """Ground-frame drawing coordinates of frames of a record (what :func:`animate` draws).
+
+    Parameters
+    ----------
+    record : KinematicSweep, Trajectory or Kinetostatics
+        Anything with body poses ``x`` (n, n_x) and its compiled ``model``.
+    index : int or array_like of int, optional
+        Samples (default all).
+    trace : "BODY.POINT" or (body, point), optional
+        Add the path of this point.
+
+    Returns
+    -------
+    dict
+        ``bodies``: name -> (m, k, 2) outline (m frames, k points; style in
+        ``styles``); ``revolutes``, ``locks``: joint -> (m, 2) joint point;
+        ``anchors``: joint -> (2,) ground point; ``guides``: joint -> (m, 2, 2)
+        guide segment; ``trace``: (m, 2) or absent; ``limits``: ((xmin, xmax),
+        (ymin, ymax)) over the whole motion; ``size``: symbol size; all in m.
+    """
+    model, x = _record_parts(record)
+    drawing = _drawing(model, x)
+    return _geometry(model, x, drawing, index, _trace_spec(model, trace))
+
+
+def _geometry(model, x, drawing: MechanismDrawing, index, trace) -> dict:
+    sel = np.arange(x.shape[0]) if index is None else np.atleast_1d(np.asarray(index, int))
+    xs = x[sel]
+    g: dict = {"bodies": {}, "styles": {}, "revolutes": {}, "locks": {}, "guides": {},
+               "anchors": dict(drawing.anchors), "size": drawing.size}
+    for b, (local, style) in drawing.bodies.items():
+        g["bodies"][b] = _world(model, xs, b, local)
+        g["styles"][b] = style
+    for j, (b, p) in drawing.revolutes.items():
+        g["revolutes"][j] = _world(model, xs, b, p[None, :])[:, 0]
+    for j, (b, p) in drawing.locks.items():
+        g["locks"][j] = _world(model, xs, b, p[None, :])[:, 0]
+    for j, (b, seg) in drawing.guides.items():
+        g["guides"][j] = np.array(_world(model, xs, b, seg))
+    if trace is not None:
+        body, point = trace
+        g["trace"] = _world(model, xs, body, model.point_local(body, point)[None, :])[:, 0]
+    return g
+
+
+def _limits(model, x, drawing, trace) -> tuple[tuple[float, float], tuple[float, float]]:
+    g = _geometry(model, x, drawing, None, trace)
+    arrs = [a.reshape(-1, 2) for a in g["bodies"].values()]
+    arrs += [a.reshape(-1, 2) for a in g["guides"].values()]
+    s = drawing.size
+    for a in g["anchors"].values():  # the anchor triangles and their ground lines
+        arrs.append(np.asarray(a).reshape(1, 2) + [[-1.8 * s, -1.8 * s], [1.8 * s, 0.0]])
+    if "trace" in g:
+        arrs.append(g["trace"])
+    P = np.concatenate(arrs)
+    lo, hi = P.min(axis=0), P.max(axis=0)
+    pad = 1.5 * s
+    return ((float(lo[0] - pad), float(hi[0] + pad)),
+            (float(lo[1] - pad), float(hi[1] + pad)))
+
+
+class _Scene:
+    """The matplotlib artists of one figure, updated frame by frame."""
+
+    def __init__(self, record, *, trace=None, title=None, width: float = 6.4):
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+        from matplotlib.patches import Polygon
+
+        self.record = record
+        self.model, self.x = _record_parts(record)
+        self.trace = _trace_spec(self.model, trace)
+        self.drawing = d = _drawing(self.model, self.x)
+        (x0, x1), (y0, y1) = self.limits = _limits(self.model, self.x, d, self.trace)
+        # the figure's shape follows the drawing's (room for title and labels added)
+        height = float(np.clip((width - 1.0) * (y1 - y0) / (x1 - x0) + 1.2, 3.0, 7.5))
+        self.fig = fig = Figure(figsize=(width, height), layout="constrained")
+        FigureCanvasAgg(fig)
+        ax = self.ax = fig.add_subplot()
+        ax.set_xlim(x0, x1)
+        ax.set_ylim(y0, y1)
+        ax.set_aspect("equal", adjustable="box")
+        ax.grid(True, alpha=0.25)
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        mech = self.model.mechanism
+        ax.set_title(title if title is not None else getattr(mech, "name", "mechanism"))
+        s = d.size
+        # static: anchors (hatched triangles) and ground guides
+        for p in d.anchors.values():
+            tri = np.array([p, p + [-1.2 * s, -1.8 * s], p + [1.2 * s, -1.8 * s]])
+            ax.add_patch(Polygon(tri, closed=True, facecolor="0.85", edgecolor="0.3",
+                                 hatch="////", lw=1.0, zorder=1))
+            ax.plot([p[0] - 1.8 * s, p[0] + 1.8 * s], [p[1] - 1.8 * s] * 2, color="0.3",
+                    lw=1.5, zorder=1)
+        g0 = _geometry(self.model, self.x, d, [0], self.trace)
+        self.guides = {}
+        for j, seg in g0["guides"].items():
+            (ln,) = ax.plot(seg[0, :, 0], seg[0, :, 1], color="0.35", lw=2.5, alpha=0.6,
+                            solid_capstyle="butt", zorder=1)
+            self.guides[j] = ln
+        if self.trace is not None:
+            gt = _geometry(self.model, self.x, d, None, self.trace)["trace"]
+            ax.plot(gt[:, 0], gt[:, 1], color="tab:red", lw=0.8, ls=":", alpha=0.6, zorder=2)
+            (self.trace_line,) = ax.plot([], [], color="tab:red", lw=1.4, zorder=2,
+                                         label=f"path of {self.trace[0]}.{self.trace[1]}")
+            (self.trace_dot,) = ax.plot([], [], "o", color="tab:red", ms=4, zorder=6)
+            ax.legend(loc="upper right", fontsize="small")
+            self.trace_all = gt
+        # moving bodies
+        self.bodies = {}
+        for k, (b, (_, style)) in enumerate(d.bodies.items()):
+            c = _COLORS[k % len(_COLORS)]
+            P = g0["bodies"][b][0]
+            if style in ("polygon", "block"):
+                art = Polygon(P, closed=True, facecolor=c, alpha=0.45, edgecolor=c, lw=2.0,
+                              zorder=3, label=b)
+                ax.add_patch(art)
+            elif style == "bar":
+                (art,) = ax.plot(P[:, 0], P[:, 1], color=c, lw=5.0, alpha=0.8,
+                                 solid_capstyle="round", zorder=3, label=b)
+            else:
+                (art,) = ax.plot(P[:, 0], P[:, 1], "o", color=c, ms=9, zorder=3, label=b)
+            self.bodies[b] = (art, style)
+        rv = np.array(list(g0["revolutes"].values())).reshape(-1, 2)
+        (self.revolutes,) = ax.plot(rv[:, 0], rv[:, 1], "o", ms=6, mfc="white", mec="black",
+                                    mew=1.3, zorder=5, ls="none")
+        lk = np.array(list(g0["locks"].values())).reshape(-1, 2)
+        (self.locks,) = ax.plot(lk[:, 0], lk[:, 1], "s", ms=6, mfc="0.2", mec="black",
+                                zorder=5, ls="none")
+        self.text = ax.text(0.02, 0.97, "", transform=ax.transAxes, ha="left", va="top",
+                            family="monospace", fontsize="medium",
+                            bbox={"boxstyle": "round", "fc": "white", "ec": "0.7",
+                                  "alpha": 0.85}, zorder=7)
+
+    def artists(self) -> list:
+        """The artists that move from frame to frame."""
+        out = [a for a, _ in self.bodies.values()] + list(self.guides.values())
+        out += [self.revolutes, self.locks, self.text]
+        if self.trace is not None:
+            out += [self.trace_line, self.trace_dot]
+        return out
+
+    def render(self, idx, labels, dpi: int):
+        """Yield one RGB :class:`PIL.Image.Image` per sample of ``idx`` (blitting)."""
+        from PIL import Image
+
+        canvas = self.fig.canvas
+        self.fig.set_dpi(dpi)
+        moving = self.artists()
+        for a in moving:
+            a.set_animated(True)
+        canvas.draw()  # the background: axes, anchors, the faint trace
+        self.fig.set_layout_engine("none")
+        background = canvas.copy_from_bbox(self.fig.bbox)
+        for i, lab in zip(idx, labels, strict=True):
+            canvas.restore_region(background)
+            self.update(int(i), lab)
+            for a in moving:
+                self.ax.draw_artist(a)
+            buf = np.asarray(canvas.buffer_rgba())
+            yield Image.fromarray(buf[..., :3].copy(), mode="RGB")
+        for a in moving:
+            a.set_animated(False)
+
+    def update(self, i: int, label: str) -> None:
+        """Move every artist to sample ``i``."""
+        g = _geometry(self.model, self.x, self.drawing, [i], self.trace)
+        for b, (art, style) in self.bodies.items():
+            P = g["bodies"][b][0]
+            if style in ("polygon", "block"):
+                art.set_xy(P)
+            else:
+                art.set_data(P[:, 0], P[:, 1])
+        rv = np.array([v[0] for v in g["revolutes"].values()]).reshape(-1, 2)
+        self.revolutes.set_data(rv[:, 0], rv[:, 1])
+        lk = np.array([v[0] for v in g["locks"].values()]).reshape(-1, 2)
+        self.locks.set_data(lk[:, 0], lk[:, 1])
+        for j, ln in self.guides.items():
+            seg = g["guides"][j][0]
+            ln.set_data(seg[:, 0], seg[:, 1])
+        if self.trace is not None:
+            self.trace_line.set_data(self.trace_all[: i + 1, 0], self.trace_all[: i + 1, 1])
+            self.trace_dot.set_data([self.trace_all[i, 0]], [self.trace_all[i, 1]])
+        self.text.set_text(label)
+
+
+def _check_path(path) -> Path:
+    path = Path(path)
+    if path.parent and not path.parent.exists():
+        path.parent.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def animate(record, path, *, fps: int = 25, frames: int | None = None, trace=None,
+            title: str | None = None, dpi: int = 80) -> Path:
+    """Write an animation of a mechanism's motion (GIF, or MP4 when ffmpeg exists).
+
+    Parameters
+    ----------
+    record : KinematicSweep, Trajectory or Kinetostatics
+        Anything with body poses ``x`` (n, n_x) and its compiled ``model``.
+    path : str or Path
+        Output file; ``.gif`` (always available) or ``.mp4`` (needs ffmpeg).
+    fps : int
+        Frames per second of the animation.
+    frames : int, optional
+        Number of frames drawn, subsampled from the record (default
+        ``min(n, 200)``; a trajectory is subsampled equally in time).
+    trace : "BODY.POINT" or (body, point), optional
+        Draw the path of this point.
+    title : str, optional
+        Title above the drawing (default the mechanism's name).
+    dpi : int
+        Resolution of the frames (the figure is 6.4 inches wide).
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    MechdynError
+        Unsupported file type, or ``.mp4`` without ffmpeg (use ``.gif``).
+    ModelError
+        A record without poses or model, or an unknown trace point.
+    """
+    from matplotlib import animation
+
+    path = check_animation_path(path)
+    suffix = path.suffix.lower()
+    if fps <= 0:
+        raise ModelError(f"fps must be positive, got {fps}")
+    idx = frame_indices(record, frames)
+    labels = _labels(record, idx)
+    scene = _Scene(record, trace=trace, title=title)
+    path = _check_path(path)
+    if suffix == ".mp4":  # pragma: no cover - needs ffmpeg
+        writer = animation.FFMpegWriter(fps=fps)
+        with writer.saving(scene.fig, str(path), dpi):
+            for i, lab in zip(idx, labels, strict=True):
+                scene.update(int(i), lab)
+                writer.grab_frame()
+        return path
+    images = _paletted(list(scene.render(idx, labels, dpi)))
+    # as matplotlib's PillowWriter does, but with the background drawn once and one palette
+    images[0].save(path, save_all=True, append_images=images[1:],
+                   duration=max(1, round(1000 / fps)), loop=0)
+    return path
+
+
+def _paletted(images: list) -> list:
+    """Quantize RGB frames to one shared palette (taken from the first, middle and last)."""
+    from PIL import Image
+
+    w, h = images[0].size
+    probe_ids = sorted({0, len(images) // 2, len(images) - 1})
+    probe = Image.new("RGB", (w, h * len(probe_ids)))
+    for j, k in enumerate(probe_ids):
+        probe.paste(images[k], (0, j * h))
+    palette = probe.quantize(colors=128, method=Image.Quantize.MEDIANCUT,
+                             dither=Image.Dither.NONE)
+    return [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
+
+
+def check_animation_path(path) -> Path:
+    """The output path of :func:`animate` if its format can be written, else a clear error.
+
+    Raises
+    ------
+    MechdynError
+        Neither ``.gif`` nor ``.mp4``, or ``.mp4`` without ffmpeg.
+    """
+    from matplotlib import animation
+
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in (".gif", ".mp4"):
+        raise MechdynError(f"cannot write {str(path)!r}: animations are written as .gif "
+                           "(or .mp4 when ffmpeg is installed)")
+    if suffix == ".mp4" and not animation.FFMpegWriter.isAvailable():
+        raise MechdynError(f"cannot write {str(path)!r}: MP4 needs ffmpeg, which is not "
+                           "installed; write a .gif instead (e.g. -o motion.gif)")
+    return path
+
+
+def snapshot(record, path, index: int = 0, *, trace=None, title: str | None = None,
+             dpi: int = 110) -> Path:
+    """Write one frame of the motion as an image (PNG, or any matplotlib format).
+
+    Parameters
+    ----------
+    record : KinematicSweep, Trajectory or Kinetostatics
+    path : str or Path
+        Image file (format from the suffix, e.g. ``.png``, ``.svg``); a binary
+        file object is also accepted (PNG).
+    index : int
+        Sample to draw (negative counts from the end).
+    trace : "BODY.POINT" or (body, point), optional
+        Draw the path of this point (up to this sample, and faint for all of it).
+    title : str, optional
+    dpi : int
+
+    Returns
+    -------
+    Path or the file object
+    """
+    model, x = _record_parts(record)
+    n = x.shape[0]
+    if not -n <= index < n:
+        raise ModelError(f"index {index} is outside the record's {n} samples")
+    i = int(index) % n
+    scene = _Scene(record, trace=trace, title=title)
+    scene.update(i, _labels(record, np.array([i]))[0])
+    if hasattr(path, "write"):
+        scene.fig.savefig(path, dpi=dpi, format="png")
+        return path
+    path = _check_path(path)
+    scene.fig.savefig(path, dpi=dpi)
+    return path

@@ -1,0 +1,645 @@
+"""Self-contained HTML reports for engineers: the model, its kinematics, its forces.
+
+:func:`write_report` and :func:`report_trajectory` only consume result records
+(a :class:`~mechdyn.kinematics.records.KinematicSweep`, a
+:class:`~mechdyn.results.kinetostatics_record.Kinetostatics`, a
+:class:`~mechdyn.results.trajectory.Trajectory`) and the compiled model; the
+convenience :func:`report` composes the standard analyses of a model (a sweep
+over one turn and, for one degree of freedom or a given speed, the kinetostatic
+cycle) and hands the records to :func:`write_report`.
+
+A report is one HTML file: tables (pandas ``to_html``), plots and a drawing of
+the mechanism embedded as base64 PNG images, a small inline style sheet; no
+other files, no scripts, no network.  Units are in every column heading (the
+column names of ``docs/notation.md``).
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+import tempfile
+from dataclasses import fields, is_dataclass
+from datetime import datetime
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["report", "report_records", "write_report", "report_trajectory", "model_tables"]
+
+_CSS = """
+body { font-family: -apple-system, "Segoe UI", Helvetica, Arial, sans-serif; margin: 2em auto;
+       max-width: 62em; color: #222; line-height: 1.4; padding: 0 1em; }
+h1 { border-bottom: 2px solid #2c5d8f; padding-bottom: .2em; }
+h2 { color: #2c5d8f; margin-top: 1.8em; border-bottom: 1px solid #ccd; }
+h3 { margin-bottom: .3em; }
+table { border-collapse: collapse; margin: .4em 0 1em 0; font-size: .9em; }
+th, td { border: 1px solid #ccd; padding: .25em .6em; text-align: right; }
+th { background: #eef2f7; }
+td:first-child, th:first-child { text-align: left; }
+.note { color: #555; font-size: .9em; }
+.status-ok { color: #1a7f37; font-weight: bold; }
+.status-bad { color: #b42318; font-weight: bold; }
+img { max-width: 100%; border: 1px solid #ddd; margin: .5em 0; }
+code { background: #f3f3f3; padding: 0 .25em; }
+"""
+
+
+# ------------------------------------------------------------------ html helpers
+def _esc(text) -> str:
+    return html.escape(str(text))
+
+
+def _table(df, *, digits: int = 6) -> str:
+    """A DataFrame as an HTML table (numbers to ``digits`` significant digits)."""
+    return df.to_html(index=False, border=0, na_rep="",
+                      float_format=lambda v: f"{v:.{digits}g}")
+
+
+def _img_png(data: bytes, alt: str) -> str:
+    b64 = base64.b64encode(data).decode("ascii")
+    return f'<img alt="{_esc(alt)}" src="data:image/png;base64,{b64}">'
+
+
+def _img_gif(data: bytes, alt: str) -> str:
+    b64 = base64.b64encode(data).decode("ascii")
+    return f'<img alt="{_esc(alt)}" src="data:image/gif;base64,{b64}">'
+
+
+def _plot_png(fn, record, **kwargs) -> bytes:
+    """Run a ``plot_*(record, path, ...)`` function into a temporary PNG; its bytes."""
+    with tempfile.TemporaryDirectory() as tmp:
+        p = Path(tmp) / "plot.png"
+        fn(record, p, **kwargs)
+        return p.read_bytes()
+
+
+def _snapshot_png(record, index: int = 0, **kwargs) -> bytes:
+    from .animate import snapshot
+
+    buf = io.BytesIO()
+    snapshot(record, buf, index, **kwargs)
+    return buf.getvalue()
+
+
+def _animation_gif(record, frames: int = 72, **kwargs) -> bytes:
+    from .animate import animate
+
+    with tempfile.TemporaryDirectory() as tmp:
+        p = Path(tmp) / "motion.gif"
+        animate(record, p, frames=frames, dpi=60, **kwargs)
+        return p.read_bytes()
+
+
+def _page(title: str, sections: list[str]) -> str:
+    from .. import __version__
+
+    stamp = datetime.now().strftime("%Y-%m-%d %H:%M")
+    return (f"<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+            f"<title>{_esc(title)}</title>\n<style>{_CSS}</style>\n</head>\n<body>\n"
+            f"<h1>{_esc(title)}</h1>\n"
+            f"<p class=\"note\">mechdyn {__version__}, {stamp}. SI units unless a column says "
+            f"otherwise; angles counter-clockwise positive; joint reactions are the force "
+            f"on the child body from the parent at the joint point, ground frame.</p>\n"
+            + "\n".join(sections) + "\n</body>\n</html>\n")
+
+
+def _write(path, text: str) -> Path:
+    path = Path(path)
+    if path.parent and not path.parent.exists():
+        path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def _status(status: str, ok: bool, message: str = "") -> str:
+    cls = "status-ok" if ok else "status-bad"
+    msg = f" &mdash; {_esc(message)}" if message else ""
+    return f'<p>Status: <span class="{cls}">{_esc(status)}</span>{msg}</p>'
+
+
+# ------------------------------------------------------------------ the model
+def _mm(v: float) -> float:
+    return float(v) * 1e3
+
+
+def _pt_text(p) -> str:
+    if isinstance(p, str):
+        return p
+    return f"({_mm(p[0]):.6g}, {_mm(p[1]):.6g}) mm"
+
+
+def _value_text(v) -> str:
+    """Short text of a parameter value: numbers to 6 significant digits, sequences shortened."""
+    if isinstance(v, (bool, str)) or v is None:
+        return str(v)
+    if isinstance(v, (int, float, np.number)):
+        return f"{float(v):.6g}"
+    if isinstance(v, (tuple, list, np.ndarray)):
+        items = list(v)
+        if len(items) > 8:
+            return (f"({len(items)} values: {_value_text(items[0])} .. "
+                    f"{_value_text(items[-1])})")
+        return "(" + ", ".join(_value_text(a) for a in items) + ")"
+    return str(v)
+
+
+def _element_params(el, skip=("name",)) -> str:
+    """Fields of a load or drive dataclass as ``key = value`` text."""
+    if not is_dataclass(el):
+        return _esc(repr(el))
+    parts = []
+    for f in fields(el):
+        if f.name in skip:
+            continue
+        v = getattr(el, f.name)
+        if v is None or (isinstance(v, (int, float)) and not isinstance(v, bool) and v == 0
+                         and f.name in ("damping", "preload")):
+            continue
+        if is_dataclass(v):
+            v = f"{type(v).__name__}({_element_params(v, skip=())})"
+        elif callable(v):
+            v = getattr(v, "__name__", "function")
+        else:
+            v = _value_text(v)
+        parts.append(f"{f.name} = {v}")
+    return "; ".join(parts)
+
+
+def model_tables(model) -> dict:
+    """Tables describing a compiled model, with units in the column names.
+
+    Parameters
+    ----------
+    model : Model
+
+    Returns
+    -------
+    dict of str to pandas.DataFrame
+        ``bodies`` (mass, inertia, centre of mass, named points), ``joints``
+        (type, parent, child, points, axis), ``coordinates`` (kind, what it
+        measures, unit, initial value and rate), ``loads`` and ``drives``
+        (kind, name, parameters in SI); empty tables are left out.
+    """
+    import pandas as pd
+
+    mech = model.mechanism
+    out = {}
+    rows = []
+    for k, b in enumerate(model.body_names):
+        body = mech.bodies[b]
+        rows.append({"body": b, "mass_kg": model.mass[k], "J_c_kg_m2": model.inertia[k],
+                     "com_x_mm": _mm(body.com[0]), "com_y_mm": _mm(body.com[1]),
+                     "points (body frame)": ", ".join(f"{n} {_pt_text(p)}"
+                                                      for n, p in body.points.items())})
+    out["bodies"] = pd.DataFrame(rows)
+    if mech.ground.points:
+        out["ground points"] = pd.DataFrame(
+            [{"point": n, "x_mm": _mm(p[0]), "y_mm": _mm(p[1])}
+             for n, p in mech.ground.points.items()])
+    rows = []
+    for name, j in mech.joints.items():
+        kind = model.joint_kind(name)
+        row = {"joint": name, "type": kind, "parent": j.parent, "child": j.child}
+        if kind == "lock":
+            row["parent point"] = ""
+            row["child point"] = ""
+            row["axis / note"] = "engaged" if j.engaged else "released"
+        else:
+            row["parent point"] = _pt_text(j.parent_point)
+            row["child point"] = _pt_text(j.child_point)
+            row["axis / note"] = (f"({j.axis[0]:.4g}, {j.axis[1]:.4g})" if kind == "prismatic"
+                                  else "")
+        rows.append(row)
+    out["joints"] = pd.DataFrame(rows)
+    from ..kinematics.sweep import initial_coordinates
+
+    try:
+        q0 = initial_coordinates(model)
+    except Exception:  # noqa: BLE001 - the report still lists the coordinates
+        q0 = np.full(model.n_q, np.nan)
+    qd0 = (mech.extras.get("initial") or {}).get("qdot") or {}
+    rows = []
+    for k, (name, c) in enumerate(mech.coordinates.items()):
+        ang = c.is_angle
+        what = c.body if c.kind == "angle" else c.joint
+        rate = float(qd0.get(name, 0.0)) if isinstance(qd0, dict) else 0.0
+        rows.append({"coordinate": name, "kind": c.kind, "of": what,
+                     "unit": "rad" if ang else "m",
+                     "initial": f"{np.rad2deg(q0[k]):.6g} deg" if ang
+                     else f"{_mm(q0[k]):.6g} mm",
+                     "initial rate": f"{rate * 30 / np.pi:.6g} rpm" if ang
+                     else f"{rate:.6g} m/s"})
+    out["coordinates"] = pd.DataFrame(rows)
+    if mech.loads:
+        out["loads"] = pd.DataFrame([{"kind": type(el).__name__,
+                                      "name": getattr(el, "name", ""),
+                                      "parameters (SI)": _element_params(el)}
+                                     for el in mech.loads])
+    if mech.drives:
+        out["drives"] = pd.DataFrame([{"kind": type(el).__name__,
+                                       "name": getattr(el, "name", ""),
+                                       "parameters (SI)": _element_params(el)}
+                                      for el in mech.drives])
+    return out
+
+
+def _model_section(model) -> str:
+    mech = model.mechanism
+    parts = ["<h2>Model</h2>"]
+    if mech.description:
+        parts.append(f"<p>{_esc(mech.description)}</p>")
+    g = model.gravity
+    parts.append(f"<p>{model.n_bodies} moving bodies, {len(model.joint_names)} joints, "
+                 f"coordinates {', '.join(model.coordinate_names)} "
+                 f"({mech.dof} degree(s) of freedom); gravity ({g[0]:.4g}, {g[1]:.4g}) "
+                 f"m/s&sup2;.</p>")
+    for title, df in model_tables(model).items():
+        parts.append(f"<h3>{_esc(title.capitalize())}</h3>")
+        parts.append(_table(df))
+    return "\n".join(parts)
+
+
+# ------------------------------------------------------------------ kinematics
+def _at_text(over_is_angle: bool, v: float) -> str:
+    if over_is_angle:
+        return f"{np.rad2deg(v):.3f} deg"
+    return f"{_mm(v):.4f} mm"
+
+
+def _sweep_section(sw, *, animation: bool, trace) -> str:
+    import pandas as pd
+
+    from .plot import plot_kinematic_sweep
+
+    model = sw.model
+    ang = sw.over_is_angle
+    k = sw.over_index
+    rate = float(sw.qdot[0, k]) if len(sw) else 1.0
+    unit_v = ("m/s", "m/s&sup2;")
+    parts = ["<h2>Kinematics</h2>"]
+    rng = (f"{_at_text(ang, sw.values[0])} to {_at_text(ang, sw.values[-1])}"
+           if len(sw) else "no positions")
+    rate_txt = (f"{rate:.6g} rad/s ({rate * 30 / np.pi:.6g} rpm)" if ang
+                else f"{rate:.6g} m/s")
+    parts.append(f"<p>Sweep of <code>{_esc(sw.over)}</code> over {rng}, {len(sw)} positions, "
+                 f"at a constant rate of {rate_txt}"
+                 + (" &mdash; velocities and accelerations are then the first- and "
+                    "second-order velocity analogs." if rate == 1.0 else ".") + "</p>")
+    parts.append(_status(sw.status, sw.ok, sw.message))
+    if not len(sw):
+        return "\n".join(parts)
+    summ = sw.summary()
+    if summ.strokes:
+        rows = []
+        for j, s in summ.strokes.items():
+            row = {"slider (joint)": j, "stroke_mm": f"{_mm(s):.4f}"}
+            for d in summ.dead_centres:
+                if d.joint == j:
+                    row[f"{d.label} at"] = _at_text(ang, d.at)
+                    row[f"{d.label} travel_mm"] = f"{_mm(d.travel):.4f}"
+            rows.append(row)
+        parts.append("<h3>Strokes and dead centres</h3>")
+        parts.append(_table(pd.DataFrame(rows)))
+    if summ.transmission:
+        rows = []
+        for t in summ.transmission:
+            lo, hi = np.rad2deg(t.min), np.rad2deg(t.max)
+            rows.append({"loop (coupler/rocker)": f"{t.loop.coupler}/{t.loop.rocker}",
+                         "joint": t.loop.joints[2], "mu_min_deg": f"{lo:.3f}",
+                         "at (min)": _at_text(ang, t.min_at), "mu_max_deg": f"{hi:.3f}",
+                         "at (max)": _at_text(ang, t.max_at),
+                         "largest deviation from 90 deg": f"{max(90 - lo, hi - 90):.3f}"})
+        parts.append("<h3>Transmission angles</h3>")
+        parts.append(_table(pd.DataFrame(rows)))
+    if summ.extremes:
+        rows = [{"point": f"{e.body}.{e.point}", f"v_max ({unit_v[0]})": e.v_max,
+                 "at (v)": _at_text(ang, e.v_max_at), "a_max (m/s²)": e.a_max,
+                 "at (a)": _at_text(ang, e.a_max_at)} for e in summ.extremes]
+        parts.append("<h3>Extreme speeds and accelerations of the named points</h3>")
+        parts.append(_table(pd.DataFrame(rows)))
+    omegas = []
+    for b in model.body_names:
+        _, om, al = sw.angular(b)
+        if np.ptp(om) > 0 or np.any(om):
+            omegas.append({"body": b, "omega_min_rad_s": om.min(), "omega_max_rad_s": om.max(),
+                           "alpha_min_rad_s2": al.min(), "alpha_max_rad_s2": al.max()})
+    if omegas:
+        parts.append("<h3>Angular velocities and accelerations of the bodies</h3>")
+        parts.append(_table(pd.DataFrame(omegas)))
+    parts.append("<h3>Drawing</h3>")
+    parts.append(_img_png(_snapshot_png(sw, 0, trace=trace), "the mechanism"))
+    if animation:
+        parts.append(_img_gif(_animation_gif(sw, trace=trace), "the motion"))
+    parts.append("<h3>Plot</h3>")
+    parts.append(_img_png(_plot_png(plot_kinematic_sweep, sw), "kinematics plot"))
+    return "\n".join(parts)
+
+
+# ------------------------------------------------------------------ kinetostatics
+def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
+    import pandas as pd
+
+    from .plot_kinetostatics import plot_kinetostatics
+
+    ang = ks.over_is_angle
+    parts = ["<h2>Kinetostatics</h2>"]
+    if ks.n:
+        k = ks.coordinate_names.index(ks.over)
+        rate = float(ks.qdot[0, k])
+        rate_txt = (f"{rate:.6g} rad/s ({rate * 30 / np.pi:.6g} rpm)" if ang
+                    else f"{rate:.6g} m/s")
+        parts.append(f"<p>Driven coordinate(s) {', '.join(ks.driven)} at constant "
+                     f"{_esc(ks.over)}-rate {rate_txt}, {ks.n} positions; forces include "
+                     "gravity, inertia and the model's loads.</p>")
+    parts.append(_status(ks.status, ks.status == "ok", ks.message))
+    if not ks.n:
+        return "\n".join(parts)
+    p = ks.peaks()
+    rows = []
+    for c, d in p["driving"].items():
+        sym, unit = ks._drive_unit(c)
+        u = "Nm" if unit == "Nm" else "N"
+        rows.append({"drive": c, f"peak |{sym}|_{u}": abs(d["peak_abs"]),
+                     "at": _at_text(ang, d["peak_abs_at"]), f"max_{u}": d["max"],
+                     f"min_{u}": d["min"], f"RMS_{u}": d["rms"], f"mean_{u}": d["mean"],
+                     "peak power_W": d["peak_power"]})
+    parts.append("<h3>Driving torque</h3>")
+    parts.append(_table(pd.DataFrame(rows)))
+    rows = []
+    for j, d in p["joints"].items():
+        row = {"joint": j, "type": ks.joint_kinds[j], "peak force_N": d["peak"],
+               "at": _at_text(ang, d["peak_at"]), "RMS force_N": d["rms"]}
+        if "peak_moment" in d:
+            row["peak moment_Nm"] = d["peak_moment"]
+        rows.append(row)
+    parts.append("<h3>Peak joint forces</h3>")
+    parts.append(_table(pd.DataFrame(rows)))
+    fr = p["frame"]
+    parts.append("<h3>Frame (shaking) loads</h3>")
+    parts.append(_table(pd.DataFrame([
+        {"quantity": "|F| frame (N)", "min": np.nan, "max": fr["force_peak"],
+         "peak at": _at_text(ang, fr["force_peak_at"])},
+        {"quantity": "Fx frame (N)", "min": fr["Fx_min"], "max": fr["Fx_max"], "peak at": ""},
+        {"quantity": "Fy frame (N)", "min": fr["Fy_min"], "max": fr["Fy_max"], "peak at": ""},
+        {"quantity": f"M frame about ({ks.frame_point[0]:.4g}, {ks.frame_point[1]:.4g}) m "
+                     "(N m)", "min": fr["M_min"], "max": fr["M_max"],
+         "peak at": _at_text(ang, fr["moment_peak_at"])}])))
+    if harmonics > 0 and ang:
+        try:
+            h = ks.harmonics(harmonics)
+        except ValueError as exc:
+            parts.append(f'<p class="note">No harmonics: {_esc(exc)}</p>')
+        else:
+            h = h[["order", "f_Hz", "Fx_frame_N", "Fy_frame_N", "M_frame_Nm"]].copy()
+            for c in ("Fx_frame_N", "Fy_frame_N", "M_frame_Nm"):  # round-off noise -> 0
+                a = h[c].to_numpy()
+                h[c] = np.where(np.abs(a) < 1e-9 * max(np.max(np.abs(a)), 1e-300), 0.0, a)
+            parts.append("<h3>Harmonics of the shaking force and moment</h3>")
+            parts.append('<p class="note">Amplitudes per order of the crank turn '
+                         "(order 0: the mean).</p>")
+            parts.append(_table(h))
+    for w in ks.warnings:
+        parts.append(f'<p class="note">Warning: {_esc(w)}</p>')
+    parts.append("<h3>Plot</h3>")
+    parts.append(_img_png(_plot_png(plot_kinetostatics, ks), "kinetostatics plot"))
+    return "\n".join(parts)
+
+
+# ------------------------------------------------------------------ public
+def write_report(model, path, *, sweep=None, kinetostatics=None, title: str | None = None,
+                 animation: bool = False, trace=None) -> Path:
+    """Write an HTML report of a model and of its analysis records.
+
+    Parameters
+    ----------
+    model : Model
+        The compiled model (its elements fill the model tables).
+    path : str or Path
+        The HTML file to write.
+    sweep : KinematicSweep, optional
+        Adds the kinematics section: strokes and dead centres, transmission angles,
+        extreme point speeds and accelerations, a drawing and the plot.
+    kinetostatics : Kinetostatics, optional
+        Adds the kinetostatics section: peak and RMS driving torque, peak joint
+        forces, frame loads and their harmonics, and the plot.
+    title : str, optional
+        Default ``"<mechanism name>: report"``.
+    animation : bool
+        Embed an animated GIF of the sweep (adds some 100 kB to 1 MB).
+    trace : "BODY.POINT" or (body, point), optional
+        Draw this point's path in the drawing and the animation.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    name = getattr(model.mechanism, "name", "mechanism")
+    sections = [_model_section(model)]
+    if sweep is not None:
+        sections.append(_sweep_section(sweep, animation=animation, trace=trace))
+    if kinetostatics is not None:
+        sections.append(_kinetostatics_section(kinetostatics))
+    return _write(path, _page(title or f"{name}: report", sections))
+
+
+def report_records(mech_or_model, *, speed: float | None = None, over: str | None = None,
+                   values=None, steps: int = 361, point=(0.0, 0.0)):
+    """The analyses a :func:`report` shows: a sweep and, when it applies, the kinetostatics.
+
+    Runs a kinematic sweep of ``over`` and -- for a mechanism with one degree of
+    freedom, or when ``speed`` is given -- the kinetostatic cycle at that speed.
+
+    Parameters
+    ----------
+    mech_or_model : Mechanism or Model
+    speed : float, optional
+        Constant rate of ``over``, rad/s (m/s for a travel).  Default: the model's
+        initial rate of ``over`` if it is not zero, else 1 (velocities are then the
+        velocity analogs).
+    over : str, optional
+        The coordinate to sweep (default the first).
+    values : array_like, optional
+        Its values, rad or m (default one full turn from its initial value for an
+        angle, in ``steps`` positions; required for a travel).
+    steps : int
+        Number of positions of the default range (ends included).
+    point : (float, float)
+        Point of the frame moments (shaking moment), m.
+
+    Returns
+    -------
+    model : Model
+    sweep : KinematicSweep
+    kinetostatics : Kinetostatics or None
+
+    Raises
+    ------
+    ModelError
+        Unknown coordinate, or a travel coordinate without ``values``.
+    """
+    import warnings
+
+    from ..dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
+    from ..errors import ModelError
+    from ..kinematics.sweep import initial_coordinates
+    from ..kinematics.sweep import sweep as run_sweep
+    from ..model import as_model
+
+    model = as_model(mech_or_model)
+    over = over if over is not None else model.coordinate_names[0]
+    k = model.coordinate_index(over)
+    if values is None:
+        if not model.coord_is_angle[k]:
+            raise ModelError(f"coordinate {over!r} is a travel: give its values")
+        start = float(initial_coordinates(model)[k])
+        values = np.linspace(start, start + 2 * np.pi, int(steps))
+    values = np.asarray(values, dtype=float)
+    given_speed = speed is not None
+    if speed is None:
+        qd0 = (model.mechanism.extras.get("initial") or {}).get("qdot") or {}
+        speed = float(qd0.get(over, 0.0)) if isinstance(qd0, dict) else 0.0
+        speed = speed if speed != 0.0 else 1.0
+    sw = run_sweep(model, over, values, speed=float(speed))
+    ks = None
+    if given_speed or model.mechanism.dof == 1:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", KinetostaticsWarning)  # shown in the report
+            ks = kinetostatics(model, over=over, speed=float(speed), values=values,
+                               point=point)
+    return model, sw, ks
+
+
+def report(mech_or_model, path, *, speed: float | None = None, over: str | None = None,
+           values=None, steps: int = 361, title: str | None = None, animation: bool = False,
+           trace=None, point=(0.0, 0.0)) -> Path:
+    """Analyse a model over one turn and write an HTML report.
+
+    :func:`report_records` runs the analyses (a sweep of ``over``; the kinetostatic
+    cycle for one degree of freedom or a given ``speed``), :func:`write_report`
+    writes them.
+
+    Parameters
+    ----------
+    mech_or_model : Mechanism or Model
+    path : str or Path
+        The HTML file to write.
+    speed, over, values, steps, point
+        As for :func:`report_records`.
+    title : str, optional
+    animation : bool
+        Embed an animated GIF of the motion.
+    trace : "BODY.POINT" or (body, point), optional
+        Draw this point's path.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    model, sw, ks = report_records(mech_or_model, speed=speed, over=over, values=values,
+                                   steps=steps, point=point)
+    return write_report(model, path, sweep=sw, kinetostatics=ks, title=title,
+                        animation=animation, trace=trace)
+
+
+def report_trajectory(traj, path, *, title: str | None = None, animation: bool = False,
+                      trace=None, max_events: int = 200) -> Path:
+    """Write an HTML report of a simulated motion.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The record of :func:`mechdyn.simulate` (with its ``model``).
+    path : str or Path
+        The HTML file to write.
+    title : str, optional
+        Default ``"<mechanism name>: simulation report"``.
+    animation : bool
+        Embed an animated GIF of the motion.
+    trace : "BODY.POINT" or (body, point), optional
+        Draw this point's path.
+    max_events : int
+        Largest number of events listed.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    import pandas as pd
+
+    from .plot_dynamics import plot_trajectory
+
+    model = traj.model
+    name = getattr(getattr(model, "mechanism", None), "name", "mechanism")
+    sections = []
+    if model is not None:
+        sections.append(_model_section(model))
+    parts = ["<h2>Simulation</h2>", _status(traj.status, traj.success, traj.message)]
+    s = traj.stats or {}
+    run = {"integrator": s.get("integrator"), "formulation": s.get("formulation"),
+           "backend": s.get("backend"), "steps": s.get("steps"),
+           "rejected steps": s.get("rejected"), "evaluations": s.get("evaluations"),
+           "wall time_s": s.get("wall_time_s"), "samples": traj.n_samples}
+    if traj.t.size:
+        run["t start_s"], run["t end_s"] = float(traj.t[0]), float(traj.t[-1])
+    parts.append("<h3>Run</h3>")
+    parts.append(_table(pd.DataFrame([{"quantity": k, "value": v} for k, v in run.items()
+                                      if v is not None]).astype({"value": str})))
+    if traj.t.size:
+        rows = []
+        for k, c in enumerate(traj.coordinate_names):
+            ang = traj.coordinate_is_angle[k] if traj.coordinate_is_angle else True
+            f, u, ur = (np.rad2deg(1.0), "deg", "rpm") if ang else (1e3, "mm", "m/s")
+            fr = 30 / np.pi if ang else 1.0
+            rows.append({"coordinate": c, f"start ({u})": traj.q[0, k] * f,
+                         f"end ({u})": traj.q[-1, k] * f,
+                         f"start rate ({ur})": traj.qdot[0, k] * fr,
+                         f"end rate ({ur})": traj.qdot[-1, k] * fr,
+                         f"min rate ({ur})": traj.qdot[:, k].min() * fr,
+                         f"max rate ({ur})": traj.qdot[:, k].max() * fr})
+        parts.append("<h3>Coordinates</h3>")
+        parts.append(_table(pd.DataFrame(rows), digits=9))
+    if traj.energy and traj.t.size:
+        e = traj.energy
+        parts.append("<h3>Energy balance</h3>")
+        parts.append(_table(pd.DataFrame([
+            {"quantity": "kinetic energy T_J", "start": e["kinetic"][0], "end": e["kinetic"][-1]},
+            {"quantity": "potential energy U_J", "start": e["potential"][0],
+             "end": e["potential"][-1]},
+            {"quantity": "work of non-conservative forces W_nc_J", "start": e["work_nc"][0],
+             "end": e["work_nc"][-1]},
+            {"quantity": "balance T + U - W_nc_J", "start": e["balance"][0],
+             "end": e["balance"][-1]}]), digits=9))
+        parts.append(f"<p>The balance drifts by at most {traj.energy_drift():.3e} J; the "
+                     f"largest constraint residual is {np.max(e['residual']):.3e} "
+                     "(m or rad).</p>")
+    parts.append("<h3>Events</h3>")
+    if traj.events:
+        rows = []
+        for ev in traj.events[:max_events]:
+            row = {"t_s": getattr(ev, "t", np.nan),
+                   "kind": getattr(ev, "kind", type(ev).__name__),
+                   "element": getattr(ev, "element", getattr(ev, "name", "")),
+                   "mode after": " ".join(sorted(getattr(ev, "mode_after", ()) or ())),
+                   "energy lost_J": getattr(ev, "energy_lost", 0.0)}
+            rows.append(row)
+        parts.append(_table(pd.DataFrame(rows), digits=9))
+        if len(traj.events) > max_events:
+            parts.append(f'<p class="note">{len(traj.events) - max_events} more events '
+                         "not listed.</p>")
+    else:
+        parts.append("<p>No events.</p>")
+    if model is not None and traj.t.size:
+        parts.append("<h3>Drawing</h3>")
+        parts.append(_img_png(_snapshot_png(traj, 0, trace=trace), "the mechanism at the start"))
+        if animation:
+            parts.append(_img_gif(_animation_gif(traj, trace=trace), "the motion"))
+    if traj.t.size:
+        parts.append("<h3>Plot</h3>")
+        parts.append(_img_png(_plot_png(plot_trajectory, traj), "trajectory plot"))
+    sections.append("\n".join(parts))
+    return _write(path, _page(title or f"{name}: simulation report", sections))

@@ -1,0 +1,76 @@
+"""``mechdyn animate`` and ``mechdyn report`` end to end, through ``mechdyn.cli.main``."""
+
+import re
+import tomllib
+
+from PIL import Image
+
+from mechdyn import examples
+from mechdyn.cli import main
+from mechdyn.units import parse_quantity
+
+
+def _crank_radius() -> float:
+    """r of the bundled slider-crank, read from its model file (crank point A), m."""
+    data = tomllib.loads(examples.path("slider_crank").read_text(encoding="utf-8"))
+    ax, ay = (parse_quantity(v, "length") for v in data["bodies"]["crank"]["points"]["A"])
+    assert ay == 0.0
+    return ax
+
+
+def test_animate_writes_a_gif_with_one_frame_per_position(tmp_path, capsys):
+    gif, png = tmp_path / "crank.gif", tmp_path / "first.png"
+    rc = main(["animate", "slider_crank", "--over", "phi", "--from", "0deg", "--to", "360deg",
+               "--steps", "15", "--trace", "rod.com", "-o", str(gif), "--snapshot", str(png)])
+    assert rc == 0, capsys.readouterr().err
+    with Image.open(gif) as im:
+        assert im.n_frames == 15
+    assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_animate_a_short_simulation(tmp_path, capsys):
+    gif = tmp_path / "run.gif"
+    rc = main(["animate", "slider_crank", "--simulate", "--t-end", "5 ms", "--frames", "8",
+               "-o", str(gif)])
+    assert rc == 0, capsys.readouterr().err
+    with Image.open(gif) as im:
+        assert im.n_frames == 8
+
+
+def test_animate_bad_input_is_one_line_and_exit_code_2(tmp_path, capsys):
+    assert main(["animate", "slider_crank", "-o", str(tmp_path / "m.avi")]) == 2
+    assert main(["animate", "slider_crank", "--trace", "rod.Q", "-o",
+                 str(tmp_path / "m.gif")]) == 2
+    assert main(["animate", "slider_crank", "--simulate", "-o", str(tmp_path / "m.gif")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 3 and all(line.startswith("mechdyn animate: error:") for line in err)
+    assert "valid point names" in err[1] and "--t-end" in err[2]
+
+
+def test_report_has_the_sections_and_the_stroke_is_twice_the_crank_radius(tmp_path, capsys):
+    html = tmp_path / "report.html"
+    rc = main(["report", "slider_crank", "--speed", "1500rpm", "--steps", "73", "-o", str(html)])
+    assert rc == 0, capsys.readouterr().err
+    text = html.read_text(encoding="utf-8")
+    for section in ("<h2>Model</h2>", "<h3>Bodies</h3>", "<h3>Joints</h3>",
+                    "<h3>Coordinates</h3>", "<h3>Drives</h3>", "<h2>Kinematics</h2>",
+                    "<h3>Strokes and dead centres</h3>", "<h2>Kinetostatics</h2>",
+                    "<h3>Driving torque</h3>", "<h3>Peak joint forces</h3>",
+                    "<h3>Harmonics of the shaking force and moment</h3>"):
+        assert section in text, section
+    assert text.count("data:image/png;base64,") == 3  # drawing, kinematics, kinetostatics
+    assert "<script" not in text and "http" not in text.split("</style>")[1]  # self-contained
+    m = re.search(r"<td>cylinder</td>\s*<td>([0-9.]+)</td>", text)
+    assert m, "stroke row of the slider 'cylinder'"
+    printed = m.group(1)  # stroke in mm, four decimals
+    assert printed == f"{2 * _crank_radius() * 1e3:.4f}"  # closed form: stroke = 2 r
+
+
+def test_report_of_a_simulation_has_energy_balance_and_events(tmp_path, capsys):
+    html = tmp_path / "run.html"
+    rc = main(["report", "slider_crank", "--simulate", "--t-end", "5ms", "-o", str(html)])
+    assert rc == 0, capsys.readouterr().err
+    text = html.read_text(encoding="utf-8")
+    for section in ("<h2>Simulation</h2>", "<h3>Run</h3>", "<h3>Energy balance</h3>",
+                    "<h3>Events</h3>", "success"):
+        assert section in text, section
