@@ -4,30 +4,69 @@ import numpy as np
 import pytest
 
 from mechdyn.examples import bolt_buffer, press_cycle
+from mechdyn.mechanism import Table
 from mechdyn.simulate_events import format_events
+
+CYCLES = 4
 
 
 @pytest.fixture(scope="module")
 def press():
-    return press_cycle.run(2)
+    # four cycles to just after the fourth release (1.564 s; the ram is back on its stop
+    # at 1.666 s, as in the three cycles before), output every 2 ms (events are located
+    # on the dense output regardless): about 55 s of wall time
+    return press_cycle.run(t_end=1.60, dt_out=2e-3, progress=False)
+
+
+def test_cylinder_command_is_fired_by_crank_angle_every_third_revolution():
+    p = press_cycle.PARAMETERS
+    cmd = press_cycle.cylinder_command()
+    assert cmd.variable == "phi" and cmd.period == pytest.approx(6 * np.pi)
+    on, off = p["phi_on"], p["phi_off"]
+    for k in range(-1, 12):
+        shift = k * p["command_period"]
+        assert cmd(0.5 * (on + off) + shift) == p["F_cylinder"]
+        assert cmd(on - 0.1 + shift) == 0.0 and cmd(off + 0.1 + shift) == 0.0
+    # the model file carries the same command
+    mech = press_cycle.load_model_file()
+    (tab,) = [ld.magnitude for ld in mech.loads if ld.name == "cylinder_force"]
+    assert isinstance(tab, Table) and tab.variable == "phi"
+    np.testing.assert_allclose(tab.x, cmd.x, atol=1e-12)
+    np.testing.assert_allclose(tab.y, cmd.y)
+    assert tab.period == pytest.approx(cmd.period) and tab.outside == 0.0
 
 
 @pytest.mark.slow
-def test_press_runs_idle_engage_lock_stroke_release_twice(press):
+def test_press_locks_and_releases_once_in_every_cycle(press):
     tr = press
     assert tr.status == "success", tr.message
     kinds = [(e.kind, e.element) for e in tr.events]
-    assert kinds.count(("engage", "rocker_lock")) == 2
-    assert kinds.count(("release", "rocker_lock")) == 2
+    assert kinds.count(("engage", "rocker_lock")) == CYCLES
+    assert kinds.count(("release", "rocker_lock")) == CYCLES
+    assert ("ignored", "lock_on") not in kinds  # the rocker never passes psi = 0 unlocked
     modes = tr.stats["variable_structure"]["modes"]
     assert frozenset({"piston_stops@upper", "ram_stop@upper"}) in modes  # idle
     assert any("rocker_lock" in m for m in modes)  # working stroke
-    # the lock engages only with the ram pushed down, as the rocker reaches the ram axis
-    for e in tr.events:
-        if e.kind == "engage":
-            k = tr.coordinate_names.index("psi")
-            assert abs(e.q_after[k]) < 1e-12
-            assert e.energy_lost > 0
+    k = tr.coordinate_names.index("psi")
+    kphi = tr.coordinate_names.index("phi")
+    lock = [e for e in tr.events if e.element == "rocker_lock"]
+    assert [e.kind for e in lock] == ["engage", "release"] * CYCLES
+    per = press_cycle.PARAMETERS["command_period"]
+    for c in range(CYCLES):
+        eng, rel = lock[2 * c], lock[2 * c + 1]
+        # the lock engages only with the ram pushed down, as the rocker reaches the ram axis
+        assert abs(eng.q_after[k]) < 1e-12
+        assert eng.energy_lost > 0
+        # at the same crank phase in every cycle (the command follows the crank)
+        for e, phase in ((eng, np.deg2rad(344.0)), (rel, np.deg2rad(337.9 + 360.0))):
+            assert e.q_before[kphi] - c * per == pytest.approx(phase, abs=np.deg2rad(3.0))
+    # and every cycle ends in idle: the ram lands on its upper stop after the release,
+    # before the next command
+    cmd = [e.t for e in tr.events if (e.kind, e.element) == ("separate", "piston_stops@upper")]
+    assert len(cmd) == CYCLES
+    for c in range(CYCLES - 1):
+        assert any(lock[2 * c + 1].t < e.t < cmd[c + 1] for e in tr.events
+                   if (e.kind, e.element) == ("impact", "ram_stop@upper"))
     text = format_events(tr.events, tr.coordinate_names)
     assert "engage" in text and "release" in text
 
@@ -74,7 +113,7 @@ def test_press_model_file_runs_to_the_first_work_stroke():
     mech = press_cycle.load_model_file()
     assert {len(mech.extras[k]) for k in ("stops", "contacts", "coordinate_locks",
                                           "switches")} <= {1, 2}
-    tr = simulate_events(mech, 0.25, rtol=1e-9, dt_out=1e-3)
+    tr = simulate_events(mech, 0.17, rtol=1e-9, dt_out=2e-3, progress=False)
     assert tr.status == "success", tr.message
     eng = [e for e in tr.events if e.kind == "engage"]
     assert len(eng) == 1 and 0.15 < eng[0].t < 0.17

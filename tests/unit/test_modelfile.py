@@ -448,3 +448,32 @@ def test_motor_drives_are_built_by_the_motors_module():
     # the schema knows the same motor types as the motors module
     enum = schema()["$defs"]["drive"]["then"]["properties"]["type"]["enum"]
     assert sorted(enum) == sorted(DRIVE_TYPES)
+
+
+def test_periodic_tables_and_pulses():
+    m = bad('variable = "phi" }', 'variable = "phi", period = "360 deg" }')
+    gas = m.loads[0].magnitude
+    assert gas.period == pytest.approx(2 * math.pi)
+    for k in (-2, 0, 3):  # -1 kN * |sin|-like hat over every revolution
+        assert gas(math.pi / 2 + 2 * math.pi * k) == pytest.approx(-500.0)
+        assert gas(1.5 * math.pi + 2 * math.pi * k) == pytest.approx(-500.0)
+    m = bad('duration = "20 ms" }', 'duration = "20 ms", period = "0.1 s" }')
+    brake = m.loads[3].magnitude
+    assert brake.period == pytest.approx(0.1)
+    assert brake(0.11) == pytest.approx(-2.0) and brake(0.61) == pytest.approx(-2.0)
+    assert brake(0.05) == 0.0 and brake(-0.39) == pytest.approx(-2.0)
+    with pytest.raises(ModelError, match=r"\[\[loads\]\] #1 'gas' magnitude\.period: the "
+                                         r"period of the table over 'phi' \('180 deg' = "
+                                         r"3\.14159 SI\) is shorter than the table's span"):
+        bad('variable = "phi" }', 'variable = "phi", period = "180 deg" }')
+    with pytest.raises(ModelError, match=r"\[\[loads\]\] #1 'gas' magnitude\.period: the "
+                                         r"period of the table over 'phi' must be > 0, got "
+                                         r"'-1 deg'"):
+        bad('variable = "phi" }', 'variable = "phi", period = "-1 deg" }')
+    with pytest.raises(UnitError, match=r"\[\[loads\]\] #1 'gas' magnitude\.period: '1 s': "
+                                        r"the unit s is a time unit; expected an angle"):
+        bad('variable = "phi" }', 'variable = "phi", period = "1 s" }')
+    with pytest.raises(ModelError, match=r"\[\[loads\]\] #4 'brake' magnitude\.period: the "
+                                         r"period of the pulse over 't' \('10 ms'\) must be "
+                                         r"longer than its duration"):
+        bad('duration = "20 ms" }', 'duration = "20 ms", period = "10 ms" }')

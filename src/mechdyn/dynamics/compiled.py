@@ -13,7 +13,8 @@ the ~1 us per NumPy call of the batched reference path.
 The model is packed into one integer and one float array (see ``_Packer``).
 Supported: revolute, prismatic and lock joints; angle, relative-angle and
 travel coordinates; gravity; springs and dampers; rotary springs; forces and
-torques of constant magnitude or tabulated in time or in a coordinate (rate);
+torques of constant magnitude or tabulated (periodic or not) in time or in a
+coordinate (rate);
 drives constant, tabulated or given by a torque-speed curve.  A load given by a
 Python callable (or anything else) makes :func:`compile_kernel` return None
 with the reason, and the NumPy path is used.
@@ -71,7 +72,8 @@ IR_COORD, FR_COORD = 4, 1
 IR_SPR, FR_SPR = 2, 8
 IR_ROT, FR_ROT = 2, 4
 # value records (forces, torques, drives): mode, tab_off, tab_len, var_kind, var_index,
-# has_outside, then a target part
+# table flags (T_OUTSIDE | T_PERIODIC), then a target part; a table is stored in the
+# table section as xs (tab_len), ys (tab_len) and, if periodic, its period
 IR_VAL = 6
 IR_FOR, FR_FOR = IR_VAL + 2, 5 + 1  # body, frame | sx, sy, dx, dy, value, outside
 IR_TOR, FR_TOR = IR_VAL + 2, 2  # body, reaction | value, outside
@@ -80,6 +82,7 @@ FR_BODY = 4  # m, J, cx, cy
 F_GLOBAL = 4  # gx, gy, length_scale, tol (at the start of the float array)
 # value modes and table variables
 V_CONST, V_TABLE = 0, 1
+T_OUTSIDE, T_PERIODIC = 1, 2  # table flags
 VAR_T, VAR_Q, VAR_QDOT = 0, 1, 2
 # work array layout: x (nx) | q_last (nq) | B_last (nx nq) | xdot (nx) | x_good (nx) | flags
 W_VALID = 0  # flags: B_last valid
@@ -124,16 +127,20 @@ class _Packer:
             else:
                 raise _Unsupported(f"{where}: table over {var!r} (only t, coordinates and "
                                    f"their rates are compiled)")
-            return self.table(v.x, v.y, kind, idx, v.outside)
+            return self.table(v.x, v.y, kind, idx, v.outside, v.period)
         raise _Unsupported(f"{where}: value {type(v).__name__} is not compiled "
                            f"(a Python callable is evaluated on the NumPy path)")
 
-    def table(self, xs, ys, kind, idx, outside):
+    def table(self, xs, ys, kind, idx, outside, period=None):
+        """Append a table (xs, ys, then the period if any) to the table section."""
         off = len(self.tabs)
         self.tabs.extend(float(a) for a in xs)
         self.tabs.extend(float(b) for b in ys)
-        has_out = 0 if outside is None else 1
-        return ([V_TABLE, off, len(xs), kind, idx, has_out], 0.0,
+        flags = 0 if outside is None else T_OUTSIDE
+        if period is not None:
+            self.tabs.append(float(period))
+            flags |= T_PERIODIC
+        return ([V_TABLE, off, len(xs), kind, idx, flags], 0.0,
                 0.0 if outside is None else float(outside))
 
     def pack(self):
@@ -642,7 +649,15 @@ def _value(ip, fp, irec, fval, t, q, qdot):
         s = q[idx]
     else:
         s = qdot[idx]
-    return _interp(fp[tab0:tab0 + n], fp[tab0 + n:tab0 + 2 * n], n, s, ip[irec + 5] == 1,
+    flags = ip[irec + 5]
+    if flags & 2:  # T_PERIODIC: wrap into [x0, x0 + period), as Table.wrap
+        x0 = fp[tab0]
+        per = fp[tab0 + 2 * n]
+        u = (s - x0) % per
+        if u >= per:
+            u = 0.0
+        s = x0 + u
+    return _interp(fp[tab0:tab0 + n], fp[tab0 + n:tab0 + 2 * n], n, s, (flags & 1) == 1,
                    fp[fval + 1])
 
 

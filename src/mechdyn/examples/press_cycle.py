@@ -13,21 +13,31 @@ The cycle, as the paper describes it:
 1. **idle** - preloaded springs hold the ram up against its upper stop
    (x_C = 28 mm); the crank turns and the rocker swings: the machine is a
    crank-rocker four-bar on the ram (2 DOF phi, psi; with the stop closed 1).
-2. **engaging** - the cylinder pushes the piston down; it closes the 0.5 mm
-   gap onto the ram (an impact) and pushes the ram 4 mm down, to the piston's
-   lower stop (x_C = 24 mm).
+2. **engaging** - at a fixed crank angle (phi = 185 deg, every third
+   revolution; see below) the control switches the cylinder on; it pushes the
+   piston down, closes the 0.5 mm gap onto the ram (an impact) and pushes the
+   ram 4 mm down, to the piston's lower stop (x_C = 24 mm).
 3. **locking** - with the ram down, the rocker's swing now reaches the ram
    axis (psi = 0, before the crank's top dead centre); there it locks onto the
    ram (a plastic impact).  The machine is a 1-DOF slider-crank: the ram
    rises to top dead centre (25 mm), leaves the piston and does its 30 mm
    work stroke with a punch load in the last 3 mm.
-4. **release** - the cylinder is switched off during the stroke (the piston
-   returns); when the ram comes back up through x_C = 23.0 mm the lock
+4. **release** - the cylinder is switched off during the stroke (at
+   phi = 487 deg, 127 deg into the revolution after the lock; the piston
+   returns); when the ram comes back up through x_C = 23.5 mm the lock
    releases (no jump); the return torque of the second cylinder turns the
    rocker back and the springs return the ram to its upper stop (an impact
    with restitution 0.2, bounces, then it rests there): idle again.
 
-
+The commands are fired by the crank angle, as a press control does with a cam
+or an encoder on the crankshaft, not by a clock: the cylinder force is a table
+over phi repeating every ``command_period`` (a periodic
+:class:`~mechdyn.mechanism.load.Table`), and the lock and its release are
+crossings of psi and of the ram position.  So every cycle starts at the same
+crank phase however the crank speed varies (a time schedule drifts against the
+crank: in its third cycle the rocker passes psi = 0 before the ram is down,
+goes to the mirror branch and that cycle does not lock).  The machine locks and
+releases once per command, indefinitely.
 
 Values the paper does not give, chosen here (SI):
 
@@ -49,6 +59,16 @@ Values the paper does not give, chosen here (SI):
   x_C = 24 mm), return spring 300 N; **cylinder force** 85 kN (beats the
   70.8 kN of the springs minus the ram's weight, with margin for the linkage
   forces that push the ram up).
+* **cylinder command** by crank angle: on from phi = 185 deg to 487 deg
+  (2 deg ramps; 302 deg, about 0.12 s) of every third revolution
+  (``command_period`` 1080 deg, one work stroke per 3 revolutions, about
+  0.42 s).  At 185 deg the ram is down (x_C = 24 mm) about 25 deg later, long
+  before the rocker reaches the ram axis (psi = 0 at 342 deg); fired much
+  later (e.g. 265 deg) the linkage pushes the ram back above 24.5 mm near
+  330 deg and the lock is missed.  After the release (at 338 deg of the
+  revolution after the lock) the springs need about 0.1 s (250 deg) to bring
+  the ram back to its stop, so the next command at 185 deg can only come in
+  the third revolution.
 * **locking**: rocker-to-ram relative angle held (a CoordinateLock on joint
   C) when psi rises through 0 with the ram below 24 mm and the piston down.
 * **return torque** of the second cylinder on the rocker: 20 N m towards
@@ -76,7 +96,7 @@ from ..mechanism.contact import Contact, Stop
 from ..mechanism.drive import Drive
 from ..mechanism.switch import CoordinateLock, Switch, add_element
 
-__all__ = ["build", "run", "PARAMETERS", "command_times", "load_model_file"]
+__all__ = ["build", "run", "PARAMETERS", "cylinder_command", "run_time", "load_model_file"]
 
 #: every chosen value, SI (see the module docstring for the reasons)
 PARAMETERS = dict(
@@ -86,6 +106,8 @@ PARAMETERS = dict(
     x_stop_up=0.028, piston_gap=0.0005, piston_stroke=0.0045,
     k_ram=2e5, push_ram=70000.0, spring_travel=0.006, e_stop=0.2,
     k_piston=1e4, pull_piston=300.0, F_cylinder=85000.0,
+    phi_on=np.deg2rad(185.0), phi_off=np.deg2rad(487.0), command_ramp=np.deg2rad(2.0),
+    command_period=np.deg2rad(1080.0),
     M_return=20.0, psi_return=np.deg2rad(2.0),
     x_lock_below=0.0245, x_release=0.0235,
     F_punch=15000.0, x_punch=-0.002,
@@ -94,10 +116,39 @@ PARAMETERS = dict(
 )
 
 
-def command_times(cycles: int = 2, first: float = 0.10, period: float = 0.4265,
-                  duration: float = 0.12) -> list[tuple[float, float]]:
-    """(on, off) times of the engaging cylinder, s: one stroke per ``period``."""
-    return [(first + k * period, first + k * period + duration) for k in range(cycles)]
+def cylinder_command(p: dict | None = None) -> Table:
+    """The force of the engaging cylinder (N) as a periodic table over the crank angle.
+
+    Parameters
+    ----------
+    p : dict, optional
+        Parameters (default :data:`PARAMETERS`): ``F_cylinder`` from ``phi_on``
+        to ``phi_off`` (rad), linear ramps of ``command_ramp`` before and after
+        (rising to full force at ``phi_on``, falling from ``phi_off``), zero
+        elsewhere, repeated every ``command_period`` of phi.
+
+    Returns
+    -------
+    Table
+        Over ``"phi"``, with ``period = command_period``.
+    """
+    p = PARAMETERS if p is None else p
+    r = p["command_ramp"]
+    on, off = p["phi_on"], p["phi_off"]
+    return Table((on - r, on, off, off + r), (0.0, p["F_cylinder"], p["F_cylinder"], 0.0),
+                 "phi", outside=0.0, period=p["command_period"])
+
+
+def run_time(cycles: int = 4, p: dict | None = None) -> float:
+    """A simulated time (s) that covers ``cycles`` whole cycles, the last one back in idle.
+
+    The ram is back on its upper stop about 2.25 revolutions after the command
+    of its cycle; the time is reckoned at the nominal motor speed (slower than
+    the mean crank speed, so the estimate is on the late side).
+    """
+    p = PARAMETERS if p is None else p
+    end = p["phi_on"] + (cycles - 1) * p["command_period"] + 2.25 * 2 * np.pi
+    return float((end - p["phi0"]) / p["omega_nominal"])
 
 
 def _rocker_angle(p, x_c, phi) -> float:
@@ -116,13 +167,14 @@ def _rocker_angle(p, x_c, phi) -> float:
     return float(np.arctan2(b[1] - c[1], b[0] - c[0]))
 
 
-def build(cycles: int = 2, **overrides) -> Mechanism:
+def build(**overrides) -> Mechanism:
     """The press with its switches, stops, contact and loads.
+
+    The cylinder command repeats every ``command_period`` of the crank angle,
+    so the mechanism runs any number of cycles (the simulated time decides).
 
     Parameters
     ----------
-    cycles : int
-        Number of engaging commands (work strokes).
     **overrides
         Replace entries of :data:`PARAMETERS`.
 
@@ -178,12 +230,7 @@ def build(cycles: int = 2, **overrides) -> Mechanism:
     L_pis = 0.2 - x_piston_up
     m.add(Spring("piston_return", "ground", "piston_anchor", "piston", (0.0, 0.0),
                  stiffness=p["k_piston"], free_length=L_pis - p["pull_piston"] / p["k_piston"]))
-    times, vals = [-1.0], [0.0]
-    ramp = 1e-3
-    for on, off in command_times(cycles):
-        times += [on, on + ramp, off, off + ramp]
-        vals += [0.0, p["F_cylinder"], p["F_cylinder"], 0.0]
-    m.add(Force("cylinder_force", "piston", (0.0, 0.0), Table(times, vals, "t"),
+    m.add(Force("cylinder_force", "piston", (0.0, 0.0), cylinder_command(p),
                 direction=(-1.0, 0.0)))
     ps = p["psi_return"]
     m.add(Torque("return_cylinder", "rocker",
@@ -217,18 +264,29 @@ def build(cycles: int = 2, **overrides) -> Mechanism:
     return m
 
 
-def run(cycles: int = 2, t_end: float | None = None, **options):
+def run(cycles: int = 4, t_end: float | None = None, **options):
     """Simulate ``cycles`` work cycles; returns the Trajectory.
 
-    ``options`` go to :func:`mechdyn.simulate_events.simulate_events`
-    (default rtol 1e-9, output every 0.5 ms).
+    Parameters
+    ----------
+    cycles : int
+        Whole cycles to cover (idle, engage, lock, stroke, release, idle);
+        sets the end time by :func:`run_time`.
+    t_end : float, optional
+        End time, s, instead.
+    **options
+        Go to :func:`mechdyn.simulate_events.simulate_events` (default rtol
+        1e-9, output every 0.5 ms).
+
+    Returns
+    -------
+    Trajectory
     """
     from ..simulate_events import simulate_events
 
-    mech = build(cycles)
+    mech = build()
     if t_end is None:
-        on, _ = command_times(cycles)[-1]
-        t_end = on + 0.30
+        t_end = run_time(cycles)
     options.setdefault("rtol", 1e-9)
     options.setdefault("dt_out", 5e-4)
     return simulate_events(mech, t_end, **options)

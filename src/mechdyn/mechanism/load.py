@@ -1,7 +1,8 @@
 """Applied loads: springs, dampers, forces and torques (gravity is ``Mechanism.gravity``).
 
 A load's magnitude is a *value*: a constant (SI), a :class:`Table` interpolated in
-time, a coordinate, a coordinate rate or a point coordinate, or a callable that
+time, a coordinate, a coordinate rate or a point coordinate (optionally periodic in
+it, e.g. over the crank angle every revolution), or a callable that
 receives a :class:`mechdyn.dynamics.forces.LoadContext` (attributes ``t``, ``q``,
 ``qdot`` and methods ``coord``, ``rate``, ``point``, ``velocity``) and returns a
 float.  The elements are frozen data; ``mechdyn.dynamics.forces`` evaluates them.
@@ -9,6 +10,7 @@ float.  The elements are frozen data; ``mechdyn.dynamics.forces`` evaluates them
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -30,12 +32,35 @@ class Table:
         or a point coordinate ``"body.point.x"`` / ``"body.point.y"`` (m).
     outside : float or None
         Value outside the table; None holds the end values.
+    period : float or None
+        If given, the table repeats: the variable s is first wrapped into
+        ``[x[0], x[0] + period)`` (s -> x[0] + (s - x[0]) mod period), then
+        interpolated; on ``(x[-1], x[0] + period)`` the end value (or ``outside``)
+        applies.  In the variable's unit (rad for an angle: ``2 pi`` for once per
+        revolution).  Must be > 0 and >= ``x[-1] - x[0]``.  None: not periodic.
+
+    Raises
+    ------
+    ValueError
+        For unequal or too short x and y, x not strictly increasing, values that
+        are not finite, or a bad ``period``; the message names the variable.
+
+    Examples
+    --------
+    A punch force over the crank angle, 120 to 150 deg of every revolution:
+
+    >>> import numpy as np
+    >>> f = Table(np.deg2rad([120, 121, 149, 150]), [0, 5e3, 5e3, 0], "phi",
+    ...           outside=0.0, period=2 * np.pi)
+    >>> f(np.deg2rad(135.0 + 3 * 360.0)), f(np.deg2rad(135.0 - 360.0))
+    (5000.0, 5000.0)
     """
 
     x: tuple
     y: tuple
     variable: str = "t"
     outside: float | None = None
+    period: float | None = None
 
     def __post_init__(self):
         x = np.asarray(self.x, dtype=float).reshape(-1)
@@ -47,12 +72,37 @@ class Table:
             raise ValueError(f"table over {self.variable!r}: x values must increase strictly")
         if not (np.all(np.isfinite(x)) and np.all(np.isfinite(y))):
             raise ValueError(f"table over {self.variable!r}: values must be finite")
+        if self.period is not None:
+            per = self.period
+            if isinstance(per, bool) or not isinstance(per, int | float | np.integer
+                                                       | np.floating):
+                raise ValueError(f"table over {self.variable!r}: period must be a number, "
+                                 f"got {per!r}")
+            per = float(per)
+            span = float(x[-1] - x[0])
+            if not (math.isfinite(per) and per > 0):
+                raise ValueError(f"table over {self.variable!r}: period must be finite and "
+                                 f"> 0, got {per!r}")
+            if per < span * (1.0 - 1e-12):
+                raise ValueError(f"table over {self.variable!r}: period {per!r} is shorter "
+                                 f"than the table's span x[-1] - x[0] = {span!r}")
+            object.__setattr__(self, "period", per)
         object.__setattr__(self, "x", tuple(x))
         object.__setattr__(self, "y", tuple(y))
 
+    def wrap(self, s):
+        """The variable ``s`` wrapped into ``[x[0], x[0] + period)`` (``s`` itself if
+        the table is not periodic); float or array like ``s``."""
+        if self.period is None:
+            return s
+        x0, per = self.x[0], self.period
+        u = np.mod(np.asarray(s, dtype=float) - x0, per)
+        u = np.where(u >= per, 0.0, u)  # mod of a tiny negative number rounds up to per
+        return x0 + u
+
     def __call__(self, s):
         """The value at ``s`` (a float, or an array of the shape of an array ``s``)."""
-        s = np.asarray(s, dtype=float)
+        s = np.asarray(self.wrap(np.asarray(s, dtype=float)))
         y = np.interp(s, self.x, self.y)
         if self.outside is not None:
             y = np.where((s < self.x[0]) | (s > self.x[-1]), self.outside, y)
@@ -63,17 +113,42 @@ Value = float | Table | Callable
 
 
 def pulse(magnitude: float, start: float, duration: float, variable: str = "t",
-          ramp: float = 0.0) -> Table:
+          ramp: float = 0.0, period: float | None = None) -> Table:
     """A rectangular (or trapezoidal, with ``ramp``) pulse as a :class:`Table`.
 
-    ``magnitude`` acts for ``start <= variable <= start + duration``; zero elsewhere.
-    With ``ramp`` > 0 the value rises and falls linearly over that width.
+    Parameters
+    ----------
+    magnitude : float
+        Value during the pulse, SI.
+    start, duration : float
+        ``magnitude`` acts for ``start <= variable <= start + duration``; zero
+        elsewhere.  In the variable's unit.
+    variable : str
+        As for :class:`Table`.
+    ramp : float
+        With ``ramp`` > 0 the value rises (before ``start``) and falls (after
+        ``start + duration``) linearly over that width.
+    period : float or None
+        Repeat the pulse every ``period`` of the variable (see :class:`Table`);
+        it must be > ``duration`` and >= ``duration + 2 ramp``.
+
+    Returns
+    -------
+    Table
     """
     if duration <= 0:
-        raise ValueError(f"pulse: duration must be > 0, got {duration!r}")
+        raise ValueError(f"pulse over {variable!r}: duration must be > 0, got {duration!r}")
+    if ramp < 0:
+        raise ValueError(f"pulse over {variable!r}: ramp must be >= 0, got {ramp!r}")
     r = max(float(ramp), 1e-12 * max(abs(duration), 1.0))
+    if period is not None:
+        if not period > 0 or period <= duration or period < duration + 2 * float(ramp):
+            raise ValueError(f"pulse over {variable!r}: period must be > duration and >= "
+                             f"duration + 2 ramp = {duration + 2 * float(ramp)!r}, "
+                             f"got {period!r}")
+        r = min(r, 0.5 * (period - duration))  # the vanishing ramps of a rectangular pulse
     xs = (start - r, start, start + duration, start + duration + r)
-    return Table(xs, (0.0, magnitude, magnitude, 0.0), variable, outside=0.0)
+    return Table(xs, (0.0, magnitude, magnitude, 0.0), variable, outside=0.0, period=period)
 
 
 @dataclass(frozen=True)

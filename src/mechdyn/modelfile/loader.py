@@ -637,11 +637,22 @@ class _Builder:
         raise _Failed
 
     def value(self, raw: Any, kind: str, *path):
-        """A constant, a ``{x, y, variable}`` table or a ``{pulse, start, duration}`` pulse."""
+        """A constant, a ``{x, y, variable}`` table or a ``{pulse, start, duration}`` pulse
+        (either with an optional ``period`` of the variable)."""
         if not isinstance(raw, dict):
             return self.quantity(raw, kind, *path)
         var = raw.get("variable", "t")
         vkind = self.variable_kind(var, *path, "variable")
+        period, bad_period = None, False
+        if "period" in raw:
+            try:
+                period = self.quantity(raw["period"], vkind, *path, "period")
+            except _Failed:
+                bad_period = True
+            if period is not None and not period > 0:
+                self.problem(f"{self.where(*path, 'period')}: the period of the table over "
+                             f"{var!r} must be > 0, got {raw['period']!r}")
+                period, bad_period = None, True
         if "pulse" in raw:
             mag = self.quantity(raw["pulse"], kind, *path, "pulse")
             start = self.quantity(raw["start"], vkind, *path, "start")
@@ -650,8 +661,16 @@ class _Builder:
             if dur <= 0 or ramp < 0:
                 self.problem(f"{self.where(*path)}: the pulse needs duration > 0 and ramp >= 0")
                 raise _Failed
-            return pulse(mag, start, dur, var, ramp)
-        xs, ys, failed = [], [], False
+            if bad_period:
+                raise _Failed
+            if period is not None and (period <= dur or period < dur + 2 * ramp):
+                self.problem(f"{self.where(*path, 'period')}: the period of the pulse over "
+                             f"{var!r} ({raw['period']!r}) must be longer than its duration "
+                             f"and >= duration + 2 ramp ({raw['duration']!r}"
+                             + (f" + 2 x {raw['ramp']!r}" if "ramp" in raw else "") + ")")
+                raise _Failed
+            return pulse(mag, start, dur, var, ramp, period)
+        xs, ys, failed = [], [], bad_period
         for key, kk, out in (("x", vkind, xs), ("y", kind, ys)):
             for i, v in enumerate(raw[key]):
                 try:
@@ -663,16 +682,26 @@ class _Builder:
             outside = self.quantity(raw["outside"], kind, *path, "outside")
         if failed:
             raise _Failed
-        return self.table(xs, ys, var, outside, *path)
+        return self.table(xs, ys, var, outside, *path, period=period,
+                          period_text=raw.get("period"))
 
-    def table(self, xs, ys, var, outside, *path):
+    def table(self, xs, ys, var, outside, *path, period=None, period_text=None):
         if len(xs) != len(ys):
             self.problem(f"{self.where(*path)}: x has {len(xs)} values but y has {len(ys)}")
             raise _Failed
         if any(b <= a for a, b in zip(xs, xs[1:], strict=False)):
             self.problem(f"{self.where(*path, 'x')}: the values must increase strictly")
             raise _Failed
-        return Table(tuple(xs), tuple(ys), var, outside)
+        if period is not None and len(xs) >= 2 and period < (xs[-1] - xs[0]) * (1 - 1e-12):
+            self.problem(f"{self.where(*path, 'period')}: the period of the table over {var!r} "
+                         f"({period_text!r} = {period:.6g} SI) is shorter than the table's "
+                         f"span x[-1] - x[0] = {xs[-1] - xs[0]:.6g} SI")
+            raise _Failed
+        try:
+            return Table(tuple(xs), tuple(ys), var, outside, period)
+        except ValueError as exc:
+            self.problem(f"{self.where(*path)}: {exc}")
+            raise _Failed from None
 
     def load(self, k: int, spec: dict):
         P = ("loads", k)
