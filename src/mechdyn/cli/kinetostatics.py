@@ -60,22 +60,6 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def _load_model(spec: str):
-    try:
-        from .kinematics import load_model
-    except ImportError:  # pragma: no cover - the kinematics command is optional
-        from pathlib import Path
-
-        from .. import examples
-        from ..modelfile import load
-
-        def load_model(s):
-            if Path(s).is_file():
-                return load(s)
-            return examples.load(s)
-    return load_model(spec)
-
-
 def _point(text: str):
     from ..errors import UnitError
     from ..units import parse_quantity
@@ -95,8 +79,9 @@ def run(args) -> int:
     from ..dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
     from ..errors import ModelError
     from ..units import parse_quantity
+    from .kinematics import load_model
 
-    mech = _load_model(args.model)
+    mech = load_model(args.model)
     model = mech.compile()
     over = args.over if args.over is not None else model.coordinate_names[0]
     k = model.coordinate_index(over)
