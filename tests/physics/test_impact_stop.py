@@ -124,3 +124,18 @@ def test_locking_with_offset_centre_of_mass_uses_inertia_about_the_axis():
     eng = [e for e in tr.events if e.kind == "engage"][0]
     np.testing.assert_allclose(eng.qdot_after, [w, w], rtol=1e-12)
     assert eng.energy_lost == pytest.approx(0.5 * J1 * J2 / (J1 + J2) * 14.0 ** 2, rel=1e-12)
+
+
+def test_table_of_a_switched_run_has_the_mode_and_the_load_on_the_frame():
+    # free flight: the frame carries only the spring's end at A, a tension K s pulling A
+    # towards the mass (+x); in contact the stop's reaction is added
+    tr = simulate_events(_oscillator(0.0), 0.5, q0=[X0], qdot0=[0.0], dt_out=0.01, rtol=1e-10)
+    df = tr.to_dataframe()
+    vs = tr.stats["variable_structure"]
+    assert list(df["mode_index"]) == list(vs["mode_index"])
+    free = (df["mode"] == "-").to_numpy()
+    assert free.sum() > 10
+    s_m = df["s_m"].to_numpy()
+    np.testing.assert_allclose(df["Fx_frame_N"].to_numpy()[free], K * s_m[free], rtol=0,
+                               atol=1e-9 * K * X0)
+    np.testing.assert_allclose(df["Fy_frame_N"].to_numpy(), 0.0, atol=1e-9 * K * X0)

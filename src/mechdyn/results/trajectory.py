@@ -166,6 +166,9 @@ class Trajectory:
             cols["W_nc_J"] = e["work_nc"]
             cols["E_balance_J"] = e["balance"]
             cols["residual"] = e["residual"]
+        vs = self.stats.get("variable_structure")
+        if vs and self.t.size:
+            cols.update(_switched_columns(vs))
         return pd.DataFrame(cols)
 
     def xddot(self) -> np.ndarray:
@@ -196,3 +199,28 @@ class Trajectory:
             for k, ax in enumerate("xy"):
                 out[f"a{ax}_{body}_{pt}_m_s2"] = a[:, k]
         return out
+
+
+def _switched_columns(vs: dict) -> dict:
+    """Columns of a variable-structure run: the mode of each sample, the force on the
+    frame and the force of every lock, stop and contact (see ``docs/variable-structure.md``).
+    """
+    cols: dict[str, np.ndarray] = {
+        "mode": np.array([" ".join(sorted(m)) or "-" for m in vs["mode"]], dtype=object),
+        "mode_index": np.asarray(vs["mode_index"]),
+    }
+    frame = np.asarray(vs["frame_force"], float)
+    cols["Fx_frame_N"] = frame[:, 0]
+    cols["Fy_frame_N"] = frame[:, 1]
+    cols["F_frame_N"] = np.hypot(frame[:, 0], frame[:, 1])
+    for name, f in vs.get("forces", {}).items():
+        f = np.asarray(f, float)
+        key = str(name).replace("@", "_")
+        if f.ndim == 1:
+            cols[f"F_{key}_N"] = f
+        else:
+            cols[f"Fx_{key}_N"] = f[:, 0]
+            cols[f"Fy_{key}_N"] = f[:, 1]
+            if f.shape[1] > 2:
+                cols[f"M_{key}_Nm"] = f[:, 2]
+    return cols
