@@ -95,6 +95,10 @@ def run(args) -> int:
     print(f"  Delta E_max           {fs.delta_E_max:.6g} J (refined {fs.delta_E_refined:.6g} J)")
     print(f"  J_fly energy method   {fs.J_fly_energy:.6g} kg m^2 (refined "
           f"{fs.J_fly_refined:.6g} kg m^2)")
+    if fs.J_fly_energy < 0:
+        print("                        (negative: by the energy method alone the machine's own "
+              "mean inertia already meets the target; the refined method, which accounts for "
+              "the varying J_red, decides)")
     print(f"  J_fly on the crank    {fs.J_fly:.6g} kg m^2")
     if fs.J_fly_motor is not None:
         print(f"  J_fly on the motor    {fs.J_fly_motor:.6g} kg m^2 (gear ratio "
