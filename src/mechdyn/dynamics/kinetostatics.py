@@ -210,15 +210,62 @@ def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
     >>> round(float(res.driving["phi"][0]), 4)   # holds the weight: 1 kg x 9.81 x 0.1 m
     0.981
     """
-    t_start = time.perf_counter()
     model = as_model(mech_or_model)
-    fm = force_model(model)
     if model_drives not in ("replace", "load"):
         raise ValueError(f"model_drives must be 'replace' or 'load', got {model_drives!r}")
+    vs = _variable_structure(trajectory)
+    if vs is not None:
+        if any(v is not None for v in (speed, values, t, law)):
+            raise ValueError("give either trajectory= or speed/values/t/law, not both")
+        if mode is not None:
+            raise ValueError("mode= cannot be given with a variable-structure trajectory: "
+                             "each sample is analysed in its recorded mode")
+        from .kinetostatics_switched import kinetostatics_switched
+
+        return kinetostatics_switched(model, trajectory, vs, over=over, point=point,
+                                      model_drives=model_drives,
+                                      reacting_loads=reacting_loads)
+    return _kinetostatics(model, over=over, speed=speed, values=values, t=t, law=law,
+                          start=start, trajectory=trajectory, hold=hold, mode=mode,
+                          point=point, model_drives=model_drives,
+                          reacting_loads=reacting_loads, x_guess=x_guess)
+
+
+def _variable_structure(trajectory):
+    """The ``stats["variable_structure"]`` record of a switched run, else None."""
+    if trajectory is None:
+        return None
+    stats = getattr(trajectory, "stats", None)
+    vs = stats.get("variable_structure") if isinstance(stats, Mapping) else None
+    if not vs or "mode" not in vs:
+        return None
+    if len(vs["mode"]) != np.size(trajectory.t):
+        raise ValueError("the trajectory's variable_structure record does not match its "
+                         f"samples ({len(vs['mode'])} modes for {np.size(trajectory.t)} "
+                         f"samples)")
+    return vs
+
+
+def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=None,
+                   start=None, trajectory=None, hold=None, mode=None, point=(0.0, 0.0),
+                   model_drives="replace", reacting_loads=(), x_guess=None, lay=None,
+                   kmodel=None, candidates=None, x_start=None) -> Kinetostatics:
+    """The analysis in one mode (see :func:`kinetostatics`).
+
+    For the segments of a switched trajectory: ``lay`` (a layout or
+    :class:`~mechdyn.dynamics.prescribed_motion.ModeRows`), ``kmodel`` (the model
+    with the lock offsets held in that segment), ``candidates`` (order in which
+    coordinates are chosen as driven) and ``x_start`` (a pose of the segment)."""
+    t_start = time.perf_counter()
+    record_model = model
+    if kmodel is not None:
+        model = kmodel
+    fm = force_model(model)
     if mode is None and trajectory is not None and isinstance(
             getattr(trajectory, "mode", None), frozenset):
         mode = trajectory.mode
-    lay = model.layout(mode)
+    if lay is None:
+        lay = model.layout(mode)
     load_names = {getattr(ld, "name", None) for ld in model.mechanism.loads}
     for nm in reacting_loads:
         if nm not in load_names:
@@ -228,7 +275,8 @@ def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
         if hasattr(ld, "generalized"):
             warn.append(f"load {getattr(ld, 'name', '?')!r} ({type(ld).__name__}) is an "
                         f"extension load that kinetostatics does not evaluate; it is left out")
-    x_start = getattr(model, "x0", None)
+    if x_start is None:
+        x_start = getattr(model, "x0", None)
     if x_start is None:
         x_start = model.x_sketch
     if x_guess is not None:
@@ -254,13 +302,13 @@ def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
         Q = np.asarray(trajectory.q, dtype=float).reshape(tt.size, model.n_q)
         Qd = np.asarray(trajectory.qdot, dtype=float).reshape(tt.size, model.n_q)
         Qdd = np.asarray(trajectory.qddot, dtype=float).reshape(tt.size, model.n_q)
-        didx = _independent_subset(model, lay, x_start, over_idx)
+        didx = _independent_subset(model, lay, x_start, over_idx, candidates)
         qd, qd_dot, qd_ddot = Q[:, didx], Qd[:, didx], Qdd[:, didx]
         tx = getattr(trajectory, "x", None)
         if x_guess is None and tx is not None and np.shape(tx) == (tt.size, model.n_x):
             x_guess = np.asarray(tx, dtype=float)
         if not over_names:
-            over_names = [model.coordinate_names[didx[0]]]
+            over_names = [model.coordinate_names[didx[0] if len(didx) else 0]]
     else:
         if not over_idx:
             over_idx = _independent_subset(model, lay, x_start, [])[:1]
@@ -376,5 +424,8 @@ def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
         frame_point=np.asarray(point, dtype=float).copy(), frame_loads=core["frame_loads"],
         multipliers=core["lam"], joint_kinds=core["kinds"], mode=lay.mode,
         redundant_joints=tuple(core["redundant"]), status=status, message=message,
-        warnings=tuple(warn), stats=stats, model=model)
+        warnings=tuple(warn), stats=stats, model=record_model,
+        element_forces=core["element_forces"],
+        element_units={el: ("N m" if bool(lay.row_is_angle[idx[0] - lay.n_base]) else "N")
+                       for el, idx in getattr(lay, "elements", {}).items()})
 

@@ -18,6 +18,7 @@ from ..kinematics.constraints import (
     coordinates,
     coordinates_gamma,
     coordinates_jacobian,
+    extend,
     gamma,
     jacobian,
     point_position,
@@ -25,10 +26,98 @@ from ..kinematics.constraints import (
 )
 from ..model import ConstraintLayout, Model, as_model
 
-__all__ = ["dead_centres"]
+__all__ = ["dead_centres", "ModeRows"]
 
 #: relative singular value below which constraint equations count as dependent
 REDUNDANT_RCOND = 1e-9
+
+
+class ModeRows:
+    """The constraint rows of a variable-structure mode for kinetostatics: the
+    :class:`~mechdyn.model.ConstraintLayout` of the joints and engaged weld locks,
+    followed by one row per other switchable element of the mode (coordinate locks,
+    closed stops, closed contacts and sticking contacts), the
+    :class:`~mechdyn.dynamics.modes.Row` objects of :mod:`mechdyn.dynamics.modes`.
+
+    It stands in for a layout everywhere kinetostatics uses one (``n_rows``,
+    ``rows``, ``row_joint``, ``lock_active``, ``mode``); the row values, Jacobian
+    and acceleration terms come from :func:`mode_residual`, :func:`mode_jacobian`
+    and :func:`mode_gamma`.
+    """
+
+    def __init__(self, base: ConstraintLayout, extra, mode, n_bodies: int):
+        self.base = base
+        self.extra = list(extra)
+        self.mode = frozenset(mode)
+        self.nb = n_bodies
+        self.n_base = base.n_rows
+        self.n_rows = base.n_rows + len(self.extra)
+        self.lock_active = base.lock_active
+        self.rows = dict(base.rows)
+        self.elements: dict[str, list[int]] = {}
+        for k, r in enumerate(self.extra):
+            key = r.label if r.kind == "stick" else r.element
+            self.elements.setdefault(key, []).append(self.n_base + k)
+        self.row_joint = np.concatenate(
+            [base.row_joint, np.array([r.label if r.kind == "stick" else r.element
+                                       for r in self.extra], dtype=object)])
+        self.row_is_angle = np.array([bool(r.measure.is_angle) for r in self.extra], bool)
+
+
+def _base(lay):
+    return lay.base if isinstance(lay, ModeRows) else lay
+
+
+def _per_pose(model, x, fn, n_out):
+    """fn(X) (n_out values) on every pose of a batch x (..., n_x) -> (..., n_out)."""
+    x = np.asarray(x, dtype=float)
+    flat = x.reshape(-1, model.n_x)
+    X = extend(model, flat)
+    out = np.array([fn(X[k], k) for k in range(flat.shape[0])], dtype=float)
+    return out.reshape(x.shape[:-1] + np.shape(out)[1:]) if out.size else np.zeros(
+        x.shape[:-1] + n_out)
+
+
+def mode_residual(model: Model, x, lay) -> np.ndarray:
+    """Residuals of every row of ``lay`` (a layout or :class:`ModeRows`), (..., n_rows)."""
+    base = residual(model, x, _base(lay))
+    if not isinstance(lay, ModeRows) or not lay.extra:
+        return base
+    own = _per_pose(model, x, lambda X, k: [r.sign * (r.measure.value(X) - r.target)
+                                            for r in lay.extra], (len(lay.extra),))
+    return np.concatenate([base, own], axis=-1)
+
+
+def mode_jacobian(model: Model, x, lay, *, friction: bool = False) -> np.ndarray:
+    """Jacobian of every row of ``lay``, (..., n_rows, n_x).  With ``friction``, the
+    rows of slipping contacts carry their Coulomb friction (R - mu s T_x, the force
+    direction of the row, as in :meth:`mechdyn.dynamics.modes.ModeSystem.evaluate_x`)."""
+    base = jacobian(model, x, _base(lay))
+    if not isinstance(lay, ModeRows) or not lay.extra:
+        return base
+
+    def rows(X, k):
+        out = []
+        for r in lay.extra:
+            g = r.sign * r.measure.grad(X, lay.nb)
+            if friction and r.slip:
+                g = g - r.mu * r.slip * r.tangent.grad(X, lay.nb)
+            out.append(g)
+        return out
+
+    own = _per_pose(model, x, rows, (len(lay.extra), model.n_x))
+    return np.concatenate([base, own], axis=-2)
+
+
+def mode_gamma(model: Model, x, xdot, lay) -> np.ndarray:
+    """Acceleration right-hand side of every row (Phi_x xddot = gamma), (..., n_rows)."""
+    base = gamma(model, x, xdot, _base(lay))
+    if not isinstance(lay, ModeRows) or not lay.extra:
+        return base
+    V = extend(model, np.asarray(xdot, dtype=float).reshape(-1, model.n_x))
+    own = _per_pose(model, x, lambda X, k: [-r.sign * r.measure.quad(X, V[k])
+                                            for r in lay.extra], (len(lay.extra),))
+    return np.concatenate([base, own], axis=-1)
 
 
 def _col_scale(model: Model) -> np.ndarray:
@@ -38,11 +127,11 @@ def _col_scale(model: Model) -> np.ndarray:
 
 
 def _kin_system(model, lay, didx, x, qd):
-    Phi = residual(model, x, lay)
+    Phi = mode_residual(model, x, lay)
     g = coordinates(model, x)[..., didx]
     F = np.concatenate([Phi, g - qd], axis=-1)
-    J = np.concatenate([jacobian(model, x, lay), coordinates_jacobian(model, x)[..., didx, :]],
-                       axis=-2)
+    J = np.concatenate([mode_jacobian(model, x, lay),
+                        coordinates_jacobian(model, x)[..., didx, :]], axis=-2)
     return F, J
 
 
@@ -137,7 +226,11 @@ class _Positions:
         return x
 
     def _error(self, qd, x, t=None):
-        res = joint_residuals(self.model, x, self.lay)
+        res = joint_residuals(self.model, x, _base(self.lay))
+        if isinstance(self.lay, ModeRows) and self.lay.extra:
+            r = mode_residual(self.model, x, self.lay)
+            for el, idx in self.lay.elements.items():
+                res[el] = float(np.linalg.norm(r[idx]))
         names = [self.model.coordinate_names[k] for k in self.didx]
         if max(res.values(), default=0.0) < 1e-6 * self.model.length_scale:
             return SingularPositionError(
@@ -221,16 +314,17 @@ class _Positions:
         rhs = np.zeros(x.shape[:-1] + (J.shape[-2],))
         rhs[..., lay.n_rows:] = qd_dot
         xdot = _lin_solve(J, rhs)
-        gam = np.concatenate([gamma(m, x, xdot, lay),
+        gam = np.concatenate([mode_gamma(m, x, xdot, lay),
                               coordinates_gamma(m, x, xdot)[..., self.didx] + qd_ddot], axis=-1)
         xddot = _lin_solve(J, gam)
         return xdot, xddot
 
 
-def _independent_subset(model, lay, x0, first: list[int]) -> list[int]:
-    """Extend ``first`` with coordinates that add rank, up to the DOF of the layout."""
+def _independent_subset(model, lay, x0, first: list[int], candidates=None) -> list[int]:
+    """Extend ``first`` with coordinates that add rank, up to the DOF of the layout
+    (``candidates``: the order in which the others are tried; default declared order)."""
     sc = _col_scale(model)
-    P = jacobian(model, x0, lay) * sc
+    P = mode_jacobian(model, x0, lay) * sc
     G = coordinates_jacobian(model, x0) * sc
 
     def rank(A):
@@ -250,7 +344,7 @@ def _independent_subset(model, lay, x0, first: list[int]) -> list[int]:
                 f"coordinate {model.coordinate_names[k]!r} cannot be driven in mode "
                 f"{sorted(lay.mode)}: it is fixed by the other driven coordinates and the "
                 f"constraints ({dof} degree(s) of freedom)")
-    for k in range(model.n_q):
+    for k in (range(model.n_q) if candidates is None else candidates):
         if len(chosen) >= dof:
             break
         if k in chosen:

@@ -18,11 +18,11 @@ import warnings as _warnings
 import numpy as np
 
 from ..kinematics.assembly import SINGULAR_RCOND
-from ..kinematics.constraints import _perp, coordinates_jacobian, extend, jacobian
+from ..kinematics.constraints import _perp, coordinates_jacobian, extend
 from ..model import COORD_TRAVEL, ConstraintLayout, Model
 from .forces import applied_forces, cross, rotate
 from .inertia import inertia_forces
-from .prescribed_motion import REDUNDANT_RCOND, _col_scale
+from .prescribed_motion import REDUNDANT_RCOND, ModeRows, _col_scale, mode_jacobian
 
 __all__ = ["KinetostaticsWarning"]
 
@@ -48,7 +48,7 @@ def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
     x = np.asarray(x, dtype=float).reshape(-1, model.n_x)
     if x.shape[0] > 64:  # redundancy is structural: a sample of the positions suffices
         x = x[np.unique(np.linspace(0, x.shape[0] - 1, 64).astype(int))]
-    P = jacobian(model, x, lay) * sc
+    P = mode_jacobian(model, x, lay) * sc
     s = np.linalg.svd(P, compute_uv=False)
     r = np.sum(s > REDUNDANT_RCOND * s[..., :1], axis=-1)
     if s.shape[-1] < lay.n_rows:  # more equations than unknowns
@@ -63,7 +63,11 @@ def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
     rows = [i for i in range(lay.n_rows) if weight[i] > 1e-6]
     joints = sorted({str(lay.row_joint[i]) for i in rows})
     labels = []
+    n_base = lay.n_base if isinstance(lay, ModeRows) else lay.n_rows
     for i in rows:
+        if i >= n_base:
+            labels.append(lay.extra[i - n_base].label)
+            continue
         j = str(lay.row_joint[i])
         pos = int(np.flatnonzero(lay.rows[j] == i)[0])
         labels.append(f"{j} ({_ROW_LABELS[model.joint_kind(j)][pos]})")
@@ -109,7 +113,8 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     F, F_ground, Qd_loads = applied_forces(model, t, x, xdot, q, qdot, skip_drives=skip,
                                            reacting_loads=reacting)
     Ix = inertia_forces(model, x, xdot, xddot)
-    P = jacobian(model, x, lay)  # (n, rows, n_x)
+    # (n, rows, n_x); slipping contacts' rows carry their friction
+    P = mode_jacobian(model, x, lay, friction=True)
     G = coordinates_jacobian(model, x)  # (n, n_q, n_x)
     Gd = G[:, didx, :]
     A = np.concatenate([-P, Gd], axis=1).transpose(0, 2, 1)  # (n, n_x, rows + n_d)
@@ -124,6 +129,8 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
             cs[rows[1]] = L
         elif kind == "lock":
             cs[rows[2]] = L
+    if isinstance(lay, ModeRows):
+        cs[lay.n_base:lay.n_rows] = np.where(lay.row_is_angle, L, 1.0)
     for i, k in enumerate(didx):
         if model.coord_kind[k] != COORD_TRAVEL:
             cs[lay.n_rows + i] = L
@@ -209,6 +216,21 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
             frame_loads[name] = np.concatenate(
                 [ff, (mm + cross(Pt - point, ff))[:, None]], axis=-1)
 
+    # ------------------------------------------------ switchable elements (modes.py rows)
+    element_forces: dict[str, np.ndarray] = {}
+    p_el = np.zeros(n)
+    if isinstance(lay, ModeRows):
+        for el, idx in lay.elements.items():
+            # the multiplier in the forward convention (M xddot = F + R^T lambda_m):
+            # the normal force of a stop or contact (>= 0), the torque/force of a
+            # coordinate lock on its measure, the tangential force of a sticking contact
+            element_forces[el] = -lam[:, idx[0]]
+            Del = C[:, idx, :].sum(axis=1)
+            p_el += np.einsum("nx,nx->n", Del, xdot)
+            fe = _net_on_ground(model, x, Del)
+            fe[:, 2] -= cross(np.broadcast_to(point, (n, 2)), fe[:, :2])
+            frame_loads[el] = fe
+
     # ------------------------------------------------ drives' stator and ground-attached loads
     D = np.einsum("nd,ndx->nx", tau, Gd) + np.einsum("nq,nqx->nx", Qd_loads, G)
     dr = _net_on_ground(model, x, D)
@@ -219,7 +241,9 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     frame_loads["loads"] = lg
     tot = sum(frame_loads.values())
     # ------------------------------------------------ power balance (self-check)
-    p_in = np.einsum("nd,nd->n", tau, qdot[:, didx]) + np.einsum("nx,nx->n", F, xdot)
+    # (p_el: power of the switchable rows, zero but for sliding friction)
+    p_in = (np.einsum("nd,nd->n", tau, qdot[:, didx]) + np.einsum("nx,nx->n", F, xdot)
+            + p_el)
     p_kin = np.einsum("nx,nx->n", Ix, xdot)
     p_scale = max(float(np.max(np.abs(p_kin))), float(np.max(np.abs(p_in))),
                   float(np.max(np.abs(F * xdot))), 1e-300)
@@ -229,6 +253,6 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     return {"reactions": reactions, "moments": moments, "joint_frame": jframe,
             "joint_points": jpoints, "kinds": kinds, "frame_loads": frame_loads,
             "frame_force": tot[:, :2].copy(), "frame_moment": tot[:, 2].copy(), "tau": tau,
-            "lam": lam, "status": status, "warnings": warn, "redundant": redundant,
-            "stats": stats}
+            "lam": lam, "element_forces": element_forces, "status": status,
+            "warnings": warn, "redundant": redundant, "stats": stats}
 

@@ -59,11 +59,13 @@ class Kinetostatics:
         the stator reactions, ``"loads"`` for spring/torque ends): force x, y
         (N) and moment about ``frame_point`` (N m) that the frame receives.
     multipliers : ndarray, shape (n, n_rows)
-        Lagrange multipliers of the joint equations (layout row order).
+        Lagrange multipliers of the joint equations (layout row order; for a
+        switched trajectory the row order of each sample's mode, NaN-padded).
     joint_kinds : dict str -> str
         "revolute", "prismatic" or "lock" for each reported joint.
     mode : frozenset of str
-        Engaged locks.
+        Engaged locks (switched trajectory: every token active in some sample;
+        see ``sample_modes``).
     redundant_joints : tuple of str
         Joints whose equations are linearly dependent (their reactions are not
         unique; the minimum-norm solution is reported).
@@ -74,7 +76,24 @@ class Kinetostatics:
     warnings : tuple of str
     stats : dict
         Run figures: positions, seconds, Newton iterations, power-balance
-        residual (relative), smallest rcond, ...
+        residual (relative), smallest rcond, ...; for a switched trajectory also
+        ``segments`` (one dict per segment: mode, sample range, times, driven
+        coordinates, status, power-balance residual).
+    element_forces : dict str -> ndarray, shape (n,)
+        Switchable elements other than weld locks (coordinate locks, closed stops
+        and contacts, ``"<contact>.tangent"`` for a sticking contact): the
+        multiplier in the convention of ``mechdyn.simulate`` (``M xddot = F +
+        Phi_x^T lambda``): the normal force of a stop or contact (>= 0 while it
+        pushes), the torque (N m) or force (N) a coordinate lock applies along its
+        variable.  NaN where the element is not active.
+    element_units : dict str -> str
+        "N" or "N m" for each entry of ``element_forces``.
+    sample_modes : tuple of frozenset or None
+        Switched trajectory: the mode of every sample (None otherwise).
+    mode_index : ndarray of int, shape (n,), or None
+        Switched trajectory: index of each sample's mode in ``modes``.
+    modes : tuple of frozenset
+        Switched trajectory: the distinct modes in order of appearance.
     """
 
     over: str
@@ -107,10 +126,22 @@ class Kinetostatics:
     warnings: tuple
     stats: dict
     model: Model | None = field(default=None, compare=False)
+    element_forces: dict = field(default_factory=dict)
+    element_units: dict = field(default_factory=dict)
+    sample_modes: tuple | None = None
+    mode_index: np.ndarray | None = None
+    modes: tuple = ()
 
     def __repr__(self) -> str:
+        sw = f", {len(self.modes)} modes" if self.sample_modes is not None else ""
         return (f"Kinetostatics(status={self.status!r}, {len(self.t)} positions over "
-                f"{self.over!r}, driven={list(self.driven)}, joints={list(self.reactions)})")
+                f"{self.over!r}, driven={list(self.driven)}, joints={list(self.reactions)}"
+                f"{sw})")
+
+    @property
+    def switched(self) -> bool:
+        """True for the analysis of a variable-structure (switched) trajectory."""
+        return self.sample_modes is not None
 
     # ------------------------------------------------------------ helpers
     @property
@@ -178,6 +209,10 @@ class Kinetostatics:
         import pandas as pd
 
         cols: dict[str, np.ndarray] = {"t_s": self.t}
+        if self.switched:
+            cols["mode"] = np.array([" ".join(sorted(m)) or "-" for m in self.sample_modes],
+                                    dtype=object)
+            cols["mode_index"] = np.asarray(self.mode_index)
         for k, c in enumerate(self.coordinate_names):
             if self._is_angle(k):
                 cols[f"{c}_deg"] = np.rad2deg(self.q[:, k])
@@ -202,6 +237,12 @@ class Kinetostatics:
                 cols[f"Fn_{j}_N"] = self.joint_frame[j][:, 1]
             if kind in ("prismatic", "lock"):
                 cols[f"M_{j}_Nm"] = self.moments[j]
+        for el, f in self.element_forces.items():
+            key = el.replace("@", "_")
+            if self.element_units.get(el) == "N m":
+                cols[f"M_{key}_Nm"] = f
+            else:
+                cols[f"F_{key}_N"] = f
         for j, L in self.frame_loads.items():
             if j in self.reactions:
                 cols[f"Fx_frame_{j}_N"] = L[:, 0]
@@ -224,6 +265,8 @@ class Kinetostatics:
         (trapezoidal rule), else by position count."""
         y = np.asarray(series, dtype=float)
         t = self.t
+        if not np.all(np.isfinite(y)):
+            return _rms_finite(y, t)
         if y.size < 2:
             return float(np.sqrt(np.mean(y**2)))
         if np.all(np.diff(t) > 0):
@@ -236,37 +279,49 @@ class Kinetostatics:
     def peaks(self) -> dict:
         """The figures of :meth:`summary` as a dict (SI units; positions in ``over``'s unit)."""
         out: dict = {"driving": {}, "joints": {}, "frame": {}}
+        # NaN marks samples where a drive, joint or element is not part of the mode
+        # (switched trajectories); extremes are taken over the others.  "*_t" are the
+        # times of the extremes.
+        t = self.t
         for c in self.driven:
             m = self.driving[c]
-            ka, kmx, kmn = int(np.argmax(np.abs(m))), int(np.argmax(m)), int(np.argmin(m))
+            ka, kmx, kmn = _arg(np.abs(m)), _arg(m), _arg(-m)
             out["driving"][c] = {
-                "peak_abs": float(m[ka]), "peak_abs_at": float(self.values[ka]),
-                "max": float(m[kmx]), "max_at": float(self.values[kmx]),
-                "min": float(m[kmn]), "min_at": float(self.values[kmn]),
-                "rms": self.rms(m), "mean": float(np.mean(m)),
-                "peak_power": float(np.max(np.abs(self.power[c]))),
+                "peak_abs": _at(m, ka), "peak_abs_at": _at(self.values, ka),
+                "max": _at(m, kmx), "max_at": _at(self.values, kmx),
+                "min": _at(m, kmn), "min_at": _at(self.values, kmn),
+                "rms": self.rms(m), "mean": _nanmean(m),
+                "peak_power": _at(np.abs(self.power[c]), _arg(np.abs(self.power[c]))),
+                "peak_abs_t": _at(t, ka),
             }
         for j in self.reactions:
             F = self.force_magnitude(j)
-            k = int(np.argmax(F))
-            out["joints"][j] = {"peak": float(F[k]), "peak_at": float(self.values[k]),
-                                "rms": self.rms(F)}
+            k = _arg(F)
+            out["joints"][j] = {"peak": _at(F, k), "peak_at": _at(self.values, k),
+                                "peak_t": _at(t, k), "rms": self.rms(F)}
             if self.joint_kinds[j] != "revolute":
                 M = self.moments[j]
-                km = int(np.argmax(np.abs(M)))
-                out["joints"][j].update(peak_moment=float(M[km]),
-                                        peak_moment_at=float(self.values[km]))
+                km = _arg(np.abs(M))
+                out["joints"][j].update(peak_moment=_at(M, km),
+                                        peak_moment_at=_at(self.values, km),
+                                        peak_moment_t=_at(t, km))
+        out["elements"] = {}
+        for el, f in self.element_forces.items():
+            k = _arg(np.abs(f))
+            out["elements"][el] = {"peak": _at(f, k), "peak_at": _at(self.values, k),
+                                   "peak_t": _at(t, k), "unit": self.element_units.get(el, "N")}
         Ff = np.hypot(self.frame_force[:, 0], self.frame_force[:, 1])
-        k, km = int(np.argmax(Ff)), int(np.argmax(np.abs(self.frame_moment)))
+        k, km = _arg(Ff), _arg(np.abs(self.frame_moment))
         out["frame"] = {
-            "force_peak": float(Ff[k]), "force_peak_at": float(self.values[k]),
-            "Fx_min": float(self.frame_force[:, 0].min()),
-            "Fx_max": float(self.frame_force[:, 0].max()),
-            "Fy_min": float(self.frame_force[:, 1].min()),
-            "Fy_max": float(self.frame_force[:, 1].max()),
-            "moment_peak": float(self.frame_moment[km]),
-            "moment_peak_at": float(self.values[km]),
-            "M_min": float(self.frame_moment.min()), "M_max": float(self.frame_moment.max()),
+            "force_peak": _at(Ff, k), "force_peak_at": _at(self.values, k),
+            "Fx_min": _nanext(self.frame_force[:, 0], np.nanmin),
+            "Fx_max": _nanext(self.frame_force[:, 0], np.nanmax),
+            "Fy_min": _nanext(self.frame_force[:, 1], np.nanmin),
+            "Fy_max": _nanext(self.frame_force[:, 1], np.nanmax),
+            "moment_peak": _at(self.frame_moment, km),
+            "moment_peak_at": _at(self.values, km),
+            "M_min": _nanext(self.frame_moment, np.nanmin),
+            "M_max": _nanext(self.frame_moment, np.nanmax),
         }
         return out
 
@@ -279,22 +334,41 @@ class Kinetostatics:
         lines = [f"kinetostatics over {self.over}: {self.n} positions, "
                  f"{self.over} from {self.values[0] * f:.4g} to {self.values[-1] * f:.4g} "
                  f"{unit}; status {self.status}"]
+        sw = self.switched
+
+        def when(key, d):
+            return f" (t = {d[key]:.6g} s)" if sw else ""
+
+        if sw:
+            segs = self.stats.get("segments", [])
+            lines.append(f"  switched trajectory: {len(segs)} segment(s) in {len(self.modes)} "
+                         f"mode(s); the quantities of a joint, drive or element that is not "
+                         f"part of a sample's mode are NaN there")
+            for sg in segs:
+                lines.append(f"    t = {sg['t_start']:.6g} .. {sg['t_end']:.6g} s, samples "
+                             f"{sg['start']}..{sg['stop'] - 1}, mode "
+                             f"{{{', '.join(sorted(sg['mode']))}}}: driven "
+                             f"{', '.join(sg['driven']) or '-'}; {sg['status']}")
         for c, d in p["driving"].items():
             sym, u = self._drive_unit(c)
             u = "N m" if u == "Nm" else u
             lines.append(
                 f"  drive {c}: peak {d['peak_abs']:.6g} {u} at {self.over} = "
-                f"{d['peak_abs_at'] * f:.4g} {unit}; max {d['max']:.6g} {u} at "
+                f"{d['peak_abs_at'] * f:.4g} {unit}{when('peak_abs_t', d)}; max "
+                f"{d['max']:.6g} {u} at "
                 f"{d['max_at'] * f:.4g} {unit}; min {d['min']:.6g} {u} at "
                 f"{d['min_at'] * f:.4g} {unit}; RMS {d['rms']:.6g} {u}; mean "
                 f"{d['mean']:.6g} {u}; peak power {d['peak_power']:.6g} W")
         for j, d in p["joints"].items():
             s = (f"  joint {j} ({self.joint_kinds[j]}): peak force {d['peak']:.6g} N at "
-                 f"{self.over} = {d['peak_at'] * f:.4g} {unit}")
+                 f"{self.over} = {d['peak_at'] * f:.4g} {unit}{when('peak_t', d)}")
             if "peak_moment" in d:
                 s += (f"; peak moment {d['peak_moment']:.6g} N m at "
-                      f"{d['peak_moment_at'] * f:.4g} {unit}")
+                      f"{d['peak_moment_at'] * f:.4g} {unit}{when('peak_moment_t', d)}")
             lines.append(s)
+        for el, d in p["elements"].items():
+            lines.append(f"  element {el}: peak {d['peak']:.6g} {d['unit']} at {self.over} = "
+                         f"{d['peak_at'] * f:.4g} {unit}{when('peak_t', d)}")
         fr = p["frame"]
         lines.append(
             f"  frame: shaking force peak {fr['force_peak']:.6g} N at {self.over} = "
@@ -367,3 +441,45 @@ class Kinetostatics:
             cols[f"{name}_phase_deg"] = np.rad2deg(ph)
         return pd.DataFrame(cols)
 
+
+
+def _arg(y) -> int:
+    """Index of the largest finite value (-1 when there is none)."""
+    y = np.asarray(y, dtype=float)
+    ok = np.isfinite(y)
+    if not ok.any():
+        return -1
+    return int(np.argmax(np.where(ok, y, -np.inf)))
+
+
+def _at(y, k: int) -> float:
+    return float(np.asarray(y)[k]) if k >= 0 else float("nan")
+
+
+def _nanmean(y) -> float:
+    y = np.asarray(y, dtype=float)
+    ok = np.isfinite(y)
+    return float(np.mean(y[ok])) if ok.any() else float("nan")
+
+
+def _nanext(y, fn) -> float:
+    y = np.asarray(y, dtype=float)
+    return float(fn(y)) if np.isfinite(y).any() else float("nan")
+
+
+def _rms_finite(y, t) -> float:
+    """RMS over the samples where y is finite: time-weighted over each run of finite
+    samples when time does not decrease, else the plain mean square."""
+    ok = np.isfinite(y)
+    if not ok.any():
+        return float("nan")
+    if y.size > 1 and np.all(np.diff(t) >= 0) and t[-1] > t[0]:
+        num = den = 0.0
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(int), [0]])))
+        for a, b in zip(edges[0::2], edges[1::2], strict=True):
+            if t[b - 1] > t[a]:
+                num += float(np.trapezoid(y[a:b] ** 2, t[a:b]))
+                den += float(t[b - 1] - t[a])
+        if den > 0:
+            return float(np.sqrt(num / den))
+    return float(np.sqrt(np.mean(y[ok] ** 2)))

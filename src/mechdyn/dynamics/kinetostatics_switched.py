@@ -1,0 +1,259 @@
+"""Kinetostatics of a switched (variable-structure) trajectory, segment by segment.
+
+A :class:`~mechdyn.results.trajectory.Trajectory` of ``mechdyn.simulate`` through
+switches records the mode of every sample in ``stats["variable_structure"]``.
+The samples are split into segments of constant mode (consecutive samples with
+the same mode; the samples at a switching instant appear twice, before and after,
+and fall into the two neighbouring segments).  Each segment is analysed in its own
+mode:
+
+* engaged weld locks through the model's layout (:meth:`Model.layout`), holding
+  the offset they held in the run (declared, or captured on the segment's first
+  pose, as :meth:`mechdyn.dynamics.modes.SwitchedModel.capture_target` does);
+* coordinate locks, closed stops, closed contacts and sticking contacts through the
+  rows of :mod:`mechdyn.dynamics.modes` (:meth:`SwitchedModel.rows`), appended to
+  the joint rows (:class:`~mechdyn.dynamics.prescribed_motion.ModeRows`); a
+  slipping contact's row carries its Coulomb friction as in the forward dynamics;
+* the driven coordinates are the independent coordinates of the mode, chosen in the
+  order: ``over``, the coordinates with a ``Drive``, the others, the ``frees`` of
+  the engaged locks last.
+
+The segments are concatenated into one
+:class:`~mechdyn.results.kinetostatics_record.Kinetostatics`; a joint, driving
+torque or element that is not part of a sample's mode is NaN there.  A segment that
+cannot be analysed gives NaN rows, a warning and status ``"partial"``.
+"""
+
+from __future__ import annotations
+
+import time
+from types import SimpleNamespace
+
+import numpy as np
+
+from ..errors import MechdynError
+from ..model import Model
+from ..results.kinetostatics_record import Kinetostatics
+from .forces import force_model
+from .modes import SwitchedModel, mode_friction, mode_locks
+from .prescribed_motion import ModeRows
+
+__all__ = ["kinetostatics_switched", "mode_segments"]
+
+
+def mode_segments(modes) -> list[tuple[int, int]]:
+    """[start, stop) sample ranges of consecutive samples with the same mode."""
+    out = []
+    a = 0
+    for k in range(1, len(modes) + 1):
+        if k == len(modes) or modes[k] != modes[a]:
+            out.append((a, k))
+            a = k
+    return out
+
+
+def _fmt(mode) -> str:
+    return "{" + ", ".join(sorted(mode)) + "}"
+
+
+def _with_lock_offsets(model: Model, held: dict) -> Model:
+    """The model with the weld locks' held offsets ``{name: (c (2,), angle)}`` (a shallow
+    copy sharing everything else; the model itself when nothing changes)."""
+    import copy
+    import dataclasses
+
+    lk = model.lock
+    c, ang = lk.c.copy(), lk.angle.copy()
+    for n, (cn, an) in held.items():
+        k = lk.names.index(n)
+        c[k], ang[k] = np.asarray(cn, float), float(an)
+    if np.array_equal(c, lk.c) and np.array_equal(ang, lk.angle):
+        return model
+    km = copy.copy(model)
+    km.lock = dataclasses.replace(lk, c=c, angle=ang)
+    km._layouts = {}
+    return km
+
+
+def _mode_rows(model: Model, sm: SwitchedModel, mode: frozenset, x0):
+    """(model with the held lock offsets, layout or ModeRows, frees) of a mode whose
+    first pose is ``x0``."""
+    targets: dict = {}
+    for n in mode_locks(mode):
+        sm.capture_target(n, x0, targets)
+    for c, s in mode_friction(mode).items():
+        if s == "stick":
+            sm.capture_target(f"{c}:stick", x0, targets)
+    welds = sorted(n for n in mode_locks(mode) if n in sm.welds)
+    kmodel = _with_lock_offsets(model, {n: targets[n] for n in welds})
+    base = kmodel.layout(welds)
+    extra = [r for r in sm.rows(mode, targets)
+             if not (r.kind == "lock" and r.element in sm.welds)]
+    lay = ModeRows(base, extra, mode, model.n_bodies) if extra else base
+    frees = [f for n in mode_locks(mode) for f in sm.lock_frees(n)]
+    return kmodel, lay, frees
+
+
+def _candidates(model: Model, over_k, drive_coords, frees) -> list[int]:
+    order = ([] if over_k is None else [over_k]) + list(drive_coords) + list(range(model.n_q))
+    late = {model.coordinate_index(f) for f in frees if f in model.coordinate_names}
+    order = list(dict.fromkeys(order))
+    return [k for k in order if k not in late] + [k for k in order if k in late]
+
+
+def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
+                           point=(0.0, 0.0), model_drives="replace",
+                           reacting_loads=()) -> Kinetostatics:
+    """Kinetostatics of a switched trajectory (called by
+    :func:`mechdyn.dynamics.kinetostatics.kinetostatics`; see the module docstring)."""
+    from .kinetostatics import _kinetostatics
+
+    t_start = time.perf_counter()
+    names = model.coordinate_names
+    tt = np.asarray(trajectory.t, dtype=float).reshape(-1)
+    n = tt.size
+    if n == 0:
+        raise ValueError("no positions to analyse")
+    Q = np.asarray(trajectory.q, dtype=float).reshape(n, model.n_q)
+    Qd = np.asarray(trajectory.qdot, dtype=float).reshape(n, model.n_q)
+    Qdd = np.asarray(trajectory.qddot, dtype=float).reshape(n, model.n_q)
+    X = getattr(trajectory, "x", None)
+    if X is None or np.shape(X) != (n, model.n_x):
+        raise ValueError("a switched trajectory needs its body poses x (n, n_x) to be "
+                         "analysed mode by mode")
+    X = np.asarray(X, dtype=float)
+    if isinstance(over, str):
+        over_k = model.coordinate_index(over)
+    elif over is None:
+        over_k = None
+    else:
+        raise ValueError("over= names one coordinate for a switched trajectory (the driven "
+                         "coordinates are the independent ones of each mode)")
+    sm = SwitchedModel(model)
+    fm = force_model(model)
+    drive_coords = [k for _, k in fm.drives]
+    sample_modes = tuple(frozenset(m) for m in vs["mode"])
+    modes = tuple(dict.fromkeys(sample_modes))
+    mode_index = np.array([modes.index(m) for m in sample_modes], int)
+
+    parts = []
+    for a, b in mode_segments(sample_modes):
+        mode = sample_modes[a]
+        seg = SimpleNamespace(t=tt[a:b], q=Q[a:b], qdot=Qd[a:b], qddot=Qdd[a:b], x=X[a:b])
+        try:
+            kmodel, lay, frees = _mode_rows(model, sm, mode, X[a])
+            res = _kinetostatics(model, trajectory=seg, point=point, model_drives=model_drives,
+                                 reacting_loads=reacting_loads, lay=lay, kmodel=kmodel,
+                                 candidates=_candidates(model, over_k, drive_coords, frees),
+                                 x_start=X[a])
+            parts.append((a, b, mode, res, None))
+        except (MechdynError, np.linalg.LinAlgError) as exc:
+            parts.append((a, b, mode, None, exc))
+
+    done = [p[3] for p in parts if p[3] is not None]
+    if over_k is None:
+        over_k = names.index(done[0].driven[0]) if done and done[0].driven else 0
+
+    # ------------------------------------------------------------ concatenation
+    def nan(*tail):
+        return np.full((n, *tail), np.nan)
+
+    q, qdot, qddot = Q.copy(), Qd.copy(), Qdd.copy()
+    x, xdot, xddot = X.copy(), nan(model.n_x), nan(model.n_x)
+    tx = getattr(trajectory, "xdot", None)
+    if tx is not None and np.shape(tx) == (n, model.n_x):
+        xdot = np.asarray(tx, dtype=float).copy()
+    driven = [c for c in names if any(c in r.driven for r in done)]
+    joints = [j for j in model.joint_names if any(j in r.reactions for r in done)]
+    elements = list(dict.fromkeys(e for r in done for e in r.element_forces))
+    frame_keys = list(dict.fromkeys(k for r in done for k in r.frame_loads))
+    driving = {c: nan() for c in driven}
+    power = {c: nan() for c in driven}
+    reactions = {j: nan(2) for j in joints}
+    moments = {j: nan() for j in joints}
+    jframe = {j: nan(2) for j in joints}
+    jpoints = {j: nan(2) for j in joints}
+    element_forces = {e: nan() for e in elements}
+    frame_loads = {k: nan(3) for k in frame_keys}
+    frame_force, frame_moment = nan(2), nan()
+    n_rows = max([r.multipliers.shape[1] for r in done], default=0)
+    multipliers = nan(n_rows)
+    kinds: dict = {}
+    units: dict = {}
+    redundant: set = set()
+    warn: list[str] = []
+    notes: list[str] = []
+    seg_stats = []
+    statuses = set()
+    for a, b, mode, r, exc in parts:
+        sl = slice(a, b)
+        info = dict(mode=mode, start=a, stop=b, t_start=float(tt[a]), t_end=float(tt[b - 1]))
+        if r is None:
+            statuses.add("partial")
+            info.update(driven=(), status=f"not analysed: {exc}")
+            warn.append(f"samples {a}..{b - 1} (t = {tt[a]:.6g} .. {tt[b - 1]:.6g} s, mode "
+                        f"{_fmt(mode)}) could not be analysed ({type(exc).__name__}: {exc}); "
+                        f"their forces are NaN")
+            seg_stats.append(info)
+            continue
+        statuses.add(r.status)
+        q[sl], qdot[sl], qddot[sl] = r.q, r.qdot, r.qddot
+        x[sl], xdot[sl], xddot[sl] = r.x, r.xdot, r.xddot
+        for c in r.driven:
+            driving[c][sl] = r.driving[c]
+            power[c][sl] = r.power[c]
+        for j in r.reactions:
+            reactions[j][sl] = r.reactions[j]
+            moments[j][sl] = r.moments[j]
+            jframe[j][sl] = r.joint_frame[j]
+            jpoints[j][sl] = r.joint_points[j]
+            kinds[j] = r.joint_kinds[j]
+        for e, f in r.element_forces.items():
+            element_forces[e][sl] = f
+            units[e] = r.element_units.get(e, "N")
+        for k, v in r.frame_loads.items():
+            frame_loads[k][sl] = v
+        frame_force[sl], frame_moment[sl] = r.frame_force, r.frame_moment
+        multipliers[sl, :r.multipliers.shape[1]] = r.multipliers
+        redundant.update(r.redundant_joints)
+        for w in r.warnings:
+            w = f"mode {_fmt(mode)}: {w}"
+            if w not in warn:
+                warn.append(w)
+        for note in r.message.split("; ")[1:]:
+            if note not in notes:
+                notes.append(note)
+        info.update(driven=r.driven, status=r.status,
+                    power_balance_rel=r.stats["power_balance_rel"],
+                    rcond_min=r.stats["rcond_min"])
+        seg_stats.append(info)
+
+    status = next((s for s in ("partial", "singular", "redundant") if s in statuses), "ok")
+    head = {"ok": "kinetostatic analysis completed",
+            "redundant": "completed; reactions of redundant joints are not unique "
+                         "(minimum-norm solution reported)",
+            "singular": "completed with singular positions: the driven coordinates lose "
+                        "control there and the reactions are unbounded",
+            "partial": "completed in part: segments whose mode could not be analysed are "
+                       "NaN (see warnings)"}[status]
+    head += (f" for a switched trajectory: {len(parts)} segment(s) in {len(modes)} mode(s)")
+    stats = dict(positions=n, segments=seg_stats,
+                 seconds=time.perf_counter() - t_start,
+                 newton_iterations=int(sum(r.stats["newton_iterations"] for r in done)),
+                 power_balance_rel=max([r.stats["power_balance_rel"] for r in done],
+                                       default=float("nan")),
+                 rcond_min=min([r.stats["rcond_min"] for r in done], default=float("nan")),
+                 redundant_equations=max([r.stats["redundant_equations"] for r in done],
+                                         default=0),
+                 singular_positions=int(sum(r.stats["singular_positions"] for r in done)))
+    return Kinetostatics(
+        over=names[over_k], t=tt, values=q[:, over_k].copy(), q=q, qdot=qdot, qddot=qddot,
+        x=x, xdot=xdot, xddot=xddot, coordinate_names=tuple(names), driven=tuple(driven),
+        reactions=reactions, moments=moments, joint_frame=jframe, joint_points=jpoints,
+        driving=driving, power=power, frame_force=frame_force, frame_moment=frame_moment,
+        frame_point=np.asarray(point, dtype=float).copy(), frame_loads=frame_loads,
+        multipliers=multipliers, joint_kinds=kinds,
+        mode=frozenset().union(*sample_modes), redundant_joints=tuple(sorted(redundant)),
+        status=status, message="; ".join([head, *notes]), warnings=tuple(warn), stats=stats,
+        model=model, element_forces=element_forces, element_units=units,
+        sample_modes=sample_modes, mode_index=mode_index, modes=modes)
