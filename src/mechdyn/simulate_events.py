@@ -385,16 +385,19 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     bar = _Progress(progress, t0, t_end)
     while t < t_end:
         stats["segments"] += 1
-        state_cache = {}
+        # the last few states evaluated: the integrator's last stage, the dense-output
+        # stages, the event functions and the output samples often meet the same (t, y)
+        state_cache: dict = {}
 
         def evaluate(tt, y, ms=ms, cache=state_cache):
             n_i = ms.n_i
-            qi_, qdi_ = y[:n_i], y[n_i:2 * n_i]
             key = (tt, y.tobytes())
-            if key in cache:
-                return cache[key]
-            ev = ms.evaluate(tt, qi_, qdi_)
-            cache.clear()
+            ev = cache.get(key)
+            if ev is not None:
+                return ev
+            ev = ms.evaluate(tt, y[:n_i], y[n_i:2 * n_i])
+            if len(cache) >= 8:
+                del cache[next(iter(cache))]
             cache[key] = ev
             return ev
 
@@ -402,7 +405,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             stats["evaluations"] += 1
             ev = evaluate(tt, y)
             n_i = ms.n_i
-            p = float((ev.F - sm.fm.conservative(ev.x)) @ ev.xdot)
+            Fc = ev.F_conservative
+            p = float((ev.F - (sm.fm.conservative(ev.x) if Fc is None else Fc)) @ ev.xdot)
             p += _friction_power(ms, ev)
             return np.concatenate([y[n_i:2 * n_i], ev.qddot[ms.coords], [p]])
 

@@ -116,6 +116,12 @@ class LoadContext:
 
     def variable(self, name: str):
         """A named variable: 't', a coordinate, '<coordinate>_dot', 'body.point.x|y'."""
+        res = _resolved_variable(self.model, name)
+        if res is not None:  # a body point coordinate, resolved once per model
+            b, s, comp = res
+            x = np.asarray(self.x)
+            p = x[..., 3 * b + comp] + rotate(x[..., 3 * b + 2], s)[..., comp]
+            return _scalar_or_array(p)
         if name == "t":
             return _scalar_or_array(self.t)
         if name in self.model.coordinate_names:
@@ -129,6 +135,33 @@ class LoadContext:
         raise ModelError(f"unknown table variable {name!r}; use 't', a coordinate "
                          f"({', '.join(self.model.coordinate_names)}), '<coordinate>_dot' or "
                          f"'body.point.x' / 'body.point.y'")
+
+
+def _resolved_variable(model: Model, name: str):
+    """(body, local point, component) of a 'body.point.x|y' variable on a moving
+    body, or None (cached on the model)."""
+    cache = getattr(model, "_load_variables", None)
+    if cache is None:
+        cache = {}
+        try:
+            model._load_variables = cache
+        except AttributeError:
+            return None
+    if name in cache:
+        return cache[name]
+    out = None
+    parts = name.split(".")
+    if (name != "t" and name not in model.coordinate_names and len(parts) == 3
+            and parts[2] in ("x", "y")):
+        try:
+            b = model.body_index(parts[0])
+            s = np.asarray(model.point_local(parts[0], parts[1]), dtype=float)
+        except ModelError:
+            b = None
+        if b is not None and 0 <= b < model.n_bodies:
+            out = (b, s, 0 if parts[2] == "x" else 1)
+    cache[name] = out
+    return out
 
 
 def _each(fn, shape: tuple):
@@ -198,6 +231,8 @@ class ForceModel:
         has = bool(np.any(m.gravity)) and bool(np.any(m.mass))
         #: the weights (n_bodies, 2), N, or None without gravity
         self._weights = m.mass[:, None] * m.gravity if has else None
+        self._damped = any(sp[7] != 0.0 for sp in self.springs) or any(
+            r[5] != 0.0 for r in self.rotary)
 
     # ----------------------------------------------------------------- forces
     def loads(self, t, x, xdot, q, qdot, *, skip_drives: Sequence[int] = (),
@@ -229,6 +264,12 @@ class ForceModel:
         Qd : ndarray, shape (..., n_q)
             The drive torques/forces on the coordinates.
         """
+        return self._loads(t, x, xdot, q, qdot, skip_drives, reacting_loads, conservative)[:3]
+
+    def _loads(self, t, x, xdot, q, qdot, skip_drives=(), reacting_loads=(),
+               conservative=False, keep_conservative=False):
+        """:meth:`loads`, plus (with ``keep_conservative``, and no dampers) the
+        conservative forces of the same pose as a fourth item (else None)."""
         m = self.model
         x = np.asarray(x, dtype=float)
         batch = x.shape[:-1]
@@ -258,6 +299,9 @@ class ForceModel:
             tq = -(tq + pre)
             F[..., j, 2] += tq
             F[..., i, 2] -= tq
+        Fc = None
+        if keep_conservative and not self._damped:
+            Fc = F[..., :nb, :].reshape(batch + (m.n_x,)).copy()
         Qd = np.zeros(batch + (m.n_q,))
         if not conservative and (self.forces or self.torques or self.drives):
             if batch and np.shape(t) != batch:  # one time for a batch of poses
@@ -284,7 +328,13 @@ class ForceModel:
             for (dr, k) in self.drives:
                 if k not in skip:
                     Qd[..., k] += self.drive_torque(dr, ctx, k)
-        return F[..., :nb, :].reshape(batch + (m.n_x,)), F[..., nb, :], Qd
+        return F[..., :nb, :].reshape(batch + (m.n_x,)), F[..., nb, :], Qd, Fc
+
+    def applied_and_conservative(self, t, x, xdot, q, qdot):
+        """(F, Q_drive, F_c): :meth:`applied` and :meth:`conservative` at one state,
+        the loads evaluated once when no spring has a damper (same values)."""
+        F, _, Qd, Fc = self._loads(t, x, xdot, q, qdot, keep_conservative=True)
+        return F, Qd, (self.conservative(x) if Fc is None else Fc)
 
     def applied(self, t, x, xdot, q, qdot) -> tuple[np.ndarray, np.ndarray]:
         """Applied forces F (..., n_x) on the body poses and drive forces Q_drive (..., n_q)."""

@@ -307,6 +307,9 @@ def parse_variable(model: Model, spec: str, *, allow_time=False, allow_rate=Fals
 
 
 # ============================================================================ mass
+_MASS_INDEX: dict = {}  # flat indices of the nonzeros of M, per number of bodies
+
+
 def mass_matrix_x(model: Model, x, xdot=None):
     """Mass matrix M(x) (n_x, n_x) of the body poses and the centripetal term h (n_x,).
 
@@ -316,21 +319,29 @@ def mass_matrix_x(model: Model, x, xdot=None):
     origin, N m).
     """
     nb = model.n_bodies
-    M = np.zeros((3 * nb, 3 * nb))
-    h = np.zeros(3 * nb)
+    n_x = 3 * nb
+    M = np.zeros((n_x, n_x))
+    h = np.zeros(n_x)
     th = np.asarray(x, float)[2::3]
-    for k in range(nb):
-        m, J = model.mass[k], model.inertia[k]
-        rho = _rot(th[k], model.com[k])
-        p = _perp(rho)
-        i = 3 * k
-        M[i, i] = M[i + 1, i + 1] = m
-        M[i, i + 2] = M[i + 2, i] = m * p[0]
-        M[i + 1, i + 2] = M[i + 2, i + 1] = m * p[1]
-        M[i + 2, i + 2] = J + m * (rho @ rho)
-        if xdot is not None:
-            w = xdot[3 * k + 2]
-            h[i:i + 2] = -m * w * w * rho
+    c, sn = np.cos(th), np.sin(th)
+    cx, cy = model.com[:, 0], model.com[:, 1]
+    rx = c * cx - sn * cy
+    ry = sn * cx + c * cy
+    m = model.mass
+    i = 3 * np.arange(nb)
+    flat = _MASS_INDEX.get(nb)
+    if flat is None:
+        flat = _MASS_INDEX[nb] = np.concatenate([
+            i * n_x + i, (i + 1) * n_x + i + 1, i * n_x + i + 2, (i + 2) * n_x + i,
+            (i + 1) * n_x + i + 2, (i + 2) * n_x + i + 1, (i + 2) * n_x + i + 2])
+    mry, mrx = m * -ry, m * rx
+    M.flat[flat] = np.concatenate([m, m, mry, mry, mrx, mrx,
+                                   model.inertia + m * (rx * rx + ry * ry)])
+    if xdot is not None:
+        w = np.asarray(xdot, float)[2::3]
+        f = -m * w * w
+        h[i] = f * rx
+        h[i + 1] = f * ry
     return M, h
 
 
@@ -405,6 +416,11 @@ class SwitchedModel:
         self.nb = nb
         self.coord_measures = [coordinate_measure(model, k) for k in range(model.n_q)]
         self.base_layout = model.layout(frozenset())
+        # batched kernels of the coordinates and joint rows (None: generic path)
+        cterms = [_measure_term(m_, nb) for m_ in self.coord_measures]
+        self._coord_batch = (_MeasureBatch(cterms, nb) if model.n_q and None not in cterms
+                             and not self.base_layout.lock_active.any() else None)
+        self._base_terms = _base_terms(model)
         probs: list[str] = []
         # weld locks (model tables); coordinate locks
         self.welds = {}
@@ -565,6 +581,147 @@ class SwitchedModel:
         return out
 
 
+# ============================================================================ batched rows
+class _MeasureBatch:
+    """Values, gradients and quadratic terms of a list of measures, in a few NumPy calls.
+
+    Every measure of a mode (joint rows, lock/stop/contact rows, coordinates) has
+    the form ``m(x) = w . (p1 - p2) + ka theta_a + kb theta_b + c`` with
+    ``p = r_b + A(theta_b) s`` body points and ``w = A(theta_d) u`` a direction
+    fixed in body ``d``; body index ``nb`` is the ground (zero pose).  The index
+    arrays and the scatter pattern of the gradients are built once per mode.
+    """
+
+    def __init__(self, terms, nb):
+        n = len(terms)
+        self.n, self.nb = n, nb
+        n_x = 3 * nb
+        arr = np.array([t[:12] for t in terms], float).reshape(n, 12)
+        idx = arr[:, [0, 3, 6, 9, 10]].astype(int)
+        self.b1, self.b2, self.d, self.a, self.bb = (idx[:, k] for k in range(5))
+        self.s1x, self.s1y = arr[:, 1].copy(), arr[:, 2].copy()
+        self.s2x, self.s2y = arr[:, 4].copy(), arr[:, 5].copy()
+        self.ux, self.uy = arr[:, 7].copy(), arr[:, 8].copy()
+        self.ka = np.array([t[11] for t in terms], float)
+        self.kb = np.array([t[12] for t in terms], float)
+        self.c = np.array([t[13] for t in terms], float)
+        # gradient scatter: columns of (b1 x, y, th), (b2 x, y, th), d th, a th, bb th
+        cols = []
+        for b, k in ((self.b1, 0), (self.b1, 1), (self.b1, 2), (self.b2, 0), (self.b2, 1),
+                     (self.b2, 2), (self.d, 2), (self.a, 2), (self.bb, 2)):
+            col = 3 * b + k
+            cols.append(np.where(b >= nb, n_x, col))  # ground -> a dump column
+        rows = np.arange(n)
+        self._flat = np.concatenate([rows * (n_x + 1) + c for c in cols])
+        self._size = n * (n_x + 1)
+        self._has_w = bool(np.any(self.ux) or np.any(self.uy))
+
+    def parts(self, k):
+        """Geometric parts at a pose: ``k`` = (cos, sin, theta, px, py) of the
+        bodies with the ground appended (see :func:`_pose_parts`)."""
+        c, s, th, px, py = k
+        b1, b2, d = self.b1, self.b2, self.d
+        c1, sn1, c2, sn2, cd, sd = c[b1], s[b1], c[b2], s[b2], c[d], s[d]
+        r1x = c1 * self.s1x - sn1 * self.s1y
+        r1y = sn1 * self.s1x + c1 * self.s1y
+        r2x = c2 * self.s2x - sn2 * self.s2y
+        r2y = sn2 * self.s2x + c2 * self.s2y
+        wx = cd * self.ux - sd * self.uy
+        wy = sd * self.ux + cd * self.uy
+        dx = px[b1] + r1x - px[b2] - r2x
+        dy = py[b1] + r1y - py[b2] - r2y
+        return r1x, r1y, r2x, r2y, wx, wy, dx, dy
+
+    def values(self, k, parts=None):
+        """m(x), shape (n,)."""
+        th = k[2]
+        r1x, r1y, r2x, r2y, wx, wy, dx, dy = parts or self.parts(k)
+        return wx * dx + wy * dy + self.ka * th[self.a] + self.kb * th[self.bb] + self.c
+
+    def jacobian(self, k, parts=None) -> np.ndarray:
+        """m_x, shape (n, n_x)."""
+        r1x, r1y, r2x, r2y, wx, wy, dx, dy = parts or self.parts(k)
+        vals = np.concatenate([wx, wy, wy * r1x - wx * r1y, -wx, -wy, wx * r2y - wy * r2x,
+                               wx * dy - wy * dx, self.ka, self.kb])
+        out = np.bincount(self._flat, vals, self._size).reshape(self.n, 3 * self.nb + 1)
+        return out[:, :-1]
+
+    def quad(self, k, kv, parts=None) -> np.ndarray:
+        """Velocity-quadratic part of d2m/dt2, shape (n,); ``kv`` = (vx, vy, omega)
+        of the bodies with the ground appended."""
+        if not self._has_w:
+            return np.zeros(self.n)
+        r1x, r1y, r2x, r2y, wx, wy, dx, dy = parts or self.parts(k)
+        vx, vy, om = kv
+        w1, w2, wd = om[self.b1], om[self.b2], om[self.d]
+        ddx = vx[self.b1] - w1 * r1y - vx[self.b2] + w2 * r2y
+        ddy = vy[self.b1] + w1 * r1x - vy[self.b2] - w2 * r2x
+        w1s, w2s = w1 * w1, w2 * w2
+        return (-wd * wd * (wx * dx + wy * dy) + 2.0 * wd * (wx * ddy - wy * ddx)
+                + wx * (w2s * r2x - w1s * r1x) + wy * (w2s * r2y - w1s * r1y))
+
+
+def _pose_parts(x, nb):
+    """(cos, sin, theta, px, py) of the bodies, ground (zeros) appended."""
+    X = np.zeros((nb + 1, 3))
+    X[:nb] = np.reshape(x, (nb, 3))
+    th = X[:, 2]
+    return np.cos(th), np.sin(th), th, X[:, 0], X[:, 1]
+
+
+def _rate_parts(xdot, nb):
+    """(vx, vy, omega) of the bodies, ground (zeros) appended."""
+    V = np.zeros((nb + 1, 3))
+    V[:nb] = np.reshape(xdot, (nb, 3))
+    return V[:, 0], V[:, 1], V[:, 2]
+
+
+def _measure_term(meas, nb, sign=1.0, const=0.0):
+    """The term of :class:`_MeasureBatch` of ``sign * (meas(x) - target)``
+    (``const`` = -target), or None for a measure of another kind."""
+    g = nb
+    t = type(meas)
+    z = (0.0, 0.0)
+    if t is AngleMeasure:
+        spec = (g, z, g, z, g, z, meas.b, 1.0, g, 0.0, meas.offset)
+    elif t is RelAngleMeasure:
+        spec = (g, z, g, z, g, z, meas.j, 1.0, meas.i, -1.0, meas.offset)
+    elif t is PointMeasure:
+        u = (1.0, 0.0) if meas.comp == 0 else (0.0, 1.0)
+        spec = (meas.b, meas.s, g, z, g, u, g, 0.0, g, 0.0, 0.0)
+    elif t is LineMeasure:
+        u = meas.u if not meas.normal else (-meas.u[1], meas.u[0])
+        spec = (meas.b1, meas.s1, meas.b2, meas.s2, meas.b2, u, g, 0.0, g, 0.0, meas.offset)
+    else:
+        return None
+    b1, s1, b2, s2, d, u, a, ka, bb, kb, off = spec
+    return (b1, s1[0], s1[1], b2, s2[0], s2[1], d, sign * u[0], sign * u[1], a, bb,
+            sign * ka, sign * kb, sign * (off + const))
+
+
+def _base_terms(model: Model) -> list:
+    """Terms of the revolute and prismatic joint rows (the rows of the layout
+    without locks)."""
+    nb = model.n_bodies
+    terms = []
+    rv = model.rev
+    for k in range(len(rv.names)):
+        i, j = int(rv.i[k]), int(rv.j[k])
+        si, sj = rv.si[k], rv.sj[k]
+        for u in ((1.0, 0.0), (0.0, 1.0)):
+            terms.append((i, si[0], si[1], j, sj[0], sj[1], nb, u[0], u[1], nb, nb, 0.0, 0.0,
+                          0.0))
+    pr = model.pri
+    for k in range(len(pr.names)):
+        i, j = int(pr.i[k]), int(pr.j[k])
+        si, sj, ui = pr.si[k], pr.sj[k], pr.ui[k]
+        terms.append((j, sj[0], sj[1], i, si[0], si[1], i, -ui[1], ui[0], nb, nb, 0.0, 0.0,
+                      0.0))
+        terms.append((nb, 0.0, 0.0, nb, 0.0, 0.0, nb, 0.0, 0.0, j, i, 1.0, -1.0,
+                      -float(pr.angle[k])))
+    return terms
+
+
 # ============================================================================ the mode system
 @dataclass
 class ModeEval:
@@ -577,6 +734,11 @@ class ModeEval:
         All declared coordinates (dependent ones measured on the pose).
     lam : ndarray, shape (n_rows,)
         Multipliers of the base joint rows, then of the switchable rows.
+    F : ndarray, shape (n_x,)
+        Applied forces on the poses, drives included.
+    F_conservative : ndarray, shape (n_x,) or None
+        Forces of gravity and spring stiffness alone at the pose, when they
+        came out of the same evaluation of the loads (None otherwise).
     """
 
     x: np.ndarray
@@ -587,6 +749,7 @@ class ModeEval:
     qddot: np.ndarray
     lam: np.ndarray
     F: np.ndarray = field(repr=False, default=None)
+    F_conservative: np.ndarray | None = field(repr=False, default=None)
 
 
 class ModeSystem:
@@ -632,6 +795,18 @@ class ModeSystem:
             [base_is_angle, np.array([r.measure.is_angle for r in self.rows], bool)])
         self._rowscale = np.where(self._row_is_angle, 1.0, 1.0 / L)
         self.x_ref = np.array(x, float)
+        # batched kernels of the rows (None: a measure of another kind, generic path)
+        self._rows_batch = self._pos_batch = self._slip_batch = None
+        own = [_measure_term(r.measure, sm.nb, r.sign, -r.target) for r in self.rows]
+        if sm._coord_batch is not None and None not in own:
+            self._rows_batch = _MeasureBatch(sm._base_terms + own, sm.nb)
+            slip = [(self.n_base + k, _measure_term(r.tangent, sm.nb, -r.mu * r.slip))
+                    for k, r in enumerate(self.rows) if r.slip]
+            if slip and None in [t_ for _, t_ in slip]:
+                self._rows_batch = None
+            elif slip:
+                self._slip_rows = np.array([k for k, _ in slip], int)
+                self._slip_batch = _MeasureBatch([t_ for _, t_ in slip], sm.nb)
         R = self.row_jacobian(self.x_ref)
         Rs = R * self._rowscale[:, None] * self._colscale[None, :]
         self.independent_rows = _independent_rows(Rs)
@@ -670,6 +845,16 @@ class ModeSystem:
             self.coords = chosen
         self.coord_names = tuple(model.coordinate_names[k] for k in self.coords)
         self.n_i = len(self.coords)
+        if self._rows_batch is not None:
+            terms = sm._base_terms + own
+            cterms = [_measure_term(m_, sm.nb) for m_ in sm.coord_measures]
+            self._pos_batch = _MeasureBatch([terms[k] for k in self.independent_rows]
+                                            + [cterms[k] for k in self.coords], sm.nb)
+            # rows and coordinates in one batch, for the dynamics
+            self._all_batch = _MeasureBatch(terms + cterms, sm.nb)
+        self._eye_i = np.zeros((n_x, self.n_i))
+        self._eye_i[len(self.independent_rows):, :] = np.eye(self.n_i)
+        self._rs = np.tile([1.0, 1.0, 1.0 / L], model.n_bodies)
         self._x_last = self.x_ref.copy()
         self._B_last = None
         self._qi_last = None
@@ -677,6 +862,8 @@ class ModeSystem:
     # ------------------------------------------------------------------ rows
     def row_values(self, x) -> np.ndarray:
         """Residuals of every row (base joints, then switchable rows), m or rad."""
+        if self._rows_batch is not None:
+            return self._rows_batch.values(_pose_parts(x, self.sm.nb))
         X = extend(self.model, x)
         base = residual(self.model, x, self.sm.base_layout)
         own = [r.sign * (r.measure.value(X) - r.target) for r in self.rows]
@@ -684,6 +871,8 @@ class ModeSystem:
 
     def row_jacobian(self, x) -> np.ndarray:
         """Jacobian of every row, shape (n_rows, n_x)."""
+        if self._rows_batch is not None:
+            return self._rows_batch.jacobian(_pose_parts(x, self.sm.nb))
         X = extend(self.model, x)
         base = jacobian(self.model, x, self.sm.base_layout)
         own = [r.sign * r.measure.grad(X, self.sm.nb) for r in self.rows]
@@ -695,12 +884,17 @@ class ModeSystem:
         """Velocity-quadratic part of every row's second derivative."""
         from ..kinematics.constraints import gamma
 
+        if self._rows_batch is not None:
+            nb = self.sm.nb
+            return self._rows_batch.quad(_pose_parts(x, nb), _rate_parts(xdot, nb))
         X, V = extend(self.model, x), extend(self.model, xdot)
         base = -gamma(self.model, x, xdot, self.sm.base_layout)
         own = [r.sign * r.measure.quad(X, V) for r in self.rows]
         return np.concatenate([base, np.array(own, float)])
 
     def _coord_jac(self, x) -> np.ndarray:
+        if self.sm._coord_batch is not None:
+            return self.sm._coord_batch.jacobian(_pose_parts(x, self.sm.nb))
         X = extend(self.model, x)
         if not self.model.n_q:
             return np.zeros((0, self.model.n_x))
@@ -708,6 +902,8 @@ class ModeSystem:
 
     def coordinates(self, x) -> np.ndarray:
         """All declared coordinates measured on a pose, shape (n_q,)."""
+        if self.sm._coord_batch is not None:
+            return self.sm._coord_batch.values(_pose_parts(x, self.sm.nb))
         X = extend(self.model, x)
         return np.array([m.value(X) for m in self.sm.coord_measures], float)
 
@@ -741,13 +937,21 @@ class ModeSystem:
         tol = 1e-13 * max(model.length_scale, 1e-3)
         err_prev = np.inf
         J = None
+        pb, nb, n_r = self._pos_batch, self.sm.nb, len(idx)
         for _ in range(40):
-            F = np.concatenate([self.row_values(x)[idx], self.coordinates(x)[self.coords] - qi])
+            if pb is not None:
+                k = _pose_parts(x, nb)
+                parts = pb.parts(k)
+                F = pb.values(k, parts)
+                F[n_r:] -= qi
+            else:
+                F = np.concatenate([self.row_values(x)[idx],
+                                    self.coordinates(x)[self.coords] - qi])
             err = float(np.max(np.abs(F))) if F.size else 0.0
             if err <= tol or (err <= 1e3 * tol and err >= 0.5 * err_prev):
                 break
             err_prev = err
-            J = self._system(x)
+            J = pb.jacobian(k, parts) if pb is not None else self._system(x)
             try:
                 dx = np.linalg.solve(J, F)
             except np.linalg.LinAlgError:
@@ -814,6 +1018,8 @@ class ModeSystem:
     def evaluate_x(self, t, x, xdot, B=None, *, qdoti=None) -> ModeEval:
         """As :meth:`evaluate`, from a consistent pose and velocity (or, with
         ``xdot`` None, the independent rates ``qdoti``)."""
+        if self._rows_batch is not None:
+            return self._evaluate_batched(t, x, xdot, B, qdoti)
         model = self.model
         idx = self.independent_rows
         R = self.row_jacobian(x)
@@ -856,6 +1062,53 @@ class ModeSystem:
         xddot = B @ qddi + b
         qddot = G @ xddot + quad_g
         return ModeEval(x, xdot, xddot, q, qdot, qddot, lam, F)
+
+    def _evaluate_batched(self, t, x, xdot, B, qdoti) -> ModeEval:
+        """:meth:`evaluate_x` with the batched row kernels (same equations)."""
+        model = self.model
+        sm = self.sm
+        nb = sm.nb
+        idx, coords = self.independent_rows, self.coords
+        ab, n_rows = self._all_batch, self.n_rows
+        k = _pose_parts(x, nb)
+        parts = ab.parts(k)
+        RG = ab.jacobian(k, parts)
+        R, G = RG[:n_rows], RG[n_rows:]
+        J = np.concatenate([R[idx], G[coords]])
+        if B is None:
+            B = np.linalg.solve(J, self._eye_i) if J.size else np.zeros((model.n_x, 0))
+        if xdot is None:
+            xdot = B @ np.asarray(qdoti, float)
+            self._B_last = B
+        quad = ab.quad(k, _rate_parts(xdot, nb), parts)
+        quad_all, quad_g = quad[:n_rows], quad[n_rows:]
+        rhs_b = -np.concatenate([quad_all[idx], quad_g[coords]])
+        b = np.linalg.solve(J, rhs_b) if J.size else np.zeros(0)
+        q = ab.values(k, parts)[n_rows:]
+        qdot = G @ xdot
+        F, Qd, Fc = sm.fm.applied_and_conservative(t, x, xdot, q, qdot)
+        F = F + G.T @ Qd
+        M, h = mass_matrix_x(model, x, xdot)
+        Reff = R
+        if self._slip_batch is not None:
+            Reff = R.copy()
+            Reff[self._slip_rows] += self._slip_batch.jacobian(k)
+        # [M B, -Reff^T] [qddot; lam] = F - h - M b
+        K = np.concatenate([M @ B, -Reff.T], axis=1)
+        rhs = F - h - M @ b
+        rs = self._rs
+        Ks = K * rs[:, None]
+        try:
+            sol = np.linalg.solve(Ks, rhs * rs) if Ks.shape[0] == Ks.shape[1] else None
+        except np.linalg.LinAlgError:
+            sol = None
+        if sol is None:
+            sol = self._redundant_solve(Ks, rhs * rs)
+        qddi = sol[:self.n_i]
+        lam = sol[self.n_i:]
+        xddot = B @ qddi + b
+        qddot = G @ xddot + quad_g
+        return ModeEval(x, xdot, xddot, q, qdot, qddot, lam, F, Fc)
 
     def _redundant_solve(self, Ks, rhs):
         """Least-squares solution of a rank-deficient [M B, -Phi^T] system whose
