@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ModelError, did_you_mean
+from .errors import MechdynError, ModelError, did_you_mean
 from .mechanism.body import GROUND
 from .mechanism.joint import Lock, Prismatic, Revolute
 
@@ -256,7 +256,7 @@ class Model:
 
         try:
             x0 = assemble(self)
-        except Exception as exc:  # an AssemblyError carries its own message
+        except (MechdynError, np.linalg.LinAlgError, ValueError) as exc:  # AssemblyError says where
             probs = [f"the initial sketch cannot be assembled: {exc}"]
             if gruebler_message is not None:
                 probs.insert(0, gruebler_message)

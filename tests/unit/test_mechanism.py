@@ -83,3 +83,12 @@ def test_newton_keeps_branch_and_reaches_tiny_residual():
         x = solve_position(model, [phi], x)
         assert np.max(np.abs(residual(model, x))) < 1e-12
         assert x[6] > 0  # the slider stays on the right of the crank pivot
+
+
+def test_non_finite_sketch_pose_is_named():
+    m = slider_crank()
+    rod = m.bodies["rod"]
+    m.bodies["rod"] = type(rod)("rod", mass=rod.mass, inertia=rod.inertia, com=rod.com,
+                                points=dict(rod.points), pose=(np.nan, 0.0, 0.0))
+    with pytest.raises(ModelError, match=r"body 'rod': pose must be finite"):
+        m.validate()

@@ -157,6 +157,8 @@ class Mechanism:
                 out.append(f"body {b.name!r}: mass must be >= 0 kg, got {b.mass!r}")
             if not np.isfinite(b.inertia) or b.inertia < 0:
                 out.append(f"body {b.name!r}: inertia must be >= 0 kg*m^2, got {b.inertia!r}")
+            if not np.all(np.isfinite(b.pose)):
+                out.append(f"body {b.name!r}: pose must be finite (x, y, theta), got {b.pose!r}")
             for k, v in [("com", b.com), *b.points.items()]:
                 if not np.all(np.isfinite(v)):
                     out.append(f"body {b.name!r}: point {k!r} is not finite: {v!r}")
