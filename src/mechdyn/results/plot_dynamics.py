@@ -40,20 +40,35 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
     names = list(coordinates) if coordinates is not None else list(traj.coordinate_names)
     idx = [traj.coordinate_names.index(n) for n in names]
     show_energy = bool(energy and traj.energy and traj.t.size)
-    rows = 3 + (1 if show_energy else 0)
+    vs = traj.stats.get("variable_structure") if traj.t.size else None
+    rows = 3 + (1 if show_energy else 0) + (1 if vs else 0)
     fig, axes = plt.subplots(rows, 1, figsize=(8.0, 2.4 * rows), sharex=True,
                              constrained_layout=True)
     t = traj.t
-    for k, name in zip(idx, names, strict=True):
-        ang = traj.coordinate_is_angle[k] if traj.coordinate_is_angle else True
-        f = np.rad2deg(1.0) if (ang and degrees) else 1.0
-        u = ("deg" if degrees else "rad") if ang else "m"
-        axes[0].plot(t, traj.q[:, k] * f, label=f"{name} [{u}]")
-        axes[1].plot(t, traj.qdot[:, k] * f, label=f"{name}' [{u}/s]")
-        axes[2].plot(t, traj.qddot[:, k] * f, label=f"{name}'' [{u}/s^2]")
-    axes[0].set_ylabel("coordinate")
-    axes[1].set_ylabel("rate")
-    axes[2].set_ylabel("acceleration")
+    is_angle = [traj.coordinate_is_angle[k] if traj.coordinate_is_angle else True for k in idx]
+    au = "deg" if degrees else "rad"
+    fa = np.rad2deg(1.0) if degrees else 1.0
+    # lengths (travels) in mm on a right-hand axis when angles share the panel
+    twins = [ax.twinx() if (any(is_angle) and not all(is_angle)) else ax for ax in axes[:3]]
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for n, (k, name, ang) in enumerate(zip(idx, names, is_angle, strict=True)):
+        c = colours[n % len(colours)]
+        panel = axes[:3] if ang else twins
+        f, u = (fa, au) if ang else (1e3, "mm")
+        panel[0].plot(t, traj.q[:, k] * f, color=c, label=f"{name} [{u}]")
+        panel[1].plot(t, traj.qdot[:, k] * f, color=c, label=f"{name}' [{u}/s]")
+        panel[2].plot(t, traj.qddot[:, k] * f, color=c, label=f"{name}'' [{u}/s^2]")
+    for ax, twin, what in zip(axes[:3], twins, ("coordinate", "rate", "acceleration"),
+                              strict=True):
+        if twin is ax:
+            unit = au if any(is_angle) else "mm"
+            ax.set_ylabel(f"{what} [{unit}{'' if what == 'coordinate' else '/s'}"
+                          f"{'^2' if what == 'acceleration' else ''}]")
+        else:
+            ax.set_ylabel(f"{what}: angles")
+            twin.set_ylabel(f"{what}: travels")
+            lines = ax.get_lines() + twin.get_lines()
+            ax.legend(lines, [ln.get_label() for ln in lines], loc="best", fontsize="small")
     if show_energy:
         e = traj.energy
         ax = axes[3]
@@ -62,9 +77,17 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
         ax.plot(t, e["work_nc"], label="W_nc [J]")
         ax.plot(t, e["balance"], "k--", label="T + U - W_nc [J]")
         ax.set_ylabel("energy [J]")
+    if vs:
+        ax = axes[-1]
+        frame = np.asarray(vs["frame_force"], float)
+        ax.plot(t, frame[:, 0] * 1e-3, label="Fx frame [kN]")
+        ax.plot(t, frame[:, 1] * 1e-3, label="Fy frame [kN]")
+        ax.set_ylabel("force on the frame [kN]")
+        _shade_modes(axes, t, np.asarray(vs["mode_index"]), vs["modes"])
     for ax in axes:
         ax.grid(True, alpha=0.3)
-        ax.legend(loc="best", fontsize="small")
+        if ax.get_legend() is None:
+            ax.legend(loc="best", fontsize="small")
     axes[-1].set_xlabel("t [s]")
     head = title or f"simulation: {traj.stats.get('integrator', '')} " \
                     f"({traj.stats.get('formulation', '')})"
@@ -75,3 +98,17 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
     return path
+
+
+def _shade_modes(axes, t, mode_index, modes) -> None:
+    """Shade the time spans of the modes of a variable-structure run (one tint per mode)."""
+    if t.size < 2 or len(modes) < 2:
+        return
+    cmap = __import__("matplotlib").colormaps["Pastel2"]
+    change = np.flatnonzero(np.diff(mode_index) != 0) + 1
+    starts = np.concatenate([[0], change])
+    ends = np.concatenate([change, [t.size - 1]])
+    for a, b in zip(starts, ends, strict=True):
+        colour = cmap(int(mode_index[a]) % cmap.N)
+        for ax in axes:
+            ax.axvspan(t[a], t[b], color=colour, alpha=0.35, lw=0)
