@@ -139,3 +139,11 @@ def test_table_of_a_switched_run_has_the_mode_and_the_load_on_the_frame():
     np.testing.assert_allclose(df["Fx_frame_N"].to_numpy()[free], K * s_m[free], rtol=0,
                                atol=1e-9 * K * X0)
     np.testing.assert_allclose(df["Fy_frame_N"].to_numpy(), 0.0, atol=1e-9 * K * X0)
+
+
+def test_plot_of_a_switched_run_is_written(tmp_path):
+    from mechdyn.results.plot_dynamics import plot_trajectory
+
+    tr = simulate_events(_oscillator(0.5), 0.3, q0=[X0], qdot0=[0.0], dt_out=0.01)
+    out = plot_trajectory(tr, tmp_path / "run.png")
+    assert out.stat().st_size > 10_000
