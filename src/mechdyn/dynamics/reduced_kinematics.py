@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
-from ..model import Model
+from ..model import Model, as_model
 
 __all__ = ["reduced_kinematics"]
 
@@ -93,6 +93,7 @@ class _ModelEvaluator:
     """Exact reduced quantities of a 1-DOF model at any position, with branch continuation."""
 
     def __init__(self, model: Model, coordinate: str | None = None, *, mode=None, x0=None):
+        model = as_model(model)  # a Mechanism is compiled (and validated) here
         if model.n_q != 1:
             raise ModelError(
                 f"the reduction method needs one degree of freedom, but the model has "

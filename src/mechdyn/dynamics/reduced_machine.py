@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import IntegrationError, ModelError, did_you_mean
-from ..model import Model
+from ..model import Model, as_model
 from .reduced_kinematics import _ModelEvaluator
 
 if TYPE_CHECKING:
@@ -241,6 +241,7 @@ class ReducedMachine:
         force of all loads and drives; ``extra_inertia`` defaults to the
         drives' rotor and gear inertia.
         """
+        model = as_model(model)  # a Mechanism is compiled (and validated) here
         ev = _ModelEvaluator(model, coordinate, mode=mode, x0=x0)
         if extra_inertia is None:
             extra_inertia = ev.drive_inertia()

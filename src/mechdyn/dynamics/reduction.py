@@ -54,7 +54,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError
-from ..model import Model
+from ..model import Model, as_model
 from .flywheel import FlywheelSizing, SteadyCycle, size_flywheel, steady_state
 from .reduced_kinematics import _ModelEvaluator, _perp, _rot, reduced_kinematics
 from .reduced_machine import (
@@ -241,6 +241,7 @@ def reduce_model(model: Model, *, coordinate: str | None = None, link: str | Non
     -------
     Reduction
     """
+    model = as_model(model)  # a Mechanism is compiled (and validated) here
     ev = _ModelEvaluator(model, coordinate, mode=mode, x0=x0)
     if phi is None:
         if steps is None or int(steps) < 2:
