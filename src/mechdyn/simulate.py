@@ -324,11 +324,20 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
 
     if needs_event_loop(model):
         # switches, stops, contacts: the event loop integrates mode by mode
+        from .integrate import RungeKutta4, Wilson
+
         name = integrator if isinstance(integrator, str) else type(integrator).__name__
+        if isinstance(integrator, (Wilson, RungeKutta4)) or name.lower() in ("wilson", "rk4"):
+            # fixed step: a grid of dt from the start of every mode segment
+            return simulate_events(model, t_end_f, q0=q0, qdot0=qdot0, t0=t0, mode=mode,
+                                   t_eval=t_eval, progress=progress,
+                                   method=integrator if not isinstance(integrator, str)
+                                   else name.lower(), dt=dt, steps=steps,
+                                   iterations=iterations, tol=tol, theta=theta)
         if name.lower() not in ("dop853", "rk45"):
             raise IntegratorOptionError(
                 f"integrator {name!r} is not available for a variable-structure mechanism "
-                "(switches, stops or contacts): use 'dop853' or 'rk45'")
+                "(switches, stops or contacts): use 'dop853', 'rk45', 'rk4' or 'wilson'")
         return simulate_events(model, t_end_f, q0=q0, qdot0=qdot0, t0=t0, mode=mode,
                                rtol=rtol, atol=atol, max_step=max_step, t_eval=t_eval,
                                method=name.upper(), progress=progress)

@@ -4,7 +4,8 @@ The motion is integrated piecewise, one *mode* (set of active switchable
 constraints, ``State.mode``) at a time:
 
 1. in a mode, the independent coordinates q_I (a subset of the declared
-   coordinates) are integrated with SciPy's DOP853 (rtol 1e-10 by default);
+   coordinates) are integrated with SciPy's DOP853 (rtol 1e-10 by default), or
+   RK45, or the project's fixed-step ``rk4`` / ``wilson``;
    positions are re-solved from q_I at every evaluation, so every constraint
    of the mode holds to round-off;
 2. after every accepted step the event functions are evaluated; a sign change
@@ -211,7 +212,9 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                     small_velocity: float | None = None, gap_tol: float | None = None,
                     zeno_time: float | None = None,
                     max_wall_time: float | None = None,
-                    progress: bool | None = None) -> Trajectory:
+                    progress: bool | None = None, dt: float | None = None,
+                    steps: int | None = None, iterations: int | None = None,
+                    tol: float | None = None, theta: float | None = None) -> Trajectory:
     """Simulate a variable-structure mechanism through all its switches.
 
     Parameters
@@ -239,8 +242,13 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         also stored just before and just after every event.
     t_eval : array_like, optional
         Explicit output times (instead of ``dt_out``).
-    method : {"DOP853", "RK45"}
-        SciPy integrator used within a mode.
+    method : {"DOP853", "RK45", "rk4", "wilson"} or Integrator
+        Integrator used within a mode: SciPy's adaptive ``DOP853`` or ``RK45``, or
+        the fixed-step ``rk4`` / ``wilson`` (or an instance of
+        :class:`~mechdyn.integrate.RungeKutta4` / :class:`~mechdyn.integrate.Wilson`),
+        which step on a grid of ``dt`` from the start of every mode segment (the
+        last step of a segment shortened to the event) through
+        :class:`~mechdyn.integrate.solver_adapter.FixedStepSolver`.
     max_events : int
         Stop (status ``"too-many-events"``) after this many switching instants.
     small_velocity : float, optional
@@ -258,6 +266,11 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         Stop (status ``"timeout"``) after this many seconds of computing.
     progress : bool or None
         Progress bar on stderr: always, never, or (None) once a run takes > 2 s.
+    dt, steps : optional
+        Step size (s) of ``rk4`` / ``wilson``, or a number of steps over
+        [t0, t_end] (``dt = (t_end - t0) / steps``; default 100 steps).
+    iterations, tol, theta : optional
+        Corrector passes, corrector tolerance and theta of ``wilson``.
 
     Returns
     -------
@@ -290,23 +303,22 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         zeno_time = 1e-4 * (t_end - t0)
     last_impact: dict = {}
     if t_eval is None:
-        dt = dt_out if dt_out is not None else (t_end - t0) / 500.0
-        n = int(math.floor((t_end - t0) / dt + 1e-9))
-        t_eval = t0 + dt * np.arange(n + 1)
+        h_out = dt_out if dt_out is not None else (t_end - t0) / 500.0
+        n = int(math.floor((t_end - t0) / h_out + 1e-9))
+        t_eval = t0 + h_out * np.arange(n + 1)
         if t_eval[-1] < t_end - 1e-12 * max(1.0, abs(t_end)):
             t_eval = np.append(t_eval, t_end)
     t_eval = np.asarray(t_eval, float)
     weight = float(np.sum(model.mass) * max(np.hypot(*model.gravity), 1.0))
     force_scale = max(weight, 1.0)
-    solver_cls = {"DOP853": DOP853, "RK45": RK45}.get(method.upper())
-    if solver_cls is None:
-        raise ModelError(f"method must be 'DOP853' or 'RK45', got {method!r}")
+    solver_cls, method_name = _solver_class(method, t0, t_end, dt=dt, steps=steps,
+                                            iterations=iterations, tol=tol, theta=theta)
 
     # ---------------------------------------------------------------- records
     rec = dict(t=[], q=[], qd=[], qdd=[], x=[], xd=[], mode=[], frame=[], forces=[], T=[],
                U=[], W=[], res=[], lost=[])
     events: list[SwitchEvent] = []
-    stats = dict(steps=0, rejected=0, evaluations=0, integrator=f"scipy-{method.upper()}",
+    stats = dict(steps=0, rejected=0, evaluations=0, integrator=method_name,
                  formulation="variable-structure (reduced, exact constraints)", backend="numpy",
                  rtol=rtol, atol=atol, segments=0)
     lost_total = 0.0
@@ -544,6 +556,41 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     stats["penetration"] = penetration
     bar.close()
     return _finish(model, rec, events, stats, wall0, status, message, sm)
+
+
+def _solver_class(method, t0, t_end, *, dt=None, steps=None, iterations=None, tol=None,
+                  theta=None):
+    """The solver class of a mode segment (SciPy's, or a fixed-step adapter) and its name."""
+    from functools import partial
+
+    from .integrate import RungeKutta4, Wilson
+    from .integrate.base import IntegratorOptionError
+    from .integrate.driver import make_integrator
+    from .integrate.solver_adapter import FixedStepSolver
+
+    fixed_opts = dict(dt=dt, steps=steps, iterations=iterations, tol=tol, theta=theta)
+    if isinstance(method, (Wilson, RungeKutta4)):
+        integ = make_integrator(method, **fixed_opts)
+    elif isinstance(method, str) and method.lower() in ("wilson", "rk4"):
+        integ = make_integrator(method.lower(), **fixed_opts)
+    else:
+        cls = {"DOP853": DOP853, "RK45": RK45}.get(method.upper()) \
+            if isinstance(method, str) else None
+        if cls is None:
+            raise ModelError(f"method must be 'DOP853', 'RK45', 'rk4' or 'wilson', "
+                             f"got {method!r}")
+        given = [k for k, v in fixed_opts.items() if v is not None]
+        if given:
+            raise IntegratorOptionError(f"option(s) {', '.join(given)} are for the "
+                                        f"fixed-step methods 'rk4' / 'wilson', not {method!r}")
+        return cls, f"scipy-{method.upper()}"
+    # one step size for every segment: the grid restarts at each segment's start
+    h = integ.dt if integ.dt is not None else (t_end - t0) / (integ.steps or 100)
+    if isinstance(integ, Wilson):
+        seg = Wilson(dt=h, iterations=integ.iterations, tol=integ.tol, theta=integ.theta)
+    else:
+        seg = RungeKutta4(dt=h)
+    return partial(FixedStepSolver, integrator=seg), f"{seg.name} (dt={h:.6g} s)"
 
 
 def _friction_power(ms: ModeSystem, ev) -> float:
