@@ -299,6 +299,36 @@ def _lu_solve(a, piv, b, n):
 
 
 @_njit
+def _pri_pose(x, nb, i, j, fp, f0):
+    """Geometry of prismatic joint rows: body angles, rotated points A_i s_i, axis u,
+    A_j s_j and the separation d = r_j + A_j s_j - r_i - A_i s_i."""
+    xi = yi = ti = 0.0
+    if i < nb:
+        xi, yi, ti = x[3 * i], x[3 * i + 1], x[3 * i + 2]
+    xj = yj = tj = 0.0
+    if j < nb:
+        xj, yj, tj = x[3 * j], x[3 * j + 1], x[3 * j + 2]
+    ci, si = np.cos(ti), np.sin(ti)
+    cj, sj = np.cos(tj), np.sin(tj)
+    aix, aiy = ci * fp[f0] - si * fp[f0 + 1], si * fp[f0] + ci * fp[f0 + 1]
+    ux, uy = ci * fp[f0 + 2] - si * fp[f0 + 3], si * fp[f0 + 2] + ci * fp[f0 + 3]
+    ajx, ajy = cj * fp[f0 + 4] - sj * fp[f0 + 5], sj * fp[f0 + 4] + cj * fp[f0 + 5]
+    return ti, tj, aix, aiy, ux, uy, ajx, ajy, xj + ajx - xi - aix, yj + ajy - yi - aiy
+
+
+@_njit
+def _pri_rates(v, nb, i, j, aix, aiy, ajx, ajy):
+    """Angular rates of the two bodies and the rate of the separation d."""
+    vxi = vyi = wi = 0.0
+    if i < nb:
+        vxi, vyi, wi = v[3 * i], v[3 * i + 1], v[3 * i + 2]
+    vxj = vyj = wj = 0.0
+    if j < nb:
+        vxj, vyj, wj = v[3 * j], v[3 * j + 1], v[3 * j + 2]
+    return wi, wj, vxj - wj * ajy - vxi + wi * aiy, vyj + wj * ajx - vyi - wi * aix
+
+
+@_njit
 def _system(x, q, ip, fp, F, J, want_jac):
     """Residual [Phi; g - q] (F) and Jacobian (J, columns scaled by the length scale for
     rotations when used through ``_solve_scaled``) at pose x."""
@@ -346,20 +376,8 @@ def _system(x, q, ip, fp, F, J, want_jac):
         i = ip[oi + IR_PRI * k]
         j = ip[oi + IR_PRI * k + 1]
         f0 = of + FR_PRI * k
-        xi = yi = ti = 0.0
-        if i < nb:
-            xi, yi, ti = x[3 * i], x[3 * i + 1], x[3 * i + 2]
-        xj = yj = tj = 0.0
-        if j < nb:
-            xj, yj, tj = x[3 * j], x[3 * j + 1], x[3 * j + 2]
-        ci, si = np.cos(ti), np.sin(ti)
-        cj, sj = np.cos(tj), np.sin(tj)
-        aix, aiy = ci * fp[f0] - si * fp[f0 + 1], si * fp[f0] + ci * fp[f0 + 1]
-        ux, uy = ci * fp[f0 + 2] - si * fp[f0 + 3], si * fp[f0 + 2] + ci * fp[f0 + 3]
-        ajx, ajy = cj * fp[f0 + 4] - sj * fp[f0 + 5], sj * fp[f0 + 4] + cj * fp[f0 + 5]
+        ti, tj, aix, aiy, ux, uy, ajx, ajy, dx, dy = _pri_pose(x, nb, i, j, fp, f0)
         nx_, ny_ = -uy, ux
-        dx = xj + ajx - xi - aix
-        dy = yj + ajy - yi - aiy
         F[row] = nx_ * dx + ny_ * dy
         F[row + 1] = tj - ti - fp[f0 + 6]
         if want_jac:
@@ -430,19 +448,7 @@ def _system(x, q, ip, fp, F, J, want_jac):
             i = ip[opi + IR_PRI * p]
             j = ip[opi + IR_PRI * p + 1]
             f0 = opf + FR_PRI * p
-            xi = yi = ti = 0.0
-            if i < nb:
-                xi, yi, ti = x[3 * i], x[3 * i + 1], x[3 * i + 2]
-            xj = yj = tj = 0.0
-            if j < nb:
-                xj, yj, tj = x[3 * j], x[3 * j + 1], x[3 * j + 2]
-            ci, si = np.cos(ti), np.sin(ti)
-            cj, sj = np.cos(tj), np.sin(tj)
-            aix, aiy = ci * fp[f0] - si * fp[f0 + 1], si * fp[f0] + ci * fp[f0 + 1]
-            ux, uy = ci * fp[f0 + 2] - si * fp[f0 + 3], si * fp[f0 + 2] + ci * fp[f0 + 3]
-            ajx, ajy = cj * fp[f0 + 4] - sj * fp[f0 + 5], sj * fp[f0 + 4] + cj * fp[f0 + 5]
-            dx = xj + ajx - xi - aix
-            dy = yj + ajy - yi - aiy
+            ti, tj, aix, aiy, ux, uy, ajx, ajy, dx, dy = _pri_pose(x, nb, i, j, fp, f0)
             F[row] = ux * dx + uy * dy + off - q[c]
             if want_jac:
                 if j < nb:
@@ -482,24 +488,9 @@ def _gamma(x, v, ip, fp, g):
         i = ip[oi + IR_PRI * k]
         j = ip[oi + IR_PRI * k + 1]
         f0 = of + FR_PRI * k
-        xi = yi = ti = vxi = vyi = wi = 0.0
-        if i < nb:
-            xi, yi, ti = x[3 * i], x[3 * i + 1], x[3 * i + 2]
-            vxi, vyi, wi = v[3 * i], v[3 * i + 1], v[3 * i + 2]
-        xj = yj = tj = vxj = vyj = wj = 0.0
-        if j < nb:
-            xj, yj, tj = x[3 * j], x[3 * j + 1], x[3 * j + 2]
-            vxj, vyj, wj = v[3 * j], v[3 * j + 1], v[3 * j + 2]
-        ci, si = np.cos(ti), np.sin(ti)
-        cj, sj = np.cos(tj), np.sin(tj)
-        aix, aiy = ci * fp[f0] - si * fp[f0 + 1], si * fp[f0] + ci * fp[f0 + 1]
-        ux, uy = ci * fp[f0 + 2] - si * fp[f0 + 3], si * fp[f0 + 2] + ci * fp[f0 + 3]
-        ajx, ajy = cj * fp[f0 + 4] - sj * fp[f0 + 5], sj * fp[f0 + 4] + cj * fp[f0 + 5]
+        ti, tj, aix, aiy, ux, uy, ajx, ajy, dx, dy = _pri_pose(x, nb, i, j, fp, f0)
+        wi, wj, ddx, ddy = _pri_rates(v, nb, i, j, aix, aiy, ajx, ajy)
         nx_, ny_ = -uy, ux
-        dx = xj + ajx - xi - aix
-        dy = yj + ajy - yi - aiy
-        ddx = vxj - wj * ajy - vxi + wi * aiy
-        ddy = vyj + wj * ajx - vyi - wi * aix
         quad = (-wi * wi * (nx_ * dx + ny_ * dy) - 2.0 * wi * (ux * ddx + uy * ddy)
                 + nx_ * (-wj * wj * ajx + wi * wi * aix) + ny_ * (-wj * wj * ajy + wi * wi * aiy))
         g[row] = -quad
@@ -528,24 +519,9 @@ def _gamma(x, v, ip, fp, g):
             i = ip[opi + IR_PRI * p]
             j = ip[opi + IR_PRI * p + 1]
             f0 = opf + FR_PRI * p
-            xi = yi = ti = vxi = vyi = wi = 0.0
-            if i < nb:
-                xi, yi, ti = x[3 * i], x[3 * i + 1], x[3 * i + 2]
-                vxi, vyi, wi = v[3 * i], v[3 * i + 1], v[3 * i + 2]
-            xj = yj = tj = vxj = vyj = wj = 0.0
-            if j < nb:
-                xj, yj, tj = x[3 * j], x[3 * j + 1], x[3 * j + 2]
-                vxj, vyj, wj = v[3 * j], v[3 * j + 1], v[3 * j + 2]
-            ci, si = np.cos(ti), np.sin(ti)
-            cj, sj = np.cos(tj), np.sin(tj)
-            aix, aiy = ci * fp[f0] - si * fp[f0 + 1], si * fp[f0] + ci * fp[f0 + 1]
-            ux, uy = ci * fp[f0 + 2] - si * fp[f0 + 3], si * fp[f0 + 2] + ci * fp[f0 + 3]
-            ajx, ajy = cj * fp[f0 + 4] - sj * fp[f0 + 5], sj * fp[f0 + 4] + cj * fp[f0 + 5]
+            ti, tj, aix, aiy, ux, uy, ajx, ajy, dx, dy = _pri_pose(x, nb, i, j, fp, f0)
+            wi, wj, ddx, ddy = _pri_rates(v, nb, i, j, aix, aiy, ajx, ajy)
             nx_, ny_ = -uy, ux
-            dx = xj + ajx - xi - aix
-            dy = yj + ajy - yi - aiy
-            ddx = vxj - wj * ajy - vxi + wi * aiy
-            ddy = vyj + wj * ajx - vyi - wi * aix
             quad = (-wi * wi * (ux * dx + uy * dy) + 2.0 * wi * (nx_ * ddx + ny_ * ddy)
                     + ux * (-wj * wj * ajx + wi * wi * aix) + uy * (-wj * wj * ajy + wi * wi * aiy))
             g[row] = -quad
