@@ -1046,19 +1046,8 @@ class ModeSystem:
         for k, r in enumerate(self.rows):
             if r.slip:
                 Reff[self.n_base + k] -= r.mu * r.slip * r.tangent.grad(X, self.sm.nb)
-        # [M B, -Reff^T] [qddot; lam] = F - h - M b
-        K = np.concatenate([M @ B, -Reff.T], axis=1)
-        rhs = F - h - M @ b
         rs = np.tile([1.0, 1.0, 1.0 / model.length_scale], model.n_bodies)
-        Ks = K * rs[:, None]
-        try:
-            sol = np.linalg.solve(Ks, rhs * rs) if Ks.shape[0] == Ks.shape[1] else None
-        except np.linalg.LinAlgError:
-            sol = None
-        if sol is None:
-            sol = self._redundant_solve(Ks, rhs * rs)
-        qddi = sol[:self.n_i]
-        lam = sol[self.n_i:]
+        qddi, lam = self._solve_motion(M, B, Reff, F - h - M @ b, rs)
         xddot = B @ qddi + b
         qddot = G @ xddot + quad_g
         return ModeEval(x, xdot, xddot, q, qdot, qddot, lam, F)
@@ -1093,22 +1082,22 @@ class ModeSystem:
         if self._slip_batch is not None:
             Reff = R.copy()
             Reff[self._slip_rows] += self._slip_batch.jacobian(k)
-        # [M B, -Reff^T] [qddot; lam] = F - h - M b
-        K = np.concatenate([M @ B, -Reff.T], axis=1)
-        rhs = F - h - M @ b
-        rs = self._rs
-        Ks = K * rs[:, None]
+        qddi, lam = self._solve_motion(M, B, Reff, F - h - M @ b, self._rs)
+        xddot = B @ qddi + b
+        qddot = G @ xddot + quad_g
+        return ModeEval(x, xdot, xddot, q, qdot, qddot, lam, F, Fc)
+
+    def _solve_motion(self, M, B, Reff, rhs, rs):
+        """Solve [M B, -Reff^T] [qddot_i; lam] = rhs (rows scaled by ``rs``) for the
+        independent accelerations and the multipliers; redundant sets by least squares."""
+        Ks = np.concatenate([M @ B, -Reff.T], axis=1) * rs[:, None]
         try:
             sol = np.linalg.solve(Ks, rhs * rs) if Ks.shape[0] == Ks.shape[1] else None
         except np.linalg.LinAlgError:
             sol = None
         if sol is None:
             sol = self._redundant_solve(Ks, rhs * rs)
-        qddi = sol[:self.n_i]
-        lam = sol[self.n_i:]
-        xddot = B @ qddi + b
-        qddot = G @ xddot + quad_g
-        return ModeEval(x, xdot, xddot, q, qdot, qddot, lam, F, Fc)
+        return sol[:self.n_i], sol[self.n_i:]
 
     def _redundant_solve(self, Ks, rhs):
         """Least-squares solution of a rank-deficient [M B, -Phi^T] system whose
