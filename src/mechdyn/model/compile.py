@@ -13,9 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import MechdynError, ModelError, did_you_mean
-from .mechanism.body import GROUND
-from .mechanism.joint import Lock, Prismatic, Revolute
+from ..errors import MechdynError, ModelError, did_you_mean
+from ..mechanism.body import GROUND
+from ..mechanism.joint import Lock, Prismatic, Revolute
+from . import rows as R
 
 __all__ = ["Model", "RevoluteRows", "PrismaticRows", "LockRows", "as_model"]
 
@@ -161,6 +162,8 @@ class Model:
         scale = max([p for p in pts if np.isfinite(p)] + [0.0])
         self.length_scale = scale if scale > 0 else 1.0
 
+        self._lower_rows()
+
         self.mass_diag = np.repeat(self.mass, 3).reshape(nb, 3)
         self.mass_diag[:, 2] = self.inertia
         self.mass_diag = self.mass_diag.reshape(-1)
@@ -171,6 +174,30 @@ class Model:
                        for b, ref in am.points))
             for am in mechanism.extras.get("assembly", [])]
         self._layouts: dict = {}
+
+    def _lower_rows(self) -> None:
+        """Lower every joint and coordinate to constraint rows (:mod:`mechdyn.model.rows`)."""
+        nb = self.n_bodies
+        rv, pr, lk = self.rev, self.pri, self.lock
+        self.joint_rows = R.concat(
+            nb,
+            *[R.revolute(n, rv.i[k], rv.si[k], rv.j[k], rv.sj[k], nb=nb)
+              for k, n in enumerate(rv.names)],
+            *[R.prismatic(n, pr.i[k], pr.si[k], pr.ui[k], pr.j[k], pr.sj[k], pr.angle[k], nb=nb)
+              for k, n in enumerate(pr.names)])
+        self.weld_rows = {n: R.weld(n, lk.i[k], lk.c[k], lk.j[k], lk.angle[k], nb=nb)
+                          for k, n in enumerate(lk.names)}
+        coords = []
+        for k, name in enumerate(self.coordinate_names):
+            kind, off, jj = self.coord_kind[k], self.coord_offset[k], self.coord_joint[k]
+            if kind == COORD_ANGLE:
+                coords.append(R.angle(name, self.coord_body[k], off, nb=nb))
+            elif kind == COORD_RELATIVE:
+                coords.append(R.relative_angle(name, rv.i[jj], rv.j[jj], off, nb=nb))
+            else:
+                coords.append(R.line(name, pr.j[jj], pr.sj[jj], pr.i[jj], pr.si[jj], pr.ui[jj],
+                                     normal=False, offset=off, nb=nb))
+        self.coordinate_rows = R.concat(nb, *coords)
 
     # ------------------------------------------------------------------ lookups
     def _point(self, body: str, ref) -> tuple[float, float]:
@@ -252,7 +279,7 @@ class Model:
             and the constraints are not merely redundant, or if the sketch cannot be
             assembled.
         """
-        from .kinematics.assembly import assemble, rank_report
+        from ..kinematics.assembly import assemble, rank_report
 
         try:
             x0 = assemble(self)
@@ -307,6 +334,10 @@ class ConstraintLayout:
         self.row_joint = np.empty(k, dtype=object)
         for n, r in rows.items():
             self.row_joint[r] = n
+        #: the constraint rows of the mode (joints, then engaged locks), as data
+        self.rowset = R.concat(model.n_bodies, model.joint_rows,
+                               *[model.weld_rows[n] for n, a in
+                                 zip(model.lock.names, active, strict=True) if a])
 
 
 def as_model(mech_or_model) -> Model:

@@ -1,0 +1,109 @@
+"""The compiled (Numba) twin of :mod:`mechdyn.kernels.rows_numpy`, over packed rows.
+
+Rows are packed by :meth:`mechdyn.model.rows.Rows.packed` into ``ints`` (n, 5):
+b1, b2, d, a, bb and ``flts`` (n, 9): s1x, s1y, s2x, s2y, ux, uy, ka, kb, c.
+The functions are generic over these arrays, so they compile once for every
+model (and are cached on disk).  Without numba installed they run as plain
+Python (slow, but the same results).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["rows_values", "rows_jacobian", "rows_quad", "njit", "NUMBA"]
+
+try:  # pragma: no cover - depends on the environment
+    import numba
+
+    NUMBA = True
+except ImportError:  # pragma: no cover
+    numba = None
+    NUMBA = False
+
+
+def njit(fn):
+    """numba.njit with the project's settings (cached, no fastmath), or ``fn`` itself."""
+    if NUMBA:
+        return numba.njit(cache=True, fastmath=False, nogil=True)(fn)
+    return fn
+
+
+@njit
+def _pose(x, nb, b):
+    if b < nb:
+        return x[3 * b], x[3 * b + 1], x[3 * b + 2]
+    return 0.0, 0.0, 0.0
+
+
+@njit
+def _row_parts(x, nb, ints, flts, k):
+    """th_b1, th_b2, rotated s1, rotated s2, w, separation d of row k."""
+    x1, y1, t1 = _pose(x, nb, ints[k, 0])
+    x2, y2, t2 = _pose(x, nb, ints[k, 1])
+    _, _, td = _pose(x, nb, ints[k, 2])
+    c1, s1 = np.cos(t1), np.sin(t1)
+    c2, s2 = np.cos(t2), np.sin(t2)
+    cd, sd = np.cos(td), np.sin(td)
+    r1x = c1 * flts[k, 0] - s1 * flts[k, 1]
+    r1y = s1 * flts[k, 0] + c1 * flts[k, 1]
+    r2x = c2 * flts[k, 2] - s2 * flts[k, 3]
+    r2y = s2 * flts[k, 2] + c2 * flts[k, 3]
+    wx = cd * flts[k, 4] - sd * flts[k, 5]
+    wy = sd * flts[k, 4] + cd * flts[k, 5]
+    return r1x, r1y, r2x, r2y, wx, wy, x1 + r1x - x2 - r2x, y1 + r1y - y2 - r2y
+
+
+@njit
+def rows_values(x, nb, ints, flts, out, row0):
+    """m(x) of every row into ``out[row0:row0 + n]``."""
+    for k in range(ints.shape[0]):
+        r1x, r1y, r2x, r2y, wx, wy, dx, dy = _row_parts(x, nb, ints, flts, k)
+        v = wx * dx + wy * dy + flts[k, 8]
+        a, bb = ints[k, 3], ints[k, 4]
+        if a < nb:
+            v += flts[k, 6] * x[3 * a + 2]
+        if bb < nb:
+            v += flts[k, 7] * x[3 * bb + 2]
+        out[row0 + k] = v
+
+
+@njit
+def rows_jacobian(x, nb, ints, flts, J, row0):
+    """Add m_x of every row into ``J[row0:row0 + n, :]`` (J zeroed by the caller)."""
+    for k in range(ints.shape[0]):
+        r1x, r1y, r2x, r2y, wx, wy, dx, dy = _row_parts(x, nb, ints, flts, k)
+        r = row0 + k
+        b1, b2, d, a, bb = ints[k, 0], ints[k, 1], ints[k, 2], ints[k, 3], ints[k, 4]
+        if b1 < nb:
+            J[r, 3 * b1] += wx
+            J[r, 3 * b1 + 1] += wy
+            J[r, 3 * b1 + 2] += wy * r1x - wx * r1y
+        if b2 < nb:
+            J[r, 3 * b2] -= wx
+            J[r, 3 * b2 + 1] -= wy
+            J[r, 3 * b2 + 2] += wx * r2y - wy * r2x
+        if d < nb:
+            J[r, 3 * d + 2] += wx * dy - wy * dx
+        if a < nb:
+            J[r, 3 * a + 2] += flts[k, 6]
+        if bb < nb:
+            J[r, 3 * bb + 2] += flts[k, 7]
+
+
+@njit
+def rows_quad(x, v, nb, ints, flts, out, row0):
+    """Velocity-quadratic part of d2m/dt2 of every row into ``out[row0:row0 + n]``."""
+    for k in range(ints.shape[0]):
+        r1x, r1y, r2x, r2y, wx, wy, dx, dy = _row_parts(x, nb, ints, flts, k)
+        if wx == 0.0 and wy == 0.0:
+            out[row0 + k] = 0.0
+            continue
+        vx1, vy1, w1 = _pose(v, nb, ints[k, 0])
+        vx2, vy2, w2 = _pose(v, nb, ints[k, 1])
+        _, _, wd = _pose(v, nb, ints[k, 2])
+        ddx = vx1 - w1 * r1y - vx2 + w2 * r2y
+        ddy = vy1 + w1 * r1x - vy2 - w2 * r2x
+        out[row0 + k] = (-wd * wd * (wx * dx + wy * dy) + 2.0 * wd * (wx * ddy - wy * ddx)
+                         + wx * (w2 * w2 * r2x - w1 * w1 * r1x)
+                         + wy * (w2 * w2 * r2y - w1 * w1 * r1y))

@@ -1,0 +1,119 @@
+"""The NumPy evaluator of constraint rows, batched over poses.
+
+For rows m(x) = w . (p1 - p2) + ka theta_a + kb theta_b + c (see
+:mod:`mechdyn.model.rows`) it returns the value, the Jacobian m_x and the
+velocity-quadratic part of the second derivative,
+
+    d2m/dt2 = m_x xddot + quad(x, xdot),
+    quad = -w_d^2 w.(p1 - p2) + 2 w_d perp(w).(v_p1 - v_p2) + w.(w_2^2 rho_2 - w_1^2 rho_1),
+
+(rho_k = A(theta_k) s_k, perp = rotation by +90 deg, w_k the angular rates), so
+that the acceleration right-hand side of Phi_x xddot = gamma is gamma = -quad.
+Poses ``x`` have shape (..., n_x); every result carries the same leading
+dimensions.  :mod:`mechdyn.kernels.rows_numba` is the compiled twin over the
+same arrays.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..model.rows import Rows
+
+__all__ = ["Parts", "parts", "values", "jacobian", "quad", "evaluate"]
+
+
+class Parts:
+    """Geometric parts of the rows at a pose (rotated points, direction, separation)."""
+
+    __slots__ = ("th", "r1x", "r1y", "r2x", "r2y", "wx", "wy", "dx", "dy")
+
+    def __init__(self, rows: Rows, x):
+        x = np.asarray(x, dtype=float)
+        nb = rows.nb
+        X = np.zeros(x.shape[:-1] + (nb + 1, 3))
+        X[..., :nb, :] = x.reshape(x.shape[:-1] + (nb, 3))
+        th = X[..., 2]
+        c, s = np.cos(th), np.sin(th)
+        b1, b2, d = rows.b1, rows.b2, rows.d
+        c1, s1, c2, s2, cd, sd = c[..., b1], s[..., b1], c[..., b2], s[..., b2], \
+            c[..., d], s[..., d]
+        self.th = th
+        self.r1x = c1 * rows.s1[:, 0] - s1 * rows.s1[:, 1]
+        self.r1y = s1 * rows.s1[:, 0] + c1 * rows.s1[:, 1]
+        self.r2x = c2 * rows.s2[:, 0] - s2 * rows.s2[:, 1]
+        self.r2y = s2 * rows.s2[:, 0] + c2 * rows.s2[:, 1]
+        self.wx = cd * rows.u[:, 0] - sd * rows.u[:, 1]
+        self.wy = sd * rows.u[:, 0] + cd * rows.u[:, 1]
+        self.dx = X[..., b1, 0] + self.r1x - X[..., b2, 0] - self.r2x
+        self.dy = X[..., b1, 1] + self.r1y - X[..., b2, 1] - self.r2y
+
+
+def parts(rows: Rows, x) -> Parts:
+    """The :class:`Parts` of ``rows`` at poses ``x`` (..., n_x)."""
+    return Parts(rows, x)
+
+
+def values(rows: Rows, x, p: Parts | None = None) -> np.ndarray:
+    """m(x), shape (..., n) (m or rad).
+
+    Examples
+    --------
+    >>> from mechdyn.model import rows as R
+    >>> r = R.revolute("A", 0, (0.1, 0.0), 1, (0.0, 0.0), nb=2)
+    >>> values(r, [0.0, 0.0, 0.0, 0.1, 0.0, 1.0]).round(12).tolist()
+    [0.0, 0.0]
+    """
+    p = p or Parts(rows, x)
+    return (p.wx * p.dx + p.wy * p.dy + rows.ka * p.th[..., rows.a]
+            + rows.kb * p.th[..., rows.bb] + rows.c)
+
+
+def jacobian(rows: Rows, x, p: Parts | None = None) -> np.ndarray:
+    """m_x, shape (..., n, n_x)."""
+    p = p or Parts(rows, x)
+    n, n_x = len(rows), rows.n_x
+    batch = p.dx.shape[:-1]
+    terms = (p.wx, p.wy, p.wy * p.r1x - p.wx * p.r1y, -p.wx, -p.wy,
+             p.wx * p.r2y - p.wy * p.r2x, p.wx * p.dy - p.wy * p.dx,
+             np.broadcast_to(rows.ka, batch + (n,)), np.broadcast_to(rows.kb, batch + (n,)))
+    if not batch:
+        out = np.bincount(rows.scatter, np.concatenate(terms), n * (n_x + 1))
+        return out.reshape(n, n_x + 1)[:, :n_x]
+    flat = rows.scatter.reshape(9, n)
+    out = np.zeros(batch + (n * (n_x + 1),))
+    for k in range(9):  # within one term every (row, column) pair is distinct
+        out[..., flat[k]] += terms[k]
+    return out.reshape(batch + (n, n_x + 1))[..., :n_x]
+
+
+def quad(rows: Rows, x, xdot, p: Parts | None = None) -> np.ndarray:
+    """Velocity-quadratic part of d2m/dt2, shape (..., n); gamma = -quad."""
+    p = p or Parts(rows, x)
+    xdot = np.asarray(xdot, dtype=float)
+    nb = rows.nb
+    V = np.zeros(xdot.shape[:-1] + (nb + 1, 3))
+    V[..., :nb, :] = xdot.reshape(xdot.shape[:-1] + (nb, 3))
+    om = V[..., 2]
+    w1, w2, wd = om[..., rows.b1], om[..., rows.b2], om[..., rows.d]
+    ddx = V[..., rows.b1, 0] - w1 * p.r1y - V[..., rows.b2, 0] + w2 * p.r2y
+    ddy = V[..., rows.b1, 1] + w1 * p.r1x - V[..., rows.b2, 1] - w2 * p.r2x
+    w1s, w2s = w1 * w1, w2 * w2
+    return (-wd * wd * (p.wx * p.dx + p.wy * p.dy) + 2.0 * wd * (p.wx * ddy - p.wy * ddx)
+            + p.wx * (w2s * p.r2x - w1s * p.r1x) + p.wy * (w2s * p.r2y - w1s * p.r1y))
+
+
+def evaluate(rows: Rows, x, xdot=None):
+    """(value (..., n), Jacobian (..., n, n_x), quad (..., n) or None) in one pass.
+
+    Examples
+    --------
+    >>> from mechdyn.model import rows as R
+    >>> r = R.angle("phi", 0, nb=1)
+    >>> v, J, q = evaluate(r, [0.0, 0.0, 0.5], [0.0, 0.0, 2.0])
+    >>> float(v[0]), J.tolist(), float(q[0])
+    (0.5, [[0.0, 0.0, 1.0]], 0.0)
+    """
+    p = Parts(rows, x)
+    return values(rows, x, p), jacobian(rows, x, p), (
+        None if xdot is None else quad(rows, x, xdot, p))

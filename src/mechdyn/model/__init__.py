@@ -1,0 +1,21 @@
+"""The compiled model: index layout, parameter arrays and constraint rows.
+
+:mod:`mechdyn.model.compile` holds :class:`Model`; :mod:`mechdyn.model.rows`
+the lowering rules that turn every joint, coordinate, lock, stop and contact
+into constraint rows of one form.
+"""
+
+from .compile import (
+    COORD_ANGLE,
+    COORD_RELATIVE,
+    COORD_TRAVEL,
+    ConstraintLayout,
+    LockRows,
+    Model,
+    PrismaticRows,
+    RevoluteRows,
+    as_model,
+)
+
+__all__ = ["Model", "RevoluteRows", "PrismaticRows", "LockRows", "ConstraintLayout", "as_model",
+           "COORD_ANGLE", "COORD_RELATIVE", "COORD_TRAVEL"]
