@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 import sys
 import time
+import warnings
 from collections.abc import Mapping
 
 import numpy as np
@@ -32,7 +33,7 @@ from .errors import (
     SingularPositionError,
     did_you_mean,
 )
-from .integrate.base import IntegratorOptionError
+from .integrate.base import DEFAULT_RTOL, IntegratorOptionError, IntegratorWarning
 from .integrate.driver import make_integrator, sample_times
 from .integrate.events import as_events, locate_events
 from .kinematics.analogs import velocity_analogs
@@ -247,7 +248,7 @@ def _turning_point_check(eom: EquationsOfMotion, step, qd_old, x_good):
 
 
 def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | None = None,
-             dt: float | None = None, rtol: float = 1e-9, atol=None, q0=None, qdot0=None,
+             dt: float | None = None, rtol: float = DEFAULT_RTOL, atol=None, q0=None, qdot0=None,
              t_eval=None, formulation: str = "exact", d=None, progress: bool | None = None,
              events=None, t0: float = 0.0, mode=None, backend: str = "auto",
              iterations: int | None = None, tol: float | None = None,
@@ -267,7 +268,8 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
     steps, dt
         Number of steps or step size (s) of the fixed-step integrators.
     rtol, atol
-        Tolerances of the adaptive integrators (atol default ``1e-3 rtol``, SI units
+        Tolerances of the adaptive integrators (rtol default 1e-10, atol default
+        ``1e-3 rtol``, the same on every path; SI units
         of q, q' and of the work W_nc in J).
     q0, qdot0 : array_like (n_q,) or mapping {name: value}, optional
         Initial state; default from the model file's ``initial`` table, then the
@@ -323,24 +325,18 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
     from .simulate_events import needs_event_loop, simulate_events
 
     if needs_event_loop(model):
-        # switches, stops, contacts: the event loop integrates mode by mode
-        from .integrate import RungeKutta4, Wilson
-
-        name = integrator if isinstance(integrator, str) else type(integrator).__name__
-        if isinstance(integrator, (Wilson, RungeKutta4)) or name.lower() in ("wilson", "rk4"):
-            # fixed step: a grid of dt from the start of every mode segment
-            return simulate_events(model, t_end_f, q0=q0, qdot0=qdot0, t0=t0, mode=mode,
-                                   t_eval=t_eval, progress=progress,
-                                   method=integrator if not isinstance(integrator, str)
-                                   else name.lower(), dt=dt, steps=steps,
-                                   iterations=iterations, tol=tol, theta=theta)
-        if name.lower() not in ("dop853", "rk45"):
-            raise IntegratorOptionError(
-                f"integrator {name!r} is not available for a variable-structure mechanism "
-                "(switches, stops or contacts): use 'dop853', 'rk45', 'rk4' or 'wilson'")
+        # switches, stops, contacts: the same equations, integrated mode by mode
+        if formulation != "exact" or d is not None:
+            warnings.warn(f"formulation={formulation!r}"
+                          + (" and d" if d is not None else "")
+                          + " have no effect on a variable-structure run (switches, stops or "
+                          "contacts): its modes use the exact formulation", IntegratorWarning,
+                          stacklevel=2)
         return simulate_events(model, t_end_f, q0=q0, qdot0=qdot0, t0=t0, mode=mode,
-                               rtol=rtol, atol=atol, max_step=max_step, t_eval=t_eval,
-                               method=name.upper(), progress=progress)
+                               rtol=rtol, atol=atol, max_step=max_step, first_step=first_step,
+                               t_eval=sample_times(t0, t_end_f, t_eval), method=integrator,
+                               progress=progress, dt=dt, steps=steps, iterations=iterations,
+                               tol=tol, theta=theta, events=events, backend=backend)
     integ = make_integrator(integrator, steps=steps, dt=dt, rtol=rtol, atol=atol,
                             iterations=iterations, tol=tol, theta=theta,
                             first_step=first_step, max_step=max_step)

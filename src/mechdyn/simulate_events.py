@@ -32,15 +32,16 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import DOP853, RK45
 from scipy.optimize import brentq
 
 from .dynamics.contact import ContactError, resolve_mode, touching
 from .dynamics.impact import element_forces, frame_forces, impact
+from .dynamics.mode_equations import ModeEquations
 from .dynamics.modes import (
     ModeSystem,
     SwitchedModel,
@@ -57,6 +58,10 @@ from .errors import (
     SingularPositionError,
     did_you_mean,
 )
+from .integrate.base import DEFAULT_RTOL, Integrator, IntegratorOptionError, IntegratorWarning
+from .integrate.driver import INTEGRATORS, make_integrator
+from .integrate.events import EventRecord, as_events
+from .integrate.scipy_ivp import ScipyIntegrator
 from .kinematics.constraints import extend
 from .model import Model
 from .results.trajectory import Trajectory
@@ -206,15 +211,17 @@ def _initial(model: Model, q0, qdot0):
 
 # ============================================================================ main
 def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: float = 0.0,
-                    mode=None, rtol: float = 1e-10, atol: float | None = None,
+                    mode=None, rtol: float = DEFAULT_RTOL, atol=None,
                     max_step: float | None = None, dt_out: float | None = None,
-                    t_eval=None, method: str = "DOP853", max_events: int = 100000,
+                    t_eval=None, method="dop853", max_events: int = 100000,
                     small_velocity: float | None = None, gap_tol: float | None = None,
                     zeno_time: float | None = None,
                     max_wall_time: float | None = None,
                     progress: bool | None = None, dt: float | None = None,
                     steps: int | None = None, iterations: int | None = None,
-                    tol: float | None = None, theta: float | None = None) -> Trajectory:
+                    tol: float | None = None, theta: float | None = None,
+                    first_step: float | None = None, events=None,
+                    backend: str = "auto") -> Trajectory:
     """Simulate a variable-structure mechanism through all its switches.
 
     Parameters
@@ -234,7 +241,9 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         Engaged locks at the start (default: as declared by the elements).
         Stops and contacts found touching are closed automatically.
     rtol, atol : float
-        Integrator tolerances (atol default rtol x 1e-2 in SI units).
+        Tolerances of the adaptive integrators (defaults 1e-10 and 1e-3 rtol, as
+        :func:`mechdyn.simulate`; atol in SI units, scaled by the length scale for
+        travels).
     max_step : float, optional
         Largest step, s.
     dt_out : float, optional
@@ -242,13 +251,12 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         also stored just before and just after every event.
     t_eval : array_like, optional
         Explicit output times (instead of ``dt_out``).
-    method : {"DOP853", "RK45", "rk4", "wilson"} or Integrator
-        Integrator used within a mode: SciPy's adaptive ``DOP853`` or ``RK45``, or
-        the fixed-step ``rk4`` / ``wilson`` (or an instance of
-        :class:`~mechdyn.integrate.RungeKutta4` / :class:`~mechdyn.integrate.Wilson`),
-        which step on a grid of ``dt`` from the start of every mode segment (the
-        last step of a segment shortened to the event) through
-        :class:`~mechdyn.integrate.solver_adapter.FixedStepSolver`.
+    method : str or Integrator
+        Integrator used within a mode, any of :func:`mechdyn.simulate`'s: the adaptive
+        ``"dop853"`` (default), ``"rk45"``, ``"rk23"``, ``"radau"``, ``"bdf"``,
+        ``"lsoda"``, or the fixed-step ``"rk4"`` / ``"wilson"`` (or an instance), which
+        step on a grid of ``dt`` from the start of every mode segment (the last step of
+        a segment shortened to the event).
     max_events : int
         Stop (status ``"too-many-events"``) after this many switching instants.
     small_velocity : float, optional
@@ -271,6 +279,15 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         [t0, t_end] (``dt = (t_end - t0) / steps``; default 100 steps).
     iterations, tol, theta : optional
         Corrector passes, corrector tolerance and theta of ``wilson``.
+    first_step : float, optional
+        First step of the adaptive integrators, s (after an event: 1e-7 of the run).
+    events : callable or list, optional
+        The caller's event functions ``g(t, q, qdot)`` over the declared coordinates
+        (:class:`mechdyn.integrate.Event`); each crossing is recorded in ``events``
+        as an :class:`~mechdyn.integrate.events.EventRecord`, a terminal one ends the
+        run with status ``"event"``.
+    backend : {"auto", "numpy", "numba"}
+        Evaluation of the equations in each mode (:class:`ModeEquations`).
 
     Returns
     -------
@@ -294,7 +311,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     if not t_end > t0:
         raise ModelError(f"t_end must be after t0 = {t0} s, got {t_end}")
     if atol is None:
-        atol = rtol * 1e-2
+        atol = 1e-3 * rtol  # the same default as every integrator of the package
     if small_velocity is None:
         small_velocity = 1e-6 * L
     if gap_tol is None:
@@ -311,16 +328,18 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     t_eval = np.asarray(t_eval, float)
     weight = float(np.sum(model.mass) * max(np.hypot(*model.gravity), 1.0))
     force_scale = max(weight, 1.0)
-    solver_cls, method_name = _solver_class(method, t0, t_end, dt=dt, steps=steps,
-                                            iterations=iterations, tol=tol, theta=theta)
+    segment_integrator, method_name = _segment_integrators(
+        method, t0, t_end, rtol=rtol, atol=atol, dt=dt, steps=steps, iterations=iterations,
+        tol=tol, theta=theta, first_step=first_step, max_step=max_step)
+    user_events = as_events(events)
 
     # ---------------------------------------------------------------- records
     rec = dict(t=[], q=[], qd=[], qdd=[], x=[], xd=[], mode=[], frame=[], forces=[], T=[],
                U=[], W=[], res=[], lost=[])
     events: list[SwitchEvent] = []
     stats = dict(steps=0, rejected=0, evaluations=0, integrator=method_name,
-                 formulation="variable-structure (reduced, exact constraints)", backend="numpy",
-                 rtol=rtol, atol=atol, segments=0)
+                 formulation="exact", backend="numpy", rtol=rtol, atol=atol, segments=0)
+    backends: set = set()
     lost_total = 0.0
     penetration = 0.0
 
@@ -397,35 +416,32 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     bar = _Progress(progress, t0, t_end)
     while t < t_end:
         stats["segments"] += 1
-        # the last few states evaluated: the integrator's last stage, the dense-output
-        # stages, the event functions and the output samples often meet the same (t, y)
+        eqs = ModeEquations(sm, ms, backend)
+        backends.add(eqs.backend)
+        if eqs.note:
+            stats["backend_note"] = eqs.note
+        # the last few states evaluated: the step ends, the event functions and the output
+        # samples often meet the same (t, y)
         state_cache: dict = {}
 
-        def evaluate(tt, y, ms=ms, cache=state_cache):
-            n_i = ms.n_i
+        def evaluate(tt, y, eqs=eqs, cache=state_cache):
+            n_i = eqs.ms.n_i
             key = (tt, y.tobytes())
             ev = cache.get(key)
             if ev is not None:
                 return ev
-            ev = ms.evaluate(tt, y[:n_i], y[n_i:2 * n_i])
+            ev = eqs.evaluate(tt, y[:n_i], y[n_i:2 * n_i])
             if len(cache) >= 8:
                 del cache[next(iter(cache))]
             cache[key] = ev
             return ev
 
-        def rhs(tt, y, ms=ms):
-            stats["evaluations"] += 1
-            ev = evaluate(tt, y)
-            n_i = ms.n_i
-            Fc = ev.F_conservative
-            p = float((ev.F - (sm.fm.conservative(ev.x) if Fc is None else Fc)) @ ev.xdot)
-            p += _friction_power(ms, ev)
-            return np.concatenate([y[n_i:2 * n_i], ev.qddot[ms.coords], [p]])
-
         y0 = np.concatenate([qi, qdi, [w_nc]])
         efns = _event_functions(sm, ms, t, fired_once, force_scale, gap_tol, L)
+        efns += _user_event_functions(user_events)
         for e in efns:
             e.fresh = (e.kind, e.key) in just_fired
+        steps_iter = None
         try:
             ev0 = evaluate(t, y0)
             if not rec["t"] or rec["t"][-1] != t or rec["mode"][-1] != ms.mode:
@@ -434,61 +450,31 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                 g0 = e.fn(t, ev0)
                 e.armed = g0 > 0 and not e.fresh
             first = None if not just_fired else 1e-7 * (t_end - t0)
-            solver = solver_cls(rhs, t, y0, t_end, rtol=rtol, first_step=first,
-                                atol=_atol(ms, atol, L), max_step=max_step or np.inf)
+            integ = segment_integrator(ms, first)
+            steps_iter = integ.integrate(eqs.rhs, t, qi, qdi, t_end, w0=[w_nc],
+                                         first_order=eqs.first_order_function())
             hit = None
-            while solver.status == "running":
-                msg = solver.step()
-                if solver.status == "failed":
-                    raise _Stop("failed", f"the integrator failed at t = {solver.t:.9g} s: "
-                                f"{msg}")
+            for step in steps_iter:
                 stats["steps"] += 1
-                t_old, t_new = solver.t_old, solver.t
+                t_old, t_new = step.t_old, step.t
                 bar.update(t_new)
-                dense = solver.dense_output()
-                ev_new = evaluate(t_new, solver.y)
-                gs = [e.fn(t_new, ev_new) for e in efns]
-                cands = []
-                for e, g in zip(efns, gs, strict=True):
-                    if (e.armed and g <= 0) or g < -e.hard:
-                        cands.append(e)
-                if cands:
-                    def gfun(s, e, dense=dense):
-                        return e.fn(s, evaluate(s, dense(s)))
 
-                    roots = []
-                    for e in cands:
-                        a_val = gfun(t_old, e)
-                        t_a = t_old
-                        if a_val <= 0:
-                            # started at (or just below) zero: look for the positive
-                            # excursion inside the step before the crossing
-                            h_ = t_new - t_old
-                            probes = np.concatenate([t_old + h_ * 2.0 ** -np.arange(30, 0, -1),
-                                                     np.linspace(t_old, t_new, 33)[1:-1]])
-                            for s_ in np.unique(probes):
-                                if gfun(s_, e) > 0:
-                                    t_a, a_val = s_, 1.0
-                                    break
-                        if a_val > 0:
-                            ts = brentq(gfun, t_a, t_new, args=(e,), xtol=1e-15,
-                                        rtol=4 * np.finfo(float).eps, maxiter=200)
-                            # take the side where the event has happened
-                            if gfun(ts, e) > 0:
-                                ts = min(np.nextafter(ts, np.inf), t_new)
-                        else:
-                            ts = t_old
-                        roots.append((ts, e))
-                    roots.sort(key=lambda r: r[0])
-                    t_hit = roots[0][0]
-                    tol_sim = 1e-12 * max(1.0, abs(t_hit))
-                    hit = (t_hit, [e for ts, e in roots if ts <= t_hit + tol_sim], dense)
-                    t_new = t_hit
+                def dense(s_, step=step):
+                    return np.concatenate(step.dense(s_))
+
+                y_new = np.concatenate([step.q, step.qdot, step.w])
+                ev_new = evaluate(t_new, y_new)
+                gs = [e.fn(t_new, ev_new) for e in efns]
+                cands = [e for e, g in zip(efns, gs, strict=True)
+                         if (e.armed and g <= 0) or g < -e.hard]
+                if cands:
+                    hit = _locate(cands, t_old, t_new, dense, evaluate)
+                    t_new = hit[0]
                 # output samples
                 while next_out < t_eval.size and t_eval[next_out] <= t_new:
                     to = t_eval[next_out]
                     if to > t_old or (to == t_old and (not rec["t"] or rec["t"][-1] < to)):
-                        yo = dense(to) if to < solver.t else solver.y
+                        yo = dense(to) if to < step.t else y_new
                         evo = evaluate(to, yo)
                         store(to, ms, evo, float(yo[-1]))
                         penetration = max(penetration, _penetration(sm, evo.x, ms))
@@ -501,6 +487,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                 if max_wall_time is not None and time.perf_counter() - wall0 > max_wall_time:
                     raise _Stop("timeout", f"stopped after {max_wall_time} s of computing at "
                                 f"t = {t_new:.9g} s")
+            _add_counts(stats, integ, eqs)
             if hit is None:
                 t = t_end
                 break
@@ -512,6 +499,18 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             if not rec["t"] or rec["t"][-1] != t_hit:
                 store(t_hit, ms, ev_hit, w_nc)
             penetration = max(penetration, _penetration(sm, ev_hit.x, ms))
+            user = [e for e in fired if e.kind == "user"]
+            fired = [e for e in fired if e.kind != "user"]
+            for e in user:
+                events.append(EventRecord(e.key, float(t_hit), ev_hit.q.copy(),
+                                          ev_hit.qdot.copy()))
+            if any(e.data.terminal for e in user):
+                raise _Stop("event", f"terminal event {user[0].key!r} at t = {t_hit:.9g} s")
+            just_fired = {(e.kind, e.key) for e in user}
+            if not fired:  # only the caller's events: go on in the same mode
+                t = t_hit
+                qi, qdi = y_hit[:ms.n_i], y_hit[ms.n_i:2 * ms.n_i]
+                continue
             n_before = len(events)
             plastic = {k for k, tl in last_impact.items() if t_hit - tl <= zeno_time}
             ms_new, x, xd, lost = _switch(sm, t_hit, ms, ev_hit.x, ev_hit.xdot, targets, events,
@@ -519,12 +518,12 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                                           gap_tol=gap_tol, force_scale=force_scale,
                                           plastic=plastic)
             for ev_ in events[n_before:]:
-                if ev_.kind == "impact":
+                if getattr(ev_, "kind", None) == "impact":
                     last_impact[ev_.element] = t_hit
             for e in fired:
                 if e.kind == "switch" and e.data[0].once and len(events) > n_before \
-                        and any(ev.kind in ("engage", "release") and ev.element == e.key
-                                for ev in events[n_before:]):
+                        and any(getattr(ev, "kind", None) in ("engage", "release")
+                                and ev.element == e.key for ev in events[n_before:]):
                     fired_once.add(e.key)
                 if e.kind == "time":
                     fired_once.add((e.key, e.data[1]))
@@ -541,7 +540,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             if n_events >= max_events:
                 raise _Stop("too-many-events", f"stopped after {max_events} switching events "
                             f"at t = {t_hit:.9g} s")
-            just_fired = {(e.kind, e.key) for e in fired}
+            just_fired |= {(e.kind, e.key) for e in fired}
             ms = ms_new
             t = t_hit
             qi, qdi = ms.independent(x, xd)
@@ -551,58 +550,126 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             status, message = exc.status, exc.message
             break
         except (MechdynError, np.linalg.LinAlgError, ValueError) as exc:
+            if isinstance(exc, IntegratorOptionError):
+                raise
             status, message = _status_of(exc)
             break
+        finally:
+            if steps_iter is not None:
+                steps_iter.close()
+    stats["backend"] = "numba" if backends == {"numba"} else (
+        "numpy" if backends <= {"numpy"} else "numba+numpy")
     stats["penetration"] = penetration
     bar.close()
     return _finish(model, rec, events, stats, wall0, status, message, sm)
 
 
-def _solver_class(method, t0, t_end, *, dt=None, steps=None, iterations=None, tol=None,
-                  theta=None):
-    """The solver class of a mode segment (SciPy's, or a fixed-step adapter) and its name."""
-    from functools import partial
+def _segment_integrators(method, t0, t_end, *, rtol, atol, dt, steps, iterations, tol, theta,
+                         first_step, max_step):
+    """``(factory, name)``: ``factory(ms, first) -> Integrator`` for a mode segment.
 
-    from .integrate import RungeKutta4, Wilson
-    from .integrate.base import IntegratorOptionError
-    from .integrate.driver import make_integrator
-    from .integrate.solver_adapter import FixedStepSolver
-
-    fixed_opts = dict(dt=dt, steps=steps, iterations=iterations, tol=tol, theta=theta)
-    if isinstance(method, (Wilson, RungeKutta4)):
-        integ = make_integrator(method, **fixed_opts)
-    elif isinstance(method, str) and method.lower() in ("wilson", "rk4"):
-        integ = make_integrator(method.lower(), **fixed_opts)
+    Every integrator of the package is allowed (:data:`mechdyn.integrate.INTEGRATORS` or an
+    instance).  The fixed-step ones (``wilson``, ``rk4``) step on a grid of one ``dt``
+    from the start of every segment, the last step shortened to the event; the
+    adaptive ones get per-mode absolute tolerances (scaled by the length scale for
+    travels) and, after an event, a small first step.
+    """
+    fixed = dict(dt=dt, steps=steps, iterations=iterations, tol=tol, theta=theta)
+    if isinstance(method, Integrator):
+        if any(v is not None for v in fixed.values()):
+            raise IntegratorOptionError(
+                "options " + ", ".join(k for k, v in fixed.items() if v is not None)
+                + f" cannot be combined with an integrator instance ({method!r}); set them on "
+                "the instance")
+        if isinstance(method, ScipyIntegrator):
+            name, rtol, atol = method.name, method.rtol, method.atol
+            first_step = method.first_step if first_step is None else first_step
+            max_step = method.max_step if max_step is None else max_step
+        else:
+            name = method.name
+            fixed.update(dt=method.dt, steps=method.steps,
+                         **{k: getattr(method, k, None) for k in ("iterations", "tol", "theta")})
+    elif isinstance(method, str):
+        name = method.lower()
     else:
-        cls = {"DOP853": DOP853, "RK45": RK45}.get(method.upper()) \
-            if isinstance(method, str) else None
-        if cls is None:
-            raise ModelError(f"method must be 'DOP853', 'RK45', 'rk4' or 'wilson', "
-                             f"got {method!r}")
-        given = [k for k, v in fixed_opts.items() if v is not None]
+        raise IntegratorOptionError(f"unknown integrator {method!r}; valid integrator names: "
+                                    + ", ".join(INTEGRATORS))
+    if name in ("wilson", "rk4"):
+        make_integrator(name, **fixed)  # validates the options
+        given = [k for k, v in (("first_step", first_step), ("max_step", max_step))
+                 if v is not None]
         if given:
-            raise IntegratorOptionError(f"option(s) {', '.join(given)} are for the "
-                                        f"fixed-step methods 'rk4' / 'wilson', not {method!r}")
-        return cls, f"scipy-{method.upper()}"
-    # one step size for every segment: the grid restarts at each segment's start
-    h = integ.dt if integ.dt is not None else (t_end - t0) / (integ.steps or 100)
-    if isinstance(integ, Wilson):
-        seg = Wilson(dt=h, iterations=integ.iterations, tol=integ.tol, theta=integ.theta)
-    else:
-        seg = RungeKutta4(dt=h)
-    return partial(FixedStepSolver, integrator=seg), f"{seg.name} (dt={h:.6g} s)"
+            warnings.warn(f"option(s) {', '.join(given)} have no effect with the fixed-step "
+                          f"integrator {name!r}", IntegratorWarning, stacklevel=4)
+        h = fixed["dt"] if fixed["dt"] is not None else (t_end - t0) / (fixed["steps"] or 100)
+        opts = {k: fixed[k] for k in ("iterations", "tol", "theta") if name == "wilson"}
+
+        def factory(ms, first):
+            return make_integrator(name, dt=h, **opts)
+
+        return factory, f"{name} (dt={h:.6g} s)"
+    make_integrator(name, rtol=rtol, atol=atol, first_step=first_step, max_step=max_step,
+                    **fixed)  # validates the options (steps/dt are refused here)
+
+    def factory(ms, first):
+        return make_integrator(name, rtol=rtol, atol=_atol(ms, atol, ms.model.length_scale),
+                               first_step=first_step if first_step is not None else first,
+                               max_step=max_step)
+
+    return factory, name
 
 
-def _friction_power(ms: ModeSystem, ev) -> float:
-    p = 0.0
-    if not any(r.slip for r in ms.rows):
-        return 0.0
-    X, V = extend(ms.model, ev.x), extend(ms.model, ev.xdot)
-    for k, r in enumerate(ms.rows):
-        if r.slip:
-            vt = r.tangent.rate(X, V, ms.sm.nb)
-            p += -r.mu * r.slip * ev.lam[ms.n_base + k] * vt
-    return p
+def _locate(cands, t_old, t_new, dense, evaluate):
+    """The first of the candidate events crossed in (t_old, t_new], located by Brent's
+    method on the step's dense output: ``(t_hit, events at t_hit, dense)``."""
+
+    def gfun(s, e):
+        return e.fn(s, evaluate(s, dense(s)))
+
+    roots = []
+    for e in cands:
+        a_val = gfun(t_old, e)
+        t_a = t_old
+        if a_val <= 0:
+            # started at (or just below) zero: look for the positive excursion inside
+            # the step before the crossing
+            h_ = t_new - t_old
+            probes = np.concatenate([t_old + h_ * 2.0 ** -np.arange(30, 0, -1),
+                                     np.linspace(t_old, t_new, 33)[1:-1]])
+            for s_ in np.unique(probes):
+                if gfun(s_, e) > 0:
+                    t_a, a_val = s_, 1.0
+                    break
+        if a_val > 0:
+            ts = brentq(gfun, t_a, t_new, args=(e,), xtol=1e-15,
+                        rtol=4 * np.finfo(float).eps, maxiter=200)
+            if gfun(ts, e) > 0:  # take the side where the event has happened
+                ts = min(np.nextafter(ts, np.inf), t_new)
+        else:
+            ts = t_old
+        roots.append((ts, e))
+    roots.sort(key=lambda r: r[0])
+    t_hit = roots[0][0]
+    tol_sim = 1e-12 * max(1.0, abs(t_hit))
+    return t_hit, [e for ts, e in roots if ts <= t_hit + tol_sim], dense
+
+
+def _user_event_functions(user_events) -> list:
+    """The caller's events g(t, q, qdot) (declared coordinates) as event functions that
+    fire when they fall to zero (a rising event is watched as -g)."""
+    out = []
+    for ev in user_events:
+        for d in ((1, -1) if ev.direction == 0 else (ev.direction,)):
+            sign = -1.0 if d > 0 else 1.0
+            out.append(_EventFn("user", ev.name,
+                                lambda tt, me, ev=ev, sign=sign: sign * ev(tt, me.q, me.qdot),
+                                np.inf, ev))
+    return out
+
+
+def _add_counts(stats: dict, integ, eqs) -> None:
+    stats["rejected"] += integ.stats.rejected
+    stats["evaluations"] += integ.stats.evaluations
 
 
 def _atol(ms, atol, L):

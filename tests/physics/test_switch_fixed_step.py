@@ -1,13 +1,13 @@
-"""The fixed-step integrators (rk4, wilson) in the event loop of variable-structure models."""
+"""Every integrator (rk4, wilson, the adaptive ones) in the segment loop of variable-structure
+models."""
 
 import numpy as np
 import pytest
 from test_impact_stop import X0, M, _closed_form, _oscillator
 
 from mechdyn.cli import main
-from mechdyn.integrate import RungeKutta4, Wilson
+from mechdyn.integrate import RungeKutta4
 from mechdyn.integrate.base import IntegratorOptionError
-from mechdyn.integrate.solver_adapter import FixedStepSolver
 from mechdyn.simulate import simulate
 
 E = 0.6
@@ -51,34 +51,13 @@ def test_steps_option_and_integrator_instances():
     tr2 = simulate(_oscillator(E), 0.3, integrator=RungeKutta4(dt=2e-3), q0=[X0],
                    qdot0=[0.0], progress=False)
     assert tr2.status == "success" and tr2.stats["integrator"].startswith("rk4")
-    with pytest.raises(IntegratorOptionError, match="not available"):
-        simulate(_oscillator(E), 0.1, integrator="radau", progress=False)
+    # every integrator of the package runs the switched model; an implicit one
+    # finds the same impacts
+    tr3, imp3 = _impacts("radau", None, rtol=1e-10)
+    times, _, _ = _closed_form(E, len(imp3))
+    assert np.max(np.abs([ev.t for ev in imp3] - np.asarray(times))) < 1e-6
     with pytest.raises(IntegratorOptionError, match="theta"):
         simulate(_oscillator(E), 0.1, integrator="wilson", dt=1e-3, theta=1.2, progress=False)
-
-
-def test_adapter_grid_and_dense_output():
-    # y'' = -y as y = (q, q', w) with w' = q'^2; steps on the grid t0 + k dt, last one short
-    def fun(t, y):
-        return np.array([y[1], -y[0], y[1] ** 2])
-
-    s = FixedStepSolver(fun, 0.25, [1.0, 0.0, 0.0], 1.0, integrator=RungeKutta4(dt=0.1),
-                        rtol=1e-9, first_step=None)
-    ts = []
-    while s.status == "running":
-        assert s.step() is None
-        ts.append((s.t_old, s.t))
-        d = s.dense_output()
-        tm = 0.5 * (s.t_old + s.t)
-        np.testing.assert_allclose(d(tm)[:2], [np.cos(tm - 0.25), -np.sin(tm - 0.25)],
-                                   atol=1e-5)
-        assert d(np.array([s.t_old, s.t])).shape == (3, 2)
-        np.testing.assert_allclose(d(s.t), s.y, atol=1e-15)
-    np.testing.assert_allclose([b for _, b in ts], [0.35, 0.45, 0.55, 0.65, 0.75, 0.85, 0.95,
-                                                    1.0])
-    assert s.status == "finished" and s.t == 1.0
-    with pytest.raises(IntegratorOptionError):
-        FixedStepSolver(fun, 0.0, [1.0, 0.0, 0.0], 1.0, integrator=Wilson(steps=10))
 
 
 def test_cli_press_cycle_rk4_with_dt(capsys):

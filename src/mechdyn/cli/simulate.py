@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import sys
 
+from ..integrate.base import DEFAULT_RTOL
+
 __all__ = ["register", "run"]
 
 
@@ -40,7 +42,8 @@ def register(sub) -> None:
                    help=f"one of {', '.join(INTEGRATORS)} (default dop853)")
     p.add_argument("--steps", type=int, metavar="N", help="steps of wilson / rk4")
     p.add_argument("--dt", metavar="TIME", help="step size of wilson / rk4")
-    p.add_argument("--rtol", type=float, default=1e-9, help="relative tolerance (default 1e-9)")
+    p.add_argument("--rtol", type=float, default=DEFAULT_RTOL,
+                   help=f"relative tolerance (default {DEFAULT_RTOL:g})")
     p.add_argument("--atol", type=float, help="absolute tolerance (default 1e-3 rtol)")
     p.add_argument("--theta", type=float, help="Wilson theta (1 or >= 1.37)")
     p.add_argument("--iterations", type=int, help="corrector passes of wilson (default 4)")

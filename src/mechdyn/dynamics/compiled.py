@@ -45,16 +45,17 @@ from ..kernels.loads_numba import (
     forces,
 )
 from ..kernels.rows_numba import NUMBA, njit, rows_jacobian, rows_quad, rows_values
-from ..model.rows import concat
-from .forces import force_model
+from ..model.rows import concat, point
+from .forces import force_model, resolved_variable
 
 __all__ = ["compile_kernel", "compile_mode_kernel", "CompiledKernel", "numba_available"]
 
 #: seconds after which the first compilation is announced on stderr
 ANNOUNCE_AFTER = 1.0
 
-# dims: n_c (constraint rows), n_i (independent coordinates), n_q (declared coordinates)
-D_NC, D_NI, D_NQ = range(3)
+# dims: n_c (constraint rows), n_i (independent coordinates), n_q (declared coordinates),
+# n_v (rows of table variables); the row arrays hold these four blocks in this order
+D_NC, D_NI, D_NQ, D_NV = range(4)
 # flags at the end of the work array
 W_VALID = 0  # B_last valid
 W_PIVOT = 1  # pivot ratio of the last factorisation
@@ -167,7 +168,7 @@ def _evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out):
     1 position solve failed, 2 mass matrix not positive definite, 3 non-finite."""
     nb = ip[H_NB]
     nx = 3 * nb
-    nc, ni, nq = dims[D_NC], dims[D_NI], dims[D_NQ]
+    nc, ni, nq, nv = dims[D_NC], dims[D_NI], dims[D_NQ], dims[D_NV]
     ls = fp[2]
     J = np.empty((nx, nx))
     piv = np.empty(nx, dtype=np.int64)
@@ -202,7 +203,7 @@ def _evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out):
         bb[r] = -bb[r]
     _solve_scaled(J, piv, bb, nx, nb, ls)
     # declared coordinates, their rates, analogs G B and bias G b + quad_g
-    gi, gf = ri[nc + ni:], rf[nc + ni:]
+    gi, gf = ri[nc + ni:nc + ni + nq], rf[nc + ni:nc + ni + nq]
     q = np.empty(nq)
     G = np.zeros((nq, nx))
     qdot = np.zeros(nq)
@@ -259,7 +260,9 @@ def _evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out):
     Fa = np.empty(nx)
     Fnc = np.empty(nx)
     Qd = np.empty(nq)
-    forces(t, q, qdot, x, v, ip, fp, Fa, Fnc, Qd)
+    varv = np.empty(nv)
+    rows_values(x, nb, ri[nc + ni + nq:], rf[nc + ni + nq:], varv, 0)
+    forces(t, q, qdot, x, v, ip, fp, Fa, Fnc, Qd, varv)
     rhs = np.empty(ni)
     P = 0.0
     for r in range(nx):
@@ -464,16 +467,28 @@ def compile_mode_kernel(model, force_model, constraint_rows, independent):
         return None, "nothing to compile"
     if len(constraint_rows) + independent.size != model.n_x:
         return None, "redundant constraints (non-square position Jacobian)"
+    packer = LoadPacker(model, force_model, variable_row=lambda name: _variable_row(model, name))
     try:
-        ip, fp = LoadPacker(model, force_model).pack()
+        ip, fp = packer.pack()
     except Unsupported as exc:
         return None, str(exc)
     crd = model.coordinate_rows
-    ri, rf = concat(model.n_bodies, constraint_rows, crd.take(independent), crd).packed()
-    dims = np.array([len(constraint_rows), independent.size, model.n_q], dtype=np.int64)
+    var = concat(model.n_bodies, *packer.variable_rows)
+    ri, rf = concat(model.n_bodies, constraint_rows, crd.take(independent), crd, var).packed()
+    dims = np.array([len(constraint_rows), independent.size, model.n_q, len(var)],
+                    dtype=np.int64)
     args = (ip, fp, ri, rf, dims, model.n_x)
     ct = _warm_up(args)
     return CompiledKernel(ip, fp, ri, rf, dims, model.n_x, ct), ""
+
+
+def _variable_row(model, name: str):
+    """The one-row measure of a 'body.point.x|y' table variable, or None."""
+    res = resolved_variable(model, name)
+    if res is None:
+        return None
+    b, s, comp = res
+    return point(name, b, s, comp, nb=model.n_bodies)
 
 
 def compile_kernel(model, layout):

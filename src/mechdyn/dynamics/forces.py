@@ -116,7 +116,7 @@ class LoadContext:
 
     def variable(self, name: str):
         """A named variable: 't', a coordinate, '<coordinate>_dot', 'body.point.x|y'."""
-        res = _resolved_variable(self.model, name)
+        res = resolved_variable(self.model, name)
         if res is not None:  # a body point coordinate, resolved once per model
             b, s, comp = res
             x = np.asarray(self.x)
@@ -137,7 +137,7 @@ class LoadContext:
                          f"'body.point.x' / 'body.point.y'")
 
 
-def _resolved_variable(model: Model, name: str):
+def resolved_variable(model: Model, name: str):
     """(body, local point, component) of a 'body.point.x|y' variable on a moving
     body, or None (cached on the model)."""
     cache = getattr(model, "_load_variables", None)

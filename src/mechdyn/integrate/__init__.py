@@ -5,9 +5,8 @@ from .driver import INTEGRATORS, Solution, make_integrator, solve
 from .events import Event, EventRecord
 from .runge_kutta import RungeKutta4
 from .scipy_ivp import ScipyIntegrator
-from .solver_adapter import FixedStepSolver
 from .wilson import Wilson
 
 __all__ = ["Integrator", "IntegratorOptionError", "IntegratorStats", "Step", "INTEGRATORS",
            "Solution", "make_integrator", "solve", "Event", "EventRecord", "RungeKutta4",
-           "ScipyIntegrator", "Wilson", "FixedStepSolver"]
+           "ScipyIntegrator", "Wilson"]

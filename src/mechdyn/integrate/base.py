@@ -33,11 +33,19 @@ import numpy as np
 from ..errors import MechdynError
 
 __all__ = ["Integrator", "IntegratorStats", "Step", "hermite_dense", "check_positive",
-           "IntegratorOptionError", "fixed_grid"]
+           "IntegratorOptionError", "IntegratorWarning", "fixed_grid", "DEFAULT_RTOL"]
 
 
 class IntegratorOptionError(MechdynError, ValueError):
     """A bad integrator option (the message names the option and the value)."""
+
+
+#: default relative tolerance of every adaptive integration of the package
+DEFAULT_RTOL = 1e-10
+
+
+class IntegratorWarning(UserWarning):
+    """An option that has no effect where it was given (the message names it)."""
 
 
 def check_positive(name: str, value, *, integer: bool = False, allow_none: bool = False):

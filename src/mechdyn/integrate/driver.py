@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .base import Integrator, IntegratorOptionError
+from .base import DEFAULT_RTOL, Integrator, IntegratorOptionError
 from .events import as_events, locate_events
 from .runge_kutta import RungeKutta4
 from .scipy_ivp import SCIPY_METHODS, ScipyIntegrator
@@ -29,7 +29,7 @@ _ADAPTIVE_OPTIONS = ("first_step", "max_step")
 
 
 def make_integrator(name: str | Integrator = "dop853", *, steps: int | None = None,
-                    dt: float | None = None, rtol: float = 1e-9, atol=None,
+                    dt: float | None = None, rtol: float = DEFAULT_RTOL, atol=None,
                     **options) -> Integrator:
     """An integrator from its name and options.
 

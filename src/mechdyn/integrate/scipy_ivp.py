@@ -17,7 +17,7 @@ import numpy as np
 import scipy.integrate as si
 
 from ..errors import IntegrationError
-from .base import Integrator, IntegratorOptionError, Step, check_positive
+from .base import DEFAULT_RTOL, Integrator, IntegratorOptionError, Step, check_positive
 
 __all__ = ["ScipyIntegrator", "SCIPY_METHODS"]
 
@@ -35,7 +35,7 @@ class ScipyIntegrator(Integrator):
     method : {"dop853", "rk45", "rk23", "radau", "bdf", "lsoda"}
         The solver (case-insensitive; SciPy's spelling ``"DOP853"`` works too).
     rtol : float
-        Relative tolerance (> 0), default 1e-9.
+        Relative tolerance (> 0), default ``DEFAULT_RTOL`` (1e-10).
     atol : float or array_like
         Absolute tolerance, SI units of each state component (> 0); a scalar, or an
         array of length 2 n + n_w over (q, q', w).  Default ``1e-3 rtol``.
@@ -45,7 +45,7 @@ class ScipyIntegrator(Integrator):
 
     adaptive = True
 
-    def __init__(self, method: str = "dop853", rtol: float = 1e-9, atol=None, *,
+    def __init__(self, method: str = "dop853", rtol: float = DEFAULT_RTOL, atol=None, *,
                  first_step: float | None = None, max_step: float | None = None):
         super().__init__()
         key = str(method).lower()

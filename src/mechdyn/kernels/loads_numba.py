@@ -44,7 +44,7 @@ F_GLOBAL = 4  # gx, gy, length_scale, tol (at the start of the float array)
 # value modes and table variables
 V_CONST, V_TABLE = 0, 1
 T_OUTSIDE, T_PERIODIC = 1, 2  # table flags
-VAR_T, VAR_Q, VAR_QDOT = 0, 1, 2
+VAR_T, VAR_Q, VAR_QDOT, VAR_ROW = 0, 1, 2, 3  # VAR_ROW: a row of ``variable_rows``
 
 
 class Unsupported(Exception):
@@ -59,10 +59,19 @@ class LoadPacker:
     model : Model
     force_model : ForceModel
         The model's parsed loads (:func:`mechdyn.dynamics.forces.force_model`).
+    variable_row : callable, optional
+        ``variable_row(name) -> Rows or None``: the one-row measure of a table variable
+        that is not t, a coordinate or its rate (e.g. ``"slider.com.x"``); such rows are
+        collected in :attr:`variable_rows` and their values are passed to
+        :func:`forces` as ``varv``.
     """
 
-    def __init__(self, model, force_model):
+    def __init__(self, model, force_model, variable_row=None):
         self.model, self.fm = model, force_model
+        self.variable_row = variable_row
+        #: rows measuring the table variables that are not coordinates (body points)
+        self.variable_rows: list = []
+        self._var_index: dict[str, int] = {}
         self.tabs: list[float] = []
         self.ints: dict[int, list[int]] = {s: [] for s in range(N_SECTIONS)}
         self.flts: dict[int, list[float]] = {s: [] for s in range(N_SECTIONS)}
@@ -84,6 +93,11 @@ class LoadPacker:
                 kind, idx = VAR_Q, m.coordinate_index(var)
             elif var.endswith("_dot") and var[:-4] in m.coordinate_names:
                 kind, idx = VAR_QDOT, m.coordinate_index(var[:-4])
+            elif self.variable_row is not None and self.variable_row(var) is not None:
+                if var not in self._var_index:
+                    self._var_index[var] = len(self.variable_rows)
+                    self.variable_rows.append(self.variable_row(var))
+                kind, idx = VAR_ROW, self._var_index[var]
             else:
                 raise Unsupported(f"{where}: table over {var!r} (only t, coordinates and "
                                    f"their rates are compiled)")
@@ -185,7 +199,7 @@ def interp(xs, ys, n, s, has_out, outside):
 
 
 @njit
-def load_value(ip, fp, irec, fval, t, q, qdot):
+def load_value(ip, fp, irec, fval, t, q, qdot, varv):
     if ip[irec] == 0:
         return fp[fval]
     tab0 = ip[H_FOFF + S_TAB] + ip[irec + 1]
@@ -196,8 +210,10 @@ def load_value(ip, fp, irec, fval, t, q, qdot):
         s = t
     elif kind == 1:
         s = q[idx]
-    else:
+    elif kind == 2:
         s = qdot[idx]
+    else:
+        s = varv[idx]
     flags = ip[irec + 5]
     if flags & 2:  # T_PERIODIC: wrap into [x0, x0 + period), as Table.wrap
         x0 = fp[tab0]
@@ -219,7 +235,7 @@ def _apply(F, b, nb, armx, army, fx, fy):
 
 
 @njit
-def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd):
+def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv):
     """Applied forces F (all) and Fnc (non-conservative part) on the poses, drives Qd."""
     nb = ip[H_NB]
     nq = ip[H_NQ]
@@ -287,7 +303,7 @@ def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd):
     for k in range(ip[H_NFOR]):
         i0 = oi + IR_FOR * k
         f0 = of + FR_FOR * k
-        mag = load_value(ip, fp, i0, f0 + 4, t, q, qdot)
+        mag = load_value(ip, fp, i0, f0 + 4, t, q, qdot, varv)
         b = ip[i0 + IR_VAL]
         frame = ip[i0 + IR_VAL + 1]
         th = x[3 * b + 2] if b < nb else 0.0
@@ -302,7 +318,7 @@ def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd):
     for k in range(ip[H_NTOR]):
         i0 = oi + IR_TOR * k
         f0 = of + FR_TOR * k
-        tq = load_value(ip, fp, i0, f0, t, q, qdot)
+        tq = load_value(ip, fp, i0, f0, t, q, qdot, varv)
         b = ip[i0 + IR_VAL]
         r = ip[i0 + IR_VAL + 1]
         if b < nb:
@@ -315,4 +331,4 @@ def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd):
     for k in range(ip[H_NDRV]):
         i0 = oi + IR_DRV * k
         f0 = of + FR_DRV * k
-        Qd[ip[i0 + IR_VAL]] += load_value(ip, fp, i0, f0, t, q, qdot)
+        Qd[ip[i0 + IR_VAL]] += load_value(ip, fp, i0, f0, t, q, qdot, varv)

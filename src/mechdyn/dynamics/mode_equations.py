@@ -1,0 +1,151 @@
+"""The equations of motion of one mode, as the integrators see them.
+
+Lagrange II in the independent coordinates q_I of the mode (a subset of the
+declared coordinates, chosen by :class:`~mechdyn.dynamics.modes.ModeSystem`):
+A(q) q_I'' = Q - c, with the rows of every active element (joints, engaged
+locks, closed stops and contacts, sticking contacts) and the rotor and gear
+inertia of the drives reduced to their coordinates.  The right-hand side runs
+on the compiled kernel (:mod:`mechdyn.dynamics.compiled`) whenever the mode
+allows (numba installed, every load compiled, no sliding friction); otherwise,
+and to diagnose a failure, on the NumPy evaluation of the mode
+(:meth:`ModeSystem.evaluate`), which also gives every multiplier.  A
+fixed-structure run is a run in one mode.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ModelError
+from ..model.rows import Rows
+from .compiled import compile_mode_kernel
+
+__all__ = ["ModeEquations", "BACKENDS"]
+
+#: valid values of ``backend``
+BACKENDS = ("auto", "numpy", "numba")
+
+
+def mode_rows(ms) -> Rows | None:
+    """The constraint rows of a mode (all of them, in the mode's row order)."""
+    rows = getattr(ms, "rowset", None)
+    if rows is not None:
+        return rows
+    # transitional: from the batched row terms of the mode
+    from .modes import _measure_term
+
+    nb = ms.sm.nb
+    terms = list(ms.sm._base_terms) + [_measure_term(r.measure, nb, r.sign, -r.target)
+                                       for r in ms.rows]
+    if any(t is None for t in terms):
+        return None
+    a = np.array(terms, dtype=float).reshape(len(terms), 14)
+    n = a.shape[0]
+    return Rows(nb, a[:, 0], a[:, 1:3], a[:, 3], a[:, 4:6], a[:, 6], a[:, 7:9], a[:, 9],
+                a[:, 11], a[:, 10], a[:, 12], a[:, 13], tuple(f"row{k}" for k in range(n)))
+
+
+class ModeEquations:
+    """q_I'' = f(t, q_I, q_I') of one mode, with the power of the non-conservative forces.
+
+    Parameters
+    ----------
+    sm : SwitchedModel
+    ms : ModeSystem
+        The mode (rows, independent coordinates, targets of the locks).
+    backend : {"auto", "numpy", "numba"}
+        ``"auto"`` uses the compiled kernel when it can; ``"numba"`` insists on it.
+
+    Attributes
+    ----------
+    kernel : CompiledKernel or None
+    backend : str
+        ``"numba"`` or ``"numpy"``, what this mode runs on.
+    note : str
+        Why the compiled path is not used, or ``""``.
+
+    Raises
+    ------
+    ModelError
+        An unknown backend, or ``backend="numba"`` where the compiled path cannot run.
+    """
+
+    def __init__(self, sm, ms, backend: str = "auto"):
+        if backend not in BACKENDS:
+            raise ModelError(f"unknown backend {backend!r}; valid: "
+                             + ", ".join(repr(b) for b in BACKENDS))
+        self.sm, self.ms = sm, ms
+        self.kernel, self.note = None, ""
+        if backend != "numpy":
+            rows = mode_rows(ms)
+            if any(r.slip for r in ms.rows):
+                self.note = "sliding friction is evaluated on the NumPy path"
+            elif rows is None:
+                self.note = "the mode has a row the compiled path does not evaluate"
+            else:
+                self.kernel, self.note = compile_mode_kernel(
+                    ms.model, sm.fm, rows.take(ms.independent_rows), ms.coords)
+            if self.kernel is None and backend == "numba":
+                raise ModelError(f"the compiled (numba) backend is not available: {self.note}")
+        if self.kernel is not None:
+            self.kernel.reset(ms.x_ref)
+        self.backend = "numba" if self.kernel is not None else "numpy"
+
+    @property
+    def evaluations(self) -> int:
+        """Evaluations by the compiled kernel (the NumPy ones are counted by the caller)."""
+        return self.kernel.evaluations if self.kernel is not None else 0
+
+    def evaluate(self, t: float, qi, qdi):
+        """The full NumPy evaluation (:class:`ModeEval`: poses, rates, accelerations of
+        every declared coordinate, every multiplier) at a state of the mode."""
+        guess = self.kernel.x.copy() if self.kernel is not None else None
+        return self.ms.evaluate(t, qi, qdi, x_guess=guess)
+
+    def numpy_rhs(self, t: float, qi, qdi):
+        """(q_I'', array([P_nc])) on the NumPy path; raises the diagnosed error of a
+        failure (assembly, lock-up)."""
+        ms = self.ms
+        ev = self.evaluate(t, qi, qdi)
+        Fc = ev.F_conservative
+        p = float((ev.F - (self.sm.fm.conservative(ev.x) if Fc is None else Fc)) @ ev.xdot)
+        p += friction_power(ms, ev)
+        return ev.qddot[ms.coords], np.array([p])
+
+    def rhs(self, t: float, qi, qdi):
+        """(q_I'' (n_i,), array([P_nc])) at (t, q_I, q_I')."""
+        if self.kernel is not None:
+            out = self.kernel.rhs(t, qi, qdi)
+            if out is not None:
+                return out
+        return self.numpy_rhs(t, qi, qdi)
+
+    def first_order_function(self):
+        """``fun(t, y) -> y'`` for y = (q_I, q_I', w) on the compiled kernel, or None."""
+        if self.kernel is None:
+            return None
+        n = self.ms.n_i
+
+        def on_failure(t, y):
+            qdd, p = self.numpy_rhs(t, y[:n], y[n:2 * n])
+            return np.concatenate([y[n:2 * n], qdd, p])
+
+        return self.kernel.first_order_function(on_failure)
+
+
+def friction_power(ms, ev) -> float:
+    """Power of the sliding friction of the mode's slipping contacts, W (<= 0)."""
+    p = 0.0
+    for k, r in enumerate(ms.rows):
+        if r.slip:
+            vt = r.tangent_rate(ev.x, ev.xdot) if hasattr(r, "tangent_rate") else \
+                _tangent_rate(ms, r, ev)
+            p += -r.mu * r.slip * ev.lam[ms.n_base + k] * vt
+    return p
+
+
+def _tangent_rate(ms, r, ev) -> float:
+    from ..kinematics.constraints import extend
+
+    X, V = extend(ms.model, ev.x), extend(ms.model, ev.xdot)
+    return r.tangent.rate(X, V, ms.sm.nb)
