@@ -28,7 +28,7 @@ import time
 
 import numpy as np
 
-from ..kernels.linalg import cholesky_solve, lu_factor, lu_solve
+from ..kernels.linalg import cholesky_solve, lu_factor, lu_solve, lu_solve_transposed
 from ..kernels.loads_numba import (
     FR_BODY,
     FR_DRV,
@@ -163,9 +163,15 @@ def _solve_scaled(J, piv, col, nx, nb, ls):
 
 
 @njit
-def _evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out):
+def _evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
     """q_I'' and P_nc at (t, q_I, q_I'); out = [q_I' | q_I'' | P_nc].  Status: 0 ok,
-    1 position solve failed, 2 mass matrix not positive definite, 3 non-finite."""
+    1 position solve failed, 2 mass matrix not positive definite, 3 non-finite.
+
+    With ``full``, ``ext`` receives [x'' (n_x) | q | q' | q'' (n_q each) | lambda (n_c) |
+    F (n_x)]: the accelerations, every declared coordinate, the multipliers of the
+    constraint rows from the same factorization (M x'' + h - F = Phi_x^T lambda, solved
+    with the transposed LU of the position Jacobian) and the applied forces on the
+    poses, drives included."""
     nb = ip[H_NB]
     nx = 3 * nb
     nc, ni, nq, nv = dims[D_NC], dims[D_NI], dims[D_NQ], dims[D_NV]
@@ -278,6 +284,8 @@ def _evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out):
         rhs[c] = s
     if not cholesky_solve(A, rhs, ni):
         return 2
+    if full:
+        _reactions(x, v, bb, rhs, q, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, ni, nq, ext)
     ok = P == P
     for c in range(ni):
         out[c] = qdi[c]
@@ -290,12 +298,81 @@ def _evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out):
 
 
 @njit
+def _reactions(x, v, bb, qdd, q, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, ni, nq, ext):
+    """Fill ``ext`` (see :func:`_evaluate`) after the solve for q_I''."""
+    nx = 3 * nb
+    ls = fp[2]
+    xdd = ext[:nx]
+    for r in range(nx):
+        s = bb[r]
+        for c in range(ni):
+            s += Bl[r * ni + c] * qdd[c]
+        xdd[r] = s
+    o = nx
+    rows_q = ext[o:o + nq]
+    rows_v = ext[o + nq:o + 2 * nq]
+    rows_a = ext[o + 2 * nq:o + 3 * nq]
+    for k in range(nq):
+        s = Gb[k]
+        for c in range(ni):
+            s += GB[k, c] * qdd[c]
+        rows_a[k] = s
+        rows_q[k] = q[k]
+        sq = 0.0
+        for r in range(nx):
+            sq += G[k, r] * v[r]
+        rows_v[k] = sq
+    # residual of the free bodies: M x'' + h - F (F with the drives on their coordinates)
+    z = np.empty(nx)
+    Ftot = ext[o + 3 * nq + nc:o + 3 * nq + nc + nx]
+    ob = ip[H_FOFF + S_BODY]
+    for r in range(nx):
+        s = Fa[r]
+        for k in range(nq):
+            s += G[k, r] * Qd[k]
+        Ftot[r] = s
+    for b in range(nb):
+        m = fp[ob + FR_BODY * b]
+        Jc = fp[ob + FR_BODY * b + 1]
+        cx, cy = fp[ob + FR_BODY * b + 2], fp[ob + FR_BODY * b + 3]
+        th = x[3 * b + 2]
+        co, si = np.cos(th), np.sin(th)
+        ax, ay = co * cx - si * cy, si * cx + co * cy
+        w = v[3 * b + 2]
+        al = xdd[3 * b + 2]
+        acx = xdd[3 * b] - al * ay - w * w * ax
+        acy = xdd[3 * b + 1] + al * ax - w * w * ay
+        z[3 * b] = m * acx - Ftot[3 * b]
+        z[3 * b + 1] = m * acy - Ftot[3 * b + 1]
+        z[3 * b + 2] = Jc * al + m * (ax * acy - ay * acx) - Ftot[3 * b + 2]
+    od_i, od_f = ip[H_IOFF + S_DRV], ip[H_FOFF + S_DRV]
+    for k in range(ip[H_NDRV]):
+        c = ip[od_i + IR_DRV * k + IR_VAL]
+        je = fp[od_f + FR_DRV * k + 2]
+        if je != 0.0:
+            for r in range(nx):
+                z[r] += je * rows_a[c] * G[c, r]
+    # Phi_x^T lambda = z with J = [Phi_x; g_I,x] factored with scaled rotation columns
+    for b in range(nb):
+        z[3 * b + 2] *= ls
+    lu_solve_transposed(J, piv, z, nx)
+    for r in range(nc):
+        ext[o + 3 * nq + r] = z[r]
+
+
+@njit
 def _first_order(t, y, ip, fp, ri, rf, dims, ws, status):
     """y = (q_I, q_I', w) -> y' = (q_I', q_I'', P_nc); status[0] receives the status."""
     ni = dims[D_NI]
     out = np.empty(2 * ni + 1)
-    status[0] = _evaluate(t, y[:ni], y[ni:2 * ni], ip, fp, ri, rf, dims, ws, out)
+    status[0] = _evaluate(t, y[:ni], y[ni:2 * ni], ip, fp, ri, rf, dims, ws, out,
+                          np.empty(0), False)
     return out
+
+
+@njit
+def _full(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, status):
+    status[0] = _evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, True)
 
 
 @njit
@@ -379,6 +456,33 @@ class CompiledKernel:
             return None
         return out[n:2 * n], out[2 * n:]
 
+    def evaluation(self, t, q, qdot):
+        """Everything at one state, or None on failure (see ``status``).
+
+        Returns
+        -------
+        dict with ``x``, ``xdot``, ``xddot`` (n_x,), ``q``, ``qdot``, ``qddot`` (n_q,,
+        every declared coordinate), ``qddot_i`` (n_i,), ``lam`` (n_c,) multipliers of the
+        constraint rows (M x'' + h - F = Phi_x^T lambda), ``F`` (n_x,) applied forces
+        with the drives, ``power_nc`` (W).
+        """
+        n, nx, nq = self.n_i, self.n_x, int(self.dims[D_NQ])
+        nc = int(self.dims[D_NC])
+        out = np.empty(2 * n + 1)
+        ext = np.empty(nx + 3 * nq + nc + nx)
+        _full(float(t), np.asarray(q, np.float64), np.asarray(qdot, np.float64), self.ip,
+              self.fp, self.ri, self.rf, self.dims, self.ws, out, ext, self._st)
+        self.status = int(self._st[0])
+        if self.status:
+            return None
+        o = nx
+        return dict(x=self.x.copy(), xdot=self.xdot.copy(), xddot=ext[:nx].copy(),
+                    q=ext[o:o + nq].copy(), qdot=ext[o + nq:o + 2 * nq].copy(),
+                    qddot=ext[o + 2 * nq:o + 3 * nq].copy(),
+                    lam=ext[o + 3 * nq:o + 3 * nq + nc].copy(),
+                    F=ext[o + 3 * nq + nc:].copy(), qddot_i=out[n:2 * n].copy(),
+                    power_nc=float(out[2 * n]))
+
     @property
     def evaluations(self) -> int:
         """Evaluations of the equations by this kernel so far."""
@@ -427,8 +531,11 @@ def _warm_up(args) -> float:
     try:
         ws = np.zeros(_work_size(n_x, ni))
         _positions(np.zeros(ni), ip, fp, ri, rf, dims, ws)
-        _first_order(0.0, np.zeros(2 * ni + 1), ip, fp, ri, rf, dims, ws,
-                     np.zeros(1, dtype=np.int64))
+        st = np.zeros(1, dtype=np.int64)
+        _first_order(0.0, np.zeros(2 * ni + 1), ip, fp, ri, rf, dims, ws, st)
+        nq, nc = int(dims[D_NQ]), int(dims[D_NC])
+        _full(0.0, np.zeros(ni), np.zeros(ni), ip, fp, ri, rf, dims, ws, np.empty(2 * ni + 1),
+              np.empty(2 * n_x + 3 * nq + nc), st)
     finally:
         timer.cancel()
     _COMPILED["done"] = True

@@ -19,6 +19,7 @@ import numpy as np
 from ..errors import ModelError
 from ..model.rows import Rows
 from .compiled import compile_mode_kernel
+from .modes import ModeEval
 
 __all__ = ["ModeEquations", "BACKENDS"]
 
@@ -90,6 +91,9 @@ class ModeEquations:
         if self.kernel is not None:
             self.kernel.reset(ms.x_ref)
         self.backend = "numba" if self.kernel is not None else "numpy"
+        # the kernel's multipliers are those of the independent rows: all of them unless
+        # the mode has redundant rows (their share is chosen on the NumPy path)
+        self._full = len(ms.independent_rows) == ms.n_rows
 
     @property
     def evaluations(self) -> int:
@@ -97,10 +101,21 @@ class ModeEquations:
         return self.kernel.evaluations if self.kernel is not None else 0
 
     def evaluate(self, t: float, qi, qdi):
-        """The full NumPy evaluation (:class:`ModeEval`: poses, rates, accelerations of
-        every declared coordinate, every multiplier) at a state of the mode."""
-        guess = self.kernel.x.copy() if self.kernel is not None else None
-        return self.ms.evaluate(t, qi, qdi, x_guess=guess)
+        """Everything at a state of the mode (:class:`ModeEval`: poses, rates,
+        accelerations of every declared coordinate, every multiplier), from the compiled
+        kernel when the mode has no redundant rows, else from the NumPy evaluation."""
+        ms = self.ms
+        if self.kernel is not None:
+            if self._full:
+                k = self.kernel.evaluation(t, qi, qdi)
+                if k is not None:
+                    lam = np.zeros(ms.n_rows)
+                    lam[ms.independent_rows] = k["lam"]
+                    return ModeEval(k["x"], k["xdot"], k["xddot"], k["q"], k["qdot"],
+                                    k["qddot"], lam, k["F"])
+            guess = self.kernel.x.copy()
+            return ms.evaluate(t, qi, qdi, x_guess=guess)
+        return ms.evaluate(t, qi, qdi)
 
     def numpy_rhs(self, t: float, qi, qdi):
         """(q_I'', array([P_nc])) on the NumPy path; raises the diagnosed error of a

@@ -10,7 +10,7 @@ import numpy as np
 
 from .rows_numba import njit
 
-__all__ = ["lu_factor", "lu_solve", "cholesky_solve"]
+__all__ = ["lu_factor", "lu_solve", "lu_solve_transposed", "cholesky_solve"]
 
 
 @njit
@@ -104,3 +104,25 @@ def cholesky_solve(A, rhs, n):
             s -= A[k, i] * rhs[k]
         rhs[i] = s / A[i, i]
     return True
+
+
+@njit
+def lu_solve_transposed(a, piv, b, n):
+    """Solve A^T z = b with the factors of ``lu_factor`` of A (b overwritten by z)."""
+    # P A = L U, so A^T = U^T L^T P: solve U^T y = b, L^T u = y, then z = P^T u
+    for r in range(n):
+        s = b[r]
+        for c in range(r):
+            s -= a[c, r] * b[c]
+        b[r] = s / a[r, r]
+    for r in range(n - 1, -1, -1):
+        s = b[r]
+        for c in range(r + 1, n):
+            s -= a[c, r] * b[c]
+        b[r] = s
+    for k in range(n - 1, -1, -1):
+        p = piv[k]
+        if p != k:
+            tmp = b[k]
+            b[k] = b[p]
+            b[p] = tmp
