@@ -156,6 +156,18 @@ def _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb):
 
 
 @njit
+def _body_inertia(fp, ob, b, x):
+    """Mass, inertia about the centre of mass and the centre-of-mass arm A(theta) c
+    (ground frame) of body b at pose x."""
+    m = fp[ob + FR_BODY * b]
+    Jc = fp[ob + FR_BODY * b + 1]
+    cx, cy = fp[ob + FR_BODY * b + 2], fp[ob + FR_BODY * b + 3]
+    th = x[3 * b + 2]
+    co, si = np.cos(th), np.sin(th)
+    return m, Jc, co * cx - si * cy, si * cx + co * cy
+
+
+@njit
 def _solve_scaled(J, piv, col, nx, nb, ls):
     lu_solve(J, piv, col, nx)
     for b in range(nb):
@@ -233,12 +245,7 @@ def _evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
     bcx = np.empty(ni)
     bcy = np.empty(ni)
     for b in range(nb):
-        m = fp[ob + FR_BODY * b]
-        Jc = fp[ob + FR_BODY * b + 1]
-        cx, cy = fp[ob + FR_BODY * b + 2], fp[ob + FR_BODY * b + 3]
-        th = x[3 * b + 2]
-        co, si = np.cos(th), np.sin(th)
-        ax, ay = co * cx - si * cy, si * cx + co * cy
+        m, Jc, ax, ay = _body_inertia(fp, ob, b, x)
         w = v[3 * b + 2]
         for i in range(ni):
             bcx[i] = Bl[(3 * b) * ni + i] - ay * Bl[(3 * b + 2) * ni + i]
@@ -332,12 +339,7 @@ def _reactions(x, v, bb, qdd, q, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, 
             s += G[k, r] * Qd[k]
         Ftot[r] = s
     for b in range(nb):
-        m = fp[ob + FR_BODY * b]
-        Jc = fp[ob + FR_BODY * b + 1]
-        cx, cy = fp[ob + FR_BODY * b + 2], fp[ob + FR_BODY * b + 3]
-        th = x[3 * b + 2]
-        co, si = np.cos(th), np.sin(th)
-        ax, ay = co * cx - si * cy, si * cx + co * cy
+        m, Jc, ax, ay = _body_inertia(fp, ob, b, x)
         w = v[3 * b + 2]
         al = xdd[3 * b + 2]
         acx = xdd[3 * b] - al * ay - w * w * ax
