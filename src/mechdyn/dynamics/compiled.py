@@ -51,7 +51,7 @@ from .forces import force_model, resolved_variable
 __all__ = ["compile_kernel", "compile_mode_kernel", "CompiledKernel", "numba_available"]
 
 #: seconds after which the first compilation is announced on stderr
-ANNOUNCE_AFTER = 1.0
+ANNOUNCE_AFTER = 2.0
 
 # dims: n_c (constraint rows), n_i (independent coordinates), n_q (declared coordinates),
 # n_v (rows of table variables); the row arrays hold these four blocks in this order
