@@ -409,7 +409,6 @@ class SwitchedModel:
 
     def __init__(self, model: Model):
         self.model = model
-        self.fm = force_model(model)
         mech = model.mechanism
         ex = mech.extras or {}
         nb = model.n_bodies
@@ -498,6 +497,7 @@ class SwitchedModel:
         if probs:
             raise ModelError(probs)
         self.lock_names = tuple(sorted(lock_names))
+        self.fm = force_model(model)
 
     # ------------------------------------------------------------------ modes
     @property

@@ -268,9 +268,20 @@ class Mechanism:
 
     @staticmethod
     def _check_loads(model):
+        """Validate the loads, drives and every switchable element (locks, stops,
+        contacts, switches with their targets, variables and guards) of a compiled
+        model; raise one ModelError listing every problem found."""
         from ..dynamics.forces import force_model
+        from ..dynamics.modes import SwitchedModel
 
-        force_model(model)  # raises one ModelError listing every bad load or drive
+        probs: list[str] = []
+        for check in (force_model, SwitchedModel):
+            try:
+                check(model)
+            except ModelError as exc:
+                probs.extend(p for p in exc.problems if p not in probs)
+        if probs:
+            raise ModelError(probs)
         return model
 
     def __repr__(self) -> str:
