@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from mechdyn import Mechanism, ModelError, SingularPositionError
+from mechdyn.kernels import rows_numba
 from mechdyn.kinematics import branch_sign, residual
 from mechdyn.kinematics._sweep_kernel import Kernel
 from mechdyn.kinematics.constraints import coordinates
@@ -264,17 +265,21 @@ def test_kernel_jacobian_and_gamma_are_derivatives_of_its_residual(mode):
     assert np.max(np.abs(kern.gamma(x[None], v[None])[0] + rate)) < 1e-9
 
 
-def test_kernel_single_position_path_equals_the_batched_path():
+def test_kernel_paths_agree_single_and_batched_compiled_and_numpy():
     model = every_joint_model()
     kern = Kernel(model, model.layout())
     rng = np.random.default_rng(8)
     x = rng.normal(size=(3, model.n_x))
     q = rng.normal(size=(3, model.n_q))
     v = rng.normal(size=(3, model.n_x))
+    kern.compiled = False  # the NumPy evaluator, as without numba
     F, J = kern.system(x, q)
     g = kern.gamma(x, v)
-    for compiled in (kern.compiled, False):  # the compiled evaluator, and without numba
+    for compiled in sorted({False, rows_numba.NUMBA}):
         kern.compiled = compiled
+        Fc, Jc = kern.system(x, q)
+        assert np.allclose(Fc, F, rtol=0, atol=1e-15) and np.allclose(Jc, J, rtol=0, atol=1e-15)
+        assert np.allclose(kern.gamma(x, v), g, rtol=0, atol=1e-14)
         for k in range(3):
             F1, J1 = kern.system1(x[k], q[k])
             assert np.allclose(F1, F[k], rtol=0, atol=1e-15)

@@ -4,18 +4,20 @@ The position problem of :mod:`mechdyn.kinematics.sweep` stacks the constraint
 rows and the coordinate rows of a model into one :class:`~mechdyn.model.rows.Rows`
 (``n_rows`` constraint rows, then ``n_q`` coordinate rows) and solves
 F(x) = [Phi(x); g(x) - q] = 0.  These helpers evaluate F, its Jacobian and the
-acceleration right-hand side -quad at one pose with the compiled evaluators of
-:mod:`mechdyn.kernels.rows_numba`, in one call, where NumPy's per-call overhead
-would dominate (the sequential continuation).  They contain no formulas of
-their own.  Use them only when ``rows_numba.NUMBA`` is True: without numba they
-run as (slow) plain Python.
+acceleration right-hand side -quad with the compiled evaluators of
+:mod:`mechdyn.kernels.rows_numba`, at one pose or over a batch, in one call:
+for one pose NumPy's per-call overhead would dominate (the sequential
+continuation), and over a batch the compiled loop avoids NumPy's temporaries
+(one array per intermediate quantity).  They contain no formulas of their own.
+Use them only when ``rows_numba.NUMBA`` is True: without numba they run as
+(slow) plain Python.
 """
 
 from __future__ import annotations
 
 from .rows_numba import njit, rows_jacobian, rows_quad, rows_values
 
-__all__ = ["system1", "gamma1"]
+__all__ = ["system1", "gamma1", "system_batch", "gamma_batch"]
 
 
 @njit
@@ -54,3 +56,18 @@ def gamma1(x, xdot, nb, ints, flts, out):
     for k in range(out.shape[0]):
         out[k] = -out[k]
 
+
+
+@njit
+def system_batch(x, q, nb, ints, flts, n_rows, F, J):
+    """:func:`system1` at every pose of a batch: x (N, n_x), q (N, n_q), into F (N, n_eq)
+    and J (N, n_eq, n_x) (zeroed by the caller)."""
+    for i in range(x.shape[0]):
+        system1(x[i], q[i], nb, ints, flts, n_rows, F[i], J[i])
+
+
+@njit
+def gamma_batch(x, xdot, nb, ints, flts, out):
+    """:func:`gamma1` at every pose of a batch: x, xdot (N, n_x), into out (N, n_eq)."""
+    for i in range(x.shape[0]):
+        gamma1(x[i], xdot[i], nb, ints, flts, out[i])

@@ -7,10 +7,11 @@ right-hand side [gamma; gamma_g] = -quad, the same rows that
 formulas; it only evaluates the rows where each evaluator is cheapest and
 solves with their Jacobian:
 
-* batches of positions go to :mod:`mechdyn.kernels.rows_numpy`;
-* a single position (the sequential continuation), where NumPy's per-call
-  overhead would dominate, goes to the compiled :mod:`mechdyn.kernels.rows_sweep`
-  (the NumPy evaluator when numba is not installed);
+* with numba, one position (the sequential continuation, where NumPy's per-call
+  overhead would dominate) and batches (where NumPy's temporaries cost more
+  than the compiled loop) go to the compiled drivers of
+  :mod:`mechdyn.kernels.rows_sweep`; without numba, to the NumPy evaluator
+  :mod:`mechdyn.kernels.rows_numpy`;
 * batched linear solves exploit the sparsity of the Jacobian: rows and columns
   are permuted to block-triangular form (a maximum matching followed by the
   strongly connected components, as in the Dulmage-Mendelsohn decomposition),
@@ -29,7 +30,7 @@ from scipy.linalg import lapack
 from scipy.sparse import csr_array
 from scipy.sparse.csgraph import connected_components, maximum_bipartite_matching
 
-from ..kernels import rows_numba, rows_numpy, rows_sweep
+from ..kernels import rows_numpy
 from ..model import ConstraintLayout, Model
 from ..model.rows import concat
 from .assembly import _scale
@@ -235,15 +236,20 @@ def _inverse4(A):
     return inv, np.sign(det)
 
 
+def _c(a) -> np.ndarray:
+    """A C-contiguous float array (one compiled specialization for every caller)."""
+    return np.ascontiguousarray(a, dtype=float)
+
+
 class Kernel:
     """Residual, Jacobian and gamma of the position problem of one model and layout.
 
     The equations are the rows of the layout (joints, then engaged locks) followed
-    by the coordinate rows, F(x) = [Phi(x); g(x) - q], evaluated by
-    :mod:`mechdyn.kernels.rows_numpy` (batches) or :mod:`mechdyn.kernels.rows_sweep`
-    (compiled, one position; NumPy without numba).  Batched methods take 2-D
-    arrays: ``x`` (N, n_x), ``q`` (N, n_q); the ``*1`` methods take one position
-    (1-D arrays).
+    by the coordinate rows, F(x) = [Phi(x); g(x) - q], evaluated by the compiled
+    drivers of :mod:`mechdyn.kernels.rows_sweep` (or, when numba is not installed
+    or ``compiled`` is set to False, by :mod:`mechdyn.kernels.rows_numpy`).
+    Batched methods take 2-D arrays: ``x`` (N, n_x), ``q`` (N, n_q); the ``*1``
+    methods take one position (1-D arrays).
 
     Parameters
     ----------
@@ -265,6 +271,10 @@ class Kernel:
         #: the rows of F: the layout's constraint rows, then the coordinate rows
         self.rows = concat(nb, layout.rowset, model.coordinate_rows)
         self._ints, self._flts = self.rows.packed()
+        from ..kernels import rows_numba, rows_sweep  # numba is imported only here
+
+        self._drivers = rows_sweep
+        #: evaluate with the compiled drivers (numba installed), else with NumPy
         self.compiled = rows_numba.NUMBA
 
         # ---- sparsity pattern and block-triangular solver
@@ -279,16 +289,31 @@ class Kernel:
             self.blocks = None
 
     # ------------------------------------------------------------------ batched
-    def system(self, x, q):
-        """F (N, n_eq) (m or rad) and J (N, n_eq, n_x) at poses x (N, n_x), q (N, n_q)."""
+    def _system_numpy(self, x, q):
+        """F and J by the NumPy evaluator, for one pose or a batch."""
         p = rows_numpy.parts(self.rows, x)
         F = rows_numpy.values(self.rows, x, p)
-        F[:, self.n_rows:] -= q
+        F[..., self.n_rows:] -= q
         return F, rows_numpy.jacobian(self.rows, x, p)
+
+    def system(self, x, q):
+        """F (N, n_eq) (m or rad) and J (N, n_eq, n_x) at poses x (N, n_x), q (N, n_q)."""
+        if not self.compiled:
+            return self._system_numpy(x, q)
+        N = x.shape[0]
+        F = np.empty((N, self.n_eq))
+        J = np.zeros((N, self.n_eq, self.n_x))
+        self._drivers.system_batch(_c(x), _c(q), self.nb, self._ints, self._flts,
+                                   self.n_rows, F, J)
+        return F, J
 
     def gamma(self, x, xdot):
         """[gamma; gamma_g] (N, n_eq): [Phi_x; g_x] xddot = this + [0; qddot]."""
-        return -rows_numpy.quad(self.rows, x, xdot)
+        if not self.compiled:
+            return -rows_numpy.quad(self.rows, x, xdot)
+        out = np.empty((x.shape[0], self.n_eq))
+        self._drivers.gamma_batch(_c(x), _c(xdot), self.nb, self._ints, self._flts, out)
+        return out
 
     def solve(self, J, rhs):
         """y with J y = rhs for J (N, n_eq, n_x), rhs (N, n_eq, k) -> (N, n_x, k)."""
@@ -340,13 +365,10 @@ class Kernel:
     def system1(self, x, q):
         """F (n_eq,) and J (n_eq, n_x) at one position, x (n_x,), q (n_q,)."""
         if not self.compiled:
-            F, J = rows_numpy.values(self.rows, x), rows_numpy.jacobian(self.rows, x)
-            F[self.n_rows:] -= q
-            return F, J
+            return self._system_numpy(x, q)
         F = np.empty(self.n_eq)
         J = np.zeros((self.n_eq, self.n_x))
-        rows_sweep.system1(np.asarray(x, float), np.asarray(q, float), self.nb, self._ints,
-                           self._flts, self.n_rows, F, J)
+        self._drivers.system1(_c(x), _c(q), self.nb, self._ints, self._flts, self.n_rows, F, J)
         return F, J
 
     def gamma1(self, x, xdot):
@@ -354,8 +376,7 @@ class Kernel:
         if not self.compiled:
             return -rows_numpy.quad(self.rows, x, xdot)
         out = np.empty(self.n_eq)
-        rows_sweep.gamma1(np.asarray(x, float), np.asarray(xdot, float), self.nb, self._ints,
-                          self._flts, out)
+        self._drivers.gamma1(_c(x), _c(xdot), self.nb, self._ints, self._flts, out)
         return out
 
     def factor1(self, J, want_sign: bool = True):
