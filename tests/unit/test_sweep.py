@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 from mechdyn import Mechanism, ModelError, SingularPositionError
+from mechdyn.kernels import rows_numba
 from mechdyn.kinematics import branch_sign, residual
 from mechdyn.kinematics._sweep_kernel import Kernel
-from mechdyn.kinematics.constraints import coordinates_gamma, gamma, system
+from mechdyn.kinematics.constraints import coordinates
 from mechdyn.kinematics.sweep import (
     KinematicSweep,
     _anchor_indices,
@@ -239,24 +240,51 @@ def test_quintic_hermite_is_exact_for_quintics():
 
 
 @pytest.mark.parametrize("mode", [frozenset(), frozenset({"L"})])
-def test_kernel_equals_the_constraint_functions(mode):
+def test_kernel_jacobian_and_gamma_are_derivatives_of_its_residual(mode):
+    # the kernel's own consistency: J = dF/dx and gamma = -d2F/dt2 along x + v t,
+    # by fourth-order central differences (the joint formulas are the rows' own)
     model = every_joint_model()
     lay = model.layout(mode)
     kern = Kernel(model, lay)
+    assert kern.rows.labels == lay.rowset.labels + model.coordinate_rows.labels
     rng = np.random.default_rng(5)
-    x = rng.normal(size=(7, model.n_x))
-    q = rng.normal(size=(7, model.n_q))
-    v = rng.normal(size=(7, model.n_x))
+    x, q, v = rng.normal(size=model.n_x), rng.normal(size=model.n_q), rng.normal(size=model.n_x)
+    h = 1e-3
+
+    def d(f):
+        return (8.0 * (f(h) - f(-h)) - (f(2 * h) - f(-2 * h))) / (12.0 * h)
+
+    F, J = kern.system(x[None], q[None])
+    assert np.allclose(F[0, lay.n_rows:] + q, coordinates(model, x), rtol=0, atol=1e-15)
+    E = np.eye(model.n_x)
+    J_fd = np.stack([d(lambda t, e=e: kern.system((x + t * e)[None], q[None])[0][0])
+                     for e in E], axis=1)
+    assert np.max(np.abs(J[0] - J_fd)) < 1e-9
+    # F(x + v t) has second derivative (J v)' = -gamma at zero acceleration
+    rate = d(lambda t: kern.system((x + t * v)[None], q[None])[1][0] @ v)
+    assert np.max(np.abs(kern.gamma(x[None], v[None])[0] + rate)) < 1e-9
+
+
+def test_kernel_paths_agree_single_and_batched_compiled_and_numpy():
+    model = every_joint_model()
+    kern = Kernel(model, model.layout())
+    rng = np.random.default_rng(8)
+    x = rng.normal(size=(3, model.n_x))
+    q = rng.normal(size=(3, model.n_q))
+    v = rng.normal(size=(3, model.n_x))
+    kern.compiled = False  # the NumPy evaluator, as without numba
     F, J = kern.system(x, q)
-    F0, J0 = system(model, x, q, lay)
-    assert np.allclose(J, J0, rtol=0, atol=1e-15) and np.allclose(F, F0, rtol=0, atol=1e-15)
-    g0 = np.concatenate([gamma(model, x, v, lay), coordinates_gamma(model, x, v)], axis=-1)
-    assert np.allclose(kern.gamma(x, v), g0, rtol=0, atol=1e-14)
-    for k in range(3):
-        F1, J1 = kern.system1(x[k], q[k])
-        assert np.allclose(J1, J0[k], rtol=0, atol=1e-15)
-        assert np.allclose(F1, F0[k], rtol=0, atol=1e-15)
-        assert np.allclose(kern.gamma1(x[k], v[k]), g0[k], rtol=0, atol=1e-14)
+    g = kern.gamma(x, v)
+    for compiled in sorted({False, rows_numba.NUMBA}):
+        kern.compiled = compiled
+        Fc, Jc = kern.system(x, q)
+        assert np.allclose(Fc, F, rtol=0, atol=1e-15) and np.allclose(Jc, J, rtol=0, atol=1e-15)
+        assert np.allclose(kern.gamma(x, v), g, rtol=0, atol=1e-14)
+        for k in range(3):
+            F1, J1 = kern.system1(x[k], q[k])
+            assert np.allclose(F1, F[k], rtol=0, atol=1e-15)
+            assert np.allclose(J1, J[k], rtol=0, atol=1e-15)
+            assert np.allclose(kern.gamma1(x[k], v[k]), g[k], rtol=0, atol=1e-14)
 
 
 def test_block_triangular_solve_and_sign_equal_dense_ones():

@@ -11,11 +11,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ModelError
 from ..kernels import rows_numpy
 from ..model import ConstraintLayout, Model
+from ..model import rows as R
 
 __all__ = ["residual", "jacobian", "gamma", "coordinates", "coordinates_jacobian",
-           "coordinates_gamma", "system", "point_position", "point_velocity",
+           "coordinates_gamma", "system", "travel_rows", "point_position", "point_velocity",
            "point_acceleration", "extend"]
 
 
@@ -36,10 +38,6 @@ def _rot(th, s):
 def _perp(v):
     """Rotate vectors (..., 2) by +90 deg."""
     return np.stack([-v[..., 1], v[..., 0]], axis=-1)
-
-
-def _dot(a, b):
-    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
 
 
 def residual(model: Model, x, layout: ConstraintLayout | None = None) -> np.ndarray:
@@ -78,6 +76,27 @@ def system(model: Model, x, q, layout: ConstraintLayout | None = None):
     F = np.concatenate([residual(model, x, lay), coordinates(model, x) - q], axis=-1)
     J = np.concatenate([jacobian(model, x, lay), coordinates_jacobian(model, x)], axis=-2)
     return F, J
+
+
+def travel_rows(model: Model, joint: str) -> R.Rows:
+    """The travel of a prismatic joint as one row, u . (r_P - r_O) (m), for the evaluators.
+
+    r_P is the child point, r_O the parent point of the line and u the axis turned
+    with the parent: the row a travel coordinate on ``joint`` lowers to, without
+    its offset.
+
+    Raises
+    ------
+    ModelError
+        If ``joint`` is not a prismatic joint.
+    """
+    if model.joint_kind(joint) != "prismatic":
+        raise ModelError(f"joint {joint!r} is not a prismatic joint; prismatic joints: "
+                         + (", ".join(repr(v) for v in model.pri.names) or "(none)"))
+    pr = model.pri
+    k = pr.names.index(joint)
+    return R.line(joint, pr.j[k], pr.sj[k], pr.i[k], pr.si[k], pr.ui[k], normal=False,
+                  nb=model.n_bodies)
 
 
 # ---------------------------------------------------------------- points

@@ -15,10 +15,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import ModelError
+from ..kernels import rows_numpy
 from ..model import Model
 from .assembly import _position_tol
-from .constraints import _dot, _point_kinematics, point_position
+from .constraints import point_position, travel_rows
 from .continuation import _kernel, _newton1, _node
 
 if TYPE_CHECKING:
@@ -149,33 +149,14 @@ class SweepSummary:
 def _travel(model: Model, joint: str, x, xdot, xddot):
     """Travel s of a prismatic joint's child point along the parent's axis, and its rates.
 
-    s = u . (r_P - r_O): r_P the child point, r_O the parent point of the line, u the axis.
+    s = u . (r_P - r_O) (the joint's travel row, :func:`~.constraints.travel_rows`),
+    s' = s_x xdot and s'' = s_x xddot + quad, at poses x (..., n_x); each (...,), in m,
+    m/s and m/s^2 (or per unit and per unit squared of a coordinate for analogs).
     """
-    if model.joint_kind(joint) != "prismatic":
-        valid = list(model.pri.names)
-        raise ModelError(f"joint {joint!r} is not a prismatic joint; prismatic joints: "
-                         + (", ".join(repr(v) for v in valid) or "(none)"))
-    p = model.pri.names.index(joint)
-    jn = model.mechanism.joints[joint]
-    x, xdot, xddot = (np.asarray(v, float) for v in (x, xdot, xddot))
-    rP, vP, aP = _point_kinematics(model, x, xdot, xddot, jn.child, jn.child_point)
-    if jn.parent == "ground" or model.body_index(jn.parent) == model.n_bodies:
-        rO = np.broadcast_to(model.pri.si[p], rP.shape)
-        vO = aO = np.zeros_like(rP)
-        th = w = al = np.zeros(rP.shape[:-1])
-    else:
-        rO, vO, aO = _point_kinematics(model, x, xdot, xddot, jn.parent, jn.parent_point)
-        k = 3 * model.body_index(jn.parent) + 2
-        th, w, al = x[..., k], xdot[..., k], xddot[..., k]
-    ui = model.pri.ui[p]
-    u = np.stack([np.cos(th) * ui[0] - np.sin(th) * ui[1],
-                  np.sin(th) * ui[0] + np.cos(th) * ui[1]], axis=-1)
-    n = np.stack([-u[..., 1], u[..., 0]], axis=-1)
-    d, dd, ddd = rP - rO, vP - vO, aP - aO
-    s = _dot(u, d)
-    sd = w * _dot(n, d) + _dot(u, dd)
-    sdd = al * _dot(n, d) - w**2 * _dot(u, d) + 2 * w * _dot(n, dd) + _dot(u, ddd)
-    return s, sd, sdd
+    xdot, xddot = np.asarray(xdot, float), np.asarray(xddot, float)
+    s, s_x, quad = rows_numpy.evaluate(travel_rows(model, joint), x, xdot)
+    s_x = s_x[..., 0, :]
+    return s[..., 0], np.sum(s_x * xdot, axis=-1), np.sum(s_x * xddot, axis=-1) + quad[..., 0]
 
 
 def four_bar_loops(model: Model, over: str | None = None) -> list[FourBarLoop]:

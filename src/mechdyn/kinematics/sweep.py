@@ -27,10 +27,11 @@ How it is computed (vectorized over the positions):
 3. *Velocities and accelerations* of all positions in one batched solve:
    ``xdot = B qdot`` and ``xddot = B qddot + b(x, xdot)`` (here ``qddot = 0``).
 
-The residual, Jacobian and acceleration right-hand side are the exact
-equations of :mod:`mechdyn.kinematics.constraints`, evaluated by a private
-kernel that precomputes the sparsity pattern of the Jacobian (the result is
-identical; it is only cheaper per call).
+The residual, Jacobian and acceleration right-hand side are the model's
+constraint and coordinate rows (:mod:`mechdyn.model.rows`), the equations of
+:mod:`mechdyn.kinematics.constraints`, evaluated by a private kernel
+(compiled when numba is installed) that also solves with the block-triangular
+structure of the Jacobian.
 
 This module holds the analyses :func:`sweep` and :func:`analyze`; the building
 blocks of the continuation are in :mod:`mechdyn.kinematics.continuation`, the

@@ -35,6 +35,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import MechdynError, ModelError
+from ..kernels import rows_numpy
+from ..kinematics.constraints import travel_rows
 
 __all__ = ["animate", "snapshot", "frame_geometry", "frame_indices", "check_animation_path",
            "MechanismDrawing"]
@@ -140,7 +142,7 @@ def _drawing(model, x: np.ndarray) -> MechanismDrawing:
                 a = -model.pri.angle[k]
                 ca, sa = np.cos(a), np.sin(a)
                 guided[j.child] = (np.array([ca * u[0] - sa * u[1], sa * u[0] + ca * u[1]]), 0.0)
-            guides[name] = (j.parent, pp, u, j.child, cp)
+            guides[name] = (j.parent, pp, u, j.child)
 
     span = _extent(model, x, pts)
     size = 0.035 * span
@@ -164,17 +166,10 @@ def _drawing(model, x: np.ndarray) -> MechanismDrawing:
                 bodies[b] = (c[None, :], "disc")
     # guide segments: the travel range of the child point over the motion, plus margins
     out_guides = {}
-    for name, (parent, pp, u, child, cp) in guides.items():
+    for name, (parent, pp, u, child) in guides.items():
         if child == ground or parent == child:
             continue
-        r_c = _world(model, x, child, cp[None, :])[:, 0]
-        r_o = _world(model, x, parent, pp[None, :])[:, 0]
-        if parent == ground:
-            u_w = np.broadcast_to(u, r_c.shape)
-        else:
-            th = x[:, 3 * model.body_index(parent) + 2]
-            u_w = _rot(th, u[None, :])[:, 0]
-        s = np.einsum("ij,ij->i", r_c - r_o, u_w)
+        s = rows_numpy.values(travel_rows(model, name), x)[:, 0]
         lo, hi = float(np.min(s)), float(np.max(s))
         m = max(2.5 * size, 0.1 * (hi - lo))
         out_guides[name] = (parent, np.array([pp + (lo - m) * u, pp + (hi + m) * u]))
