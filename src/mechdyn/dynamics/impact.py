@@ -102,9 +102,11 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     xdot_minus = np.asarray(xdot_minus, float)
     base = ModeSystem(sm, frozenset(locks_before), targets, x)
     B, _ = base.velocity_analogs(x)
-    M, _ = mass_matrix_x(model, x)
+    G_all = base._coord_jac(x)
+    # bodies, plus the rotors and gears of the drives reduced to their coordinates
+    M, _ = sm.with_drive_inertia(*mass_matrix_x(model, x), G_all, np.zeros(model.n_q))
     A = B.T @ M @ B
-    G = base._coord_jac(x)[base.coords]
+    G = G_all[base.coords]
     qd_minus = G @ xdot_minus
     new_locks = frozenset(locks_after) - frozenset(locks_before)
     rows_b = sm.rows(new_locks, targets) if new_locks else []

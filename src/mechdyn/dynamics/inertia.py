@@ -9,7 +9,7 @@ from ..kinematics.constraints import _perp
 from ..model import Model
 from .forces import com_arms, cross
 
-__all__ = ["frame_mass_matrix", "inertia_forces"]
+__all__ = ["frame_mass_matrix", "inertia_forces", "drive_inertia"]
 
 
 def frame_mass_matrix(model: Model, x) -> np.ndarray:
@@ -59,3 +59,13 @@ def inertia_forces(model: Model, x, xdot, xddot) -> np.ndarray:
     mom = model.inertia * W[..., 2] + cross(a, f)
     return np.concatenate([f, mom[..., None]], axis=-1).reshape(batch + (model.n_x,))
 
+
+def drive_inertia(model: Model) -> np.ndarray:
+    """Inertia the drives add to their own coordinates (rotor and gears reduced to the
+    coordinate, ``extra_inertia()`` of a drive's torque object), shape (n_q,), kg m^2."""
+    out = np.zeros(model.n_q)
+    for dr in model.mechanism.drives:
+        fn = getattr(dr.torque, "extra_inertia", None)
+        if fn is not None and dr.coordinate in model.coordinate_names:
+            out[model.coordinate_index(dr.coordinate)] += float(fn())
+    return out

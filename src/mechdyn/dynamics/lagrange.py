@@ -45,6 +45,7 @@ from ..kinematics.assembly import solve_position
 from ..kinematics.constraints import coordinates_jacobian, extend, jacobian, residual
 from ..model import Model
 from .forces import com_arms, force_model
+from .inertia import drive_inertia
 
 __all__ = ["EquationsOfMotion", "Terms", "FORMULATIONS", "equations_of_motion", "drive_inertia",
            "com_analogs", "kinetic_energy", "potential_energy", "mass_matrix"]
@@ -150,17 +151,6 @@ def kinetic_energy(model: Model, x, xdot) -> np.ndarray:
 def potential_energy(model: Model, x) -> np.ndarray:
     """Potential energy of gravity and springs, J, shape (...) (batched over poses)."""
     return force_model(model).potential_energy(x)
-
-
-def drive_inertia(model: Model) -> np.ndarray:
-    """Inertia the drives add to their own coordinates (rotor and gears reduced to the
-    coordinate, ``extra_inertia()`` of a drive's torque object), shape (n_q,), kg m^2."""
-    out = np.zeros(model.n_q)
-    for dr in model.mechanism.drives:
-        fn = getattr(dr.torque, "extra_inertia", None)
-        if fn is not None and dr.coordinate in model.coordinate_names:
-            out[model.coordinate_index(dr.coordinate)] += float(fn())
-    return out
 
 
 def _full_jacobian(model, x, lay):

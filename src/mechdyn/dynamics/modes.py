@@ -40,6 +40,7 @@ from ..errors import AssemblyError, ModelError, did_you_mean
 from ..kinematics.constraints import extend, jacobian, residual
 from ..model import COORD_ANGLE, COORD_RELATIVE, Model
 from .forces import force_model
+from .inertia import drive_inertia
 
 __all__ = ["Measure", "parse_variable", "SwitchedModel", "Row", "ModeSystem", "ModeEval",
            "mass_matrix_x", "mode_locks", "mode_unilateral", "mode_friction"]
@@ -498,6 +499,19 @@ class SwitchedModel:
             raise ModelError(probs)
         self.lock_names = tuple(sorted(lock_names))
         self.fm = force_model(model)
+        self.drive_inertia = drive_inertia(model)
+
+    def with_drive_inertia(self, M, h, G, quad_g):
+        """M and h with the rotor and gear inertia J_e of every drive on its coordinate k:
+        the kinetic energy 1/2 J_e qdot_k^2 adds J_e g_k^T g_k to M and J_e quad_k g_k to h
+        (g_k the coordinate's gradient, quad_k its velocity-quadratic term)."""
+        if not self.drive_inertia.any():
+            return M, h
+        for k in np.flatnonzero(self.drive_inertia):
+            je = self.drive_inertia[k]
+            M = M + je * np.outer(G[k], G[k])
+            h = h + je * quad_g[k] * G[k]
+        return M, h
 
     # ------------------------------------------------------------------ modes
     @property
@@ -1041,7 +1055,7 @@ class ModeSystem:
         qdot = G @ xdot
         F, Qd = self.sm.fm.applied(t, x, xdot, q, qdot)
         F = F + G.T @ Qd
-        M, h = mass_matrix_x(model, x, xdot)
+        M, h = self.sm.with_drive_inertia(*mass_matrix_x(model, x, xdot), G, quad_g)
         Reff = R.copy()
         for k, r in enumerate(self.rows):
             if r.slip:
@@ -1077,7 +1091,7 @@ class ModeSystem:
         qdot = G @ xdot
         F, Qd, Fc = sm.fm.applied_and_conservative(t, x, xdot, q, qdot)
         F = F + G.T @ Qd
-        M, h = mass_matrix_x(model, x, xdot)
+        M, h = self.sm.with_drive_inertia(*mass_matrix_x(model, x, xdot), G, quad_g)
         Reff = R
         if self._slip_batch is not None:
             Reff = R.copy()
@@ -1141,12 +1155,13 @@ class ModeSystem:
         q, qdot = self.coordinates(x), G @ xdot
         F, Qd = self.sm.fm.applied(t, x, xdot, q, qdot)
         F = F + G.T @ Qd
-        M, h = mass_matrix_x(model, x, xdot)
+        M, h = self.sm.with_drive_inertia(*mass_matrix_x(model, x, xdot), G, quad_g)
         return dict(B=B, b=b, A=B.T @ M @ B, f=B.T @ (F - h - M @ b), M=M, F=F, h=h)
 
     def kinetic_energy(self, x, xdot) -> float:
-        """T = 1/2 xdot^T M xdot, J."""
-        M, _ = mass_matrix_x(self.model, x)
+        """T = 1/2 xdot^T M xdot of the bodies and the drives' rotors and gears, J."""
+        M, _ = self.sm.with_drive_inertia(*mass_matrix_x(self.model, x), self._coord_jac(x),
+                                          np.zeros(self.model.n_q))
         return 0.5 * float(xdot @ M @ xdot)
 
 
