@@ -247,8 +247,25 @@ def _turning_point_check(eom: EquationsOfMotion, step, qd_old, x_good):
     return None
 
 
+def _keywords_without_effect(integrator, rtol, atol, formulation, d) -> float:
+    """Warn (IntegratorWarning, naming them) about keywords that would have no effect;
+    returns rtol with its default filled in."""
+    name = integrator.lower() if isinstance(integrator, str) else getattr(integrator, "name", "")
+    if name in ("wilson", "rk4"):
+        given = [k for k, v in (("rtol", rtol), ("atol", atol)) if v is not None]
+        if given:
+            warnings.warn(f"option(s) {', '.join(given)} have no effect with the fixed-step "
+                          f"integrator {name!r} (it takes steps or dt)", IntegratorWarning,
+                          stacklevel=3)
+    if d is not None and formulation == "exact":
+        warnings.warn("option d (the virtual displacement) has no effect with "
+                      "formulation='exact'; it belongs to formulation='analogs'",
+                      IntegratorWarning, stacklevel=3)
+    return DEFAULT_RTOL if rtol is None else rtol
+
+
 def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | None = None,
-             dt: float | None = None, rtol: float = DEFAULT_RTOL, atol=None, q0=None, qdot0=None,
+             dt: float | None = None, rtol: float | None = None, atol=None, q0=None, qdot0=None,
              t_eval=None, formulation: str = "exact", d=None, progress: bool | None = None,
              events=None, t0: float = 0.0, mode=None, backend: str = "auto",
              iterations: int | None = None, tol: float | None = None,
@@ -319,6 +336,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
     if not math.isfinite(t_end_f) or t_end_f < t0 or t_end_f < 0:
         raise IntegratorOptionError(f"`t_end` must be finite and >= t0 = {t0:g} s, "
                                     f"got {t_end!r}")
+    rtol = _keywords_without_effect(integrator, rtol, atol, formulation, d)
     if formulation not in FORMULATIONS:
         raise IntegratorOptionError(f"unknown formulation {formulation!r}; valid formulations: "
                                     + ", ".join(FORMULATIONS))
@@ -457,7 +475,8 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
              **integ.stats.as_dict(), "evaluations": eom.total_evaluations - eval0,
              "integrator_evaluations": integ.stats.evaluations, "wall_time_s": wall,
              "setup_time_s": t_compile, "settings": integ.settings(),
-             "mode": sorted(lay.mode)}
+             "mode": sorted(lay.mode), "rtol": getattr(integ, "rtol", None),
+             "atol": getattr(integ, "atol", None)}
     if eom.kernel is not None:
         stats["compile_time_s"] = eom.kernel.compile_time
     elif eom.backend_note:

@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import math
 import time
-import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -58,7 +57,7 @@ from .errors import (
     SingularPositionError,
     did_you_mean,
 )
-from .integrate.base import DEFAULT_RTOL, Integrator, IntegratorOptionError, IntegratorWarning
+from .integrate.base import DEFAULT_RTOL, Integrator, IntegratorOptionError
 from .integrate.driver import INTEGRATORS, make_integrator
 from .integrate.events import EventRecord, as_events
 from .integrate.scipy_ivp import ScipyIntegrator
@@ -247,8 +246,9 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     max_step : float, optional
         Largest step, s.
     dt_out : float, optional
-        Output sampling interval, s (default (t_end - t0) / 500).  Samples are
-        also stored just before and just after every event.
+        Output sampling interval, s (default: every accepted step, as a
+        fixed-structure run).  Samples are also stored just before and just after
+        every event.
     t_eval : array_like, optional
         Explicit output times (instead of ``dt_out``).
     method : str or Integrator
@@ -319,8 +319,11 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     if zeno_time is None:
         zeno_time = 1e-4 * (t_end - t0)
     last_impact: dict = {}
-    if t_eval is None:
-        h_out = dt_out if dt_out is not None else (t_end - t0) / 500.0
+    every_step = t_eval is None and dt_out is None  # as a fixed-structure run
+    if every_step:
+        t_eval = np.zeros(0)
+    elif t_eval is None:
+        h_out = dt_out
         n = int(math.floor((t_end - t0) / h_out + 1e-9))
         t_eval = t0 + h_out * np.arange(n + 1)
         if t_eval[-1] < t_end - 1e-12 * max(1.0, abs(t_end)):
@@ -481,6 +484,9 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                     next_out += 1
                 if hit is not None:
                     break
+                if every_step:
+                    store(t_new, ms, ev_new, float(y_new[-1]))
+                    penetration = max(penetration, _penetration(sm, ev_new.x, ms))
                 for e, g in zip(efns, gs, strict=True):
                     if g > 0 and (not e.fresh or g > e.arm):
                         e.armed = True
@@ -595,12 +601,8 @@ def _segment_integrators(method, t0, t_end, *, rtol, atol, dt, steps, iterations
         raise IntegratorOptionError(f"unknown integrator {method!r}; valid integrator names: "
                                     + ", ".join(INTEGRATORS))
     if name in ("wilson", "rk4"):
-        make_integrator(name, **fixed)  # validates the options
-        given = [k for k, v in (("first_step", first_step), ("max_step", max_step))
-                 if v is not None]
-        if given:
-            warnings.warn(f"option(s) {', '.join(given)} have no effect with the fixed-step "
-                          f"integrator {name!r}", IntegratorWarning, stacklevel=4)
+        # the same validation as a fixed-structure run (first_step, max_step are refused)
+        make_integrator(name, first_step=first_step, max_step=max_step, **fixed)
         h = fixed["dt"] if fixed["dt"] is not None else (t_end - t0) / (fixed["steps"] or 100)
         opts = {k: fixed[k] for k in ("iterations", "tol", "theta") if name == "wilson"}
 

@@ -48,7 +48,8 @@ def register(sub) -> None:
     s.add_argument("--t-end", metavar="TIME", help="end time of the run, e.g. 0.05s")
     s.add_argument("--integrator", default="dop853", metavar="NAME",
                    help="integrator (default dop853; see `mechdyn simulate --help`)")
-    s.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance (default 1e-8)")
+    s.add_argument("--rtol", type=float,
+                   help="relative tolerance of the adaptive integrators (default 1e-10)")
     d = p.add_argument_group("drawing")
     d.add_argument("--trace", metavar="BODY.POINT", help="draw the path of this point")
     d.add_argument("--fps", type=int, default=25, help="frames per second (default 25)")

@@ -42,8 +42,9 @@ def register(sub) -> None:
                    help=f"one of {', '.join(INTEGRATORS)} (default dop853)")
     p.add_argument("--steps", type=int, metavar="N", help="steps of wilson / rk4")
     p.add_argument("--dt", metavar="TIME", help="step size of wilson / rk4")
-    p.add_argument("--rtol", type=float, default=DEFAULT_RTOL,
-                   help=f"relative tolerance (default {DEFAULT_RTOL:g})")
+    p.add_argument("--rtol", type=float,
+                   help=f"relative tolerance of the adaptive integrators (default "
+                   f"{DEFAULT_RTOL:g})")
     p.add_argument("--atol", type=float, help="absolute tolerance (default 1e-3 rtol)")
     p.add_argument("--theta", type=float, help="Wilson theta (1 or >= 1.37)")
     p.add_argument("--iterations", type=int, help="corrector passes of wilson (default 4)")
