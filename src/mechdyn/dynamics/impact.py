@@ -52,9 +52,12 @@ class ImpactResult:
         Impulse of each row (N s, or N m s for angular rows) by row label;
         joint rows are labelled ``"O.x"``, ``"O.y"``, ....
     element_impulses : dict
-        For each joint or lock, the impulse (Px, Py, L) on its child body from
-        its parent (N s, N s, N m s about the child frame origin); for each
-        stop or contact, the normal impulse (N s).
+        For each joint or weld lock, the impulse on its child body from its
+        parent at the joint point, ground frame (:func:`~mechdyn.dynamics.reactions.
+        element_forces`): (Px, Py) N s for a revolute joint, (Px, Py, L) N s, N s,
+        N m s for a prismatic joint or a weld (L about the child frame origin, the
+        weld's point); for each coordinate lock, stop or contact, the impulse of
+        its row (N s or N m s).
     velocity_before, velocity_after : dict
         Rate of each new row (m/s or rad/s) before and after the impact.
     """

@@ -1,8 +1,15 @@
-"""Joint reactions and driving torques of a prescribed motion: the batched solve for
-the Lagrange multipliers, the reactions in the ground and the joint frames, the loads
-the frame receives, and the redundancy check; and the forces of the elements of a
-mode of a forward run from its multipliers (:func:`element_forces`,
-:func:`frame_forces`).
+"""Reactions of joints and locks from multipliers (the one reporter, for forward runs,
+impacts and kinetostatics), and the driving torques of a prescribed motion: the batched
+solve for the Lagrange multipliers, the reactions in the ground and the joint frames,
+the loads the frame receives, and the redundancy check.
+
+The reaction of a joint or weld lock (:func:`joint_reaction`) is the force AND
+the moment on the CHILD body from the PARENT, at the joint point, in the ground
+frame: the child's point of a revolute joint (moment zero) or of a prismatic
+joint; for a weld lock the child frame origin, which the lock holds at its
+offset c in the parent frame.  The forward runs (:func:`element_forces`, per
+sample and per impact) and kinetostatics compute it here from the same
+multipliers.
 
 With the poses, rates and accelerations known, one linear system per position
 (batched over all positions at once)::
@@ -10,9 +17,7 @@ With the poses, rates and accelerations known, one linear system per position
     -Phi_x^T lambda + g_d,x^T tau = I(x, xdot, xddot) - F(t, x, xdot)
 
 gives the multipliers ``lambda`` and the driving torques ``tau``; the sign
-conventions are those of :mod:`mechdyn.dynamics.kinetostatics`.  The reaction of
-a joint or weld lock (:func:`joint_reaction`) is the force and the moment on the
-child body from the parent, at the joint point, in the ground frame.
+conventions are those of :mod:`mechdyn.dynamics.kinetostatics`.
 """
 
 from __future__ import annotations
@@ -144,11 +149,11 @@ def element_forces(ms, x, lam) -> dict:
     Returns
     -------
     dict
-        Joints and weld locks: (Fx, Fy, M) on the child body from the parent, N, N,
-        N m about the child frame origin, ground frame; coordinate locks, stops and
-        contacts: the multiplier of their (first) row, float (the normal force of a
-        stop or contact, N or N m, the torque or force of a coordinate lock along its
-        variable).
+        Joints and weld locks: their reaction (:func:`joint_reaction`), (Fx, Fy)
+        N for a revolute joint, (Fx, Fy, M) N, N, N m for a prismatic joint or a
+        weld; coordinate locks, stops and contacts: the multiplier of their
+        (first) row, float (the normal force of a stop or contact, N or N m, the
+        torque or force of a coordinate lock along its variable).
     """
     model = ms.model
     R = ms.row_jacobian(x)
@@ -158,9 +163,8 @@ def element_forces(ms, x, lam) -> dict:
         if el not in joints:
             out[el] = float(lam[idx[0]])
             continue
-        child = model.body_index(joints[el].child)
-        gen = R[idx].T @ lam[idx]
-        out[el] = np.zeros(3) if child >= model.n_bodies else gen[3 * child:3 * child + 3]
+        f, m, _ = joint_reaction(model, el, x, R[idx].T @ lam[idx])
+        out[el] = f if model.joint_kind(el) == "revolute" else np.array([f[0], f[1], m])
     return out
 
 
