@@ -299,7 +299,9 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         ``"failed"``) and ``message``; ``energy`` (kinetic, potential,
         work_nc, balance = T + U - W_nc + impact losses, residual); and
         ``stats["variable_structure"]``: ``mode`` (list of frozensets per
-        sample), ``frame_force`` (n, 2) N, ``forces`` {element: (n,) or (n, 3)},
+        sample), ``frame_force`` (n, 2) N, ``forces`` {element: (n,), (n, 2) or (n, 3)}
+        (joint and weld reactions at the joint point as in kinetostatics, see
+        :func:`mechdyn.dynamics.reactions.element_forces`),
         ``modes`` (distinct modes in order), ``penetration`` (largest, m).
     """
     wall0 = time.perf_counter()

@@ -45,8 +45,9 @@ from ..kernels.loads_numba import (
     forces,
 )
 from ..kernels.rows_numba import NUMBA, njit, rows_jacobian, rows_quad, rows_values
-from ..model.rows import concat, point
-from .forces import force_model, resolved_variable
+from ..model.rows import concat
+from ..model.variable import lower, parse
+from .forces import force_model
 
 __all__ = ["compile_kernel", "compile_mode_kernel", "CompiledKernel", "numba_available"]
 
@@ -576,7 +577,7 @@ def compile_mode_kernel(model, force_model, constraint_rows, independent):
         return None, "nothing to compile"
     if len(constraint_rows) + independent.size != model.n_x:
         return None, "redundant constraints (non-square position Jacobian)"
-    packer = LoadPacker(model, force_model, variable_row=lambda name: _variable_row(model, name))
+    packer = LoadPacker(model, force_model, variable=lambda name: _variable(model, name))
     try:
         ip, fp = packer.pack()
     except Unsupported as exc:
@@ -591,13 +592,17 @@ def compile_mode_kernel(model, force_model, constraint_rows, independent):
     return CompiledKernel(ip, fp, ri, rf, dims, model.n_x, ct), ""
 
 
-def _variable_row(model, name: str):
-    """The one-row measure of a 'body.point.x|y' table variable, or None."""
-    res = resolved_variable(model, name)
-    if res is None:
-        return None
-    b, s, comp = res
-    return point(name, b, s, comp, nb=model.n_bodies)
+def _variable(model, name: str):
+    """A table variable for :class:`LoadPacker`, read with the one grammar
+    (:mod:`mechdyn.model.variable`): ``(kind, ref)``."""
+    var = parse(name, model.coordinate_names)
+    if var.kind == "time":
+        return "t", None
+    if var.kind == "coordinate":
+        return ("qdot" if var.rate else "q"), model.coordinate_index(var.name)
+    if var.kind == "distance" or var.rate:
+        return None, None
+    return "row", lower(model, var)
 
 
 def compile_kernel(model, layout):

@@ -35,6 +35,8 @@ import numpy as np
 from scipy.optimize import nnls
 
 from ..errors import MechdynError
+from ..kernels import rows_numpy
+from ..model.rows import concat
 from .modes import ModeSystem, Row, SwitchedModel
 
 __all__ = ["ContactError", "solve_lcp", "LCPResult", "resolve_mode", "constrained_inverse",
@@ -160,41 +162,33 @@ def constrained_inverse(A, C_eq):
     return N @ np.linalg.solve(K, N.T)
 
 
-def row_terms(ms: ModeSystem, rows: list[Row], x, xdot, B, b, nb):
+def row_terms(ms: ModeSystem, rows: list[Row], x, xdot, B, b):
     """For rows in a mode's coordinates: C (m, n_i) with rate = C qdot_I, the
     acceleration offset d (m,) with accel = C qddot_I + d, and the force
     directions W (m, n_i) including sliding friction."""
-    from ..kinematics.constraints import extend
-
-    X, V = extend(ms.model, x), extend(ms.model, xdot)
-    C, W, d = [], [], []
-    for r in rows:
-        g = r.sign * r.measure.grad(X, nb)
-        C.append(g @ B)
-        d.append(g @ b + r.sign * r.measure.quad(X, V))
-        gw = g.copy()
-        if r.slip:
-            gw = gw - r.mu * r.slip * r.tangent.grad(X, nb)
-        W.append(gw @ B)
     n = B.shape[1]
-    return (np.array(C).reshape(-1, n), np.array(W).reshape(-1, n), np.array(d, float))
+    if not rows:
+        return np.zeros((0, n)), np.zeros((0, n)), np.zeros(0)
+    nb = ms.model.n_bodies
+    _, g, quad = rows_numpy.evaluate(concat(nb, *[r.rows for r in rows]), x, xdot)
+    gw = g.copy()
+    for k, r in enumerate(rows):
+        if r.slip:
+            gw[k] += rows_numpy.jacobian(r.friction_rows, x)[0]
+    return g @ B, gw @ B, g @ b + quad
 
 
 def touching(sm: SwitchedModel, ms: ModeSystem, x, *, gap_tol: float) -> list[str]:
     """Unilateral tokens whose gap is within ``gap_tol`` (m, or rad for angle stops)."""
-    from ..kinematics.constraints import extend
-
-    X = extend(sm.model, x)
     out = []
     for n, (st, meas) in sm.stops.items():
-        v = meas.value(X)
-        L = 1.0 if meas.is_angle else 1.0
-        if st.lower is not None and v - st.lower <= gap_tol * L:
+        v = meas.value(x)
+        if st.lower is not None and v - st.lower <= gap_tol:
             out.append(f"{n}@lower")
-        if st.upper is not None and st.upper - v <= gap_tol * L:
+        if st.upper is not None and st.upper - v <= gap_tol:
             out.append(f"{n}@upper")
     for n, (_ct, gap, _) in sm.contacts.items():
-        if gap.value(X) <= gap_tol:
+        if gap.value(x) <= gap_tol:
             out.append(f"{n}@contact")
     return out
 
@@ -240,8 +234,6 @@ def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates
     ------
     ContactError
     """
-    from ..kinematics.constraints import extend
-
     locks = frozenset(locks)
     cand = sorted(set(candidates))
     if not cand:
@@ -251,7 +243,6 @@ def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates
     base = ModeSystem(sm, locks, targets, x)
     terms = base.terms(t, x, xdot)
     B, b, A, f = terms["B"], terms["b"], terms["A"], terms["f"]
-    X, V = extend(sm.model, x), extend(sm.model, xdot)
     # friction state of each candidate contact
     fric = {}
     for tok in cand:
@@ -260,7 +251,7 @@ def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates
             if c in forced_slip:
                 fric[c] = "slip+" if forced_slip[c] > 0 else "slip-"
                 continue
-            vt = sm.contacts[c][2].rate(X, V, sm.nb)
+            vt = sm.contacts[c][2].rate(x, xdot)
             if abs(vt) <= slip_velocity_tol or c in forced_stick:
                 fric[c] = "stick"
             else:
@@ -272,12 +263,12 @@ def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates
         stick_targets = dict(targets)
         for c in [a[:-8] for a in active if a.endswith("@contact")]:
             if fric.get(c) == "stick":
-                stick_targets[f"{c}:stick"] = sm.contacts[c][2].value(X)
+                stick_targets[f"{c}:stick"] = sm.contacts[c][2].value(x)
         rows = sm.rows(toks, stick_targets)
         eq = [r for r in rows if r.kind == "stick"]
         uni = [r for r in rows if r.unilateral]
-        Ce, _, de = row_terms(base, eq, x, xdot, B, b, sm.nb)
-        Cu, Wu, du = row_terms(base, uni, x, xdot, B, b, sm.nb)
+        Ce, _, de = row_terms(base, eq, x, xdot, B, b)
+        Cu, Wu, du = row_terms(base, uni, x, xdot, B, b)
         # equality rows: A qdd = f + Ce^T mu + Wu^T lam ; Ce qdd + de = 0
         n = A.shape[0]
         ne = Ce.shape[0]
@@ -314,7 +305,7 @@ def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates
             if forced_open:
                 trial = sm.rows(frozenset(forced_open & set(cand)), targets)
                 Ct, _, dt_ = row_terms(base, [r_ for r_ in trial if r_.unilateral], x, xdot, B,
-                                       b, sm.nb)
+                                       b)
                 qdd = base_sol[:n] + resp[:n] @ lam
                 at = Ct @ qdd + dt_
                 for r_, a_ in zip([r_ for r_ in trial if r_.unilateral], at, strict=True):
@@ -328,7 +319,7 @@ def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates
                 f"{c}:{s}" for c, s in fric.items() if f"{c}@contact" in active)
             for c in [a[:-8] for a in active if a.endswith("@contact")]:
                 if fric.get(c) == "stick":
-                    targets[f"{c}:stick"] = sm.contacts[c][2].value(X)
+                    targets[f"{c}:stick"] = sm.contacts[c][2].value(x)
             forces = {u.label: float(l_) for u, l_ in zip(uni, lam, strict=True)
                       if u.label in active}
             return mode, forces

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
+from ..kernels import rows_numpy
 from ..kinematics.constraints import (
     _perp,
     coordinates_jacobian,
@@ -28,6 +29,7 @@ from ..kinematics.constraints import (
 from ..mechanism.drive import Drive
 from ..mechanism.load import Force, RotarySpring, Spring, Table, Torque
 from ..model import Model
+from ..model.variable import lower, parse
 
 __all__ = ["LoadContext", "ForceModel", "force_model", "evaluate", "applied_forces",
            "com_arms"]
@@ -115,53 +117,52 @@ class LoadContext:
         return point_velocity(self.model, self.x, self.xdot, body, point)
 
     def variable(self, name: str):
-        """A named variable: 't', a coordinate, '<coordinate>_dot', 'body.point.x|y'."""
-        res = resolved_variable(self.model, name)
-        if res is not None:  # a body point coordinate, resolved once per model
-            b, s, comp = res
-            x = np.asarray(self.x)
-            p = x[..., 3 * b + comp] + rotate(x[..., 3 * b + 2], s)[..., comp]
-            return _scalar_or_array(p)
-        if name == "t":
-            return _scalar_or_array(self.t)
-        if name in self.model.coordinate_names:
-            return self.coord(name)
-        if name.endswith("_dot") and name[:-4] in self.model.coordinate_names:
-            return self.rate(name[:-4])
-        parts = name.split(".")
-        if len(parts) == 3 and parts[2] in ("x", "y"):
-            p = self.point(parts[0], parts[1])
-            return _scalar_or_array(p[..., 0] if parts[2] == "x" else p[..., 1])
-        raise ModelError(f"unknown table variable {name!r}; use 't', a coordinate "
-                         f"({', '.join(self.model.coordinate_names)}), '<coordinate>_dot' or "
-                         f"'body.point.x' / 'body.point.y'")
+        """A named variable (:mod:`mechdyn.model.variable`): ``'t'``, a coordinate,
+        ``'<coordinate>_dot'``, ``'joint:NAME'``, ``'angle:BODY'``, ``'body.point.x|y'``
+        or ``'dist(body.point, body.point)'``; s, rad, m or their rates."""
+        return _scalar_or_array(_variable_reader(self.model, name)(self))
 
 
-def resolved_variable(model: Model, name: str):
-    """(body, local point, component) of a 'body.point.x|y' variable on a moving
-    body, or None (cached on the model)."""
-    cache = getattr(model, "_load_variables", None)
-    if cache is None:
-        cache = {}
-        try:
-            model._load_variables = cache
-        except AttributeError:
-            return None
-    if name in cache:
-        return cache[name]
-    out = None
-    parts = name.split(".")
-    if (name != "t" and name not in model.coordinate_names and len(parts) == 3
-            and parts[2] in ("x", "y")):
-        try:
-            b = model.body_index(parts[0])
-            s = np.asarray(model.point_local(parts[0], parts[1]), dtype=float)
-        except ModelError:
-            b = None
-        if b is not None and 0 <= b < model.n_bodies:
-            out = (b, s, 0 if parts[2] == "x" else 1)
-    cache[name] = out
-    return out
+def _variable_reader(model: Model, name: str):
+    """A function of a :class:`LoadContext` giving variable ``name`` (array or float),
+    resolved once per model and name (cached on the model).
+
+    Raises
+    ------
+    ModelError
+        Unknown variable, coordinate, joint, body or point; the message lists the
+        valid forms or names.
+    """
+    cache = model.__dict__.setdefault("_load_variables", {})
+    fn = cache.get(name)
+    if fn is not None:
+        return fn
+    var = parse(name, model.coordinate_names)
+    if var.kind == "time":
+        def fn(ctx):
+            return ctx.t
+    elif var.kind == "coordinate":
+        k = model.coordinate_index(var.name)
+
+        def fn(ctx, k=k, rate=var.rate):
+            return np.asarray(ctx.qdot if rate else ctx.q)[..., k]
+    else:
+        rows = lower(model, var)
+        if var.kind == "point" and rows.b1[0] < model.n_bodies:
+            b, s, comp = int(rows.b1[0]), rows.s1[0], var.comp
+
+            def fn(ctx, b=b, s=s, comp=comp):  # a body point: its position, the short way
+                x = np.asarray(ctx.x)
+                return x[..., 3 * b + comp] + rotate(x[..., 3 * b + 2], s)[..., comp]
+        elif var.kind == "distance":
+            def fn(ctx, rows=rows):
+                d = rows_numpy.values(rows, ctx.x)
+                return np.hypot(d[..., 0], d[..., 1])
+        else:
+            def fn(ctx, rows=rows):
+                return rows_numpy.values(rows, ctx.x)[..., 0]
+    cache[name] = fn
+    return fn
 
 
 def _each(fn, shape: tuple):
@@ -495,6 +496,15 @@ def force_model(model: Model) -> ForceModel:
         else:
             probs.append(f"{where}: not a load mechdyn knows (Spring, RotarySpring, Force, "
                          f"Torque)")
+    for ld in [*mech.loads, *mech.drives]:  # table variables: resolved once, here
+        for fld in ("magnitude", "torque"):
+            tab = getattr(ld, fld, None)
+            if isinstance(tab, Table):
+                try:
+                    _variable_reader(model, tab.variable)
+                except ModelError as exc:
+                    probs.append(f"{type(ld).__name__.lower()} {getattr(ld, 'name', '?')!r}: "
+                                 f"{fld}: table variable: {exc}")
     for dr in mech.drives:
         if dr.coordinate not in model.coordinate_names:
             probs.append(f"drive {dr.name!r}: coordinate: "

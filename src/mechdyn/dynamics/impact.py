@@ -33,6 +33,7 @@ import numpy as np
 
 from .contact import constrained_inverse, row_terms, solve_lcp
 from .modes import ModeSystem, SwitchedModel, mass_matrix_x
+from .reactions import element_forces, frame_forces
 
 __all__ = ["ImpactResult", "impact", "element_forces", "frame_forces"]
 
@@ -51,9 +52,12 @@ class ImpactResult:
         Impulse of each row (N s, or N m s for angular rows) by row label;
         joint rows are labelled ``"O.x"``, ``"O.y"``, ....
     element_impulses : dict
-        For each joint or lock, the impulse (Px, Py, L) on its child body from
-        its parent (N s, N s, N m s about the child frame origin); for each
-        stop or contact, the normal impulse (N s).
+        For each joint or weld lock, the impulse on its child body from its
+        parent at the joint point, ground frame (:func:`~mechdyn.dynamics.reactions.
+        element_forces`): (Px, Py) N s for a revolute joint, (Px, Py, L) N s, N s,
+        N m s for a prismatic joint or a weld (L about the child frame origin, the
+        weld's point); for each coordinate lock, stop or contact, the impulse of
+        its row (N s or N m s).
     velocity_before, velocity_after : dict
         Rate of each new row (m/s or rad/s) before and after the impact.
     """
@@ -113,8 +117,8 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     uni_tokens = sorted(set(unilateral))
     rows_u = [r for r in sm.rows(frozenset(uni_tokens), targets) if r.unilateral]
     zero_b = np.zeros_like(B[:, 0]) if B.shape[1] else np.zeros(model.n_x)
-    Cb, _, _ = row_terms(base, rows_b, x, xdot_minus, B, zero_b, sm.nb)
-    Cu, _, _ = row_terms(base, rows_u, x, xdot_minus, B, zero_b, sm.nb)
+    Cb, _, _ = row_terms(base, rows_b, x, xdot_minus, B, zero_b)
+    Cu, _, _ = row_terms(base, rows_u, x, xdot_minus, B, zero_b)
     Z = constrained_inverse(A, Cb)
     p_minus = A @ qd_minus
     v_minus = Cu @ qd_minus
@@ -152,96 +156,3 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
         res.velocity_before[r.label] = float(vm)
         res.velocity_after[r.label] = float(vp)
     return res
-
-
-def element_forces(ms: ModeSystem, x, lam) -> dict:
-    """Per element: (Fx, Fy, M) on its child body from the rows' multipliers (joints,
-    weld locks), or the scalar multiplier (coordinate locks: N m or N; stops and
-    contacts: the normal force); pass impulses to get impulses.
-
-    The joint convention is that of ``mechdyn``'s reactions: the force on the child
-    from the parent, at the child frame origin for the moment, ground frame.
-    """
-    model = ms.model
-    R = ms.row_jacobian(x)
-    elements = ms.row_elements()
-    out: dict = {}
-    nb = model.n_bodies
-    for el in dict.fromkeys(elements):
-        idx = [k for k, e in enumerate(elements) if e == el]
-        kind = _element_kind(ms, el)
-        if kind in ("stop", "contact", "stick") or el in ms.sm.coord_locks:
-            # normal multiplier (the first row of the element); stick adds tangential
-            out[el] = float(lam[idx[0]])
-            continue
-        child = _child_index(ms, el)
-        gen = R[idx].T @ lam[idx]
-        if child is None or child >= nb:
-            out[el] = np.zeros(3)
-        else:
-            out[el] = gen[3 * child:3 * child + 3].copy()
-    return out
-
-
-def _element_kind(ms: ModeSystem, el: str) -> str:
-    for r in ms.rows:
-        if r.element == el:
-            return r.kind
-    return "joint"
-
-
-def _child_index(ms: ModeSystem, el: str):
-    mech = ms.model.mechanism
-    if el in mech.joints:
-        return ms.model.body_index(mech.joints[el].child)
-    return None
-
-
-def frame_forces(ms: ModeSystem, x, lam) -> dict:
-    """Forces (Fx, Fy) the mechanism exerts on the frame through each ground joint,
-    lock, stop or contact attached to the ground, N; key ``"total"`` sums them."""
-    model = ms.model
-    R = ms.row_jacobian(x)
-    elements = ms.row_elements()
-    nb = model.n_bodies
-    mech = model.mechanism
-    out: dict = {}
-    total = np.zeros(2)
-    for el in dict.fromkeys(elements):
-        idx = [k for k, e in enumerate(elements) if e == el]
-        gen = R[idx].T @ lam[idx]  # constraint force on each moving body
-        on_bodies = gen.reshape(nb, 3)[:, :2]
-        if el in mech.joints:
-            j = mech.joints[el]
-            grounded = "ground" in (j.parent, j.child)
-        else:
-            grounded = _touches_ground(ms, el)
-        if not grounded:
-            continue
-        f = -on_bodies.sum(axis=0)  # Newton's third law: the frame gets the opposite
-        out[el] = f
-        total = total + f
-    out["total"] = total
-    return out
-
-
-def _touches_ground(ms: ModeSystem, el: str) -> bool:
-    sm = ms.sm
-    mech = ms.model.mechanism
-    if el in sm.contacts:
-        ct = sm.contacts[el][0]
-        return "ground" in (ct.body, ct.line_body)
-    if el in sm.welds:
-        j = mech.joints[el]
-        return "ground" in (j.parent, j.child)
-    meas = None
-    if el in sm.stops:
-        meas = sm.stops[el][1]
-    elif el in sm.coord_locks:
-        meas = sm.coord_locks[el][1]
-    if meas is None:
-        return False
-    nb = ms.model.n_bodies
-    bodies = [getattr(meas, a) for a in ("b", "i", "j", "b1", "b2") if hasattr(meas, a)]
-    return any(b == nb for b in bodies)
-

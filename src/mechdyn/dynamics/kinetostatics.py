@@ -249,17 +249,14 @@ def _variable_structure(trajectory):
 def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=None,
                    start=None, trajectory=None, hold=None, mode=None, point=(0.0, 0.0),
                    model_drives="replace", reacting_loads=(), x_guess=None, lay=None,
-                   kmodel=None, candidates=None, x_start=None) -> Kinetostatics:
+                   candidates=None, x_start=None) -> Kinetostatics:
     """The analysis in one mode (see :func:`kinetostatics`).
 
     For the segments of a switched trajectory: ``lay`` (a layout or
-    :class:`~mechdyn.dynamics.prescribed_motion.ModeRows`), ``kmodel`` (the model
-    with the lock offsets held in that segment), ``candidates`` (order in which
+    :class:`~mechdyn.dynamics.prescribed_motion.ModeRows`, the rows of the segment's
+    mode with the targets its locks held), ``candidates`` (order in which
     coordinates are chosen as driven) and ``x_start`` (a pose of the segment)."""
     t_start = time.perf_counter()
-    record_model = model
-    if kmodel is not None:
-        model = kmodel
     fm = force_model(model)
     if mode is None and trajectory is not None and isinstance(
             getattr(trajectory, "mode", None), frozenset):
@@ -424,7 +421,7 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
         frame_point=np.asarray(point, dtype=float).copy(), frame_loads=core["frame_loads"],
         multipliers=core["lam"], joint_kinds=core["kinds"], mode=lay.mode,
         redundant_joints=tuple(core["redundant"]), status=status, message=message,
-        warnings=tuple(warn), stats=stats, model=record_model,
+        warnings=tuple(warn), stats=stats, model=model,
         element_forces=core["element_forces"],
         element_units={el: ("N m" if bool(lay.row_is_angle[idx[0] - lay.n_base]) else "N")
                        for el, idx in getattr(lay, "elements", {}).items()})

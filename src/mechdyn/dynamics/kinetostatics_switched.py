@@ -7,13 +7,15 @@ the same mode; the samples at a switching instant appear twice, before and after
 and fall into the two neighbouring segments).  Each segment is analysed in its own
 mode:
 
-* engaged weld locks through the model's layout (:meth:`Model.layout`), holding
-  the offset they held in the run (declared, or captured on the segment's first
-  pose, as :meth:`mechdyn.dynamics.modes.SwitchedModel.capture_target` does);
-* coordinate locks, closed stops, closed contacts and sticking contacts through the
-  rows of :mod:`mechdyn.dynamics.modes` (:meth:`SwitchedModel.rows`), appended to
-  the joint rows (:class:`~mechdyn.dynamics.prescribed_motion.ModeRows`); a
+* the rows of the mode are those of the forward dynamics
+  (:meth:`~mechdyn.dynamics.modes.SwitchedModel.rows`: weld and coordinate
+  locks, closed stops, closed contacts and sticking contacts) appended to the joint
+  rows (:class:`~mechdyn.dynamics.prescribed_motion.ModeRows`); the locks hold what
+  they held in the run (declared, or captured on the segment's first pose, as
+  :meth:`~mechdyn.dynamics.modes.SwitchedModel.capture_target` does); a
   slipping contact's row carries its Coulomb friction as in the forward dynamics;
+  weld locks report as joints (reaction at the child frame origin), the others as
+  elements;
 * the driven coordinates are the independent coordinates of the mode, chosen in the
   order: ``over``, the coordinates with a ``Drive``, the others, the ``frees`` of
   the engaged locks last.
@@ -56,42 +58,19 @@ def _fmt(mode) -> str:
     return "{" + ", ".join(sorted(mode)) + "}"
 
 
-def _with_lock_offsets(model: Model, held: dict) -> Model:
-    """The model with the weld locks' held offsets ``{name: (c (2,), angle)}`` (a shallow
-    copy sharing everything else; the model itself when nothing changes)."""
-    import copy
-    import dataclasses
-
-    lk = model.lock
-    c, ang = lk.c.copy(), lk.angle.copy()
-    for n, (cn, an) in held.items():
-        k = lk.names.index(n)
-        c[k], ang[k] = np.asarray(cn, float), float(an)
-    if np.array_equal(c, lk.c) and np.array_equal(ang, lk.angle):
-        return model
-    km = copy.copy(model)
-    km.lock = dataclasses.replace(lk, c=c, angle=ang)
-    km._layouts = {}
-    return km
-
-
 def _mode_rows(model: Model, sm: SwitchedModel, mode: frozenset, x0):
-    """(model with the held lock offsets, layout or ModeRows, frees) of a mode whose
-    first pose is ``x0``."""
+    """(layout or ModeRows, frees) of a mode whose first pose is ``x0``: the rows of the
+    forward dynamics (:meth:`SwitchedModel.rows`), the locks holding what they held."""
     targets: dict = {}
     for n in mode_locks(mode):
         sm.capture_target(n, x0, targets)
     for c, s in mode_friction(mode).items():
         if s == "stick":
             sm.capture_target(f"{c}:stick", x0, targets)
-    welds = sorted(n for n in mode_locks(mode) if n in sm.welds)
-    kmodel = _with_lock_offsets(model, {n: targets[n] for n in welds})
-    base = kmodel.layout(welds)
-    extra = [r for r in sm.rows(mode, targets)
-             if not (r.kind == "lock" and r.element in sm.welds)]
-    lay = ModeRows(base, extra, mode, model.n_bodies) if extra else base
+    extra = sm.rows(mode, targets)
+    lay = ModeRows(model, extra, mode) if extra else model.layout(frozenset())
     frees = [f for n in mode_locks(mode) for f in sm.lock_frees(n)]
-    return kmodel, lay, frees
+    return lay, frees
 
 
 def _candidates(model: Model, over_k, drive_coords, frees) -> list[int]:
@@ -141,9 +120,9 @@ def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
         mode = sample_modes[a]
         seg = SimpleNamespace(t=tt[a:b], q=Q[a:b], qdot=Qd[a:b], qddot=Qdd[a:b], x=X[a:b])
         try:
-            kmodel, lay, frees = _mode_rows(model, sm, mode, X[a])
+            lay, frees = _mode_rows(model, sm, mode, X[a])
             res = _kinetostatics(model, trajectory=seg, point=point, model_drives=model_drives,
-                                 reacting_loads=reacting_loads, lay=lay, kmodel=kmodel,
+                                 reacting_loads=reacting_loads, lay=lay,
                                  candidates=_candidates(model, over_k, drive_coords, frees),
                                  x_start=X[a])
             parts.append((a, b, mode, res, None))

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
-from ..model.rows import Rows
+from ..kinematics.constraints import extend
 from .compiled import compile_mode_kernel
 from .modes import ModeEval
 
@@ -25,25 +25,6 @@ __all__ = ["ModeEquations", "BACKENDS"]
 
 #: valid values of ``backend``
 BACKENDS = ("auto", "numpy", "numba")
-
-
-def mode_rows(ms) -> Rows | None:
-    """The constraint rows of a mode (all of them, in the mode's row order)."""
-    rows = getattr(ms, "rowset", None)
-    if rows is not None:
-        return rows
-    # transitional: from the batched row terms of the mode
-    from .modes import _measure_term
-
-    nb = ms.sm.nb
-    terms = list(ms.sm._base_terms) + [_measure_term(r.measure, nb, r.sign, -r.target)
-                                       for r in ms.rows]
-    if any(t is None for t in terms):
-        return None
-    a = np.array(terms, dtype=float).reshape(len(terms), 14)
-    n = a.shape[0]
-    return Rows(nb, a[:, 0], a[:, 1:3], a[:, 3], a[:, 4:6], a[:, 6], a[:, 7:9], a[:, 9],
-                a[:, 11], a[:, 10], a[:, 12], a[:, 13], tuple(f"row{k}" for k in range(n)))
 
 
 class ModeEquations:
@@ -78,14 +59,11 @@ class ModeEquations:
         self.sm, self.ms = sm, ms
         self.kernel, self.note = None, ""
         if backend != "numpy":
-            rows = mode_rows(ms)
             if any(r.slip for r in ms.rows):
                 self.note = "sliding friction is evaluated on the NumPy path"
-            elif rows is None:
-                self.note = "the mode has a row the compiled path does not evaluate"
             else:
                 self.kernel, self.note = compile_mode_kernel(
-                    ms.model, sm.fm, rows.take(ms.independent_rows), ms.coords)
+                    ms.model, sm.fm, ms.rowset.take(ms.independent_rows), ms.coords)
             if self.kernel is None and backend == "numba":
                 raise ModelError(f"the compiled (numba) backend is not available: {self.note}")
         if self.kernel is not None:
@@ -150,17 +128,9 @@ class ModeEquations:
 
 def friction_power(ms, ev) -> float:
     """Power of the sliding friction of the mode's slipping contacts, W (<= 0)."""
-    p = 0.0
-    for k, r in enumerate(ms.rows):
-        if r.slip:
-            vt = r.tangent_rate(ev.x, ev.xdot) if hasattr(r, "tangent_rate") else \
-                _tangent_rate(ms, r, ev)
-            p += -r.mu * r.slip * ev.lam[ms.n_base + k] * vt
-    return p
-
-
-def _tangent_rate(ms, r, ev) -> float:
-    from ..kinematics.constraints import extend
-
+    slips = [(k, r) for k, r in enumerate(ms.rows) if r.slip]
+    if not slips:
+        return 0.0
     X, V = extend(ms.model, ev.x), extend(ms.model, ev.xdot)
-    return r.tangent.rate(X, V, ms.sm.nb)
+    return float(sum(-r.mu * r.slip * ev.lam[ms.n_base + k] * r.tangent.rate(X, V)
+                     for k, r in slips))

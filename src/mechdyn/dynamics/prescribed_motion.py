@@ -13,18 +13,19 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import AssemblyError, ModelError, SingularPositionError
+from ..kernels import rows_numpy
 from ..kinematics.assembly import joint_residuals
 from ..kinematics.constraints import (
     coordinates,
     coordinates_gamma,
     coordinates_jacobian,
-    extend,
     gamma,
     jacobian,
     point_position,
     residual,
 )
 from ..model import ConstraintLayout, Model, as_model
+from ..model.rows import concat
 
 __all__ = ["dead_centres", "ModeRows"]
 
@@ -33,91 +34,56 @@ REDUNDANT_RCOND = 1e-9
 
 
 class ModeRows:
-    """The constraint rows of a variable-structure mode for kinetostatics: the
-    :class:`~mechdyn.model.ConstraintLayout` of the joints and engaged weld locks,
-    followed by one row per other switchable element of the mode (coordinate locks,
-    closed stops, closed contacts and sticking contacts), the
-    :class:`~mechdyn.dynamics.modes.Row` objects of :mod:`mechdyn.dynamics.modes`.
+    """The constraint rows of a variable-structure mode for kinetostatics: the joint
+    rows of the model, then the switchable rows of the mode (weld and coordinate
+    locks, closed stops, closed contacts and sticking contacts), the
+    :class:`~mechdyn.dynamics.modes.Row` objects of
+    :meth:`~mechdyn.dynamics.modes.SwitchedModel.rows` -- the rows of the
+    forward dynamics, :attr:`mechdyn.dynamics.modes.ModeSystem.rowset`.
 
-    It stands in for a layout everywhere kinetostatics uses one (``n_rows``,
-    ``rows``, ``row_joint``, ``lock_active``, ``mode``); the row values, Jacobian
-    and acceleration terms come from :func:`mode_residual`, :func:`mode_jacobian`
-    and :func:`mode_gamma`.
+    It stands in for a layout everywhere kinetostatics uses one (``rowset``,
+    ``n_rows``, ``rows`` of the joints and weld locks, ``row_joint``,
+    ``lock_active``, ``mode``); ``extra`` are the switchable rows, ``elements``
+    the row indices of every switchable element but the weld locks (which report
+    as joints), ``row_is_angle`` whether each switchable row is in rad.
     """
 
-    def __init__(self, base: ConstraintLayout, extra, mode, n_bodies: int):
-        self.base = base
+    def __init__(self, model: Model, extra, mode):
+        base = model.layout(frozenset())
         self.extra = list(extra)
         self.mode = frozenset(mode)
-        self.nb = n_bodies
         self.n_base = base.n_rows
-        self.n_rows = base.n_rows + len(self.extra)
-        self.lock_active = base.lock_active
+        self.rowset = concat(model.n_bodies, model.joint_rows, *[r.rows for r in self.extra])
+        self.n_rows = len(self.rowset)
+        self.lock_active = np.array([n in self.mode for n in model.lock.names], dtype=bool)
         self.rows = dict(base.rows)
         self.elements: dict[str, list[int]] = {}
+        welds = set(model.lock.names)
         for k, r in enumerate(self.extra):
-            key = r.label if r.kind == "stick" else r.element
-            self.elements.setdefault(key, []).append(self.n_base + k)
-        self.row_joint = np.concatenate(
-            [base.row_joint, np.array([r.label if r.kind == "stick" else r.element
-                                       for r in self.extra], dtype=object)])
-        self.row_is_angle = np.array([bool(r.measure.is_angle) for r in self.extra], bool)
-
-
-def _base(lay):
-    return lay.base if isinstance(lay, ModeRows) else lay
-
-
-def _per_pose(model, x, fn, n_out):
-    """fn(X) (n_out values) on every pose of a batch x (..., n_x) -> (..., n_out)."""
-    x = np.asarray(x, dtype=float)
-    flat = x.reshape(-1, model.n_x)
-    X = extend(model, flat)
-    out = np.array([fn(X[k], k) for k in range(flat.shape[0])], dtype=float)
-    return out.reshape(x.shape[:-1] + np.shape(out)[1:]) if out.size else np.zeros(
-        x.shape[:-1] + n_out)
-
-
-def mode_residual(model: Model, x, lay) -> np.ndarray:
-    """Residuals of every row of ``lay`` (a layout or :class:`ModeRows`), (..., n_rows)."""
-    base = residual(model, x, _base(lay))
-    if not isinstance(lay, ModeRows) or not lay.extra:
-        return base
-    own = _per_pose(model, x, lambda X, k: [r.sign * (r.measure.value(X) - r.target)
-                                            for r in lay.extra], (len(lay.extra),))
-    return np.concatenate([base, own], axis=-1)
+            if r.element in welds:
+                self.rows[r.element] = np.append(self.rows.get(r.element, np.zeros(0, int)),
+                                                 self.n_base + k)
+            else:
+                key = r.label if r.kind == "stick" else r.element
+                self.elements.setdefault(key, []).append(self.n_base + k)
+        self.row_joint = np.array([*base.row_joint, *[r.label if r.kind == "stick" else
+                                                      r.element for r in self.extra]],
+                                  dtype=object)
+        self.row_is_angle = self.rowset.is_angle[self.n_base:]
+        slip = [(self.n_base + k, r.friction_rows) for k, r in enumerate(self.extra) if r.slip]
+        self.slip_rows = np.array([k for k, _ in slip], int)
+        self.friction = concat(model.n_bodies, *[f for _, f in slip])
 
 
 def mode_jacobian(model: Model, x, lay, *, friction: bool = False) -> np.ndarray:
-    """Jacobian of every row of ``lay``, (..., n_rows, n_x).  With ``friction``, the
-    rows of slipping contacts carry their Coulomb friction (R - mu s T_x, the force
-    direction of the row, as in :meth:`mechdyn.dynamics.modes.ModeSystem.evaluate_x`)."""
-    base = jacobian(model, x, _base(lay))
-    if not isinstance(lay, ModeRows) or not lay.extra:
-        return base
-
-    def rows(X, k):
-        out = []
-        for r in lay.extra:
-            g = r.sign * r.measure.grad(X, lay.nb)
-            if friction and r.slip:
-                g = g - r.mu * r.slip * r.tangent.grad(X, lay.nb)
-            out.append(g)
-        return out
-
-    own = _per_pose(model, x, rows, (len(lay.extra), model.n_x))
-    return np.concatenate([base, own], axis=-2)
-
-
-def mode_gamma(model: Model, x, xdot, lay) -> np.ndarray:
-    """Acceleration right-hand side of every row (Phi_x xddot = gamma), (..., n_rows)."""
-    base = gamma(model, x, xdot, _base(lay))
-    if not isinstance(lay, ModeRows) or not lay.extra:
-        return base
-    V = extend(model, np.asarray(xdot, dtype=float).reshape(-1, model.n_x))
-    own = _per_pose(model, x, lambda X, k: [-r.sign * r.measure.quad(X, V[k])
-                                            for r in lay.extra], (len(lay.extra),))
-    return np.concatenate([base, own], axis=-1)
+    """Jacobian of every row of ``lay`` (a layout or :class:`ModeRows`), (..., n_rows, n_x).
+    With ``friction``, the rows of slipping contacts carry their Coulomb friction
+    (R - mu s T_x, the force direction of the row, as in
+    :meth:`mechdyn.dynamics.modes.ModeSystem.evaluate_x`)."""
+    J = jacobian(model, x, lay)
+    if friction and isinstance(lay, ModeRows) and lay.slip_rows.size:
+        J[..., lay.slip_rows, :] += rows_numpy.jacobian(lay.friction, x)
+    return J
 
 
 def _col_scale(model: Model) -> np.ndarray:
@@ -127,7 +93,7 @@ def _col_scale(model: Model) -> np.ndarray:
 
 
 def _kin_system(model, lay, didx, x, qd):
-    Phi = mode_residual(model, x, lay)
+    Phi = residual(model, x, lay)
     g = coordinates(model, x)[..., didx]
     F = np.concatenate([Phi, g - qd], axis=-1)
     J = np.concatenate([mode_jacobian(model, x, lay),
@@ -226,9 +192,9 @@ class _Positions:
         return x
 
     def _error(self, qd, x, t=None):
-        res = joint_residuals(self.model, x, _base(self.lay))
+        res = joint_residuals(self.model, x, self.lay)
         if isinstance(self.lay, ModeRows) and self.lay.extra:
-            r = mode_residual(self.model, x, self.lay)
+            r = residual(self.model, x, self.lay)
             for el, idx in self.lay.elements.items():
                 res[el] = float(np.linalg.norm(r[idx]))
         names = [self.model.coordinate_names[k] for k in self.didx]
@@ -314,7 +280,7 @@ class _Positions:
         rhs = np.zeros(x.shape[:-1] + (J.shape[-2],))
         rhs[..., lay.n_rows:] = qd_dot
         xdot = _lin_solve(J, rhs)
-        gam = np.concatenate([mode_gamma(m, x, xdot, lay),
+        gam = np.concatenate([gamma(m, x, xdot, lay),
                               coordinates_gamma(m, x, xdot)[..., self.didx] + qd_ddot], axis=-1)
         xddot = _lin_solve(J, gam)
         return xdot, xddot

@@ -1,6 +1,15 @@
-"""Joint reactions and driving torques of a prescribed motion: the batched solve for
-the Lagrange multipliers, the reactions in the ground and the joint frames, the loads
-the frame receives, and the redundancy check.
+"""Reactions of joints and locks from multipliers (the one reporter, for forward runs,
+impacts and kinetostatics), and the driving torques of a prescribed motion: the batched
+solve for the Lagrange multipliers, the reactions in the ground and the joint frames,
+the loads the frame receives, and the redundancy check.
+
+The reaction of a joint or weld lock (:func:`joint_reaction`) is the force AND
+the moment on the CHILD body from the PARENT, at the joint point, in the ground
+frame: the child's point of a revolute joint (moment zero) or of a prismatic
+joint; for a weld lock the child frame origin, which the lock holds at its
+offset c in the parent frame.  The forward runs (:func:`element_forces`, per
+sample and per impact) and kinetostatics compute it here from the same
+multipliers.
 
 With the poses, rates and accelerations known, one linear system per position
 (batched over all positions at once)::
@@ -24,7 +33,8 @@ from .forces import applied_forces, cross, rotate
 from .inertia import inertia_forces
 from .prescribed_motion import REDUNDANT_RCOND, ModeRows, _col_scale, mode_jacobian
 
-__all__ = ["KinetostaticsWarning"]
+__all__ = ["KinetostaticsWarning", "joint_reaction", "reaction_frame", "element_forces",
+           "frame_forces", "touches_ground"]
 
 #: rcond of the scaled inverse-dynamics matrix below which a position is reported
 #: as close to singular (a warning; the solve is still exact)
@@ -74,18 +84,130 @@ def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
     return n_red, joints, labels
 
 
+def reaction_frame(model: Model, name: str) -> tuple[str, int, int, np.ndarray]:
+    """(kind, parent index, child index, reaction point in the child frame (2,) m) of a
+    joint or weld lock.
+
+    The reaction point is the joint point: the child's point of a revolute or
+    prismatic joint; for a weld lock the child frame origin, which the lock holds
+    at the offset c in the parent frame.
+    """
+    for kind, tab in (("revolute", model.rev), ("prismatic", model.pri)):
+        if name in tab.names:
+            k = tab.names.index(name)
+            return kind, int(tab.i[k]), int(tab.j[k]), np.asarray(tab.sj[k], float)
+    k = model.lock.names.index(name)
+    return "lock", int(model.lock.i[k]), int(model.lock.j[k]), np.zeros(2)
+
+
+def joint_reaction(model: Model, name: str, x, gen):
+    """The reaction of a joint or weld lock: the force and the moment on the CHILD body
+    from the PARENT, at the joint point (:func:`reaction_frame`), in the ground frame.
+
+    Parameters
+    ----------
+    model : Model
+    name : str
+        A revolute or prismatic joint or a weld lock.
+    x : array_like, shape (..., n_x)
+        Poses.
+    gen : array_like, shape (..., n_x)
+        The constraint force of the element's rows on the poses, Phi_e,x^T lambda_e
+        (force, N, and moment about each body frame origin, N m), in the
+        convention M xddot + h = F + Phi_x^T lambda.
+
+    Returns
+    -------
+    force : ndarray, shape (..., 2)
+        N.
+    moment : ndarray, shape (...)
+        N m about the joint point; zero for a revolute joint.  With the ground as
+        the child, minus the parent's share (action and reaction).
+    point : ndarray, shape (..., 2)
+        The joint point in the ground frame, m.
+    """
+    kind, i, j, sj = reaction_frame(model, name)
+    X = extend(model, np.asarray(x, float))
+    gen = np.asarray(gen, float)
+    P = X[..., j, :2] + rotate(X[..., j, 2], sj)
+    b, sgn = (j, 1.0) if j < model.n_bodies else (i, -1.0)
+    f = gen[..., 3 * b:3 * b + 2]
+    m = gen[..., 3 * b + 2] - cross(P - X[..., b, :2], f)
+    return sgn * f, (sgn * m if kind != "revolute" else np.zeros(np.shape(m))), P
+
+
+def element_forces(ms, x, lam) -> dict:
+    """The force of every element of a mode from its multipliers at one pose.
+
+    Parameters
+    ----------
+    ms : ModeSystem
+    x : ndarray, shape (n_x,)
+    lam : ndarray, shape (n_rows,)
+        Multipliers of ``ms.rowset`` (forward convention); impulses give impulses.
+
+    Returns
+    -------
+    dict
+        Joints and weld locks: their reaction (:func:`joint_reaction`), (Fx, Fy)
+        N for a revolute joint, (Fx, Fy, M) N, N, N m for a prismatic joint or a
+        weld; coordinate locks, stops and contacts: the multiplier of their
+        (first) row, float (the normal force of a stop or contact, N or N m, the
+        torque or force of a coordinate lock along its variable).
+    """
+    model = ms.model
+    R = ms.row_jacobian(x)
+    joints = model.mechanism.joints
+    out: dict = {}
+    for el, idx in ms.element_rows.items():
+        if el not in joints:
+            out[el] = float(lam[idx[0]])
+            continue
+        f, m, _ = joint_reaction(model, el, x, R[idx].T @ lam[idx])
+        out[el] = f if model.joint_kind(el) == "revolute" else np.array([f[0], f[1], m])
+    return out
+
+
+def frame_forces(ms, x, lam) -> dict:
+    """Forces (Fx, Fy) the mechanism exerts on the frame through each element of a
+    mode attached to the ground (joint, lock, stop or contact), N; key ``"total"``
+    sums them."""
+    nb = ms.model.n_bodies
+    R = ms.row_jacobian(x)
+    out: dict = {}
+    total = np.zeros(2)
+    for el, idx in ms.element_rows.items():
+        if el not in ms.grounded:
+            continue
+        gen = (R[idx].T @ lam[idx]).reshape(nb, 3)  # constraint force on each moving body
+        f = -gen[:, :2].sum(axis=0)  # Newton's third law: the frame gets the opposite
+        out[el] = f
+        total = total + f
+    out["total"] = total
+    return out
+
+
+def touches_ground(rows) -> bool:
+    """True if constraint rows act between the frame and a moving body: a point on
+    the ground, an angle of the ground, or an absolute angle."""
+    g = rows.nb
+    pts = np.any(rows.u != 0.0, axis=1) & ((rows.b1 == g) | (rows.b2 == g))
+    ang = ((rows.ka != 0.0) & (rows.a == g)) | ((rows.kb != 0.0) & (rows.bb == g)) | (
+        (rows.ka != 0.0) != (rows.kb != 0.0))
+    return bool(np.any(pts | ang))
+
+
 def _joint_geometry(model: Model, lay: ConstraintLayout):
-    """Per active joint: kind, parent index, child index, child-frame point, parent axis."""
+    """Per active joint and lock: kind, parent index, child index, parent axis."""
+    active = set(model.rev.names) | set(model.pri.names) | {
+        n for n, a in zip(model.lock.names, lay.lock_active, strict=True) if a}
     out = {}
-    for k, nme in enumerate(model.rev.names):
-        out[nme] = ("revolute", int(model.rev.i[k]), int(model.rev.j[k]), model.rev.sj[k], None)
-    for k, nme in enumerate(model.pri.names):
-        out[nme] = ("prismatic", int(model.pri.i[k]), int(model.pri.j[k]), model.pri.sj[k],
-                    model.pri.ui[k])
-    for k, nme in enumerate(model.lock.names):
-        if lay.lock_active[k]:
-            out[nme] = ("lock", int(model.lock.i[k]), int(model.lock.j[k]), np.zeros(2), None)
-    return {n: out[n] for n in model.joint_names if n in out}
+    for n in model.joint_names:
+        if n in active:
+            kind, i, j, _ = reaction_frame(model, n)
+            ui = model.pri.ui[model.pri.names.index(n)] if kind == "prismatic" else None
+            out[n] = (kind, i, j, ui)
+    return out
 
 
 def _net_on_ground(model: Model, x, D) -> np.ndarray:
@@ -186,20 +308,10 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     geo = _joint_geometry(model, lay)
     reactions, moments, jframe, jpoints, kinds = {}, {}, {}, {}, {}
     frame_loads: dict[str, np.ndarray] = {}
-    for name, (kind, i, j, sj, ui) in geo.items():
-        rows = lay.rows[name]
-        Cj = C[:, rows, :].sum(axis=1).reshape(n, nb, 3)
-        Pt = X[:, j, :2] + rotate(X[:, j, 2], sj)  # joint point (ground frame)
-        if j < nb:
-            f = Cj[:, j, :2]
-            m_o = Cj[:, j, 2]
-            mP = m_o - cross(Pt - X[:, j, :2], f)
-        else:  # child is the ground: use the parent's share (action = -reaction)
-            fi = Cj[:, i, :2]
-            mi = Cj[:, i, 2] - cross(Pt - X[:, i, :2], fi)
-            f, mP = -fi, -mi
+    for name, (kind, i, j, ui) in geo.items():
+        f, mP, Pt = joint_reaction(model, name, x, C[:, lay.rows[name], :].sum(axis=1))
         reactions[name] = f
-        moments[name] = mP if kind != "revolute" else np.zeros(n)
+        moments[name] = mP
         jpoints[name] = Pt
         kinds[name] = kind
         thi = X[:, i, 2]
@@ -217,14 +329,14 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
                 [ff, (mm + cross(Pt - point, ff))[:, None]], axis=-1)
 
     # ------------------------------------------------ switchable elements (modes.py rows)
-    element_forces: dict[str, np.ndarray] = {}
+    el_forces: dict[str, np.ndarray] = {}
     p_el = np.zeros(n)
     if isinstance(lay, ModeRows):
         for el, idx in lay.elements.items():
             # the multiplier in the forward convention (M xddot = F + R^T lambda_m):
             # the normal force of a stop or contact (>= 0), the torque/force of a
             # coordinate lock on its measure, the tangential force of a sticking contact
-            element_forces[el] = -lam[:, idx[0]]
+            el_forces[el] = -lam[:, idx[0]]
             Del = C[:, idx, :].sum(axis=1)
             p_el += np.einsum("nx,nx->n", Del, xdot)
             fe = _net_on_ground(model, x, Del)
@@ -253,6 +365,6 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     return {"reactions": reactions, "moments": moments, "joint_frame": jframe,
             "joint_points": jpoints, "kinds": kinds, "frame_loads": frame_loads,
             "frame_force": tot[:, :2].copy(), "frame_moment": tot[:, 2].copy(), "tau": tau,
-            "lam": lam, "element_forces": element_forces, "status": status,
+            "lam": lam, "element_forces": el_forces, "status": status,
             "warnings": warn, "redundant": redundant, "stats": stats}
 

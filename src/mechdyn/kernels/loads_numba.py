@@ -45,6 +45,7 @@ F_GLOBAL = 4  # gx, gy, length_scale, tol (at the start of the float array)
 V_CONST, V_TABLE = 0, 1
 T_OUTSIDE, T_PERIODIC = 1, 2  # table flags
 VAR_T, VAR_Q, VAR_QDOT, VAR_ROW = 0, 1, 2, 3  # VAR_ROW: a row of ``variable_rows``
+_VAR_KINDS = {"t": VAR_T, "q": VAR_Q, "qdot": VAR_QDOT}
 
 
 class Unsupported(Exception):
@@ -59,16 +60,18 @@ class LoadPacker:
     model : Model
     force_model : ForceModel
         The model's parsed loads (:func:`mechdyn.dynamics.forces.force_model`).
-    variable_row : callable, optional
-        ``variable_row(name) -> Rows or None``: the one-row measure of a table variable
-        that is not t, a coordinate or its rate (e.g. ``"slider.com.x"``); such rows are
-        collected in :attr:`variable_rows` and their values are passed to
+    variable : callable, optional
+        ``variable(name) -> (kind, ref)`` resolves a table variable: ``("t", None)``,
+        ``("q", k)`` or ``("qdot", k)`` for a declared coordinate k or its rate,
+        ``("row", rows)`` for a one-row measure (a body point such as
+        ``"slider.com.x"``, a joint, an angle), ``(None, None)`` for anything else.
+        Measured rows are collected in :attr:`variable_rows`; their values reach
         :func:`forces` as ``varv``.
     """
 
-    def __init__(self, model, force_model, variable_row=None):
+    def __init__(self, model, force_model, variable=None):
         self.model, self.fm = model, force_model
-        self.variable_row = variable_row
+        self.variable = variable
         #: rows measuring the table variables that are not coordinates (body points)
         self.variable_rows: list = []
         self._var_index: dict[str, int] = {}
@@ -78,7 +81,6 @@ class LoadPacker:
 
     def value(self, v, where):
         """(int record, value, outside) of a load magnitude."""
-        m = self.model
         if isinstance(v, bool):
             raise Unsupported(f"{where}: boolean value")
         if isinstance(v, int | float | np.floating | np.integer):
@@ -87,20 +89,17 @@ class LoadPacker:
             return self.table(v.omega, v.torque, VAR_QDOT, -1, None)
         if isinstance(v, Table):
             var = v.variable
-            if var == "t":
-                kind, idx = VAR_T, 0
-            elif var in m.coordinate_names:
-                kind, idx = VAR_Q, m.coordinate_index(var)
-            elif var.endswith("_dot") and var[:-4] in m.coordinate_names:
-                kind, idx = VAR_QDOT, m.coordinate_index(var[:-4])
-            elif self.variable_row is not None and self.variable_row(var) is not None:
+            kind, ref = self.variable(var) if self.variable is not None else (None, None)
+            if kind == "row":
                 if var not in self._var_index:
                     self._var_index[var] = len(self.variable_rows)
-                    self.variable_rows.append(self.variable_row(var))
+                    self.variable_rows.append(ref)
                 kind, idx = VAR_ROW, self._var_index[var]
+            elif kind in _VAR_KINDS:
+                kind, idx = _VAR_KINDS[kind], int(ref or 0)
             else:
-                raise Unsupported(f"{where}: table over {var!r} (only t, coordinates and "
-                                   f"their rates are compiled)")
+                raise Unsupported(f"{where}: table over {var!r} is evaluated on the NumPy "
+                                  f"path")
             return self.table(v.x, v.y, kind, idx, v.outside, v.period)
         raise Unsupported(f"{where}: value {type(v).__name__} is not compiled "
                            f"(a Python callable is evaluated on the NumPy path)")

@@ -36,17 +36,20 @@ class Parts:
         th = X[..., 2]
         c, s = np.cos(th), np.sin(th)
         b1, b2, d = rows.b1, rows.b2, rows.d
-        c1, s1, c2, s2, cd, sd = c[..., b1], s[..., b1], c[..., b2], s[..., b2], \
-            c[..., d], s[..., d]
+        # gathers along the last axis (take: the same for one pose and for a batch)
+        c1, s1, c2, s2 = c.take(b1, -1), s.take(b1, -1), c.take(b2, -1), s.take(b2, -1)
+        cd, sd = c.take(d, -1), s.take(d, -1)
+        s1x, s1y, s2x, s2y, ux, uy = rows.columns
         self.th = th
-        self.r1x = c1 * rows.s1[:, 0] - s1 * rows.s1[:, 1]
-        self.r1y = s1 * rows.s1[:, 0] + c1 * rows.s1[:, 1]
-        self.r2x = c2 * rows.s2[:, 0] - s2 * rows.s2[:, 1]
-        self.r2y = s2 * rows.s2[:, 0] + c2 * rows.s2[:, 1]
-        self.wx = cd * rows.u[:, 0] - sd * rows.u[:, 1]
-        self.wy = sd * rows.u[:, 0] + cd * rows.u[:, 1]
-        self.dx = X[..., b1, 0] + self.r1x - X[..., b2, 0] - self.r2x
-        self.dy = X[..., b1, 1] + self.r1y - X[..., b2, 1] - self.r2y
+        self.r1x = c1 * s1x - s1 * s1y
+        self.r1y = s1 * s1x + c1 * s1y
+        self.r2x = c2 * s2x - s2 * s2y
+        self.r2y = s2 * s2x + c2 * s2y
+        self.wx = cd * ux - sd * uy
+        self.wy = sd * ux + cd * uy
+        px, py = X[..., 0], X[..., 1]
+        self.dx = px.take(b1, -1) + self.r1x - px.take(b2, -1) - self.r2x
+        self.dy = py.take(b1, -1) + self.r1y - py.take(b2, -1) - self.r2y
 
 
 def parts(rows: Rows, x) -> Parts:
@@ -65,8 +68,8 @@ def values(rows: Rows, x, p: Parts | None = None) -> np.ndarray:
     [0.0, 0.0]
     """
     p = p or Parts(rows, x)
-    return (p.wx * p.dx + p.wy * p.dy + rows.ka * p.th[..., rows.a]
-            + rows.kb * p.th[..., rows.bb] + rows.c)
+    return (p.wx * p.dx + p.wy * p.dy + rows.ka * p.th.take(rows.a, -1)
+            + rows.kb * p.th.take(rows.bb, -1) + rows.c)
 
 
 def jacobian(rows: Rows, x, p: Parts | None = None) -> np.ndarray:
@@ -75,15 +78,14 @@ def jacobian(rows: Rows, x, p: Parts | None = None) -> np.ndarray:
     n, n_x = len(rows), rows.n_x
     batch = p.dx.shape[:-1]
     terms = (p.wx, p.wy, p.wy * p.r1x - p.wx * p.r1y, -p.wx, -p.wy,
-             p.wx * p.r2y - p.wy * p.r2x, p.wx * p.dy - p.wy * p.dx,
-             np.broadcast_to(rows.ka, batch + (n,)), np.broadcast_to(rows.kb, batch + (n,)))
+             p.wx * p.r2y - p.wy * p.r2x, p.wx * p.dy - p.wy * p.dx, rows.ka, rows.kb)
     if not batch:
         out = np.bincount(rows.scatter, np.concatenate(terms), n * (n_x + 1))
         return out.reshape(n, n_x + 1)[:, :n_x]
     flat = rows.scatter.reshape(9, n)
     out = np.zeros(batch + (n * (n_x + 1),))
     for k in range(9):  # within one term every (row, column) pair is distinct
-        out[..., flat[k]] += terms[k]
+        out[..., flat[k]] += terms[k]  # (ka, kb broadcast over the batch)
     return out.reshape(batch + (n, n_x + 1))[..., :n_x]
 
 
@@ -94,10 +96,11 @@ def quad(rows: Rows, x, xdot, p: Parts | None = None) -> np.ndarray:
     nb = rows.nb
     V = np.zeros(xdot.shape[:-1] + (nb + 1, 3))
     V[..., :nb, :] = xdot.reshape(xdot.shape[:-1] + (nb, 3))
-    om = V[..., 2]
-    w1, w2, wd = om[..., rows.b1], om[..., rows.b2], om[..., rows.d]
-    ddx = V[..., rows.b1, 0] - w1 * p.r1y - V[..., rows.b2, 0] + w2 * p.r2y
-    ddy = V[..., rows.b1, 1] + w1 * p.r1x - V[..., rows.b2, 1] - w2 * p.r2x
+    vx, vy, om = V[..., 0], V[..., 1], V[..., 2]
+    b1, b2 = rows.b1, rows.b2
+    w1, w2, wd = om.take(b1, -1), om.take(b2, -1), om.take(rows.d, -1)
+    ddx = vx.take(b1, -1) - w1 * p.r1y - vx.take(b2, -1) + w2 * p.r2y
+    ddy = vy.take(b1, -1) + w1 * p.r1x - vy.take(b2, -1) - w2 * p.r2x
     w1s, w2s = w1 * w1, w2 * w2
     return (-wd * wd * (p.wx * p.dx + p.wy * p.dy) + 2.0 * wd * (p.wx * ddy - p.wy * ddx)
             + p.wx * (w2s * p.r2x - w1s * p.r1x) + p.wy * (w2s * p.r2y - w1s * p.r1y))

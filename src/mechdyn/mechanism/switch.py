@@ -9,23 +9,11 @@ runs them.
 Variables
 ---------
 Switch conditions, coordinate locks and stops name a measured quantity by a
-short *variable* string:
-
-``"t"``
-    time, s (switch conditions only);
-``"phi"``
-    a declared generalized coordinate (rad or m);
-``"phi_dot"``
-    its rate (switch conditions only);
-``"joint:C"``
-    the relative angle of revolute joint ``C`` (theta_child - theta_parent, rad)
-    or the travel of prismatic joint ``C`` along its axis (m);
-``"angle:rocker"``
-    the absolute angle of a body, rad;
-``"rocker.B.x"`` / ``"rocker.B.y"``
-    a coordinate of a body point in the ground frame, m;
-``"dist(rocker.B, slider.P)"``
-    the distance between two body points, m (switch conditions only).
+short *variable* string: ``"t"``, a coordinate ``"phi"``, its rate
+``"phi_dot"``, ``"joint:C"``, ``"angle:rocker"``, ``"rocker.B.x"``,
+``"dist(rocker.B, slider.P)"``; the grammar and its one parser are
+:mod:`mechdyn.model.variable`.  Time, rates and distances are allowed in switch
+conditions only (a coordinate lock or a stop holds a constraint row).
 
 Elements are stored in ``Mechanism.extras`` under the key given by their
 ``extra_kind`` (``"coordinate_locks"``, ``"switches"``); :func:`add_element`

@@ -136,6 +136,12 @@ class Rows:
                     self.ka, self.bb, self.kb, self.c, labels, elements, self.is_angle)
 
     @cached_property
+    def columns(self) -> tuple[np.ndarray, ...]:
+        """Contiguous s1x, s1y, s2x, s2y, ux, uy, each (n,), for the evaluators."""
+        return tuple(np.ascontiguousarray(a[:, k]) for a in (self.s1, self.s2, self.u)
+                     for k in (0, 1))
+
+    @cached_property
     def scatter(self) -> np.ndarray:
         """Flat indices into an (n, n_x + 1) array of the nine Jacobian terms of every row
         (columns of b1 x, y, theta; b2 x, y, theta; d theta; a theta; bb theta), the

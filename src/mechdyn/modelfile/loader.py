@@ -40,6 +40,7 @@ from ..mechanism import (
     TorqueSpeedCurve,
     pulse,
 )
+from ..model.variable import parse
 from ..units import parse_quantity, parse_vector
 from .schema import locate, schema_problems
 from .switches import TABLES as SWITCH_TABLES
@@ -614,27 +615,35 @@ class _Builder:
 
     # ------------------------------------------------------------ loads and drives
     def variable_kind(self, var: str, *path) -> str:
-        """Kind of quantity of a table's variable: t, a coordinate, its rate, a point coordinate."""
-        if var == "t":
+        """Kind of quantity of a table's variable (:func:`mechdyn.model.variable.parse`):
+        time, a coordinate or its rate, a joint, an angle, a point coordinate, a distance."""
+        try:
+            v = parse(var, self.coord_kinds)
+        except ModelError:
+            valid = ["t", *self.coord_kinds, *(f"{c}_dot" for c in self.coord_kinds),
+                     "joint:NAME", "angle:BODY", "BODY.POINT.x", "BODY.POINT.y",
+                     "dist(BODY.POINT, BODY.POINT)"]
+            self.problem(f"{self.where(*path)}: {var!r}: unknown variable; valid variables: "
+                         + ", ".join(repr(v) for v in valid))
+            raise _Failed from None
+        if v.kind == "time":
             return "time"
-        if var in self.coord_kinds:
-            return self.coord_value_kind(var, rate=False)
-        if var.endswith("_dot") and var[:-4] in self.coord_kinds:
-            return self.coord_value_kind(var[:-4], rate=True)
-        parts = var.split(".")
-        if len(parts) == 3 and parts[2] in ("x", "y"):
-            body = self.body_name(parts[0], *path)
-            if parts[1] not in self.body_points.get(body, []):
-                self.problem(f"{self.where(*path)}: unknown point {parts[1]!r} of body {body!r}; "
-                             "valid point names: "
-                             + ", ".join(repr(p) for p in self.body_points[body]))
+        if v.kind == "coordinate":
+            return self.coord_value_kind(v.name, v.rate)
+        if v.kind == "joint":
+            kinds = {"revolute": "angle", "prismatic": "length"}
+            if self.joint_types.get(v.name) not in kinds:
+                self.problem(f"{self.where(*path)}: {var!r}: " + did_you_mean(
+                    v.name, [j for j, t in self.joint_types.items() if t in kinds],
+                    "revolute or prismatic joint"))
                 raise _Failed
-            return "length"
-        valid = ["t", *self.coord_kinds, *(f"{c}_dot" for c in self.coord_kinds),
-                 "BODY.POINT.x", "BODY.POINT.y"]
-        self.problem(f"{self.where(*path)}: {var!r}: unknown variable; valid variables: "
-                     + ", ".join(repr(v) for v in valid))
-        raise _Failed
+            return kinds[self.joint_types[v.name]]
+        if v.kind == "angle":
+            self.body_name(v.name, *path)
+            return "angle"
+        for body, point in v.points:
+            self.point_ref(self.body_name(body, *path), point, *path)
+        return "length"
 
     def value(self, raw: Any, kind: str, *path):
         """A constant, a ``{x, y, variable}`` table or a ``{pulse, start, duration}`` pulse

@@ -48,8 +48,8 @@ from __future__ import annotations
 
 from ..errors import ModelError, UnitError, did_you_mean
 from ..mechanism.contact import Contact, Stop
-from ..mechanism.joint import Prismatic, Revolute
 from ..mechanism.switch import GUARD_OPERATORS, SWITCH_ACTIONS, CoordinateLock, Switch
+from ..model.variable import parse, quantity
 from ..units import parse_quantity, parse_vector
 
 __all__ = ["parse_switches", "TABLES", "variable_kind"]
@@ -68,28 +68,15 @@ _DIRECTIONS = {"rising": 1, "up": 1, "falling": -1, "down": -1, "both": 0, "eith
 
 
 def variable_kind(mech, variable: str) -> str:
-    """The quantity kind (for units) of a variable string of a mechanism."""
-    v = variable.strip()
-    if v == "t":
-        return "time"
-    rate = v.endswith("_dot") and v[:-4] in mech.coordinates
-    if rate:
-        v = v[:-4]
-    if v in mech.coordinates:
-        ang = mech.coordinates[v].is_angle
-    elif v.startswith("joint:"):
-        j = mech.joints.get(v[6:])
-        if not isinstance(j, (Revolute, Prismatic)):
-            valid = [n for n, jj in mech.joints.items() if isinstance(jj, (Revolute, Prismatic))]
-            raise ModelError(did_you_mean(v[6:], valid, "revolute or prismatic joint"))
-        ang = isinstance(j, Revolute)
-    elif v.startswith("angle:"):
-        ang = True
-    else:
-        ang = False  # point coordinates and distances
-    if rate:
-        return "angular_velocity" if ang else "velocity"
-    return "angle" if ang else "length"
+    """The quantity kind (for units) of a variable string of a mechanism
+    (:func:`mechdyn.model.variable.parse` and :func:`~mechdyn.model.variable.quantity`).
+
+    Raises
+    ------
+    ModelError
+        An unknown variable, joint, body or point (the message lists the valid names).
+    """
+    return quantity(parse(variable, mech.coordinates), mech)
 
 
 def parse_switches(doc: dict, mech, where: str = "") -> list[str]:

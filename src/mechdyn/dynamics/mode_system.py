@@ -1,0 +1,458 @@
+"""Kinematics and dynamics of one *mode* of a variable-structure mechanism.
+
+A mode is the set of active switchable constraints (``State.mode``; see
+:mod:`mechdyn.dynamics.modes`).  Its constraint rows are ONE
+:class:`~mechdyn.model.rows.Rows`, :attr:`ModeSystem.rowset`: the model's joint
+rows (``Model.joint_rows``) followed by one row per active switchable element
+(:meth:`SwitchedModel.rows`, three for a weld lock), all evaluated by
+:mod:`mechdyn.kernels.rows_numpy` with their exact Jacobian and acceleration
+term.  The independent coordinates q_I (:attr:`ModeSystem.coords`) are a subset
+of the declared coordinates, chosen by the largest pivots of the declared
+coordinates' Jacobian restricted to the mode's null space (coordinates that
+became dependent are dropped); :attr:`ModeSystem.independent_rows` are a
+maximal independent subset of the rows at the pose the mode was entered.
+
+Dynamics in a mode (reduced, exact), with xddot = B qddot_I + b and the
+x-space mass matrix M(x) of bodies whose frames need not sit at their centres
+of mass (h(x, xdot) the centripetal terms of the offset centres of mass):
+
+    M (B qddot_I + b) + h = F + Phi_x^T lambda + (friction of sliding contacts)
+
+n_x equations for qddot_I and the multipliers lambda of every row: the
+accelerations and all constraint forces (joint reactions, lock forces and
+torques, contact forces) come out of one solve.  Redundant rows (a weld over a
+pin, statically indeterminate contacts) get the multipliers of least weighted
+norm, the weights being the contact compliances (the limit of the compliance-
+regularized problem of the cyclic-automata document).  The reactions of joints
+and locks follow from the multipliers in :mod:`mechdyn.dynamics.reactions`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import TYPE_CHECKING
+
+import numpy as np
+import scipy.linalg
+
+from ..errors import AssemblyError, LockupError
+from ..kernels import rows_numpy as RN
+from ..model import Model
+from ..model.rows import concat
+from .reactions import touches_ground
+
+if TYPE_CHECKING:
+    from .modes import SwitchedModel
+
+__all__ = ["ModeSystem", "ModeEval", "mass_matrix_x", "fmt_mode"]
+
+
+def fmt_mode(mode) -> str:
+    """A mode for messages: ``{a, b}``."""
+    return "{" + ", ".join(sorted(mode)) + "}" if mode else "{} (no switchable constraint)"
+
+
+# ============================================================================ mass
+_MASS_INDEX: dict = {}  # flat indices of the nonzeros of M, per number of bodies
+
+
+def mass_matrix_x(model: Model, x, xdot=None):
+    """Mass matrix M(x) (n_x, n_x) of the body poses and the centripetal term h (n_x,).
+
+    The kinetic energy is T = 1/2 sum (m |v_c|^2 + J_c omega^2) with the centre
+    of mass at rho = A(theta) com from the body frame origin; M xddot + h is the
+    inertia force conjugate to the poses (force, N; moment about the frame
+    origin, N m).
+    """
+    nb = model.n_bodies
+    n_x = 3 * nb
+    M = np.zeros((n_x, n_x))
+    h = np.zeros(n_x)
+    th = np.asarray(x, float)[2::3]
+    c, sn = np.cos(th), np.sin(th)
+    cx, cy = model.com[:, 0], model.com[:, 1]
+    rx = c * cx - sn * cy
+    ry = sn * cx + c * cy
+    m = model.mass
+    i = 3 * np.arange(nb)
+    flat = _MASS_INDEX.get(nb)
+    if flat is None:
+        flat = _MASS_INDEX[nb] = np.concatenate([
+            i * n_x + i, (i + 1) * n_x + i + 1, i * n_x + i + 2, (i + 2) * n_x + i,
+            (i + 1) * n_x + i + 2, (i + 2) * n_x + i + 1, (i + 2) * n_x + i + 2])
+    mry, mrx = m * -ry, m * rx
+    M.flat[flat] = np.concatenate([m, m, mry, mry, mrx, mrx,
+                                   model.inertia + m * (rx * rx + ry * ry)])
+    if xdot is not None:
+        w = np.asarray(xdot, float)[2::3]
+        f = -m * w * w
+        h[i] = f * rx
+        h[i + 1] = f * ry
+    return M, h
+
+
+# ============================================================================ the mode system
+@dataclass
+class ModeEval:
+    """Everything computed at one state of a mode.
+
+    Attributes
+    ----------
+    x, xdot, xddot : ndarray, shape (n_x,)
+    q, qdot, qddot : ndarray, shape (n_q,)
+        All declared coordinates (dependent ones measured on the pose).
+    lam : ndarray, shape (n_rows,)
+        Multipliers of the rows of :attr:`ModeSystem.rowset` (N for rows in m,
+        N m for rows in rad), in the convention M xddot + h = F + Phi_x^T lam.
+    F : ndarray, shape (n_x,)
+        Applied forces on the poses, drives included.
+    F_conservative : ndarray, shape (n_x,) or None
+        Forces of gravity and spring stiffness alone at the pose, when they
+        came out of the same evaluation of the loads (None otherwise).
+    """
+
+    x: np.ndarray
+    xdot: np.ndarray
+    xddot: np.ndarray
+    q: np.ndarray
+    qdot: np.ndarray
+    qddot: np.ndarray
+    lam: np.ndarray
+    F: np.ndarray = field(repr=False, default=None)
+    F_conservative: np.ndarray | None = field(repr=False, default=None)
+
+
+class ModeSystem:
+    """The constraint rows, independent coordinates and dynamics of one mode.
+
+    Parameters
+    ----------
+    sm : SwitchedModel
+    mode : frozenset of str
+    targets : dict
+        Held values of the engaged locks and sticking contacts (see
+        :meth:`SwitchedModel.capture_target`).
+    x : ndarray, shape (n_x,)
+        The pose at which rows and coordinates are chosen.
+    prefer : sequence of str
+        Declared coordinates to keep independent if possible (the previous set).
+    avoid : sequence of str
+        Declared coordinates to drop first (``frees`` of the locks just engaged).
+
+    Attributes
+    ----------
+    rows : list of Row
+        The switchable rows of the mode.
+    rowset : Rows
+        Every row of the mode: the joint rows (``n_base`` of them), then ``rows``.
+    independent_rows : ndarray of int
+        Indices into ``rowset`` of a maximal independent set of rows.
+    coords : ndarray of int
+        Indices of the independent declared coordinates (n_i of them).
+
+    Raises
+    ------
+    LockupError
+        The mode leaves no freedom that the declared coordinates can describe.
+    """
+
+    def __init__(self, sm: SwitchedModel, mode, targets: dict, x, *, prefer=(), avoid=()):
+        self.sm = sm
+        model = sm.model
+        self.model = model
+        nb = sm.nb
+        self.mode = frozenset(mode)
+        self.targets = dict(targets)
+        self.rows = sm.rows(self.mode, targets)
+        self.n_base = len(model.joint_rows)
+        self.rowset = concat(nb, model.joint_rows, *[r.rows for r in self.rows])
+        self.n_rows = len(self.rowset)
+        slip = [(self.n_base + k, r.friction_rows) for k, r in enumerate(self.rows) if r.slip]
+        self._slip_rows = np.array([k for k, _ in slip], int)
+        self._slip = concat(nb, *[f for _, f in slip]) if slip else None
+        L = model.length_scale
+        colscale = np.tile([L, L, 1.0], nb)
+        rowscale = np.where(self.rowset.is_angle, 1.0, 1.0 / L)
+        self.x_ref = np.array(x, float)
+        Rs = self.row_jacobian(self.x_ref) * rowscale[:, None] * colscale[None, :]
+        self.independent_rows = _independent_rows(Rs)
+        self.dof = model.n_x - len(self.independent_rows)
+        self.coords = self._choose_coordinates(Rs[self.independent_rows], colscale, prefer,
+                                               avoid)
+        self.coord_names = tuple(model.coordinate_names[k] for k in self.coords)
+        self.n_i = len(self.coords)
+        # every row and every coordinate, evaluated at once; the position problem
+        # [independent rows; g_I - q_I] is the subset _sel of them
+        self._all = concat(nb, self.rowset, model.coordinate_rows)
+        self._sel = np.concatenate([self.independent_rows, self.n_rows + self.coords])
+        self._at = None  # (x, Parts, values) of the last pose solved
+        self._eye_i = np.zeros((model.n_x, self.n_i))
+        self._eye_i[len(self.independent_rows):, :] = np.eye(self.n_i)
+        self._rs = np.tile([1.0, 1.0, 1.0 / L], nb)
+        self._x_last = self.x_ref.copy()
+        self._B_last = None
+        self._qi_last = None
+
+    def _choose_coordinates(self, Ri, colscale, prefer, avoid) -> np.ndarray:
+        """Pivots of G N (G the scaled coordinate Jacobian, N the null space of the
+        scaled independent rows ``Ri``), weighted by ``prefer`` and ``avoid``."""
+        model = self.model
+        if self.dof == 0:
+            return np.zeros(0, int)
+        cscale = np.where(model.coord_is_angle, 1.0, 1.0 / model.length_scale)
+        Gs = self._coord_jac(self.x_ref) * cscale[:, None] * colscale[None, :]
+        N = np.linalg.svd(Ri)[2][Ri.shape[0]:].T if Ri.shape[0] else np.eye(model.n_x)
+        GN = Gs @ N  # (n_q, dof)
+        names = model.coordinate_names
+        w = np.ones(model.n_q)
+        for k, n in enumerate(names):
+            if n in avoid:
+                w[k] = 1e-6
+            elif prefer and n not in prefer:
+                w[k] = 0.5
+        piv = scipy.linalg.qr((GN * w[:, None]).T, pivoting=True)[2]
+        chosen = np.sort(piv[:self.dof])
+        sv = np.linalg.svd(GN[chosen], compute_uv=False)
+        if sv.size < self.dof or sv[-1] < 1e-8 * max(1.0, sv[0]):
+            raise LockupError(
+                f"mode {fmt_mode(self.mode)} leaves {self.dof} degree(s) of freedom that "
+                f"the declared coordinates ({', '.join(names)}) cannot describe")
+        return chosen
+
+    # ------------------------------------------------------------------ rows
+    def row_values(self, x) -> np.ndarray:
+        """Residuals of every row of :attr:`rowset`, shape (n_rows,), m or rad."""
+        return RN.values(self.rowset, x)
+
+    def row_jacobian(self, x) -> np.ndarray:
+        """Jacobian of every row, shape (n_rows, n_x)."""
+        return RN.jacobian(self.rowset, x)
+
+    def row_quad(self, x, xdot) -> np.ndarray:
+        """Velocity-quadratic part of every row's second derivative, shape (n_rows,)."""
+        return RN.quad(self.rowset, x, xdot)
+
+    def row_labels(self) -> list[str]:
+        """A label per row (joint name + component, then the switchable rows)."""
+        return list(self.rowset.labels)
+
+    def row_elements(self) -> list[str]:
+        """The element (joint, lock, stop, contact) of each row."""
+        return list(self.rowset.elements)
+
+    @cached_property
+    def element_rows(self) -> dict[str, np.ndarray]:
+        """The rows of each element (joint, lock, stop, contact), indices into
+        :attr:`rowset`."""
+        out: dict[str, list[int]] = {}
+        for k, el in enumerate(self.rowset.elements):
+            out.setdefault(el, []).append(k)
+        return {el: np.array(idx, int) for el, idx in out.items()}
+
+    @cached_property
+    def grounded(self) -> frozenset:
+        """The elements whose rows act between the frame and the moving bodies."""
+        return frozenset(el for el, idx in self.element_rows.items()
+                         if touches_ground(self.rowset.take(idx)))
+
+    def _coord_jac(self, x) -> np.ndarray:
+        """Jacobian of all declared coordinates, shape (n_q, n_x)."""
+        return RN.jacobian(self.model.coordinate_rows, x)
+
+    def coordinates(self, x) -> np.ndarray:
+        """All declared coordinates measured on a pose, shape (n_q,)."""
+        return RN.values(self.model.coordinate_rows, x)
+
+    def residual_norm(self, x) -> float:
+        """Largest constraint residual of the mode at ``x`` (m or rad)."""
+        v = self.row_values(x)
+        return float(np.max(np.abs(v))) if v.size else 0.0
+
+    # ------------------------------------------------------------------ positions
+    def solve_position(self, qi, x_guess=None, t=None) -> np.ndarray:
+        """Pose x (n_x,) at independent coordinates ``qi`` (n_i,), by Newton from ``x_guess``.
+
+        Without ``x_guess`` the start is the last solution moved to ``qi`` along
+        its velocity analogs (a first-order predictor), which keeps the branch.
+
+        Raises
+        ------
+        AssemblyError
+            Newton does not converge; the message names the open rows.
+        """
+        qi = np.asarray(qi, float)
+        if x_guess is None:
+            x = self._x_last.copy()
+            if self._B_last is not None and self.n_i:
+                x = x + self._B_last @ (qi - self._qi_last)
+        else:
+            x = np.array(x_guess, float)
+        allr, sel, n_r = self._all, self._sel, len(self.independent_rows)
+        tol = 1e-13 * max(self.model.length_scale, 1e-3)
+        err_prev = np.inf
+        for _ in range(40):
+            p = RN.Parts(allr, x)
+            v = RN.values(allr, x, p)
+            F = v[sel]
+            F[n_r:] -= qi
+            err = float(np.max(np.abs(F))) if F.size else 0.0
+            if err <= tol or (err <= 1e3 * tol and err >= 0.5 * err_prev):
+                break
+            err_prev = err
+            J = RN.jacobian(allr, x, p)[sel]
+            try:
+                dx = np.linalg.solve(J, F)
+            except np.linalg.LinAlgError:
+                dx = np.linalg.lstsq(J, F, rcond=None)[0]
+            x = x - dx
+            if not np.all(np.isfinite(x)):
+                break
+        else:
+            err = np.inf
+        if not (err <= 1e3 * tol):
+            res = {r: float(v) for r, v in zip(self.row_labels(), self.row_values(x), strict=True)
+                   if abs(v) > 1e3 * tol} if np.all(np.isfinite(x)) else {}
+            raise AssemblyError(
+                f"the mechanism cannot be assembled in mode {fmt_mode(self.mode)}",
+                t=t, q=qi, residuals=res)
+        self._x_last = x
+        self._at = (x, p, v)
+        return x
+
+    def velocity_analogs(self, x):
+        """B (n_x, n_i) with xdot = B qdot_I, and the square Jacobian [rows_I; g_I] at x."""
+        J = RN.jacobian(self._all, x)[self._sel]
+        B = np.linalg.solve(J, self._eye_i) if J.size else np.zeros((self.model.n_x, 0))
+        return B, J
+
+    def state(self, qi, qdoti, x_guess=None, t=None):
+        """(x, xdot, B) at independent coordinates and rates."""
+        x = self.solve_position(qi, x_guess, t)
+        B, _ = self.velocity_analogs(x)
+        self._B_last, self._qi_last = B, np.array(qi, float)
+        return x, B @ np.asarray(qdoti, float), B
+
+    def independent(self, x, xdot):
+        """(q_I, qdot_I) measured on a pose and its rates."""
+        G = self._coord_jac(x)[self.coords]
+        return self.coordinates(x)[self.coords], G @ xdot
+
+    # ------------------------------------------------------------------ dynamics
+    def _kinematics(self, x, xdot=None, B=None, qdoti=None):
+        """(R, G, B, b, xdot, quad_g, q) at a pose: the row and coordinate Jacobians,
+        the velocity analogs, xddot = B qddot_I + b, the coordinates' quadratic terms
+        and values."""
+        n_rows, allr = self.n_rows, self._all
+        at = self._at
+        if at is not None and at[0] is x:  # the pose just solved: its parts and values
+            p, v = at[1], at[2]
+        else:
+            p = RN.Parts(allr, x)
+            v = RN.values(allr, x, p)
+        RG = RN.jacobian(allr, x, p)
+        R, G = RG[:n_rows], RG[n_rows:]
+        J = RG[self._sel]
+        if B is None:
+            B = np.linalg.solve(J, self._eye_i) if J.size else np.zeros((self.model.n_x, 0))
+        if xdot is None:
+            xdot = B @ np.asarray(qdoti, float)
+            self._B_last = B
+        quad = RN.quad(allr, x, xdot, p)
+        b = np.linalg.solve(J, -quad[self._sel]) if J.size else np.zeros(0)
+        return R, G, B, b, xdot, quad[n_rows:], v[n_rows:]
+
+    def evaluate(self, t, qi, qdoti, x_guess=None) -> ModeEval:
+        """Accelerations and every multiplier at a state of the mode."""
+        x = self.solve_position(qi, x_guess, t)
+        ev = self.evaluate_x(t, x, None, qdoti=qdoti)
+        self._qi_last = np.array(qi, float)
+        return ev
+
+    def evaluate_x(self, t, x, xdot, B=None, *, qdoti=None) -> ModeEval:
+        """As :meth:`evaluate`, from a consistent pose and velocity (or, with
+        ``xdot`` None, the independent rates ``qdoti``)."""
+        R, G, B, b, xdot, quad_g, q = self._kinematics(x, xdot, B, qdoti)
+        qdot = G @ xdot
+        F, Qd, Fc = self.sm.fm.applied_and_conservative(t, x, xdot, q, qdot)
+        F = F + G.T @ Qd
+        M, h = self.sm.with_drive_inertia(*mass_matrix_x(self.model, x, xdot), G, quad_g)
+        Reff = R
+        if self._slip is not None:
+            Reff = R.copy()
+            Reff[self._slip_rows] += RN.jacobian(self._slip, x)
+        qddi, lam = self._solve_motion(M, B, Reff, F - h - M @ b, self._rs)
+        xddot = B @ qddi + b
+        qddot = G @ xddot + quad_g
+        return ModeEval(x, xdot, xddot, q, qdot, qddot, lam, F, Fc)
+
+    def _solve_motion(self, M, B, Reff, rhs, rs):
+        """Solve [M B, -Reff^T] [qddot_i; lam] = rhs (rows scaled by ``rs``) for the
+        independent accelerations and the multipliers; redundant sets by least squares."""
+        Ks = np.concatenate([M @ B, -Reff.T], axis=1) * rs[:, None]
+        try:
+            sol = np.linalg.solve(Ks, rhs * rs) if Ks.shape[0] == Ks.shape[1] else None
+        except np.linalg.LinAlgError:
+            sol = None
+        if sol is None:
+            sol = self._redundant_solve(Ks, rhs * rs)
+        return sol[:self.n_i], sol[self.n_i:]
+
+    def _redundant_solve(self, Ks, rhs):
+        """Least-squares solution of a rank-deficient [M B, -Phi^T] system whose
+        multipliers are not unique: among all solutions, the one minimizing
+        sum c_k lambda_k^2 over the compliant contact rows (c_k their compliances;
+        1 for rigid unilateral rows, ~0 for the rigid joints and locks)."""
+        sol0, *_ = np.linalg.lstsq(Ks, rhs, rcond=None)
+        u, s, vt = np.linalg.svd(Ks)
+        rank = int(np.sum(s > 1e-11 * (s[0] if s.size else 1.0)))
+        N = vt[rank:].T
+        if N.shape[1] == 0:
+            return sol0
+        w = np.full(Ks.shape[1], 1e-9)
+        comp = np.array([r.compliance for r in self.rows], float)
+        cpos = comp[comp > 0]
+        cref = float(np.mean(cpos)) if cpos.size else 1.0
+        for k, r in enumerate(self.rows):
+            if r.unilateral:
+                w[self.n_i + self.n_base + k] = comp[k] / cref if comp[k] > 0 else 1.0
+        NW = N.T * w
+        z = -np.linalg.lstsq(NW @ N, NW @ sol0, rcond=None)[0]
+        return sol0 + N @ z
+
+    def terms(self, t, x, xdot):
+        """Reduced dynamics at a consistent state: A qddot_I = f (no friction terms).
+
+        Returns
+        -------
+        dict with B (n_x, n_i), b (n_x,) [xddot = B qddot_I + b], A (n_i, n_i)
+        generalized mass matrix, f (n_i,) = B^T (F - h - M b), M (n_x, n_x).
+        """
+        _, G, B, b, xdot, quad_g, q = self._kinematics(x, xdot)
+        F, Qd = self.sm.fm.applied(t, x, xdot, q, G @ xdot)
+        F = F + G.T @ Qd
+        M, h = self.sm.with_drive_inertia(*mass_matrix_x(self.model, x, xdot), G, quad_g)
+        return dict(B=B, b=b, A=B.T @ M @ B, f=B.T @ (F - h - M @ b), M=M, F=F, h=h)
+
+    def kinetic_energy(self, x, xdot) -> float:
+        """T = 1/2 xdot^T M xdot of the bodies and the drives' rotors and gears, J."""
+        M, _ = self.sm.with_drive_inertia(*mass_matrix_x(self.model, x), self._coord_jac(x),
+                                          np.zeros(self.model.n_q))
+        return 0.5 * float(xdot @ M @ xdot)
+
+
+def _independent_rows(Rs, tol=1e-9) -> np.ndarray:
+    """Indices of a maximal set of linearly independent rows, earlier rows first."""
+    keep = []
+    basis = np.zeros((0, Rs.shape[1]))
+    scale = max(np.max(np.abs(Rs)) if Rs.size else 1.0, 1e-300)
+    for k in range(Rs.shape[0]):
+        r = Rs[k] / scale
+        if basis.shape[0]:
+            r = r - basis.T @ (basis @ r)
+            r = r - basis.T @ (basis @ r)
+        nr = np.linalg.norm(r)
+        if nr > tol * max(np.linalg.norm(Rs[k] / scale), 1e-300) and nr > 1e-12:
+            basis = np.vstack([basis, r / nr])
+            keep.append(k)
+    return np.array(keep, int)
