@@ -1,0 +1,1 @@
+"""Evaluators over data: the constraint rows (NumPy, batched; Numba twin), the packed loads and the small dense linear algebra of the compiled kernels."""
