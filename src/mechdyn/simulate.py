@@ -23,6 +23,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from .dynamics.branch_dynamics import BranchEquations
 from .dynamics.lagrange import FORMULATIONS, EquationsOfMotion, kinetic_energy, potential_energy
 from .errors import (
     AssemblyError,
@@ -35,7 +36,6 @@ from .errors import (
 from .integrate.base import IntegratorOptionError
 from .integrate.driver import make_integrator, sample_times
 from .integrate.events import as_events, locate_events
-from .kinematics.analogs import velocity_analogs
 from .kinematics.assembly import singularity, solve_position
 from .kinematics.constraints import coordinates, residual
 from .model import Model, as_model
@@ -227,6 +227,8 @@ def _turning_point_check(eom: EquationsOfMotion, step, qd_old, x_good):
         except ValueError:
             continue
         qk = step.dense(tk)[0]
+        if isinstance(eom, BranchEquations) and eom.chart_at(qk) is not None:
+            continue  # a bifurcation: the branch goes on through it
         try:
             xk = solve_position(model, qk, x_good, layout=lay, check_singular=False)
         except AssemblyError:
@@ -349,7 +351,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
 
     q_init, qd_init, x_init = initial_state(model, q0, qdot0, mode=mode)
     t_compile = time.perf_counter()
-    eom = EquationsOfMotion(model, formulation, d=d, mode=mode, x0=x_init, backend=backend)
+    eom = BranchEquations(model, formulation, d=d, mode=mode, x0=x_init, backend=backend)
     t_compile = time.perf_counter() - t_compile
     # the initial position must be regular and the equations solvable there
     x_init = eom.positions(q_init, t0, check_singular=True)
@@ -443,7 +445,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
     x_arr = np.array(X, float).reshape(-1, n_x)
     lay = eom.layout
     if t_arr.size:
-        B = velocity_analogs(model, x_arr, lay)
+        B = eom.velocity_analogs(q_arr, x_arr)
         xd_arr = (B @ qd_arr[..., None])[..., 0]
         # bodies, plus rotors and gears of the drives reduced to their coordinates
         Tk = kinetic_energy(model, x_arr, xd_arr) + 0.5 * (qd_arr**2) @ eom.extra_inertia
@@ -461,7 +463,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
              **integ.stats.as_dict(), "evaluations": eom.total_evaluations - eval0,
              "integrator_evaluations": integ.stats.evaluations, "wall_time_s": wall,
              "setup_time_s": t_compile, "settings": integ.settings(),
-             "mode": sorted(lay.mode)}
+             "mode": sorted(lay.mode), "bifurcations": eom.report()}
     if eom.kernel is not None:
         stats["compile_time_s"] = eom.kernel.compile_time
     elif eom.backend_note:
