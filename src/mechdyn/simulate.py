@@ -404,6 +404,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
                         t_stop = rec[-1].t
                 # positions at the step end, re-solved from q and checked for a dead position
                 x_end = eom.positions(step.q, step.t, check_singular=True)
+                eom.watching = False  # samples of the dense output leave the run as it is
                 if te is None:
                     if terminal:
                         q, v, w = step.dense(t_stop)
@@ -422,6 +423,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
                             record(ts, q, v, eom.qddot(ts, q, v), x, w)
                         k_eval += 1
                     eom.positions(step.q, step.t)  # continue from the step end
+                eom.watching = True
                 t_good, q_good, x_good, qd_good = step.t, step.q, x_end, step.qdot
                 bar.update(step.t)
                 if terminal:

@@ -94,6 +94,9 @@ class BranchEquations(EquationsOfMotion):
                 and self.layout.n_rows + 1 == model.n_x):
             self.book = ChartBook(PathProblem(model, self.layout, [0], [0.0], 0))
         self._s_last: float | None = None
+        #: whether evaluations look out for singular positions (off while a caller
+        #: samples dense output, so that output times do not change the run)
+        self.watching = True
 
     # ------------------------------------------------------------------ charts
     def chart_at(self, q) -> BranchChart | None:
@@ -118,7 +121,7 @@ class BranchEquations(EquationsOfMotion):
         """After a direct solve at s: build a chart if a singular position is within
         reach; returns it if its zone holds s."""
         self._s_last = s
-        if not self.book.due(s):
+        if not self.watching or not self.book.due(s):
             return None
         x = self.kernel.x.copy() if self.kernel is not None and not self.kernel.status \
             else self.x
