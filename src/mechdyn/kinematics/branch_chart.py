@@ -233,7 +233,8 @@ class PathProblem:
 
 @dataclass
 class BranchChart:
-    """One branch around a singular position: x(s), x'(s), x''(s) as a Chebyshev series.
+    """One branch around a singular position: x(s), x'(s), x''(s) as a Chebyshev series
+    (built by :func:`bridge`; see its example and that of :class:`ChartBook`).
 
     Attributes
     ----------
@@ -333,6 +334,35 @@ def bridge(path: PathProblem, start: _Node, s_star: float, *, zone: float = ZONE
         None where the branch does not go on past s* (a dead position: no solution
         beyond, or only the other half of a fold), or where there is no singular
         position after all.
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        A Jacobian on the way is exactly singular (:meth:`ChartBook.watch` catches it).
+
+    Examples
+    --------
+    A parallelogram four-bar of unit bars, its crank at 0.5 rad, towards its flat
+    position phi = 0: the coupler stays level on the other side too.
+
+    >>> import numpy as np, mechdyn as md
+    >>> m = md.Mechanism("parallelogram")
+    >>> _ = m.add_ground({"O": (0.0, 0.0), "C": (1.0, 0.0)})
+    >>> c, s = np.cos(0.5), np.sin(0.5)
+    >>> _ = m.add_body("crank", points={"E": (1.0, 0.0)}, pose=(0.0, 0.0, 0.5))
+    >>> _ = m.add_body("coupler", points={"E": (1.0, 0.0)}, pose=(c, s, 0.0))
+    >>> _ = m.add_body("rocker", points={"E": (1.0, 0.0)}, pose=(1.0, 0.0, 0.5))
+    >>> o = (0.0, 0.0)
+    >>> pins = [("O", "ground", "crank", "O", o), ("B", "coupler", "rocker", "E", "E"),
+    ...         ("A", "crank", "coupler", "E", o), ("C", "ground", "rocker", "C", o)]
+    >>> _ = [m.add_revolute(*pin) for pin in pins]
+    >>> _ = m.add_coordinate("phi", kind="angle", body="crank")
+    >>> model = m.compile()
+    >>> path = PathProblem(model, model.layout(), [0], [0.5], 0)
+    >>> chart = bridge(path, path.node(0.5, model.x0), 0.0)
+    >>> x, _, _ = chart.evaluate(-0.1)
+    >>> round(float(x[2]), 12), round(float(x[5]), 12)   # crank angle, coupler angle
+    (-0.1, 0.0)
     """
     r1, R = zone * path.unit, window * path.unit
     ts = r1 + (R - r1) * (1.0 - np.cos(np.array([0.0, 0.25, 0.5]) * np.pi))  # r1 .. R
