@@ -9,6 +9,11 @@ that cannot be assembled, a singular mass matrix, a failing integrator) ends
 with its ``status`` and a ``message`` naming the time, the coordinates and the
 joints concerned, and returns everything computed so far.
 
+Near a bifurcation (change-point) position -- two assembly branches crossing,
+the coordinate keeping control, a parallelogram lying flat -- the equations are
+evaluated on the branch from a chart (:mod:`mechdyn.dynamics.branch_dynamics`),
+so the run goes through it; ``stats["bifurcations"]`` lists where.
+
 The work of the non-conservative forces is integrated with the motion, as an
 extra state w' = P_nc, so that the energy balance T + U - W_nc = const holds
 to the integrator's tolerance.

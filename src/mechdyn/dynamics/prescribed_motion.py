@@ -6,6 +6,9 @@ The driving constraints ``g_d(x) - q_d = 0`` are appended to the joint constrain
 ``Phi(x) = 0``; the poses are found by continuation (branch kept by the sign of the
 scaled Jacobian's determinant), the rates from ``[Phi_x; g_d,x] xdot = [0; qdot_d]``
 and the accelerations from the same matrix with the exact right-hand side gamma.
+Through a bifurcation position (two branches crossing, one driven coordinate
+varying) poses, rates and accelerations near it come from a branch chart
+(:mod:`mechdyn.kinematics.branch_chart`), the limit of the branch from both sides.
 """
 
 from __future__ import annotations

@@ -4,7 +4,9 @@ Newton's method on a batch of positions (:func:`_newton`, :func:`_polish`) and o
 one position (:func:`_newton1`), the solved positions of the continuation
 (:class:`_Node`: pose, velocity analogs, second derivative along the swept
 coordinate and branch sign), their quintic Hermite predictor (:func:`_hermite5`,
-:func:`_predict`), the sequential step-halving march (:func:`_march`), the choice
+:func:`_predict`), the sequential step-halving march (:func:`_march`, through
+bifurcation positions with the branch charts of
+:mod:`mechdyn.kinematics.branch_chart`: :func:`_chart_node`), the choice
 of the anchors it visits (:func:`_anchor_indices`) and the per-model cache of the
 evaluation kernel (:func:`_kernel`).  The analyses that use them are in
 :mod:`mechdyn.kinematics.sweep`; the dead-centre refinement of

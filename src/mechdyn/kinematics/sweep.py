@@ -17,7 +17,12 @@ How it is computed (vectorized over the positions):
    unchanged and the corrector stays small compared with the step; otherwise
    the step is halved.  When the step falls below ``min_step`` the mechanism
    has reached a dead (or toggle) position: the sweep stops there and reports
-   it, keeping everything computed before.
+   it, keeping everything computed before.  A *bifurcation* (change) position,
+   where two branches cross and the coordinate keeps control (a parallelogram
+   lying flat), is gone through instead: every accepted position is watched for
+   one ahead, and near it a branch chart (:mod:`mechdyn.kinematics.branch_chart`)
+   gives the positions, expects the sign change and, in step 3, the analogs
+   (the limit from both sides).  ``stats["bifurcations"]`` lists the charts.
 2. *Batched solve.*  Every value is predicted by quintic Hermite interpolation
    between the two coarse solutions around it (positions, first and second
    derivatives with respect to the swept coordinate), then polished by Newton's
