@@ -9,6 +9,11 @@ that cannot be assembled, a singular mass matrix, a failing integrator) ends
 with its ``status`` and a ``message`` naming the time, the coordinates and the
 joints concerned, and returns everything computed so far.
 
+Near a bifurcation (change-point) position -- two assembly branches crossing,
+the coordinate keeping control, a parallelogram lying flat -- the equations are
+evaluated on the branch from a chart (:mod:`mechdyn.dynamics.branch_dynamics`),
+so the run goes through it; ``stats["bifurcations"]`` lists where.
+
 The work of the non-conservative forces is integrated with the motion, as an
 extra state w' = P_nc, so that the energy balance T + U - W_nc = const holds
 to the integrator's tolerance.
@@ -24,6 +29,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from .dynamics.branch_dynamics import BranchEquations
 from .dynamics.lagrange import FORMULATIONS, EquationsOfMotion, kinetic_energy, potential_energy
 from .errors import (
     AssemblyError,
@@ -36,7 +42,6 @@ from .errors import (
 from .integrate.base import DEFAULT_RTOL, IntegratorOptionError, IntegratorWarning
 from .integrate.driver import make_integrator, sample_times
 from .integrate.events import as_events, locate_events
-from .kinematics.analogs import velocity_analogs
 from .kinematics.assembly import singularity, solve_position
 from .kinematics.constraints import coordinates, residual
 from .model import Model, as_model
@@ -228,6 +233,8 @@ def _turning_point_check(eom: EquationsOfMotion, step, qd_old, x_good):
         except ValueError:
             continue
         qk = step.dense(tk)[0]
+        if isinstance(eom, BranchEquations) and eom.chart_at(qk) is not None:
+            continue  # a bifurcation: the branch goes on through it
         try:
             xk = solve_position(model, qk, x_good, layout=lay, check_singular=False)
         except AssemblyError:
@@ -363,7 +370,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
 
     q_init, qd_init, x_init = initial_state(model, q0, qdot0, mode=mode)
     t_compile = time.perf_counter()
-    eom = EquationsOfMotion(model, formulation, d=d, mode=mode, x0=x_init, backend=backend)
+    eom = BranchEquations(model, formulation, d=d, mode=mode, x0=x_init, backend=backend)
     t_compile = time.perf_counter() - t_compile
     # the initial position must be regular and the equations solvable there
     x_init = eom.positions(q_init, t0, check_singular=True)
@@ -416,6 +423,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
                         t_stop = rec[-1].t
                 # positions at the step end, re-solved from q and checked for a dead position
                 x_end = eom.positions(step.q, step.t, check_singular=True)
+                eom.watching = False  # samples of the dense output leave the run as it is
                 if te is None:
                     if terminal:
                         q, v, w = step.dense(t_stop)
@@ -434,6 +442,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
                             record(ts, q, v, eom.qddot(ts, q, v), x, w)
                         k_eval += 1
                     eom.positions(step.q, step.t)  # continue from the step end
+                eom.watching = True
                 t_good, q_good, x_good, qd_good = step.t, step.q, x_end, step.qdot
                 bar.update(step.t)
                 if terminal:
@@ -457,7 +466,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
     x_arr = np.array(X, float).reshape(-1, n_x)
     lay = eom.layout
     if t_arr.size:
-        B = velocity_analogs(model, x_arr, lay)
+        B = eom.velocity_analogs(q_arr, x_arr)
         xd_arr = (B @ qd_arr[..., None])[..., 0]
         # bodies, plus rotors and gears of the drives reduced to their coordinates
         Tk = kinetic_energy(model, x_arr, xd_arr) + 0.5 * (qd_arr**2) @ eom.extra_inertia
@@ -476,7 +485,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
              "integrator_evaluations": integ.stats.evaluations, "wall_time_s": wall,
              "setup_time_s": t_compile, "settings": integ.settings(),
              "mode": sorted(lay.mode), "rtol": getattr(integ, "rtol", None),
-             "atol": getattr(integ, "atol", None)}
+             "atol": getattr(integ, "atol", None), "bifurcations": eom.report()}
     if eom.kernel is not None:
         stats["compile_time_s"] = eom.kernel.compile_time
     elif eom.backend_note:

@@ -74,3 +74,24 @@ def slider_crank(coordinate="phi", phi0=0.6):
     else:
         mech.add_coordinate("s", kind="travel", joint="guide")
     return mech
+
+
+def parallelogram(phi0=np.pi / 2, g=9.81, m=1.0, l=1.0):
+    """Parallelogram four-bar: ground pivots O = (0, 0) and C = (l, 0), crank O-A, coupler
+    A-B and rocker C-B all of length l; uniform rods of mass m (centre of mass at
+    mid-length, J_c = m l^2 / 12).  Coordinate ``phi`` = absolute crank angle; sketched
+    on the parallelogram branch (the rocker parallel to the crank, the coupler level).
+    Flat (bifurcation) positions at phi = 0 and pi."""
+    mech = Mechanism("parallelogram four-bar", gravity=(0.0, -g))
+    mech.add_ground({"O": (0.0, 0.0), "C": (l, 0.0)})
+    A = l * np.array([np.cos(phi0), np.sin(phi0)])
+    for name, pose in (("crank", (0.0, 0.0, phi0)), ("coupler", (A[0], A[1], 0.0)),
+                       ("rocker", (l, 0.0, phi0))):
+        mech.add_body(name, mass=m, inertia=m * l * l / 12, com=(l / 2, 0.0),
+                      points={"E": (l, 0.0)}, pose=pose)
+    mech.add_revolute("O", "ground", "crank", "O", (0.0, 0.0))
+    mech.add_revolute("A", "crank", "coupler", "E", (0.0, 0.0))
+    mech.add_revolute("B", "coupler", "rocker", "E", "E")
+    mech.add_revolute("C", "ground", "rocker", "C", (0.0, 0.0))
+    mech.add_coordinate("phi", kind="angle", body="crank")
+    return mech

@@ -388,7 +388,8 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
 
     core = _inverse(model, lay, didx, tt, x, xdot, xddot, q, qdot,
                     skip=didx if model_drives == "replace" else (),
-                    reacting=tuple(reacting_loads), point=np.asarray(point, dtype=float))
+                    reacting=tuple(reacting_loads), point=np.asarray(point, dtype=float),
+                    charted=pos.charted)
     warn.extend(core["warnings"])
     notes = []
     if model_drives == "replace":
@@ -400,6 +401,7 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
     over_values = q[:, model.coordinate_index(over_names[0])]
     stats = dict(core["stats"])
     stats.update(positions=n, newton_iterations=pos.iterations,
+                 bifurcations=pos.book.report() if pos.book is not None else [],
                  seconds=time.perf_counter() - t_start)
     status = core["status"]
     message = {"ok": "kinetostatic analysis completed",
@@ -407,6 +409,10 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                             "(minimum-norm solution reported)",
                "singular": "completed with singular positions: the driven coordinates lose "
                            "control there and the reactions are unbounded"}[status]
+    if status == "singular" and not stats.get("singular_positions"):
+        message = ("completed through bifurcation position(s): the mechanism stays on its "
+                   "branch, the driving torques are the limits along it; the reactions are "
+                   "unbounded there")
     message = "; ".join([message, *notes])
     names = model.coordinate_names
     return Kinetostatics(

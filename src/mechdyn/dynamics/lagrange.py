@@ -360,8 +360,15 @@ class EquationsOfMotion:
         rhs[lay.n_rows:, :] = np.eye(model.n_q)
         B = np.linalg.solve(J, rhs) if J.shape[0] == J.shape[1] else np.linalg.pinv(J) @ rhs
         self._B_last = B
+        b = acceleration_bias(model, x, B @ qdot, lay, J=J)
+        return self._lagrange(t, q, qdot, x, B, b)
+
+    def _lagrange(self, t, q, qdot, x, B, b) -> Terms:
+        """The terms at a pose x (n_x,) with its velocity analogs B (n_x, n_q) and
+        acceleration bias b (n_x,): A = B_c^T M B_c, c = B_c^T M b_c, Q = B^T F + Q_drive
+        and q'' = A^-1 (Q - c)."""
+        model = self.model
         xdot = B @ qdot
-        b = acceleration_bias(model, x, xdot, lay, J=J)
         Bc, bc = com_analogs(model, x, B, b, xdot)
         M = model.mass_diag
         A = Bc.T @ (M[:, None] * Bc) + np.diag(self.extra_inertia)

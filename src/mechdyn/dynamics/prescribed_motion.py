@@ -6,6 +6,9 @@ The driving constraints ``g_d(x) - q_d = 0`` are appended to the joint constrain
 ``Phi(x) = 0``; the poses are found by continuation (branch kept by the sign of the
 scaled Jacobian's determinant), the rates from ``[Phi_x; g_d,x] xdot = [0; qdot_d]``
 and the accelerations from the same matrix with the exact right-hand side gamma.
+Through a bifurcation position (two branches crossing, one driven coordinate
+varying) poses, rates and accelerations near it come from a branch chart
+(:mod:`mechdyn.kinematics.branch_chart`), the limit of the branch from both sides.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ import numpy as np
 from ..errors import AssemblyError, ModelError, SingularPositionError
 from ..kernels import rows_numpy
 from ..kinematics.assembly import joint_residuals
+from ..kinematics.branch_chart import ChartBook, PathProblem
 from ..kinematics.constraints import (
     coordinates,
     coordinates_gamma,
@@ -122,6 +126,11 @@ class _Positions:
         self.scale = _col_scale(model)
         self.iterations = 0
         self.branch_changes: list = []
+        #: branch charts of the bifurcation positions passed (one varying coordinate)
+        self.book: ChartBook | None = None
+        self._j = 0
+        #: samples in a chart's zone: mask (n,), x' and x'' along the varying coordinate
+        self.charted = None
 
     def jac(self, x):
         """[Phi_x; g_d,x] at x, shape (..., n_rows + n_d, n_x)."""
@@ -244,14 +253,17 @@ class _Positions:
         Newton solve for all the others from the anchors' first-order predictions
         (with a branch check, falling back to continuation where it fails)."""
         n = qd.shape[0]
+        self._open_book(qd)
         if x_guess is not None:
             x, ok, _ = self.newton(qd, x_guess)
             if np.all(ok):
-                return x
+                return self._charts_after(qd, x)
         x = np.empty((n, self.model.n_x))
-        x[0] = self.first(qd[0], x_start if x_guess is None else x_guess[0])
+        x[0] = self._reach(qd[0], x_start) if x_guess is None else None
+        if x_guess is not None or not np.all(np.isfinite(x[0])):
+            x[0] = self.first(qd[0], x_start if x_guess is None else x_guess[0])
         if n == 1:
-            return x
+            return self._charts_after(qd, x)
         stride = max(1, n // 100)
         anchors = list(range(0, n, stride))
         if anchors[-1] != n - 1:
@@ -259,18 +271,108 @@ class _Positions:
         Ja = np.empty((len(anchors),) + self.jac(x[0]).shape)
         Ja[0] = self.jac(x[0])
         for i, (a0, a1) in enumerate(zip(anchors[:-1], anchors[1:], strict=True)):
-            x[a1], Ja[i + 1] = self.step(qd[a0], x[a0], qd[a1], Ja[i])
+            x[a1], Ja[i + 1] = self.advance(qd[a0], x[a0], qd[a1], Ja[i])
         rest = np.setdiff1d(np.arange(n), anchors)
         if rest.size:
             base = np.searchsorted(anchors, rest, side="right") - 1
             a = np.asarray(anchors)[base]
-            B = self.analogs(Ja[base])
+            with np.errstate(all="ignore"):
+                B = self.analogs(Ja[base])
             pred = x[a] + (B @ (qd[rest] - qd[a])[..., None])[..., 0]
-            xr, ok, Jr = self.newton(qd[rest], pred)
-            ok &= self.det_sign(Jr) == self.det_sign(Ja[base])
+            sign = self.det_sign(Ja[base])
+            near = np.zeros(rest.size, dtype=bool)
+            if self.book is not None:  # near a bifurcation: the chart predicts
+                for i, k in enumerate(rest):
+                    ch = self.book.window_chart(qd[k, self._j])
+                    if ch is not None:
+                        near[i] = True
+                        pred[i] = ch.evaluate(qd[k, self._j])[0]
+                        sign[i] = ch.side_sign(qd[k, self._j])
+            with np.errstate(all="ignore"):
+                xr, ok, Jr = self.newton(qd[rest], np.where(np.isfinite(pred), pred, x[a]))
+                ok &= (self.det_sign(Jr) == sign) | near
             x[rest] = xr
             for k in rest[~ok]:
-                x[k] = self.step(qd[k - 1], x[k - 1], qd[k])[0]
+                x[k] = self.advance(qd[k - 1], x[k - 1], qd[k])[0]
+        return self._charts_after(qd, x)
+
+    # ------------------------------------------------------------------ bifurcations
+    def _open_book(self, qd):
+        """A chart book when one driven coordinate varies and the others are held, for
+        a square system of joint rows (not the rows of a variable-structure mode)."""
+        self.book, self.charted = None, None
+        var = np.flatnonzero(np.ptp(qd, axis=0) > 0) if qd.shape[0] > 1 else []
+        if isinstance(self.lay, ModeRows) or len(var) != 1 or \
+                self.lay.n_rows + len(self.didx) != self.model.n_x:
+            return
+        self._j = int(var[0])
+        self.book = ChartBook(PathProblem(self.model, self.lay, self.didx, qd[0], self._j))
+
+    def advance(self, qd_from, x_from, qd_to, J_from=None):
+        """:meth:`step` that goes through bifurcation positions on the branch: poses in
+        a chart's zone come from the chart, steps near or across a chart start from it."""
+        book, j = self.book, self._j
+        if book is None:
+            return self.step(qd_from, x_from, qd_to, J_from)
+        s0, s1 = float(qd_from[j]), float(qd_to[j])
+        if book.zone_chart(s0) is None:
+            book.watch(s0, x_from)
+        ch = book.zone_chart(s1)
+        if ch is not None:
+            x = ch.evaluate(s1)[0]
+            return x, self.jac(x)
+        ch = book.window_chart(s1) or book.crossed(s0, s1) or book.window_chart(s0)
+        if ch is None:
+            return self.step(qd_from, x_from, qd_to, J_from)
+        se = float(np.clip(s1, ch.centre - ch.window, ch.centre + ch.window))
+        qe = np.array(qd_to, dtype=float)
+        qe[j] = se
+        xe = ch.evaluate(se)[0]
+        if se == s1:
+            x, ok, J = self.newton(qd_to, xe)
+            if ok:
+                return x, J
+        return self.step(qe, xe, qd_to)
+
+    def _reach(self, qd, x_start) -> np.ndarray:
+        """The first pose by :meth:`advance` in small steps along the varying coordinate
+        from the start pose (so that a bifurcation on the way is charted); NaN when
+        that does not apply (then :meth:`first` is used)."""
+        nan = np.full(self.model.n_x, np.nan)
+        if self.book is None:
+            return nan
+        j = self._j
+        q_s = coordinates(self.model, x_start)[self.didx]
+        F, _ = _kin_system(self.model, self.lay, self.didx, x_start, q_s)
+        if np.delete(q_s - qd, j).any() or np.max(np.abs(F), initial=0.0) > 1e3 * self.tol:
+            return nan
+        unit = self.book.path.unit
+        n_sub = max(1, int(np.ceil(abs(qd[j] - q_s[j]) / (0.1 * unit))))
+        x, q = np.array(x_start, dtype=float), q_s
+        try:
+            for i in range(1, n_sub + 1):
+                qn = q_s + (qd - q_s) * (i / n_sub)
+                x = self.advance(q, x, qn)[0]
+                q = qn
+        except (AssemblyError, SingularPositionError):
+            return nan
+        return x
+
+    def _charts_after(self, qd, x):
+        """Watch the solved poses for bifurcations (when they came from guesses), and
+        take the poses in the charts' zones from the charts."""
+        if self.book is None:
+            return x
+        j = self._j
+        if not self.book.charts:
+            for k in range(qd.shape[0]):
+                if self.book.zone_chart(qd[k, j]) is None:
+                    self.book.watch(float(qd[k, j]), x[k])
+        mask, xc, xs, xss = self.book.apply(qd[:, j])
+        if mask.any():
+            x = x.copy()
+            x[mask] = xc
+            self.charted = (mask, xs, xss)
         return x
 
     def motion(self, x, qd_dot, qd_ddot):
@@ -279,10 +381,20 @@ class _Positions:
         _, J = _kin_system(m, lay, self.didx, x, np.zeros(x.shape[:-1] + (len(self.didx),)))
         rhs = np.zeros(x.shape[:-1] + (J.shape[-2],))
         rhs[..., lay.n_rows:] = qd_dot
-        xdot = _lin_solve(J, rhs)
-        gam = np.concatenate([gamma(m, x, xdot, lay),
-                              coordinates_gamma(m, x, xdot)[..., self.didx] + qd_ddot], axis=-1)
-        xddot = _lin_solve(J, gam)
+        with np.errstate(all="ignore"):  # singular at a bifurcation: charted below
+            xdot = _lin_solve(J, rhs)
+            gam = np.concatenate([gamma(m, x, xdot, lay),
+                                  coordinates_gamma(m, x, xdot)[..., self.didx] + qd_ddot],
+                                 axis=-1)
+            xddot = _lin_solve(J, gam)
+        if self.charted is not None and x.ndim == 2:
+            mask, xs, xss = self.charted
+            held = np.delete(qd_dot[mask], self._j, axis=1)
+            if not np.any(held) and not np.any(np.delete(qd_ddot[mask], self._j, axis=1)):
+                w, a = qd_dot[mask, self._j, None], qd_ddot[mask, self._j, None]
+                xdot, xddot = xdot.copy(), xddot.copy()
+                xdot[mask] = xs * w
+                xddot[mask] = xs * a + xss * w * w
         return xdot, xddot
 
 

@@ -225,8 +225,14 @@ def _net_on_ground(model: Model, x, D) -> np.ndarray:
 
 
 def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qdot, *,
-             skip, reacting, point) -> dict:
-    """The batched inverse-dynamics solve and the reaction bookkeeping."""
+             skip, reacting, point, charted=None) -> dict:
+    """The batched inverse-dynamics solve and the reaction bookkeeping.
+
+    ``charted`` = (mask (n,), x' (m, n_x), x'' (m, n_x)): samples near a bifurcation
+    position, where the system is (nearly) singular but the branch goes on; with one
+    driven coordinate its torque there is the virtual work along the branch's tangent
+    x', tau = x'^T (I - F) (the reactions do no work along it), and these samples do
+    not count for the redundancy check."""
     n = t.shape[0]
     nb = model.n_bodies
     L = model.length_scale
@@ -258,7 +264,8 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
             cs[lay.n_rows + i] = L
     As = A * rs[:, None] * cs[None, :]
     bs = rhs * rs
-    n_red, red_joints, red_labels = _redundancy(model, lay, x)
+    mask = charted[0] if charted is not None else np.zeros(n, dtype=bool)
+    n_red, red_joints, red_labels = _redundancy(model, lay, x[~mask] if (~mask).any() else x)
     sv = np.linalg.svd(As, compute_uv=False)
     rank_need = lay.n_rows + n_d - n_red
     smax = sv[:, 0]
@@ -277,6 +284,10 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     z = z * cs
     lam = z[:, :lay.n_rows]
     tau = z[:, lay.n_rows:]
+    if mask.any() and n_d == 1:
+        tau[mask, 0] = np.einsum("nx,nx->n", charted[1], rhs[mask])
+    bif = singular & mask
+    singular &= ~mask
     status = "ok"
     redundant: list[str] = []
     if n_red:
@@ -287,13 +298,20 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
                     "joints " + ", ".join(repr(j) for j in red_joints) + " are not unique; "
                     "the minimum-norm solution is reported (forces in N, moments in N m "
                     f"divided by the length scale {L:.4g} m)")
+    if bif.any():
+        status = "singular"
+        ks = np.flatnonzero(bif)
+        warn.append(f"{ks.size} bifurcation position(s) (first at index {ks[0]}, t = "
+                    f"{t[ks[0]]:.6g} s): the mechanism goes on on its branch and the driving "
+                    f"torque there is its limit along the branch, but the joint equations are "
+                    f"dependent: the reactions there are unbounded (least-squares values)")
     if singular.any():
         status = "singular"
         ks = np.flatnonzero(singular)
         warn.append(f"{ks.size} singular position(s) (first at index {ks[0]}, t = "
                     f"{t[ks[0]]:.6g} s): the driven coordinates do not control the "
                     f"mechanism there; reactions there are least-squares values")
-    near = (rcond < NEAR_SINGULAR_RCOND) & ~singular
+    near = (rcond < NEAR_SINGULAR_RCOND) & ~singular & ~bif
     if near.any():
         k = int(np.argmin(np.where(near, rcond, np.inf)))
         warn.append(f"{int(near.sum())} position(s) close to a singular position (smallest "
@@ -361,7 +379,8 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
                   float(np.max(np.abs(F * xdot))), 1e-300)
     stats = {"power_balance_rel": float(np.max(np.abs(p_in - p_kin)) / p_scale),
              "rcond_min": float(np.min(rcond)), "redundant_equations": n_red,
-             "singular_positions": int(singular.sum())}
+             "singular_positions": int(singular.sum()),
+             "bifurcation_positions": int(bif.sum())}
     return {"reactions": reactions, "moments": moments, "joint_frame": jframe,
             "joint_points": jpoints, "kinds": kinds, "frame_loads": frame_loads,
             "frame_force": tot[:, :2].copy(), "frame_moment": tot[:, 2].copy(), "tau": tau,

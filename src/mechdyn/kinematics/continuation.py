@@ -4,7 +4,9 @@ Newton's method on a batch of positions (:func:`_newton`, :func:`_polish`) and o
 one position (:func:`_newton1`), the solved positions of the continuation
 (:class:`_Node`: pose, velocity analogs, second derivative along the swept
 coordinate and branch sign), their quintic Hermite predictor (:func:`_hermite5`,
-:func:`_predict`), the sequential step-halving march (:func:`_march`), the choice
+:func:`_predict`), the sequential step-halving march (:func:`_march`, through
+bifurcation positions with the branch charts of
+:mod:`mechdyn.kinematics.branch_chart`: :func:`_chart_node`), the choice
 of the anchors it visits (:func:`_anchor_indices`) and the per-model cache of the
 evaluation kernel (:func:`_kernel`).  The analyses that use them are in
 :mod:`mechdyn.kinematics.sweep`; the dead-centre refinement of
@@ -136,9 +138,32 @@ def _predict(prev: _Node | None, node: _Node, k: int, h: float) -> np.ndarray:
     return node.x + node.B[:, k] * h + 0.5 * node.H * h * h
 
 
+def _chart_node(kern: Kernel, chart, q, k: int) -> _Node:
+    """The node at q from a branch chart (a bifurcation zone, see
+    :mod:`mechdyn.kinematics.branch_chart`): pose, analogs along coordinate k and second
+    derivative from the chart; the other columns of B by a direct solve at that pose."""
+    x, xs, xss = chart.evaluate(q[k])
+    with np.errstate(all="ignore"):
+        _, J = kern.system1(x, q)
+        try:
+            B = kern.solve1(J, kern.factor1(J, want_sign=False), kern.rhs_unit(1)[0])
+        except (np.linalg.LinAlgError, ZeroDivisionError):
+            B = np.full((x.size, q.size), np.nan)
+    B = np.array(B, dtype=float)
+    B[:, k] = xs
+    return _Node(np.array(q, dtype=float), x, B, xss, chart.side_sign(q[k]))
+
+
 def _march(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, tol,
-           counter: dict, prev: _Node | None = None):
+           counter: dict, prev: _Node | None = None, book=None):
     """Sequential continuation through ``targets`` (values of coordinate k).
+
+    With ``book`` (a :class:`~mechdyn.kinematics.branch_chart.ChartBook` of this path)
+    every accepted position is watched for a bifurcation ahead; in a chart's zone the
+    positions come from the chart, in its window the chart predicts them and tells
+    the branch sign to expect, so the march goes through the bifurcation on its
+    branch.  Where the step would fall below ``min_step`` without a chart, one is
+    tried from an earlier position at least a zone away before giving up.
 
     Returns the list of nodes reached (one per target) and a :class:`_Stop` or None.
     """
@@ -146,6 +171,7 @@ def _march(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, t
     out: list[_Node] = []
     h_try = max_step
     L = kern.model.length_scale
+    trail: list[_Node] = [node]
     for target in targets:
         while node.q[k] != target:
             remaining = target - node.q[k]
@@ -155,8 +181,16 @@ def _march(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, t
             else:
                 qn[k] = node.q[k] + np.sign(remaining) * h_try
             h = qn[k] - node.q[k]
-            xp = _predict(prev, node, k, h)
             counter["coarse_steps"] = counter.get("coarse_steps", 0) + 1
+            zone = book.zone_chart(qn[k]) if book is not None else None
+            if zone is not None:
+                prev, node = node, _chart_node(kern, zone, qn, k)
+                h_try = min(2 * h_try, max_step)
+                continue
+            win = None
+            if book is not None:
+                win = book.window_chart(qn[k]) or book.window_chart(node.q[k])
+            xp = win.evaluate(qn[k])[0] if win is not None else _predict(prev, node, k, h)
             x, ok, J, fac = _newton1(kern, xp, qn, tol)
             accepted = False
             reason = "Newton's method does not converge"
@@ -164,7 +198,8 @@ def _march(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, t
                 nn = _node(kern, x, qn, k, J=J, fac=fac)
                 step = _scaled_norm(kern, nn.x - node.x)
                 corr = _scaled_norm(kern, nn.x - xp)
-                if nn.sign != node.sign:
+                expected = win.side_sign(qn[k]) if win is not None else node.sign
+                if nn.sign != expected:
                     reason = "the sign of det [Phi_x; g_x] changes (the branch would be left)"
                 elif corr > 0.25 * step + 1e-9 * L:
                     reason = "the corrector moves far from the predictor"
@@ -175,12 +210,27 @@ def _march(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, t
                 h_try = abs(h) / 2
                 prev = None  # fall back to the Taylor predictor near trouble
                 if h_try < min_step:
+                    if book is not None and _chart_across(book, trail, node, k):
+                        h_try = max_step
+                        continue
                     return out, _Stop(node, qn, reason)
                 continue
             prev, node = node, nn
+            trail = (trail + [nn])[-64:]
+            if book is not None:
+                book.watch(nn.q[k], nn.x)
             h_try = min(2 * h_try, max_step)
         out.append(node)
     return out, None
+
+
+def _chart_across(book, trail, node: _Node, k: int) -> bool:
+    """A chart across the singular position the march stopped at (near node), built
+    from the latest earlier position at least a zone away; whether one was built."""
+    s_star = float(node.q[k])
+    far = [nd for nd in trail if abs(nd.q[k] - s_star) >= book.zone * book.path.unit]
+    base = far[-1] if far else trail[0]
+    return book.watch(float(base.q[k]), base.x, force_at=s_star) is not None
 
 
 def _hermite5(t, h, x0, d0, a0, x1, d1, a1):

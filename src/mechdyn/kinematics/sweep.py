@@ -17,7 +17,12 @@ How it is computed (vectorized over the positions):
    unchanged and the corrector stays small compared with the step; otherwise
    the step is halved.  When the step falls below ``min_step`` the mechanism
    has reached a dead (or toggle) position: the sweep stops there and reports
-   it, keeping everything computed before.
+   it, keeping everything computed before.  A *bifurcation* (change) position,
+   where two branches cross and the coordinate keeps control (a parallelogram
+   lying flat), is gone through instead: every accepted position is watched for
+   one ahead, and near it a branch chart (:mod:`mechdyn.kinematics.branch_chart`)
+   gives the positions, expects the sign change and, in step 3, the analogs
+   (the limit from both sides).  ``stats["bifurcations"]`` lists the charts.
 2. *Batched solve.*  Every value is predicted by quintic Hermite interpolation
    between the two coarse solutions around it (positions, first and second
    derivatives with respect to the swept coordinate), then polished by Newton's
@@ -51,6 +56,7 @@ import numpy as np
 from ..errors import ModelError, SingularPositionError, did_you_mean
 from ..model import Model, as_model
 from .assembly import _position_tol, assemble, singularity
+from .branch_chart import ChartBook, PathProblem
 from .constraints import coordinates
 from .continuation import (
     _anchor_indices,
@@ -212,6 +218,10 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
         x_init = assemble(model, q_init, x_guess=x0, layout=lay)
         J0 = fac0 = None
     start = _node(kern, x_init, q_init, k, J=J0, fac=fac0)
+    # bifurcation positions on the way are gone through on the branch (branch charts)
+    book = None
+    if lay.n_rows + model.n_q == model.n_x:
+        book = ChartBook(PathProblem(model, lay, np.arange(model.n_q), q_init, k))
 
     if values is None:
         if not is_angle:
@@ -228,7 +238,7 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
     # ---- 1. coarse continuation through the anchors
     anchors = _anchor_indices(values, max_step)
     anodes, stop = _march(kern, start, k, values[anchors], max_step=max_step,
-                          min_step=min_step, tol=tol, counter=counter)
+                          min_step=min_step, tol=tol, counter=counter, book=book)
     n_anch = len(anodes)
 
     t_coarse = time.perf_counter() - t_coarse
@@ -265,7 +275,8 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
             fallback += 1
             i0, i1 = a_idx[m_], a_idx[m_ + 1]
             nodes, st = _march(kern, anodes[m_], k, values[i0 + 1:i1 + 1],
-                               max_step=max_step, min_step=min_step, tol=tol, counter=counter)
+                               max_step=max_step, min_step=min_step, tol=tol, counter=counter,
+                               book=book)
             for r, nd in enumerate(nodes):
                 X[i0 + 1 + r] = nd.x
             if st is not None:  # only if a singular position lies between two anchors
@@ -283,7 +294,8 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
         last = anodes[-1] if n_anch else start
         nxt = anchors[n_anch] if n_anch < len(anchors) else n_req - 1
         nodes, stop = _march(kern, last, k, values[n_ok:nxt + 1], max_step=max_step,
-                             min_step=min_step, tol=tol, counter=counter, prev=None)
+                             min_step=min_step, tol=tol, counter=counter, prev=None,
+                             book=book)
         if stop is None:  # cannot happen: the anchor itself was unreachable
             stop = _Stop(nodes[-1], nodes[-1].q, "the continuation could not reach "
                          f"{over} = {values[nxt]:.9g}")
@@ -301,12 +313,15 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
     qdot = np.broadcast_to(qdot_c, (N, model.n_q)).copy()
     qddot = np.zeros((N, model.n_q))
     if N:
-        rhs = np.concatenate([F[..., None], kern.rhs_unit(N)], axis=-1)
-        sol = kern.apply(J, fac, rhs)
-        X = X - sol[:, :, 0]  # a last Newton correction, at round-off level
-        B = sol[:, :, 1:]
-        xdot = np.einsum("nij,nj->ni", B, qdot)
-        xddot = kern.apply(J, fac, kern.gamma(X, xdot)[..., None])[..., 0]
+        with np.errstate(all="ignore"):  # a Jacobian singular at a bifurcation: charted
+            rhs = np.concatenate([F[..., None], kern.rhs_unit(N)], axis=-1)
+            sol = kern.apply(J, fac, rhs)
+            X = X - sol[:, :, 0]  # a last Newton correction, at round-off level
+            B = sol[:, :, 1:]
+            xdot = np.einsum("nij,nj->ni", B, qdot)
+            xddot = kern.apply(J, fac, kern.gamma(X, xdot)[..., None])[..., 0]
+        if book is not None and book.charts:
+            X, B, xdot, xddot = _charted(book, k, Q, qdot, X, B, xdot, xddot)
     else:
         B = np.empty((0, model.n_x, model.n_q))
         xdot = xddot = np.empty((0, model.n_x))
@@ -324,11 +339,29 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
              "fallback_segments": int(fallback), "time_s": elapsed,
              "time_coarse_s": t_coarse,
              "positions_per_s": N / elapsed if elapsed > 0 else np.inf,
+             "bifurcations": book.report() if book is not None else [],
              "mode": tuple(sorted(lay.mode))}
     return KinematicSweep(
         over=over, values=_ro(values[:N].copy()), q=_ro(Q), qdot=_ro(qdot), qddot=_ro(qddot),
         x=_ro(X), xdot=_ro(xdot), xddot=_ro(xddot), B=_ro(B), status=status, message=message,
         stats=stats, events=events, error=error, model=model)
+
+
+def _charted(book: ChartBook, k: int, Q, qdot, X, B, xdot, xddot):
+    """Poses, analogs and motion of the samples in bifurcation zones, from the charts:
+    the limit from both sides, where the equations are ill-conditioned.  The analogs
+    of the other coordinates stay those of the direct solve, and so does the part of
+    the acceleration due to their rates."""
+    mask, xc, xs, xss = book.apply(Q[:, k])
+    if mask.any():
+        X, B, xdot, xddot = X.copy(), B.copy(), xdot.copy(), xddot.copy()
+        X[mask] = xc
+        B[mask, :, k] = xs
+        xdot[mask] = np.einsum("nij,nj->ni", B[mask], qdot[mask])
+        others = np.delete(qdot[mask], k, axis=1)
+        if not np.any(others):
+            xddot[mask] = xss * qdot[mask, k, None] ** 2
+    return X, B, xdot, xddot
 
 
 def _dead_report(model, lay, k, stop: _Stop, n_done, n_req):

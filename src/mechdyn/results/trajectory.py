@@ -111,6 +111,13 @@ class Trajectory:
                 f"evaluations, wall time {s.get('wall_time_s', float('nan')):.4g} s")
         if self.t.size:
             lines.append(f"samples: {self.t.size}, t = {self.t[0]:.6g} .. {self.t[-1]:.6g} s")
+        bif = s.get("bifurcations") if s else None
+        if bif:
+            unit = " rad" if self.coordinate_is_angle[0] else " m"
+            lines.append(f"went through {len(bif)} bifurcation position(s) on its branch, at "
+                         f"{self.coordinate_names[0]} = "
+                         + ", ".join(f"{b['at']:.6g}" for b in bif[:6])
+                         + (" ..." if len(bif) > 6 else "") + unit)
         if self.energy and self.t.size:
             e = self.energy
             lines.append(

@@ -1,0 +1,577 @@
+"""Branch charts: a mechanism's branch through a bifurcation position, by continuity.
+
+At a *bifurcation* (change point) two assembly branches cross: the joint
+Jacobian Phi_x loses rank, [Phi_x; g_x] is singular, yet the branch the
+mechanism is on goes on smoothly and its coordinate keeps control (the flat
+positions of a parallelogram four-bar).  The pose x(s) along the path
+coordinate s is an analytic function there, but evaluated from the equations
+at a distance d from the crossing it is ill-conditioned: the pose is fixed
+only to eps/d in the direction of the other branch, and the analogs x' and
+x'' are computed with errors growing like eps/d^2 and eps/d^3 (a parallelogram
+four-bar's crank acceleration errs by about 2e-16/d^3 rad/s^2, d in rad).
+
+A :class:`BranchChart` replaces the equations in a zone |s - s*| < ``zone``
+around the singular position s* by the limit from the sides: one polynomial
+x(s) (a Chebyshev series) that interpolates x, x' and x'' at nodes
+``zone <= |s - s*| <= window`` on both sides, where the equations are well
+conditioned.  The nodes beyond s* are reached by continuation across it: a
+quintic Hermite extrapolation of the approach side predicts the pose, Newton
+corrects it, and the landing is accepted only if the corrector is small and
+the tangent continues the predicted one -- so the branch kept is the one the
+motion is on (continuity), never the other one through the same point.  The
+same test rejects a *dead* position (a fold, where the coordinate cannot go
+on): there is no solution beyond it, and no chart is built.
+
+
+:class:`ChartBook` watches poses along a path, estimates the distance to the
+nearest singular position by a Newton step on the determinant D of the scaled
+Jacobian along the branch (s* ~ s - D / D'), builds charts
+when one comes within reach and remembers where none could be built.
+
+The path is a line in coordinate space: coordinates ``idx`` of the model are
+prescribed, all held at ``q_fixed`` but the one at position ``k`` in ``idx``,
+which is the path coordinate s (rad or m).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.polynomial import chebyshev as cheb
+
+from ..kernels import rows_numpy
+from ..model import ConstraintLayout, Model
+from .continuation import _hermite5
+
+__all__ = ["PathProblem", "BranchChart", "ChartBook", "bridge", "ZONE", "WINDOW", "REACH"]
+
+#: half-width of the zone where a chart replaces the equations, in units of the path
+#: coordinate (rad; the model's length scale for travels)
+ZONE = 0.15
+#: half-width of the chart's node window (same units)
+WINDOW = 0.6
+#: a singular position estimated closer than this starts a chart (same units)
+REACH = 0.9
+#: a chart without a sign change of det [Phi_x; g_x] is kept only if the smallest
+#: sigma_min / sigma_max along it falls below this (a near miss of a crossing)
+NEAR_MISS_RCOND = 1e-3
+#: largest continuation step while placing the nodes (same units)
+_STEP = 0.1
+#: the chart is rejected if it misses a direct solve at a check point by more (scaled)
+_CHART_TOL = 1e-7
+
+
+@dataclass
+class _Node:
+    """A solved pose of the path: coordinate s, pose x, x' = dx/ds, x'' and the sign of
+    det of the scaled Jacobian."""
+
+    s: float
+    x: np.ndarray
+    xs: np.ndarray
+    xss: np.ndarray
+    sign: float
+
+
+class PathProblem:
+    """The position problem along a line in coordinate space.
+
+    Parameters
+    ----------
+    model : Model
+    layout : ConstraintLayout
+        Joint rows of the mode.
+    idx : sequence of int
+        Prescribed coordinates (the others follow from the constraints); with the
+        joint rows they must form a square system.
+    q_fixed : array_like, shape (len(idx),)
+        Values of the prescribed coordinates (rad or m); entry ``k`` is replaced by s.
+    k : int
+        Position in ``idx`` of the path coordinate s.
+
+    Raises
+    ------
+    ValueError
+        The system [Phi_x; g_idx,x] is not square.
+
+    Examples
+    --------
+    >>> import numpy as np, mechdyn as md
+    >>> m = md.Mechanism("crank")
+    >>> _ = m.add_body("crank", points={"A": (0.1, 0.0)})
+    >>> _ = m.add_revolute("O", "ground", "crank")
+    >>> _ = m.add_coordinate("phi", kind="angle", body="crank")
+    >>> path = PathProblem(m.compile(), m.compile().layout(), [0], [0.0], 0)
+    >>> node = path.solve(0.3, np.zeros(3))
+    >>> round(float(node.x[2]), 12), float(node.xs[2])
+    (0.3, 1.0)
+    """
+
+    def __init__(self, model: Model, layout: ConstraintLayout, idx, q_fixed, k: int):
+        self.model, self.layout = model, layout
+        self.idx = np.asarray(idx, dtype=int).reshape(-1)
+        self.q_fixed = np.asarray(q_fixed, dtype=float).reshape(self.idx.size).copy()
+        self.k = int(k)
+        if layout.n_rows + self.idx.size != model.n_x:
+            raise ValueError("a branch chart needs a square position system "
+                             f"({layout.n_rows} joint rows + {self.idx.size} coordinates "
+                             f"for {model.n_x} pose components)")
+        self.scale = np.ones(model.n_x)
+        self.scale[2::3] = model.length_scale
+        angle = bool(model.coord_is_angle[self.idx[self.k]])
+        #: unit of the path coordinate for the zone sizes: 1 rad, or the length scale
+        self.unit = 1.0 if angle else float(model.length_scale)
+        self.tol = 1e-14 * max(model.length_scale, 1e-3)
+        self._e = np.zeros(model.n_x)
+        self._e[layout.n_rows + self.k] = 1.0
+
+    # ------------------------------------------------------------------ equations
+    def system(self, x, s):
+        """Residual [Phi; g_idx - q(s)] and Jacobian, shapes (n_x,) and (n_x, n_x)."""
+        q = self.q_fixed.copy()
+        q[self.k] = s
+        v, J, _ = rows_numpy.evaluate(self.layout.rowset, x)
+        vg, Jg, _ = rows_numpy.evaluate(self.model.coordinate_rows, x)
+        return (np.concatenate([v, vg[self.idx] - q]),
+                np.concatenate([J, Jg[self.idx]]))
+
+    def _quad(self, x, v):
+        """The rows' velocity-quadratic terms at pose x for rates v: Phi_xx[v, v], (n_x,)."""
+        return np.concatenate([rows_numpy.quad(self.layout.rowset, x, v),
+                               rows_numpy.quad(self.model.coordinate_rows, x, v)[self.idx]])
+
+    def newton(self, x, s, max_iter: int = 12):
+        """Newton from ``x`` to the pose at s, converged to round-off; (x, J) or None."""
+        x = np.array(x, dtype=float)
+        prev = np.inf
+        for _ in range(max_iter):
+            F, J = self.system(x, s)
+            err = float(np.max(np.abs(F)))
+            if not np.isfinite(err):
+                return None
+            if err <= self.tol or (err >= 0.5 * prev and err <= 1e3 * self.tol):
+                return x, J
+            prev = err
+            try:
+                x = x - np.linalg.solve(J, F)
+            except np.linalg.LinAlgError:
+                return None
+        return None
+
+    def node(self, s, x, J=None) -> _Node:
+        """Analogs x', x'' and the branch sign at a solved pose."""
+        if J is None:
+            J = self.system(x, s)[1]
+        xs = np.linalg.solve(J, self._e)
+        xss = np.linalg.solve(J, -self._quad(x, xs))
+        sign = float(np.sign(np.linalg.det(J * self.scale)))
+        return _Node(float(s), np.array(x, dtype=float), xs, xss, sign)
+
+    def solve(self, s, x_guess) -> _Node | None:
+        """The node at s by Newton from ``x_guess`` (None if it does not converge)."""
+        out = self.newton(x_guess, s)
+        return None if out is None else self.node(s, *out)
+
+    # ------------------------------------------------------------------ singular values
+    def jacobian(self, x) -> np.ndarray:
+        """[Phi_x; g_idx,x] at x, shape (n_x, n_x)."""
+        return np.concatenate([rows_numpy.jacobian(self.layout.rowset, x),
+                               rows_numpy.jacobian(self.model.coordinate_rows, x)[self.idx]])
+
+    def singular_offset(self, x, xs=None) -> float:
+        """Estimated offset s* - s of the nearest singular position from the pose x at s
+        (``xs``: its analog dx/ds, computed if not given).
+
+        The determinant D(s) of the scaled Jacobian along the branch is smooth with a
+        simple zero at a crossing (and a square-root zero at a fold); one Newton step
+        on it, s* ~ s - D / D' with D' by a difference along the tangent, places
+        the singular position (exact to first order).  The smallest singular value is
+        no guide: away from the crossing the vanishing one need not be the smallest."""
+        J = self.jacobian(x)
+        if xs is None:
+            xs = np.linalg.solve(J, self._e)
+        h = 1e-5 * self.unit
+        d0 = np.linalg.det(J * self.scale)
+        d1 = (np.linalg.det(self.jacobian(x + h * xs) * self.scale) - d0) / h
+        if d1 == 0.0 or not np.isfinite(d1):
+            return np.inf
+        return float(-d0 / d1)
+
+    def rcond(self, x) -> float:
+        """sigma_min / sigma_max of the scaled Jacobian at x."""
+        sv = np.linalg.svd(self.jacobian(x) * self.scale, compute_uv=False)
+        return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
+
+    # ------------------------------------------------------------------ continuation
+    def march(self, node: _Node, s_to: float, *, keep_sign: bool = True):
+        """Continuation from ``node`` to s_to (second-order Taylor predictor, step
+        halving); returns (node reached, ok).  With ``keep_sign`` a change of the branch
+        sign is refused, so the march stops in front of a singular position."""
+        h_max = _STEP * self.unit
+        h_min = 1e-9 * self.unit
+        h_try = h_max
+        while node.s != s_to:
+            rem = s_to - node.s
+            h = rem if abs(rem) <= h_try * (1 + 1e-9) else np.sign(rem) * h_try
+            xp = node.x + node.xs * h + 0.5 * node.xss * h * h
+            nn = self.solve(node.s + h if h != rem else s_to, xp)
+            ok = nn is not None and (not keep_sign or nn.sign == node.sign)
+            if ok:
+                step = np.max(np.abs((nn.x - node.x) * self.scale))
+                corr = np.max(np.abs((nn.x - xp) * self.scale))
+                ok = corr <= 0.25 * step + 1e-9 * self.model.length_scale
+            if not ok:
+                h_try = abs(h) / 2
+                if h_try < h_min:
+                    return node, False
+                continue
+            node = nn
+            h_try = min(2 * h_try, h_max)
+        return node, True
+
+
+@dataclass
+class BranchChart:
+    """One branch around a singular position: x(s), x'(s), x''(s) as a Chebyshev series
+    (built by :func:`bridge`; see its example and that of :class:`ChartBook`).
+
+    Attributes
+    ----------
+    centre : float
+        Estimated singular position s* (rad or m).
+    zone : float
+        Half-width of the zone where the chart replaces the equations.
+    window : float
+        Half-width of the node window (the chart is valid there).
+    coef : ndarray, shape (N, 3 n_x)
+        Chebyshev coefficients of (x, x', x'') on u = (s - centre) / window.
+    kind : str
+        ``"bifurcation"`` (the branch sign changes across it) or ``"near-singular"``.
+    signs : tuple of float
+        Branch sign (det of the scaled Jacobian) below and above the centre.
+    error : float
+        Largest scaled difference from direct solves at two check points (m).
+    rcond : float
+        sigma_min / sigma_max at the nodes next to the centre.
+    """
+
+    centre: float
+    zone: float
+    window: float
+    coef: np.ndarray = field(repr=False)
+    kind: str
+    signs: tuple
+    error: float
+    rcond: float
+
+    def in_zone(self, s) -> bool:
+        """Whether s lies in the zone where the chart replaces the equations."""
+        return abs(s - self.centre) < self.zone
+
+    def in_window(self, s) -> bool:
+        """Whether s lies in the node window (where the chart is valid)."""
+        return abs(s - self.centre) <= self.window
+
+    def side_sign(self, s) -> float:
+        """The branch sign expected at s (on its side of the centre)."""
+        return self.signs[0] if s < self.centre else self.signs[1]
+
+    def evaluate(self, s):
+        """Pose x, x' = dx/ds and x'' at s (scalar, or an array of shape (m,)).
+
+        Returns
+        -------
+        x, xs, xss : ndarray, shape (n_x,) or (m, n_x)
+        """
+        s = np.asarray(s, dtype=float)
+        u = (s - self.centre) / self.window
+        out = cheb.chebvander(u, self.coef.shape[0] - 1) @ self.coef
+        if s.ndim == 0:
+            out = out.reshape(-1)
+        n = out.shape[-1] // 3
+        return out[..., :n], out[..., n:2 * n], out[..., 2 * n:]
+
+    def summary(self) -> dict:
+        """The chart as a plain dict (for run statistics)."""
+        return {"at": self.centre, "kind": self.kind, "zone": self.zone,
+                "window": self.window, "error": self.error, "rcond": self.rcond}
+
+
+def _fit(nodes, centre: float, window: float) -> np.ndarray:
+    """Chebyshev coefficients (N, 3 n_x) of the confluent Hermite interpolant of the
+    nodes (value, first and second derivative at each)."""
+    N = 3 * len(nodes)
+    u = np.array([(nd.s - centre) / window for nd in nodes])
+    V0 = cheb.chebvander(u, N - 1)
+    eye = np.eye(N)
+    D1 = np.array([np.pad(cheb.chebder(eye[j]), (0, 1)) for j in range(N)])
+    D2 = np.array([np.pad(cheb.chebder(eye[j], 2), (0, 2)) for j in range(N)])
+    V = np.concatenate([V0, V0 @ D1.T / window, V0 @ D2.T / window**2])
+    Y = np.concatenate([[nd.x for nd in nodes], [nd.xs for nd in nodes],
+                        [nd.xss for nd in nodes]])
+    c = np.linalg.solve(V, Y)
+    return np.concatenate([c, D1.T @ c / window, D2.T @ c / window**2], axis=1)
+
+
+def bridge(path: PathProblem, start: _Node, s_star: float, *, zone: float = ZONE,
+           window: float = WINDOW) -> BranchChart | None:
+    """Build the chart of the branch of ``start`` across the singular position near s*.
+
+    Parameters
+    ----------
+    path : PathProblem
+    start : _Node
+        A solved pose on the branch (its side of s* is the approach side).
+    s_star : float
+        Estimate of the singular position (rad or m); refined on the way.
+    zone, window : float
+        Half-widths of the zone and the node window, in units of the path coordinate.
+
+    Returns
+    -------
+    BranchChart or None
+        None where the branch does not go on past s* (a dead position: no solution
+        beyond, or only the other half of a fold), or where there is no singular
+        position after all.
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        A Jacobian on the way is exactly singular (:meth:`ChartBook.watch` catches it).
+
+    Examples
+    --------
+    A parallelogram four-bar of unit bars, its crank at 0.5 rad, towards its flat
+    position phi = 0: the coupler stays level on the other side too.
+
+    >>> import numpy as np, mechdyn as md
+    >>> m = md.Mechanism("parallelogram")
+    >>> _ = m.add_ground({"O": (0.0, 0.0), "C": (1.0, 0.0)})
+    >>> c, s = np.cos(0.5), np.sin(0.5)
+    >>> _ = m.add_body("crank", points={"E": (1.0, 0.0)}, pose=(0.0, 0.0, 0.5))
+    >>> _ = m.add_body("coupler", points={"E": (1.0, 0.0)}, pose=(c, s, 0.0))
+    >>> _ = m.add_body("rocker", points={"E": (1.0, 0.0)}, pose=(1.0, 0.0, 0.5))
+    >>> o = (0.0, 0.0)
+    >>> pins = [("O", "ground", "crank", "O", o), ("B", "coupler", "rocker", "E", "E"),
+    ...         ("A", "crank", "coupler", "E", o), ("C", "ground", "rocker", "C", o)]
+    >>> _ = [m.add_revolute(*pin) for pin in pins]
+    >>> _ = m.add_coordinate("phi", kind="angle", body="crank")
+    >>> model = m.compile()
+    >>> path = PathProblem(model, model.layout(), [0], [0.5], 0)
+    >>> chart = bridge(path, path.node(0.5, model.x0), 0.0)
+    >>> x, _, _ = chart.evaluate(-0.1)
+    >>> round(float(x[2]), 12), round(float(x[5]), 12)   # crank angle, coupler angle
+    (-0.1, 0.0)
+    """
+    r1, R = zone * path.unit, window * path.unit
+    ts = r1 + (R - r1) * (1.0 - np.cos(np.array([0.0, 0.25, 0.5]) * np.pi))  # r1 .. R
+    dsgn = 1.0 if s_star >= start.s else -1.0
+    node = start
+    near: list[_Node] = []
+    for _ in range(4):  # place the approach side, re-centring on the way
+        near, n = [], node
+        for t in ts[::-1]:
+            n, ok = path.march(n, s_star - dsgn * t)
+            if not ok:  # the singular position is closer than estimated
+                break
+            near.append(n)
+        if len(near) < ts.size:
+            s_star = n.s + dsgn * 1e-3 * path.unit
+            continue
+        off = path.singular_offset(near[-1].x, near[-1].xs)
+        new = near[-1].s + off
+        if not np.isfinite(new) or abs(new - s_star) <= 0.2 * r1:
+            break
+        s_star = new
+    else:
+        return None
+    if len(near) < ts.size:
+        return None
+    # ---- across: extrapolate the approach side, correct, check the continuation
+    a, b = near[-2], near[-1]
+    sb = s_star + dsgn * r1
+    hp = b.s - a.s
+    xp = _hermite5(1.0 + (sb - b.s) / hp, hp, a.x, a.xs, a.xss, b.x, b.xs, b.xss)
+    nb = path.solve(sb, xp)
+    if nb is None:
+        return None
+    sc = path.scale
+    step = np.max(np.abs((nb.x - b.x) * sc))
+    if np.max(np.abs((nb.x - xp) * sc)) > 0.1 * step:
+        return None
+    xs_p = b.xs + b.xss * (sb - b.s)
+    if np.max(np.abs((nb.xs - xs_p) * sc)) > 0.25 * max(np.max(np.abs(nb.xs * sc)),
+                                                         np.max(np.abs(b.xs * sc))):
+        return None
+    far = [nb]
+    for t in ts[1:]:
+        n, ok = path.march(far[-1], s_star + dsgn * t)
+        if not ok:
+            return None
+        far.append(n)
+    flip = nb.sign != b.sign
+    rc = min(path.rcond(b.x), path.rcond(nb.x))
+    if not flip:
+        # no crossing: keep the chart only if the branches nearly touch in between
+        xs_mid = 0.5 * (b.s + nb.s)
+        mid = path.solve(xs_mid, _hermite5(0.5, nb.s - b.s, b.x, b.xs, b.xss, nb.x, nb.xs,
+                                           nb.xss))
+        if mid is None:
+            return None
+        rc = min(rc, path.rcond(mid.x))
+        if rc >= NEAR_MISS_RCOND:
+            return None
+    nodes = sorted(near + far, key=lambda nd: nd.s)
+    coef = _fit(nodes, s_star, R)
+    signs = (b.sign, nb.sign) if dsgn > 0 else (nb.sign, b.sign)
+    chart = BranchChart(float(s_star), r1, R, coef, "bifurcation" if flip else "near-singular",
+                        signs, 0.0, rc)
+    err = 0.0
+    for t in (0.5 * (ts[0] + ts[1]), -0.5 * (ts[0] + ts[1])):
+        x, xs, _ = chart.evaluate(s_star + t)
+        chk = path.solve(s_star + t, x)
+        if chk is None:
+            return None
+        err = max(err, float(np.max(np.abs((chk.x - x) * sc))),
+                  float(np.max(np.abs((chk.xs - xs) * sc))) * path.unit)
+    if err > _CHART_TOL * path.model.length_scale:
+        return None
+    chart.error = err
+    return chart
+
+
+class ChartBook:
+    """The charts met along one path, and the places where none could be built.
+
+    Parameters
+    ----------
+    path : PathProblem
+    zone, window, reach : float
+        Zone and window half-widths of the charts, and the estimated distance of a
+        singular position that starts a chart (units of the path coordinate).
+
+    Examples
+    --------
+    A parallelogram four-bar goes through its flat position on the parallelogram
+    branch: the rocker turns with the crank, also at the flat position itself.
+
+    >>> import numpy as np, mechdyn as md
+    >>> m = md.Mechanism("parallelogram")
+    >>> _ = m.add_ground({"O": (0.0, 0.0), "C": (1.0, 0.0)})
+    >>> for name, pose in (("crank", (0, 0, 0.5)), ("coupler", (np.cos(0.5), np.sin(0.5), 0)),
+    ...                    ("rocker", (1, 0, 0.5))):
+    ...     _ = m.add_body(name, points={"E": (1.0, 0.0)}, pose=pose)
+    >>> _ = m.add_revolute("O", "ground", "crank", "O", (0.0, 0.0))
+    >>> _ = m.add_revolute("A", "crank", "coupler", "E", (0.0, 0.0))
+    >>> _ = m.add_revolute("B", "coupler", "rocker", "E", "E")
+    >>> _ = m.add_revolute("C", "ground", "rocker", "C", (0.0, 0.0))
+    >>> _ = m.add_coordinate("phi", kind="angle", body="crank")
+    >>> model = m.compile()
+    >>> book = ChartBook(PathProblem(model, model.layout(), [0], [0.5], 0))
+    >>> chart = book.watch(0.5, model.x0)
+    >>> chart.kind, abs(chart.centre) < 1e-3     # centre: an estimate of the crossing
+    ('bifurcation', True)
+    >>> x, xs, _ = chart.evaluate(0.0)
+    >>> round(float(x[8]), 12), round(float(xs[8]), 12)  # rocker angle, its analog
+    (0.0, 1.0)
+    """
+
+    def __init__(self, path: PathProblem, *, zone: float = ZONE, window: float = WINDOW,
+                 reach: float = REACH):
+        self.path = path
+        self.zone, self.window, self.reach = zone, window, reach
+        self.charts: list[BranchChart] = []
+        #: windows (lo, hi, reason) where no chart is needed or none can be built
+        self.skipped: list[tuple] = []
+        self._checked: tuple | None = None
+
+    def zone_chart(self, s) -> BranchChart | None:
+        """The chart whose zone holds s, else None."""
+        for ch in self.charts:
+            if ch.in_zone(s):
+                return ch
+        return None
+
+    def window_chart(self, s) -> BranchChart | None:
+        """The chart whose window holds s, else None."""
+        for ch in self.charts:
+            if ch.in_window(s):
+                return ch
+        return None
+
+    def crossed(self, s_from, s_to) -> BranchChart | None:
+        """A chart whose centre lies between s_from and s_to, else None."""
+        for ch in self.charts:
+            if (s_from - ch.centre) * (s_to - ch.centre) < 0:
+                return ch
+        return None
+
+    def due(self, s: float) -> bool:
+        """Whether a pose at s would be checked by :meth:`watch` (cheap)."""
+        return self._checked is None or abs(s - self._checked[0]) >= self._checked[1]
+
+    def watch(self, s: float, x, *, force_at: float | None = None) -> BranchChart | None:
+        """Check the solved pose x at s for a singular position within reach and build
+        its chart.  Returns the chart built by this call, else None.
+
+        ``force_at`` skips the estimate: a singular position is known to lie there."""
+        unit = self.path.unit
+        if force_at is None:
+            if not self.due(s):
+                return None
+            if self.window_chart(s) is not None or self._skipped(s):
+                return None
+        try:
+            off = force_at - s if force_at is not None else self.path.singular_offset(x)
+        except np.linalg.LinAlgError:
+            return None
+        dist = abs(off)
+        if force_at is None:
+            # far estimates are rough: look again sooner than halfway there
+            r = self.reach * unit
+            again = min(0.25 * min(dist, r) + 0.3 * max(dist - r, 0.0), r)
+            self._checked = (s, max(again, 0.02 * unit))
+            if not dist <= r:
+                return None
+        s_star = s + off
+        if self.window_chart(s_star) is not None or self._skipped(s_star):
+            return None
+        try:
+            with np.errstate(all="ignore"):
+                chart = bridge(self.path, self.path.node(s, x), s_star, zone=self.zone,
+                               window=self.window)
+        except np.linalg.LinAlgError:
+            chart = None
+        if chart is None:
+            w = self.window * unit
+            self.skipped.append((s_star - w, s_star + w, "no chart"))
+            return None
+        self.charts.append(chart)
+        return chart
+
+    def _skipped(self, s) -> bool:
+        return any(lo <= s <= hi for lo, hi, _ in self.skipped)
+
+    def apply(self, s):
+        """Chart values for the samples s (m,) that lie in a zone.
+
+        Returns
+        -------
+        mask : ndarray of bool, shape (m,)
+        x, xs, xss : ndarray, shape (mask.sum(), n_x)
+        """
+        s = np.asarray(s, dtype=float).reshape(-1)
+        mask = np.zeros(s.size, dtype=bool)
+        n_x = self.path.model.n_x
+        x, xs, xss = (np.empty((s.size, n_x)) for _ in range(3))
+        for ch in self.charts:
+            m = (np.abs(s - ch.centre) < ch.zone) & ~mask
+            if m.any():
+                x[m], xs[m], xss[m] = ch.evaluate(s[m])
+                mask |= m
+        return mask, x[mask], xs[mask], xss[mask]
+
+    def report(self) -> list[dict]:
+        """The charts built, as plain dicts (``at``, ``kind``, ``zone``, ``error`` ...)."""
+        return [ch.summary() for ch in self.charts]
