@@ -24,6 +24,7 @@ from .errors import (
                                  MechdynError,
                                  ModelError,
                                  SingularPositionError,
+                                 Status,
                                  UnitError,
 )
 from .kinematics.sweep import KinematicPoint, KinematicSweep, SweepSummary, analyze, sweep
@@ -67,7 +68,7 @@ __all__ = [
     # analyses and their records
     "sweep", "analyze", "KinematicSweep", "KinematicPoint", "SweepSummary",
     "simulate", "Trajectory", "SwitchEvent", "format_events",
-    "kinetostatics", "Kinetostatics",
+    "kinetostatics", "Kinetostatics", "Status",
     "reduce_model", "Reduction", "run_reduced", "steady_state", "SteadyCycle", "size_flywheel",
     "FlywheelSizing", "startup",
     # errors

@@ -1,4 +1,4 @@
-"""The exception tree of mechdyn.
+"""The exception tree of mechdyn, and the one status vocabulary of its records.
 
 Every error names the element, the field and the value concerned.  Errors raised
 during an analysis carry the time ``t`` and the generalized coordinates ``q`` at
@@ -8,10 +8,12 @@ which they happened, so that a caller can report where a run stopped.
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
+from enum import StrEnum
 
 import numpy as np
 
 __all__ = [
+    "Status",
     "MechdynError",
     "ModelError",
     "UnitError",
@@ -22,6 +24,57 @@ __all__ = [
     "IntegrationError",
     "did_you_mean",
 ]
+
+
+class Status(StrEnum):
+    """How an analysis ended: the one status vocabulary of every record.
+
+    A ``Status`` is a ``str`` (``Status.SUCCESS == "success"``), so records print and
+    compare as plain text.  Everything but ``SUCCESS`` and ``REDUNDANT`` means the
+    analysis did not cover all that was asked, and the record's ``message`` says where
+    (time, coordinates, elements).
+
+    Examples
+    --------
+    >>> Status("singular-position") is Status.SINGULAR_POSITION
+    True
+    >>> Status.SUCCESS == "success"
+    True
+    """
+
+    #: completed
+    SUCCESS = "success"
+    #: completed; reactions of redundant joints are not unique (minimum-norm ones given)
+    REDUNDANT = "redundant"
+    #: a terminal event of the caller ended the run
+    EVENT = "event"
+    #: a dead, toggle or bifurcation position: the coordinates lose control there
+    SINGULAR_POSITION = "singular-position"
+    #: the mechanism cannot be assembled at the coordinates reached
+    ASSEMBLY_FAILED = "assembly-failed"
+    #: the generalized mass matrix is singular (a coordinate without inertia)
+    SINGULAR_MASS_MATRIX = "singular-mass-matrix"
+    #: non-finite values appeared
+    NON_FINITE = "non-finite"
+    #: no consistent set of contact forces (complementarity has no solution)
+    NO_CONTACT_SOLUTION = "no-contact-solution"
+    #: a mode leaves no freedom the declared coordinates describe
+    LOCKUP = "lockup"
+    #: switching does not settle (too many events)
+    TOO_MANY_EVENTS = "too-many-events"
+    #: the wall-time limit was reached
+    TIMEOUT = "timeout"
+    #: stopped by the user (Ctrl-C); the data so far is kept
+    INTERRUPTED = "interrupted"
+    #: a transient did not reach its steady state in the time given
+    NOT_SETTLED = "not-settled"
+    #: some segments could not be analysed (their rows are NaN)
+    PARTIAL = "partial"
+    #: anything else (the integrator failed ...)
+    FAILED = "failed"
+
+    def __repr__(self) -> str:
+        return repr(self.value)
 
 
 class MechdynError(Exception):

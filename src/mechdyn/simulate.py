@@ -22,10 +22,8 @@ to the integrator's tolerance.
 from __future__ import annotations
 
 import math
-import sys
 import time
 import warnings
-from collections.abc import Mapping
 
 import numpy as np
 
@@ -37,130 +35,25 @@ from .errors import (
     MechdynError,
     ModelError,
     SingularPositionError,
-    did_you_mean,
+    Status,
 )
+from .initial_state import initial_state
 from .integrate.base import DEFAULT_RTOL, IntegratorOptionError, IntegratorWarning
 from .integrate.driver import make_integrator, sample_times
 from .integrate.events import as_events, locate_events
 from .kinematics.assembly import singularity, solve_position
-from .kinematics.constraints import coordinates, residual
-from .model import Model, as_model
+from .kinematics.constraints import residual
+from .model import as_model
+from .progress import Progress
 from .results.trajectory import Trajectory
 
-__all__ = ["simulate", "initial_state"]
+__all__ = ["simulate", "initial_state"]  # initial_state: re-exported from .initial_state
 
 #: sigma_min / sigma_max of the scaled position Jacobian below which a stop is
 #: reported as a dead position
 DEAD_RCOND = 1e-4
-#: runs predicted longer than this (s of wall time) show a progress bar (progress=None)
-PROGRESS_AFTER = 2.0
 
 
-
-
-def _values(model: Model, given, base: np.ndarray, what: str) -> np.ndarray:
-    """Coordinates from an array (n_q,) or a mapping {name: value} over ``base``."""
-    out = np.array(base, dtype=float)
-    if given is None:
-        return out
-    if isinstance(given, Mapping):
-        for name, v in given.items():
-            if name not in model.coordinate_names:
-                raise ModelError(f"{what}: " + did_you_mean(name, model.coordinate_names,
-                                                            "coordinate"))
-            out[model.coordinate_index(name)] = float(v)
-        return out
-    arr = np.asarray(given, dtype=float).reshape(-1)
-    if arr.shape != (model.n_q,):
-        names = ", ".join(model.coordinate_names)
-        raise ModelError(f"{what} must have {model.n_q} values ({names}), got {arr.size}")
-    return arr
-
-
-def _continue_to(model: Model, q_from, x_from, q_to, layout) -> np.ndarray:
-    """Newton continuation from a solved pose to new coordinates (keeps the branch)."""
-    q_from = np.asarray(q_from, float)
-    dq = np.asarray(q_to, float) - q_from
-    size = np.where(model.coord_is_angle, np.abs(dq) / 0.05,
-                    np.abs(dq) / (0.05 * model.length_scale))
-    n = max(1, int(math.ceil(float(np.max(size, initial=0.0)))))
-    x = np.array(x_from, float)
-    for k in range(1, n + 1):
-        x = solve_position(model, q_from + dq * (k / n), x, layout=layout, check_singular=False)
-    return x
-
-
-def initial_state(model: Model, q0=None, qdot0=None, *, mode=None):
-    """Initial (q, qdot, x): arguments, else ``mechanism.extras["initial"]``, else the sketch.
-
-    Parameters
-    ----------
-    q0, qdot0 : array_like (n_q,) or mapping {coordinate name: value}, optional
-        Values given override those of the model file; missing ones come from the
-        model file's ``initial`` table, then from the sketch (rates: zero).
-
-    Returns
-    -------
-    q, qdot : ndarray, shape (n_q,)
-    x : ndarray, shape (n_x,)
-        The assembled pose at q, reached by continuation from the sketch.
-    """
-    layout = model.layout(mode)
-    x_sk = getattr(model, "x0", None)
-    if x_sk is None:
-        from .kinematics.assembly import assemble
-
-        x_sk = assemble(model, layout=layout)
-    q_sk = coordinates(model, x_sk)
-    init = {}
-    extras = getattr(model.mechanism, "extras", None) or {}
-    if isinstance(extras, Mapping):
-        init = extras.get("initial", {}) or {}
-    q = _values(model, init.get("q"), q_sk, "initial q")
-    qd = _values(model, init.get("qdot"), np.zeros(model.n_q), "initial qdot")
-    q = _values(model, q0, q, "q0")
-    qd = _values(model, qdot0, qd, "qdot0")
-    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd))):
-        raise ModelError(f"the initial state must be finite, got q = {q}, qdot = {qd}")
-    x = _continue_to(model, q_sk, x_sk, q, layout)
-    return q, qd, x
-
-
-class _Progress:
-    """A tqdm bar over simulated time, shown at once (True), never (False) or once
-    the run has taken longer than PROGRESS_AFTER seconds (None)."""
-
-    def __init__(self, mode, t0, t_end):
-        self.mode, self.t0, self.t_end = mode, t0, t_end
-        self.bar = None
-        self.start = time.perf_counter()
-        self.shown = t0
-        if mode is True:
-            self._open()
-
-    def _open(self):
-        try:
-            from tqdm import tqdm
-        except ImportError:  # pragma: no cover - tqdm is a dependency
-            self.mode = False
-            return
-        self.bar = tqdm(total=self.t_end - self.t0, unit="s", file=sys.stderr,
-                        desc="simulate", bar_format="{l_bar}{bar}| {n:.4g}/{total:.4g} s "
-                        "[{elapsed}<{remaining}]")
-
-    def update(self, t):
-        if self.bar is None and self.mode is None and \
-                time.perf_counter() - self.start > PROGRESS_AFTER:
-            self._open()
-            if self.bar is not None:
-                self.bar.update(self.shown - self.t0)
-        if self.bar is not None:
-            self.bar.update(t - self.shown)
-        self.shown = t
-
-    def close(self):
-        if self.bar is not None:
-            self.bar.close()
 
 
 def _fmt_q(model, q):
@@ -173,7 +66,7 @@ def _diagnose(eom: EquationsOfMotion, exc: Exception, t_good: float, q_good, x_g
     """Status and message of a run that stopped with ``exc`` after the state at ``t_good``."""
     model, lay = eom.model, eom.layout
     if isinstance(exc, SingularPositionError):
-        return "singular-position", str(exc)
+        return Status.SINGULAR_POSITION, str(exc)
     if isinstance(exc, AssemblyError) and exc.q is not None and q_good is not None:
         # The solve failed between an assemblable q_good and q_bad: the segment leaves the
         # assembly region, whose boundary is a singular position. Bisect for it.
@@ -194,28 +87,28 @@ def _diagnose(eom: EquationsOfMotion, exc: Exception, t_good: float, q_good, x_g
         rep = singularity(model, x_lo, lay)
         t_edge = t_good + lo * (t_bad - t_good)
         if rep["rcond"] < DEAD_RCOND:
-            return "singular-position", (
+            return Status.SINGULAR_POSITION, (
                 f"dead position reached near t = {t_edge:.9g} s at {_fmt_q(model, q_edge)}: "
                 f"the mechanism cannot move past it (sigma_min/sigma_max of the constraint "
                 f"Jacobian {rep['rcond']:.2e}); coordinate(s) "
                 f"{', '.join(rep['coordinates']) or '-'} lose control, joints "
                 f"{', '.join(rep['joints']) or '-'} become dependent")
-        return "assembly-failed", f"position solve failed at t = {t_bad:.9g} s: {exc}"
+        return Status.ASSEMBLY_FAILED, f"position solve failed at t = {t_bad:.9g} s: {exc}"
     if x_good is not None:
         rep = singularity(model, x_good, lay)
         if rep["rcond"] < DEAD_RCOND:
-            return "singular-position", (
+            return Status.SINGULAR_POSITION, (
                 f"dead position near t = {t_good:.9g} s at {_fmt_q(model, q_good)}: "
                 f"sigma_min/sigma_max = {rep['rcond']:.2e}; coordinate(s) "
                 f"{', '.join(rep['coordinates']) or '-'} lose control, joints "
                 f"{', '.join(rep['joints']) or '-'} become dependent ({exc})")
     if isinstance(exc, AssemblyError):
-        return "assembly-failed", str(exc)
+        return Status.ASSEMBLY_FAILED, str(exc)
     if isinstance(exc, IntegrationError) and "mass matrix" in str(exc):
-        return "singular-mass-matrix", str(exc)
+        return Status.SINGULAR_MASS_MATRIX, str(exc)
     if isinstance(exc, FloatingPointError | ArithmeticError):
-        return "non-finite", f"non-finite values after t = {t_good:.9g} s: {exc}"
-    return "failed", str(exc)
+        return Status.NON_FINITE, f"non-finite values after t = {t_good:.9g} s: {exc}"
+    return Status.FAILED, str(exc)
 
 
 def _turning_point_check(eom: EquationsOfMotion, step, qd_old, x_good):
@@ -244,7 +137,7 @@ def _turning_point_check(eom: EquationsOfMotion, step, qd_old, x_good):
             name = model.coordinate_names[k]
             if rep is None:
                 rep = singularity(model, x_good, lay)
-            return "singular-position", (
+            return Status.SINGULAR_POSITION, (
                 f"dead position reached near t = {tk:.9g} s at {_fmt_q(model, qk)}: "
                 f"{name} turns back where the constraint Jacobian is singular "
                 f"(sigma_min/sigma_max {rep['rcond']:.2e}); coordinate(s) "
@@ -395,10 +288,10 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
             record(t0, q_init, qd_init, a_init, x_init, [0.0])
             k_eval += 1
 
-    status, message = "success", ""
+    status, message = Status.SUCCESS, ""
     records: list = []
     g_old = np.array([e(t0, q_init, qd_init) for e in ev])
-    bar = _Progress(progress, t0, t_end_f)
+    bar = Progress(progress, t0, t_end_f)
     t_good, q_good, x_good, qd_good = t0, q_init, x_init, qd_init
     steps_iter = integ.integrate(eom.rhs, t0, q_init, qd_init, t_end_f, w0=np.zeros(1),
                                  first_order=eom.first_order_function())
@@ -407,7 +300,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
             for step in steps_iter:
                 if not (np.all(np.isfinite(step.q)) and np.all(np.isfinite(step.qdot))
                         and np.all(np.isfinite(step.qddot))):
-                    status = "non-finite"
+                    status = Status.NON_FINITE
                     message = (f"non-finite state at t = {step.t:.9g} s after "
                                f"{_fmt_q(model, q_good)} at t = {t_good:.9g} s")
                     break
@@ -446,7 +339,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
                 t_good, q_good, x_good, qd_good = step.t, step.q, x_end, step.qdot
                 bar.update(step.t)
                 if terminal:
-                    status = "event"
+                    status = Status.EVENT
                     message = f"terminal event {records[-1].name!r} at t = {t_stop:.9g} s"
                     break
     except (MechdynError, FloatingPointError, ArithmeticError, np.linalg.LinAlgError) as exc:

@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -55,14 +54,17 @@ from .errors import (
     MechdynError,
     ModelError,
     SingularPositionError,
+    Status,
     did_you_mean,
 )
+from .initial_state import initial_state
 from .integrate.base import DEFAULT_RTOL, Integrator, IntegratorOptionError
 from .integrate.driver import INTEGRATORS, make_integrator
 from .integrate.events import EventRecord, as_events
 from .integrate.scipy_ivp import ScipyIntegrator
 from .kinematics.constraints import extend
 from .model import Model
+from .progress import Progress
 from .results.trajectory import Trajectory
 
 __all__ = ["simulate_events", "SwitchEvent", "format_events", "needs_event_loop"]
@@ -178,34 +180,6 @@ class _EventFn:
     armed: bool = False
     arm: float = 0.0  # after firing, re-arm only above this value
     fresh: bool = False
-
-
-def _initial(model: Model, q0, qdot0):
-    ex = model.mechanism.extras or {}
-    init = ex.get("initial", {}) if isinstance(ex, Mapping) else {}
-    x0 = getattr(model, "x0", model.x_sketch)
-    from .kinematics.constraints import coordinates
-
-    q = np.array(coordinates(model, x0), float)
-    qd = np.zeros(model.n_q)
-    for given, out, what in ((init.get("q"), q, "initial q"), (init.get("qdot"), qd,
-                                                                 "initial qdot"),
-                             (q0, q, "q0"), (qdot0, qd, "qdot0")):
-        if given is None:
-            continue
-        if isinstance(given, Mapping):
-            for n, v in given.items():
-                if n not in model.coordinate_names:
-                    raise ModelError(f"{what}: " + did_you_mean(n, model.coordinate_names,
-                                                                "coordinate"))
-                out[model.coordinate_index(n)] = float(v)
-        else:
-            arr = np.asarray(given, float).reshape(-1)
-            if arr.shape != (model.n_q,):
-                raise ModelError(f"{what} must have {model.n_q} values "
-                                 f"({', '.join(model.coordinate_names)}), got {arr.size}")
-            out[:] = arr
-    return q, qd, np.array(x0, float)
 
 
 # ============================================================================ main
@@ -368,8 +342,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         rec["lost"].append(lost_total)
 
     # ---------------------------------------------------------------- initial state
-    status, message = "success", ""
-    q_init, qd_init, x_guess = _initial(model, q0, qdot0)
+    status, message = Status.SUCCESS, ""
+    q_init, qd_init, x_guess = initial_state(model, q0, qdot0)
     targets: dict = {}
     locks = sm.initial_locks() if mode is None else frozenset(mode)
     unknown = [n for n in locks if n not in sm.lock_names]
@@ -416,9 +390,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     fired_once: set = set()
     n_events = 0
     last_event_t, repeat = None, 0
-    from .simulate import _Progress
-
-    bar = _Progress(progress, t0, t_end)
+    bar = Progress(progress, t0, t_end)
     while t < t_end:
         stats["segments"] += 1
         eqs = ModeEquations(sm, ms, backend)
@@ -493,7 +465,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                     if g > 0 and (not e.fresh or g > e.arm):
                         e.armed = True
                 if max_wall_time is not None and time.perf_counter() - wall0 > max_wall_time:
-                    raise _Stop("timeout", f"stopped after {max_wall_time} s of computing at "
+                    raise _Stop(Status.TIMEOUT, f"stopped after {max_wall_time} s of computing at "
                                 f"t = {t_new:.9g} s")
             _add_counts(stats, integ, eqs)
             if hit is None:
@@ -513,7 +485,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                 events.append(EventRecord(e.key, float(t_hit), ev_hit.q.copy(),
                                           ev_hit.qdot.copy()))
             if any(e.data.terminal for e in user):
-                raise _Stop("event", f"terminal event {user[0].key!r} at t = {t_hit:.9g} s")
+                raise _Stop(Status.EVENT, f"terminal event {user[0].key!r} at t = {t_hit:.9g} s")
             just_fired = {(e.kind, e.key) for e in user}
             if not fired:  # only the caller's events: go on in the same mode
                 t = t_hit
@@ -540,13 +512,13 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             if last_event_t is not None and t_hit - last_event_t <= 1e-12 * max(1, abs(t_hit)):
                 repeat += 1
                 if repeat > 50:
-                    raise _Stop("too-many-events", f"switching does not settle at t = "
+                    raise _Stop(Status.TOO_MANY_EVENTS, f"switching does not settle at t = "
                                 f"{t_hit:.9g} s (more than 50 events at the same instant)")
             else:
                 repeat = 0
             last_event_t = t_hit
             if n_events >= max_events:
-                raise _Stop("too-many-events", f"stopped after {max_events} switching events "
+                raise _Stop(Status.TOO_MANY_EVENTS, f"stopped after {max_events} switching events "
                             f"at t = {t_hit:.9g} s")
             just_fired |= {(e.kind, e.key) for e in fired}
             ms = ms_new
@@ -703,16 +675,16 @@ def _penetration(sm: SwitchedModel, x, ms) -> float:
 
 def _status_of(exc):
     if isinstance(exc, SingularPositionError):
-        return "singular-position", str(exc)
+        return Status.SINGULAR_POSITION, str(exc)
     if isinstance(exc, AssemblyError):
-        return "assembly-failed", str(exc)
+        return Status.ASSEMBLY_FAILED, str(exc)
     if isinstance(exc, ContactError):
-        return "no-contact-solution", str(exc)
+        return Status.NO_CONTACT_SOLUTION, str(exc)
     if isinstance(exc, LockupError):
-        return "lockup", str(exc)
+        return Status.LOCKUP, str(exc)
     if isinstance(exc, np.linalg.LinAlgError):
-        return "failed", f"singular system: {exc}"
-    return "failed", str(exc)
+        return Status.FAILED, f"singular system: {exc}"
+    return Status.FAILED, str(exc)
 
 
 # ============================================================================ events

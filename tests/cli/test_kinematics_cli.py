@@ -81,4 +81,4 @@ def test_a_dead_position_writes_what_was_computed_and_exits_1(rocker_driven_four
     assert "warning: dead position at psi = " in cap.err
     df = pd.read_csv(csv, comment="#")
     assert 1 <= len(df) < 361
-    assert "status: dead-position" in csv.read_text()
+    assert "status: singular-position" in csv.read_text()

@@ -39,7 +39,7 @@ def test_door_with_two_hinges_warns_and_splits_the_load_evenly():
                                atol=1e-9)
     # one hinge: the same torque, the whole load on it, no warning
     one = kinetostatics(door(False), over="theta", speed=0.0, values=th)
-    assert one.status == "ok" and not one.warnings
+    assert one.status == "success" and not one.warnings
     np.testing.assert_allclose(one.driving["theta"], res.driving["theta"], rtol=1e-12)
     np.testing.assert_allclose(one.reactions["hinge_top"], tot, atol=1e-9)
 
@@ -101,12 +101,12 @@ def test_parallelogram_with_redundant_third_link():
     np.testing.assert_allclose(f, model.mass[cp] * ac, atol=1e-9 * np.max(np.abs(f)) + 1e-9)
     # without the third link: no warning
     plain = kinetostatics(parallelogram(False), over="phi", speed=5.0, values=values)
-    assert plain.status == "ok" and not plain.redundant_joints
+    assert plain.status == "success" and not plain.redundant_joints
 
 
 def test_redundancy_is_not_reported_for_a_plain_mechanism():
     res = kinetostatics(door(False), over="theta", speed=1.0,
                         values=np.linspace(0.0, 1.0, 5))
-    assert res.status == "ok"
+    assert res.status == "success"
     assert res.redundant_joints == ()
     assert res.stats["redundant_equations"] == 0

@@ -120,7 +120,7 @@ def test_closed_stop_carries_the_drive_torque_less_the_weight_moment():
     assert tr.status == "success", tr.message
     res = md.kinetostatics(m, trajectory=tr)
     closed = res.mode_index == 1
-    assert closed.sum() > 10 and res.status == "ok"
+    assert closed.sum() > 10 and res.status == "success"
     assert res.stats["segments"][1]["driven"] == ()
     np.testing.assert_allclose(res.driving["th1"][~closed], 4.0, atol=1e-9)
     assert np.all(np.isnan(res.driving["th1"][closed]))

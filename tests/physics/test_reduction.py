@@ -161,7 +161,7 @@ def test_link_of_reduction_divides_by_its_angular_velocity_analog(table, model):
     np.testing.assert_allclose(rod.J_red[ok], table.J_red[ok] / dbeta[ok] ** 2, rtol=1e-11)
     np.testing.assert_allclose(rod.link_angle, beta, atol=1e-12)
     # the rod's rate vanishes at phi = 90, 270 deg: infinite there, reported
-    assert rod.status == "singular" and "vanishes" in rod.message
+    assert rod.status == "singular-position" and "vanishes" in rod.message
     # derivative with respect to the link angle, against differences along the table
     k = np.flatnonzero(ok[1:-1] & ok[:-2] & ok[2:])[10] + 1
     fd = (rod.J_red[k + 1] - rod.J_red[k - 1]) / (rod.link_angle[k + 1] - rod.link_angle[k - 1])

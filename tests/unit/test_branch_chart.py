@@ -26,7 +26,7 @@ def test_no_chart_at_a_dead_position():
     assert book.watch(psi0, model.x0, force_at=limit) is None
     assert book.charts == [] and book.skipped
     sw = sweep(model, values=psi0 + np.linspace(0.0, 1.5, 151))
-    assert sw.status == "dead-position" and sw.stats["bifurcations"] == []
+    assert sw.status == "singular-position" and sw.stats["bifurcations"] == []
 
 
 def test_charts_only_for_one_coordinate_and_exact_analogs():

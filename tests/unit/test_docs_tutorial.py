@@ -20,4 +20,4 @@ def test_tutorial_code_blocks_run(tmp_path, monkeypatch):
     assert len(blocks) >= 5
     for k, block in enumerate(blocks):
         exec(compile(block, f"{TUTORIAL.name} block {k}", "exec"), namespace)
-    assert namespace["sw"].status == "dead-position"
+    assert namespace["sw"].status == "singular-position"

@@ -128,7 +128,7 @@ def rotor(m=1.5, r=0.2, gravity=(0.0, 0.0)):
 def test_record_fields_dataframe_and_summary():
     res = kinetostatics(rotor(), over="phi", speed=10.0)
     assert isinstance(res, Kinetostatics)
-    assert res.n == 361 and res.status == "ok" and res.warnings == ()
+    assert res.n == 361 and res.status == "success" and res.warnings == ()
     with pytest.raises(dataclasses.FrozenInstanceError):
         res.status = "x"
     df = res.to_dataframe()
@@ -148,7 +148,7 @@ def test_record_fields_dataframe_and_summary():
     p = res.peaks()
     assert p["joints"]["O"]["peak"] == pytest.approx(30.0)
     assert p["driving"]["phi"]["rms"] == pytest.approx(0.0, abs=1e-9)
-    assert "Kinetostatics(status='ok'" in repr(res)
+    assert "Kinetostatics(status='success'" in repr(res)
 
 
 def test_harmonics_of_a_rotating_unbalance():

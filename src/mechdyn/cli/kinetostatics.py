@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import sys
 
+from ..errors import Status
+
 __all__ = ["register", "run"]
 
 
@@ -131,7 +133,7 @@ def run(args) -> int:
         from ..results.plot_kinetostatics import plot_kinetostatics
 
         print(f"  plot: {plot_kinetostatics(res, args.plot, joints=args.joints)}")
-    if res.status == "singular":
+    if res.status == Status.SINGULAR_POSITION:
         print(f"mechdyn kinetostatics: warning: {res.message}", file=sys.stderr)
         return 1
     return 0

@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import sys
 
+from ..errors import Status
+
 __all__ = ["register", "run"]
 
 
@@ -101,7 +103,7 @@ def run(args) -> int:
     for line in sw.summary().lines() if len(sw) else ():
         print("  " + line)
     problems = [] if sw.ok else [sw.message]
-    if ks is not None and ks.status == "singular":
+    if ks is not None and ks.status == Status.SINGULAR_POSITION:
         problems.append(ks.message)
     for msg in problems:
         print(f"mechdyn report: warning: {msg}", file=sys.stderr)

@@ -57,7 +57,7 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
-from ..errors import ModelError, did_you_mean
+from ..errors import ModelError, Status, did_you_mean
 from ..kinematics.constraints import coordinates, coordinates_gamma, coordinates_jacobian
 from ..model import as_model
 from ..results.kinetostatics_record import Kinetostatics
@@ -404,12 +404,13 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                  bifurcations=pos.book.report() if pos.book is not None else [],
                  seconds=time.perf_counter() - t_start)
     status = core["status"]
-    message = {"ok": "kinetostatic analysis completed",
-               "redundant": "completed; reactions of redundant joints are not unique "
+    message = {Status.SUCCESS: "kinetostatic analysis completed",
+               Status.REDUNDANT: "completed; reactions of redundant joints are not unique "
                             "(minimum-norm solution reported)",
-               "singular": "completed with singular positions: the driven coordinates lose "
+               Status.SINGULAR_POSITION:
+                   "completed with singular positions: the driven coordinates lose "
                            "control there and the reactions are unbounded"}[status]
-    if status == "singular" and not stats.get("singular_positions"):
+    if status == Status.SINGULAR_POSITION and not stats.get("singular_positions"):
         message = ("completed through bifurcation position(s): the mechanism stays on its "
                    "branch, the driving torques are the limits along it; the reactions are "
                    "unbounded there")

@@ -33,7 +33,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from ..errors import MechdynError
+from ..errors import MechdynError, Status
 from ..model import Model
 from ..results.kinetostatics_record import Kinetostatics
 from .forces import force_model
@@ -168,7 +168,7 @@ def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
         sl = slice(a, b)
         info = dict(mode=mode, start=a, stop=b, t_start=float(tt[a]), t_end=float(tt[b - 1]))
         if r is None:
-            statuses.add("partial")
+            statuses.add(Status.PARTIAL)
             info.update(driven=(), status=f"not analysed: {exc}")
             warn.append(f"samples {a}..{b - 1} (t = {tt[a]:.6g} .. {tt[b - 1]:.6g} s, mode "
                         f"{_fmt(mode)}) could not be analysed ({type(exc).__name__}: {exc}); "
@@ -207,13 +207,15 @@ def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
                     rcond_min=r.stats["rcond_min"])
         seg_stats.append(info)
 
-    status = next((s for s in ("partial", "singular", "redundant") if s in statuses), "ok")
-    head = {"ok": "kinetostatic analysis completed",
-            "redundant": "completed; reactions of redundant joints are not unique "
+    status = next((s for s in (Status.PARTIAL, Status.SINGULAR_POSITION, Status.REDUNDANT)
+                   if s in statuses), Status.SUCCESS)
+    head = {Status.SUCCESS: "kinetostatic analysis completed",
+            Status.REDUNDANT: "completed; reactions of redundant joints are not unique "
                          "(minimum-norm solution reported)",
-            "singular": "completed with singular positions: the driven coordinates lose "
+            Status.SINGULAR_POSITION:
+                "completed with singular positions: the driven coordinates lose "
                         "control there and the reactions are unbounded",
-            "partial": "completed in part: segments whose mode could not be analysed are "
+            Status.PARTIAL: "completed in part: segments whose mode could not be analysed are "
                        "NaN (see warnings)"}[status]
     head += (f" for a switched trajectory: {len(parts)} segment(s) in {len(modes)} mode(s)")
     stats = dict(positions=n, segments=seg_stats,

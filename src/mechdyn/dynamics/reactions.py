@@ -26,6 +26,7 @@ import warnings as _warnings
 
 import numpy as np
 
+from ..errors import Status
 from ..kinematics.assembly import SINGULAR_RCOND
 from ..kinematics.constraints import _perp, coordinates_jacobian, extend
 from ..model import COORD_TRAVEL, ConstraintLayout, Model
@@ -288,10 +289,10 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
         tau[mask, 0] = np.einsum("nx,nx->n", charted[1], rhs[mask])
     bif = singular & mask
     singular &= ~mask
-    status = "ok"
+    status = Status.SUCCESS
     redundant: list[str] = []
     if n_red:
-        status = "redundant"
+        status = Status.REDUNDANT
         redundant = red_joints
         warn.append(f"{n_red} redundant joint equation(s): the equations "
                     + ", ".join(red_labels) + " are linearly dependent, so the reactions of "
@@ -299,14 +300,14 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
                     "the minimum-norm solution is reported (forces in N, moments in N m "
                     f"divided by the length scale {L:.4g} m)")
     if bif.any():
-        status = "singular"
+        status = Status.SINGULAR_POSITION
         ks = np.flatnonzero(bif)
         warn.append(f"{ks.size} bifurcation position(s) (first at index {ks[0]}, t = "
                     f"{t[ks[0]]:.6g} s): the mechanism goes on on its branch and the driving "
                     f"torque there is its limit along the branch, but the joint equations are "
                     f"dependent: the reactions there are unbounded (least-squares values)")
     if singular.any():
-        status = "singular"
+        status = Status.SINGULAR_POSITION
         ks = np.flatnonzero(singular)
         warn.append(f"{ks.size} singular position(s) (first at index {ks[0]}, t = "
                     f"{t[ks[0]]:.6g} s): the driven coordinates do not control the "

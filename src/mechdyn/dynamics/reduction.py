@@ -53,7 +53,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import ModelError, Status
 from ..model import Model, as_model
 from .flywheel import FlywheelSizing, SteadyCycle, size_flywheel, steady_state
 from .reduced_kinematics import _ModelEvaluator, _perp, _rot, reduced_kinematics
@@ -301,7 +301,7 @@ def reduce_model(model: Model, *, coordinate: str | None = None, link: str | Non
     message = ""
     status = "success"
     if np.any(bad):
-        status = "singular"
+        status = Status.SINGULAR_POSITION
         message = (f"the angular-velocity analog of link {link!r} vanishes at "
                    f"{int(bad.sum())} position(s) (e.g. phi = "
                    f"{np.degrees(phis[np.argmax(bad)]):.4g} deg): the reduced quantities are "

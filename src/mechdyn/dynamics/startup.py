@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import ModelError, Status
 from .flywheel import SteadyCycle, steady_state
 from .reduced_machine import ReducedMachine, ReducedRun, run_reduced
 
@@ -148,5 +148,5 @@ def startup(machine: ReducedMachine, t_end: float, *, phi0: float = 0.0, omega0:
                          peak_drive_torque=float(np.max(run.M_drive)), peak_motor_torque=pm,
                          speed_dip=float(dip), phi_dip=float(phi_dip),
                          omega_mean=steady.omega_mean, tol=float(tol),
-                         status="success" if t_steady is not None else "not_settled",
+                         status=Status.SUCCESS if t_steady is not None else Status.NOT_SETTLED,
                          message=msg, stats=dict(run.stats))

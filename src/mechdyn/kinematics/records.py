@@ -78,8 +78,9 @@ class KinematicSweep:
         and their first and second time derivatives.
     B : ndarray, shape (n, n_x, n_q)
         Velocity analogs dx/dq (m/rad, rad/rad, m/m or rad/m).
-    status : {"success", "dead-position"}
-        ``"dead-position"``: the sweep stopped at a dead or toggle position; the
+    status : Status
+        ``"success"`` or ``"singular-position"``
+        ``"singular-position"``: the sweep stopped at a dead or toggle position; the
         positions before it are kept and ``message`` says where.
     message : str
     stats : dict

@@ -53,7 +53,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ..errors import ModelError, SingularPositionError, did_you_mean
+from ..errors import ModelError, SingularPositionError, Status, did_you_mean
 from ..model import Model, as_model
 from .assembly import _position_tol, assemble, singularity
 from .branch_chart import ChartBook, PathProblem
@@ -173,7 +173,7 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
     Returns
     -------
     KinematicSweep
-        ``status`` is ``"success"``, or ``"dead-position"`` when a dead or toggle
+        ``status`` is ``"success"``, or ``"singular-position"`` when a dead or toggle
         position stopped the sweep (the positions computed before it are kept).
 
     Raises
@@ -328,7 +328,7 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
 
     status, message, events, error = "success", "", (), None
     if stop is not None:
-        status = "dead-position"
+        status = Status.SINGULAR_POSITION
         error, event = _dead_report(model, lay, k, stop, N, n_req)
         message = str(error)
         events = (event,)

@@ -70,7 +70,7 @@ class Kinetostatics:
         Joints whose equations are linearly dependent (their reactions are not
         unique; the minimum-norm solution is reported).
     status : str
-        "ok", "redundant" (non-unique reactions) or "singular" (positions where
+        "success", "redundant" (non-unique reactions) or "singular-position" (positions where
         the driven coordinates lose control of the mechanism).
     message : str
     warnings : tuple of str

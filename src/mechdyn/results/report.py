@@ -26,6 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import Status
+
 __all__ = ["report", "report_records", "write_report", "report_trajectory", "model_tables"]
 
 _CSS = """
@@ -353,7 +355,7 @@ def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
         parts.append(f"<p>Driven coordinate(s) {', '.join(ks.driven)} at constant "
                      f"{_esc(ks.over)}-rate {rate_txt}, {ks.n} positions; forces include "
                      "gravity, inertia and the model's loads.</p>")
-    parts.append(_status(ks.status, ks.status == "ok", ks.message))
+    parts.append(_status(ks.status, ks.status in (Status.SUCCESS, Status.REDUNDANT), ks.message))
     if not ks.n:
         return "\n".join(parts)
     p = ks.peaks()

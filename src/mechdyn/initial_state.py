@@ -1,0 +1,86 @@
+"""The initial state of a run: coordinates, rates and the assembled pose.
+
+Values given by the caller override those of the model file's ``initial`` table,
+which override the sketch (rates: zero); the pose is reached from the assembled
+sketch by Newton continuation, which keeps the sketch's assembly branch.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+import numpy as np
+
+from .errors import ModelError, did_you_mean
+from .kinematics.assembly import assemble, solve_position
+from .kinematics.constraints import coordinates
+from .model import Model
+
+__all__ = ["initial_state"]
+
+
+def _values(model: Model, given, base: np.ndarray, what: str) -> np.ndarray:
+    """Coordinates from an array (n_q,) or a mapping {name: value} over ``base``."""
+    out = np.array(base, dtype=float)
+    if given is None:
+        return out
+    if isinstance(given, Mapping):
+        for name, v in given.items():
+            if name not in model.coordinate_names:
+                raise ModelError(f"{what}: " + did_you_mean(name, model.coordinate_names,
+                                                            "coordinate"))
+            out[model.coordinate_index(name)] = float(v)
+        return out
+    arr = np.asarray(given, dtype=float).reshape(-1)
+    if arr.shape != (model.n_q,):
+        names = ", ".join(model.coordinate_names)
+        raise ModelError(f"{what} must have {model.n_q} values ({names}), got {arr.size}")
+    return arr
+
+
+def _continue_to(model: Model, q_from, x_from, q_to, layout) -> np.ndarray:
+    """Newton continuation from a solved pose to new coordinates (keeps the branch)."""
+    q_from = np.asarray(q_from, float)
+    dq = np.asarray(q_to, float) - q_from
+    size = np.where(model.coord_is_angle, np.abs(dq) / 0.05,
+                    np.abs(dq) / (0.05 * model.length_scale))
+    n = max(1, int(math.ceil(float(np.max(size, initial=0.0)))))
+    x = np.array(x_from, float)
+    for k in range(1, n + 1):
+        x = solve_position(model, q_from + dq * (k / n), x, layout=layout, check_singular=False)
+    return x
+
+
+def initial_state(model: Model, q0=None, qdot0=None, *, mode=None):
+    """Initial (q, qdot, x): arguments, else ``mechanism.extras["initial"]``, else the sketch.
+
+    Parameters
+    ----------
+    q0, qdot0 : array_like (n_q,) or mapping {coordinate name: value}, optional
+        Values given override those of the model file; missing ones come from the
+        model file's ``initial`` table, then from the sketch (rates: zero).
+
+    Returns
+    -------
+    q, qdot : ndarray, shape (n_q,)
+    x : ndarray, shape (n_x,)
+        The assembled pose at q, reached by continuation from the sketch.
+    """
+    layout = model.layout(mode)
+    x_sk = getattr(model, "x0", None)
+    if x_sk is None:
+        x_sk = assemble(model, layout=layout)
+    q_sk = coordinates(model, x_sk)
+    init = {}
+    extras = getattr(model.mechanism, "extras", None) or {}
+    if isinstance(extras, Mapping):
+        init = extras.get("initial", {}) or {}
+    q = _values(model, init.get("q"), q_sk, "initial q")
+    qd = _values(model, init.get("qdot"), np.zeros(model.n_q), "initial qdot")
+    q = _values(model, q0, q, "q0")
+    qd = _values(model, qdot0, qd, "qdot0")
+    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd))):
+        raise ModelError(f"the initial state must be finite, got q = {q}, qdot = {qd}")
+    x = _continue_to(model, q_sk, x_sk, q, layout)
+    return q, qd, x
