@@ -41,7 +41,7 @@ from .initial_state import initial_state
 from .integrate.base import DEFAULT_RTOL, IntegratorOptionError, IntegratorWarning
 from .integrate.driver import make_integrator, sample_times
 from .integrate.events import as_events, locate_events
-from .kinematics.assembly import singularity, solve_position
+from .kinematics.assembly import DEAD_RCOND, singularity, solve_position
 from .kinematics.constraints import residual
 from .model import as_model
 from .progress import Progress
@@ -49,9 +49,6 @@ from .results.trajectory import Trajectory
 
 __all__ = ["simulate", "initial_state"]  # initial_state: re-exported from .initial_state
 
-#: sigma_min / sigma_max of the scaled position Jacobian below which a stop is
-#: reported as a dead position
-DEAD_RCOND = 1e-4
 
 
 

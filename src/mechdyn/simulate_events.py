@@ -62,6 +62,7 @@ from .integrate.base import DEFAULT_RTOL, Integrator, IntegratorOptionError
 from .integrate.driver import INTEGRATORS, make_integrator
 from .integrate.events import EventRecord, as_events
 from .integrate.scipy_ivp import ScipyIntegrator
+from .kinematics.assembly import DEAD_RCOND
 from .kinematics.constraints import extend
 from .model import Model
 from .progress import Progress
@@ -386,6 +387,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
 
     qi, qdi = ms.independent(x, xd)
     just_fired: set = set()
+    good = None  # (t, ModeEval) of the last accepted step: where a failed run was well
     next_out = 0
     fired_once: set = set()
     n_events = 0
@@ -441,6 +443,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
 
                 y_new = np.concatenate([step.q, step.qdot, step.w])
                 ev_new = evaluate(t_new, y_new)
+                eqs.check_position(t_new, ev_new.x, ev_new.q)
+                good = (t_new, ev_new, ms)
                 gs = [e.fn(t_new, ev_new) for e in efns]
                 cands = [e for e, g in zip(efns, gs, strict=True)
                          if (e.armed and g <= 0) or g < -e.hard]
@@ -532,7 +536,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         except (MechdynError, np.linalg.LinAlgError, ValueError) as exc:
             if isinstance(exc, IntegratorOptionError):
                 raise
-            status, message = _status_of(exc)
+            status, message = _dead_position(exc, good) or _status_of(exc)
             break
         finally:
             if steps_iter is not None:
@@ -671,6 +675,23 @@ def _penetration(sm: SwitchedModel, x, ms) -> float:
     for _n, (_ct, gap, _) in sm.contacts.items():
         worst = max(worst, -gap.value(X))
     return worst
+
+
+def _dead_position(exc, good):
+    """(status, message) when a position solve failed just past a dead position of the
+    mode (the last accepted state is nearly singular), else None."""
+    if not isinstance(exc, AssemblyError) or good is None:
+        return None
+    t_good, ev, ms = good
+    rc = ms.rcond(ev.x)
+    if rc >= DEAD_RCOND:
+        return None
+    names = ", ".join(f"{n} = {v:.9g}" for n, v in zip(ms.model.coordinate_names, ev.q,
+                                                         strict=True))
+    return Status.SINGULAR_POSITION, (
+        f"dead position reached near t = {t_good:.9g} s at {names}: the mechanism cannot "
+        f"move past it in mode {sorted(ms.mode) or '(none)'} (sigma_min/sigma_max of the "
+        f"position Jacobian {rc:.2e}; {exc})")
 
 
 def _status_of(exc):

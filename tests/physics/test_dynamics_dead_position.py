@@ -41,3 +41,20 @@ def test_dead_position_data_in_dataframe():
     assert len(df) == tr.t.size
     assert {"t_s", "psi_rad", "psi_deg", "psi_dot_rad_s", "psi_ddot_rad_s2", "T_J", "U_J",
             "W_nc_J", "E_balance_J"} <= set(df.columns)
+
+
+def test_a_switched_run_reports_the_dead_position_too():
+    """The same rocker-driven four-bar with a stop it never reaches runs on the segment
+    loop of variable-structure models: it stops at the same dead position, says when
+    and where, and keeps the motion so far."""
+    from mechdyn.mechanism.contact import Stop
+    from mechdyn.mechanism.switch import add_element
+
+    mech = rocker_driven()
+    add_element(mech, Stop("far", "psi", upper=10.0))
+    tr = simulate(mech, 1.0, progress=False)
+    assert tr.status == "singular-position", tr.message
+    assert re.search(r"t = 0\.3[01]\d* s", tr.message), tr.message
+    assert "psi" in tr.message
+    assert 0.29 < tr.t[-1] < 0.32 and tr.t.size > 10
+    assert np.all(np.isfinite(tr.q)) and np.all(np.isfinite(tr.x))

@@ -16,9 +16,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import ModelError, SingularPositionError
+from ..kinematics.assembly import SINGULAR_RCOND
 from ..kinematics.constraints import extend
 from .compiled import compile_mode_kernel
+from .lagrange import PIVOT_CHECK
 from .modes import ModeEval
 
 __all__ = ["ModeEquations", "BACKENDS"]
@@ -112,6 +114,33 @@ class ModeEquations:
             if out is not None:
                 return out
         return self.numpy_rhs(t, qi, qdi)
+
+    def check_position(self, t: float, x, q) -> None:
+        """Stop at a singular position of the mode (dead, toggle or bifurcation position:
+        the mode's coordinates lose control), with t, q and the coordinates named.
+
+        A cheap test first (the pivots of the compiled kernel's last factorization),
+        confirmed by the singular values of the scaled position Jacobian.
+
+        Raises
+        ------
+        SingularPositionError
+            sigma_min / sigma_max of [rows_I; g_I] below ``SINGULAR_RCOND``.
+        """
+        if self.kernel is not None and self.kernel.pivot_ratio >= PIVOT_CHECK:
+            return
+        rc = self.ms.rcond(x)
+        if rc >= SINGULAR_RCOND:
+            return
+        model = self.ms.model
+        names = ", ".join(f"{n} = {v:.9g}" for n, v in zip(model.coordinate_names, q,
+                                                               strict=True))
+        raise SingularPositionError(
+            f"singular position in mode {sorted(self.ms.mode) or '(none)'} at t = {t:.9g} s, "
+            f"{names}: sigma_min/sigma_max of the position Jacobian {rc:.2e}; the "
+            f"independent coordinates "
+            f"{', '.join(model.coordinate_names[k] for k in self.ms.coords)} lose control",
+            t=t, q=q)
 
     def first_order_function(self):
         """``fun(t, y) -> y'`` for y = (q_I, q_I', w) on the compiled kernel, or None."""

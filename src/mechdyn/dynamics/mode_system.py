@@ -326,6 +326,20 @@ class ModeSystem:
         B = np.linalg.solve(J, self._eye_i) if J.size else np.zeros((self.model.n_x, 0))
         return B, J
 
+    def rcond(self, x) -> float:
+        """sigma_min / sigma_max of the mode's square position Jacobian [rows_I; g_I] at
+        x, lengths and angles on one scale (1 where the mode has no freedom)."""
+        J = RN.jacobian(self._all, x)[self._sel]
+        if not J.size:
+            return 1.0
+        L = self.model.length_scale
+        angle = np.concatenate([self.rowset.is_angle,
+                                self.model.coord_is_angle])[self._sel]
+        Js = J * np.where(angle, 1.0, 1.0 / L)[:, None] \
+            * np.tile([L, L, 1.0], self.model.n_bodies)[None, :]
+        sv = np.linalg.svd(Js, compute_uv=False)
+        return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
+
     def state(self, qi, qdoti, x_guess=None, t=None):
         """(x, xdot, B) at independent coordinates and rates."""
         x = self.solve_position(qi, x_guess, t)

@@ -17,10 +17,13 @@ from ..model import ConstraintLayout, Model
 from .constraints import coordinates, extend, jacobian, residual, system
 
 __all__ = ["solve_position", "assemble", "joint_residuals", "singularity", "rank_report",
-           "branch_sign", "turn_signs", "SINGULAR_RCOND"]
+           "branch_sign", "turn_signs", "SINGULAR_RCOND", "DEAD_RCOND"]
 
 #: ratio sigma_min / sigma_max of the scaled Jacobian below which a position is singular
 SINGULAR_RCOND = 1e-9
+#: sigma_min / sigma_max below which a position where a run could not go on is reported
+#: as a dead position (the edge of the assembly region)
+DEAD_RCOND = 1e-4
 
 
 def _scale(model: Model) -> np.ndarray:
