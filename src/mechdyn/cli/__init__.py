@@ -22,7 +22,7 @@ SUBCOMMAND_MODULES = ("demo", "examples", "kinematics", "simulate", "kinetostati
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every available subcommand."""
-    from .. import __version__
+    from .._version import __version__
 
     parser = argparse.ArgumentParser(
         prog="mechdyn",
