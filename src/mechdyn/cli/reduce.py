@@ -39,7 +39,7 @@ def add_model_arguments(p) -> None:
 def prepare_model(args):
     """(mechanism, model) from the common arguments: load, mode, drive; compiled."""
     from ..errors import ModelError
-    from ..mechanism.motors import drive_from_table
+    from ..modelfile.drives import drive_from_table
     from ..units import parse_quantity
     from .kinematics import load_model
 
