@@ -33,7 +33,11 @@ from ..errors import ModelError, Status
 from ..kinematics.sweep import initial_coordinates
 from ..kinematics.sweep import sweep as run_sweep
 from ..model import as_model
-from ..results.report import write_report
+from ..results.report import report_trajectory, write_report
+from ..simulate import simulate
+from ..units import parse_quantity
+from .animate import sweep_values
+from .kinematics import load_model
 
 __all__ = ["register", "run", "report", "report_records"]
 
@@ -74,19 +78,9 @@ def register(sub) -> None:
 
 def run(args) -> int:
     """Run ``mechdyn report``; returns the exit code."""
-    from ..errors import ModelError
-    from ..units import parse_quantity
-    from .animate import sweep_values
-    from .kinematics import load_model
-
     mech = load_model(args.model)
     model = mech.compile()
     if args.simulate:
-        import numpy as np
-
-        from ..results.report import report_trajectory
-        from ..simulate import simulate
-
         if args.t_end is None:
             raise ModelError("--simulate needs --t-end, e.g. --t-end 0.05s")
         t_end = parse_quantity(args.t_end, "time", where="--t-end")

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
+from .assembly_mode import AssemblyMode
 from .body import GROUND, Body, Ground
 from .coordinate import COORDINATE_KINDS, Coordinate
 from .joint import Joint, Lock, Prismatic, Revolute
@@ -113,8 +114,6 @@ class Mechanism:
         ``p``, ``q``, ``r`` are (body, point) pairs; ``turn`` is "left" or "right"
         (see :class:`~mechdyn.mechanism.assembly_mode.AssemblyMode`).
         """
-        from .assembly_mode import AssemblyMode
-
         return self.add(AssemblyMode(name, (tuple(p), tuple(q), tuple(r)), turn))
 
     def add_coordinate(self, name, kind="angle", body=None, joint=None,

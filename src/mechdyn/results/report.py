@@ -29,6 +29,11 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import Status
+from ..kinematics.sweep import initial_coordinates
+from .animate import animate, snapshot
+from .plot import plot_kinematic_sweep
+from .plot_dynamics import plot_trajectory
+from .plot_kinetostatics import plot_kinetostatics
 
 __all__ = ["write_report", "report_trajectory", "model_tables"]
 
@@ -80,16 +85,12 @@ def _plot_png(fn, record, **kwargs) -> bytes:
 
 
 def _snapshot_png(record, index: int = 0, **kwargs) -> bytes:
-    from .animate import snapshot
-
     buf = io.BytesIO()
     snapshot(record, buf, index, **kwargs)
     return buf.getvalue()
 
 
 def _animation_gif(record, frames: int = 72, **kwargs) -> bytes:
-    from .animate import animate
-
     with tempfile.TemporaryDirectory() as tmp:
         p = Path(tmp) / "motion.gif"
         animate(record, p, frames=frames, dpi=60, **kwargs)
@@ -215,7 +216,6 @@ def model_tables(model) -> dict:
                                   else "")
         rows.append(row)
     out["joints"] = pd.DataFrame(rows)
-    from ..kinematics.sweep import initial_coordinates
 
     try:
         q0 = initial_coordinates(model)
@@ -272,8 +272,6 @@ def _at_text(over_is_angle: bool, v: float) -> str:
 
 def _sweep_section(sw, *, animation: bool, trace) -> str:
     import pandas as pd
-
-    from .plot import plot_kinematic_sweep
 
     model = sw.model
     ang = sw.over_is_angle
@@ -342,8 +340,6 @@ def _sweep_section(sw, *, animation: bool, trace) -> str:
 # ------------------------------------------------------------------ kinetostatics
 def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
     import pandas as pd
-
-    from .plot_kinetostatics import plot_kinetostatics
 
     ang = ks.over_is_angle
     parts = ["<h2>Kinetostatics</h2>"]
@@ -472,8 +468,6 @@ def report_trajectory(traj, path, *, title: str | None = None, animation: bool =
         The file written.
     """
     import pandas as pd
-
-    from .plot_dynamics import plot_trajectory
 
     model = traj.model
     name = getattr(getattr(model, "mechanism", None), "name", "mechanism")
