@@ -8,7 +8,7 @@ Run ``python -m benchmarks`` (all benchmarks) or ``python benchmarks/bench_dynam
   tolerances / step counts (a work-precision table), with the compiled kernel
   and, for comparison, the NumPy reference path.  Target: 8 significant digits
   in <= 50 ms, position solves included.
-* The clutchless press (paper case, ``mechdyn.dynamics.paper_case``) over 1 s.
+* The clutchless press (paper case, ``mechdyn.examples.paper_case``) over 1 s.
 """
 
 from __future__ import annotations
@@ -59,7 +59,7 @@ def andrews_table(backend="auto", repeat=3):
 
 
 def press_run(seconds=1.0):
-    from mechdyn.dynamics.paper_case import motor_curve, press_idle
+    from mechdyn.examples.paper_case import motor_curve, press_idle
     from mechdyn.simulate import simulate
 
     # over 1 s a constant torque would run the unloaded press away: a motor-like curve

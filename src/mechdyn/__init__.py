@@ -5,6 +5,7 @@ model-file format and tutorials.
 """
 
 from . import examples, units
+from ._version import __version__ as __version__
 from .dynamics.kinetostatics import Kinetostatics, kinetostatics
 from .dynamics.reduction import (
                                  FlywheelSizing,
@@ -55,8 +56,6 @@ from .results.trajectory import Trajectory
 from .simulate import simulate
 from .simulate_events import SwitchEvent, format_events
 from .state import State
-
-__version__ = "0.1.0"
 
 __all__ = [
     # description

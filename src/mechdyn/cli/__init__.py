@@ -11,6 +11,7 @@ import argparse
 import importlib
 import sys
 
+from .._version import __version__
 from ..errors import MechdynError
 
 __all__ = ["main", "SUBCOMMAND_MODULES"]
@@ -22,8 +23,6 @@ SUBCOMMAND_MODULES = ("demo", "examples", "kinematics", "simulate", "kinetostati
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every available subcommand."""
-    from .. import __version__
-
     parser = argparse.ArgumentParser(
         prog="mechdyn",
         description="Kinematics, dynamics and kinetostatics of planar mechanisms.",

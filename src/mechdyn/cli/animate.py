@@ -14,6 +14,15 @@ from __future__ import annotations
 
 import sys
 
+import numpy as np
+
+from ..errors import ModelError
+from ..kinematics.sweep import initial_coordinates, sweep
+from ..results.animate import _trace_spec, animate, check_animation_path, snapshot
+from ..simulate import simulate
+from ..units import parse_quantity
+from .kinematics import load_model
+
 __all__ = ["register", "run", "sweep_values"]
 
 
@@ -69,12 +78,6 @@ def sweep_values(model, over: str | None, start: str | None, stop: str | None, s
         The coordinate's name and ``steps`` values from ``start`` (default its
         initial value) to ``stop`` (default one turn later; required for a travel).
     """
-    import numpy as np
-
-    from ..errors import ModelError
-    from ..kinematics.sweep import initial_coordinates
-    from ..units import parse_quantity
-
     over = over if over is not None else model.coordinate_names[0]
     k = model.coordinate_index(over)
     angle = bool(model.coord_is_angle[k])
@@ -94,20 +97,11 @@ def sweep_values(model, over: str | None, start: str | None, stop: str | None, s
 
 def run(args) -> int:
     """Run ``mechdyn animate``; returns the exit code."""
-    import numpy as np
-
-    from ..errors import ModelError
-    from ..results.animate import _trace_spec, animate, check_animation_path, snapshot
-    from .kinematics import load_model
-
     check_animation_path(args.output)  # before any computing
     mech = load_model(args.model)
     model = mech.compile()
     _trace_spec(model, args.trace)
     if args.simulate:
-        from ..simulate import simulate
-        from ..units import parse_quantity
-
         if args.t_end is None:
             raise ModelError("--simulate needs --t-end, e.g. --t-end 0.05s")
         t_end = parse_quantity(args.t_end, "time", where="--t-end")
@@ -118,8 +112,6 @@ def run(args) -> int:
         print(f"{mech.name}: simulated to t = {record.t[-1] if record.t.size else 0:.6g} s "
               f"({record.status})")
     else:
-        from ..kinematics.sweep import sweep
-
         over, values = sweep_values(model, args.over, args.start, args.stop, args.steps)
         record = sweep(model, over, values)
         ok, why = record.ok, record.message

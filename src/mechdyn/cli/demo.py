@@ -10,6 +10,17 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+import numpy as np
+
+from .. import examples
+from ..dynamics.kinetostatics import kinetostatics
+from ..kinematics.sweep import sweep
+from ..results.plot import plot_kinematic_sweep
+from ..results.plot_dynamics import plot_trajectory
+from ..results.plot_kinetostatics import plot_kinetostatics
+from ..results.table import write_csv
+from ..simulate import simulate
+
 __all__ = ["register", "run"]
 
 
@@ -24,17 +35,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    import numpy as np
-
-    from .. import examples
-    from ..dynamics.kinetostatics import kinetostatics
-    from ..kinematics.sweep import sweep
-    from ..results.plot import plot_kinematic_sweep
-    from ..results.plot_dynamics import plot_trajectory
-    from ..results.plot_kinetostatics import plot_kinetostatics
-    from ..results.table import write_csv
-    from ..simulate import simulate
-
     out = Path(args.dir)
     out.mkdir(parents=True, exist_ok=True)
     written: list[Path] = []

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from ..examples import list_examples, path
+
 
 def register(sub) -> None:
     p = sub.add_parser("examples", help="list the bundled example models",
@@ -12,8 +14,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..examples import list_examples, path
-
     if args.path:
         print(path(args.path))
         return 0

@@ -19,7 +19,14 @@ Exit codes: 0 done; 1 the simulated delta misses the target by more than 5 %;
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
+from ..dynamics.flywheel import size_flywheel
+from ..dynamics.reduced_machine import ReducedMachine
+from ..dynamics.reduction import reduce_model
+from ..errors import ModelError
+from ..results.plot_reduction import plot_steady_cycle
+from ..units import parse_quantity
 from .reduce import add_model_arguments, prepare_model
 
 __all__ = ["register", "run"]
@@ -59,12 +66,6 @@ def register(sub) -> None:
 
 def run(args) -> int:
     """Run ``mechdyn flywheel``; returns the exit code."""
-    from ..dynamics.flywheel import size_flywheel
-    from ..dynamics.reduced_machine import ReducedMachine
-    from ..dynamics.reduction import reduce_model
-    from ..errors import ModelError
-    from ..units import parse_quantity
-
     mech, model = prepare_model(args)
     delta = parse_quantity(args.delta, "ratio", where="--delta")
     speed = None if args.speed is None else parse_quantity(args.speed, "angular_velocity",
@@ -111,15 +112,11 @@ def run(args) -> int:
         print(f"  steady cycle          omega {c.omega_min:.6g} .. {c.omega_max:.6g} rad/s, "
               f"cycle time {c.cycle_time:.6g} s")
         if args.output:
-            from pathlib import Path
-
             out = Path(args.output)
             out.parent.mkdir(parents=True, exist_ok=True)
             c.to_dataframe().to_csv(out, index=False, float_format="%.10g")
             print(f"  table: {out}")
         if args.plot:
-            from ..results.plot_reduction import plot_steady_cycle
-
             print(f"  plot: {plot_steady_cycle(c, args.plot)}")
     if fs.message:
         print(f"  note: {fs.message}")

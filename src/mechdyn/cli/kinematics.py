@@ -14,6 +14,16 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+import numpy as np
+
+from .. import examples
+from ..errors import ModelError
+from ..kinematics.sweep import initial_coordinates, sweep
+from ..modelfile import load
+from ..results.plot import plot_kinematic_sweep
+from ..results.table import write_csv
+from ..units import parse_quantity
+
 __all__ = ["register", "run", "load_model"]
 
 
@@ -53,9 +63,6 @@ def register(sub) -> None:
 
 def load_model(spec: str):
     """A :class:`~mechdyn.mechanism.Mechanism` from a file path or a bundled example name."""
-    from .. import examples
-    from ..modelfile import load
-
     path = Path(spec)
     if path.is_file():
         return load(path)
@@ -65,19 +72,11 @@ def load_model(spec: str):
 
 
 def _fmt(value: float, angle: bool) -> str:
-    import numpy as np
-
     return f"{np.rad2deg(value):.6g} deg" if angle else f"{value * 1e3:.6g} mm"
 
 
 def run(args) -> int:
     """Run ``mechdyn kinematics``; returns the exit code."""
-    import numpy as np
-
-    from ..errors import ModelError
-    from ..kinematics.sweep import initial_coordinates, sweep
-    from ..units import parse_quantity
-
     mech = load_model(args.model)
     model = mech.compile()
     if args.over is None:
@@ -115,12 +114,8 @@ def run(args) -> int:
     for line in sw.summary().lines():
         print("  " + line)
     if args.output:
-        from ..results.table import write_csv
-
         print(f"  table: {write_csv(sw, args.output)}")
     if args.plot:
-        from ..results.plot import plot_kinematic_sweep
-
         print(f"  plot: {plot_kinematic_sweep(sw, args.plot, points=args.points)}")
     if sw.status != "success":
         print(f"mechdyn kinematics: warning: {sw.message}", file=sys.stderr)

@@ -12,8 +12,15 @@ Exit codes: 0 done; 1 done with a warning that matters (singular positions);
 from __future__ import annotations
 
 import sys
+import warnings
 
-from ..errors import Status
+import numpy as np
+
+from ..dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
+from ..errors import ModelError, Status, UnitError
+from ..results.plot_kinetostatics import plot_kinetostatics
+from ..units import parse_quantity
+from .kinematics import load_model
 
 __all__ = ["register", "run"]
 
@@ -63,9 +70,6 @@ def register(sub) -> None:
 
 
 def _point(text: str):
-    from ..errors import UnitError
-    from ..units import parse_quantity
-
     parts = [p.strip() for p in text.split(",")]
     if len(parts) != 2:
         raise UnitError(f"--point: {text!r}: expected two lengths X,Y, e.g. 0,0 or 100mm,-50mm")
@@ -74,15 +78,6 @@ def _point(text: str):
 
 def run(args) -> int:
     """Run ``mechdyn kinetostatics``; returns the exit code."""
-    import warnings
-
-    import numpy as np
-
-    from ..dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
-    from ..errors import ModelError
-    from ..units import parse_quantity
-    from .kinematics import load_model
-
     mech = load_model(args.model)
     model = mech.compile()
     over = args.over if args.over is not None else model.coordinate_names[0]
@@ -130,8 +125,6 @@ def run(args) -> int:
         res.to_dataframe().to_csv(args.output, index=False)
         print(f"  table: {args.output}")
     if args.plot:
-        from ..results.plot_kinetostatics import plot_kinetostatics
-
         print(f"  plot: {plot_kinetostatics(res, args.plot, joints=args.joints)}")
     if res.status == Status.SINGULAR_POSITION:
         print(f"mechdyn kinetostatics: warning: {res.message}", file=sys.stderr)

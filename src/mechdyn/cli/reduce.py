@@ -13,6 +13,17 @@ reduction that stops); 2 bad input (one line on stderr).
 from __future__ import annotations
 
 import sys
+from pathlib import Path
+
+import numpy as np
+
+from ..dynamics.reduced_machine import mode_mechanism
+from ..dynamics.reduction import reduce_model
+from ..errors import ModelError
+from ..modelfile.drives import drive_from_table
+from ..results.plot_reduction import plot_reduction
+from ..units import parse_quantity
+from .kinematics import load_model
 
 __all__ = ["register", "run", "add_model_arguments", "prepare_model"]
 
@@ -38,11 +49,6 @@ def add_model_arguments(p) -> None:
 
 def prepare_model(args):
     """(mechanism, model) from the common arguments: load, mode, drive; compiled."""
-    from ..errors import ModelError
-    from ..mechanism.motors import drive_from_table
-    from ..units import parse_quantity
-    from .kinematics import load_model
-
     mech = load_model(args.model)
     engage, offsets = [], {}
     for spec in args.engage:
@@ -57,8 +63,6 @@ def prepare_model(args):
                              parse_quantity(parts[1], "length", where="--engage y"),
                              parse_quantity(parts[2], "angle", where="--engage theta"))
     if engage or args.drop:
-        from ..dynamics.reduced_machine import mode_mechanism
-
         mech = mode_mechanism(mech, engage=engage, offsets=offsets, drop=args.drop)
     if args.motor is None and (args.gear_ratio is not None or args.efficiency is not None):
         raise ModelError("--gear-ratio and --efficiency need --motor")
@@ -107,12 +111,6 @@ def register(sub) -> None:
 
 def run(args) -> int:
     """Run ``mechdyn reduce``; returns the exit code."""
-    import numpy as np
-
-    from ..dynamics.reduction import reduce_model
-    from ..errors import ModelError
-    from ..units import parse_quantity
-
     mech, model = prepare_model(args)
     if args.steps < 2:
         raise ModelError(f"--steps must be at least 2, got {args.steps}")
@@ -146,15 +144,11 @@ def run(args) -> int:
             print(f"  m_red at {args.point}: min {np.min(red.m_red[fin]):.6g}  max "
                   f"{np.max(red.m_red[fin]):.6g} kg")
     if args.output:
-        from pathlib import Path
-
         out = Path(args.output)
         out.parent.mkdir(parents=True, exist_ok=True)
         red.to_dataframe().to_csv(out, index=False, float_format="%.10g")
         print(f"  table: {out}")
     if args.plot:
-        from ..results.plot_reduction import plot_reduction
-
         print(f"  plot: {plot_reduction(red, args.plot, title=f'{mech.name}: reduction')}")
     if red.status != "success":
         print(f"mechdyn reduce: warning: {red.message}", file=sys.stderr)

@@ -14,15 +14,32 @@ RMS driving torque, peak joint forces, shaking-force harmonics) with its plot;
 with ``--simulate``, the run summary, energy balance and events instead.
 
 Exit codes: 0 done; 1 an analysis stopped early (the report says where); 2 bad input.
+
+:func:`report_records` runs the analyses a report shows and :func:`report` writes
+them with :func:`mechdyn.results.report.write_report`: the composing lives here,
+the writing in :mod:`mechdyn.results.report`, which only reads records.
 """
 
 from __future__ import annotations
 
 import sys
+import warnings
+from pathlib import Path
 
-from ..errors import Status
+import numpy as np
 
-__all__ = ["register", "run"]
+from ..dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
+from ..errors import ModelError, Status
+from ..kinematics.sweep import initial_coordinates
+from ..kinematics.sweep import sweep as run_sweep
+from ..model import as_model
+from ..results.report import report_trajectory, write_report
+from ..simulate import simulate
+from ..units import parse_quantity
+from .animate import sweep_values
+from .kinematics import load_model
+
+__all__ = ["register", "run", "report", "report_records"]
 
 
 def register(sub) -> None:
@@ -61,19 +78,9 @@ def register(sub) -> None:
 
 def run(args) -> int:
     """Run ``mechdyn report``; returns the exit code."""
-    from ..errors import ModelError
-    from ..units import parse_quantity
-    from .animate import sweep_values
-    from .kinematics import load_model
-
     mech = load_model(args.model)
     model = mech.compile()
     if args.simulate:
-        import numpy as np
-
-        from ..results.report import report_trajectory
-        from ..simulate import simulate
-
         if args.t_end is None:
             raise ModelError("--simulate needs --t-end, e.g. --t-end 0.05s")
         t_end = parse_quantity(args.t_end, "time", where="--t-end")
@@ -86,8 +93,6 @@ def run(args) -> int:
             print(f"mechdyn report: warning: {traj.status}: {traj.message}", file=sys.stderr)
             return 1
         return 0
-
-    from ..results.report import report_records, write_report
 
     over, values = sweep_values(model, args.over, args.start, args.stop, args.steps)
     k = model.coordinate_index(over)
@@ -108,3 +113,95 @@ def run(args) -> int:
     for msg in problems:
         print(f"mechdyn report: warning: {msg}", file=sys.stderr)
     return 1 if problems else 0
+
+
+def report_records(mech_or_model, *, speed: float | None = None, over: str | None = None,
+                   values=None, steps: int = 361, point=(0.0, 0.0)):
+    """The analyses a :func:`report` shows: a sweep and, when it applies, the kinetostatics.
+
+    Runs a kinematic sweep of ``over`` and -- for a mechanism with one degree of
+    freedom, or when ``speed`` is given -- the kinetostatic cycle at that speed.
+
+    Parameters
+    ----------
+    mech_or_model : Mechanism or Model
+    speed : float, optional
+        Constant rate of ``over``, rad/s (m/s for a travel).  Default: the model's
+        initial rate of ``over`` if it is not zero, else 1 (velocities are then the
+        velocity analogs).
+    over : str, optional
+        The coordinate to sweep (default the first).
+    values : array_like, optional
+        Its values, rad or m (default one full turn from its initial value for an
+        angle, in ``steps`` positions; required for a travel).
+    steps : int
+        Number of positions of the default range (ends included).
+    point : (float, float)
+        Point of the frame moments (shaking moment), m.
+
+    Returns
+    -------
+    model : Model
+    sweep : KinematicSweep
+    kinetostatics : Kinetostatics or None
+
+    Raises
+    ------
+    ModelError
+        Unknown coordinate, or a travel coordinate without ``values``.
+    """
+    model = as_model(mech_or_model)
+    over = over if over is not None else model.coordinate_names[0]
+    k = model.coordinate_index(over)
+    if values is None:
+        if not model.coord_is_angle[k]:
+            raise ModelError(f"coordinate {over!r} is a travel: give its values")
+        start = float(initial_coordinates(model)[k])
+        values = np.linspace(start, start + 2 * np.pi, int(steps))
+    values = np.asarray(values, dtype=float)
+    given_speed = speed is not None
+    if speed is None:
+        qd0 = (model.mechanism.extras.get("initial") or {}).get("qdot") or {}
+        speed = float(qd0.get(over, 0.0)) if isinstance(qd0, dict) else 0.0
+        speed = speed if speed != 0.0 else 1.0
+    sw = run_sweep(model, over, values, speed=float(speed))
+    ks = None
+    if given_speed or model.mechanism.dof == 1:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", KinetostaticsWarning)  # shown in the report
+            ks = kinetostatics(model, over=over, speed=float(speed), values=values,
+                               point=point)
+    return model, sw, ks
+
+
+def report(mech_or_model, path, *, speed: float | None = None, over: str | None = None,
+           values=None, steps: int = 361, title: str | None = None, animation: bool = False,
+           trace=None, point=(0.0, 0.0)) -> Path:
+    """Analyse a model over one turn and write an HTML report.
+
+    :func:`report_records` runs the analyses (a sweep of ``over``; the kinetostatic
+    cycle for one degree of freedom or a given ``speed``), :func:`write_report`
+    writes them.
+
+    Parameters
+    ----------
+    mech_or_model : Mechanism or Model
+    path : str or Path
+        The HTML file to write.
+    speed, over, values, steps, point
+        As for :func:`report_records`.
+    title : str, optional
+    animation : bool
+        Embed an animated GIF of the motion.
+    trace : "BODY.POINT" or (body, point), optional
+        Draw this point's path.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    model, sw, ks = report_records(mech_or_model, speed=speed, over=over, values=values,
+                                   steps=steps, point=point)
+    return write_report(model, path, sweep=sw, kinetostatics=ks, title=title,
+                        animation=animation, trace=trace)

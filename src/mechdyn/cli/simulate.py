@@ -13,17 +13,26 @@ singular mass matrix ...; the samples computed so far are written); 2 bad input.
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
+import numpy as np
+
+from ..dynamics.lagrange import FORMULATIONS
+from ..errors import ModelError, did_you_mean
 from ..integrate.base import DEFAULT_RTOL
+from ..integrate.driver import INTEGRATORS
+from ..mechanism import Drive
+from ..results.plot_dynamics import plot_trajectory
+from ..simulate import simulate
+from ..simulate_events import format_events
+from ..units import parse_quantity
+from .kinematics import load_model
 
 __all__ = ["register", "run"]
 
 
 def register(sub) -> None:
     """Add the ``simulate`` subcommand to an argparse subparsers object."""
-    from ..dynamics.lagrange import FORMULATIONS
-    from ..integrate.driver import INTEGRATORS
-
     p = sub.add_parser(
         "simulate",
         help="forward dynamics: integrate the equations of motion over time",
@@ -76,8 +85,6 @@ def register(sub) -> None:
 
 
 def _pairs(items, kind_of, model, what, parse):
-    from ..errors import ModelError, did_you_mean
-
     out = {}
     for item in items:
         if "=" not in item:
@@ -91,13 +98,6 @@ def _pairs(items, kind_of, model, what, parse):
 
 def run(args) -> int:
     """Run ``mechdyn simulate``; returns the exit code."""
-    import numpy as np
-
-    from ..mechanism import Drive
-    from ..simulate import simulate
-    from ..units import parse_quantity
-    from .kinematics import load_model
-
     mech = load_model(args.model)
     t_end = parse_quantity(args.t_end, "time", where="--t-end")
     t0 = parse_quantity(args.t0, "time", where="--t0")
@@ -120,8 +120,6 @@ def run(args) -> int:
     t_eval = None
     if args.samples is not None:
         if args.samples < 2:
-            from ..errors import ModelError
-
             raise ModelError(f"--samples must be >= 2, got {args.samples}")
         t_eval = np.linspace(t0, t_end, args.samples)
     fixed = args.integrator.lower() in ("wilson", "rk4")
@@ -132,8 +130,6 @@ def run(args) -> int:
                     iterations=args.iterations if fixed else None)
     print(traj.summary())
     if traj.events:
-        from ..simulate_events import format_events
-
         print(format_events(traj.events, traj.coordinate_names, limit=40))
     if traj.t.size:
         last = ", ".join(
@@ -149,8 +145,6 @@ def run(args) -> int:
             _events_table(traj).to_csv(ev_path, index=False)
             print(f"wrote {ev_path} ({len(traj.events)} events)")
     if args.plot:
-        from ..results.plot_dynamics import plot_trajectory
-
         plot_trajectory(traj, args.plot)
         print(f"wrote {args.plot}")
     if not traj.success:
@@ -160,15 +154,12 @@ def run(args) -> int:
 
 
 def _events_path(output: str):
-    from pathlib import Path
-
     p = Path(output)
     return p.with_name(p.stem + "_events.csv")
 
 
 def _events_table(traj):
     """One row per switching event: time, kind, element, modes, coordinates, energy lost."""
-    import numpy as np
     import pandas as pd
 
     rows = []

@@ -37,6 +37,7 @@ from ..errors import MechdynError, Status
 from ..model import Model
 from ..results.kinetostatics_record import Kinetostatics
 from .forces import force_model
+from .kinetostatics import _kinetostatics
 from .modes import SwitchedModel, mode_friction, mode_locks
 from .prescribed_motion import ModeRows
 
@@ -85,8 +86,6 @@ def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
                            reacting_loads=()) -> Kinetostatics:
     """Kinetostatics of a switched trajectory (called by
     :func:`mechdyn.dynamics.kinetostatics.kinetostatics`; see the module docstring)."""
-    from .kinetostatics import _kinetostatics
-
     t_start = time.perf_counter()
     names = model.coordinate_names
     tt = np.asarray(trajectory.t, dtype=float).reshape(-1)

@@ -23,7 +23,18 @@ import math
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
+from ..kinematics.assembly import assemble, solve_position
+from ..kinematics.constraints import (
+    coordinates,
+    coordinates_gamma,
+    coordinates_jacobian,
+    gamma,
+    jacobian,
+    residual,
+)
+from ..mechanism.motors import extra_inertia_by_coordinate
 from ..model import Model, as_model
+from .forces import force_model
 
 __all__ = ["reduced_kinematics"]
 
@@ -66,8 +77,6 @@ def reduced_kinematics(model: Model, x, layout=None) -> dict:
         d2theta/dphi2; ``J`` (...): J_red, kg m^2; ``dJ`` (...): dJ_red/dphi,
         kg m^2/rad; ``Jf`` (..., n_x, n_x): the Jacobian [Phi_x; g_x].
     """
-    from ..kinematics.constraints import coordinates_gamma, coordinates_jacobian, gamma, jacobian
-
     lay = layout or model.layout()
     x = np.asarray(x, dtype=float)
     Jf = np.concatenate([jacobian(model, x, lay), coordinates_jacobian(model, x)], axis=-2)
@@ -101,10 +110,6 @@ class _ModelEvaluator:
                 f"1-DOF model (for a variable-structure machine: the model of one mode)")
         if coordinate is not None and coordinate not in model.coordinate_names:
             raise ModelError(did_you_mean(coordinate, model.coordinate_names, "coordinate"))
-        from ..dynamics.forces import force_model
-        from ..kinematics.assembly import assemble
-        from ..kinematics.constraints import coordinates
-
         self.model = model
         self.coordinate = model.coordinate_names[0]
         self.is_angle = bool(model.coord_is_angle[0])
@@ -127,8 +132,6 @@ class _ModelEvaluator:
         Near the last evaluated position the Newton solve starts from the
         second-order predictor ``x + B dphi + b dphi^2 / 2``.
         """
-        from ..kinematics.assembly import solve_position
-
         phi = float(phi)
         pred = self._pred
         if pred is not None and abs(phi - pred[0]) <= 3.0 * self.max_step:
@@ -149,8 +152,6 @@ class _ModelEvaluator:
 
     def _chord(self, phi, x, Jf, max_iter: int = 8):
         """Chord Newton from a close predictor with the last Jacobian; None if it stalls."""
-        from ..kinematics.constraints import coordinates, residual
-
         tol = 1e-13 * max(self.model.length_scale, 1e-3)
         if Jf.shape[0] != Jf.shape[1]:
             return None
@@ -175,8 +176,6 @@ class _ModelEvaluator:
         Taylor predictor of its coarse neighbour, ``x_c + B dphi + b dphi^2/2``,
         and all are polished by one batched Newton solve.
         """
-        from ..kinematics.assembly import solve_position
-
         phis = np.asarray(phis, float).reshape(-1)
         n = phis.size
         if n <= 4:
@@ -208,8 +207,6 @@ class _ModelEvaluator:
 
     def drive_inertia(self) -> float:
         """Rotor and gear inertia of the drives on the coordinate, kg m^2."""
-        from ..mechanism.motors import extra_inertia_by_coordinate
-
         return extra_inertia_by_coordinate(self.model.mechanism).get(self.coordinate, 0.0)
 
     def inertia(self, phi):

@@ -23,6 +23,7 @@ mode_mechanism
 from __future__ import annotations
 
 import bisect
+import dataclasses
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -31,6 +32,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import IntegrationError, ModelError, did_you_mean
+from ..integrate import solve
+from ..mechanism.drive import TorqueSpeedCurve
+from ..mechanism.joint import Lock
+from ..mechanism.load import Table
 from ..model import Model, as_model
 from .reduced_kinematics import _ModelEvaluator
 
@@ -395,9 +400,6 @@ class _SpeedDrives:
 
 def _speed_drive(model: Model, coordinate: str):
     """The drives of a coordinate as a function of its speed only (None without drives)."""
-    from ..mechanism.drive import TorqueSpeedCurve
-    from ..mechanism.load import Table
-
     parts = []
     for d in model.mechanism.drives:
         if d.coordinate != coordinate:
@@ -525,8 +527,6 @@ def run_reduced(machine: ReducedMachine, t_end: float, *, phi0: float = 0.0,
     -------
     ReducedRun
     """
-    from ..integrate import solve
-
     sol = solve(integrator, machine.rhs, t0, [phi0], [omega0], t_end, t_eval=t_eval,
                 events=events, **options)
     return _history(machine, sol.t, sol.q[:, 0], sol.qdot[:, 0],
@@ -606,10 +606,6 @@ def mode_mechanism(mechanism, *, engage: Sequence[str] = (), offsets: dict | Non
         The original is not changed; initial values of dropped coordinates are
         removed from ``extras["initial"]``.
     """
-    import dataclasses
-
-    from ..mechanism.joint import Lock
-
     offsets = dict(offsets or {})
     joints = dict(mechanism.joints)
     probs = []

@@ -13,6 +13,7 @@ from importlib import resources
 from pathlib import Path
 
 from ..errors import ModelError, did_you_mean
+from ..modelfile import load as _load
 
 __all__ = ["list_examples", "path", "load", "names"]
 
@@ -67,6 +68,4 @@ def path(name: str) -> Path:
 
 def load(name: str):
     """Load a bundled example as a validated :class:`~mechdyn.mechanism.Mechanism`."""
-    from ..modelfile import load as _load
-
     return _load(path(name))

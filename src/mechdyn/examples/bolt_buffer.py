@@ -14,6 +14,7 @@ from __future__ import annotations
 from ..mechanism import Mechanism, Spring
 from ..mechanism.contact import Contact, Stop
 from ..mechanism.switch import add_element
+from ..simulate_events import simulate_events
 
 __all__ = ["build", "run"]
 
@@ -45,7 +46,5 @@ def build() -> Mechanism:
 
 def run(t_end: float = 0.2, **options):
     """Simulate the bolt-buffer cycle; returns the Trajectory."""
-    from ..simulate_events import simulate_events
-
     options.setdefault("dt_out", 2e-4)
     return simulate_events(build(), t_end, **options)

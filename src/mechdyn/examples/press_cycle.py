@@ -89,12 +89,19 @@ Use :func:`build` for the mechanism and :func:`run` to simulate it.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
+from ..errors import ModelError
 from ..mechanism import Force, Mechanism, Spring, Table, Torque, TorqueSpeedCurve
 from ..mechanism.contact import Contact, Stop
 from ..mechanism.drive import Drive
 from ..mechanism.switch import CoordinateLock, Switch, add_element
+from ..modelfile.loader import build as build_doc
+from ..modelfile.loader import read_document
+from ..modelfile.switches import TABLES, parse_switches
+from ..simulate_events import simulate_events
 
 __all__ = ["build", "run", "PARAMETERS", "cylinder_command", "run_time", "load_model_file"]
 
@@ -282,8 +289,6 @@ def run(cycles: int = 4, t_end: float | None = None, **options):
     -------
     Trajectory
     """
-    from ..simulate_events import simulate_events
-
     mech = build()
     if t_end is None:
         t_end = run_time(cycles)
@@ -299,13 +304,6 @@ def load_model_file(path=None):
     Works whether or not the model-file loader already knows the tables
     ``[[stops]]``, ``[[contacts]]``, ``[[coordinate_locks]]`` and ``[[switches]]``.
     """
-    from pathlib import Path
-
-    from ..errors import ModelError
-    from ..modelfile.loader import build as build_doc
-    from ..modelfile.loader import read_document
-    from ..modelfile.switches import TABLES, parse_switches
-
     path = Path(path) if path is not None else Path(__file__).with_name("press_cycle.toml")
     doc = read_document(path.read_text(encoding="utf-8"), str(path))
     if any(t in doc for t in TABLES):

@@ -16,9 +16,12 @@ same arrays.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from ..model.rows import Rows
+if TYPE_CHECKING:  # the row data is lowered by mechdyn.model, which imports these kernels
+    from ..model.rows import Rows
 
 __all__ = ["Parts", "parts", "values", "jacobian", "quad", "evaluate"]
 

@@ -14,7 +14,7 @@ from scipy.optimize import least_squares
 
 from ..errors import AssemblyError, SingularPositionError
 from ..model import ConstraintLayout, Model
-from .constraints import coordinates, extend, jacobian, residual, system
+from .constraints import coordinates, coordinates_jacobian, extend, jacobian, residual, system
 
 __all__ = ["solve_position", "assemble", "joint_residuals", "singularity", "rank_report",
            "branch_sign", "turn_signs", "SINGULAR_RCOND", "DEAD_RCOND"]
@@ -350,8 +350,6 @@ def rank_report(model: Model, x, layout=None) -> dict:
     sc = _scale(model)
     P = jacobian(model, x, lay) * sc
     G = np.concatenate([P, np.zeros((0, model.n_x))])
-    from .constraints import coordinates_jacobian
-
     Gq = coordinates_jacobian(model, x) * sc
     tol_rel = 1e-9
     rank_phi = _rank(P, tol_rel)

@@ -10,12 +10,13 @@ point.  :func:`_travel` is the travel of a prismatic joint and its rates.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..kernels import rows_numpy
+from ..mechanism.joint import Revolute
 from ..model import Model
 from .assembly import _position_tol
 from .constraints import point_position, travel_rows
@@ -115,8 +116,6 @@ class SweepSummary:
 
     def as_dict(self) -> dict:
         """Plain nested dict (for JSON)."""
-        from dataclasses import asdict
-
         return asdict(self)
 
     def lines(self) -> list[str]:
@@ -166,7 +165,6 @@ def four_bar_loops(model: Model, over: str | None = None) -> list[FourBarLoop]:
     two grounded links of a loop; otherwise the grounded link added first.
     """
     mech = model.mechanism
-    from ..mechanism.joint import Revolute
 
     revs = [j for j in mech.joints.values() if isinstance(j, Revolute)]
     adj: dict[str, list[tuple[str, str]]] = {}

@@ -31,6 +31,7 @@ import warnings
 from dataclasses import dataclass, field
 
 from ..errors import ModelError, did_you_mean
+from .motors import InductionMotor
 
 __all__ = ["CatalogueEntry", "MOTORS", "catalogue_entry", "induction_motor", "list_motors",
            "KRAVCHIK_1982"]
@@ -156,8 +157,6 @@ def induction_motor(designation: str, characteristic: str = "kloss", **overrides
     **overrides
         Any InductionMotor field (SI), e.g. ``rotor_inertia=0.0035``.
     """
-    from .motors import InductionMotor
-
     entry = catalogue_entry(designation)
     if "rotor_inertia" in overrides:
         with warnings.catch_warnings():

@@ -3,7 +3,8 @@
 ``Mechanism`` is a builder: add elements, then call :meth:`Mechanism.validate`
 (which reports every problem at once) or :meth:`Mechanism.compile`, which
 validates and returns the constant :class:`mechdyn.model.Model` that every
-analysis uses.  Nothing here knows about solvers or time.
+analysis uses (built by :func:`mechdyn.compiler.compile_mechanism`).  Nothing
+here knows about solvers or time.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
+from .assembly_mode import AssemblyMode
 from .body import GROUND, Body, Ground
 from .coordinate import COORDINATE_KINDS, Coordinate
 from .joint import Joint, Lock, Prismatic, Revolute
@@ -112,8 +114,6 @@ class Mechanism:
         ``p``, ``q``, ``r`` are (body, point) pairs; ``turn`` is "left" or "right"
         (see :class:`~mechdyn.mechanism.assembly_mode.AssemblyMode`).
         """
-        from .assembly_mode import AssemblyMode
-
         return self.add(AssemblyMode(name, (tuple(p), tuple(q), tuple(r)), turn))
 
     def add_coordinate(self, name, kind="angle", body=None, joint=None,
@@ -247,42 +247,14 @@ class Mechanism:
         return self
 
     def compile(self):
-        """Validate and build the constant :class:`mechdyn.model.Model`."""
-        from ..model import Model
+        """Validate and build the constant :class:`mechdyn.model.Model`
+        (:func:`mechdyn.compiler.compile_mechanism`, which lists every problem found)."""
+        # The one import of mechanism/ upwards, deferred and declared in the import
+        # contracts (pyproject.toml): compiling needs the model, the assembly and the load
+        # evaluators, which all import mechanism/; this convenience hands itself to them.
+        from ..compiler import compile_mechanism
 
-        probs = self.problems()
-        if self.bodies and self.coordinates and probs and any(
-                p.startswith("degrees of freedom") for p in probs):
-            # A Gruebler mismatch may be a redundant constraint set; decide by rank below.
-            rest = [p for p in probs if not p.startswith("degrees of freedom")]
-            if rest:
-                raise ModelError(probs)
-            model = Model(self)
-            model.check_rank(gruebler_message=probs[-1])
-            return self._check_loads(model)
-        if probs:
-            raise ModelError(probs)
-        model = Model(self)
-        model.check_rank()
-        return self._check_loads(model)
-
-    @staticmethod
-    def _check_loads(model):
-        """Validate the loads, drives and every switchable element (locks, stops,
-        contacts, switches with their targets, variables and guards) of a compiled
-        model; raise one ModelError listing every problem found."""
-        from ..dynamics.forces import force_model
-        from ..dynamics.modes import SwitchedModel
-
-        probs: list[str] = []
-        for check in (force_model, SwitchedModel):
-            try:
-                check(model)
-            except ModelError as exc:
-                probs.extend(p for p in exc.problems if p not in probs)
-        if probs:
-            raise ModelError(probs)
-        return model
+        return compile_mechanism(self)
 
     def __repr__(self) -> str:
         return (f"Mechanism({self.name!r}: {len(self.bodies)} bodies, {len(self.joints)} joints, "

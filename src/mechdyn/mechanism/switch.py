@@ -26,6 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ModelError
+
 __all__ = ["CoordinateLock", "Switch", "add_element", "SWITCH_ACTIONS", "GUARD_OPERATORS"]
 
 #: what a switch can do to its target lock
@@ -163,8 +165,6 @@ def add_element(mechanism, element):
     kind = element.extra_kind
     lst = mechanism.extras.setdefault(kind, [])
     if any(e.name == element.name for e in lst):
-        from ..errors import ModelError
-
         raise ModelError(f"{kind[:-1].replace('_', ' ')} {element.name!r} is defined twice")
     lst.append(element)
     return element

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import MechdynError, ModelError, did_you_mean
+from ..errors import ModelError, did_you_mean
 from ..mechanism.body import GROUND
 from ..mechanism.joint import Lock, Prismatic, Revolute
 from . import rows as R
@@ -80,6 +80,9 @@ class Model:
         The sketch poses, which choose the assembly branch.
     length_scale : float
         A characteristic length (m) used to scale tolerances and rotations.
+    x0 : ndarray, shape (n_x,)
+        The assembled sketch; set when the model is compiled
+        (:func:`mechdyn.compiler.check_rank`, which also sets ``redundant``).
     """
 
     def __init__(self, mechanism):
@@ -268,47 +271,6 @@ class Model:
             self._layouts[mode] = lay
         return lay
 
-    # ------------------------------------------------------------------ checks
-    def check_rank(self, gruebler_message: str | None = None):
-        """Assemble the sketch and check the coordinates and constraints by rank.
-
-        Raises
-        ------
-        ModelError
-            If the coordinates are not independent, if the DOF count does not match
-            and the constraints are not merely redundant, or if the sketch cannot be
-            assembled.
-        """
-        from ..kinematics.assembly import assemble, rank_report
-
-        try:
-            x0 = assemble(self)
-        except (MechdynError, np.linalg.LinAlgError, ValueError) as exc:  # AssemblyError says where
-            probs = [f"the initial sketch cannot be assembled: {exc}"]
-            if gruebler_message is not None:
-                probs.insert(0, gruebler_message)
-            raise ModelError(probs) from exc
-        self.x0 = x0
-        rep = rank_report(self, x0)
-        self.redundant = rep["redundant_joints"]
-        problems = []
-        if rep["dependent_coordinates"]:
-            problems.append(
-                "coordinates are not independent at the sketch position: "
-                + ", ".join(repr(c) for c in rep["dependent_coordinates"])
-                + " can be expressed by the others (choose coordinates that each move a "
-                "different part of the mechanism)")
-        dof_rank = self.n_x - rep["rank_phi"]
-        if dof_rank != self.n_q:
-            problems.append(
-                f"the mechanism has {dof_rank} degree(s) of freedom at the sketch position "
-                f"(rank of the constraint Jacobian {rep['rank_phi']}), but {self.n_q} "
-                f"coordinate(s) are declared")
-        elif gruebler_message is not None and not self.redundant:
-            problems.append(gruebler_message)
-        if problems:
-            raise ModelError(problems)
-
 
 class ConstraintLayout:
     """Which rows of Phi belong to which joint, for one mode."""
@@ -341,7 +303,8 @@ class ConstraintLayout:
 
 
 def as_model(mech_or_model) -> Model:
-    """The compiled :class:`Model` of a Mechanism (compiled and validated here) or a Model."""
+    """The compiled :class:`Model` of a Mechanism (compiled and validated by
+    :meth:`Mechanism.compile <mechdyn.mechanism.Mechanism.compile>`) or a Model."""
     if isinstance(mech_or_model, Model):
         return mech_or_model
     if hasattr(mech_or_model, "compile"):

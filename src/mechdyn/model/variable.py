@@ -39,6 +39,7 @@ import numpy as np
 
 from ..errors import ModelError, did_you_mean
 from ..kernels import rows_numpy
+from ..mechanism.joint import Prismatic, Revolute
 from . import rows as R
 from .rows import Rows
 
@@ -145,8 +146,6 @@ def quantity(var: Variable, mech) -> str:
         A body, point or joint the mechanism does not have (the message lists
         the valid names).
     """
-    from ..mechanism.joint import Prismatic, Revolute
-
     if var.kind == "time":
         return "time"
     if var.kind == "coordinate":

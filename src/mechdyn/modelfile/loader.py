@@ -42,6 +42,7 @@ from ..mechanism import (
 )
 from ..model.variable import parse
 from ..units import parse_quantity, parse_vector
+from .drives import drive_from_table
 from .schema import locate, schema_problems
 from .switches import TABLES as SWITCH_TABLES
 from .switches import parse_switches
@@ -832,8 +833,6 @@ class _Builder:
                          + did_you_mean(coord, self.coord_kinds, "coordinate"))
             raise _Failed
         if "type" in spec:  # a motor model (induction motor, DC motor, ...)
-            from ..mechanism.motors import drive_from_table
-
             table = dict(spec)
             table.setdefault("name", name)
             try:

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import ModelError, did_you_mean
+
 __all__ = ["plot_kinetostatics"]
 
 
@@ -36,8 +38,6 @@ def plot_kinetostatics(record, path, *, joints: Sequence[str] | None = None,
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
-    from ..errors import ModelError, did_you_mean
 
     path = Path(path)
     names = list(record.reactions) if joints is None else list(joints)

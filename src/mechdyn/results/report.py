@@ -3,10 +3,11 @@
 :func:`write_report` and :func:`report_trajectory` only consume result records
 (a :class:`~mechdyn.kinematics.records.KinematicSweep`, a
 :class:`~mechdyn.results.kinetostatics_record.Kinetostatics`, a
-:class:`~mechdyn.results.trajectory.Trajectory`) and the compiled model; the
-convenience :func:`report` composes the standard analyses of a model (a sweep
-over one turn and, for one degree of freedom or a given speed, the kinetostatic
-cycle) and hands the records to :func:`write_report`.
+:class:`~mechdyn.results.trajectory.Trajectory`) and the compiled model; they
+run no analysis.  The convenience :func:`mechdyn.cli.report.report` composes
+the standard analyses of a model (a sweep over one turn and, for one degree of
+freedom or a given speed, the kinetostatic cycle) and hands the records to
+:func:`write_report`.
 
 A report is one HTML file: tables (pandas ``to_html``), plots and a drawing of
 the mechanism embedded as base64 PNG images, a small inline style sheet; no
@@ -26,9 +27,15 @@ from pathlib import Path
 
 import numpy as np
 
+from .._version import __version__
 from ..errors import Status
+from ..kinematics.sweep import initial_coordinates
+from .animate import animate, snapshot
+from .plot import plot_kinematic_sweep
+from .plot_dynamics import plot_trajectory
+from .plot_kinetostatics import plot_kinetostatics
 
-__all__ = ["report", "report_records", "write_report", "report_trajectory", "model_tables"]
+__all__ = ["write_report", "report_trajectory", "model_tables"]
 
 _CSS = """
 body { font-family: -apple-system, "Segoe UI", Helvetica, Arial, sans-serif; margin: 2em auto;
@@ -78,16 +85,12 @@ def _plot_png(fn, record, **kwargs) -> bytes:
 
 
 def _snapshot_png(record, index: int = 0, **kwargs) -> bytes:
-    from .animate import snapshot
-
     buf = io.BytesIO()
     snapshot(record, buf, index, **kwargs)
     return buf.getvalue()
 
 
 def _animation_gif(record, frames: int = 72, **kwargs) -> bytes:
-    from .animate import animate
-
     with tempfile.TemporaryDirectory() as tmp:
         p = Path(tmp) / "motion.gif"
         animate(record, p, frames=frames, dpi=60, **kwargs)
@@ -95,8 +98,6 @@ def _animation_gif(record, frames: int = 72, **kwargs) -> bytes:
 
 
 def _page(title: str, sections: list[str]) -> str:
-    from .. import __version__
-
     stamp = datetime.now().strftime("%Y-%m-%d %H:%M")
     return (f"<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
             f"<title>{_esc(title)}</title>\n<style>{_CSS}</style>\n</head>\n<body>\n"
@@ -215,7 +216,6 @@ def model_tables(model) -> dict:
                                   else "")
         rows.append(row)
     out["joints"] = pd.DataFrame(rows)
-    from ..kinematics.sweep import initial_coordinates
 
     try:
         q0 = initial_coordinates(model)
@@ -272,8 +272,6 @@ def _at_text(over_is_angle: bool, v: float) -> str:
 
 def _sweep_section(sw, *, animation: bool, trace) -> str:
     import pandas as pd
-
-    from .plot import plot_kinematic_sweep
 
     model = sw.model
     ang = sw.over_is_angle
@@ -342,8 +340,6 @@ def _sweep_section(sw, *, animation: bool, trace) -> str:
 # ------------------------------------------------------------------ kinetostatics
 def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
     import pandas as pd
-
-    from .plot_kinetostatics import plot_kinetostatics
 
     ang = ks.over_is_angle
     parts = ["<h2>Kinetostatics</h2>"]
@@ -447,106 +443,6 @@ def write_report(model, path, *, sweep=None, kinetostatics=None, title: str | No
     return _write(path, _page(title or f"{name}: report", sections))
 
 
-def report_records(mech_or_model, *, speed: float | None = None, over: str | None = None,
-                   values=None, steps: int = 361, point=(0.0, 0.0)):
-    """The analyses a :func:`report` shows: a sweep and, when it applies, the kinetostatics.
-
-    Runs a kinematic sweep of ``over`` and -- for a mechanism with one degree of
-    freedom, or when ``speed`` is given -- the kinetostatic cycle at that speed.
-
-    Parameters
-    ----------
-    mech_or_model : Mechanism or Model
-    speed : float, optional
-        Constant rate of ``over``, rad/s (m/s for a travel).  Default: the model's
-        initial rate of ``over`` if it is not zero, else 1 (velocities are then the
-        velocity analogs).
-    over : str, optional
-        The coordinate to sweep (default the first).
-    values : array_like, optional
-        Its values, rad or m (default one full turn from its initial value for an
-        angle, in ``steps`` positions; required for a travel).
-    steps : int
-        Number of positions of the default range (ends included).
-    point : (float, float)
-        Point of the frame moments (shaking moment), m.
-
-    Returns
-    -------
-    model : Model
-    sweep : KinematicSweep
-    kinetostatics : Kinetostatics or None
-
-    Raises
-    ------
-    ModelError
-        Unknown coordinate, or a travel coordinate without ``values``.
-    """
-    import warnings
-
-    from ..dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
-    from ..errors import ModelError
-    from ..kinematics.sweep import initial_coordinates
-    from ..kinematics.sweep import sweep as run_sweep
-    from ..model import as_model
-
-    model = as_model(mech_or_model)
-    over = over if over is not None else model.coordinate_names[0]
-    k = model.coordinate_index(over)
-    if values is None:
-        if not model.coord_is_angle[k]:
-            raise ModelError(f"coordinate {over!r} is a travel: give its values")
-        start = float(initial_coordinates(model)[k])
-        values = np.linspace(start, start + 2 * np.pi, int(steps))
-    values = np.asarray(values, dtype=float)
-    given_speed = speed is not None
-    if speed is None:
-        qd0 = (model.mechanism.extras.get("initial") or {}).get("qdot") or {}
-        speed = float(qd0.get(over, 0.0)) if isinstance(qd0, dict) else 0.0
-        speed = speed if speed != 0.0 else 1.0
-    sw = run_sweep(model, over, values, speed=float(speed))
-    ks = None
-    if given_speed or model.mechanism.dof == 1:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", KinetostaticsWarning)  # shown in the report
-            ks = kinetostatics(model, over=over, speed=float(speed), values=values,
-                               point=point)
-    return model, sw, ks
-
-
-def report(mech_or_model, path, *, speed: float | None = None, over: str | None = None,
-           values=None, steps: int = 361, title: str | None = None, animation: bool = False,
-           trace=None, point=(0.0, 0.0)) -> Path:
-    """Analyse a model over one turn and write an HTML report.
-
-    :func:`report_records` runs the analyses (a sweep of ``over``; the kinetostatic
-    cycle for one degree of freedom or a given ``speed``), :func:`write_report`
-    writes them.
-
-    Parameters
-    ----------
-    mech_or_model : Mechanism or Model
-    path : str or Path
-        The HTML file to write.
-    speed, over, values, steps, point
-        As for :func:`report_records`.
-    title : str, optional
-    animation : bool
-        Embed an animated GIF of the motion.
-    trace : "BODY.POINT" or (body, point), optional
-        Draw this point's path.
-
-    Returns
-    -------
-    Path
-        The file written.
-    """
-    model, sw, ks = report_records(mech_or_model, speed=speed, over=over, values=values,
-                                   steps=steps, point=point)
-    return write_report(model, path, sweep=sw, kinetostatics=ks, title=title,
-                        animation=animation, trace=trace)
-
-
 def report_trajectory(traj, path, *, title: str | None = None, animation: bool = False,
                       trace=None, max_events: int = 200) -> Path:
     """Write an HTML report of a simulated motion.
@@ -572,8 +468,6 @@ def report_trajectory(traj, path, *, title: str | None = None, animation: bool =
         The file written.
     """
     import pandas as pd
-
-    from .plot_dynamics import plot_trajectory
 
     model = traj.model
     name = getattr(getattr(model, "mechanism", None), "name", "mechanism")

@@ -1,0 +1,144 @@
+"""The compiler: a :class:`~mechdyn.mechanism.Mechanism` becomes a validated, constant Model.
+
+:func:`compile_mechanism` is the one place a model is built and validated, in order:
+
+1. the problems of the description that need no solving
+   (:meth:`Mechanism.problems <mechdyn.mechanism.Mechanism.problems>`);
+2. the index layout, parameter arrays and constraint rows (:class:`mechdyn.model.Model`);
+3. the sketch assembled and the coordinates and constraints checked by rank
+   (:func:`check_rank`, with :mod:`mechdyn.kinematics.assembly`);
+4. the loads, drives and every switchable element -- locks, stops, contacts and
+   switches with their targets, variables and guards (:func:`check_loads`, by building
+   :func:`mechdyn.dynamics.forces.force_model` and
+   :class:`mechdyn.dynamics.modes.SwitchedModel` once),
+
+so that an analysis never discovers a bad name.  The module sits above the analyses
+it borrows from; :meth:`Mechanism.compile <mechdyn.mechanism.Mechanism.compile>` and
+:func:`mechdyn.model.as_model` hand a mechanism to it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .dynamics.forces import force_model
+from .dynamics.modes import SwitchedModel
+from .errors import MechdynError, ModelError
+from .kinematics.assembly import assemble, rank_report
+from .model import Model
+
+__all__ = ["compile_mechanism", "check_rank", "check_loads"]
+
+_GRUEBLER = "degrees of freedom"
+
+
+def compile_mechanism(mechanism) -> Model:
+    """Validate a mechanism and build its constant :class:`~mechdyn.model.Model`.
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+
+    Returns
+    -------
+    Model
+        With ``x0`` (the assembled sketch, shape (n_x,)) and ``redundant`` (the
+        joints whose rows are redundant) set by :func:`check_rank`.
+
+    Raises
+    ------
+    ModelError
+        Listing every problem found (names, masses, DOF count, rank, loads, drives,
+        switchable elements).
+
+    Examples
+    --------
+    >>> from mechdyn import Mechanism
+    >>> m = Mechanism("pendulum")
+    >>> _ = m.add_body("bar", mass=2.0, inertia=0.05, com=(0.5, 0.0))
+    >>> _ = m.add_revolute("O", "ground", "bar")
+    >>> _ = m.add_coordinate("theta", kind="angle", body="bar")
+    >>> compile_mechanism(m).n_q
+    1
+    """
+    probs = mechanism.problems()
+    if mechanism.bodies and mechanism.coordinates and probs and any(
+            p.startswith(_GRUEBLER) for p in probs):
+        # A Gruebler mismatch may be a redundant constraint set; decide by rank below.
+        rest = [p for p in probs if not p.startswith(_GRUEBLER)]
+        if rest:
+            raise ModelError(probs)
+        model = Model(mechanism)
+        check_rank(model, gruebler_message=probs[-1])
+        return check_loads(model)
+    if probs:
+        raise ModelError(probs)
+    model = Model(mechanism)
+    check_rank(model)
+    return check_loads(model)
+
+
+def check_rank(model: Model, gruebler_message: str | None = None) -> None:
+    """Assemble the sketch and check the coordinates and constraints by rank.
+
+    Sets ``model.x0`` (the assembled sketch) and ``model.redundant``.
+
+    Raises
+    ------
+    ModelError
+        If the coordinates are not independent, if the DOF count does not match
+        and the constraints are not merely redundant, or if the sketch cannot be
+        assembled.
+    """
+    try:
+        x0 = assemble(model)
+    except (MechdynError, np.linalg.LinAlgError, ValueError) as exc:  # AssemblyError says where
+        probs = [f"the initial sketch cannot be assembled: {exc}"]
+        if gruebler_message is not None:
+            probs.insert(0, gruebler_message)
+        raise ModelError(probs) from exc
+    model.x0 = x0
+    rep = rank_report(model, x0)
+    model.redundant = rep["redundant_joints"]
+    problems = []
+    if rep["dependent_coordinates"]:
+        problems.append(
+            "coordinates are not independent at the sketch position: "
+            + ", ".join(repr(c) for c in rep["dependent_coordinates"])
+            + " can be expressed by the others (choose coordinates that each move a "
+            "different part of the mechanism)")
+    dof_rank = model.n_x - rep["rank_phi"]
+    if dof_rank != model.n_q:
+        problems.append(
+            f"the mechanism has {dof_rank} degree(s) of freedom at the sketch position "
+            f"(rank of the constraint Jacobian {rep['rank_phi']}), but {model.n_q} "
+            f"coordinate(s) are declared")
+    elif gruebler_message is not None and not model.redundant:
+        problems.append(gruebler_message)
+    if problems:
+        raise ModelError(problems)
+
+
+def check_loads(model: Model) -> Model:
+    """Validate the loads, drives and every switchable element (locks, stops, contacts,
+    switches with their targets, variables and guards) of a compiled model.
+
+    Returns
+    -------
+    Model
+        ``model`` itself.
+
+    Raises
+    ------
+    ModelError
+        Listing every problem found.
+    """
+    probs: list[str] = []
+    for check in (force_model, SwitchedModel):
+        try:
+            check(model)
+        except ModelError as exc:
+            probs.extend(p for p in exc.problems if p not in probs)
+    if probs:
+        raise ModelError(probs)
+    return model

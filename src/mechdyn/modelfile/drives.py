@@ -1,0 +1,179 @@
+"""Drives of a model file: a ``[[drives]]`` table with a ``type`` -> a :class:`Drive`.
+
+:func:`drive_from_table` reads the table's quantities with their units
+(:mod:`mechdyn.units`) and builds one of the motors of
+:mod:`mechdyn.mechanism.motors` (an induction motor possibly named from the
+catalogue :mod:`mechdyn.mechanism.catalogue`, a DC motor, a constant-speed drive
+or a tabulated characteristic), wrapped in a
+:class:`~mechdyn.mechanism.motors.GearStage` when a gear ratio is given.  The
+loader (:mod:`mechdyn.modelfile.loader`) and ``mechdyn reduce --motor`` use it;
+``docs/reduction-and-drives.md`` describes the keys.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from ..errors import ModelError, did_you_mean
+from ..mechanism.catalogue import catalogue_entry
+from ..mechanism.drive import Drive
+from ..mechanism.motors import (
+    ConstantSpeedDrive,
+    DCMotor,
+    GearStage,
+    InductionMotor,
+    TabulatedMotor,
+)
+from ..units import parse_quantity
+
+__all__ = ["drive_from_table", "DRIVE_TYPES"]
+
+#: drive types of the model file and the keys each accepts (besides name, coordinate, type)
+DRIVE_TYPES: dict[str, tuple[str, ...]] = {
+    "induction_motor": ("catalogue", "rated_power", "synchronous_speed", "rated_speed",
+                        "rated_slip", "breakdown_ratio", "starting_ratio", "rotor_inertia",
+                        "characteristic", "source"),
+    "dc_motor": ("no_load_speed", "stall_torque", "rated_power", "rated_speed",
+                 "rotor_inertia", "source"),
+    "constant_speed": ("speed", "stiffness"),
+    "torque_speed": ("omega", "torque", "rotor_inertia", "extrapolate", "source"),
+}
+_GEAR_KEYS = ("gear_ratio", "efficiency", "gear_input_inertia", "gear_output_inertia")
+_COMMON_KEYS = ("name", "coordinate", "type", "description")
+
+
+def _q(table, key, kind, where, default=None):
+    if key not in table:
+        return default
+    return parse_quantity(table[key], kind, where=f"{where}: {key}")
+
+
+def drive_from_table(table: Mapping, where: str = "drives") -> Drive:
+    """Build a :class:`Drive` from a model-file ``[[drives]]`` table with a ``type``.
+
+    Parameters
+    ----------
+    table : mapping
+        The TOML table, values as written (quantities as strings with units,
+        e.g. ``"1.5 kW"``, ``"1500 rpm"``; bare numbers are SI).
+    where : str
+        Location for messages, e.g. ``"press.toml: drives[0]"``.
+
+    Returns
+    -------
+    Drive
+        Its ``torque`` is the motor, wrapped in a :class:`GearStage` when
+        ``gear_ratio`` is given.
+
+    Raises
+    ------
+    ModelError
+        Naming the key at fault; unknown keys and types list the valid ones.
+
+    Examples
+    --------
+    The source paper's press drive (motor 4A80B4U3 through a 3.4 : 1 stage)::
+
+        [[drives]]
+        name = "motor"
+        coordinate = "phi"
+        type = "induction_motor"
+        catalogue = "4A80B4U3"
+        characteristic = "extended"
+        gear_ratio = 3.4
+        efficiency = 0.95
+    """
+    t = dict(table)
+    kind = t.get("type")
+    if kind not in DRIVE_TYPES:
+        raise ModelError(f"{where}: type: " + did_you_mean(str(kind), DRIVE_TYPES, "drive type"))
+    name = str(t.get("name", kind))
+    problems = []
+    if "coordinate" not in t:
+        problems.append(f"{where}: coordinate: missing (the driven generalized coordinate)")
+    allowed = set(_COMMON_KEYS) | set(DRIVE_TYPES[kind]) | set(_GEAR_KEYS)
+    for key in t:
+        if key not in allowed:
+            problems.append(f"{where}: " + did_you_mean(key, sorted(allowed),
+                                                        f"key of a {kind!r} drive"))
+    if problems:
+        raise ModelError(problems)
+
+    if kind == "induction_motor":
+        motor = _induction_from_table(t, name, where)
+    elif kind == "dc_motor":
+        jr = _q(t, "rotor_inertia", "inertia", where, 0.0)
+        w0 = _q(t, "no_load_speed", "angular_velocity", where)
+        if w0 is None:
+            raise ModelError(f"{where}: no_load_speed: missing (rad/s, e.g. \"3000 rpm\")")
+        if "stall_torque" in t:
+            motor = DCMotor(name, w0, _q(t, "stall_torque", "torque", where), jr,
+                            str(t.get("source", "")))
+        else:
+            pn = _q(t, "rated_power", "power", where)
+            wn = _q(t, "rated_speed", "angular_velocity", where)
+            if pn is None or wn is None:
+                raise ModelError(f"{where}: give stall_torque, or rated_power and rated_speed")
+            motor = DCMotor.from_rated(name, pn, wn, w0, jr, str(t.get("source", "")))
+    elif kind == "constant_speed":
+        sp = _q(t, "speed", "angular_velocity", where)
+        if sp is None:
+            raise ModelError(f"{where}: speed: missing (e.g. \"43.5 rad/s\")")
+        motor = ConstantSpeedDrive(name, sp, _q(t, "stiffness", "rotational_damping", where))
+    else:
+        om, tq = t.get("omega"), t.get("torque")
+        if not isinstance(om, list) or not isinstance(tq, list):
+            raise ModelError(f"{where}: omega and torque must be lists of quantities")
+        w = [parse_quantity(v, "angular_velocity", where=f"{where}: omega[{k}]")
+             for k, v in enumerate(om)]
+        m = [parse_quantity(v, "torque", where=f"{where}: torque[{k}]")
+             for k, v in enumerate(tq)]
+        motor = TabulatedMotor(name, tuple(w), tuple(m), _q(t, "rotor_inertia", "inertia",
+                                                           where, 0.0),
+                               bool(t.get("extrapolate", True)), str(t.get("source", "")))
+    try:
+        torque = motor
+        if "gear_ratio" in t or any(k in t for k in _GEAR_KEYS):
+            if "gear_ratio" not in t:
+                raise ModelError(f"{where}: gear_ratio: missing (the efficiency and gear "
+                                 f"inertias need a gear ratio omega_motor/omega_driven)")
+            torque = GearStage(motor, _q(t, "gear_ratio", "ratio", where),
+                               _q(t, "efficiency", "ratio", where, 1.0),
+                               _q(t, "gear_input_inertia", "inertia", where, 0.0),
+                               _q(t, "gear_output_inertia", "inertia", where, 0.0),
+                               name=f"{name} gear")
+    except ModelError as exc:
+        raise ModelError([p if p.startswith(where) else f"{where}: {p}"
+                          for p in exc.problems]) from None
+    return Drive(name, str(t["coordinate"]), torque)
+
+
+def _induction_from_table(t, name, where) -> InductionMotor:
+    data: dict = {}
+    source = str(t.get("source", ""))
+    if "catalogue" in t:
+        entry = catalogue_entry(str(t["catalogue"]))
+        data = entry.motor_kwargs()
+        name = str(t.get("name", entry.designation))
+        source = source or entry.source_text()
+    spec = {"rated_power": "power", "synchronous_speed": "angular_velocity",
+            "rated_speed": "angular_velocity", "rated_slip": "ratio",
+            "breakdown_ratio": "ratio", "starting_ratio": "ratio", "rotor_inertia": "inertia"}
+    for key, kind in spec.items():
+        if key in t:
+            data[key] = _q(t, key, kind, where)
+    if "rated_speed" in t and "rated_slip" not in t:
+        data.pop("rated_slip", None)  # the file's rated speed replaces the catalogue slip
+    elif "rated_slip" in t and "rated_speed" not in t:
+        data.pop("rated_speed", None)
+    missing = [k for k in ("rated_power", "synchronous_speed", "breakdown_ratio") if k not in data]
+    if "rated_speed" not in data and "rated_slip" not in data:
+        missing.append("rated_speed (or rated_slip)")
+    if missing:
+        raise ModelError(f"{where}: missing {', '.join(missing)} (or name a motor with "
+                         f"catalogue = \"4A80B4U3\")")
+    data["characteristic"] = str(t.get("characteristic", "kloss"))
+    try:
+        return InductionMotor(name, source=source, **data)
+    except ModelError as exc:
+        raise ModelError([f"{where}: {p}" for p in exc.problems]) from None
