@@ -46,6 +46,7 @@ from .kinematics.constraints import residual
 from .model import as_model
 from .progress import Progress
 from .results.trajectory import Trajectory
+from .simulate_events import needs_event_loop, simulate_events
 
 __all__ = ["simulate", "initial_state"]  # initial_state: re-exported from .initial_state
 
@@ -237,8 +238,6 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
     if formulation not in FORMULATIONS:
         raise IntegratorOptionError(f"unknown formulation {formulation!r}; valid formulations: "
                                     + ", ".join(FORMULATIONS))
-    from .simulate_events import needs_event_loop, simulate_events
-
     if needs_event_loop(model):
         # switches, stops, contacts: the same equations, integrated mode by mode
         if formulation != "exact" or d is not None:

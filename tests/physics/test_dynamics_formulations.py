@@ -7,7 +7,7 @@ from dynamics_models import four_bar, slider_crank
 from test_dynamics_energy import loaded_slider_crank
 
 from mechdyn.dynamics.lagrange import EquationsOfMotion, potential_energy
-from mechdyn.dynamics.paper_case import press_idle
+from mechdyn.examples.paper_case import press_idle
 from mechdyn.simulate import initial_state
 
 D_DEG = np.array([0.4, 0.2, 0.1, 0.05])

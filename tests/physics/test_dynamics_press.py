@@ -11,7 +11,7 @@ orders, and the exact formulation against the paper's finite-difference one.
 import numpy as np
 import pytest
 
-from mechdyn.dynamics.paper_case import T_END, WILSON_STEPS, press_idle
+from mechdyn.examples.paper_case import T_END, WILSON_STEPS, press_idle
 from mechdyn.simulate import simulate
 
 GRID = np.linspace(0.0, T_END, WILSON_STEPS + 1)

@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 from mechdyn.mechanism import Mechanism
-from mechdyn.mechanism.motors import drive_from_table
 from mechdyn.mechanism.switch import CoordinateLock, Switch, add_element
+from mechdyn.modelfile.drives import drive_from_table
 from mechdyn.simulate import simulate
 
 J1, J2 = 0.02, 0.01  # kg m^2, both discs centred on the axis

@@ -3,7 +3,7 @@
 import numpy as np
 
 import mechdyn
-from mechdyn.dynamics.paper_case import T_END, WILSON_STEPS, press_idle
+from mechdyn.examples.paper_case import T_END, WILSON_STEPS, press_idle
 
 
 def test_model_file_and_python_case_give_the_same_motion():

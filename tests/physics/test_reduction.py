@@ -303,7 +303,7 @@ def test_reduced_run_with_fixed_step_integrators(integrator, options):
 
 def test_full_simulation_includes_rotor_inertia_through_the_gear():
     simulate = pytest.importorskip("mechdyn.simulate").simulate
-    from mechdyn.mechanism.motors import drive_from_table
+    from mechdyn.modelfile.drives import drive_from_table
 
     mech = slider_crank(**GEOM)
     mech.add(drive_from_table({"type": "induction_motor", "coordinate": "phi",

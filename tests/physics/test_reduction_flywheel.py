@@ -28,7 +28,8 @@ from mechdyn.dynamics.reduction import (
 )
 from mechdyn.errors import IntegrationError, LockupError, ModelError
 from mechdyn.mechanism.catalogue import induction_motor
-from mechdyn.mechanism.motors import GearStage, drive_from_table
+from mechdyn.mechanism.motors import GearStage
+from mechdyn.modelfile.drives import drive_from_table
 
 J0, T0, A = 0.05, 10.0, 4.0  # kg m^2, N m, N m
 

@@ -432,7 +432,8 @@ def test_examples_in_the_documentation_are_valid():
 
 
 def test_motor_drives_are_built_by_the_motors_module():
-    from mechdyn.mechanism.motors import DRIVE_TYPES, ConstantSpeedDrive, GearStage
+    from mechdyn.mechanism.motors import ConstantSpeedDrive, GearStage
+    from mechdyn.modelfile.drives import DRIVE_TYPES
 
     curve = 'torque = { omega = ["0 rpm", "3000 rpm"], torque = ["20 N*m", "0 N*m"] }'
     m = bad(curve, 'type = "constant_speed"\nspeed = "100 rpm"')

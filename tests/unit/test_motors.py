@@ -21,11 +21,11 @@ from mechdyn.mechanism.motors import (
     GearStage,
     InductionMotor,
     TabulatedMotor,
-    drive_from_table,
     extra_inertia_by_coordinate,
     fit_extended_kloss,
     kloss_critical_slip,
 )
+from mechdyn.modelfile.drives import drive_from_table
 
 W0 = 1500 * math.pi / 30  # synchronous speed of a 4-pole motor at 50 Hz, rad/s
 DATA = dict(rated_power=1500.0, synchronous_speed=W0, rated_slip=0.058, breakdown_ratio=2.2,

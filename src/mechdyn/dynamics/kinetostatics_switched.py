@@ -37,7 +37,7 @@ from ..errors import MechdynError, Status
 from ..model import Model
 from ..results.kinetostatics_record import Kinetostatics
 from .forces import force_model
-from .kinetostatics import _kinetostatics
+from .kinetostatics_mode import _kinetostatics
 from .modes import SwitchedModel, mode_friction, mode_locks
 from .prescribed_motion import ModeRows
 

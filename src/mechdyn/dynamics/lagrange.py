@@ -41,7 +41,7 @@ import numpy as np
 
 from ..errors import IntegrationError, ModelError
 from ..kinematics.analogs import acceleration_bias, default_displacement
-from ..kinematics.assembly import solve_position
+from ..kinematics.assembly import assemble, solve_position
 from ..kinematics.constraints import coordinates_jacobian, extend, jacobian, residual
 from ..model import Model
 from .forces import com_arms, force_model
@@ -208,8 +208,6 @@ class EquationsOfMotion:
         if x0 is None:
             x0 = getattr(model, "x0", None)
             if x0 is None:
-                from ..kinematics.assembly import assemble
-
                 x0 = assemble(model, layout=self.layout)
         self.x = np.array(x0, dtype=float)
         self._q_last = None

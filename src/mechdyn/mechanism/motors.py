@@ -595,19 +595,3 @@ def extra_inertia_by_coordinate(mechanism) -> dict[str, float]:
         if j:
             out[dr.coordinate] = out.get(dr.coordinate, 0.0) + j
     return out
-
-
-# ---------------------------------------------------------------------- moved names
-#: names that moved to :mod:`mechdyn.modelfile.drives` -- reading a model-file table
-#: parses units, which is the model file's business -- and are still importable here
-_MOVED_TO_MODELFILE = ("drive_from_table", "DRIVE_TYPES")
-
-
-def __getattr__(name: str):
-    if name in _MOVED_TO_MODELFILE:
-        # Deferred, and declared in the import contracts (pyproject.toml): modelfile
-        # imports this module, and mechanism/ itself must not pull in pint.
-        from ..modelfile import drives
-
-        return getattr(drives, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

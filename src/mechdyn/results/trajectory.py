@@ -6,6 +6,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import ModelError, did_you_mean
+from ..kinematics.analogs import accelerations
+from ..kinematics.constraints import point_acceleration, point_position, point_velocity
+
 __all__ = ["Trajectory"]
 
 #: statuses of a run that reached its end (or a terminal event)
@@ -86,8 +90,6 @@ class Trajectory:
         return self.qddot[:, self._ci(name)]
 
     def _ci(self, name):
-        from ..errors import ModelError, did_you_mean
-
         try:
             return self.coordinate_names.index(name)
         except ValueError:
@@ -180,8 +182,6 @@ class Trajectory:
 
     def xddot(self) -> np.ndarray:
         """Body frame accelerations xddot = B q'' + b, shape (n, n_x) (needs ``model``)."""
-        from ..kinematics.analogs import accelerations
-
         return accelerations(self.model, self.x, self.xdot, self.qddot,
                              layout=self._layout())
 
@@ -190,8 +190,6 @@ class Trajectory:
         return self.model.layout(mode)
 
     def _point_columns(self) -> dict:
-        from ..kinematics.constraints import point_acceleration, point_position, point_velocity
-
         m = self.model
         xdd = self.xddot()
         out = {}

@@ -1,0 +1,271 @@
+"""The kinetostatic analysis in one mode: the motion prescribed on the driven
+coordinates, the multipliers of every row, the driving torques and frame loads
+(see :func:`mechdyn.dynamics.kinetostatics.kinetostatics`, the public entry, and
+the sign conventions there).  Switched trajectories are analysed segment by segment
+with this function (:mod:`mechdyn.dynamics.kinetostatics_switched`).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from ..errors import ModelError, Status, did_you_mean
+from ..kinematics.constraints import coordinates, coordinates_gamma, coordinates_jacobian
+from ..results.kinetostatics_record import Kinetostatics
+from .forces import force_model
+from .prescribed_motion import _independent_subset, _Positions
+from .reactions import _inverse
+
+__all__ = ["_kinetostatics"]
+
+
+def _on_times(fn: Callable, tt, n_d: int) -> np.ndarray:
+    """fn at the times tt (n,), shape (n, n_d): one call on the array when fn accepts
+    arrays, else one call per time."""
+    tt = np.asarray(tt, dtype=float)
+    try:
+        out = np.asarray(fn(tt), dtype=float)
+        if out.shape[:1] != tt.shape:
+            raise ValueError
+    except (ValueError, TypeError):
+        out = np.array([np.asarray(fn(float(s)), dtype=float) for s in tt.ravel()])
+    return out.reshape(tt.size, n_d)
+
+
+def _derivs(law: Callable, t: np.ndarray, n_d: int):
+    """Values and two derivatives of a law of time (5-point central differences)."""
+    def ev(tt):
+        return _on_times(law, tt, n_d)
+
+    first = law(float(t[0])) if t.size else None
+    if isinstance(first, tuple) and len(first) == 3:
+        parts = [np.array([np.asarray(law(float(s))[i], dtype=float).reshape(n_d) for s in t])
+                 for i in range(3)]
+        return parts[0], parts[1], parts[2]
+    span = float(np.ptp(t)) if t.size > 1 else 1.0
+    h = 1e-3 * (span if span > 0 else 1.0)
+    y0 = ev(t)
+    yp1, ym1, yp2, ym2 = ev(t + h), ev(t - h), ev(t + 2 * h), ev(t - 2 * h)
+    yd = (8 * (yp1 - ym1) - (yp2 - ym2)) / (12 * h)
+    ydd = (16 * (yp1 + ym1) - (yp2 + ym2) - 30 * y0) / (12 * h * h)
+    return y0, yd, ydd
+
+
+def _integrate_speed(omega: Callable, t: np.ndarray, start: np.ndarray, n_d: int):
+    """q(t) = start + integral of omega, by 5-point Gauss-Legendre per interval."""
+    def ev(tt):
+        return _on_times(omega, tt, n_d)
+
+    xg, wg = np.polynomial.legendre.leggauss(5)
+    q = np.empty((t.size, n_d))
+    q[0] = start
+    if t.size > 1:
+        a, b = t[:-1], t[1:]
+        mid, half = 0.5 * (a + b), 0.5 * (b - a)
+        nodes = (mid[:, None] + half[:, None] * xg[None, :]).ravel()
+        w = ev(nodes).reshape(a.size, xg.size, n_d)
+        inc = np.einsum("k,nkd->nd", wg, w) * half[:, None]
+        q[1:] = start + np.cumsum(inc, axis=0)
+    _, wd, wdd = _derivs(lambda s: ev(np.atleast_1d(s)), t, n_d)
+    return q, ev(t), wd
+
+
+def _to_array(v, n_d: int, what: str) -> np.ndarray:
+    a = np.asarray(v, dtype=float)
+    if a.ndim == 0:
+        a = np.full(n_d, float(a))
+    if a.shape != (n_d,):
+        raise ValueError(f"{what}: expected {n_d} value(s), got shape {a.shape}")
+    return a
+
+
+def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=None,
+                   start=None, trajectory=None, hold=None, mode=None, point=(0.0, 0.0),
+                   model_drives="replace", reacting_loads=(), x_guess=None, lay=None,
+                   candidates=None, x_start=None) -> Kinetostatics:
+    """The analysis in one mode (see :func:`kinetostatics`).
+
+    For the segments of a switched trajectory: ``lay`` (a layout or
+    :class:`~mechdyn.dynamics.prescribed_motion.ModeRows`, the rows of the segment's
+    mode with the targets its locks held), ``candidates`` (order in which
+    coordinates are chosen as driven) and ``x_start`` (a pose of the segment)."""
+    t_start = time.perf_counter()
+    fm = force_model(model)
+    if mode is None and trajectory is not None and isinstance(
+            getattr(trajectory, "mode", None), frozenset):
+        mode = trajectory.mode
+    if lay is None:
+        lay = model.layout(mode)
+    load_names = {getattr(ld, "name", None) for ld in model.mechanism.loads}
+    for nm in reacting_loads:
+        if nm not in load_names:
+            raise ModelError(did_you_mean(nm, [n for n in load_names if n], "load"))
+    warn: list[str] = []
+    for ld in model.mechanism.loads:
+        if hasattr(ld, "generalized"):
+            warn.append(f"load {getattr(ld, 'name', '?')!r} ({type(ld).__name__}) is an "
+                        f"extension load that kinetostatics does not evaluate; it is left out")
+    if x_start is None:
+        x_start = getattr(model, "x0", None)
+    if x_start is None:
+        x_start = model.x_sketch
+    if x_guess is not None:
+        xg = np.asarray(x_guess, dtype=float)
+        if xg.ndim == 1:
+            x_start, x_guess = xg, None
+        else:
+            x_guess = xg
+
+    # ---------------------------------------------------------- the motion
+    if over is None:
+        over_names: list[str] = []
+    elif isinstance(over, str):
+        over_names = [over]
+    else:
+        over_names = list(over)
+    over_idx = [model.coordinate_index(c) for c in over_names]
+
+    if trajectory is not None:
+        if any(v is not None for v in (speed, values, t, law)):
+            raise ValueError("give either trajectory= or speed/values/t/law, not both")
+        tt = np.asarray(trajectory.t, dtype=float).reshape(-1)
+        Q = np.asarray(trajectory.q, dtype=float).reshape(tt.size, model.n_q)
+        Qd = np.asarray(trajectory.qdot, dtype=float).reshape(tt.size, model.n_q)
+        Qdd = np.asarray(trajectory.qddot, dtype=float).reshape(tt.size, model.n_q)
+        didx = _independent_subset(model, lay, x_start, over_idx, candidates)
+        qd, qd_dot, qd_ddot = Q[:, didx], Qd[:, didx], Qdd[:, didx]
+        tx = getattr(trajectory, "x", None)
+        if x_guess is None and tx is not None and np.shape(tx) == (tt.size, model.n_x):
+            x_guess = np.asarray(tx, dtype=float)
+        if not over_names:
+            over_names = [model.coordinate_names[didx[0] if len(didx) else 0]]
+    else:
+        if not over_idx:
+            over_idx = _independent_subset(model, lay, x_start, [])[:1]
+            over_names = [model.coordinate_names[over_idx[0]]]
+        n_o = len(over_idx)
+        if law is not None:
+            if t is None:
+                raise ValueError("law= needs the times t=")
+            if speed is not None or values is not None:
+                raise ValueError("give law= or speed=/values=, not both")
+            tt = np.asarray(t, dtype=float).reshape(-1)
+            qo, qo_d, qo_dd = _derivs(law, tt, n_o)
+        elif callable(speed):
+            if t is None:
+                raise ValueError("a speed law omega(t) needs the times t=")
+            tt = np.asarray(t, dtype=float).reshape(-1)
+            if start is None:
+                start = coordinates(model, x_start)[over_idx]
+            qo, qo_d, qo_dd = _integrate_speed(speed, tt, _to_array(start, n_o, "start"), n_o)
+        else:
+            if speed is None:
+                raise ValueError("give the motion: speed= (a constant, 0 for statics, or a "
+                                 "callable omega(t) with t=), law= with t=, or trajectory=")
+            w = _to_array(speed, n_o, "speed")
+            if values is None:
+                if not all(model.coord_is_angle[k] for k in over_idx):
+                    raise ValueError("values= is needed for a travel coordinate")
+                sgn = np.where(w < 0, -1.0, 1.0)
+                values = np.linspace(0.0, 2 * np.pi, 361)[:, None] * sgn
+            qo = np.asarray(values, dtype=float).reshape(-1, n_o)
+            qo_d = np.broadcast_to(w, qo.shape).copy()
+            qo_dd = np.zeros_like(qo)
+            k0 = int(np.argmax(np.abs(w)))
+            tt = ((qo[:, k0] - qo[0, k0]) / w[k0]) if w[k0] != 0 else np.zeros(qo.shape[0])
+            if t is not None:
+                raise ValueError("t= is used with law= or a callable speed, not with a "
+                                 "constant speed (time follows from values and speed)")
+        didx = _independent_subset(model, lay, x_start, over_idx)
+        n = tt.size
+        extra = didx[n_o:]
+        held = coordinates(model, x_start)[extra] if extra else np.zeros(0)
+        hold = dict(hold or {})
+        for nm in hold:
+            model.coordinate_index(nm)
+        for i, k in enumerate(extra):
+            nm = model.coordinate_names[k]
+            if nm in hold:
+                held[i] = float(hold[nm])
+        qd = np.concatenate([qo, np.broadcast_to(held, (n, len(extra)))], axis=1)
+        qd_dot = np.concatenate([qo_d, np.zeros((n, len(extra)))], axis=1)
+        qd_ddot = np.concatenate([qo_dd, np.zeros((n, len(extra)))], axis=1)
+        if extra:
+            warn.append("coordinate(s) " + ", ".join(
+                f"{model.coordinate_names[k]!r} = {h:.6g}" for k, h in zip(extra, held,
+                                                                           strict=True))
+                + " are held fixed (not driven by the given motion); their driving entries "
+                  "are holding torques/forces")
+    didx = np.asarray(didx, dtype=int)
+    n = tt.size
+    if n == 0:
+        raise ValueError("no positions to analyse")
+
+    # ---------------------------------------------------------- kinematics
+    pos = _Positions(model, lay, didx)
+    x = pos.solve(qd, np.asarray(x_start, dtype=float), x_guess)
+    xdot, xddot = pos.motion(x, qd_dot, qd_ddot)
+    if pos.branch_changes:
+        names = [model.coordinate_names[k] for k in didx]
+        at = ", ".join(f"{nm} = {v:.6g}" for nm, v in zip(names, pos.branch_changes[0],
+                                                          strict=True))
+        warn.append(f"the assembly branch changes near {at} ({len(pos.branch_changes)} "
+                    f"time(s)): the motion passes a singular (change or dead) position; "
+                    f"results beyond it belong to another assembly mode")
+    G = coordinates_jacobian(model, x)
+    q = coordinates(model, x)
+    qdot = np.einsum("nqx,nx->nq", G, xdot)
+    qddot = np.einsum("nqx,nx->nq", G, xddot) - coordinates_gamma(model, x, xdot)
+    # keep the prescribed values exactly (the poses satisfy them to round-off)
+    q[:, didx], qdot[:, didx], qddot[:, didx] = qd, qd_dot, qd_ddot
+
+    core = _inverse(model, lay, didx, tt, x, xdot, xddot, q, qdot,
+                    skip=didx if model_drives == "replace" else (),
+                    reacting=tuple(reacting_loads), point=np.asarray(point, dtype=float),
+                    charted=pos.charted)
+    warn.extend(core["warnings"])
+    notes = []
+    if model_drives == "replace":
+        replaced = [dr.name for dr, k in fm.drives if k in set(didx.tolist())]
+        if replaced:
+            notes.append("drive(s) " + ", ".join(repr(r) for r in replaced)
+                         + " on driven coordinates are replaced by the prescribed motion "
+                           "(driving = the whole torque the drive must deliver)")
+    over_values = q[:, model.coordinate_index(over_names[0])]
+    stats = dict(core["stats"])
+    stats.update(positions=n, newton_iterations=pos.iterations,
+                 bifurcations=pos.book.report() if pos.book is not None else [],
+                 seconds=time.perf_counter() - t_start)
+    status = core["status"]
+    message = {Status.SUCCESS: "kinetostatic analysis completed",
+               Status.REDUNDANT: "completed; reactions of redundant joints are not unique "
+                            "(minimum-norm solution reported)",
+               Status.SINGULAR_POSITION:
+                   "completed with singular positions: the driven coordinates lose "
+                           "control there and the reactions are unbounded"}[status]
+    if status == Status.SINGULAR_POSITION and not stats.get("singular_positions"):
+        message = ("completed through bifurcation position(s): the mechanism stays on its "
+                   "branch, the driving torques are the limits along it; the reactions are "
+                   "unbounded there")
+    message = "; ".join([message, *notes])
+    names = model.coordinate_names
+    return Kinetostatics(
+        over=over_names[0], t=tt, values=over_values, q=q, qdot=qdot, qddot=qddot, x=x,
+        xdot=xdot, xddot=xddot, coordinate_names=tuple(names),
+        driven=tuple(names[k] for k in didx), reactions=core["reactions"],
+        moments=core["moments"], joint_frame=core["joint_frame"],
+        joint_points=core["joint_points"],
+        driving={names[k]: core["tau"][:, i] for i, k in enumerate(didx)},
+        power={names[k]: core["tau"][:, i] * qdot[:, k] for i, k in enumerate(didx)},
+        frame_force=core["frame_force"], frame_moment=core["frame_moment"],
+        frame_point=np.asarray(point, dtype=float).copy(), frame_loads=core["frame_loads"],
+        multipliers=core["lam"], joint_kinds=core["kinds"], mode=lay.mode,
+        redundant_joints=tuple(core["redundant"]), status=status, message=message,
+        warnings=tuple(warn), stats=stats, model=model,
+        element_forces=core["element_forces"],
+        element_units={el: ("N m" if bool(lay.row_is_angle[idx[0] - lay.n_base]) else "N")
+                       for el, idx in getattr(lay, "elements", {}).items()})
+
