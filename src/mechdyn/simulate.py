@@ -40,12 +40,13 @@ from .errors import (
 from .initial_state import initial_state
 from .integrate.base import DEFAULT_RTOL, IntegratorOptionError, IntegratorWarning
 from .integrate.driver import make_integrator, sample_times
-from .integrate.events import as_events, locate_events
+from .integrate.events import EventRecord, as_events
 from .kinematics.assembly import DEAD_RCOND, singularity, solve_position
 from .kinematics.constraints import residual
 from .model import as_model
 from .progress import Progress
 from .results.trajectory import Trajectory
+from .segment import Stop, run_segment, user_event_functions
 from .simulate_events import needs_event_loop, simulate_events
 
 __all__ = ["simulate", "initial_state"]  # initial_state: re-exported from .initial_state
@@ -143,6 +144,15 @@ def _turning_point_check(eom: EquationsOfMotion, step, qd_old, x_good):
                 f"{', '.join(rep['joints']) or '-'} become dependent; going on would need "
                 f"the other assembly branch")
     return None
+
+
+class _Coordinates:
+    """The declared coordinates and rates of a state, as the caller's events read them."""
+
+    __slots__ = ("q", "qdot")
+
+    def __init__(self, q, qdot):
+        self.q, self.qdot = q, qdot
 
 
 def _keywords_without_effect(integrator, rtol, atol, formulation, d) -> float:
@@ -286,66 +296,77 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
 
     status, message = Status.SUCCESS, ""
     records: list = []
-    g_old = np.array([e(t0, q_init, qd_init) for e in ev])
     bar = Progress(progress, t0, t_end_f)
-    t_good, q_good, x_good, qd_good = t0, q_init, x_init, qd_init
-    steps_iter = integ.integrate(eom.rhs, t0, q_init, qd_init, t_end_f, w0=np.zeros(1),
-                                 first_order=eom.first_order_function())
+    n = model.n_q
+    good = [t0, q_init, x_init, qd_init]  # the last accepted state: t, q, x, qdot
+    counts = {"steps": 0, "rejected": 0, "evaluations": 0}
+
+    def evaluate(t, y):  # what the caller's event functions read
+        return _Coordinates(y[:n], y[n:2 * n])
+
+    def after_step(step, y):
+        if not (np.all(np.isfinite(step.q)) and np.all(np.isfinite(step.qdot))
+                and np.all(np.isfinite(step.qddot))):
+            raise Stop(Status.NON_FINITE, f"non-finite state at t = {step.t:.9g} s after "
+                       f"{_fmt_q(model, good[1])} at t = {good[0]:.9g} s")
+        turn = _turning_point_check(eom, step, good[3], good[2])
+        if turn is not None:
+            raise Stop(*turn)
+        # positions at the step end, re-solved from q and checked for a dead position
+        x_end = eom.positions(step.q, step.t, check_singular=True)
+        good[:] = [step.t, step.q, x_end, step.qdot]
+        return None
+
+    def sample(ts, y, step, ev):
+        if ts == step.t:
+            record(ts, step.q, step.qdot, step.qddot, good[2], step.w)
+            return
+        eom.watching = False  # samples of the dense output leave the run as it is
+        q, v, w = y[:n], y[n:2 * n], y[2 * n:]
+        record(ts, q, v, eom.qddot(ts, q, v), eom.positions(q, ts), w)
+        eom.positions(step.q, step.t)  # continue from the step end
+        eom.watching = True
+
+    efns = user_event_functions(ev)
+    t, y = t0, np.concatenate([q_init, qd_init, [0.0]])
+    fresh: set = set()
     try:
         with np.errstate(over="raise", invalid="raise", divide="raise"):
-            for step in steps_iter:
-                if not (np.all(np.isfinite(step.q)) and np.all(np.isfinite(step.qdot))
-                        and np.all(np.isfinite(step.qddot))):
-                    status = Status.NON_FINITE
-                    message = (f"non-finite state at t = {step.t:.9g} s after "
-                               f"{_fmt_q(model, q_good)} at t = {t_good:.9g} s")
+            while True:  # one segment, restarted at each of the caller's events
+                for e in efns:
+                    e.fresh = e.key in fresh
+                    e.armed = e.fn(t, evaluate(t, y)) > 0 and not e.fresh
+                hit, k_eval = run_segment(
+                    integ, eom, t, y, t_end_f, efns, evaluate=evaluate,
+                    after_step=after_step, sample=sample,
+                    t_eval=np.zeros(0) if te is None else te, next_out=k_eval,
+                    every_step=te is None, stats=counts, bar=bar)
+                if hit is None:
                     break
-                turn = _turning_point_check(eom, step, qd_good, x_good)
-                if turn is not None:
-                    status, message = turn
-                    break
-                t_stop, terminal = step.t, False
-                if ev:
-                    rec, g_old, terminal = locate_events(ev, g_old, step)
-                    records.extend(rec)
+                t, fired, dense = hit
+                y = dense(t)
+                records.extend(EventRecord(e.key, float(t), y[:n].copy(), y[n:2 * n].copy())
+                               for e in fired)
+                fresh = {e.key for e in fired}
+                terminal = [e for e in fired if e.data.terminal]
+                if terminal or t >= t_end_f:
+                    if te is None and T[-1] < t:
+                        q, v, w = y[:n], y[n:2 * n], y[2 * n:]
+                        record(t, q, v, eom.qddot(t, q, v), eom.positions(q, t), w)
                     if terminal:
-                        t_stop = rec[-1].t
-                # positions at the step end, re-solved from q and checked for a dead position
-                x_end = eom.positions(step.q, step.t, check_singular=True)
-                eom.watching = False  # samples of the dense output leave the run as it is
-                if te is None:
-                    if terminal:
-                        q, v, w = step.dense(t_stop)
-                        x = eom.positions(q, t_stop)
-                        record(t_stop, q, v, eom.qddot(t_stop, q, v), x, w)
-                    else:
-                        record(step.t, step.q, step.qdot, step.qddot, x_end, step.w)
-                else:
-                    while k_eval < te.size and te[k_eval] <= t_stop:
-                        ts = te[k_eval]
-                        if ts == step.t:
-                            record(ts, step.q, step.qdot, step.qddot, x_end, step.w)
-                        else:
-                            q, v, w = step.dense(ts)
-                            x = eom.positions(q, ts)
-                            record(ts, q, v, eom.qddot(ts, q, v), x, w)
-                        k_eval += 1
-                    eom.positions(step.q, step.t)  # continue from the step end
-                eom.watching = True
-                t_good, q_good, x_good, qd_good = step.t, step.q, x_end, step.qdot
-                bar.update(step.t)
-                if terminal:
-                    status = Status.EVENT
-                    message = f"terminal event {records[-1].name!r} at t = {t_stop:.9g} s"
+                        status = Status.EVENT
+                        message = f"terminal event {terminal[0].key!r} at t = {t:.9g} s"
                     break
+                eom.positions(y[:n], t)
+    except Stop as exc:
+        status, message = exc.status, exc.message
     except (MechdynError, FloatingPointError, ArithmeticError, np.linalg.LinAlgError) as exc:
         if isinstance(exc, ModelError) and not isinstance(exc, IntegratorOptionError):
             bar.close()
             raise
-        status, message = _diagnose(eom, exc, t_good, q_good, x_good)
+        status, message = _diagnose(eom, exc, *good[:3])
     finally:
         bar.close()
-        steps_iter.close() if hasattr(steps_iter, "close") else None
 
     n_q, n_x = model.n_q, model.n_x
     t_arr = np.array(T, float)
@@ -370,8 +391,8 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
         energy = None
     wall = time.perf_counter() - wall0
     stats = {"integrator": integ.name, "formulation": formulation, "backend": eom.backend,
-             **integ.stats.as_dict(), "evaluations": eom.total_evaluations - eval0,
-             "integrator_evaluations": integ.stats.evaluations, "wall_time_s": wall,
+             **counts, "evaluations": eom.total_evaluations - eval0,
+             "integrator_evaluations": counts["evaluations"], "wall_time_s": wall,
              "setup_time_s": t_compile, "settings": integ.settings(),
              "mode": sorted(lay.mode), "rtol": getattr(integ, "rtol", None),
              "atol": getattr(integ, "atol", None), "bifurcations": eom.report()}

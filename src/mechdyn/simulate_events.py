@@ -35,7 +35,6 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .dynamics.contact import ContactError, resolve_mode, touching
 from .dynamics.impact import element_forces, frame_forces, impact
@@ -67,6 +66,7 @@ from .kinematics.constraints import extend
 from .model import Model
 from .progress import Progress
 from .results.trajectory import Trajectory
+from .segment import EventFunction, Stop, run_segment, user_event_functions
 
 __all__ = ["simulate_events", "SwitchEvent", "format_events", "needs_event_loop"]
 
@@ -165,24 +165,6 @@ def format_events(events, coordinate_names=None, *, limit: int | None = None) ->
 
 
 # ============================================================================ helpers
-class _Stop(Exception):
-    def __init__(self, status, message):
-        self.status, self.message = status, message
-        super().__init__(message)
-
-
-@dataclass
-class _EventFn:
-    kind: str  # switch, gap, force, cone, slip, time
-    key: str  # element / token
-    fn: object  # (t, ev) -> float
-    hard: float  # fire at once below -hard
-    data: object = None
-    armed: bool = False
-    arm: float = 0.0  # after firing, re-arm only above this value
-    fresh: bool = False
-
-
 # ============================================================================ main
 def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: float = 0.0,
                     mode=None, rtol: float = DEFAULT_RTOL, atol=None,
@@ -417,10 +399,9 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
 
         y0 = np.concatenate([qi, qdi, [w_nc]])
         efns = _event_functions(sm, ms, t, fired_once, force_scale, gap_tol, L)
-        efns += _user_event_functions(user_events)
+        efns += user_event_functions(user_events)
         for e in efns:
             e.fresh = (e.kind, e.key) in just_fired
-        steps_iter = None
         try:
             ev0 = evaluate(t, y0)
             if not rec["t"] or rec["t"][-1] != t or rec["mode"][-1] != ms.mode:
@@ -429,49 +410,27 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                 g0 = e.fn(t, ev0)
                 e.armed = g0 > 0 and not e.fresh
             first = None if not just_fired else 1e-7 * (t_end - t0)
-            integ = segment_integrator(ms, first)
-            steps_iter = integ.integrate(eqs.rhs, t, qi, qdi, t_end, w0=[w_nc],
-                                         first_order=eqs.first_order_function())
-            hit = None
-            for step in steps_iter:
-                stats["steps"] += 1
-                t_old, t_new = step.t_old, step.t
-                bar.update(t_new)
 
-                def dense(s_, step=step):
-                    return np.concatenate(step.dense(s_))
+            def after_step(step, y, eqs=eqs, evaluate=evaluate, ms=ms):
+                nonlocal good
+                ev = evaluate(step.t, y)
+                eqs.check_position(step.t, ev.x, ev.q)
+                good = (step.t, ev, ms)
+                return ev
 
-                y_new = np.concatenate([step.q, step.qdot, step.w])
-                ev_new = evaluate(t_new, y_new)
-                eqs.check_position(t_new, ev_new.x, ev_new.q)
-                good = (t_new, ev_new, ms)
-                gs = [e.fn(t_new, ev_new) for e in efns]
-                cands = [e for e, g in zip(efns, gs, strict=True)
-                         if (e.armed and g <= 0) or g < -e.hard]
-                if cands:
-                    hit = _locate(cands, t_old, t_new, dense, evaluate)
-                    t_new = hit[0]
-                # output samples
-                while next_out < t_eval.size and t_eval[next_out] <= t_new:
-                    to = t_eval[next_out]
-                    if to > t_old or (to == t_old and (not rec["t"] or rec["t"][-1] < to)):
-                        yo = dense(to) if to < step.t else y_new
-                        evo = evaluate(to, yo)
-                        store(to, ms, evo, float(yo[-1]))
-                        penetration = max(penetration, _penetration(sm, evo.x, ms))
-                    next_out += 1
-                if hit is not None:
-                    break
-                if every_step:
-                    store(t_new, ms, ev_new, float(y_new[-1]))
-                    penetration = max(penetration, _penetration(sm, ev_new.x, ms))
-                for e, g in zip(efns, gs, strict=True):
-                    if g > 0 and (not e.fresh or g > e.arm):
-                        e.armed = True
-                if max_wall_time is not None and time.perf_counter() - wall0 > max_wall_time:
-                    raise _Stop(Status.TIMEOUT, f"stopped after {max_wall_time} s of computing at "
-                                f"t = {t_new:.9g} s")
-            _add_counts(stats, integ, eqs)
+            def sample(ts, y, step, ev, ms=ms, evaluate=evaluate):
+                nonlocal penetration
+                if rec["t"] and rec["t"][-1] >= ts:
+                    return
+                ev = ev if ev is not None else evaluate(ts, y)
+                store(ts, ms, ev, float(y[-1]))
+                penetration = max(penetration, _penetration(sm, ev.x, ms))
+
+            hit, next_out = run_segment(
+                segment_integrator(ms, first), eqs, t, y0, t_end, efns, evaluate=evaluate,
+                after_step=after_step, sample=sample, t_eval=t_eval, next_out=next_out,
+                every_step=every_step, stats=stats, bar=bar,
+                deadline=None if max_wall_time is None else wall0 + max_wall_time)
             if hit is None:
                 t = t_end
                 break
@@ -489,7 +448,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                 events.append(EventRecord(e.key, float(t_hit), ev_hit.q.copy(),
                                           ev_hit.qdot.copy()))
             if any(e.data.terminal for e in user):
-                raise _Stop(Status.EVENT, f"terminal event {user[0].key!r} at t = {t_hit:.9g} s")
+                raise Stop(Status.EVENT, f"terminal event {user[0].key!r} at t = {t_hit:.9g} s")
             just_fired = {(e.kind, e.key) for e in user}
             if not fired:  # only the caller's events: go on in the same mode
                 t = t_hit
@@ -516,13 +475,13 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             if last_event_t is not None and t_hit - last_event_t <= 1e-12 * max(1, abs(t_hit)):
                 repeat += 1
                 if repeat > 50:
-                    raise _Stop(Status.TOO_MANY_EVENTS, f"switching does not settle at t = "
+                    raise Stop(Status.TOO_MANY_EVENTS, f"switching does not settle at t = "
                                 f"{t_hit:.9g} s (more than 50 events at the same instant)")
             else:
                 repeat = 0
             last_event_t = t_hit
             if n_events >= max_events:
-                raise _Stop(Status.TOO_MANY_EVENTS, f"stopped after {max_events} switching events "
+                raise Stop(Status.TOO_MANY_EVENTS, f"stopped after {max_events} switching events "
                             f"at t = {t_hit:.9g} s")
             just_fired |= {(e.kind, e.key) for e in fired}
             ms = ms_new
@@ -530,7 +489,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             qi, qdi = ms.independent(x, xd)
             ev_after = ms.evaluate_x(t, x, xd)
             store(t, ms, ev_after, w_nc)
-        except _Stop as exc:
+        except Stop as exc:
             status, message = exc.status, exc.message
             break
         except (MechdynError, np.linalg.LinAlgError, ValueError) as exc:
@@ -538,9 +497,6 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                 raise
             status, message = _dead_position(exc, good) or _status_of(exc)
             break
-        finally:
-            if steps_iter is not None:
-                steps_iter.close()
     stats["backend"] = "numba" if backends == {"numba"} else (
         "numpy" if backends <= {"numpy"} else "numba+numpy")
     stats["penetration"] = penetration
@@ -597,59 +553,6 @@ def _segment_integrators(method, t0, t_end, *, rtol, atol, dt, steps, iterations
                                max_step=max_step)
 
     return factory, name
-
-
-def _locate(cands, t_old, t_new, dense, evaluate):
-    """The first of the candidate events crossed in (t_old, t_new], located by Brent's
-    method on the step's dense output: ``(t_hit, events at t_hit, dense)``."""
-
-    def gfun(s, e):
-        return e.fn(s, evaluate(s, dense(s)))
-
-    roots = []
-    for e in cands:
-        a_val = gfun(t_old, e)
-        t_a = t_old
-        if a_val <= 0:
-            # started at (or just below) zero: look for the positive excursion inside
-            # the step before the crossing
-            h_ = t_new - t_old
-            probes = np.concatenate([t_old + h_ * 2.0 ** -np.arange(30, 0, -1),
-                                     np.linspace(t_old, t_new, 33)[1:-1]])
-            for s_ in np.unique(probes):
-                if gfun(s_, e) > 0:
-                    t_a, a_val = s_, 1.0
-                    break
-        if a_val > 0:
-            ts = brentq(gfun, t_a, t_new, args=(e,), xtol=1e-15,
-                        rtol=4 * np.finfo(float).eps, maxiter=200)
-            if gfun(ts, e) > 0:  # take the side where the event has happened
-                ts = min(np.nextafter(ts, np.inf), t_new)
-        else:
-            ts = t_old
-        roots.append((ts, e))
-    roots.sort(key=lambda r: r[0])
-    t_hit = roots[0][0]
-    tol_sim = 1e-12 * max(1.0, abs(t_hit))
-    return t_hit, [e for ts, e in roots if ts <= t_hit + tol_sim], dense
-
-
-def _user_event_functions(user_events) -> list:
-    """The caller's events g(t, q, qdot) (declared coordinates) as event functions that
-    fire when they fall to zero (a rising event is watched as -g)."""
-    out = []
-    for ev in user_events:
-        for d in ((1, -1) if ev.direction == 0 else (ev.direction,)):
-            sign = -1.0 if d > 0 else 1.0
-            out.append(_EventFn("user", ev.name,
-                                lambda tt, me, ev=ev, sign=sign: sign * ev(tt, me.q, me.qdot),
-                                np.inf, ev))
-    return out
-
-
-def _add_counts(stats: dict, integ, eqs) -> None:
-    stats["rejected"] += integ.stats.rejected
-    stats["evaluations"] += integ.stats.evaluations
 
 
 def _atol(ms, atol, L):
@@ -710,8 +613,8 @@ def _status_of(exc):
 
 # ============================================================================ events
 def _event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_scale, gap_tol,
-                     L) -> list[_EventFn]:
-    out: list[_EventFn] = []
+                     L) -> list[EventFunction]:
+    out: list[EventFunction] = []
     nb = sm.nb
     model = sm.model
     locks = mode_locks(ms.mode)
@@ -737,7 +640,7 @@ def _event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_sca
             nxt = [tc for tc in nxt if (sw.name, tc) not in fired_once]
             if nxt:
                 tc = nxt[0]
-                out.append(_EventFn("time", sw.name, lambda tt, ev, tc=tc: tc - tt, 0.0,
+                out.append(EventFunction("time", sw.name, lambda tt, ev, tc=tc: tc - tt, 0.0,
                                     (sw, tc)))
             continue
         hard = np.inf
@@ -749,7 +652,7 @@ def _event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_sca
                 def fn(tt, ev, m=meas, v=sw.value):
                     return (value_of(m, tt, ev) - v)
             scale = 1.0 if isinstance(meas, TimeMeasure) or meas.is_angle else L
-            out.append(_EventFn("switch", sw.name, fn, hard, (sw, d),
+            out.append(EventFunction("switch", sw.name, fn, hard, (sw, d),
                                 arm=1e-11 * (abs(sw.value) + scale)))
     closed = set(mode_unilateral(ms.mode))
     # open stops and contacts: gaps
@@ -761,13 +664,13 @@ def _event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_sca
             lim = getattr(st, side)
             sgn = 1.0 if side == "lower" else -1.0
             tol = gap_tol / L if meas.is_angle else gap_tol
-            out.append(_EventFn("gap", tok,
+            out.append(EventFunction("gap", tok,
                                 lambda tt, ev, m=meas, lim=lim, s=sgn:
                                 s * (m.value(extend(model, ev.x)) - lim), tol, arm=1e-3 * tol))
     for n, (_ct, gap, _) in sm.contacts.items():
         if f"{n}@contact" in closed:
             continue
-        out.append(_EventFn("gap", f"{n}@contact",
+        out.append(EventFunction("gap", f"{n}@contact",
                             lambda tt, ev, m=gap: m.value(extend(model, ev.x)),
                             gap_tol, arm=1e-3 * gap_tol))
     # closed ones: forces
@@ -776,7 +679,7 @@ def _event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_sca
         idx = ms.n_base + k
         if r.unilateral:
             tok = r.label
-            out.append(_EventFn("force", tok, lambda tt, ev, i=idx: ev.lam[i],
+            out.append(EventFunction("force", tok, lambda tt, ev, i=idx: ev.lam[i],
                                 1e-7 * force_scale, arm=1e-10 * force_scale))
     for c, s in fr.items():
         ct = sm.contacts[c][0]
@@ -785,13 +688,13 @@ def _event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_sca
         if s == "stick":
             kt = [ms.n_base + k for k, r in enumerate(ms.rows) if r.element == c
                   and r.kind == "stick"][0]
-            out.append(_EventFn("cone", c, lambda tt, ev, kn=kn, kt=kt, mu=ct.friction:
+            out.append(EventFunction("cone", c, lambda tt, ev, kn=kn, kt=kt, mu=ct.friction:
                                 mu * ev.lam[kn] - abs(ev.lam[kt]), 1e-7 * force_scale,
                                 arm=1e-10 * force_scale))
         else:
             sg = 1.0 if s == "slip+" else -1.0
             slip = sm.contacts[c][2]
-            out.append(_EventFn("slip", c, lambda tt, ev, m=slip, sg=sg:
+            out.append(EventFunction("slip", c, lambda tt, ev, m=slip, sg=sg:
                                 sg * m.rate(extend(model, ev.x), extend(model, ev.xdot), nb),
                                 np.inf, arm=1e-12 * L))
     return out
