@@ -41,12 +41,12 @@ from .initial_state import initial_state
 from .integrate.base import DEFAULT_RTOL, IntegratorOptionError, IntegratorWarning
 from .integrate.driver import make_integrator, sample_times
 from .integrate.events import EventRecord, as_events
+from .integrate.segment import Stop, run_segment, user_event_functions
 from .kinematics.assembly import DEAD_RCOND, singularity, solve_position
 from .kinematics.constraints import residual
 from .model import as_model
 from .progress import Progress
 from .results.trajectory import Trajectory
-from .segment import Stop, run_segment, user_event_functions
 from .simulate_events import needs_event_loop, simulate_events
 
 __all__ = ["simulate", "initial_state"]  # initial_state: re-exported from .initial_state

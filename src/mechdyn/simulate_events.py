@@ -61,12 +61,12 @@ from .integrate.base import DEFAULT_RTOL, Integrator, IntegratorOptionError
 from .integrate.driver import INTEGRATORS, make_integrator
 from .integrate.events import EventRecord, as_events
 from .integrate.scipy_ivp import ScipyIntegrator
+from .integrate.segment import EventFunction, Stop, run_segment, user_event_functions
 from .kinematics.assembly import DEAD_RCOND
 from .kinematics.constraints import extend
 from .model import Model
 from .progress import Progress
 from .results.trajectory import Trajectory
-from .segment import EventFunction, Stop, run_segment, user_event_functions
 
 __all__ = ["simulate_events", "SwitchEvent", "format_events", "needs_event_loop"]
 

@@ -14,9 +14,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .base import DEFAULT_RTOL, Integrator, IntegratorOptionError
-from .events import as_events, locate_events
+from .events import EventRecord, as_events
 from .runge_kutta import RungeKutta4
 from .scipy_ivp import SCIPY_METHODS, ScipyIntegrator
+from .segment import run_segment, user_event_functions
 from .wilson import Wilson
 
 __all__ = ["INTEGRATORS", "make_integrator", "solve", "Solution", "sample_times"]
@@ -129,59 +130,80 @@ def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end
         Passed to :func:`make_integrator` when ``integrator`` is a name.
     """
     integ = make_integrator(integrator, **options)
-    ev = as_events(events)
+    efns = user_event_functions(as_events(events))
     te = sample_times(t0, t_end, t_eval)
     q0 = np.asarray(q0, float).reshape(-1)
     v0 = np.asarray(qdot0, float).reshape(-1)
+    n = q0.size
     wz = np.zeros(0) if w0 is None else np.asarray(w0, float).reshape(-1)
     out_t, out_q, out_v, out_a, out_w = [], [], [], [], []
 
-    def acc(t, q, v):
+    def rhs(t, q, v):
         r = f(t, q, v)
-        return np.asarray(r[0] if w0 is not None else r, float)
+        if w0 is None:
+            return np.asarray(r, float), np.zeros(0)
+        return np.asarray(r[0], float), np.asarray(r[1], float).reshape(-1)
 
-    def push(t, q, v, w, a=None):
+    def push(t, y, a=None):
         out_t.append(t)
-        out_q.append(np.array(q))
-        out_v.append(np.array(v))
-        out_w.append(np.array(w))
-        out_a.append(np.array(acc(t, q, v) if a is None else a))
+        out_q.append(y[:n].copy())
+        out_v.append(y[n:2 * n].copy())
+        out_w.append(y[2 * n:].copy())
+        out_a.append(rhs(t, y[:n], y[n:2 * n])[0] if a is None else np.array(a))
 
-    steps = integ.integrate(f, t0, q0, v0, t_end, w0=w0)
+    eqs = _Equations(rhs)
+    y = np.concatenate([q0, v0, wz])
     k_eval = 0
     if te is None:
-        push(t0, q0, v0, wz)
+        push(t0, y)
     else:
         while k_eval < te.size and te[k_eval] <= t0:
-            push(t0, q0, v0, wz)
+            push(t0, y)
             k_eval += 1
-    g_old = np.array([e(t0, q0, v0) for e in ev])
-    records = []
-    status = "success"
-    for step in steps:
-        t_stop = step.t
-        terminal = False
-        if ev:
-            rec, g_old, terminal = locate_events(ev, g_old, step)
-            records.extend(rec)
-            if terminal:
-                t_stop = rec[-1].t
-        if te is None:
-            if terminal:
-                q, v, w = step.dense(t_stop)
-                push(t_stop, q, v, w)
-            else:
-                push(step.t, step.q, step.qdot, step.w, step.qddot)
-        else:
-            while k_eval < te.size and te[k_eval] <= t_stop:
-                q, v, w = step.dense(te[k_eval])
-                push(te[k_eval], q, v, w)
-                k_eval += 1
-        if terminal:
-            status = "event"
+    records, status, counts, t = [], "success", {"steps": 0, "rejected": 0, "evaluations": 0}, t0
+    fresh: set = set()
+    while True:  # one segment, restarted at each non-terminal event
+        for e in efns:
+            e.fresh = e.key in fresh
+            e.armed = e.fn(t, _State(y, n)) > 0 and not e.fresh
+        hit, k_eval = run_segment(
+            integ, eqs, t, y, t_end, efns, evaluate=lambda t_, y_: _State(y_, n),
+            after_step=lambda step, y_: None,
+            sample=lambda ts, y_, step, ev: push(ts, y_, step.qddot if ts == step.t else None),
+            t_eval=np.zeros(0) if te is None else te, next_out=k_eval, every_step=te is None,
+            stats=counts, n=n)
+        if hit is None:
             break
-    n = q0.size
+        t, fired, dense = hit
+        y = dense(t)
+        records.extend(EventRecord(e.key, float(t), y[:n].copy(), y[n:2 * n].copy())
+                       for e in fired)
+        fresh = {e.key for e in fired}
+        if any(e.data.terminal for e in fired) or t >= t_end:
+            if te is None:
+                push(t, y)
+            status = "event" if any(e.data.terminal for e in fired) else status
+            break
     return Solution(np.array(out_t), np.array(out_q).reshape(-1, n),
                     np.array(out_v).reshape(-1, n), np.array(out_a).reshape(-1, n),
                     np.array(out_w).reshape(len(out_t), -1), records,
-                    {"integrator": integ.name, **integ.stats.as_dict()}, status)
+                    {"integrator": integ.name, **counts}, status)
+
+
+class _Equations:
+    """A plain right-hand side as the segment integrator calls it."""
+
+    def __init__(self, rhs):
+        self.rhs = rhs
+
+    def first_order_function(self):
+        return None
+
+
+class _State:
+    """(q, qdot) of a state vector y = (q, q', w), as event functions read them."""
+
+    __slots__ = ("q", "qdot")
+
+    def __init__(self, y, n):
+        self.q, self.qdot = y[:n], y[n:2 * n]

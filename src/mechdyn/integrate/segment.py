@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from .errors import Status
+from ..errors import Status
 
 __all__ = ["EventFunction", "Stop", "run_segment", "locate", "user_event_functions"]
 
@@ -122,7 +122,7 @@ def locate(cands, t_old: float, t_new: float, dense: Callable, evaluate: Callabl
 def run_segment(integ, eqs, t: float, y0, t_end: float, efns: list[EventFunction], *,
                 evaluate: Callable, after_step: Callable, sample: Callable, t_eval,
                 next_out: int, every_step: bool, stats: dict, bar=None,
-                deadline: float | None = None):
+                deadline: float | None = None, n: int | None = None):
     """Integrate one segment from ``t`` until the first event or ``t_end``.
 
     Parameters
@@ -131,8 +131,8 @@ def run_segment(integ, eqs, t: float, y0, t_end: float, efns: list[EventFunction
         The segment's integrator (settings only).
     eqs
         ``rhs(t, q_I, q_I') -> (q_I'', p)`` and ``first_order_function()``.
-    y0 : ndarray, shape (2 n_i + 1,)
-        (q_I, q_I', w) at ``t``.
+    y0 : ndarray, shape (2 n + n_w,)
+        (q, q', w) at ``t``.
     efns : list of EventFunction
         Armed by the caller.
     evaluate : callable
@@ -152,6 +152,8 @@ def run_segment(integ, eqs, t: float, y0, t_end: float, efns: list[EventFunction
         ``steps``, ``rejected``, ``evaluations`` are counted in it.
     deadline : float, optional
         ``time.perf_counter()`` value after which the run stops (status timeout).
+    n : int, optional
+        Number of coordinates q (default: one quadrature state w, n = (len(y0) - 1) / 2).
 
     Returns
     -------
@@ -159,7 +161,7 @@ def run_segment(integ, eqs, t: float, y0, t_end: float, efns: list[EventFunction
         ``(t_hit, fired event functions, dense)``; None at ``t_end``.
     next_out : int
     """
-    n = (np.size(y0) - 1) // 2
+    n = (np.size(y0) - 1) // 2 if n is None else n
     y0 = np.asarray(y0, float)
     steps = integ.integrate(eqs.rhs, t, y0[:n], y0[n:2 * n], t_end, w0=y0[2 * n:],
                             first_order=eqs.first_order_function())
