@@ -40,8 +40,8 @@ from .errors import (
 from .initial_state import initial_state
 from .integrate.base import DEFAULT_RTOL, IntegratorOptionError, IntegratorWarning
 from .integrate.driver import make_integrator, sample_times
-from .integrate.events import EventRecord, as_events
-from .integrate.segment import Stop, run_segment, user_event_functions
+from .integrate.events import as_events
+from .integrate.segment import Stop, arm, run_segment, user_event_functions, user_event_records
 from .kinematics.assembly import DEAD_RCOND, singularity, solve_position
 from .kinematics.constraints import residual
 from .model import as_model
@@ -333,9 +333,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
     try:
         with np.errstate(over="raise", invalid="raise", divide="raise"):
             while True:  # one segment, restarted at each of the caller's events
-                for e in efns:
-                    e.fresh = e.key in fresh
-                    e.armed = e.fn(t, evaluate(t, y)) > 0 and not e.fresh
+                arm(efns, t, evaluate(t, y), fresh)
                 hit, k_eval = run_segment(
                     integ, eom, t, y, t_end_f, efns, evaluate=evaluate,
                     after_step=after_step, sample=sample,
@@ -345,9 +343,8 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
                     break
                 t, fired, dense = hit
                 y = dense(t)
-                records.extend(EventRecord(e.key, float(t), y[:n].copy(), y[n:2 * n].copy())
-                               for e in fired)
-                fresh = {e.key for e in fired}
+                records.extend(user_event_records(fired, t, y, n))
+                fresh = {(e.kind, e.key) for e in fired}
                 terminal = [e for e in fired if e.data.terminal]
                 if terminal or t >= t_end_f:
                     if te is None and T[-1] < t:

@@ -59,9 +59,16 @@ from .errors import (
 from .initial_state import initial_state
 from .integrate.base import DEFAULT_RTOL, Integrator, IntegratorOptionError
 from .integrate.driver import INTEGRATORS, make_integrator
-from .integrate.events import EventRecord, as_events
+from .integrate.events import as_events
 from .integrate.scipy_ivp import ScipyIntegrator
-from .integrate.segment import EventFunction, Stop, run_segment, user_event_functions
+from .integrate.segment import (
+    EventFunction,
+    Stop,
+    arm,
+    run_segment,
+    user_event_functions,
+    user_event_records,
+)
 from .kinematics.assembly import DEAD_RCOND
 from .kinematics.constraints import extend
 from .model import Model
@@ -400,15 +407,11 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         y0 = np.concatenate([qi, qdi, [w_nc]])
         efns = _event_functions(sm, ms, t, fired_once, force_scale, gap_tol, L)
         efns += user_event_functions(user_events)
-        for e in efns:
-            e.fresh = (e.kind, e.key) in just_fired
         try:
             ev0 = evaluate(t, y0)
             if not rec["t"] or rec["t"][-1] != t or rec["mode"][-1] != ms.mode:
                 store(t, ms, ev0, w_nc)
-            for e in efns:
-                g0 = e.fn(t, ev0)
-                e.armed = g0 > 0 and not e.fresh
+            arm(efns, t, ev0, just_fired)
             first = None if not just_fired else 1e-7 * (t_end - t0)
 
             def after_step(step, y, eqs=eqs, evaluate=evaluate, ms=ms):
@@ -444,9 +447,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             penetration = max(penetration, _penetration(sm, ev_hit.x, ms))
             user = [e for e in fired if e.kind == "user"]
             fired = [e for e in fired if e.kind != "user"]
-            for e in user:
-                events.append(EventRecord(e.key, float(t_hit), ev_hit.q.copy(),
-                                          ev_hit.qdot.copy()))
+            events.extend(user_event_records(user, t_hit, np.concatenate([ev_hit.q, ev_hit.qdot]),
+                                             model.n_q))
             if any(e.data.terminal for e in user):
                 raise Stop(Status.EVENT, f"terminal event {user[0].key!r} at t = {t_hit:.9g} s")
             just_fired = {(e.kind, e.key) for e in user}

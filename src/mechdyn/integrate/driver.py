@@ -14,10 +14,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .base import DEFAULT_RTOL, Integrator, IntegratorOptionError
-from .events import EventRecord, as_events
+from .events import as_events
 from .runge_kutta import RungeKutta4
 from .scipy_ivp import SCIPY_METHODS, ScipyIntegrator
-from .segment import run_segment, user_event_functions
+from .segment import arm, run_segment, user_event_functions, user_event_records
 from .wilson import Wilson
 
 __all__ = ["INTEGRATORS", "make_integrator", "solve", "Solution", "sample_times"]
@@ -163,9 +163,7 @@ def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end
     records, status, counts, t = [], "success", {"steps": 0, "rejected": 0, "evaluations": 0}, t0
     fresh: set = set()
     while True:  # one segment, restarted at each non-terminal event
-        for e in efns:
-            e.fresh = e.key in fresh
-            e.armed = e.fn(t, _State(y, n)) > 0 and not e.fresh
+        arm(efns, t, _State(y, n), fresh)
         hit, k_eval = run_segment(
             integ, eqs, t, y, t_end, efns, evaluate=lambda t_, y_: _State(y_, n),
             after_step=lambda step, y_: None,
@@ -176,9 +174,8 @@ def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end
             break
         t, fired, dense = hit
         y = dense(t)
-        records.extend(EventRecord(e.key, float(t), y[:n].copy(), y[n:2 * n].copy())
-                       for e in fired)
-        fresh = {e.key for e in fired}
+        records.extend(user_event_records(fired, t, y, n))
+        fresh = {(e.kind, e.key) for e in fired}
         if any(e.data.terminal for e in fired) or t >= t_end:
             if te is None:
                 push(t, y)

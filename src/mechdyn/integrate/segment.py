@@ -24,8 +24,10 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..errors import Status
+from .events import EventRecord
 
-__all__ = ["EventFunction", "Stop", "run_segment", "locate", "user_event_functions"]
+__all__ = ["EventFunction", "Stop", "run_segment", "locate", "user_event_functions", "arm",
+           "user_event_records"]
 
 
 class Stop(Exception):
@@ -82,6 +84,21 @@ def user_event_functions(user_events) -> list[EventFunction]:
                 "user", ev.name, lambda tt, me, ev=ev, sign=sign: sign * ev(tt, me.q, me.qdot),
                 np.inf, ev))
     return out
+
+
+def arm(efns, t: float, ev, fresh) -> None:
+    """Arm the event functions at the start of a segment: those positive at (t, ev)
+    and not among ``fresh`` (``(kind, key)`` of the events that fired at t)."""
+    for e in efns:
+        e.fresh = (e.kind, e.key) in fresh
+        e.armed = e.fn(t, ev) > 0 and not e.fresh
+
+
+def user_event_records(fired, t: float, y, n: int) -> list:
+    """An :class:`~mechdyn.integrate.events.EventRecord` per caller's event that fired at
+    ``t``; ``y`` = (q, q', ...) there with ``n`` coordinates."""
+    return [EventRecord(e.key, float(t), np.array(y[:n]), np.array(y[n:2 * n]))
+            for e in fired if e.kind == "user"]
 
 
 def locate(cands, t_old: float, t_new: float, dense: Callable, evaluate: Callable):
