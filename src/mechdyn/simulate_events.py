@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -59,7 +58,7 @@ from .errors import (
 from .initial_state import initial_state
 from .integrate.base import DEFAULT_RTOL, Integrator, IntegratorOptionError
 from .integrate.driver import INTEGRATORS, make_integrator
-from .integrate.events import as_events
+from .integrate.events import EventRecord, as_events
 from .integrate.scipy_ivp import ScipyIntegrator
 from .integrate.segment import (
     EventFunction,
@@ -78,58 +77,9 @@ from .results.trajectory import Trajectory
 __all__ = ["simulate_events", "SwitchEvent", "format_events", "needs_event_loop"]
 
 
-@dataclass
-class SwitchEvent:
-    """One switching instant of a variable-structure run.
-
-    Attributes
-    ----------
-    t : float
-        Time, s (located to machine precision on the dense output).
-    kind : str
-        ``"engage"``, ``"release"`` (a switch acted on a lock), ``"impact"``
-        (a stop or contact closed with a velocity jump), ``"close"``,
-        ``"separate"`` (a closed stop or contact opened), ``"slip"``,
-        ``"stick"``, ``"ignored"`` (a switch whose guard failed or whose
-        action changed nothing).
-    element : str
-        The switch, lock, stop (``"name@side"``) or contact concerned.
-    mode_before, mode_after : frozenset of str
-    q_before, qdot_before, q_after, qdot_after : ndarray, shape (n_q,)
-        Declared coordinates and rates just before and just after.
-    energy_lost : float
-        Kinetic energy dissipated by the impact, J (0 without a jump).
-    impulses : dict
-        Impulse of every element: (Px, Py, L) on a joint's or lock's child
-        body (N s, N m s), normal impulse of stops and contacts (N s).
-    message : str
-    """
-
-    t: float
-    kind: str
-    element: str
-    mode_before: frozenset
-    mode_after: frozenset
-    q_before: np.ndarray
-    qdot_before: np.ndarray
-    q_after: np.ndarray
-    qdot_after: np.ndarray
-    energy_lost: float = 0.0
-    impulses: dict = field(default_factory=dict)
-    message: str = ""
-
-    @property
-    def name(self) -> str:
-        """``kind:element`` (for listings that expect an event name)."""
-        return f"{self.kind}:{self.element}"
-
-    @property
-    def q(self) -> np.ndarray:
-        return self.q_after
-
-    @property
-    def qdot(self) -> np.ndarray:
-        return self.qdot_after
+#: a switching instant is an :class:`~mechdyn.integrate.events.EventRecord`, the one record
+#: of events in the package (kind ``"engage"``, ``"release"``, ``"impact"`` ...)
+SwitchEvent = EventRecord
 
 
 def needs_event_loop(model: Model) -> bool:
@@ -149,7 +99,7 @@ def format_events(events, coordinate_names=None, *, limit: int | None = None) ->
     limit : int, optional
         Show at most this many (the first ``limit - 1`` and the last).
     """
-    evs = [e for e in events if isinstance(e, SwitchEvent)]
+    evs = [e for e in events if e.kind != "event"]
     if not evs:
         return "no switching events"
     lines = [f"{len(evs)} switching event(s):",

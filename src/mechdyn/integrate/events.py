@@ -11,7 +11,7 @@ so its accuracy is that of the dense output.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -42,14 +42,63 @@ class Event:
         return float(self.function(t, q, qdot))
 
 
-@dataclass(frozen=True)
+@dataclass
 class EventRecord:
-    """One occurrence of an event: its name, time (s) and state there."""
+    """One occurrence of an event during a run: the one event record of the package.
 
-    name: str
+    A caller's event function crossing zero has kind ``"event"`` and its name as
+    ``element``; a variable-structure run records its switching instants with the
+    same type (kinds ``"engage"``, ``"release"`` of a lock by a switch, ``"impact"``
+    of a stop or contact closing with a velocity jump, ``"close"``, ``"separate"``,
+    ``"slip"``, ``"stick"``, ``"ignored"`` for a switch whose guard failed or whose
+    action changed nothing).
+
+    Attributes
+    ----------
+    t : float
+        Time, s (located on the step's dense output).
+    kind : str
+    element : str
+        The event's name, or the switch, lock, stop (``"name@side"``) or contact.
+    mode_before, mode_after : frozenset of str
+        The active switchable constraints before and after (empty without switching).
+    q_before, qdot_before, q_after, qdot_after : ndarray, shape (n_q,)
+        Coordinates and rates just before and just after (equal without a jump).
+    energy_lost : float
+        Kinetic energy dissipated by an impact, J (0 without a jump).
+    impulses : dict
+        Impulse of every element of an impact: (Px, Py[, L]) on a joint's or lock's
+        child body (N s, N m s), the normal impulse of stops and contacts (N s).
+    message : str
+    """
+
     t: float
-    q: np.ndarray
-    qdot: np.ndarray
+    kind: str = "event"
+    element: str = ""
+    mode_before: frozenset = frozenset()
+    mode_after: frozenset = frozenset()
+    q_before: np.ndarray = None
+    qdot_before: np.ndarray = None
+    q_after: np.ndarray = None
+    qdot_after: np.ndarray = None
+    energy_lost: float = 0.0
+    impulses: dict = field(default_factory=dict)
+    message: str = ""
+
+    @property
+    def name(self) -> str:
+        """The event's name, or ``kind:element`` of a switching instant."""
+        return self.element if self.kind == "event" else f"{self.kind}:{self.element}"
+
+    @property
+    def q(self) -> np.ndarray:
+        """Coordinates after the event."""
+        return self.q_after
+
+    @property
+    def qdot(self) -> np.ndarray:
+        """Rates after the event."""
+        return self.qdot_after
 
 
 def as_events(events) -> list[Event]:

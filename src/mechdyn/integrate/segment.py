@@ -97,8 +97,9 @@ def arm(efns, t: float, ev, fresh) -> None:
 def user_event_records(fired, t: float, y, n: int) -> list:
     """An :class:`~mechdyn.integrate.events.EventRecord` per caller's event that fired at
     ``t``; ``y`` = (q, q', ...) there with ``n`` coordinates."""
-    return [EventRecord(e.key, float(t), np.array(y[:n]), np.array(y[n:2 * n]))
-            for e in fired if e.kind == "user"]
+    q, qdot = np.array(y[:n]), np.array(y[n:2 * n])
+    return [EventRecord(float(t), "event", e.key, q_before=q, qdot_before=qdot, q_after=q,
+                        qdot_after=qdot) for e in fired if e.kind == "user"]
 
 
 def locate(cands, t_old: float, t_new: float, dense: Callable, evaluate: Callable):
