@@ -10,7 +10,7 @@
 4. the loads, drives and every switchable element -- locks, stops, contacts and
    switches with their targets, variables and guards (:func:`check_loads`, by building
    :func:`mechdyn.dynamics.forces.force_model` and
-   :class:`mechdyn.dynamics.modes.SwitchedModel` once),
+   :func:`mechdyn.dynamics.modes.switched_model` once),
 
 so that an analysis never discovers a bad name.  The module sits above the analyses
 it borrows from; :meth:`Mechanism.compile <mechdyn.mechanism.Mechanism.compile>` and
@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from .dynamics.forces import force_model
-from .dynamics.modes import SwitchedModel
+from .dynamics.modes import switched_model
 from .errors import MechdynError, ModelError
 from .kinematics.assembly import assemble, rank_report
 from .model import Model
@@ -70,12 +70,12 @@ def compile_mechanism(mechanism) -> Model:
             raise ModelError(probs)
         model = Model(mechanism)
         check_rank(model, gruebler_message=probs[-1])
-        return check_loads(model)
+        return check_loads(model).freeze()
     if probs:
         raise ModelError(probs)
     model = Model(mechanism)
     check_rank(model)
-    return check_loads(model)
+    return check_loads(model).freeze()
 
 
 def check_rank(model: Model, gruebler_message: str | None = None) -> None:
@@ -134,7 +134,7 @@ def check_loads(model: Model) -> Model:
         Listing every problem found.
     """
     probs: list[str] = []
-    for check in (force_model, SwitchedModel):
+    for check in (force_model, switched_model):
         try:
             check(model)
         except ModelError as exc:

@@ -45,6 +45,7 @@ from .dynamics.modes import (
     mode_friction,
     mode_locks,
     mode_unilateral,
+    switched_model,
 )
 from .errors import (
     AssemblyError,
@@ -83,9 +84,9 @@ SwitchEvent = EventRecord
 
 
 def needs_event_loop(model: Model) -> bool:
-    """True if the mechanism has switches, stops, contacts or coordinate locks."""
-    ex = model.mechanism.extras or {}
-    return any(ex.get(k) for k in ("switches", "stops", "contacts", "coordinate_locks"))
+    """True if the model has switches, stops, contacts or coordinate locks (decided when
+    it was compiled)."""
+    return model.has_switching
 
 
 def format_events(events, coordinate_names=None, *, limit: int | None = None) -> str:
@@ -220,7 +221,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     """
     wall0 = time.perf_counter()
     model = mech_or_model if isinstance(mech_or_model, Model) else mech_or_model.compile()
-    sm = SwitchedModel(model)
+    sm = switched_model(model)
     L = model.length_scale
     t_end = float(t_end)
     t0 = float(t0)

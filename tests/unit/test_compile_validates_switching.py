@@ -40,3 +40,13 @@ def test_stop_on_an_unknown_variable_and_a_bad_drive_are_reported_together():
     text = str(info.value)
     assert "stop 'end'" in text and "s_typo" in text
     assert "drive 'push'" in text and "q_typo" in text
+
+
+def test_a_compiled_model_is_frozen_and_keeps_its_structure():
+    m = _slider()
+    add_element(m, Stop("end", "s", lower=-0.1))
+    model = m.compile()
+    with pytest.raises(AttributeError, match="frozen"):
+        model.n_q = 3
+    m.extras.pop("stops")  # changing the mechanism afterwards does not change the model
+    assert model.has_switching

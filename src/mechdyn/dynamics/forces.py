@@ -133,7 +133,7 @@ def _variable_reader(model: Model, name: str):
         Unknown variable, coordinate, joint, body or point; the message lists the
         valid forms or names.
     """
-    cache = model.__dict__.setdefault("_load_variables", {})
+    cache = model.memo.setdefault("load_variables", {})
     fn = cache.get(name)
     if fn is not None:
         return fn
@@ -440,7 +440,7 @@ def applied_forces(model: Model, t, x, xdot, q, qdot, *, skip_drives: Sequence[i
 def force_model(model: Model) -> ForceModel:
     """Resolve the loads and drives of ``model.mechanism`` to indices; all problems at once."""
     mech = model.mechanism
-    cached = getattr(model, "_force_model", None)
+    cached = model.memo.get("force_model")
     if cached is not None:
         return cached
     probs: list[str] = []
@@ -514,5 +514,5 @@ def force_model(model: Model) -> ForceModel:
     if probs:
         raise ModelError(probs)
     fm = ForceModel(model, np.zeros(model.n_x), springs, rotary, forces, torques, drives)
-    model._force_model = fm
+    model.memo["force_model"] = fm
     return fm

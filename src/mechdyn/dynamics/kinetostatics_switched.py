@@ -38,7 +38,7 @@ from ..model import Model
 from ..results.kinetostatics_record import Kinetostatics
 from .forces import force_model
 from .kinetostatics_mode import _kinetostatics
-from .modes import SwitchedModel, mode_friction, mode_locks
+from .modes import SwitchedModel, mode_friction, mode_locks, switched_model
 from .prescribed_motion import ModeRows
 
 __all__ = ["kinetostatics_switched", "mode_segments"]
@@ -107,7 +107,7 @@ def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
     else:
         raise ValueError("over= names one coordinate for a switched trajectory (the driven "
                          "coordinates are the independent ones of each mode)")
-    sm = SwitchedModel(model)
+    sm = switched_model(model)
     fm = force_model(model)
     drive_coords = [k for _, k in fm.drives]
     sample_modes = tuple(frozenset(m) for m in vs["mode"])

@@ -37,7 +37,8 @@ from .forces import force_model
 from .inertia import drive_inertia
 from .mode_system import ModeEval, ModeSystem, mass_matrix_x
 
-__all__ = ["Row", "SwitchedModel", "mode_locks", "mode_unilateral", "mode_friction",
+__all__ = ["Row", "SwitchedModel", "switched_model", "mode_locks", "mode_unilateral",
+           "mode_friction",
            "ModeSystem", "ModeEval", "mass_matrix_x", "Measure", "TimeMeasure",
            "parse_variable"]
 
@@ -310,3 +311,18 @@ class SwitchedModel:
                 slip = self.contacts[c][2]
                 out.append(Row(c, f"{c}.tangent", "stick", slip, float(targets[f"{c}:stick"])))
         return out
+
+
+def switched_model(model: Model) -> SwitchedModel:
+    """The switchable elements of a compiled model, compiled once (validated by the
+    compiler) and kept with the model.
+
+    Raises
+    ------
+    ModelError
+        Every problem of the switchable elements, at once.
+    """
+    sm = model.memo.get("switched_model")
+    if sm is None:
+        sm = model.memo["switched_model"] = SwitchedModel(model)
+    return sm

@@ -278,7 +278,7 @@ def _anchor_indices(values, max_step) -> np.ndarray:
 def _kernel(model: Model, layout) -> Kernel:
     """The evaluation kernel of a model in a mode, cached on the model itself (so that
     it goes away with the model)."""
-    per = model.__dict__.setdefault("_sweep_kernels", {})
+    per = model.memo.setdefault("sweep_kernels", {})
     kern = per.get(layout.mode)
     if kern is None:
         kern = per[layout.mode] = Kernel(model, layout)

@@ -176,7 +176,16 @@ class Model:
             (am, tuple((self._bindex[b], np.asarray(self._point(b, ref), dtype=float))
                        for b, ref in am.points))
             for am in mechanism.extras.get("assembly", [])]
+        ex = mechanism.extras or {}
+        #: whether the model has switchable elements (switches, stops, contacts, coordinate
+        #: locks): its runs go mode by mode
+        self.has_switching = any(ex.get(k) for k in ("switches", "stops", "contacts",
+                                                     "coordinate_locks"))
         self._layouts: dict = {}
+        #: memoized data derived from the model by the analyses (the parsed loads, the
+        #: sweep kernels ...): constants of the model computed on first use, never
+        #: the state of a run
+        self.memo: dict = {}
 
     def _lower_rows(self) -> None:
         """Lower every joint and coordinate to constraint rows (:mod:`mechdyn.model.rows`)."""
@@ -201,6 +210,18 @@ class Model:
                 coords.append(R.line(name, pr.j[jj], pr.sj[jj], pr.i[jj], pr.si[jj], pr.ui[jj],
                                      normal=False, offset=off, nb=nb))
         self.coordinate_rows = R.concat(nb, *coords)
+
+    def __setattr__(self, name, value):
+        if self.__dict__.get("_frozen", False):
+            raise AttributeError(f"a compiled Model is frozen: {name!r} cannot be set (change "
+                                 "the Mechanism and compile it again)")
+        super().__setattr__(name, value)
+
+    def freeze(self) -> Model:
+        """Forbid setting attributes from now on (the compiler calls it when the model
+        is complete and validated); returns the model."""
+        super().__setattr__("_frozen", True)
+        return self
 
     # ------------------------------------------------------------------ lookups
     def _point(self, body: str, ref) -> tuple[float, float]:
