@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-import mechdyn.simulate_events as se
+import mechdyn.dynamics.switching as switching
 from mechdyn.dynamics.contact import ContactError
 from mechdyn.errors import ModelError
 from mechdyn.mechanism import Mechanism, Spring
@@ -38,7 +38,7 @@ def test_a_lock_that_would_need_a_position_jump_stops_the_run_with_the_data_kept
 def test_a_contact_problem_without_solution_stops_the_run_with_the_data_kept(monkeypatch):
     m = _oscillator()
     add_element(m, Stop("stop", "s", lower=-0.05))
-    real = se.resolve_mode
+    real = switching.resolve_mode
     calls = {"n": 0}
 
     def failing(*args, **kw):
@@ -47,7 +47,7 @@ def test_a_contact_problem_without_solution_stops_the_run_with_the_data_kept(mon
             raise ContactError("the contact problem has no solution", t=args[1])
         return real(*args, **kw)
 
-    monkeypatch.setattr(se, "resolve_mode", failing)
+    monkeypatch.setattr(switching, "resolve_mode", failing)
     tr = simulate_events(m, 0.3, q0=[0.1], qdot0=[0.0], dt_out=0.01)
     assert tr.status == "no-contact-solution"
     assert "no solution" in tr.message

@@ -1,0 +1,274 @@
+"""What happens at a switching instant of a variable-structure run, and what is watched
+for it.
+
+:func:`event_functions` lists the event functions of a mode (switch conditions and
+schedules, gaps of open stops and contacts, forces of closed ones, the friction cone
+of a sticking contact, the slip velocity of a slipping one); :func:`apply_switch`
+applies the events fired at one instant: releases, engagements (the held value
+captured), the impact (:func:`mechdyn.dynamics.impact.impact`), the new mode by
+complementarity (:func:`mechdyn.dynamics.contact.resolve_mode`), its coordinates,
+and an :class:`~mechdyn.integrate.events.EventRecord` per thing that happened.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import AssemblyError
+from ..integrate.events import EventRecord
+from ..integrate.segment import EventFunction
+from ..kinematics.constraints import extend
+from .contact import resolve_mode, touching
+from .impact import impact
+from .modes import (
+    ModeSystem,
+    SwitchedModel,
+    TimeMeasure,
+    mode_friction,
+    mode_locks,
+    mode_unilateral,
+)
+
+__all__ = ["event_functions", "guard_holds", "apply_switch"]
+
+
+def event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_scale, gap_tol,
+                     L) -> list[EventFunction]:
+    out: list[EventFunction] = []
+    nb = sm.nb
+    model = sm.model
+    locks = mode_locks(ms.mode)
+
+    def value_of(meas, tt, ev):
+        if isinstance(meas, TimeMeasure):
+            return tt
+        X = extend(model, ev.x)
+        if meas.needs_velocity:
+            return meas.value(X, extend(model, ev.xdot))
+        return meas.value(X)
+
+    for sw, meas, _guards in sm.switches:
+        if sw.name in fired_once:
+            continue
+        if sw.action == "engage" and sw.target in locks:
+            continue
+        if sw.action == "release" and sw.target not in locks:
+            continue
+        if sw.is_scheduled:
+            nxt = [tc for tc in sw.times if tc > t or (tc == t and (sw.name, tc) not in
+                                                       fired_once)]
+            nxt = [tc for tc in nxt if (sw.name, tc) not in fired_once]
+            if nxt:
+                tc = nxt[0]
+                out.append(EventFunction("time", sw.name, lambda tt, ev, tc=tc: tc - tt, 0.0,
+                                    (sw, tc)))
+            continue
+        hard = np.inf
+        for d in ((1, -1) if sw.direction == 0 else (sw.direction,)):
+            if d > 0:
+                def fn(tt, ev, m=meas, v=sw.value):
+                    return (v - value_of(m, tt, ev))
+            else:
+                def fn(tt, ev, m=meas, v=sw.value):
+                    return (value_of(m, tt, ev) - v)
+            scale = 1.0 if isinstance(meas, TimeMeasure) or meas.is_angle else L
+            out.append(EventFunction("switch", sw.name, fn, hard, (sw, d),
+                                arm=1e-11 * (abs(sw.value) + scale)))
+    closed = set(mode_unilateral(ms.mode))
+    # open stops and contacts: gaps
+    for n, (st, meas) in sm.stops.items():
+        for side in st.sides():
+            tok = f"{n}@{side}"
+            if tok in closed:
+                continue
+            lim = getattr(st, side)
+            sgn = 1.0 if side == "lower" else -1.0
+            tol = gap_tol / L if meas.is_angle else gap_tol
+            out.append(EventFunction("gap", tok,
+                                lambda tt, ev, m=meas, lim=lim, s=sgn:
+                                s * (m.value(extend(model, ev.x)) - lim), tol, arm=1e-3 * tol))
+    for n, (_ct, gap, _) in sm.contacts.items():
+        if f"{n}@contact" in closed:
+            continue
+        out.append(EventFunction("gap", f"{n}@contact",
+                            lambda tt, ev, m=gap: m.value(extend(model, ev.x)),
+                            gap_tol, arm=1e-3 * gap_tol))
+    # closed ones: forces
+    fr = mode_friction(ms.mode)
+    for k, r in enumerate(ms.rows):
+        idx = ms.n_base + k
+        if r.unilateral:
+            tok = r.label
+            out.append(EventFunction("force", tok, lambda tt, ev, i=idx: ev.lam[i],
+                                1e-7 * force_scale, arm=1e-10 * force_scale))
+    for c, s in fr.items():
+        ct = sm.contacts[c][0]
+        kn = [ms.n_base + k for k, r in enumerate(ms.rows) if r.element == c
+              and r.kind == "contact"][0]
+        if s == "stick":
+            kt = [ms.n_base + k for k, r in enumerate(ms.rows) if r.element == c
+                  and r.kind == "stick"][0]
+            out.append(EventFunction("cone", c, lambda tt, ev, kn=kn, kt=kt, mu=ct.friction:
+                                mu * ev.lam[kn] - abs(ev.lam[kt]), 1e-7 * force_scale,
+                                arm=1e-10 * force_scale))
+        else:
+            sg = 1.0 if s == "slip+" else -1.0
+            slip = sm.contacts[c][2]
+            out.append(EventFunction("slip", c, lambda tt, ev, m=slip, sg=sg:
+                                sg * m.rate(extend(model, ev.x), extend(model, ev.xdot), nb),
+                                np.inf, arm=1e-12 * L))
+    return out
+
+
+def guard_holds(sm, guards, t, x, xd) -> bool:
+    model = sm.model
+    X, V = extend(model, x), extend(model, xd)
+    for meas, op, val in guards:
+        if isinstance(meas, TimeMeasure):
+            v = t
+        elif meas.needs_velocity:
+            v = meas.value(X, V)
+        else:
+            v = meas.value(X)
+        ok = {"<": v < val, "<=": v <= val, ">": v > val, ">=": v >= val}[op]
+        if not ok:
+            return False
+    return True
+
+
+def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *, fired,
+            small_velocity, gap_tol, force_scale, initial=False, plastic=()):
+    """Apply the fired events at (t, x, xd); returns (new ModeSystem, x, xdot, energy lost)."""
+    mode_before = ms.mode
+    q_b = ms.coordinates(x)
+    qd_b = ms._coord_jac(x) @ xd
+    locks = set(mode_locks(mode_before))
+    engage, release = [], []
+    forced_open, forced_slip, forced_stick = set(), {}, set()
+    notes = []
+    for e in fired:
+        if e.kind in ("switch", "time"):
+            sw = e.data[0]
+            guards = [g for s_, _m, g in sm.switches if s_ is sw][0]
+            if not guard_holds(sm, guards, t, x, xd):
+                notes.append(("ignored", sw.name, "guard not met"))
+                continue
+            act = sw.action
+            if act == "toggle":
+                act = "release" if sw.target in locks else "engage"
+            if act == "engage" and sw.target not in locks:
+                engage.append((sw.target, sw.name))
+            elif act == "release" and sw.target in locks:
+                release.append((sw.target, sw.name))
+            else:
+                notes.append(("ignored", sw.name, f"{sw.target} already {act}d"))
+        elif e.kind == "force":
+            forced_open.add(e.key)
+        elif e.kind == "cone":
+            kt = [ms.n_base + k for k, r in enumerate(ms.rows) if r.element == e.key
+                  and r.kind == "stick"][0]
+            ev = ms.evaluate_x(t, x, xd)
+            forced_slip[e.key] = -1 if ev.lam[kt] > 0 else 1
+        elif e.kind == "slip":
+            forced_stick.add(e.key)
+    for n, _ in release:
+        locks.discard(n)
+        targets.pop(n, None)
+    locks_before = frozenset(locks)
+    for n, _ in engage:
+        sm.capture_target(n, x, targets)
+        locks.add(n)
+    frees = [f for n, _ in engage for f in sm.lock_frees(n)]
+    locks = frozenset(locks)
+    # touching unilateral constraints (closed ones have zero gap by construction)
+    touch = set(touching(sm, ms, x, gap_tol=gap_tol)) | set(mode_unilateral(mode_before))
+    lost = 0.0
+    imp = None
+    xd_plus = xd
+    need_impact = bool(set(locks) - set(locks_before))
+    if not need_impact and touch:
+        # any touching constraint approaching?
+        free = ModeSystem(sm, locks, targets, x)
+        for r in [r for r in sm.rows(frozenset(touch), targets) if r.unilateral]:
+            X, V = extend(sm.model, x), extend(sm.model, xd)
+            v = r.sign * r.measure.rate(X, V, sm.nb)
+            if v < 0.0:
+                need_impact = True
+                break
+        del free
+    if need_impact:
+        imp = impact(sm, x, xd, locks_before, locks, targets, touch,
+                     restitution={k: 0.0 for k in plastic},
+                     small_velocity=small_velocity, t=t)
+        xd_plus = imp.xdot_plus
+        lost = imp.energy_lost
+    # candidates: touching and not separating
+    X, V = extend(sm.model, x), extend(sm.model, xd_plus)
+    cand = []
+    vtol = max(small_velocity * 1e-3, 1e-9 * float(np.max(np.abs(xd_plus), initial=0.0)))
+    for r in [r for r in sm.rows(frozenset(touch), targets) if r.unilateral]:
+        tok = r.label
+        v = r.sign * r.measure.rate(X, V, sm.nb)
+        if v <= vtol:
+            cand.append(tok)
+    vscale = max(float(np.max(np.abs(xd_plus), initial=0.0)), small_velocity)
+    mode_after, forces = resolve_mode(
+        sm, t, x, xd_plus, locks, targets, cand, slip_velocity_tol=1e-9 * vscale + 1e-12,
+        force_tol=1e-10 * force_scale, forced_open=forced_open, forced_slip=forced_slip,
+        forced_stick=forced_stick)
+    prefer = ms.coord_names
+    ms_new = ModeSystem(sm, mode_after, targets, x, prefer=prefer, avoid=frees)
+    # an engaging lock must hold the pose it engages at (no position jump)
+    tol_pos = 1e-8 * sm.model.length_scale
+    bad = {lab: float(v) for lab, v, el in zip(ms_new.row_labels(), ms_new.row_values(x),
+                                               ms_new.row_elements(), strict=True)
+           if el in dict(engage) and abs(v) > tol_pos}
+    if bad:
+        raise AssemblyError(
+            "engaging " + ", ".join(repr(n) for n, _ in engage) + " would need a position "
+            "jump: the held value differs from the pose at the switch ("
+            + ", ".join(f"{k} off by {v:.3g}" for k, v in bad.items()) + ")",
+            t=t, q=q_b, residuals=bad)
+    # project onto the new mode's constraints (removes round-off of the located crossing)
+    qi = ms_new.coordinates(x)[ms_new.coords]
+    x_new = ms_new.solve_position(qi, x, t=t)
+    B, _ = ms_new.velocity_analogs(x_new)
+    G = ms_new._coord_jac(x_new)[ms_new.coords]
+    xd_new = B @ (G @ xd_plus)
+    q_a = ms_new.coordinates(x_new)
+    qd_a = ms_new._coord_jac(x_new) @ xd_new
+    if initial and mode_after == mode_before and not engage:
+        return ms_new, x_new, xd_new, lost
+
+    def add(kind, element, msg="", lost_=0.0, impulses=None):
+        events.append(EventRecord(t, kind, element, mode_before, frozenset(mode_after),
+                                  q_b, qd_b, q_a, qd_a, lost_, dict(impulses or {}), msg))
+
+    impulses = imp.element_impulses if imp is not None else {}
+    for n, swn in release:
+        add("release", n, f"switch {swn!r} released lock {n!r}")
+    for n, swn in engage:
+        add("engage", n, f"switch {swn!r} engaged lock {n!r}", lost, impulses)
+    closed_before = set(mode_unilateral(mode_before))
+    closed_after = set(mode_unilateral(mode_after))
+    for tok in sorted(closed_after - closed_before):
+        kind = "impact" if imp is not None and not engage else "close"
+        add(kind, tok, "", lost if not engage else 0.0, impulses)
+    for tok in sorted(closed_before - closed_after):
+        bounced = imp is not None and tok in touch
+        add("impact" if bounced and tok not in closed_after else "separate", tok,
+            "rebound" if bounced else "force fell to zero", lost if bounced and not engage
+            else 0.0, impulses if bounced else None)
+    for tok in sorted(touch - closed_before - closed_after):
+        if imp is not None and not engage and tok not in forced_open:
+            add("impact", tok, "rebound", lost, impulses)
+    fb, fa = mode_friction(mode_before), mode_friction(mode_after)
+    for c in sorted(set(fb) | set(fa)):
+        if fb.get(c) != fa.get(c) and c in fa and f"{c}@contact" in closed_before:
+            add("stick" if fa[c] == "stick" else "slip", c, fa[c])
+    for kind, name, msg in notes:
+        add(kind, name, msg)
+    if len(events) == 0 or events[-1].t != t:
+        if mode_after != mode_before:
+            add("switch", ",".join(sorted(set(mode_after) ^ set(mode_before))))
+    return ms_new, x_new, xd_new, lost
