@@ -9,7 +9,7 @@ from ..kinematics.constraints import _perp
 from ..model import Model
 from .forces import com_arms, cross
 
-__all__ = ["frame_mass_matrix", "inertia_forces", "drive_inertia"]
+__all__ = ["frame_mass_matrix", "inertia_forces", "mass_matrix_x", "drive_inertia"]
 
 
 def frame_mass_matrix(model: Model, x) -> np.ndarray:
@@ -58,6 +58,16 @@ def inertia_forces(model: Model, x, xdot, xddot) -> np.ndarray:
     f = model.mass[:, None] * ac
     mom = model.inertia * W[..., 2] + cross(a, f)
     return np.concatenate([f, mom[..., None]], axis=-1).reshape(batch + (model.n_x,))
+
+
+def mass_matrix_x(model: Model, x, xdot=None):
+    """M_x (n_x, n_x) of the body-frame coordinates at one pose, and the centripetal
+    term h (n_x,) (zero without ``xdot``): M_x xddot + h are the inertia forces
+    (:func:`inertia_forces`; force, N, and moment about the frame origin, N m)."""
+    M = frame_mass_matrix(model, x)
+    if xdot is None:
+        return M, np.zeros(model.n_x)
+    return M, inertia_forces(model, x, xdot, np.zeros(model.n_x))
 
 
 def drive_inertia(model: Model) -> np.ndarray:

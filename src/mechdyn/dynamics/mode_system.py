@@ -38,8 +38,8 @@ import scipy.linalg
 
 from ..errors import AssemblyError, LockupError
 from ..kernels import rows_numpy as RN
-from ..model import Model
 from ..model.rows import concat
+from .inertia import mass_matrix_x
 from .reactions import touches_ground
 
 if TYPE_CHECKING:
@@ -51,45 +51,6 @@ __all__ = ["ModeSystem", "ModeEval", "mass_matrix_x", "fmt_mode"]
 def fmt_mode(mode) -> str:
     """A mode for messages: ``{a, b}``."""
     return "{" + ", ".join(sorted(mode)) + "}" if mode else "{} (no switchable constraint)"
-
-
-# ============================================================================ mass
-_MASS_INDEX: dict = {}  # flat indices of the nonzeros of M, per number of bodies
-
-
-def mass_matrix_x(model: Model, x, xdot=None):
-    """Mass matrix M(x) (n_x, n_x) of the body poses and the centripetal term h (n_x,).
-
-    The kinetic energy is T = 1/2 sum (m |v_c|^2 + J_c omega^2) with the centre
-    of mass at rho = A(theta) com from the body frame origin; M xddot + h is the
-    inertia force conjugate to the poses (force, N; moment about the frame
-    origin, N m).
-    """
-    nb = model.n_bodies
-    n_x = 3 * nb
-    M = np.zeros((n_x, n_x))
-    h = np.zeros(n_x)
-    th = np.asarray(x, float)[2::3]
-    c, sn = np.cos(th), np.sin(th)
-    cx, cy = model.com[:, 0], model.com[:, 1]
-    rx = c * cx - sn * cy
-    ry = sn * cx + c * cy
-    m = model.mass
-    i = 3 * np.arange(nb)
-    flat = _MASS_INDEX.get(nb)
-    if flat is None:
-        flat = _MASS_INDEX[nb] = np.concatenate([
-            i * n_x + i, (i + 1) * n_x + i + 1, i * n_x + i + 2, (i + 2) * n_x + i,
-            (i + 1) * n_x + i + 2, (i + 2) * n_x + i + 1, (i + 2) * n_x + i + 2])
-    mry, mrx = m * -ry, m * rx
-    M.flat[flat] = np.concatenate([m, m, mry, mry, mrx, mrx,
-                                   model.inertia + m * (rx * rx + ry * ry)])
-    if xdot is not None:
-        w = np.asarray(xdot, float)[2::3]
-        f = -m * w * w
-        h[i] = f * rx
-        h[i + 1] = f * ry
-    return M, h
 
 
 # ============================================================================ the mode system
