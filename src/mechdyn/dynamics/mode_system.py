@@ -38,6 +38,7 @@ import scipy.linalg
 
 from ..errors import AssemblyError, LockupError
 from ..kernels import rows_numpy as RN
+from ..kinematics.assembly import newton
 from ..model.rows import concat
 from .inertia import mass_matrix_x
 from .reactions import touches_ground
@@ -249,34 +250,18 @@ class ModeSystem:
                 x = x + self._B_last @ (qi - self._qi_last)
         else:
             x = np.array(x_guess, float)
-        allr, sel, n_r = self._all, self._sel, len(self.independent_rows)
+        n_r = len(self.independent_rows)
         tol = 1e-13 * max(self.model.length_scale, 1e-3)
-        err_prev = np.inf
-        for _ in range(40):
-            p = RN.Parts(allr, x)
-            v = RN.values(allr, x, p)
-            F = v[sel]
-            F[n_r:] -= qi
-            err = float(np.max(np.abs(F))) if F.size else 0.0
-            if err <= tol or (err <= 1e3 * tol and err >= 0.5 * err_prev):
-                break
-            err_prev = err
-            J = RN.jacobian(allr, x, p)[sel]
-            try:
-                dx = np.linalg.solve(J, F)
-            except np.linalg.LinAlgError:
-                dx = np.linalg.lstsq(J, F, rcond=None)[0]
-            x = x - dx
-            if not np.all(np.isfinite(x)):
-                break
-        else:
-            err = np.inf
-        if not (err <= 1e3 * tol):
+        x, done = newton(self._all, x, np.concatenate([np.zeros(n_r), qi]), sel=self._sel,
+                         tol=tol)
+        if not done:
             res = {r: float(v) for r, v in zip(self.row_labels(), self.row_values(x), strict=True)
                    if abs(v) > 1e3 * tol} if np.all(np.isfinite(x)) else {}
             raise AssemblyError(
                 f"the mechanism cannot be assembled in mode {fmt_mode(self.mode)}",
                 t=t, q=qi, residuals=res)
+        p = RN.Parts(self._all, x)
+        v = RN.values(self._all, x, p)
         self._x_last = x
         self._at = (x, p, v)
         return x

@@ -13,10 +13,12 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..errors import AssemblyError, SingularPositionError
+from ..kernels import rows_numpy
 from ..model import ConstraintLayout, Model
+from ..model.rows import Rows
 from .constraints import coordinates, coordinates_jacobian, extend, jacobian, residual, system
 
-__all__ = ["solve_position", "assemble", "joint_residuals", "singularity", "rank_report",
+__all__ = ["newton", "solve_position", "assemble", "joint_residuals", "singularity", "rank_report",
            "branch_sign", "turn_signs", "SINGULAR_RCOND", "DEAD_RCOND"]
 
 #: ratio sigma_min / sigma_max of the scaled Jacobian below which a position is singular
@@ -55,6 +57,70 @@ def joint_residuals(model: Model, x, layout: ConstraintLayout | None = None) -> 
     return dict(sorted(res.items(), key=lambda kv: -kv[1]))
 
 
+def newton(rows: Rows, x_guess, target, *, sel=None, tol: float, max_iter: int = 40):
+    """The one position Newton solve of the package: rows(x)[sel] = target (batched).
+
+    Parameters
+    ----------
+    rows : Rows
+        The constraint and coordinate rows (:mod:`mechdyn.model.rows`).
+    x_guess : array_like, shape (..., n_x)
+        Start, usually the previous solution (which keeps the assembly branch).
+    target : array_like, shape (..., n_sel)
+        Values the selected rows must take (0 for a constraint, q for a coordinate).
+    sel : array_like of int, optional
+        The rows solved for (default all); their number must be n_x for a unique pose.
+    tol : float
+        Residual tolerance (m, or rad for angle rows).
+
+    Returns
+    -------
+    x : ndarray, shape (..., n_x)
+    done : ndarray of bool, shape (...)
+        Converged (or stagnating at round-off, below ``1e3 tol``).
+
+    Examples
+    --------
+    >>> from mechdyn.model import rows as R
+    >>> r = R.angle("phi", 0, nb=1)
+    >>> x, done = newton(r, [0.0, 0.0, 0.0], [0.3], tol=1e-14)
+    >>> float(x[2]), bool(done)
+    (0.3, True)
+    """
+    target = np.asarray(target, dtype=float)
+    x = np.array(x_guess, dtype=float, copy=True)
+    batch = np.broadcast_shapes(target.shape[:-1], x.shape[:-1])
+    x = np.broadcast_to(x, batch + (rows.n_x,)).copy()
+    sel = np.arange(len(rows)) if sel is None else np.asarray(sel)
+    prev = np.full(batch, np.inf)
+    done = np.zeros(batch, dtype=bool)
+    for _ in range(max_iter):
+        p = rows_numpy.Parts(rows, x)
+        F = rows_numpy.values(rows, x, p)[..., sel] - target
+        err = np.max(np.abs(F), axis=-1) if F.shape[-1] else np.zeros(batch)
+        err = np.where(np.isfinite(err), err, np.inf)
+        # converged, or stagnating at round-off level
+        done = (err <= tol) | ((err >= 0.5 * prev) & (err <= 1e3 * tol))
+        if np.all(done) or not np.all(np.isfinite(x)):
+            break
+        prev = np.where(done, prev, err)
+        J = rows_numpy.jacobian(rows, x, p)[..., sel, :]
+        if J.shape[-1] == J.shape[-2]:
+            try:
+                dx = np.linalg.solve(J, F[..., None])[..., 0]
+            except np.linalg.LinAlgError:
+                dx = _lstsq(J, F)
+        else:
+            dx = _lstsq(J, F)
+        if not np.all(np.isfinite(dx)):
+            dx = _lstsq(J, F)
+        x = x - np.where(done[..., None], 0.0, dx)
+    else:
+        F = rows_numpy.values(rows, x)[..., sel] - target
+        done = np.max(np.abs(F), axis=-1) <= 1e3 * tol if F.shape[-1] else np.ones(batch, bool)
+    return x, done
+
+
 def solve_position(model: Model, q, x_guess, *, layout: ConstraintLayout | None = None,
                    tol: float | None = None, max_iter: int = 30, t: float | None = None,
                    check_singular: bool = True) -> np.ndarray:
@@ -85,36 +151,13 @@ def solve_position(model: Model, q, x_guess, *, layout: ConstraintLayout | None 
     """
     lay = layout or model.layout()
     q = np.asarray(q, dtype=float)
-    x = np.array(x_guess, dtype=float, copy=True)
     if tol is None:
         tol = _position_tol(model)
-    batch = np.broadcast_shapes(q.shape[:-1], x.shape[:-1])
-    x = np.broadcast_to(x, batch + (model.n_x,)).copy()
-    prev = np.full(batch, np.inf)
-    done = np.zeros(batch, dtype=bool)
-    for _ in range(max_iter):
-        F, J = system(model, x, q, lay)
-        err = np.max(np.abs(F), axis=-1) if F.shape[-1] else np.zeros(batch)
-        # converged, or stagnating at round-off level
-        done = (err <= tol) | ((err >= 0.5 * prev) & (err <= 1e3 * tol))
-        if np.all(done):
-            break
-        prev = np.where(done, prev, err)
-        if J.shape[-1] == J.shape[-2]:
-            try:
-                dx = np.linalg.solve(J, F[..., None])[..., 0]
-            except np.linalg.LinAlgError:
-                dx = _lstsq(J, F)
-        else:
-            dx = _lstsq(J, F)
-        if not np.all(np.isfinite(dx)):
-            dx = _lstsq(J, F)
-        x = x - np.where(done[..., None], 0.0, dx)
-    else:
-        F, J = system(model, x, q, lay)
-        err = np.max(np.abs(F), axis=-1)
-        done = err <= 1e3 * tol
+    zeros = np.zeros(q.shape[:-1] + (len(lay.rowset),))
+    x, done = newton(lay.position_rows, x_guess, np.concatenate([zeros, q], axis=-1), tol=tol,
+                     max_iter=max_iter)
     if not np.all(done):
+        batch = done.shape
         bad = np.unravel_index(np.argmax(~done), batch) if batch else ()
         xb, qb = x[bad], q[bad] if q.ndim > 1 else q
         raise _assembly_error(model, qb, xb, lay, t)

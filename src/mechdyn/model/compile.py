@@ -321,6 +321,8 @@ class ConstraintLayout:
         self.rowset = R.concat(model.n_bodies, model.joint_rows,
                                *[model.weld_rows[n] for n, a in
                                  zip(model.lock.names, active, strict=True) if a])
+        #: the rows of the position problem [Phi(x); g(x)] = [0; q]
+        self.position_rows = R.concat(model.n_bodies, self.rowset, model.coordinate_rows)
 
 
 def as_model(mech_or_model) -> Model:
