@@ -51,17 +51,17 @@ from .mechanism.contact import Contact, Stop
 from .mechanism.motors import ConstantSpeedDrive, DCMotor, GearStage, InductionMotor
 from .mechanism.switch import CoordinateLock, Switch
 from .model import Model
+from .model.state import Mode, State
 from .modelfile import load, loads
 from .results.trajectory import Trajectory
 from .simulate import simulate
 from .simulate_events import SwitchEvent, format_events
-from .state import State
 
 __all__ = [
     # description
     "Mechanism", "Body", "Ground", "Revolute", "Prismatic", "Lock", "Coordinate", "Spring",
     "RotarySpring", "Force", "Torque", "Table", "pulse", "Drive", "TorqueSpeedCurve",
-    "InductionMotor", "DCMotor", "ConstantSpeedDrive", "GearStage", "Model", "State",
+    "InductionMotor", "DCMotor", "ConstantSpeedDrive", "GearStage", "Model", "Mode", "State",
     "AssemblyMode", "CoordinateLock", "Switch", "Stop", "Contact",
     "load", "loads", "examples", "units",
     # analyses and their records

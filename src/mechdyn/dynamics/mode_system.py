@@ -40,6 +40,7 @@ from ..errors import AssemblyError, LockupError
 from ..kernels import rows_numpy as RN
 from ..kinematics.assembly import newton
 from ..model.rows import concat
+from ..model.state import Mode
 from .inertia import mass_matrix_x
 from .reactions import touches_ground
 
@@ -124,7 +125,7 @@ class ModeSystem:
         model = sm.model
         self.model = model
         nb = sm.nb
-        self.mode = frozenset(mode)
+        self.mode = Mode(mode)
         self.targets = dict(targets)
         self.rows = sm.rows(self.mode, targets)
         self.n_base = len(model.joint_rows)

@@ -32,6 +32,7 @@ from ..kinematics.constraints import extend
 from ..model import Model
 from ..model import rows as R
 from ..model.rows import Rows
+from ..model.state import Mode
 from ..model.variable import Measure, TimeMeasure, parse_variable
 from .forces import force_model
 from .inertia import drive_inertia
@@ -87,23 +88,18 @@ class Row:
 
 
 def mode_locks(mode) -> frozenset:
-    """The lock names of a mode (tokens without '@' or ':')."""
-    return frozenset(t for t in mode if "@" not in t and ":" not in t)
+    """The lock names of a mode (:attr:`Mode.locks`)."""
+    return Mode(mode).locks
 
 
 def mode_unilateral(mode) -> frozenset:
-    """Closed stop sides ('name@lower', 'name@upper') and contacts ('name@contact')."""
-    return frozenset(t for t in mode if "@" in t)
+    """Closed stop sides and contacts of a mode (:attr:`Mode.closed`)."""
+    return Mode(mode).closed
 
 
 def mode_friction(mode) -> dict:
-    """{contact: 'stick' | 'slip+' | 'slip-'} of a mode."""
-    out = {}
-    for t in mode:
-        if ":" in t:
-            c, s = t.split(":", 1)
-            out[c] = s
-    return out
+    """{contact: 'stick' | 'slip+' | 'slip-'} of a mode (:attr:`Mode.friction`)."""
+    return Mode(mode).friction
 
 
 class SwitchedModel:
