@@ -18,7 +18,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import IntegrationError, LockupError, ModelError
-from .reduced_machine import ReducedMachine, _frozen
+from .reduced_machine import ReducedMachine
+from .reduced_run import _frozen
 
 __all__ = ["SteadyCycle", "steady_state", "FlywheelSizing", "size_flywheel", "FLYWHEEL_METHODS"]
 

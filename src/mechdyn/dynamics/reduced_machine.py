@@ -14,30 +14,30 @@ ReducedMachine, Member, MemberLoad
     from plain functions.
 ReducedRun, run_reduced, energy_speed
     Time integration of the reduced equation (with :mod:`mechdyn.integrate`) and
-    the energy form.
+    the energy form; defined in :mod:`mechdyn.dynamics.reduced_run`.
 mode_mechanism
     A variable-structure mechanism in one mode (locks engaged, frozen
-    coordinates dropped), e.g. the press in its 1-DOF working mode.
+    coordinates dropped), e.g. the press in its 1-DOF working mode; defined in
+    :mod:`mechdyn.dynamics.mode_mechanism`.
 """
 
 from __future__ import annotations
 
 import bisect
-import dataclasses
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import IntegrationError, ModelError, did_you_mean
-from ..integrate import solve
+from ..errors import IntegrationError, ModelError
 from ..mechanism.drive import TorqueSpeedCurve
-from ..mechanism.joint import Lock
 from ..mechanism.load import Table
 from ..model import Model, as_model
+from .mode_mechanism import mode_mechanism
 from .reduced_kinematics import _ModelEvaluator
+from .reduced_run import ReducedRun, energy_speed, run_reduced
 
 if TYPE_CHECKING:
     from .reduction import Reduction
@@ -46,12 +46,6 @@ __all__ = ["ReducedMachine", "Member", "MemberLoad", "ReducedRun", "run_reduced"
            "energy_speed", "mode_mechanism"]
 
 TWO_PI = 2.0 * math.pi
-
-
-def _frozen(a) -> np.ndarray:
-    a = np.array(a, dtype=float, copy=True)
-    a.setflags(write=False)
-    return a
 
 
 def _extra_inertia(value) -> float:
@@ -437,200 +431,3 @@ def _nominal(drive) -> float | None:
     if v is not None:
         return 0.5 * float(v) / ratio
     return None
-
-
-# ============================================================================ time runs
-@dataclass(frozen=True)
-class ReducedRun:
-    """A time history of the reduced machine.
-
-    Attributes
-    ----------
-    t, phi, omega, epsilon : ndarray, shape (n,)
-        Time (s), position (rad), speed (rad/s), acceleration (rad/s^2).
-    J, M, M_drive : ndarray, shape (n,)
-        Total reduced inertia (kg m^2), reduced torque and drive torque (N m).
-    M_motor : ndarray or None
-        Motor-side torque through a gear stage, N m.
-    """
-
-    t: np.ndarray
-    phi: np.ndarray
-    omega: np.ndarray
-    epsilon: np.ndarray
-    J: np.ndarray
-    M: np.ndarray
-    M_drive: np.ndarray
-    M_motor: np.ndarray | None = None
-    status: str = "success"
-    message: str = ""
-    events: tuple = ()
-    stats: dict = field(default_factory=dict)
-
-    def to_dataframe(self):
-        """Columns ``t_s, phi_deg, omega_rad_s, epsilon_rad_s2, J_kgm2, M_red_Nm, ...``."""
-        import pandas as pd
-
-        cols = {"t_s": self.t, "phi_deg": np.degrees(self.phi), "phi_rad": self.phi,
-                "omega_rad_s": self.omega, "epsilon_rad_s2": self.epsilon,
-                "J_total_kgm2": self.J, "M_red_Nm": self.M, "M_drive_Nm": self.M_drive}
-        if self.M_motor is not None:
-            cols["M_motor_Nm"] = self.M_motor
-        return pd.DataFrame(cols)
-
-
-def _history(machine: ReducedMachine, t, phi, omega, **kw) -> ReducedRun:
-    n = t.size
-    J = np.empty(n)
-    M = np.empty(n)
-    eps = np.empty(n)
-    md = np.empty(n)
-    mm = np.empty(n) if machine.drive is not None else None
-    for i in range(n):
-        j, dj = machine.inertia(phi[i])
-        J[i] = j
-        M[i] = machine.torque(t[i], phi[i], omega[i])
-        eps[i] = (M[i] - 0.5 * dj * omega[i] ** 2) / j
-        md[i] = machine.drive_torque(omega[i])
-        if mm is not None:
-            mm[i] = machine.motor_torque(omega[i])
-    return ReducedRun(_frozen(t), _frozen(phi), _frozen(omega), _frozen(eps), _frozen(J),
-                      _frozen(M), _frozen(md), None if mm is None else _frozen(mm), **kw)
-
-
-def run_reduced(machine: ReducedMachine, t_end: float, *, phi0: float = 0.0,
-                omega0: float = 0.0, t0: float = 0.0, integrator: str = "dop853",
-                t_eval=None, events=None, **options) -> ReducedRun:
-    """Integrate the reduced equation of motion in time.
-
-    Parameters
-    ----------
-    machine : ReducedMachine
-    t_end : float
-        End time, s.
-    phi0, omega0 : float
-        Initial position (rad) and speed (rad/s).
-    t0 : float
-        Start time, s.
-    integrator : str
-        A name of :data:`mechdyn.integrate.INTEGRATORS` (``"wilson"``, ``"rk4"``,
-        ``"dop853"``, ...).
-    t_eval : array_like, optional
-        Output times (default every step).
-    events : optional
-        Event functions ``g(t, q, qdot)`` (see :mod:`mechdyn.integrate.events`).
-    **options
-        Integrator options (``steps``/``dt`` for fixed-step ones; ``rtol``, ``atol``,
-        ``max_step`` for the adaptive ones).
-
-    Returns
-    -------
-    ReducedRun
-    """
-    sol = solve(integrator, machine.rhs, t0, [phi0], [omega0], t_end, t_eval=t_eval,
-                events=events, **options)
-    return _history(machine, sol.t, sol.q[:, 0], sol.qdot[:, 0],
-                    status="success" if sol.status == "success" else sol.status,
-                    events=tuple(sol.events), stats=dict(sol.stats))
-
-
-def energy_speed(machine: ReducedMachine, phi, *, phi0: float = 0.0, omega0: float,
-                 t: float = 0.0, rtol: float = 1e-11) -> np.ndarray:
-    """Speed from the energy form ``J omega^2/2 = J_0 omega_0^2/2 + int M dphi``.
-
-    Valid when the reduced torque depends on the position only: it is evaluated
-    at time ``t`` and speed ``omega0``.
-
-    Parameters
-    ----------
-    phi : array_like, shape (n,)
-        Positions, rad (any order, on either side of ``phi0``).
-    phi0, omega0 : float
-        Reference position (rad) and speed there (rad/s).
-
-    Returns
-    -------
-    ndarray, shape (n,)
-        omega(phi), rad/s; NaN where the kinetic energy would be negative (the
-        machine cannot reach that position).
-    """
-    from scipy.integrate import solve_ivp
-
-    phi = np.asarray(phi, dtype=float).reshape(-1)
-    j0, _ = machine.inertia(phi0)
-    out = np.empty_like(phi)
-    for sign in (1.0, -1.0):
-        sel = (phi >= phi0) if sign > 0 else (phi < phi0)
-        if not np.any(sel):
-            continue
-        target = phi[sel]
-        end = target.max() if sign > 0 else target.min()
-        if end == phi0:
-            w = np.zeros(target.size)
-        else:
-            sol = solve_ivp(lambda p, y: [machine.torque(t, p, omega0)], (phi0, end), [0.0],
-                            method="DOP853", rtol=rtol, atol=1e-12 * max(1.0, j0 * omega0**2),
-                            dense_output=True)
-            w = sol.sol(target)[0]
-        jt = machine.inertia_along(target)
-        e2 = j0 * omega0**2 + 2.0 * w
-        with np.errstate(invalid="ignore"):
-            out[sel] = np.where(e2 >= 0, np.sqrt(np.maximum(e2, 0) / jt), np.nan)
-    return out
-
-
-# ============================================================================ modes
-def mode_mechanism(mechanism, *, engage: Sequence[str] = (), offsets: dict | None = None,
-                   drop: Sequence[str] = ()):
-    """A copy of a mechanism with locks engaged and the coordinates they freeze removed.
-
-    The reduction method needs one degree of freedom; a variable-structure
-    machine has it in some modes only (the clutchless press in its working mode:
-    rocker locked onto the slider).  This builds that mode as a mechanism of its
-    own.
-
-    Parameters
-    ----------
-    mechanism : Mechanism
-    engage : sequence of str
-        Locks to engage.
-    offsets : dict, optional
-        Lock name -> pose (x m, y m, theta rad) of the child frame in the parent
-        frame held by the lock; default the lock's own offset (or the sketch).
-    drop : sequence of str
-        Coordinates to remove (those the engaged locks freeze).
-
-    Returns
-    -------
-    Mechanism
-        The original is not changed; initial values of dropped coordinates are
-        removed from ``extras["initial"]``.
-    """
-    offsets = dict(offsets or {})
-    joints = dict(mechanism.joints)
-    probs = []
-    for name in engage:
-        j = joints.get(name)
-        if not isinstance(j, Lock):
-            locks = [n for n, jj in joints.items() if isinstance(jj, Lock)]
-            probs.append(did_you_mean(name, locks, "lock"))
-            continue
-        off = offsets.pop(name, j.offset)
-        joints[name] = dataclasses.replace(j, engaged=True,
-                                           offset=None if off is None else tuple(map(float, off)))
-    for name in offsets:
-        probs.append(f"offsets: lock {name!r} is not in engage")
-    coords = {k: v for k, v in mechanism.coordinates.items() if k not in set(drop)}
-    for name in drop:
-        if name not in mechanism.coordinates:
-            probs.append(did_you_mean(name, mechanism.coordinates, "coordinate"))
-    if probs:
-        raise ModelError(probs)
-    extras = dict(mechanism.extras)
-    init = extras.get("initial")
-    if isinstance(init, dict):
-        extras["initial"] = {k: {c: v for c, v in dict(d or {}).items() if c in coords}
-                             for k, d in init.items()}
-    return dataclasses.replace(mechanism, joints=joints, coordinates=coords,
-                               loads=list(mechanism.loads), drives=list(mechanism.drives),
-                               extras=extras)

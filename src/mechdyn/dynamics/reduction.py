@@ -64,11 +64,11 @@ from .reduced_machine import (
     ReducedMachine,
     ReducedRun,
     _extra_inertia,
-    _frozen,
     energy_speed,
     mode_mechanism,
     run_reduced,
 )
+from .reduced_run import _frozen
 from .startup import StartupResult, startup
 
 __all__ = ["Reduction", "reduce_model", "ReducedMachine", "Member", "MemberLoad",

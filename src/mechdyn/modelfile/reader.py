@@ -1,0 +1,155 @@
+"""The base that the model-file loader's table readers share.
+
+Holds the document being read, the problems found in it so far and the names
+read from it (bodies and their points, sketch frames, joint types, coordinate
+kinds), with the helpers that read one value (a quantity, a vector, a body or
+point name, a direction) and record its problem instead of raising it.
+
+Private names
+-------------
+_Reader
+    The base of the table readers (:mod:`.bodies_joints`, :mod:`.loads_drives`,
+    :mod:`.initial_assembly`), which :class:`mechdyn.modelfile.loader._Builder`
+    combines.
+_Failed
+    Raised when a value cannot be read; its problem is already recorded.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+from ..errors import UnitError, did_you_mean
+from ..mechanism import GROUND
+from ..units import parse_quantity, parse_vector
+from .schema import locate
+
+
+class _Failed(Exception):
+    """A value could not be read; its problem is already recorded."""
+
+
+class _Reader:
+    """A document being read: its problems so far, the names read, and the helpers."""
+
+    def __init__(self, doc: dict, fname: str, bad_paths: Sequence[tuple]):
+        self.doc = doc if isinstance(doc, dict) else {}
+        self.fname = fname
+        self.bad = [tuple(p) for p in bad_paths]
+        self.problems: list[str] = []
+        self.unit_problems: set[str] = set()
+        self.body_points: dict[str, list[str]] = {}
+        #: sketch frame -> body frame of each body given with frame = "sketch": (ox, oy, theta)
+        self.sketch_frames: dict[str, tuple[float, float, float]] = {}
+        self.joint_types: dict[str, str] = {}
+        self.coord_kinds: dict[str, str] = {}
+
+    # ------------------------------------------------------------ helpers
+    def where(self, *path) -> str:
+        return locate(self.fname, path, self.doc)
+
+    def broken(self, *path) -> bool:
+        """True if the schema already reported a problem at or below ``path``."""
+        n = len(path)
+        return any(p[:n] == tuple(path) for p in self.bad)
+
+    def element(self, fn, path: tuple, spec: dict, required: Sequence[str]):
+        """Build one element from the keys of ``spec`` that passed the schema check.
+
+        Keys with a schema problem are left out (so that the other keys are still
+        checked); the element is not built if a required key is missing or any
+        problem was found in it.
+        """
+        clean = {k: v for k, v in spec.items() if not self.broken(*path, k)}
+        if any(k not in clean for k in required):
+            raise _Failed
+        try:
+            el = fn(path[-1], clean)
+        except (ValueError, TypeError) as exc:  # an element's own check; keep it readable
+            self.problem(f"{self.where(*path)}: {exc}")
+            raise _Failed from None
+        if self.broken(*path):
+            raise _Failed
+        return el
+
+    def problem(self, msg: str):
+        if msg not in self.problems:
+            self.problems.append(msg)
+
+    def quantity(self, value: Any, kind: str, *path) -> float:
+        try:
+            return parse_quantity(value, kind, where=self.where(*path))
+        except UnitError as exc:
+            self.problem(str(exc))
+            self.unit_problems.add(str(exc))
+            raise _Failed from None
+
+    def vector(self, value: Any, kind, *path, size: int | None = None) -> tuple[float, ...]:
+        try:
+            return parse_vector(value, kind, self.where(*path), size=size)
+        except UnitError as exc:
+            self.problem(str(exc))
+            self.unit_problems.add(str(exc))
+            raise _Failed from None
+
+    def nonneg(self, value: float, raw: Any, unit: str, *path) -> float:
+        if value < 0:
+            self.problem(f"{self.where(*path)}: {raw!r}: {path[-1]} must be >= 0 {unit}")
+            raise _Failed
+        return value
+
+    def body_name(self, value: str, *path, ground_ok: bool = True) -> str:
+        valid = [b for b in self.body_points if b != GROUND] + ([GROUND] if ground_ok else [])
+        if value not in valid:
+            self.problem(f"{self.where(*path)}: " + did_you_mean(value, valid, "body"))
+            raise _Failed
+        return value
+
+    def point_ref(self, body: str, value: Any, *path):
+        """A point of ``body``: its name (checked) or coordinates (in the body's input frame)."""
+        if isinstance(value, str) and not value.lstrip().startswith("("):
+            names = self.body_points.get(body, [])
+            if value not in names:
+                self.problem(f"{self.where(*path)}: unknown point {value!r} of body {body!r}; "
+                             "valid point names: " + ", ".join(repr(p) for p in names))
+                raise _Failed
+            return value
+        xy = self.vector(value, "length", *path)
+        return self.to_body_frame(body, xy)
+
+    def to_body_frame(self, body: str, xy) -> tuple[float, float]:
+        """Coordinates given in a body's input frame -> its body frame."""
+        fr = self.sketch_frames.get(body)
+        if fr is None:
+            return (float(xy[0]), float(xy[1]))
+        ox, oy, th = fr
+        dx, dy = xy[0] - ox, xy[1] - oy
+        c, s = math.cos(th), math.sin(th)
+        return (c * dx + s * dy, -s * dx + c * dy)
+
+    def direction(self, body: str, value: Any, *path) -> tuple[float, float]:
+        """A direction: [x, y] numbers or an angle string, in the body's input frame."""
+        if isinstance(value, str):
+            a = self.quantity(value, "angle", *path)
+            d = (math.cos(a), math.sin(a))
+        else:
+            d = (float(value[0]), float(value[1]))
+            if not all(math.isfinite(v) for v in d) or math.hypot(*d) == 0:
+                self.problem(f"{self.where(*path)}: {value!r}: must be a non-zero direction "
+                             "[x, y]")
+                raise _Failed
+        th = self.sketch_frames.get(body, (0.0, 0.0, 0.0))[2]
+        c, s = math.cos(th), math.sin(th)
+        return (c * d[0] + s * d[1], -s * d[0] + c * d[1])
+
+    def section(self, key: str, kind: type = dict):
+        val = self.doc.get(key, kind())
+        return val if isinstance(val, kind) else kind()
+
+    def coord_value_kind(self, cname: str, rate: bool) -> str:
+        travel = self.coord_kinds.get(cname) == "travel"
+        if rate:
+            return "velocity" if travel else "angular_velocity"
+        return "length" if travel else "angle"
