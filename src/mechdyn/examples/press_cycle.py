@@ -282,8 +282,8 @@ def run(cycles: int = 4, t_end: float | None = None, **options):
     t_end : float, optional
         End time, s, instead.
     **options
-        Go to :func:`mechdyn.simulate_events.simulate_events` (default rtol
-        1e-9, output every 0.5 ms).
+        Go to :func:`mechdyn.simulate_events.simulate_events`, the segment loop of
+        :func:`mechdyn.simulate` (here rtol 1e-9 and output every 0.5 ms unless given).
 
     Returns
     -------
