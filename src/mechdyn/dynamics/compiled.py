@@ -22,8 +22,6 @@ a while and is announced on stderr.
 
 from __future__ import annotations
 
-import sys
-import threading
 import time
 
 import numpy as np
@@ -44,15 +42,20 @@ from ..kernels.loads_numba import (
     Unsupported,
     forces,
 )
-from ..kernels.rows_numba import NUMBA, njit, rows_jacobian, rows_quad, rows_values
+from ..kernels.rows_numba import (
+    NUMBA,
+    compiling,
+    njit,
+    rows_jacobian,
+    rows_quad,
+    rows_values,
+)
 from ..model.rows import concat
 from ..model.variable import lower, parse
 from .forces import force_model
 
 __all__ = ["compile_kernel", "compile_mode_kernel", "CompiledKernel", "numba_available"]
 
-#: seconds after which the first compilation is announced on stderr
-ANNOUNCE_AFTER = 2.0
 
 # dims: n_c (constraint rows), n_i (independent coordinates), n_q (declared coordinates),
 # n_v (rows of table variables); the row arrays hold these four blocks in this order
@@ -514,24 +517,14 @@ _COMPILED = {"done": False, "time": 0.0}
 
 def _warm_up(args) -> float:
     """Compile (or load from the disk cache) the kernels, once per process; a
-    compilation that takes longer than ANNOUNCE_AFTER seconds is announced on stderr
+    compilation that takes longer than a few seconds is announced on stderr
     (it happens on the first run of a fresh installation only)."""
     if _COMPILED["done"]:
         return 0.0
     ip, fp, ri, rf, dims, n_x = args
     ni = int(dims[D_NI])
     t0 = time.perf_counter()
-    said = []
-
-    def announce():
-        said.append(True)
-        print("mechdyn: compiling the numba kernels (first run only, cached afterwards) ...",
-              file=sys.stderr, flush=True)
-
-    timer = threading.Timer(ANNOUNCE_AFTER, announce)
-    timer.daemon = True
-    timer.start()
-    try:
+    with compiling("numba kernels of the dynamics"):
         ws = np.zeros(_work_size(n_x, ni))
         _positions(np.zeros(ni), ip, fp, ri, rf, dims, ws)
         st = np.zeros(1, dtype=np.int64)
@@ -539,13 +532,8 @@ def _warm_up(args) -> float:
         nq, nc = int(dims[D_NQ]), int(dims[D_NC])
         _full(0.0, np.zeros(ni), np.zeros(ni), ip, fp, ri, rf, dims, ws, np.empty(2 * ni + 1),
               np.empty(2 * n_x + 3 * nq + nc), st)
-    finally:
-        timer.cancel()
     _COMPILED["done"] = True
     _COMPILED["time"] = time.perf_counter() - t0
-    if said:
-        print(f"mechdyn: kernels compiled in {_COMPILED['time']:.1f} s", file=sys.stderr,
-              flush=True)
     return _COMPILED["time"]
 
 

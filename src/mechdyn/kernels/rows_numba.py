@@ -9,9 +9,18 @@ Python (slow, but the same results).
 
 from __future__ import annotations
 
+import sys
+import threading
+import time
+from contextlib import contextmanager
+
 import numpy as np
 
-__all__ = ["rows_values", "rows_jacobian", "rows_quad", "njit", "NUMBA"]
+__all__ = ["rows_values", "rows_jacobian", "rows_quad", "njit", "NUMBA", "compiling",
+           "ANNOUNCE_AFTER"]
+
+#: seconds after which a compilation is announced on stderr
+ANNOUNCE_AFTER = 2.0
 
 try:  # pragma: no cover - depends on the environment
     import numba
@@ -20,6 +29,37 @@ try:  # pragma: no cover - depends on the environment
 except ImportError:  # pragma: no cover
     numba = None
     NUMBA = False
+
+
+@contextmanager
+def compiling(what: str, after: float = ANNOUNCE_AFTER):
+    """Announce on stderr a first compilation of ``what`` that takes longer than
+    ``after`` seconds, and how long it took (a later run loads the cached code and
+    says nothing).
+
+    Examples
+    --------
+    >>> with compiling("nothing much"):
+    ...     pass
+    """
+    t0 = time.perf_counter()
+    said = []
+
+    def announce():
+        said.append(True)
+        print(f"mechdyn: compiling the {what} (first run only, cached afterwards) ...",
+              file=sys.stderr, flush=True)
+
+    timer = threading.Timer(after, announce)
+    timer.daemon = True
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
+        if said:
+            print(f"mechdyn: {what} compiled in {time.perf_counter() - t0:.1f} s",
+                  file=sys.stderr, flush=True)
 
 
 def njit(fn):

@@ -281,7 +281,10 @@ class Kernel:
         rng = np.random.default_rng(12345)
         L = model.length_scale
         xs = rng.normal(size=(3, self.n_x)) * np.tile([L, L, 3.0], nb)
-        J = self.system(xs, rng.normal(size=(3, self.n_q)))[1]
+        with rows_numba.compiling("numba kernels of the kinematic sweep"):
+            J = self.system(xs, rng.normal(size=(3, self.n_q)))[1]
+            if self.compiled:  # the one-position drivers too
+                self.system1(xs[0], np.zeros(self.n_q))
         self.pattern = np.any(J != 0, axis=0)
         self._arange = np.arange(self.n_eq)
         self.blocks = _BlockSolver(self.pattern) if self.square else None
