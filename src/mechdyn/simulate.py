@@ -1,10 +1,13 @@
 """Forward dynamics: integrate the equations of motion and record a :class:`Trajectory`.
 
-``simulate`` composes :mod:`mechdyn.dynamics.lagrange` (the right-hand side
-q'' = A^-1 (Q - c), positions re-solved from q at every evaluation) with an
-integrator of :mod:`mechdyn.integrate`.  After every accepted step the positions
-are re-solved from q and checked for a dead position; q, q' and q'' are
-checked finite.  A run that cannot go on (dead or toggle position, a mechanism
+``simulate`` is the entry of every run.  A model with switches, stops, contacts or
+coordinate locks goes mode by mode (:mod:`mechdyn.simulate_events`); a
+fixed-structure model is one segment of the same segment integrator
+(:func:`mechdyn.integrate.segment.run_segment`), with the equations of
+:mod:`mechdyn.dynamics.lagrange` (q'' = A^-1 (Q - c), positions re-solved from q at
+every evaluation, on the compiled kernel when it can).  After every accepted step
+the positions are re-solved from q and checked for a dead position; q, q' and q''
+are checked finite.  A run that cannot go on (dead or toggle position, a mechanism
 that cannot be assembled, a singular mass matrix, a failing integrator) ends
 with its ``status`` and a ``message`` naming the time, the coordinates and the
 joints concerned, and returns everything computed so far.

@@ -1,31 +1,31 @@
-"""The event loop of variable-structure mechanisms: locks, stops, contacts, switches.
+"""The segment loop of variable-structure mechanisms: locks, stops, contacts, switches.
 
-The motion is integrated piecewise, one *mode* (set of active switchable
-constraints, ``State.mode``) at a time:
+The motion is integrated piecewise, one *mode* (the set of active switchable
+constraints, :class:`~mechdyn.model.state.Mode`) at a time:
 
 1. in a mode, the independent coordinates q_I (a subset of the declared
-   coordinates) are integrated with SciPy's DOP853 (rtol 1e-10 by default), or
-   RK45, or the project's fixed-step ``rk4`` / ``wilson``;
-   positions are re-solved from q_I at every evaluation, so every constraint
-   of the mode holds to round-off;
-2. after every accepted step the event functions are evaluated; a sign change
-   is located to machine precision by Brent's method on the step's dense
-   output.  Events: switch conditions (a variable crossing a value in a
-   direction, command times), gaps of open stops and contacts closing, forces
-   of closed ones falling to zero, sticking contacts reaching the friction
-   cone, slipping contacts coming to rest;
-3. at an event the switch is applied: releases (no jump), engagements and
-   closures (an impact: :func:`mechdyn.dynamics.impact.impact`, plastic or
-   with restitution), then :func:`mechdyn.dynamics.contact.resolve_mode`
-   decides by complementarity which touching constraints stay closed and
-   whether they stick or slip; the independent coordinates of the new mode
-   are chosen, and the integration restarts from the consistent state.
+   coordinates) are integrated by one segment of
+   :func:`mechdyn.integrate.segment.run_segment`, with any integrator of the
+   package (DOP853 by default, rtol 1e-10 as every run), the right-hand side on
+   the compiled kernel of the mode (:mod:`mechdyn.dynamics.mode_equations`);
+   positions are re-solved from q_I at every evaluation, so every constraint of
+   the mode holds to round-off, and a singular position of the mode stops the
+   run with its time and coordinates;
+2. after every accepted step the event functions of the mode
+   (:func:`mechdyn.dynamics.switching.event_functions`: switch conditions and
+   schedules, gaps of open stops and contacts, forces of closed ones, the friction
+   cone of a sticking contact, the slip velocity of a slipping one) and the
+   caller's events are evaluated; the first crossing is located by Brent's method
+   on the step's dense output;
+3. at an event the switch is applied (:func:`mechdyn.dynamics.switching.apply_switch`:
+   releases, engagements, the impact, the new mode by complementarity, its
+   coordinates) and the next segment starts from the consistent state.
 
-All declared coordinates are recorded in every mode (dependent ones measured
-on the pose), so one :class:`~mechdyn.results.trajectory.Trajectory` covers
-the whole run; its ``events`` list holds a :class:`SwitchEvent` per switch.
-Per-sample mode, constraint forces and forces on the frame are in
-``trajectory.stats["variable_structure"]`` (see :func:`simulate_events`).
+All declared coordinates are recorded in every mode (dependent ones measured on
+the pose), so one :class:`~mechdyn.results.trajectory.Trajectory` covers the whole
+run; its ``events`` list holds an :class:`~mechdyn.integrate.events.EventRecord`
+per switching instant and per caller's event.  Per-sample mode, constraint forces
+and forces on the frame are in ``trajectory.stats["variable_structure"]``.
 """
 
 from __future__ import annotations
