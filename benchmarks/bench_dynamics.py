@@ -17,6 +17,11 @@ import time
 
 import numpy as np
 
+from mechdyn.dynamics.compiled import numba_available
+from mechdyn.examples import andrews
+from mechdyn.examples.paper_case import motor_curve, press_idle
+from mechdyn.simulate import simulate
+
 
 def _andrews_error(model, tr, andrews):
     ang = andrews.test_set_angles(model, tr.x[-1])
@@ -34,9 +39,6 @@ def _best_of(fn, repeat=3):
 
 
 def andrews_table(backend="auto", repeat=3):
-    from mechdyn.examples import andrews
-    from mechdyn.simulate import simulate
-
     model = andrews.build().compile()
     t0 = time.perf_counter()
     first = simulate(model, 0.001, backend=backend)  # compile / load the kernel
@@ -59,9 +61,6 @@ def andrews_table(backend="auto", repeat=3):
 
 
 def press_run(seconds=1.0):
-    from mechdyn.examples.paper_case import motor_curve, press_idle
-    from mechdyn.simulate import simulate
-
     # over 1 s a constant torque would run the unloaded press away: a motor-like curve
     model = press_idle(drive_torque=motor_curve()).compile()
     out = []
@@ -75,9 +74,6 @@ def press_run(seconds=1.0):
 
 def run(quick: bool = False) -> list[dict]:
     """Rows for ``python -m benchmarks``: name, value, unit, note."""
-    from mechdyn.examples import andrews
-    from mechdyn.simulate import simulate
-
     model = andrews.build().compile()
     t0 = time.perf_counter()
     first = simulate(model, 0.001)
@@ -99,8 +95,6 @@ def run(quick: bool = False) -> list[dict]:
 
 
 def main() -> None:
-    from mechdyn.dynamics.compiled import numba_available
-
     print("== bench_dynamics: Andrews' squeezer to t = 0.03 s (Test Set reference) ==")
     print(f"numba available: {numba_available()}")
     for backend in ("auto", "numpy"):

@@ -15,27 +15,26 @@ import time
 
 import numpy as np
 
+from mechdyn import examples
+from mechdyn.dynamics.kinetostatics import kinetostatics
+from mechdyn.dynamics.prescribed_motion import _Positions
+from mechdyn.dynamics.reactions import _inverse
+from mechdyn.kinematics.constraints import coordinates
+
 N_POSITIONS = 3600
 OMEGA = 40 * 2 * np.pi / 60  # rad/s, 40 strokes per minute
 
 
 def _model():
-    from mechdyn import examples
-
     return examples.load("toggle_press").compile()
 
 
 def vectorized(model, values):
-    from mechdyn.dynamics.kinetostatics import kinetostatics
-
     return kinetostatics(model, over="phi", speed=OMEGA, values=values)
 
 
 def per_position_loop(model, values):
     """The same analysis, one position at a time; returns the driving torques (n,)."""
-    from mechdyn.dynamics.kinetostatics import _inverse, _Positions
-    from mechdyn.kinematics.constraints import coordinates
-
     lay = model.layout()
     didx = np.array([model.coordinate_index("phi")])
     pos = _Positions(model, lay, didx)

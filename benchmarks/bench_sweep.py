@@ -13,13 +13,15 @@ import time
 
 import numpy as np
 
+from mechdyn import examples
+from mechdyn.kinematics import accelerations, solve_position, velocity_analogs
+from mechdyn.kinematics.sweep import initial_coordinates, sweep
+
 N_POINTS = 3600
 
 
 def toggle_press_model():
     """The bundled toggle press (``examples/toggle_press.toml``), compiled."""
-    from mechdyn import examples
-
     return examples.load("toggle_press").compile()
 
 
@@ -38,9 +40,6 @@ def _best(fn, repeats: int) -> tuple[float, float]:
 
 
 def run(quick: bool = False) -> list[dict]:
-    from mechdyn.kinematics import accelerations, solve_position, velocity_analogs
-    from mechdyn.kinematics.sweep import initial_coordinates, sweep
-
     model = toggle_press_model()
     k = 0
     phi0 = float(initial_coordinates(model)[k])

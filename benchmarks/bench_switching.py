@@ -19,13 +19,13 @@ import time
 
 import numpy as np
 
+import mechdyn
+
 T_END = 0.4  # the switched run: idle, engage, work stroke, release
 T_FIXED = 0.11  # the fixed-structure run, inside its regular range
 
 
 def _models():
-    import mechdyn
-
     switched = mechdyn.examples.load("press_cycle").compile()
     bare = mechdyn.examples.load("press_cycle")
     for key in ("switches", "stops", "contacts", "coordinate_locks"):
@@ -36,8 +36,6 @@ def _models():
 def compare(t_end: float = T_END, repeat: int = 3):
     """Best wall times per simulated second of the switched and the fixed-structure
     press, and their trajectories."""
-    import mechdyn
-
     switched, fixed = _models()
     mechdyn.simulate(fixed, 1e-3, progress=False)  # compile / load the kernels first
     best = {"switched": np.inf, "fixed": np.inf}
