@@ -360,6 +360,10 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
                 eom.positions(y[:n], t)
     except Stop as exc:
         status, message = exc.status, exc.message
+    except KeyboardInterrupt:
+        status = Status.INTERRUPTED
+        message = (f"interrupted (Ctrl-C) after t = {T[-1]:.9g} s; the samples computed so far "
+                   f"are kept")
     except (MechdynError, FloatingPointError, ArithmeticError, np.linalg.LinAlgError) as exc:
         if isinstance(exc, ModelError) and not isinstance(exc, IntegratorOptionError):
             bar.close()

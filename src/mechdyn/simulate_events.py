@@ -409,6 +409,11 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         except Stop as exc:
             status, message = exc.status, exc.message
             break
+        except KeyboardInterrupt:
+            status = Status.INTERRUPTED
+            message = (f"interrupted (Ctrl-C) after t = {rec['t'][-1] if rec['t'] else t:.9g} s; "
+                       f"the samples computed so far are kept")
+            break
         except (MechdynError, np.linalg.LinAlgError, ValueError) as exc:
             if isinstance(exc, IntegratorOptionError):
                 raise

@@ -92,3 +92,18 @@ def test_samples_every_step_by_default_or_at_t_eval(stop):
 def test_analogs_formulation_on_a_switched_run_is_warned_about():
     with pytest.warns(IntegratorWarning, match="formulation='analogs'"):
         _run(True, formulation="analogs")
+
+
+@PATHS
+def test_an_interrupted_run_keeps_its_samples_and_says_when(stop):
+    """Ctrl-C (KeyboardInterrupt) during a run ends it with status "interrupted" and the
+    samples computed so far, instead of a traceback that loses them."""
+    def g(t, q, qdot):
+        if t > 0.05:
+            raise KeyboardInterrupt
+        return 1.0
+
+    tr = _run(stop, events=[Event(g, "ctrl-c")])
+    assert tr.status == "interrupted" and "interrupted" in tr.message
+    assert tr.t.size > 3 and 0.0 < tr.t[-1] <= 0.06
+    assert np.all(np.isfinite(tr.q))
