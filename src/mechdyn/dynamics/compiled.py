@@ -50,6 +50,8 @@ from ..kernels.rows_numba import (
     rows_quad,
     rows_values,
 )
+from ..mechanism.mechanism import Mechanism
+from ..model import Model
 from ..model.rows import concat
 from ..model.variable import lower, parse
 from .forces import force_model
@@ -515,22 +517,41 @@ class CompiledKernel:
 _COMPILED = {"done": False, "time": 0.0}
 
 
-def _warm_up(args) -> float:
-    """Compile (or load from the disk cache) the kernels, once per process; a
-    compilation that takes longer than a few seconds is announced on stderr
+def _pendulum_arrays():
+    """The packed arrays of a small pendulum (a bar pinned to the ground, its angle as
+    coordinate, gravity): the kernels are generic over their arrays, so compiling them
+    on this model compiles them for every model -- and never evaluates a user's model
+    at a position its run does not visit (a spring whose ends meet at the sketch ...)."""
+    mech = Mechanism("warm-up pendulum", gravity=(0.0, -9.81))
+    mech.add_body("bar", mass=1.0, inertia=0.1, com=(0.5, 0.0), pose=(0.0, 0.0, 0.0))
+    mech.add_revolute("O", "ground", "bar")
+    mech.add_coordinate("theta", kind="angle", body="bar")
+    model = Model(mech)
+    ip, fp = LoadPacker(model, force_model(model)).pack()
+    ri, rf = concat(model.n_bodies, model.joint_rows, model.coordinate_rows,
+                    model.coordinate_rows).packed()
+    dims = np.array([len(model.joint_rows), 1, 1, 0], dtype=np.int64)
+    x0 = np.array(model.x_sketch, dtype=float)
+    return ip, fp, ri, rf, dims, model.n_x, x0
+
+
+def _warm_up() -> float:
+    """Compile (or load from the disk cache) the kernels, once per process, on a small
+    pendulum; a compilation that takes longer than a few seconds is announced on stderr
     (it happens on the first run of a fresh installation only)."""
     if _COMPILED["done"]:
         return 0.0
-    ip, fp, ri, rf, dims, n_x = args
-    ni = int(dims[D_NI])
     t0 = time.perf_counter()
     with compiling("numba kernels of the dynamics"):
+        ip, fp, ri, rf, dims, n_x, x0 = _pendulum_arrays()
+        ni, nq, nc = int(dims[D_NI]), int(dims[D_NQ]), int(dims[D_NC])
         ws = np.zeros(_work_size(n_x, ni))
-        _positions(np.zeros(ni), ip, fp, ri, rf, dims, ws)
+        ws[:n_x] = x0
+        q, qd = np.array([0.3]), np.array([1.0])
         st = np.zeros(1, dtype=np.int64)
-        _first_order(0.0, np.zeros(2 * ni + 1), ip, fp, ri, rf, dims, ws, st)
-        nq, nc = int(dims[D_NQ]), int(dims[D_NC])
-        _full(0.0, np.zeros(ni), np.zeros(ni), ip, fp, ri, rf, dims, ws, np.empty(2 * ni + 1),
+        _positions(q, ip, fp, ri, rf, dims, ws)
+        _first_order(0.0, np.concatenate([q, qd, [0.0]]), ip, fp, ri, rf, dims, ws, st)
+        _full(0.0, q, qd, ip, fp, ri, rf, dims, ws, np.empty(2 * ni + 1),
               np.empty(2 * n_x + 3 * nq + nc), st)
     _COMPILED["done"] = True
     _COMPILED["time"] = time.perf_counter() - t0
@@ -575,8 +596,7 @@ def compile_mode_kernel(model, force_model, constraint_rows, independent):
     ri, rf = concat(model.n_bodies, constraint_rows, crd.take(independent), crd, var).packed()
     dims = np.array([len(constraint_rows), independent.size, model.n_q, len(var)],
                     dtype=np.int64)
-    args = (ip, fp, ri, rf, dims, model.n_x)
-    ct = _warm_up(args)
+    ct = _warm_up()
     return CompiledKernel(ip, fp, ri, rf, dims, model.n_x, ct), ""
 
 
