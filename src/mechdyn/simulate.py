@@ -44,7 +44,7 @@ from .initial_state import initial_state
 from .integrate.base import DEFAULT_RTOL, IntegratorOptionError, IntegratorWarning
 from .integrate.driver import make_integrator, sample_times
 from .integrate.events import as_events
-from .integrate.segment import Stop, arm, run_segment, user_event_functions, user_event_records
+from .integrate.segment import Stop, run_to_end, user_event_functions
 from .kinematics.assembly import DEAD_RCOND, singularity, solve_position
 from .kinematics.constraints import residual
 from .model import as_model
@@ -331,33 +331,20 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
         eom.watching = True
 
     efns = user_event_functions(ev)
-    t, y = t0, np.concatenate([q_init, qd_init, [0.0]])
-    fresh: set = set()
+    y0 = np.concatenate([q_init, qd_init, [0.0]])
     try:
         with np.errstate(over="raise", invalid="raise", divide="raise"):
-            while True:  # one segment, restarted at each of the caller's events
-                arm(efns, t, evaluate(t, y), fresh)
-                hit, k_eval = run_segment(
-                    integ, eom, t, y, t_end_f, efns, evaluate=evaluate,
-                    after_step=after_step, sample=sample,
-                    t_eval=np.zeros(0) if te is None else te, next_out=k_eval,
-                    every_step=te is None, stats=counts, bar=bar)
-                if hit is None:
-                    break
-                t, fired, dense = hit
-                y = dense(t)
-                records.extend(user_event_records(fired, t, y, n))
-                fresh = {(e.kind, e.key) for e in fired}
-                terminal = [e for e in fired if e.data.terminal]
-                if terminal or t >= t_end_f:
-                    if te is None and T[-1] < t:
-                        q, v, w = y[:n], y[n:2 * n], y[2 * n:]
-                        record(t, q, v, eom.qddot(t, q, v), eom.positions(q, t), w)
-                    if terminal:
-                        status = Status.EVENT
-                        message = f"terminal event {terminal[0].key!r} at t = {t:.9g} s"
-                    break
-                eom.positions(y[:n], t)
+            t, y, _, terminal = run_to_end(
+                integ, eom, t0, y0, t_end_f, efns, evaluate=evaluate, after_step=after_step,
+                sample=sample, t_eval=None if te is None else te[k_eval:],
+                every_step=te is None, stats=counts, n=n, bar=bar,
+                restart=lambda t_, y_: eom.positions(y_[:n], t_), records=records)
+            if y is not None and te is None and T[-1] < t:
+                q, v, w = y[:n], y[n:2 * n], y[2 * n:]
+                record(t, q, v, eom.qddot(t, q, v), eom.positions(q, t), w)
+            if terminal is not None:
+                status = Status.EVENT
+                message = f"terminal event {terminal.key!r} at t = {t:.9g} s"
     except Stop as exc:
         status, message = exc.status, exc.message
     except KeyboardInterrupt:

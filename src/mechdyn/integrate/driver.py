@@ -17,7 +17,7 @@ from .base import DEFAULT_RTOL, Integrator, IntegratorOptionError
 from .events import as_events
 from .runge_kutta import RungeKutta4
 from .scipy_ivp import SCIPY_METHODS, ScipyIntegrator
-from .segment import arm, run_segment, user_event_functions, user_event_records
+from .segment import run_to_end, user_event_functions
 from .wilson import Wilson
 
 __all__ = ["INTEGRATORS", "make_integrator", "solve", "Solution", "sample_times"]
@@ -153,34 +153,21 @@ def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end
 
     eqs = _Equations(rhs)
     y = np.concatenate([q0, v0, wz])
-    k_eval = 0
     if te is None:
         push(t0, y)
     else:
-        while k_eval < te.size and te[k_eval] <= t0:
+        for _ in range(int(np.sum(te <= t0))):
             push(t0, y)
-            k_eval += 1
-    records, status, counts, t = [], "success", {"steps": 0, "rejected": 0, "evaluations": 0}, t0
-    fresh: set = set()
-    while True:  # one segment, restarted at each non-terminal event
-        arm(efns, t, _State(y, n), fresh)
-        hit, k_eval = run_segment(
-            integ, eqs, t, y, t_end, efns, evaluate=lambda t_, y_: _State(y_, n),
-            after_step=lambda step, y_: None,
-            sample=lambda ts, y_, step, ev: push(ts, y_, step.qddot if ts == step.t else None),
-            t_eval=np.zeros(0) if te is None else te, next_out=k_eval, every_step=te is None,
-            stats=counts, n=n)
-        if hit is None:
-            break
-        t, fired, dense = hit
-        y = dense(t)
-        records.extend(user_event_records(fired, t, y, n))
-        fresh = {(e.kind, e.key) for e in fired}
-        if any(e.data.terminal for e in fired) or t >= t_end:
-            if te is None:
-                push(t, y)
-            status = "event" if any(e.data.terminal for e in fired) else status
-            break
+        te = te[te > t0]
+    counts = {"steps": 0, "rejected": 0, "evaluations": 0}
+    t, y_end, records, terminal = run_to_end(
+        integ, eqs, t0, y, t_end, efns, evaluate=lambda t_, y_: _State(y_, n),
+        after_step=lambda step, y_: None,
+        sample=lambda ts, y_, step, ev: push(ts, y_, step.qddot if ts == step.t else None),
+        t_eval=te, every_step=te is None, stats=counts, n=n)
+    if y_end is not None and te is None:
+        push(t, y_end)
+    status = "event" if terminal is not None else "success"
     return Solution(np.array(out_t), np.array(out_q).reshape(-1, n),
                     np.array(out_v).reshape(-1, n), np.array(out_a).reshape(-1, n),
                     np.array(out_w).reshape(len(out_t), -1), records,
