@@ -70,7 +70,7 @@ from .kinematics.constraints import extend
 from .model import Model
 from .progress import Progress
 from .results.events import format_events
-from .results.trajectory import Trajectory
+from .results.trajectory import SwitchedSamples, Trajectory
 
 __all__ = ["simulate_events", "SwitchEvent", "format_events", "needs_event_loop"]
 
@@ -555,7 +555,7 @@ def _finish(model, rec, events, stats, wall0, status, message, sm) -> Trajectory
     lostc = np.array(rec["lost"], float)
     stats = dict(stats)
     stats["wall_time_s"] = time.perf_counter() - wall0
-    stats["variable_structure"] = dict(
+    stats["variable_structure"] = SwitchedSamples(
         mode=list(rec["mode"]), modes=modes,
         mode_index=np.array([modes.index(m) for m in rec["mode"]], int),
         frame_force=arr("frame", 2), forces=forces_arr, impact_losses=lostc,

@@ -171,17 +171,12 @@ def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
 
 
 def _variable_structure(trajectory):
-    """The ``stats["variable_structure"]`` record of a switched run, else None."""
-    if trajectory is None:
+    """The per-sample modes of a switched run (``trajectory.switching``), else None."""
+    vs = getattr(trajectory, "switching", None) if trajectory is not None else None
+    if vs is None:
         return None
-    stats = getattr(trajectory, "stats", None)
-    vs = stats.get("variable_structure") if isinstance(stats, Mapping) else None
-    if not vs or "mode" not in vs:
-        return None
-    if len(vs["mode"]) != np.size(trajectory.t):
+    if len(vs.mode) != np.size(trajectory.t):
         raise ValueError("the trajectory's variable_structure record does not match its "
-                         f"samples ({len(vs['mode'])} modes for {np.size(trajectory.t)} "
+                         f"samples ({len(vs.mode)} modes for {np.size(trajectory.t)} "
                          f"samples)")
     return vs
-
-

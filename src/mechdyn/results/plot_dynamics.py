@@ -40,7 +40,7 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
     names = list(coordinates) if coordinates is not None else list(traj.coordinate_names)
     idx = [traj.coordinate_names.index(n) for n in names]
     show_energy = bool(energy and traj.energy and traj.t.size)
-    vs = traj.stats.get("variable_structure") if traj.t.size else None
+    vs = traj.switching if traj.t.size else None
     rows = 3 + (1 if show_energy else 0) + (1 if vs else 0)
     fig, axes = plt.subplots(rows, 1, figsize=(8.0, 2.4 * rows), sharex=True,
                              constrained_layout=True)

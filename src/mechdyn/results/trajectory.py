@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -10,10 +11,55 @@ from ..errors import ModelError, did_you_mean
 from ..kinematics.analogs import accelerations
 from ..kinematics.constraints import point_acceleration, point_position, point_velocity
 
-__all__ = ["Trajectory"]
+__all__ = ["Trajectory", "SwitchedSamples"]
 
 #: statuses of a run that reached its end (or a terminal event)
 SUCCESS_STATUSES = ("success", "event")
+
+
+@dataclass(frozen=True)
+class SwitchedSamples(Mapping):
+    """What a variable-structure run records per sample beyond the motion (typed; it also
+    reads as the mapping ``trajectory.stats["variable_structure"]`` it used to be).
+
+    Attributes
+    ----------
+    mode : list of Mode
+        The mode of every sample, shape (n,).
+    modes : list of Mode
+        The distinct modes in the order they appeared.
+    mode_index : ndarray of int, shape (n,)
+        Index of each sample's mode in ``modes``.
+    frame_force : ndarray, shape (n, 2)
+        Force the frame receives (reactions and the ground ends of springs), N.
+    forces : dict
+        Per joint, lock, stop and contact: its reaction per sample ((n, 2) or (n, 3):
+        force on the child from the parent at the joint point, N, and moment, N m;
+        (n,) normal force of a stop or contact, N).
+    impact_losses : ndarray, shape (n,)
+        Kinetic energy lost in impacts up to each sample, J.
+    penetration : float
+        Largest penetration of a stop or contact seen, m.
+    """
+
+    mode: list
+    modes: list
+    mode_index: np.ndarray
+    frame_force: np.ndarray
+    forces: dict
+    impact_losses: np.ndarray
+    penetration: float = 0.0
+
+    def __getitem__(self, key):
+        if key not in self.__dataclass_fields__:
+            raise KeyError(key)
+        return getattr(self, key)
+
+    def __iter__(self):
+        return iter(self.__dataclass_fields__)
+
+    def __len__(self) -> int:
+        return len(self.__dataclass_fields__)
 
 
 @dataclass(frozen=True)
@@ -40,7 +86,9 @@ class Trajectory:
         Occurrences of the requested events, in time order.
     stats : dict
         ``steps``, ``rejected``, ``evaluations`` (right-hand sides), ``wall_time_s``,
-        ``integrator``, ``formulation``, ``backend`` and the integrator's settings.
+        ``integrator``, ``formulation``, ``backend`` and the integrator's settings; for a
+        variable-structure run also ``segments`` and ``variable_structure``, a
+        :class:`SwitchedSamples` (see :attr:`switching`).
     energy : dict or None
         Arrays of shape (n,): ``kinetic`` T, ``potential`` U, ``work_nc`` (work of
         the non-conservative forces since t0: drives, applied forces and torques,
@@ -175,10 +223,16 @@ class Trajectory:
             cols["W_nc_J"] = e["work_nc"]
             cols["E_balance_J"] = e["balance"]
             cols["residual"] = e["residual"]
-        vs = self.stats.get("variable_structure")
+        vs = self.switching
         if vs and self.t.size:
             cols.update(_switched_columns(vs))
         return pd.DataFrame(cols)
+
+    @property
+    def switching(self) -> SwitchedSamples | None:
+        """The per-sample modes and element forces of a variable-structure run, else None."""
+        vs = self.stats.get("variable_structure")
+        return vs if isinstance(vs, SwitchedSamples) else None
 
     def xddot(self) -> np.ndarray:
         """Body frame accelerations xddot = B q'' + b, shape (n, n_x) (needs ``model``)."""
