@@ -198,7 +198,6 @@ def evaluate(value, ctx: LoadContext, where: str = "load"):
     k = int(np.argmax(~np.isfinite(np.ravel(out))))
     raise ModelError(f"{where}: value is not finite ({float(np.ravel(out)[k])!r}) at "
                          f"t = {np.ravel(np.broadcast_to(ctx.t, shape))[k]:.6g} s")
-    return out
 
 
 # ====================================================================== the loads
@@ -352,14 +351,6 @@ class ForceModel:
         if hasattr(tq, "omega"):  # TorqueSpeedCurve
             return tq(w[()])
         return evaluate(tq, ctx, f"drive {dr.name!r}")
-
-    def add_gravity(self, F, x):
-        """Add the weight of every body at its centre of mass to F (..., n_x) (in place)."""
-        m = self.model
-        if self._weights is not None:
-            _add_weights(self._weights, m, np.asarray(F).reshape(np.shape(x)[:-1]
-                                                                 + (m.n_bodies, 3)), x)
-        return F
 
     # ----------------------------------------------------------------- energy
     def potential_energy(self, x):

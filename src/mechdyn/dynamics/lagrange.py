@@ -42,7 +42,7 @@ import numpy as np
 from ..errors import IntegrationError, ModelError
 from ..kinematics.analogs import acceleration_bias, default_displacement
 from ..kinematics.assembly import assemble, solve_position
-from ..kinematics.constraints import coordinates_jacobian, extend, jacobian, residual
+from ..kinematics.constraints import coordinates_jacobian, extend, jacobian
 from ..model import Model
 from .forces import com_arms, force_model
 from .inertia import drive_inertia
@@ -420,11 +420,6 @@ class EquationsOfMotion:
         T = 0.5 * float(qdot @ tm.A @ qdot)
         return {"kinetic": T, "potential": float(potential_energy(self.model, tm.x)),
                 "power_nc": tm.power_nc}
-
-    def constraint_residual(self, x) -> np.ndarray:
-        """Largest constraint residual per pose, m (or rad), shape (...)."""
-        r = residual(self.model, x, self.layout)
-        return np.max(np.abs(r), axis=-1) if r.shape[-1] else np.zeros(np.shape(x)[:-1])
 
 
 def equations_of_motion(model_or_mechanism, formulation: str = "exact", **kwargs

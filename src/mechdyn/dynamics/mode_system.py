@@ -192,10 +192,6 @@ class ModeSystem:
         """Jacobian of every row, shape (n_rows, n_x)."""
         return RN.jacobian(self.rowset, x)
 
-    def row_quad(self, x, xdot) -> np.ndarray:
-        """Velocity-quadratic part of every row's second derivative, shape (n_rows,)."""
-        return RN.quad(self.rowset, x, xdot)
-
     def row_labels(self) -> list[str]:
         """A label per row (joint name + component, then the switchable rows)."""
         return list(self.rowset.labels)
