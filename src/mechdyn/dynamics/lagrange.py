@@ -10,15 +10,14 @@ Two formulations evaluate the same physics:
 
 ``"exact"`` (default)
     With the exact velocity analogs B = dx/dq and the acceleration bias b
-    (``xddot = B q'' + b``), the centre-of-mass analogs are B_c = T(x) B and
-    b_c = T(x) b + (-omega^2 A_k c_k, 0) per body k, where T(x) maps the frame
-    velocity (rdot, omega) to (rdot + omega R A_k c_k, omega) (R: +90 deg
-    rotation, A_k the body's rotation, c_k its centre of mass in the body
-    frame).  Then, with M = diag(m_k, m_k, J_ck),
+    (``xddot = B q'' + b``), and the frame mass matrix M_x(x) and centripetal
+    term h(x, xdot) of :mod:`mechdyn.dynamics.inertia` (the body-frame origins
+    need not be the centres of mass),
 
-        A = B_c^T M B_c,   c = B_c^T M b_c,   Q = B^T F + Q_drive
+        A = B^T M_x B,   c = B^T (M_x b + h),   Q = B^T F + Q_drive
 
-    (F: applied forces conjugate to x, from ``force_model(model).applied``).
+    (F: applied forces conjugate to x, from ``force_model(model).applied``), plus
+    the rotor and gear inertia of the drives on their coordinates.
 
 ``"analogs"``
     The source paper's method (METHOD.md section 1): velocity analogs of the
@@ -45,10 +44,10 @@ from ..kinematics.assembly import assemble, solve_position
 from ..kinematics.constraints import coordinates_jacobian, extend, jacobian
 from ..model import Model
 from .forces import com_arms, force_model
-from .inertia import drive_inertia
+from .inertia import drive_inertia, frame_mass_matrix, mass_matrix_x
 
 __all__ = ["EquationsOfMotion", "Terms", "FORMULATIONS", "equations_of_motion", "drive_inertia",
-           "com_analogs", "kinetic_energy", "potential_energy", "mass_matrix"]
+           "kinetic_energy", "potential_energy", "mass_matrix"]
 
 #: the formulations of the equations of motion
 FORMULATIONS = ("exact", "analogs")
@@ -96,46 +95,11 @@ class Terms:
     power_nc: float
 
 
-def com_analogs(model: Model, x, B, b=None, xdot=None):
-    """Centre-of-mass analogs B_c = T(x) B and bias b_c = T(x) b - omega^2 A c.
-
-    Parameters
-    ----------
-    x : array_like, shape (..., n_x)
-    B : array_like, shape (..., n_x, n_q)
-    b, xdot : array_like, shape (..., n_x), optional
-        Frame acceleration bias and frame velocities (both needed for ``b_c``).
-
-    Returns
-    -------
-    Bc : ndarray, shape (..., n_x, n_q)
-        Rows (vx_c, vy_c, omega) per body.
-    bc : ndarray, shape (..., n_x) or None
-    """
-    arm = com_arms(model, x)
-    B = np.asarray(B, float)
-    nb = model.n_bodies
-    Bk = B.reshape(B.shape[:-2] + (nb, 3, B.shape[-1]))
-    Bc = Bk.copy()
-    Bc[..., 0, :] -= arm[..., 1, None] * Bk[..., 2, :]
-    Bc[..., 1, :] += arm[..., 0, None] * Bk[..., 2, :]
-    Bc = Bc.reshape(B.shape)
-    if b is None:
-        return Bc, None
-    b = np.asarray(b, float)
-    bk = b.reshape(b.shape[:-1] + (nb, 3))
-    w2 = np.asarray(xdot, float)[..., 2::3] ** 2
-    bck = bk.copy()
-    bck[..., 0] += -arm[..., 1] * bk[..., 2] - w2 * arm[..., 0]
-    bck[..., 1] += arm[..., 0] * bk[..., 2] - w2 * arm[..., 1]
-    return Bc, bck.reshape(b.shape)
-
-
 def mass_matrix(model: Model, x, B) -> np.ndarray:
-    """Generalized mass matrix A = B_c^T M B_c, shape (..., n_q, n_q)."""
-    Bc, _ = com_analogs(model, x, B)
-    M = model.mass_diag
-    return np.swapaxes(Bc, -1, -2) @ (M[:, None] * Bc)
+    """Generalized mass matrix A = B^T M_x B (M_x the frame mass matrix of
+    :mod:`mechdyn.dynamics.inertia`), shape (..., n_q, n_q)."""
+    B = np.asarray(B, float)
+    return np.swapaxes(B, -1, -2) @ frame_mass_matrix(model, x) @ B
 
 
 def kinetic_energy(model: Model, x, xdot) -> np.ndarray:
@@ -363,14 +327,13 @@ class EquationsOfMotion:
 
     def _lagrange(self, t, q, qdot, x, B, b) -> Terms:
         """The terms at a pose x (n_x,) with its velocity analogs B (n_x, n_q) and
-        acceleration bias b (n_x,): A = B_c^T M B_c, c = B_c^T M b_c, Q = B^T F + Q_drive
+        acceleration bias b (n_x,): A = B^T M_x B, c = B^T (M_x b + h), Q = B^T F + Q_drive
         and q'' = A^-1 (Q - c)."""
         model = self.model
         xdot = B @ qdot
-        Bc, bc = com_analogs(model, x, B, b, xdot)
-        M = model.mass_diag
-        A = Bc.T @ (M[:, None] * Bc) + np.diag(self.extra_inertia)
-        c = Bc.T @ (M * bc)
+        M, h = mass_matrix_x(model, x, xdot)
+        A = B.T @ M @ B + np.diag(self.extra_inertia)
+        c = B.T @ (M @ b + h)
         F, Qd = self.forces.applied(t, x, xdot, q, qdot)
         Q = B.T @ F + Qd
         qdd = self._solve_mass(A, Q - c, t, q)
