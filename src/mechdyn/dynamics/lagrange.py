@@ -41,7 +41,7 @@ import numpy as np
 from ..errors import IntegrationError, ModelError
 from ..kinematics.analogs import acceleration_bias, default_displacement
 from ..kinematics.assembly import assemble, solve_position
-from ..kinematics.constraints import coordinates_jacobian, extend, jacobian
+from ..kinematics.constraints import extend, full_jacobian
 from ..model import Model
 from .forces import com_arms, force_model
 from .inertia import drive_inertia, frame_mass_matrix, mass_matrix_x
@@ -115,10 +115,6 @@ def kinetic_energy(model: Model, x, xdot) -> np.ndarray:
 def potential_energy(model: Model, x) -> np.ndarray:
     """Potential energy of gravity and springs, J, shape (...) (batched over poses)."""
     return force_model(model).potential_energy(x)
-
-
-def _full_jacobian(model, x, lay):
-    return np.concatenate([jacobian(model, x, lay), coordinates_jacobian(model, x)], axis=-2)
 
 
 class EquationsOfMotion:
@@ -317,7 +313,7 @@ class EquationsOfMotion:
     def _exact(self, t, q, qdot) -> Terms:
         model, lay = self.model, self.layout
         x = self.positions(q, t)
-        J = _full_jacobian(model, x, lay)
+        J = full_jacobian(model, x, lay)
         rhs = np.zeros((J.shape[0], model.n_q))
         rhs[lay.n_rows:, :] = np.eye(model.n_q)
         B = np.linalg.solve(J, rhs) if J.shape[0] == J.shape[1] else np.linalg.pinv(J) @ rhs

@@ -15,17 +15,13 @@ import numpy as np
 
 from ..model import ConstraintLayout, Model
 from .assembly import solve_position
-from .constraints import coordinates_gamma, coordinates_jacobian, gamma, jacobian
+from .constraints import full_gamma, full_jacobian
 
 __all__ = ["velocity_analogs", "acceleration_bias", "velocities", "accelerations",
            "finite_difference_analogs", "default_displacement", "DEFAULT_ANGLE_STEP"]
 
 #: the paper's virtual displacement for angle coordinates, 0.1 deg in rad
 DEFAULT_ANGLE_STEP = np.deg2rad(0.1)
-
-
-def _full_jacobian(model, x, lay):
-    return np.concatenate([jacobian(model, x, lay), coordinates_jacobian(model, x)], axis=-2)
 
 
 def _solve(J, rhs):
@@ -37,7 +33,7 @@ def _solve(J, rhs):
 def velocity_analogs(model: Model, x, layout: ConstraintLayout | None = None) -> np.ndarray:
     """Exact velocity analogs B = dx/dq, shape (..., n_x, n_q)."""
     lay = layout or model.layout()
-    J = _full_jacobian(model, x, lay)
+    J = full_jacobian(model, x, lay)
     rhs = np.zeros(J.shape[:-2] + (J.shape[-2], model.n_q))
     rhs[..., lay.n_rows:, :] = np.eye(model.n_q)
     return _solve(J, rhs)
@@ -48,10 +44,8 @@ def acceleration_bias(model: Model, x, xdot, layout: ConstraintLayout | None = N
     """b(x, xdot): the part of xddot not proportional to qddot, shape (..., n_x)."""
     lay = layout or model.layout()
     if J is None:
-        J = _full_jacobian(model, x, lay)
-    rhs = np.concatenate([gamma(model, x, xdot, lay), coordinates_gamma(model, x, xdot)],
-                         axis=-1)
-    return _solve(J, rhs[..., None])[..., 0]
+        J = full_jacobian(model, x, lay)
+    return _solve(J, full_gamma(model, x, xdot, lay)[..., None])[..., 0]
 
 
 def velocities(model: Model, x, qdot, layout=None, B=None) -> np.ndarray:
@@ -64,7 +58,7 @@ def velocities(model: Model, x, qdot, layout=None, B=None) -> np.ndarray:
 def accelerations(model: Model, x, xdot, qddot, layout=None, B=None) -> np.ndarray:
     """xddot = B qddot + b, shape (..., n_x) (m/s^2 and rad/s^2)."""
     lay = layout or model.layout()
-    J = _full_jacobian(model, x, lay)
+    J = full_jacobian(model, x, lay)
     if B is None:
         rhs = np.zeros(J.shape[:-2] + (J.shape[-2], model.n_q))
         rhs[..., lay.n_rows:, :] = np.eye(model.n_q)

@@ -16,9 +16,9 @@ from ..kernels import rows_numpy
 from ..model import ConstraintLayout, Model
 from ..model import rows as R
 
-__all__ = ["residual", "jacobian", "gamma", "coordinates", "coordinates_jacobian",
-           "coordinates_gamma", "system", "travel_rows", "point_position", "point_velocity",
-           "point_acceleration", "extend"]
+__all__ = ["full_jacobian", "full_gamma", "residual", "jacobian", "gamma", "coordinates",
+           "coordinates_jacobian", "coordinates_gamma", "system", "travel_rows",
+           "point_position", "point_velocity", "point_acceleration", "extend"]
 
 
 def extend(model: Model, x: np.ndarray) -> np.ndarray:
@@ -72,10 +72,21 @@ def coordinates_gamma(model: Model, x, xdot) -> np.ndarray:
 
 def system(model: Model, x, q, layout: ConstraintLayout | None = None):
     """Residual [Phi; g - q] and Jacobian [Phi_x; g_x] of the position problem."""
-    lay = layout or model.layout()
-    F = np.concatenate([residual(model, x, lay), coordinates(model, x) - q], axis=-1)
-    J = np.concatenate([jacobian(model, x, lay), coordinates_jacobian(model, x)], axis=-2)
-    return F, J
+    rows = (layout or model.layout()).position_rows
+    p = rows_numpy.Parts(rows, x)
+    F = rows_numpy.values(rows, x, p)
+    F[..., len(rows) - model.n_q:] -= q
+    return F, rows_numpy.jacobian(rows, x, p)
+
+
+def full_jacobian(model: Model, x, layout: ConstraintLayout | None = None) -> np.ndarray:
+    """[Phi_x; g_x], shape (..., n_rows + n_q, n_x)."""
+    return rows_numpy.jacobian((layout or model.layout()).position_rows, x)
+
+
+def full_gamma(model: Model, x, xdot, layout: ConstraintLayout | None = None) -> np.ndarray:
+    """[gamma; gamma_g], shape (..., n_rows + n_q): [Phi_x; g_x] xddot = it + [0; qddot]."""
+    return -rows_numpy.quad((layout or model.layout()).position_rows, x, xdot)
 
 
 def travel_rows(model: Model, joint: str) -> R.Rows:
