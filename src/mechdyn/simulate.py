@@ -44,7 +44,7 @@ from .initial_state import initial_state
 from .integrate.base import DEFAULT_RTOL, IntegratorOptionError, IntegratorWarning
 from .integrate.driver import make_integrator, sample_times
 from .integrate.events import as_events
-from .integrate.segment import Stop, run_to_end, user_event_functions
+from .integrate.segment import Coordinates, Stop, run_to_end, user_event_functions
 from .kinematics.assembly import DEAD_RCOND, singularity, solve_position
 from .kinematics.constraints import residual
 from .model import as_model
@@ -149,12 +149,7 @@ def _turning_point_check(eom: EquationsOfMotion, step, qd_old, x_good):
     return None
 
 
-class _Coordinates:
-    """The declared coordinates and rates of a state, as the caller's events read them."""
-
-    __slots__ = ("q", "qdot")
-
-    def __init__(self, q, qdot):
+def __init__(self, q, qdot):
         self.q, self.qdot = q, qdot
 
 
@@ -305,7 +300,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
     counts = {"steps": 0, "rejected": 0, "evaluations": 0}
 
     def evaluate(t, y):  # what the caller's event functions read
-        return _Coordinates(y[:n], y[n:2 * n])
+        return Coordinates(y, n)
 
     def after_step(step, y):
         if not (np.all(np.isfinite(step.q)) and np.all(np.isfinite(step.qdot))

@@ -75,11 +75,6 @@ class ModeEquations:
         # the mode has redundant rows (their share is chosen on the NumPy path)
         self._full = len(ms.independent_rows) == ms.n_rows
 
-    @property
-    def evaluations(self) -> int:
-        """Evaluations by the compiled kernel (the NumPy ones are counted by the caller)."""
-        return self.kernel.evaluations if self.kernel is not None else 0
-
     def evaluate(self, t: float, qi, qdi):
         """Everything at a state of the mode (:class:`ModeEval`: poses, rates,
         accelerations of every declared coordinate, every multiplier), from the compiled

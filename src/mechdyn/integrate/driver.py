@@ -17,7 +17,7 @@ from .base import DEFAULT_RTOL, Integrator, IntegratorOptionError
 from .events import as_events
 from .runge_kutta import RungeKutta4
 from .scipy_ivp import SCIPY_METHODS, ScipyIntegrator
-from .segment import run_to_end, user_event_functions
+from .segment import Coordinates, run_to_end, user_event_functions
 from .wilson import Wilson
 
 __all__ = ["INTEGRATORS", "make_integrator", "solve", "Solution", "sample_times"]
@@ -161,7 +161,7 @@ def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end
         te = te[te > t0]
     counts = {"steps": 0, "rejected": 0, "evaluations": 0}
     t, y_end, records, terminal = run_to_end(
-        integ, eqs, t0, y, t_end, efns, evaluate=lambda t_, y_: _State(y_, n),
+        integ, eqs, t0, y, t_end, efns, evaluate=lambda t_, y_: Coordinates(y_, n),
         after_step=lambda step, y_: None,
         sample=lambda ts, y_, step, ev: push(ts, y_, step.qddot if ts == step.t else None),
         t_eval=te, every_step=te is None, stats=counts, n=n)
@@ -182,12 +182,3 @@ class _Equations:
 
     def first_order_function(self):
         return None
-
-
-class _State:
-    """(q, qdot) of a state vector y = (q, q', w), as event functions read them."""
-
-    __slots__ = ("q", "qdot")
-
-    def __init__(self, y, n):
-        self.q, self.qdot = y[:n], y[n:2 * n]

@@ -27,7 +27,7 @@ from ..errors import Status
 from .events import EventRecord
 
 __all__ = ["EventFunction", "Stop", "run_segment", "run_to_end", "locate",
-           "user_event_functions", "arm", "user_event_records"]
+           "user_event_functions", "arm", "user_event_records", "Coordinates"]
 
 
 class Stop(Exception):
@@ -71,6 +71,16 @@ class EventFunction:
     armed: bool = False
     arm: float = 0.0
     fresh: bool = False
+
+
+class Coordinates:
+    """(q, qdot) of a state vector y = (q, q', w) with n coordinates, as the caller's
+    event functions read them (``ev.q``, ``ev.qdot``)."""
+
+    __slots__ = ("q", "qdot")
+
+    def __init__(self, y, n: int):
+        self.q, self.qdot = y[:n], y[n:2 * n]
 
 
 def user_event_functions(user_events) -> list[EventFunction]:
