@@ -1,0 +1,367 @@
+"""The compiled (Numba) equations of motion of one mode, over packed arrays.
+
+For a state (t, q_I, q_I'), q_I the independent coordinates of the mode:
+:func:`evaluate` does the Newton position solve of [Phi(x); g_I(x) - q_I] = 0 from
+the last pose (with the linear predictor x + B (q_I - q_last)), the velocity
+analogs B and the acceleration bias b (x'' = B q_I'' + b), the declared
+coordinates q = g(x) with their rates and their analogs G B, the mass matrix
+A = B^T M_x B + sum_drives J_e (G_k B)^T (G_k B) (motor rotor and gear inertia
+J_e reduced to the driven coordinate k, whether it is independent or not), the
+bias c, the applied forces and Q = B^T (F + G^T Q_drive), the Cholesky solve for
+q_I'' and the power of the non-conservative forces; with ``full``, also the
+multipliers of the rows from the transposed LU of the same position Jacobian.
+
+The arrays: ``ip``, ``fp`` the packed loads (:mod:`mechdyn.kernels.loads_numba`);
+``ri``, ``rf`` the packed rows (:meth:`mechdyn.model.rows.Rows.packed`) in four
+blocks -- constraint rows, independent coordinates, declared coordinates, table
+variables -- of the sizes in ``dims``; ``ws`` the work array (:func:`work_size`).
+The functions are generic over these arrays: they compile once for every model
+and every mode.  :mod:`mechdyn.dynamics.compiled` wraps them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .linalg import cholesky_solve, lu_factor, lu_solve, lu_solve_transposed
+from .loads_numba import (
+    FR_BODY,
+    FR_DRV,
+    H_FOFF,
+    H_IOFF,
+    H_NB,
+    H_NDRV,
+    IR_DRV,
+    IR_VAL,
+    S_BODY,
+    S_DRV,
+    forces,
+)
+from .rows_numba import njit, rows_jacobian, rows_quad, rows_values
+
+__all__ = ["evaluate", "first_order", "full", "positions", "work_size", "D_NC", "D_NI",
+           "D_NQ", "D_NV", "W_VALID", "W_PIVOT", "W_COUNT", "N_FLAGS"]
+
+# dims: n_c (constraint rows), n_i (independent coordinates), n_q (declared coordinates),
+# n_v (rows of table variables); the row arrays hold these four blocks in this order
+D_NC, D_NI, D_NQ, D_NV = range(4)
+# flags at the end of the work array
+W_VALID = 0  # B_last valid
+W_PIVOT = 1  # pivot ratio of the last factorisation
+W_ITER = 2  # Newton iterations of the last solve
+W_ERR = 3  # last Newton residual
+W_COUNT = 4  # evaluations of the equations
+N_FLAGS = 5
+
+
+def work_size(n_x: int, n_i: int) -> int:
+    """Work array: x | q_last (n_i) | B_last (n_x n_i) | xdot | x_good | flags."""
+    return n_x + n_i + n_x * n_i + 2 * n_x + N_FLAGS
+
+
+@njit
+def _system(x, qi, ri, rf, dims, nb, F, J):
+    """Residual [Phi; g_I - q_I] (F) and Jacobian (J) at pose x."""
+    nc, ni = dims[D_NC], dims[D_NI]
+    nx = 3 * nb
+    for r in range(nx):
+        for c in range(nx):
+            J[r, c] = 0.0
+    rows_values(x, nb, ri[:nc + ni], rf[:nc + ni], F, 0)
+    rows_jacobian(x, nb, ri[:nc + ni], rf[:nc + ni], J, 0)
+    for c in range(ni):
+        F[nc + c] -= qi[c]
+
+
+@njit
+def _scale_cols(J, nx, ls):
+    for r in range(nx):
+        for b in range(nx // 3):
+            J[r, 3 * b + 2] *= ls
+
+
+@njit
+def _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb):
+    """Solve the positions at q_I from the pose in ws; leaves the LU of the scaled
+    Jacobian at the solution in (J, piv).  Returns 0 or 1 (no convergence)."""
+    nx = 3 * nb
+    ni = dims[D_NI]
+    ls = fp[2]
+    tol = fp[3]
+    x = ws[:nx]
+    ql = ws[nx:nx + ni]
+    Bl = ws[nx + ni:nx + ni + nx * ni]
+    flags = ws[ws.size - N_FLAGS:]
+    xg = ws[ws.size - N_FLAGS - nx:ws.size - N_FLAGS]
+    for r in range(nx):
+        xg[r] = x[r]
+    if flags[W_VALID] == 1.0:
+        for r in range(nx):
+            s = 0.0
+            for c in range(ni):
+                s += Bl[r * ni + c] * (qi[c] - ql[c])
+            x[r] += s
+    prev = np.inf
+    status = 1
+    for it in range(40):
+        _system(x, qi, ri, rf, dims, nb, F, J)
+        err = 0.0
+        for r in range(nx):
+            a = abs(F[r])
+            if not a <= err:  # catches NaN
+                err = a if a == a else np.inf
+        _scale_cols(J, nx, ls)
+        flags[W_PIVOT] = lu_factor(J, piv, nx)
+        flags[W_ITER] = it
+        flags[W_ERR] = err
+        if err <= tol or (err >= 0.5 * prev and err <= 1e3 * tol):
+            status = 0
+            break
+        if not err < np.inf or flags[W_PIVOT] == 0.0:
+            break
+        prev = err
+        lu_solve(J, piv, F, nx)
+        for b in range(nb):
+            F[3 * b + 2] *= ls
+        for r in range(nx):
+            x[r] -= F[r]
+    if status == 0:
+        for c in range(ni):
+            ql[c] = qi[c]
+    else:  # keep the last good pose for the next start and the diagnosis
+        for r in range(nx):
+            x[r] = xg[r]
+    flags[W_VALID] = 0.0
+    return status
+
+
+@njit
+def _body_inertia(fp, ob, b, x):
+    """Mass, inertia about the centre of mass and the centre-of-mass arm A(theta) c
+    (ground frame) of body b at pose x."""
+    m = fp[ob + FR_BODY * b]
+    Jc = fp[ob + FR_BODY * b + 1]
+    cx, cy = fp[ob + FR_BODY * b + 2], fp[ob + FR_BODY * b + 3]
+    th = x[3 * b + 2]
+    co, si = np.cos(th), np.sin(th)
+    return m, Jc, co * cx - si * cy, si * cx + co * cy
+
+
+@njit
+def _solve_scaled(J, piv, col, nx, nb, ls):
+    lu_solve(J, piv, col, nx)
+    for b in range(nb):
+        col[3 * b + 2] *= ls
+
+
+@njit
+def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
+    """q_I'' and P_nc at (t, q_I, q_I'); out = [q_I' | q_I'' | P_nc].  Status: 0 ok,
+    1 position solve failed, 2 mass matrix not positive definite, 3 non-finite.
+
+    With ``full``, ``ext`` receives [x'' (n_x) | q | q' | q'' (n_q each) | lambda (n_c) |
+    F (n_x)]: the accelerations, every declared coordinate, the multipliers of the
+    constraint rows from the same factorization (M x'' + h - F = Phi_x^T lambda, solved
+    with the transposed LU of the position Jacobian) and the applied forces on the
+    poses, drives included."""
+    nb = ip[H_NB]
+    nx = 3 * nb
+    nc, ni, nq, nv = dims[D_NC], dims[D_NI], dims[D_NQ], dims[D_NV]
+    ls = fp[2]
+    J = np.empty((nx, nx))
+    piv = np.empty(nx, dtype=np.int64)
+    F = np.empty(nx)
+    ws[ws.size - N_FLAGS + W_COUNT] += 1.0
+    st = _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb)
+    if st != 0:
+        return st
+    x = ws[:nx]
+    Bl = ws[nx + ni:nx + ni + nx * ni]
+    v = ws[nx + ni + nx * ni:nx + ni + nx * ni + nx]
+    flags = ws[ws.size - N_FLAGS:]
+    # velocity analogs B (row r, column c stored at r * ni + c)
+    col = np.empty(nx)
+    for c in range(ni):
+        for r in range(nx):
+            col[r] = 0.0
+        col[nc + c] = 1.0
+        _solve_scaled(J, piv, col, nx, nb, ls)
+        for r in range(nx):
+            Bl[r * ni + c] = col[r]
+    flags[W_VALID] = 1.0
+    for r in range(nx):
+        s = 0.0
+        for c in range(ni):
+            s += Bl[r * ni + c] * qdi[c]
+        v[r] = s
+    # acceleration bias: J b = -quad
+    bb = np.empty(nx)
+    rows_quad(x, v, nb, ri[:nc + ni], rf[:nc + ni], bb, 0)
+    for r in range(nx):
+        bb[r] = -bb[r]
+    _solve_scaled(J, piv, bb, nx, nb, ls)
+    # declared coordinates, their rates, analogs G B and bias G b + quad_g
+    gi, gf = ri[nc + ni:nc + ni + nq], rf[nc + ni:nc + ni + nq]
+    q = np.empty(nq)
+    G = np.zeros((nq, nx))
+    qdot = np.zeros(nq)
+    Gb = np.empty(nq)
+    GB = np.zeros((nq, ni))
+    rows_values(x, nb, gi, gf, q, 0)
+    rows_jacobian(x, nb, gi, gf, G, 0)
+    rows_quad(x, v, nb, gi, gf, Gb, 0)
+    for k in range(nq):
+        for r in range(nx):
+            g = G[k, r]
+            if g != 0.0:
+                qdot[k] += g * v[r]
+                Gb[k] += g * bb[r]
+                for c in range(ni):
+                    GB[k, c] += g * Bl[r * ni + c]
+    # mass matrix and c from the centre-of-mass analogs
+    A = np.zeros((ni, ni))
+    cc = np.zeros(ni)
+    ob = ip[H_FOFF + S_BODY]
+    bcx = np.empty(ni)
+    bcy = np.empty(ni)
+    for b in range(nb):
+        m, Jc, ax, ay = _body_inertia(fp, ob, b, x)
+        w = v[3 * b + 2]
+        for i in range(ni):
+            bcx[i] = Bl[(3 * b) * ni + i] - ay * Bl[(3 * b + 2) * ni + i]
+            bcy[i] = Bl[(3 * b + 1) * ni + i] + ax * Bl[(3 * b + 2) * ni + i]
+        sx = bb[3 * b] - ay * bb[3 * b + 2] - w * w * ax
+        sy = bb[3 * b + 1] + ax * bb[3 * b + 2] - w * w * ay
+        sw = bb[3 * b + 2]
+        for i in range(ni):
+            bwi = Bl[(3 * b + 2) * ni + i]
+            cc[i] += m * (bcx[i] * sx + bcy[i] * sy) + Jc * bwi * sw
+            for j in range(i, ni):
+                A[i, j] += m * (bcx[i] * bcx[j] + bcy[i] * bcy[j]) + \
+                    Jc * bwi * Bl[(3 * b + 2) * ni + j]
+    # rotor and gear inertia of the drives, on their (declared) coordinate
+    od_i, od_f = ip[H_IOFF + S_DRV], ip[H_FOFF + S_DRV]
+    for k in range(ip[H_NDRV]):
+        c = ip[od_i + IR_DRV * k + IR_VAL]
+        je = fp[od_f + FR_DRV * k + 2]
+        if je != 0.0:
+            for i in range(ni):
+                cc[i] += je * GB[c, i] * Gb[c]
+                for j in range(i, ni):
+                    A[i, j] += je * GB[c, i] * GB[c, j]
+    # forces
+    Fa = np.empty(nx)
+    Fnc = np.empty(nx)
+    Qd = np.empty(nq)
+    varv = np.empty(nv)
+    rows_values(x, nb, ri[nc + ni + nq:], rf[nc + ni + nq:], varv, 0)
+    forces(t, q, qdot, x, v, ip, fp, Fa, Fnc, Qd, varv)
+    rhs = np.empty(ni)
+    P = 0.0
+    for r in range(nx):
+        P += Fnc[r] * v[r]
+    for k in range(nq):
+        P += Qd[k] * qdot[k]
+    for c in range(ni):
+        s = -cc[c]
+        for r in range(nx):
+            s += Bl[r * ni + c] * Fa[r]
+        for k in range(nq):
+            s += GB[k, c] * Qd[k]
+        rhs[c] = s
+    if not cholesky_solve(A, rhs, ni):
+        return 2
+    if full:
+        _reactions(x, v, bb, rhs, q, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, ni, nq, ext)
+    ok = P == P
+    for c in range(ni):
+        out[c] = qdi[c]
+        out[ni + c] = rhs[c]
+        ok = ok and (rhs[c] - rhs[c] == 0.0)
+    out[2 * ni] = P
+    if not ok:
+        return 3
+    return 0
+
+
+@njit
+def _reactions(x, v, bb, qdd, q, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, ni, nq, ext):
+    """Fill ``ext`` (see :func:`evaluate`) after the solve for q_I''."""
+    nx = 3 * nb
+    ls = fp[2]
+    xdd = ext[:nx]
+    for r in range(nx):
+        s = bb[r]
+        for c in range(ni):
+            s += Bl[r * ni + c] * qdd[c]
+        xdd[r] = s
+    o = nx
+    rows_q = ext[o:o + nq]
+    rows_v = ext[o + nq:o + 2 * nq]
+    rows_a = ext[o + 2 * nq:o + 3 * nq]
+    for k in range(nq):
+        s = Gb[k]
+        for c in range(ni):
+            s += GB[k, c] * qdd[c]
+        rows_a[k] = s
+        rows_q[k] = q[k]
+        sq = 0.0
+        for r in range(nx):
+            sq += G[k, r] * v[r]
+        rows_v[k] = sq
+    # residual of the free bodies: M x'' + h - F (F with the drives on their coordinates)
+    z = np.empty(nx)
+    Ftot = ext[o + 3 * nq + nc:o + 3 * nq + nc + nx]
+    ob = ip[H_FOFF + S_BODY]
+    for r in range(nx):
+        s = Fa[r]
+        for k in range(nq):
+            s += G[k, r] * Qd[k]
+        Ftot[r] = s
+    for b in range(nb):
+        m, Jc, ax, ay = _body_inertia(fp, ob, b, x)
+        w = v[3 * b + 2]
+        al = xdd[3 * b + 2]
+        acx = xdd[3 * b] - al * ay - w * w * ax
+        acy = xdd[3 * b + 1] + al * ax - w * w * ay
+        z[3 * b] = m * acx - Ftot[3 * b]
+        z[3 * b + 1] = m * acy - Ftot[3 * b + 1]
+        z[3 * b + 2] = Jc * al + m * (ax * acy - ay * acx) - Ftot[3 * b + 2]
+    od_i, od_f = ip[H_IOFF + S_DRV], ip[H_FOFF + S_DRV]
+    for k in range(ip[H_NDRV]):
+        c = ip[od_i + IR_DRV * k + IR_VAL]
+        je = fp[od_f + FR_DRV * k + 2]
+        if je != 0.0:
+            for r in range(nx):
+                z[r] += je * rows_a[c] * G[c, r]
+    # Phi_x^T lambda = z with J = [Phi_x; g_I,x] factored with scaled rotation columns
+    for b in range(nb):
+        z[3 * b + 2] *= ls
+    lu_solve_transposed(J, piv, z, nx)
+    for r in range(nc):
+        ext[o + 3 * nq + r] = z[r]
+
+
+@njit
+def first_order(t, y, ip, fp, ri, rf, dims, ws, status):
+    """y = (q_I, q_I', w) -> y' = (q_I', q_I'', P_nc); status[0] receives the status."""
+    ni = dims[D_NI]
+    out = np.empty(2 * ni + 1)
+    status[0] = evaluate(t, y[:ni], y[ni:2 * ni], ip, fp, ri, rf, dims, ws, out,
+                          np.empty(0), False)
+    return out
+
+
+@njit
+def full(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, status):
+    status[0] = evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, True)
+
+
+@njit
+def positions(qi, ip, fp, ri, rf, dims, ws):
+    nb = ip[H_NB]
+    nx = 3 * nb
+    J = np.empty((nx, nx))
+    piv = np.empty(nx, dtype=np.int64)
+    F = np.empty(nx)
+    return _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb)
