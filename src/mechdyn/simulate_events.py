@@ -36,7 +36,8 @@ import time
 import numpy as np
 
 from .dynamics.contact import ContactError, touching
-from .dynamics.impact import element_forces, frame_forces
+from .dynamics.lagrange import kinetic_energy
+from .dynamics.reactions import element_forces, frame_forces
 from .dynamics.mode_equations import ModeEquations
 from .dynamics.modes import (
     ModeSystem,
@@ -65,6 +66,7 @@ from .integrate.segment import (
     user_event_functions,
     user_event_records,
 )
+from .kernels import rows_numpy as RN
 from .kinematics.assembly import DEAD_RCOND
 from .kinematics.constraints import extend
 from .model import Model
@@ -217,33 +219,17 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     user_events = as_events(events)
 
     # ---------------------------------------------------------------- records
-    rec = dict(t=[], q=[], qd=[], qdd=[], x=[], xd=[], mode=[], frame=[], forces=[], T=[],
-               U=[], W=[], res=[], lost=[])
+    # per sample: t, the mode system, the evaluation, w_nc and the impact losses so far;
+    # forces and energies are computed at the end, batched over each mode's samples
+    rec: list = []
     events: list[SwitchEvent] = []
     stats = dict(steps=0, rejected=0, evaluations=0, integrator=method_name,
                  formulation="exact", backend="numpy", rtol=rtol, atol=atol, segments=0)
     backends: set = set()
     lost_total = 0.0
-    penetration = 0.0
 
     def store(t, ms, ev, w):
-        fr = frame_forces(ms, ev.x, ev.lam)
-        rec["t"].append(t)
-        rec["q"].append(ev.q)
-        rec["qd"].append(ev.qdot)
-        rec["qdd"].append(ev.qddot)
-        rec["x"].append(ev.x)
-        rec["xd"].append(ev.xdot)
-        rec["mode"].append(ms.mode)
-        # the frame also carries the load elements anchored on it (spring ends, reactions)
-        _, on_ground, _ = sm.fm.loads(t, ev.x, ev.xdot, ev.q, ev.qdot)
-        rec["frame"].append(fr["total"] + on_ground[:2])
-        rec["forces"].append(element_forces(ms, ev.x, ev.lam))
-        rec["T"].append(ms.kinetic_energy(ev.x, ev.xdot))
-        rec["U"].append(sm.fm.potential_energy(ev.x))
-        rec["W"].append(w)
-        rec["res"].append(ms.residual_norm(ev.x))
-        rec["lost"].append(lost_total)
+        rec.append((t, ms, ev, w, lost_total))
 
     # ---------------------------------------------------------------- initial state
     status, message = Status.SUCCESS, ""
@@ -323,7 +309,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         efns += user_event_functions(user_events)
         try:
             ev0 = evaluate(t, y0)
-            if not rec["t"] or rec["t"][-1] != t or rec["mode"][-1] != ms.mode:
+            if not rec or rec[-1][0] != t or rec[-1][1].mode != ms.mode:
                 store(t, ms, ev0, w_nc)
             arm(efns, t, ev0, just_fired)
             first = None if not just_fired else 1e-7 * (t_end - t0)
@@ -336,12 +322,9 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                 return ev
 
             def sample(ts, y, step, ev, ms=ms, evaluate=evaluate):
-                nonlocal penetration
-                if rec["t"] and rec["t"][-1] >= ts:
+                if rec and rec[-1][0] >= ts:
                     return
-                ev = ev if ev is not None else evaluate(ts, y)
-                store(ts, ms, ev, float(y[-1]))
-                penetration = max(penetration, _penetration(sm, ev.x, ms))
+                store(ts, ms, ev if ev is not None else evaluate(ts, y), float(y[-1]))
 
             hit, next_out = run_segment(
                 segment_integrator(ms, first), eqs, t, y0, t_end, efns, evaluate=evaluate,
@@ -356,9 +339,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             y_hit = dense(t_hit)
             ev_hit = evaluate(t_hit, y_hit)
             w_nc = float(y_hit[-1])
-            if not rec["t"] or rec["t"][-1] != t_hit:
+            if not rec or rec[-1][0] != t_hit:
                 store(t_hit, ms, ev_hit, w_nc)
-            penetration = max(penetration, _penetration(sm, ev_hit.x, ms))
             user = [e for e in fired if e.kind == "user"]
             fired = [e for e in fired if e.kind != "user"]
             events.extend(user_event_records(user, t_hit, np.concatenate([ev_hit.q, ev_hit.qdot]),
@@ -411,7 +393,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             break
         except KeyboardInterrupt:
             status = Status.INTERRUPTED
-            message = (f"interrupted (Ctrl-C) after t = {rec['t'][-1] if rec['t'] else t:.9g} s; "
+            message = (f"interrupted (Ctrl-C) after t = {rec[-1][0] if rec else t:.9g} s; "
                        f"the samples computed so far are kept")
             break
         except (MechdynError, np.linalg.LinAlgError, ValueError) as exc:
@@ -421,7 +403,6 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             break
     stats["backend"] = "numba" if backends == {"numba"} else (
         "numpy" if backends <= {"numpy"} else "numba+numpy")
-    stats["penetration"] = penetration
     bar.close()
     return _finish(model, rec, events, stats, wall0, status, message, sm)
 
@@ -486,19 +467,19 @@ def _atol(ms, atol, L):
         np.array([atol * 1e3])
 
 
-def _penetration(sm: SwitchedModel, x, ms) -> float:
-    X = extend(sm.model, x)
+def _penetration(sm: SwitchedModel, x) -> float:
+    """Largest penetration of a stop (lengths only) or contact over poses x (n, n_x), m."""
     worst = 0.0
     for _n, (st, meas) in sm.stops.items():
         if meas.is_angle:
             continue
-        v = meas.value(X)
+        v = RN.values(meas.rows, x)[..., 0]
         if st.lower is not None:
-            worst = max(worst, st.lower - v)
+            worst = max(worst, float(np.max(st.lower - v)))
         if st.upper is not None:
-            worst = max(worst, v - st.upper)
+            worst = max(worst, float(np.max(v - st.upper)))
     for _n, (_ct, gap, _) in sm.contacts.items():
-        worst = max(worst, -gap.value(X))
+        worst = max(worst, float(np.max(-RN.values(gap.rows, x)[..., 0])))
     return worst
 
 
@@ -535,36 +516,43 @@ def _status_of(exc):
 
 # ============================================================================ output
 def _finish(model, rec, events, stats, wall0, status, message, sm) -> Trajectory:
-    n_q, n_x = model.n_q, model.n_x
-    arr = (lambda k, w: np.array(rec[k], float).reshape(-1, w))  # noqa: E731
-    t = np.array(rec["t"], float)
-    modes = []
-    for m in rec["mode"]:
-        if m not in modes:
-            modes.append(m)
+    """The Trajectory of a run from its samples: forces, frame loads and energies are
+    evaluated here, batched over the samples of each mode segment."""
+    n_q, n_x, n = model.n_q, model.n_x, len(rec)
+    t = np.array([r[0] for r in rec], float)
+    W = np.array([r[3] for r in rec], float)
+    lost = np.array([r[4] for r in rec], float)
+    x, xd, q, qd, qdd = (np.array([getattr(r[2], k) for r in rec], float).reshape(n, w)
+                         for k, w in (("x", n_x), ("xdot", n_x), ("q", n_q), ("qdot", n_q),
+                                      ("qddot", n_q)))
+    frame, res = np.zeros((n, 2)), np.zeros(n)
     forces: dict = {}
-    for k, fd in enumerate(rec["forces"]):
-        for el, v in fd.items():
-            forces.setdefault(el, [None] * len(rec["forces"]))[k] = v
-    forces_arr = {}
-    for el, lst in forces.items():
-        shape = next(np.shape(v) for v in lst if v is not None)
-        forces_arr[el] = np.array([np.full(shape, 0.0) if v is None else v for v in lst],
-                                  float)
-    T, U, W = (np.array(rec[k], float) for k in ("T", "U", "W"))
-    lostc = np.array(rec["lost"], float)
+    starts = [k for k in range(n) if k == 0 or rec[k][1] is not rec[k - 1][1]] + [n]
+    for a, b in zip(starts[:-1], starts[1:], strict=True):
+        ms, sl = rec[a][1], slice(a, b)
+        lam = np.array([r[2].lam for r in rec[a:b]], float).reshape(b - a, ms.n_rows)
+        # the frame also carries the load elements anchored on it (spring ends, reactions)
+        on_ground = sm.fm.loads(t[sl], x[sl], xd[sl], q[sl], qd[sl])[1]
+        frame[sl] = frame_forces(ms, x[sl], lam)["total"] + on_ground[:, :2]
+        for el, v in element_forces(ms, x[sl], lam).items():
+            forces.setdefault(el, np.zeros((n,) + np.shape(v)[1:]))[sl] = v
+        if ms.n_rows:
+            res[sl] = np.max(np.abs(ms.row_values(x[sl])), axis=-1)
+    modes = list(dict.fromkeys(r[1].mode for r in rec))
+    # the bodies, plus the rotors and gears of the drives reduced to their coordinates
+    T = kinetic_energy(model, x, xd) + 0.5 * (qd**2) @ sm.drive_inertia
+    U = sm.fm.potential_energy(x)
     stats = dict(stats)
+    stats["penetration"] = _penetration(sm, x) if n else 0.0
     stats["wall_time_s"] = time.perf_counter() - wall0
     stats["variable_structure"] = SwitchedSamples(
-        mode=list(rec["mode"]), modes=modes,
-        mode_index=np.array([modes.index(m) for m in rec["mode"]], int),
-        frame_force=arr("frame", 2), forces=forces_arr, impact_losses=lostc,
-        penetration=stats.get("penetration", 0.0))
-    energy = dict(kinetic=T, potential=U, work_nc=W, balance=T + U - W + lostc,
-                  residual=np.array(rec["res"], float))
-    return Trajectory(t, arr("q", n_q), arr("qd", n_q), arr("qdd", n_q), arr("x", n_x),
-                      arr("xd", n_x), status=status, message=message, events=list(events),
-                      stats=stats, energy=energy, coordinate_names=model.coordinate_names,
-                      body_names=model.body_names,
+        mode=[r[1].mode for r in rec], modes=modes,
+        mode_index=np.array([modes.index(r[1].mode) for r in rec], int),
+        frame_force=frame, forces=forces, impact_losses=lost,
+        penetration=stats["penetration"])
+    energy = dict(kinetic=T, potential=U, work_nc=W, balance=T + U - W + lost, residual=res)
+    return Trajectory(t, q, qd, qdd, x, xd, status=status, message=message,
+                      events=list(events), stats=stats, energy=energy,
+                      coordinate_names=model.coordinate_names, body_names=model.body_names,
                       coordinate_is_angle=tuple(bool(v) for v in model.coord_is_angle),
                       model=model)

@@ -272,16 +272,31 @@ class ModeSystem:
     def rcond(self, x) -> float:
         """sigma_min / sigma_max of the mode's square position Jacobian [rows_I; g_I] at
         x, lengths and angles on one scale (1 where the mode has no freedom)."""
+        return self.singularity(x)["rcond"]
+
+    def singularity(self, x) -> dict:
+        """Singular-value report of the scaled position Jacobian [rows_I; g_I] at x:
+        ``rcond`` (sigma_min / sigma_max), ``coordinates`` (those whose equations carry
+        the left null vector: they lose control) and ``joints`` (the elements whose rows
+        become dependent)."""
         J = RN.jacobian(self._all, x)[self._sel]
         if not J.size:
-            return 1.0
+            return {"rcond": 1.0, "coordinates": [], "joints": []}
         L = self.model.length_scale
         angle = np.concatenate([self.rowset.is_angle,
                                 self.model.coord_is_angle])[self._sel]
         Js = J * np.where(angle, 1.0, 1.0 / L)[:, None] \
             * np.tile([L, L, 1.0], self.model.n_bodies)[None, :]
-        sv = np.linalg.svd(Js, compute_uv=False)
-        return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
+        u, sv, _ = np.linalg.svd(Js)
+        share = u[:, -1] ** 2
+        n_r = len(self.independent_rows)
+        names = self.model.coordinate_names
+        return {"rcond": float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0,
+                "coordinates": [names[c] for c, w in zip(self.coords, share[n_r:], strict=True)
+                                if w > 1e-3],
+                "joints": sorted({self.rowset.elements[r]
+                                  for r, w in zip(self.independent_rows, share[:n_r],
+                                                  strict=True) if w > 1e-3})}
 
     def state(self, qi, qdoti, x_guess=None, t=None):
         """(x, xdot, B) at independent coordinates and rates."""
@@ -296,10 +311,10 @@ class ModeSystem:
         return self.coordinates(x)[self.coords], G @ xdot
 
     # ------------------------------------------------------------------ dynamics
-    def _kinematics(self, x, xdot=None, B=None, qdoti=None):
+    def _kinematics(self, x, xdot=None, B=None, qdoti=None, b=None):
         """(R, G, B, b, xdot, quad_g, q) at a pose: the row and coordinate Jacobians,
-        the velocity analogs, xddot = B qddot_I + b, the coordinates' quadratic terms
-        and values."""
+        the velocity analogs, xddot = B qddot_I + b (unless given), the coordinates'
+        quadratic terms and values."""
         n_rows, allr = self.n_rows, self._all
         at = self._at
         if at is not None and at[0] is x:  # the pose just solved: its parts and values
@@ -316,7 +331,8 @@ class ModeSystem:
             xdot = B @ np.asarray(qdoti, float)
             self._B_last = B
         quad = RN.quad(allr, x, xdot, p)
-        b = np.linalg.solve(J, -quad[self._sel]) if J.size else np.zeros(0)
+        if b is None:
+            b = np.linalg.solve(J, -quad[self._sel]) if J.size else np.zeros(0)
         return R, G, B, b, xdot, quad[n_rows:], v[n_rows:]
 
     def evaluate(self, t, qi, qdoti, x_guess=None) -> ModeEval:
@@ -326,20 +342,29 @@ class ModeSystem:
         self._qi_last = np.array(qi, float)
         return ev
 
-    def evaluate_x(self, t, x, xdot, B=None, *, qdoti=None) -> ModeEval:
+    def evaluate_x(self, t, x, xdot, B=None, *, qdoti=None, b=None) -> ModeEval:
         """As :meth:`evaluate`, from a consistent pose and velocity (or, with
-        ``xdot`` None, the independent rates ``qdoti``)."""
-        R, G, B, b, xdot, quad_g, q = self._kinematics(x, xdot, B, qdoti)
+        ``xdot`` None, the independent rates ``qdoti``).
+
+        With the analogs ``B`` and the bias ``b`` of a branch chart (at a bifurcation,
+        where the rows lose rank), the accelerations come from the reduced equations
+        B^T M B qddot_I = B^T (F - h - M b) and the multipliers of least norm."""
+        R, G, B, b_, xdot, quad_g, q = self._kinematics(x, xdot, B, qdoti, b)
         qdot = G @ xdot
         F, Qd, Fc = self.sm.fm.applied_and_conservative(t, x, xdot, q, qdot)
         F = F + G.T @ Qd
         M, h = self.sm.with_drive_inertia(*mass_matrix_x(self.model, x, xdot), G, quad_g)
-        Reff = R
-        if self._slip is not None:
-            Reff = R.copy()
-            Reff[self._slip_rows] += RN.jacobian(self._slip, x)
-        qddi, lam = self._solve_motion(M, B, Reff, F - h - M @ b, self._rs)
-        xddot = B @ qddi + b
+        rhs = F - h - M @ b_
+        if b is not None:
+            qddi = np.linalg.solve(B.T @ M @ B, B.T @ rhs)
+            lam = np.linalg.lstsq(R.T, M @ (B @ qddi) - rhs, rcond=None)[0]
+        else:
+            Reff = R
+            if self._slip is not None:
+                Reff = R.copy()
+                Reff[self._slip_rows] += RN.jacobian(self._slip, x)
+            qddi, lam = self._solve_motion(M, B, Reff, rhs, self._rs)
+        xddot = B @ qddi + b_
         qddot = G @ xddot + quad_g
         return ModeEval(x, xdot, xddot, q, qdot, qddot, lam, F, Fc)
 
@@ -390,12 +415,6 @@ class ModeSystem:
         F = F + G.T @ Qd
         M, h = self.sm.with_drive_inertia(*mass_matrix_x(self.model, x, xdot), G, quad_g)
         return dict(B=B, b=b, A=B.T @ M @ B, f=B.T @ (F - h - M @ b), M=M, F=F, h=h)
-
-    def kinetic_energy(self, x, xdot) -> float:
-        """T = 1/2 xdot^T M xdot of the bodies and the drives' rotors and gears, J."""
-        M, _ = self.sm.with_drive_inertia(*mass_matrix_x(self.model, x), self._coord_jac(x),
-                                          np.zeros(self.model.n_q))
-        return 0.5 * float(xdot @ M @ xdot)
 
 
 def _independent_rows(Rs, tol=1e-9) -> np.ndarray:

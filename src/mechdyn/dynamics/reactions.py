@@ -138,50 +138,56 @@ def joint_reaction(model: Model, name: str, x, gen):
 
 
 def element_forces(ms, x, lam) -> dict:
-    """The force of every element of a mode from its multipliers at one pose.
+    """The force of every element of a mode from its multipliers (batched over poses).
 
     Parameters
     ----------
     ms : ModeSystem
-    x : ndarray, shape (n_x,)
-    lam : ndarray, shape (n_rows,)
+    x : ndarray, shape (..., n_x)
+    lam : ndarray, shape (..., n_rows)
         Multipliers of ``ms.rowset`` (forward convention); impulses give impulses.
 
     Returns
     -------
     dict
-        Joints and weld locks: their reaction (:func:`joint_reaction`), (Fx, Fy)
-        N for a revolute joint, (Fx, Fy, M) N, N, N m for a prismatic joint or a
-        weld; coordinate locks, stops and contacts: the multiplier of their
-        (first) row, float (the normal force of a stop or contact, N or N m, the
-        torque or force of a coordinate lock along its variable).
+        Joints and weld locks: their reaction (:func:`joint_reaction`), (..., 2)
+        (Fx, Fy) N for a revolute joint, (..., 3) (Fx, Fy, M) N, N, N m for a
+        prismatic joint or a weld; coordinate locks, stops and contacts: the
+        multiplier of their (first) row, shape (...) (the normal force of a stop or
+        contact, N or N m, the torque or force of a coordinate lock along its variable).
     """
     model = ms.model
     R = ms.row_jacobian(x)
+    lam = np.asarray(lam, float)
     joints = model.mechanism.joints
     out: dict = {}
     for el, idx in ms.element_rows.items():
         if el not in joints:
-            out[el] = float(lam[idx[0]])
+            out[el] = lam[..., idx[0]] if lam.ndim > 1 else float(lam[idx[0]])
             continue
-        f, m, _ = joint_reaction(model, el, x, R[idx].T @ lam[idx])
-        out[el] = f if model.joint_kind(el) == "revolute" else np.array([f[0], f[1], m])
+        gen = np.einsum("...rx,...r->...x", R[..., idx, :], lam[..., idx])
+        f, m, _ = joint_reaction(model, el, x, gen)
+        out[el] = f if model.joint_kind(el) == "revolute" else np.concatenate(
+            [f, np.asarray(m)[..., None]], axis=-1)
     return out
 
 
 def frame_forces(ms, x, lam) -> dict:
-    """Forces (Fx, Fy) the mechanism exerts on the frame through each element of a
-    mode attached to the ground (joint, lock, stop or contact), N; key ``"total"``
-    sums them."""
+    """Forces (Fx, Fy), shape (..., 2), N, that the mechanism exerts on the frame through
+    each element of a mode attached to the ground (joint, lock, stop or contact);
+    key ``"total"`` sums them (batched over poses ``x`` (..., n_x) and multipliers
+    ``lam`` (..., n_rows))."""
     nb = ms.model.n_bodies
     R = ms.row_jacobian(x)
+    lam = np.asarray(lam, float)
     out: dict = {}
-    total = np.zeros(2)
+    total = np.zeros(lam.shape[:-1] + (2,))
     for el, idx in ms.element_rows.items():
         if el not in ms.grounded:
             continue
-        gen = (R[idx].T @ lam[idx]).reshape(nb, 3)  # constraint force on each moving body
-        f = -gen[:, :2].sum(axis=0)  # Newton's third law: the frame gets the opposite
+        gen = np.einsum("...rx,...r->...x", R[..., idx, :], lam[..., idx])
+        # Newton's third law: the frame gets the opposite of the force on the bodies
+        f = -gen.reshape(gen.shape[:-1] + (nb, 3))[..., :2].sum(axis=-2)
         out[el] = f
         total = total + f
     out["total"] = total
