@@ -34,19 +34,21 @@ import math
 import time
 
 import numpy as np
+from scipy.optimize import brentq
 
 from .dynamics.contact import ContactError, touching
 from .dynamics.lagrange import kinetic_energy
-from .dynamics.reactions import element_forces, frame_forces
 from .dynamics.mode_equations import ModeEquations
 from .dynamics.modes import (
     ModeSystem,
     SwitchedModel,
     switched_model,
 )
+from .dynamics.reactions import element_forces, frame_forces
 from .dynamics.switching import apply_switch, event_functions
 from .errors import (
     AssemblyError,
+    IntegrationError,
     LockupError,
     MechdynError,
     ModelError,
@@ -100,7 +102,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                     steps: int | None = None, iterations: int | None = None,
                     tol: float | None = None, theta: float | None = None,
                     first_step: float | None = None, events=None,
-                    backend: str = "auto") -> Trajectory:
+                    backend: str = "auto", formulation: str = "exact",
+                    d=None) -> Trajectory:
     """Simulate a variable-structure mechanism through all its switches.
 
     Parameters
@@ -168,6 +171,9 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         run with status ``"event"``.
     backend : {"auto", "numpy", "numba"}
         Evaluation of the equations in each mode (:class:`ModeEquations`).
+    formulation, d
+        ``"exact"`` or the source paper's ``"analogs"`` with its virtual displacement
+        (modes in which every declared coordinate is independent).
 
     Returns
     -------
@@ -190,8 +196,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     L = model.length_scale
     t_end = float(t_end)
     t0 = float(t0)
-    if not t_end > t0:
-        raise ModelError(f"t_end must be after t0 = {t0} s, got {t_end}")
+    if not t_end >= t0:
+        raise ModelError(f"t_end must not be before t0 = {t0} s, got {t_end}")
     if atol is None:
         atol = 1e-3 * rtol  # the same default as every integrator of the package
     if small_velocity is None:
@@ -224,7 +230,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     rec: list = []
     events: list[SwitchEvent] = []
     stats = dict(steps=0, rejected=0, evaluations=0, integrator=method_name,
-                 formulation="exact", backend="numpy", rtol=rtol, atol=atol, segments=0)
+                 formulation=formulation, backend="numpy", rtol=rtol, atol=atol, segments=0,
+                 bifurcations=[])
     backends: set = set()
     lost_total = 0.0
 
@@ -233,17 +240,23 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
 
     # ---------------------------------------------------------------- initial state
     status, message = Status.SUCCESS, ""
-    q_init, qd_init, x_guess = initial_state(model, q0, qdot0)
     targets: dict = {}
     locks = sm.initial_locks() if mode is None else frozenset(mode)
     unknown = [n for n in locks if n not in sm.lock_names]
     if unknown:
         raise ModelError("mode: " + did_you_mean(unknown[0], sm.lock_names, "lock"))
+    welds = sorted(locks & set(sm.welds))
+    q_init, qd_init, x_guess = initial_state(model, q0, qdot0, mode=welds)
     t = t0
     w_nc = 0.0
     try:
-        free = ModeSystem(sm, frozenset(), targets, x_guess)
-        x = free.solve_position(q_init[free.coords], x_guess, t=t)
+        x = x_guess
+        if locks:
+            try:  # the pose at which undeclared locks capture what they hold
+                free = ModeSystem(sm, frozenset(), targets, x_guess)
+                x = free.solve_position(q_init[free.coords], x_guess, t=t)
+            except LockupError:  # the coordinates need the locks: the welded pose
+                pass
         for n in locks:
             sm.capture_target(n, x, targets)
         ms = ModeSystem(sm, locks, targets, x)
@@ -266,9 +279,10 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             if gap.value(X) < -gap_tol:
                 raise ModelError(f"contact {n!r}: the initial state penetrates by "
                                  f"{-gap.value(X):.3g} m")
-        ms, x, xd, _ = apply_switch(sm, t, ms, x, xd, targets, events, fired=[],
-                                    small_velocity=small_velocity, gap_tol=gap_tol,
-                                    force_scale=force_scale, initial=True)
+        if sm.has_switching:  # the mode the state is in: touching stops and contacts
+            ms, x, xd, _ = apply_switch(sm, t, ms, x, xd, targets, events, fired=[],
+                                        small_velocity=small_velocity, gap_tol=gap_tol,
+                                        force_scale=force_scale, initial=True)
     except (MechdynError, np.linalg.LinAlgError) as exc:
         if isinstance(exc, ModelError):
             raise
@@ -282,12 +296,14 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     n_events = 0
     last_event_t, repeat = None, 0
     bar = Progress(progress, t0, t_end)
-    while t < t_end:
+    while t < t_end or not stats["segments"]:
         stats["segments"] += 1
-        eqs = ModeEquations(sm, ms, backend)
+        eqs = ModeEquations(sm, ms, backend, formulation, d)
         backends.add(eqs.backend)
         if eqs.note:
             stats["backend_note"] = eqs.note
+        if eqs.kernel is not None:
+            stats["compile_time_s"] = eqs.kernel.compile_time
         # the last few states evaluated: the step ends, the event functions and the output
         # samples often meet the same (t, y)
         state_cache: dict = {}
@@ -309,13 +325,25 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         efns += user_event_functions(user_events)
         try:
             ev0 = evaluate(t, y0)
-            if not rec or rec[-1][0] != t or rec[-1][1].mode != ms.mode:
+            # the start of the run is an output sample with every_step (else when it is
+            # one of t_eval); each segment after an event starts with one
+            if (every_step or stats["segments"] > 1 or t >= t_end) and (
+                    not rec or rec[-1][0] != t or rec[-1][1].mode != ms.mode):
                 store(t, ms, ev0, w_nc)
+            good = (t, ev0, ms)
+            if t >= t_end:
+                break
             arm(efns, t, ev0, just_fired)
             first = None if not just_fired else 1e-7 * (t_end - t0)
 
             def after_step(step, y, eqs=eqs, evaluate=evaluate, ms=ms):
                 nonlocal good
+                if not np.all(np.isfinite(y)):
+                    raise Stop(Status.NON_FINITE, f"non-finite state at t = {step.t:.9g} s "
+                               f"after t = {good[0]:.9g} s")
+                turn = _turning_point(eqs, step, good[1].qdot[ms.coords], good[1].x)
+                if turn is not None:
+                    raise Stop(Status.SINGULAR_POSITION, turn)
                 ev = evaluate(step.t, y)
                 eqs.check_position(step.t, ev.x, ev.q)
                 good = (step.t, ev, ms)
@@ -396,11 +424,13 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             message = (f"interrupted (Ctrl-C) after t = {rec[-1][0] if rec else t:.9g} s; "
                        f"the samples computed so far are kept")
             break
-        except (MechdynError, np.linalg.LinAlgError, ValueError) as exc:
+        except (MechdynError, np.linalg.LinAlgError, ValueError, ArithmeticError) as exc:
             if isinstance(exc, IntegratorOptionError):
                 raise
-            status, message = _dead_position(exc, good) or _status_of(exc)
+            status, message = _diagnose(exc, good)
             break
+        finally:
+            stats["bifurcations"] += eqs.report()
     stats["backend"] = "numba" if backends == {"numba"} else (
         "numpy" if backends <= {"numpy"} else "numba+numpy")
     bar.close()
@@ -483,21 +513,89 @@ def _penetration(sm: SwitchedModel, x) -> float:
     return worst
 
 
-def _dead_position(exc, good):
-    """(status, message) when a position solve failed just past a dead position of the
-    mode (the last accepted state is nearly singular), else None."""
-    if not isinstance(exc, AssemblyError) or good is None:
-        return None
+def _where(ms, q) -> str:
+    return ", ".join(f"{n} = {v:.9g}" for n, v in zip(ms.model.coordinate_names, q,
+                                                      strict=True))
+
+
+def _dependent(rep) -> str:
+    return (f"coordinate(s) {', '.join(rep['coordinates']) or '-'} lose control, joints "
+            f"{', '.join(rep['joints']) or '-'} become dependent")
+
+
+#: a coordinate that turns back where sigma_min / sigma_max of the mode's scaled position
+#: Jacobian is below this, and which carries its null vector, has met a dead position (a
+#: fold: near it sigma_min grows like the square root of the distance, so a fixed step
+#: lands within about 1e-2 of it)
+TURN_RCOND = 1e-2
+
+
+def _turning_point(eqs, step, qd_old, x_good) -> str | None:
+    """A coordinate whose rate changes sign during the step may turn back at a dead
+    position (the rate of the driving coordinate vanishes there and the mechanism would
+    have to change assembly branch to go on): locate the turn on the dense output and
+    test the position there.  Returns the message of a dead position, or None."""
+    ms = eqs.ms
+    for k in np.flatnonzero(np.sign(qd_old) * np.sign(step.qdot) < 0):
+        try:
+            tk = brentq(lambda s, k=k: step.dense(s)[1][k], step.t_old, step.t, xtol=1e-14,
+                        rtol=4 * np.finfo(float).eps)
+        except ValueError:
+            continue
+        qk = step.dense(tk)[0]
+        if eqs.chart_at(qk) is not None:
+            continue  # a bifurcation: the branch goes on through it
+        kept = ms._x_last
+        try:
+            xk = ms.solve_position(qk, x_good)
+        except AssemblyError:
+            xk = None
+        finally:
+            ms._x_last = kept
+        rep = ms.singularity(x_good if xk is None else xk)
+        if xk is None or (rep["rcond"] < TURN_RCOND
+                          and ms.coord_names[k] in rep["coordinates"]):
+            q = ms.coordinates(x_good if xk is None else xk)
+            return (f"dead position reached near t = {tk:.9g} s at {_where(ms, q)}: "
+                    f"{ms.coord_names[k]} turns back where the position Jacobian is singular "
+                    f"(sigma_min/sigma_max {rep['rcond']:.2e}); {_dependent(rep)}; going on "
+                    f"would need the other assembly branch")
+    return None
+
+
+def _diagnose(exc, good):
+    """(status, message) of a run that stopped with ``exc`` after the accepted state
+    ``good`` = (t, ModeEval, ModeSystem)."""
+    if isinstance(exc, SingularPositionError) or good is None:
+        return _status_of(exc)
     t_good, ev, ms = good
-    rc = ms.rcond(ev.x)
-    if rc >= DEAD_RCOND:
-        return None
-    names = ", ".join(f"{n} = {v:.9g}" for n, v in zip(ms.model.coordinate_names, ev.q,
-                                                         strict=True))
-    return Status.SINGULAR_POSITION, (
-        f"dead position reached near t = {t_good:.9g} s at {names}: the mechanism cannot "
-        f"move past it in mode {sorted(ms.mode) or '(none)'} (sigma_min/sigma_max of the "
-        f"position Jacobian {rc:.2e}; {exc})")
+    if isinstance(exc, AssemblyError) and exc.q is not None \
+            and np.size(exc.q) == ms.n_i:
+        # the solve failed between an assemblable q_good and q_bad: the segment leaves
+        # the assembly region, whose boundary is a singular position; bisect for it
+        q_good, q_bad = ev.q[ms.coords], np.asarray(exc.q, float)
+        t_bad = exc.t if exc.t is not None else t_good
+        lo, hi, x_lo = 0.0, 1.0, ev.x
+        while hi - lo > 1e-13:
+            mid = 0.5 * (lo + hi)
+            try:
+                x_lo, lo = ms.solve_position(q_good + mid * (q_bad - q_good), x_lo), mid
+            except AssemblyError:
+                hi = mid
+        rep = ms.singularity(x_lo)
+        if rep["rcond"] < DEAD_RCOND:
+            return Status.SINGULAR_POSITION, (
+                f"dead position reached near t = {t_good + lo * (t_bad - t_good):.9g} s at "
+                f"{_where(ms, ms.coordinates(x_lo))}: the mechanism cannot move past it in "
+                f"mode {sorted(ms.mode) or '(none)'} (sigma_min/sigma_max of the position "
+                f"Jacobian {rep['rcond']:.2e}); {_dependent(rep)}")
+        return Status.ASSEMBLY_FAILED, f"position solve failed at t = {t_bad:.9g} s: {exc}"
+    rep = ms.singularity(ev.x)
+    if rep["rcond"] < DEAD_RCOND:
+        return Status.SINGULAR_POSITION, (
+            f"dead position near t = {t_good:.9g} s at {_where(ms, ev.q)}: "
+            f"sigma_min/sigma_max = {rep['rcond']:.2e}; {_dependent(rep)} ({exc})")
+    return _status_of(exc)
 
 
 def _status_of(exc):
@@ -509,6 +607,10 @@ def _status_of(exc):
         return Status.NO_CONTACT_SOLUTION, str(exc)
     if isinstance(exc, LockupError):
         return Status.LOCKUP, str(exc)
+    if isinstance(exc, IntegrationError) and "mass matrix" in str(exc):
+        return Status.SINGULAR_MASS_MATRIX, str(exc)
+    if isinstance(exc, ArithmeticError):
+        return Status.NON_FINITE, f"non-finite values: {exc}"
     if isinstance(exc, np.linalg.LinAlgError):
         return Status.FAILED, f"singular system: {exc}"
     return Status.FAILED, str(exc)

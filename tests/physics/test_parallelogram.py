@@ -41,8 +41,8 @@ from dynamics_models import parallelogram
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from mechdyn.dynamics.branch_dynamics import BranchEquations
 from mechdyn.dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
+from mechdyn.dynamics.lagrange import BranchEquations
 from mechdyn.kinematics.sweep import sweep
 from mechdyn.mechanism import Drive
 from mechdyn.model import as_model

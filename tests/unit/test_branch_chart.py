@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from test_sweep import A_, B_, five_bar, four_bar, rocker_limit
 
-from mechdyn.dynamics import branch_dynamics
-from mechdyn.dynamics.branch_dynamics import BranchEquations
+from mechdyn.dynamics import lagrange
+from mechdyn.dynamics.lagrange import BranchEquations
 from mechdyn.kinematics import branch_chart
 from mechdyn.kinematics.branch_chart import ChartBook, PathProblem, bridge
 from mechdyn.kinematics.sweep import sweep
@@ -35,7 +35,7 @@ def test_charts_only_for_one_coordinate_and_exact_analogs():
     assert BranchEquations(five_bar().compile(), backend="numpy").book is None  # 2 DOF
 
 
-@pytest.mark.parametrize("module", [branch_chart, branch_dynamics])
+@pytest.mark.parametrize("module", [branch_chart, lagrange])
 def test_examples_run(module):
     failures, tried = doctest.testmod(module)
     assert tried and not failures

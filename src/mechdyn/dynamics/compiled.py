@@ -39,7 +39,7 @@ from ..model.rows import concat
 from ..model.variable import lower, parse
 from .forces import force_model
 
-__all__ = ["compile_kernel", "compile_mode_kernel", "CompiledKernel", "numba_available"]
+__all__ = ["compile_mode_kernel", "CompiledKernel", "numba_available"]
 
 
 _NUMBA = NUMBA  # the switch the package reads (tests turn it off)
@@ -243,18 +243,32 @@ def compile_mode_kernel(model, force_model, constraint_rows, independent):
         return None, "nothing to compile"
     if len(constraint_rows) + independent.size != model.n_x:
         return None, "redundant constraints (non-square position Jacobian)"
-    packer = LoadPacker(model, force_model, variable=lambda name: _variable(model, name))
-    try:
-        ip, fp = packer.pack()
-    except Unsupported as exc:
-        return None, str(exc)
-    crd = model.coordinate_rows
-    var = concat(model.n_bodies, *packer.variable_rows)
-    ri, rf = concat(model.n_bodies, constraint_rows, crd.take(independent), crd, var).packed()
-    dims = np.array([len(constraint_rows), independent.size, model.n_q, len(var)],
-                    dtype=np.int64)
-    ct = _warm_up()
-    return CompiledKernel(ip, fp, ri, rf, dims, model.n_x, ct), ""
+    # the packed arrays of a mode are kept with the model: a run, or the next run, that
+    # meets the same rows again (the same targets) only allocates a new workspace
+    ints, flts = constraint_rows.packed()
+    key = ("kernel", independent.tobytes(), ints.tobytes(), flts.tobytes())
+    packed = model.memo.get(key)
+    if packed is None:
+        packer = LoadPacker(model, force_model, variable=lambda name: _variable(model, name))
+        try:
+            ip, fp = packer.pack()
+        except Unsupported as exc:
+            packed = str(exc)
+        else:
+            crd = model.coordinate_rows
+            var = concat(model.n_bodies, *packer.variable_rows)
+            ri, rf = concat(model.n_bodies, constraint_rows, crd.take(independent), crd,
+                            var).packed()
+            dims = np.array([len(constraint_rows), independent.size, model.n_q, len(var)],
+                            dtype=np.int64)
+            packed = (ip, fp, ri, rf, dims)
+        kept = model.memo.setdefault("kernels", [])
+        if len(kept) < 64:  # a bounded number (locks capture new targets every cycle)
+            kept.append(key)
+            model.memo[key] = packed
+    if isinstance(packed, str):
+        return None, packed
+    return CompiledKernel(*packed, model.n_x, _warm_up()), ""
 
 
 def _variable(model, name: str):
@@ -268,9 +282,3 @@ def _variable(model, name: str):
     if var.kind == "distance" or var.rate:
         return None, None
     return "row", lower(model, var)
-
-
-def compile_kernel(model, layout):
-    """The compiled kernel of a fixed-structure model in one layout (every declared
-    coordinate independent), or ``(None, reason)``."""
-    return compile_mode_kernel(model, force_model(model), layout.rowset, np.arange(model.n_q))

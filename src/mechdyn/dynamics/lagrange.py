@@ -1,35 +1,27 @@
-"""Equations of motion, Lagrange's equations of the second kind:
+"""Equations of motion, Lagrange's equations of the second kind, for inspection:
 
     A(q) q'' + c(q, q') = Q(t, q, q')
 
-in the generalized coordinates q of a model, with the body poses x re-solved
-from q at every evaluation (Newton from the last solution, so the assembly
-branch is kept by continuity).
-
-Two formulations evaluate the same physics:
+in the generalized coordinates q of a model in one mode (its initial one by
+default), with the body poses x re-solved from q at every evaluation (Newton from
+the last solution, so the assembly branch is kept by continuity).
+:class:`EquationsOfMotion` is a view of the equations that every run integrates,
+:class:`~mechdyn.dynamics.mode_equations.ModeEquations` of the mode:
 
 ``"exact"`` (default)
     With the exact velocity analogs B = dx/dq and the acceleration bias b
     (``xddot = B q'' + b``), and the frame mass matrix M_x(x) and centripetal
     term h(x, xdot) of :mod:`mechdyn.dynamics.inertia` (the body-frame origins
-    need not be the centres of mass),
-
-        A = B^T M_x B,   c = B^T (M_x b + h),   Q = B^T F + Q_drive
-
-    (F: applied forces conjugate to x, from ``force_model(model).applied``), plus
-    the rotor and gear inertia of the drives on their coordinates.
+    need not be the centres of mass), A = B^T M_x B, c = B^T (M_x b + h),
+    Q = B^T F + Q_drive, plus the rotor and gear inertia of the drives on their
+    coordinates; through bifurcation positions on the branch the motion is on.
 
 ``"analogs"``
-    The source paper's method (METHOD.md section 1): velocity analogs of the
-    *partial systems* by central differences with a virtual displacement d
-    (0.1 deg by default), A_ij = sum over links of m v*_ci . v*_cj + J_c w*_i w*_j,
-    A_ij,k = dA_ij/dq_k by central differences, and the paper's eq. 35 for n
-    coordinates, c_i = sum_jk (A_ij,k - 1/2 A_jk,i) q'_j q'_k; generalized forces
-    by virtual work over the +-d displacements, Q_k = F . v*_k + Q_drive,k.
-    Its error against ``"exact"`` is O(d^2).
+    The source paper's finite-difference analogs of the partial systems
+    (:meth:`~mechdyn.dynamics.mode_equations.ModeEquations.analogs_terms`).
 
-The mass matrix is checked positive definite by a Cholesky factorisation; a
-singular one raises :class:`~mechdyn.errors.IntegrationError`.
+A mass matrix that is not positive definite raises
+:class:`~mechdyn.errors.IntegrationError`.
 """
 
 from __future__ import annotations
@@ -38,21 +30,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import IntegrationError, ModelError
-from ..kinematics.analogs import acceleration_bias, default_displacement
-from ..kinematics.assembly import assemble, solve_position
-from ..kinematics.constraints import extend, full_jacobian
+from ..errors import ModelError
+from ..kinematics.assembly import assemble
 from ..model import Model
 from .forces import com_arms, force_model
-from .inertia import drive_inertia, frame_mass_matrix, mass_matrix_x
+from .inertia import drive_inertia, frame_mass_matrix
+from .mode_equations import FORMULATIONS, PIVOT_CHECK, ModeEquations
+from .modes import ModeSystem, switched_model
 
-__all__ = ["EquationsOfMotion", "Terms", "FORMULATIONS", "equations_of_motion", "drive_inertia",
-           "kinetic_energy", "potential_energy", "mass_matrix"]
-
-#: the formulations of the equations of motion
-FORMULATIONS = ("exact", "analogs")
-#: compiled path: LU pivot ratio below which a position is checked for singularity by SVD
-PIVOT_CHECK = 1e-5
+__all__ = ["EquationsOfMotion", "BranchEquations", "Terms", "FORMULATIONS", "PIVOT_CHECK",
+           "equations_of_motion", "drive_inertia", "kinetic_energy", "potential_energy",
+           "mass_matrix"]
 
 
 @dataclass(frozen=True)
@@ -103,7 +91,7 @@ def mass_matrix(model: Model, x, B) -> np.ndarray:
 
 
 def kinetic_energy(model: Model, x, xdot) -> np.ndarray:
-    """T = 1/2 sum (m v_c^2 + J_c omega^2), J, shape (...)."""
+    """T = 1/2 sum (m v_c^2 + J_c omega^2) of the bodies, J, shape (...)."""
     xdot = np.asarray(xdot, float)
     arm = com_arms(model, x)
     w = xdot[..., 2::3]
@@ -118,7 +106,7 @@ def potential_energy(model: Model, x) -> np.ndarray:
 
 
 class EquationsOfMotion:
-    """A(q) q'' + c(q, q') = Q(t, q, q') of a model, evaluated on demand.
+    """A(q) q'' + c(q, q') = Q(t, q, q') of a model in one mode, evaluated on demand.
 
     Parameters
     ----------
@@ -134,16 +122,44 @@ class EquationsOfMotion:
         A solved pose to start the Newton continuation from (default: the
         assembled sketch).
     backend : {"auto", "numpy", "numba"}
-        ``"auto"`` uses the compiled kernel of :mod:`mechdyn.dynamics.compiled`
-        when numba is installed and every load is supported there (exact
-        formulation only); ``"numba"`` insists on it.
+        ``"auto"`` uses the compiled kernel when numba is installed and every load
+        is supported there (exact formulation only); ``"numba"`` insists on it.
 
     Attributes
     ----------
-    evaluations : int
-        Number of evaluations of the equations so far.
-    x : ndarray, shape (n_x,)
-        The last solved pose (start of the next Newton solve).
+    equations : ModeEquations
+        The equations of the mode, as the integrators see them.
+    backend, backend_note : str
+        ``"numba"`` or ``"numpy"``; why the compiled path is not used.
+
+    Raises
+    ------
+    ModelError
+        An unknown formulation or backend, or a mode in which some declared
+        coordinate is dependent.
+
+    Examples
+    --------
+    A parallelogram four-bar of 1 m bars (1 kg, uniform) under gravity, its crank at
+    1e-7 rad from the flat position (a bifurcation): (5/3) phi'' = -2 g cos(phi).
+
+    >>> import numpy as np, mechdyn as md
+    >>> m = md.Mechanism("parallelogram", gravity=(0.0, -9.81))
+    >>> _ = m.add_ground({"O": (0.0, 0.0), "C": (1.0, 0.0)})
+    >>> for name, pose in (("crank", (0, 0, 0.5)), ("coupler", (np.cos(0.5), np.sin(0.5), 0)),
+    ...                    ("rocker", (1, 0, 0.5))):
+    ...     _ = m.add_body(name, mass=1.0, inertia=1 / 12, com=(0.5, 0.0),
+    ...                    points={"E": (1.0, 0.0)}, pose=pose)
+    >>> _ = m.add_revolute("O", "ground", "crank", "O", (0.0, 0.0))
+    >>> _ = m.add_revolute("A", "crank", "coupler", "E", (0.0, 0.0))
+    >>> _ = m.add_revolute("B", "coupler", "rocker", "E", "E")
+    >>> _ = m.add_revolute("C", "ground", "rocker", "C", (0.0, 0.0))
+    >>> _ = m.add_coordinate("phi", kind="angle", body="crank")
+    >>> eom = EquationsOfMotion(m.compile(), backend="numpy")
+    >>> _ = eom.qddot(0.0, [0.5], [-1.0])          # approaching: the chart is built
+    >>> a = eom.qddot(0.0, [1e-7], [-1.0])[0]
+    >>> bool(abs(a - (-2 * 9.81 * np.cos(1e-7) / (5 / 3))) < 1e-11)
+    True
     """
 
     def __init__(self, model: Model, formulation: str = "exact", *, d=None, mode=None,
@@ -151,54 +167,53 @@ class EquationsOfMotion:
         if formulation not in FORMULATIONS:
             raise ModelError(f"unknown formulation {formulation!r}; valid formulations: "
                              + ", ".join(repr(f) for f in FORMULATIONS))
-        if backend not in ("auto", "numpy", "numba"):
-            raise ModelError(f"unknown backend {backend!r}; valid: 'auto', 'numpy', 'numba'")
-        self.model = model
-        self.formulation = formulation
+        self.model, self.formulation = model, formulation
         self.layout = model.layout(mode)
-        self.forces = force_model(model)
-        self.extra_inertia = drive_inertia(model)
-        if d is None:
-            self.d = default_displacement(model)
-        else:
-            dd = np.broadcast_to(np.asarray(d, float), (model.n_q,)).copy()
-            if not np.all(np.isfinite(dd)) or np.any(dd <= 0):
-                raise ModelError(f"virtual displacement d must be > 0, got {d!r}")
-            self.d = dd
         if x0 is None:
             x0 = getattr(model, "x0", None)
             if x0 is None:
                 x0 = assemble(model, layout=self.layout)
-        self.x = np.array(x0, dtype=float)
-        self._q_last = None
-        self._B_last = None
-        self.evaluations = 0
-        self.kernel = None
-        self.backend = "numpy"
-        self.backend_note = ""
-        if formulation == "exact" and backend in ("auto", "numba"):
-            from .compiled import compile_kernel
+        sm = switched_model(model)
+        locks = sm.initial_locks() if mode is None else frozenset(mode)
+        targets: dict = {}
+        for n in locks:
+            sm.capture_target(n, x0, targets)
+        ms = ModeSystem(sm, locks, targets, np.asarray(x0, float))
+        if ms.n_i != model.n_q:
+            raise ModelError(f"in mode {sorted(locks)} the coordinates "
+                             f"{', '.join(model.coordinate_names)} are not all independent")
+        self.equations = ModeEquations(sm, ms, backend, formulation, d)
+        self.extra_inertia = sm.drive_inertia
 
-            self.kernel, note = compile_kernel(model, self.layout)
-            self.backend_note = note
-            if self.kernel is not None:
-                self.backend = "numba"
-                self.kernel.reset(self.x)
-            elif backend == "numba":
-                raise ModelError(f"the compiled (numba) backend is not available: {note}")
-        elif backend == "numba":
-            raise ModelError("the compiled (numba) backend supports formulation 'exact' only")
+    @property
+    def backend(self) -> str:
+        return self.equations.backend
 
-    # ------------------------------------------------------------------ positions
+    @property
+    def backend_note(self) -> str:
+        return self.equations.note
+
+    @property
+    def kernel(self):
+        """The compiled kernel, or None."""
+        return self.equations.kernel
+
+    @property
+    def book(self):
+        """The branch charts (None where charts do not apply)."""
+        return self.equations.book
+
+    @property
+    def x(self) -> np.ndarray:
+        """The last solved pose."""
+        k = self.kernel
+        return k.x.copy() if k is not None else self.equations.ms._x_last.copy()
+
     def reset(self, x) -> None:
         """Restart the Newton continuation from the pose ``x`` (n_x,)."""
-        self.x = np.array(x, dtype=float)
-        self._q_last = None
-        self._B_last = None
-        if self.kernel is not None:
-            self.kernel.reset(self.x)
+        self.equations._reset(x)
 
-    def positions(self, q, t: float | None = None, *, check_singular: bool = False) -> np.ndarray:
+    def positions(self, q, t: float | None = None, *, check_singular: bool = False):
         """Body poses x (n_x,) at coordinates ``q``, by Newton from the last solution.
 
         Raises
@@ -206,62 +221,14 @@ class EquationsOfMotion:
         AssemblyError, SingularPositionError
             (the latter only with ``check_singular``).
         """
-        q = np.asarray(q, dtype=float)
-        if self.kernel is not None:
-            x = self.kernel.positions(q)
-            if x is not None:
-                # the LU pivots are a cheap indicator; confirm a near-singular one by SVD
-                if check_singular and self.kernel.pivot_ratio < PIVOT_CHECK:
-                    x = solve_position(self.model, q, x, layout=self.layout, t=t,
-                                       check_singular=True)
-                self.x = x
-                return x
-            guess = self.kernel.x.copy()
-        else:
-            guess = self.x
-            if self._q_last is not None and self._B_last is not None:
-                guess = self.x + self._B_last @ (q - self._q_last)
-        x = solve_position(self.model, q, guess, layout=self.layout, t=t,
-                           check_singular=check_singular)
-        self.x = x
-        self._q_last = q.copy()
-        self._B_last = None
-        if self.kernel is not None:
-            self.kernel.reset(x)
-        return x.copy()
+        ev = self.equations.evaluate(t or 0.0, np.asarray(q, float), np.zeros(self.model.n_q))
+        if check_singular:
+            self.equations.check_position(t or 0.0, ev.x, ev.q)
+        return ev.x.copy()
 
-    # ------------------------------------------------------------------ evaluation
     def rhs(self, t: float, q, qdot):
-        """q'' and the non-conservative power at (t, q, q'): ``(qddot (n_q,), p (1,))``.
-
-        This is the right-hand side handed to the integrators.
-        """
-        if self.kernel is not None:
-            out = self.kernel.rhs(t, q, qdot)
-            if out is not None:
-                return out
-            self._kernel_failure(t, q, self.kernel.status)
-        self.evaluations += 1
-        tm = self._terms(t, np.asarray(q, float), np.asarray(qdot, float))
-        return tm.qddot, np.array([tm.power_nc])
-
-    def first_order_function(self):
-        """``fun(t, y) -> y'`` for y = (q, q', w) with w' = P_nc, calling the compiled
-        kernel directly; None without the compiled backend."""
-        if self.kernel is None:
-            return None
-        n = self.model.n_q
-
-        def on_failure(t, y):
-            qdd, p = self.rhs(t, y[:n], y[n:2 * n])
-            return np.concatenate([y[n:2 * n], qdd, p])
-
-        return self.kernel.first_order_function(on_failure)
-
-    @property
-    def total_evaluations(self) -> int:
-        """Evaluations through :meth:`rhs` plus those of the compiled kernel called directly."""
-        return self.evaluations + (self.kernel.evaluations if self.kernel is not None else 0)
+        """q'' and the non-conservative power at (t, q, q'): ``(qddot (n_q,), p (1,))``."""
+        return self.equations.rhs(t, np.asarray(q, float), np.asarray(qdot, float))
 
     def qddot(self, t: float, q, qdot) -> np.ndarray:
         """Generalized accelerations q'' (n_q,) at (t, q, q')."""
@@ -269,116 +236,43 @@ class EquationsOfMotion:
 
     __call__ = qddot
 
+    def first_order_function(self):
+        """``fun(t, y) -> y'`` for y = (q, q', w) on the compiled kernel, or None."""
+        return self.equations.first_order_function()
+
     def terms(self, t: float, q, qdot) -> Terms:
         """All terms of the equations at one state (NumPy path, for inspection)."""
-        self.evaluations += 1
-        if self.kernel is not None:
-            self.x = self.kernel.x.copy()
-        return self._terms(t, np.asarray(q, float), np.asarray(qdot, float))
+        q, qdot = np.asarray(q, float), np.asarray(qdot, float)
+        eqs = self.equations
+        if self.formulation == "analogs":
+            tm = eqs.analogs_terms(t, q, qdot)
+            return Terms(t, q, qdot, tm["qddot"], tm["x"], tm["xdot"], tm["B"], tm["A"],
+                         tm["c"], tm["Q"], tm["Q_drive"], tm["power_nc"])
+        ev = eqs.evaluate(t, q, qdot)
+        tm = eqs.ms.terms(t, ev.x, ev.xdot)
+        B, M = tm["B"], tm["M"]
+        Qd = eqs.sm.fm.applied(t, ev.x, ev.xdot, q, qdot)[1]
+        return Terms(t, q, qdot, ev.qddot, ev.x, ev.xdot, B, tm["A"],
+                     B.T @ (M @ tm["b"] + tm["h"]), B.T @ tm["F"], Qd, eqs._power(ev))
 
-    def _kernel_failure(self, t, q, status):
-        """The kernel reported a failure: redo the evaluation on the NumPy path, which
-        raises the error with its diagnosis (joint residuals, mass matrix)."""
-        self.x = self.kernel.x.copy()
-        self._q_last = None
-        x = solve_position(self.model, np.asarray(q, float), self.x, layout=self.layout, t=t,
-                           check_singular=False)
-        self.x = x
-        self.kernel.reset(x)
-
-    def _terms(self, t, q, qdot) -> Terms:
-        if self.formulation == "exact":
-            return self._exact(t, q, qdot)
-        return self._analogs(t, q, qdot)
-
-    def _solve_mass(self, A, rhs, t, q):
-        try:
-            L = np.linalg.cholesky(A)
-        except np.linalg.LinAlgError:
-            ev = np.linalg.eigvalsh(0.5 * (A + A.T))
-            k = int(np.argmin(ev))
-            vec = np.linalg.eigh(0.5 * (A + A.T))[1][:, k]
-            names = [n for n, v in zip(self.model.coordinate_names, vec, strict=True)
-                     if abs(v) > 0.1]
-            raise IntegrationError(
-                f"the generalized mass matrix is singular or not positive definite "
-                f"(smallest eigenvalue {ev[k]:.3g}); coordinate(s) {', '.join(names)} have "
-                f"no inertia", t=t, q=q) from None
-        y = np.linalg.solve(L, rhs)
-        return np.linalg.solve(L.T, y)
-
-    def _power(self, F, Qd, x, xdot, qdot) -> float:
-        return self.forces.nonconservative_power(None, x, xdot, None, qdot, applied=(F, Qd))
-
-    def _exact(self, t, q, qdot) -> Terms:
-        model, lay = self.model, self.layout
-        x = self.positions(q, t)
-        J = full_jacobian(model, x, lay)
-        rhs = np.zeros((J.shape[0], model.n_q))
-        rhs[lay.n_rows:, :] = np.eye(model.n_q)
-        B = np.linalg.solve(J, rhs) if J.shape[0] == J.shape[1] else np.linalg.pinv(J) @ rhs
-        self._B_last = B
-        b = acceleration_bias(model, x, B @ qdot, lay, J=J)
-        return self._lagrange(t, q, qdot, x, B, b)
-
-    def _lagrange(self, t, q, qdot, x, B, b) -> Terms:
-        """The terms at a pose x (n_x,) with its velocity analogs B (n_x, n_q) and
-        acceleration bias b (n_x,): A = B^T M_x B, c = B^T (M_x b + h), Q = B^T F + Q_drive
-        and q'' = A^-1 (Q - c)."""
-        model = self.model
-        xdot = B @ qdot
-        M, h = mass_matrix_x(model, x, xdot)
-        A = B.T @ M @ B + np.diag(self.extra_inertia)
-        c = B.T @ (M @ b + h)
-        F, Qd = self.forces.applied(t, x, xdot, q, qdot)
-        Q = B.T @ F + Qd
-        qdd = self._solve_mass(A, Q - c, t, q)
-        return Terms(t, q, qdot, qdd, x, xdot, B, A, c, Q, Qd,
-                     self._power(F, Qd, x, xdot, qdot))
-
-    def _analogs(self, t, q, qdot) -> Terms:
-        model, lay = self.model, self.layout
-        n = model.n_q
-        x = self.positions(q, t)
-        d = self.d
-        E = np.diag(d)
-        pm = np.concatenate([E, -E])  # (2n, n): +d e_k then -d e_k
-        q1 = q + pm
-        x1 = solve_position(model, q1, x, layout=lay, t=t, check_singular=False)
-        q2 = q1[:, None, :] + pm[None, :, :]  # (2n, 2n, n)
-        x2 = solve_position(model, q2, x1[:, None, :], layout=lay, t=t, check_singular=False)
-
-        def analog_mass(xs):
-            """A from the poses of the partial systems xs (..., 2n, n_x)."""
-            rc = extend(model, xs)[..., :-1, :2] + com_arms(model, xs)  # (..., 2n, nb, 2)
-            th = xs[..., 2::3]
-            vc = (rc[..., :n, :, :] - rc[..., n:, :, :]) / (2 * d[:, None, None])  # (..,n,nb,2)
-            w = (th[..., :n, :] - th[..., n:, :]) / (2 * d[:, None])  # (..., n, nb)
-            A = np.einsum("...ibk,...jbk,b->...ij", vc, vc, model.mass)
-            A += np.einsum("...ib,...jb,b->...ij", w, w, model.inertia)
-            return A
-
-        A = analog_mass(x1) + np.diag(self.extra_inertia)
-        A1 = analog_mass(x2)  # (2n, n, n): A at q + d e_k and q - d e_k
-        dA = (A1[:n] - A1[n:]) / (2 * d[:, None, None])  # dA[k, i, j] = A_ij,k
-        Aijk = np.transpose(dA, (1, 2, 0))  # [i, j, k]
-        Ajki = dA  # [i, j, k] -> A_jk,i = dA[i, j, k]
-        c = np.einsum("ijk,j,k->i", Aijk - 0.5 * Ajki, qdot, qdot)
-        B = ((x1[:n] - x1[n:]) / (2 * d[:, None])).T  # (n_x, n) frame analogs
-        xdot = B @ qdot
-        F, Qd = self.forces.applied(t, x, xdot, q, qdot)
-        Q = B.T @ F + Qd
-        qdd = self._solve_mass(A, Q - c, t, q)
-        return Terms(t, q, qdot, qdd, x, xdot, B, A, c, Q, Qd,
-                     self._power(F, Qd, x, xdot, qdot))
-
-    # ------------------------------------------------------------------ energy
     def energy(self, t: float, q, qdot) -> dict:
         """Kinetic and potential energy (J) and the non-conservative power (W) at one state."""
         tm = self.terms(t, q, qdot)
         T = 0.5 * float(qdot @ tm.A @ qdot)
         return {"kinetic": T, "potential": float(potential_energy(self.model, tm.x)),
                 "power_nc": tm.power_nc}
+
+    def chart_at(self, q):
+        """The branch chart whose zone holds q, else None."""
+        return self.equations.chart_at(q)
+
+    def report(self) -> list[dict]:
+        """The bifurcation positions met."""
+        return self.equations.report()
+
+
+#: the equations go through bifurcation positions on the branch (kept as a name)
+BranchEquations = EquationsOfMotion
 
 
 def equations_of_motion(model_or_mechanism, formulation: str = "exact", **kwargs

@@ -4,12 +4,32 @@ Lagrange II in the independent coordinates q_I of the mode (a subset of the
 declared coordinates, chosen by :class:`~mechdyn.dynamics.modes.ModeSystem`):
 A(q) q_I'' = Q - c, with the rows of every active element (joints, engaged
 locks, closed stops and contacts, sticking contacts) and the rotor and gear
-inertia of the drives reduced to their coordinates.  The right-hand side runs
-on the compiled kernel (:mod:`mechdyn.dynamics.compiled`) whenever the mode
-allows (numba installed, every load compiled, no sliding friction); otherwise,
-and to diagnose a failure, on the NumPy evaluation of the mode
-(:meth:`ModeSystem.evaluate`), which also gives every multiplier.  A
-fixed-structure run is a run in one mode.
+inertia of the drives reduced to their coordinates.  A fixed-structure run is a
+run in one mode.  The right-hand side runs on the compiled kernel
+(:mod:`mechdyn.dynamics.compiled`) whenever the mode allows (numba installed,
+every load compiled, no sliding friction); otherwise, and to diagnose a failure,
+on the NumPy evaluation of the mode (:meth:`ModeSystem.evaluate`), which also
+gives every multiplier.
+
+Two formulations evaluate the same physics: ``"exact"`` (the exact velocity
+analogs, every mode) and ``"analogs"``, the source paper's finite-difference
+analogs of the partial systems (:meth:`ModeEquations.analogs_terms`; modes in
+which every declared coordinate is independent, on the NumPy path).
+
+Through bifurcation positions (a parallelogram lying flat: the rows lose rank
+but the motion stays determined) a one-coordinate mode of the joints alone takes
+its pose, analogs and bias from a branch chart
+(:mod:`mechdyn.kinematics.branch_chart`) inside a zone |q - q*| < 0.15 rad
+(0.15 length scale for a travel) around the crossing: the limit of the branch
+from both sides, reached by continuation (the branch kept is the one the motion
+is on).  Outside the zones the compiled kernel keeps its speed; inside, the
+chart's error (about 1e-13 in the acceleration of the parallelogram) replaces the
+eps/d^3 blow-up of the equations evaluated at a distance d from the crossing.
+At a *dead* position (a fold) no chart exists and the run stops there.  Why not
+an x-space formulation (augmented Lagrangian, or the KKT system with
+minimum-norm multipliers)?  At the crossing the constraint force is the limit of
+Phi_x^T lambda with lambda ~ 1/d and need not lie in the range of Phi_x^T at the
+singular pose, so a minimum-norm solve there gives a wrong acceleration.
 """
 
 from __future__ import annotations
@@ -17,16 +37,23 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError, SingularPositionError
-from ..kinematics.assembly import SINGULAR_RCOND
+from ..kinematics.analogs import default_displacement
+from ..kinematics.assembly import SINGULAR_RCOND, solve_position
+from ..kinematics.branch_chart import BranchChart, ChartBook, PathProblem
 from ..kinematics.constraints import extend
 from .compiled import compile_mode_kernel
-from .lagrange import PIVOT_CHECK
+from .forces import com_arms
+from .mode_system import solve_mass
 from .modes import ModeEval
 
-__all__ = ["ModeEquations", "BACKENDS"]
+__all__ = ["ModeEquations", "BACKENDS", "FORMULATIONS", "PIVOT_CHECK"]
 
 #: valid values of ``backend``
 BACKENDS = ("auto", "numpy", "numba")
+#: the formulations of the equations of motion
+FORMULATIONS = ("exact", "analogs")
+#: compiled path: LU pivot ratio below which a position is checked for singularity by SVD
+PIVOT_CHECK = 1e-5
 
 
 class ModeEquations:
@@ -39,6 +66,11 @@ class ModeEquations:
         The mode (rows, independent coordinates, targets of the locks).
     backend : {"auto", "numpy", "numba"}
         ``"auto"`` uses the compiled kernel when it can; ``"numba"`` insists on it.
+    formulation : {"exact", "analogs"}
+        See the module docstring.
+    d : float or array_like, shape (n_q,), optional
+        Virtual displacement of ``"analogs"`` (rad for angles, m for travels;
+        default 0.1 deg, and 0.1 deg x length scale for travels).
 
     Attributes
     ----------
@@ -47,39 +79,79 @@ class ModeEquations:
         ``"numba"`` or ``"numpy"``, what this mode runs on.
     note : str
         Why the compiled path is not used, or ``""``.
+    book : ChartBook or None
+        The branch charts of a one-coordinate mode of the joints alone (exact
+        formulation), else None.
+    watching : bool
+        Whether evaluations look out for bifurcations (off while a caller samples
+        dense output, so that output times do not change the run).
 
     Raises
     ------
     ModelError
-        An unknown backend, or ``backend="numba"`` where the compiled path cannot run.
+        An unknown backend or formulation, ``backend="numba"`` where the compiled path
+        cannot run, ``"analogs"`` in a mode with dependent coordinates, a bad ``d``.
     """
 
-    def __init__(self, sm, ms, backend: str = "auto"):
+    def __init__(self, sm, ms, backend: str = "auto", formulation: str = "exact", d=None):
         if backend not in BACKENDS:
             raise ModelError(f"unknown backend {backend!r}; valid: "
                              + ", ".join(repr(b) for b in BACKENDS))
-        self.sm, self.ms = sm, ms
-        self.kernel, self.note = None, ""
-        if backend != "numpy":
+        if formulation not in FORMULATIONS:
+            raise ModelError(f"unknown formulation {formulation!r}; valid formulations: "
+                             + ", ".join(repr(f) for f in FORMULATIONS))
+        model = ms.model
+        self.sm, self.ms, self.formulation = sm, ms, formulation
+        self.kernel, self.note, self.book = None, "", None
+        self.watching, self._s_last = True, None
+        self.d = default_displacement(model)
+        if formulation == "analogs":
+            if ms.rows or ms.n_i != model.n_q:
+                raise ModelError("formulation 'analogs' needs a mode in which every declared "
+                                 "coordinate is independent (no engaged lock, closed stop or "
+                                 f"contact); mode {sorted(ms.mode)}")
+            if d is not None:
+                dd = np.broadcast_to(np.asarray(d, float), (model.n_q,)).copy()
+                if not np.all(np.isfinite(dd)) or np.any(dd <= 0):
+                    raise ModelError(f"virtual displacement d must be > 0, got {d!r}")
+                self.d = dd
+            if backend == "numba":
+                raise ModelError("the compiled (numba) backend supports formulation "
+                                 "'exact' only")
+            self.note = "formulation 'analogs' is evaluated on the NumPy path"
+        elif backend != "numpy":
             if any(r.slip for r in ms.rows):
                 self.note = "sliding friction is evaluated on the NumPy path"
             else:
                 self.kernel, self.note = compile_mode_kernel(
-                    ms.model, sm.fm, ms.rowset.take(ms.independent_rows), ms.coords)
+                    model, sm.fm, ms.rowset.take(ms.independent_rows), ms.coords)
             if self.kernel is None and backend == "numba":
                 raise ModelError(f"the compiled (numba) backend is not available: {self.note}")
         if self.kernel is not None:
             self.kernel.reset(ms.x_ref)
+        if (formulation == "exact" and not ms.rows and model.n_q == ms.n_i == 1
+                and len(ms.independent_rows) == ms.n_rows == model.n_x - 1):
+            lay = model.layout(sorted(ms.mode.locks))
+            self.book = ChartBook(PathProblem(model, lay, [0], [0.0], 0))
         self.backend = "numba" if self.kernel is not None else "numpy"
         # the kernel's multipliers are those of the independent rows: all of them unless
         # the mode has redundant rows (their share is chosen on the NumPy path)
         self._full = len(ms.independent_rows) == ms.n_rows
 
-    def evaluate(self, t: float, qi, qdi):
+    # ------------------------------------------------------------------ evaluation
+    def evaluate(self, t: float, qi, qdi) -> ModeEval:
         """Everything at a state of the mode (:class:`ModeEval`: poses, rates,
-        accelerations of every declared coordinate, every multiplier), from the compiled
-        kernel when the mode has no redundant rows, else from the NumPy evaluation."""
+        accelerations of every declared coordinate, every multiplier): from a branch
+        chart in a bifurcation zone, from the compiled kernel when the mode has no
+        redundant rows, else from the NumPy evaluation."""
         ms = self.ms
+        ch = self.chart_at(qi)
+        if ch is not None:
+            return self._chart_eval(ch, t, qi, qdi)
+        if self.formulation == "analogs":
+            ev = ms.evaluate(t, qi, qdi)
+            ev.qddot = self.analogs_terms(t, qi, qdi, ev.x)["qddot"]
+            return ev
         if self.kernel is not None:
             if self._full:
                 k = self.kernel.evaluation(t, qi, qdi)
@@ -88,57 +160,43 @@ class ModeEquations:
                     lam[ms.independent_rows] = k["lam"]
                     return ModeEval(k["x"], k["xdot"], k["xddot"], k["q"], k["qdot"],
                                     k["qddot"], lam, k["F"])
-            guess = self.kernel.x.copy()
-            return ms.evaluate(t, qi, qdi, x_guess=guess)
+            return ms.evaluate(t, qi, qdi, x_guess=self.kernel.x.copy())
         return ms.evaluate(t, qi, qdi)
+
+    def _power(self, ev) -> float:
+        """Power of the non-conservative forces at an evaluation, W."""
+        Fc = ev.F_conservative
+        p = float((ev.F - (self.sm.fm.conservative(ev.x) if Fc is None else Fc)) @ ev.xdot)
+        return p + friction_power(self.ms, ev)
 
     def numpy_rhs(self, t: float, qi, qdi):
         """(q_I'', array([P_nc])) on the NumPy path; raises the diagnosed error of a
         failure (assembly, lock-up)."""
-        ms = self.ms
-        ev = self.evaluate(t, qi, qdi)
-        Fc = ev.F_conservative
-        p = float((ev.F - (self.sm.fm.conservative(ev.x) if Fc is None else Fc)) @ ev.xdot)
-        p += friction_power(ms, ev)
-        return ev.qddot[ms.coords], np.array([p])
+        if self.formulation == "analogs":
+            tm = self.analogs_terms(t, qi, qdi)
+            return tm["qddot"], np.array([tm["power_nc"]])
+        ev = self.ms.evaluate(t, qi, qdi, x_guess=None if self.kernel is None
+                              else self.kernel.x.copy())
+        return ev.qddot[self.ms.coords], np.array([self._power(ev)])
 
     def rhs(self, t: float, qi, qdi):
         """(q_I'' (n_i,), array([P_nc])) at (t, q_I, q_I')."""
-        if self.kernel is not None:
-            out = self.kernel.rhs(t, qi, qdi)
-            if out is not None:
-                return out
-        return self.numpy_rhs(t, qi, qdi)
-
-    def check_position(self, t: float, x, q) -> None:
-        """Stop at a singular position of the mode (dead, toggle or bifurcation position:
-        the mode's coordinates lose control), with t, q and the coordinates named.
-
-        A cheap test first (the pivots of the compiled kernel's last factorization),
-        confirmed by the singular values of the scaled position Jacobian.
-
-        Raises
-        ------
-        SingularPositionError
-            sigma_min / sigma_max of [rows_I; g_I] below ``SINGULAR_RCOND``.
-        """
-        if self.kernel is not None and self.kernel.pivot_ratio >= PIVOT_CHECK:
-            return
-        rc = self.ms.rcond(x)
-        if rc >= SINGULAR_RCOND:
-            return
-        model = self.ms.model
-        names = ", ".join(f"{n} = {v:.9g}" for n, v in zip(model.coordinate_names, q,
-                                                               strict=True))
-        raise SingularPositionError(
-            f"singular position in mode {sorted(self.ms.mode) or '(none)'} at t = {t:.9g} s, "
-            f"{names}: sigma_min/sigma_max of the position Jacobian {rc:.2e}; the "
-            f"independent coordinates "
-            f"{', '.join(model.coordinate_names[k] for k in self.ms.coords)} lose control",
-            t=t, q=q)
+        if self.book is not None:
+            ch = self._zone(qi)
+            if ch is not None:
+                return self._chart_rhs(ch, t, qi, qdi)
+        out = self.kernel.rhs(t, qi, qdi) if self.kernel is not None else None
+        if out is None:
+            out = self.numpy_rhs(t, qi, qdi)
+        if self.book is not None:
+            ch = self._watch(float(qi[0]))
+            if ch is not None:
+                return self._chart_rhs(ch, t, qi, qdi)
+        return out
 
     def first_order_function(self):
-        """``fun(t, y) -> y'`` for y = (q_I, q_I', w) on the compiled kernel, or None."""
+        """``fun(t, y) -> y'`` for y = (q_I, q_I', w) on the compiled kernel (the branch
+        charts inside bifurcation zones), or None without the compiled kernel."""
         if self.kernel is None:
             return None
         n = self.ms.n_i
@@ -147,7 +205,167 @@ class ModeEquations:
             qdd, p = self.numpy_rhs(t, y[:n], y[n:2 * n])
             return np.concatenate([y[n:2 * n], qdd, p])
 
-        return self.kernel.first_order_function(on_failure)
+        base = self.kernel.first_order_function(on_failure)
+        book = self.book
+        if book is None:
+            return base
+
+        def fun(t, y):
+            if book.charts:
+                ch = self._zone(y[:1])
+                if ch is not None:
+                    return self._chart_first_order(ch, t, y)
+            out = base(t, y)
+            s = float(y[0])
+            if not book.due(s):
+                self._s_last = s
+                return out
+            ch = self._watch(s)
+            return out if ch is None else self._chart_first_order(ch, t, y)
+
+        return fun
+
+    # ------------------------------------------------------------------ branch charts
+    def chart_at(self, qi) -> BranchChart | None:
+        """The chart whose zone holds the coordinates q_I, else None."""
+        if self.book is None or not self.book.charts:
+            return None
+        return self.book.zone_chart(float(np.asarray(qi, float).reshape(-1)[0]))
+
+    def report(self) -> list[dict]:
+        """The bifurcation positions met (see :meth:`ChartBook.report`)."""
+        return [] if self.book is None else self.book.report()
+
+    def _zone(self, qi) -> BranchChart | None:
+        """The chart whose zone holds q_I; outside the zones, prepare the direct Newton
+        solve: start it from the chart's pose in a chart window, or from the window's
+        edge when the step jumps over a chart."""
+        s = float(np.asarray(qi, float).reshape(-1)[0])
+        book = self.book
+        ch = book.zone_chart(s)
+        if ch is not None:
+            return ch
+        win = book.window_chart(s)
+        if win is None and self._s_last is not None:
+            win = book.crossed(self._s_last, s)
+            if win is not None:
+                s = win.centre + np.sign(s - win.centre) * win.window
+        if win is not None:
+            self._reset(win.evaluate(s)[0])
+        return None
+
+    def _watch(self, s: float) -> BranchChart | None:
+        """After a direct solve at s: build a chart if a singular position is within
+        reach; returns it if its zone holds s."""
+        self._s_last = s
+        if not self.watching or not self.book.due(s):
+            return None
+        k = self.kernel
+        x = k.x.copy() if k is not None and not k.status else self.ms._x_last
+        ch = self.book.watch(s, x)
+        return ch if ch is not None and ch.in_zone(s) else None
+
+    def _reset(self, x) -> None:
+        self.ms._x_last = np.array(x, float)
+        self.ms._B_last = None
+        if self.kernel is not None:
+            self.kernel.reset(x)
+
+    def _chart_eval(self, ch: BranchChart, t, qi, qdi) -> ModeEval:
+        qd = np.asarray(qdi, float).reshape(-1)
+        x, xs, xss = ch.evaluate(float(np.asarray(qi, float).reshape(-1)[0]))
+        self._reset(x)
+        return self.ms.evaluate_x(t, x, xs * qd[0], xs[:, None], b=xss * qd[0] ** 2)
+
+    def _chart_rhs(self, ch, t, qi, qdi):
+        ev = self._chart_eval(ch, t, qi, qdi)
+        return ev.qddot[self.ms.coords], np.array([self._power(ev)])
+
+    def _chart_first_order(self, ch, t, y):
+        qdd, p = self._chart_rhs(ch, t, y[:1], y[1:2])
+        return np.concatenate([y[1:2], qdd, p])
+
+    # ------------------------------------------------------------------ checks
+    def check_position(self, t: float, x, q) -> None:
+        """Stop at a singular position of the mode (dead, toggle or bifurcation position:
+        the mode's coordinates lose control), with t, q and the coordinates named.
+
+        A cheap test first (the pivots of the compiled kernel's last factorization),
+        confirmed by the singular values of the scaled position Jacobian.  Inside a
+        bifurcation zone the branch chart carries the run on.
+
+        Raises
+        ------
+        SingularPositionError
+            sigma_min / sigma_max of [rows_I; g_I] below ``SINGULAR_RCOND``.
+        """
+        if self.kernel is not None and self.kernel.pivot_ratio >= PIVOT_CHECK:
+            return
+        if self.chart_at(np.asarray(q)[self.ms.coords]) is not None:
+            return
+        rep = self.ms.singularity(x)
+        if rep["rcond"] >= SINGULAR_RCOND:
+            return
+        model = self.ms.model
+        names = ", ".join(f"{n} = {v:.9g}" for n, v in zip(model.coordinate_names, q,
+                                                               strict=True))
+        raise SingularPositionError(
+            f"singular position in mode {sorted(self.ms.mode) or '(none)'} at t = {t:.9g} s, "
+            f"{names}: sigma_min/sigma_max of the position Jacobian {rep['rcond']:.2e}; the "
+            f"coordinate(s) {', '.join(rep['coordinates']) or '-'} lose control, joints "
+            f"{', '.join(rep['joints']) or '-'} become dependent", t=t, q=q)
+
+    # ------------------------------------------------------------------ analogs
+    def analogs_terms(self, t: float, q, qdot, x=None) -> dict:
+        """The terms of A q'' + c = Q by the source paper's method (METHOD.md section 1)
+        at a state of the mode: velocity analogs of the *partial systems* by central
+        differences with the virtual displacement d, A_ij = sum over links of
+        m v*_ci . v*_cj + J_c w*_i w*_j (plus the drives' rotor and gear inertia),
+        A_ij,k = dA_ij/dq_k by central differences, the paper's eq. 35 for n
+        coordinates, c_i = sum_jk (A_ij,k - 1/2 A_jk,i) q'_j q'_k, and generalized
+        forces by virtual work, Q_k = F . v*_k + Q_drive,k.  Its error against the
+        exact formulation is O(d^2).
+
+        Returns
+        -------
+        dict with x, xdot, B (n_x, n) frame analogs, A (n, n), c, Q, Q_drive, qddot
+        (n,) and power_nc (W).
+        """
+        ms, d = self.ms, self.d
+        model = ms.model
+        q, qdot = np.asarray(q, float), np.asarray(qdot, float)
+        if x is None:
+            x = ms.solve_position(q, t=t)
+        lay = model.layout(sorted(ms.mode.locks))
+        n = model.n_q
+        E = np.diag(d)
+        pm = np.concatenate([E, -E])  # (2n, n): +d e_k then -d e_k
+        q1 = q + pm
+        x1 = solve_position(model, q1, x, layout=lay, t=t, check_singular=False)
+        q2 = q1[:, None, :] + pm[None, :, :]  # (2n, 2n, n)
+        x2 = solve_position(model, q2, x1[:, None, :], layout=lay, t=t, check_singular=False)
+
+        def analog_mass(xs):
+            """A from the poses of the partial systems xs (..., 2n, n_x)."""
+            rc = extend(model, xs)[..., :-1, :2] + com_arms(model, xs)  # (..., 2n, nb, 2)
+            th = xs[..., 2::3]
+            vc = (rc[..., :n, :, :] - rc[..., n:, :, :]) / (2 * d[:, None, None])
+            w = (th[..., :n, :] - th[..., n:, :]) / (2 * d[:, None])  # (..., n, nb)
+            return (np.einsum("...ibk,...jbk,b->...ij", vc, vc, model.mass)
+                    + np.einsum("...ib,...jb,b->...ij", w, w, model.inertia))
+
+        A = analog_mass(x1) + np.diag(self.sm.drive_inertia)
+        A1 = analog_mass(x2)  # (2n, n, n): A at q + d e_k and q - d e_k
+        dA = (A1[:n] - A1[n:]) / (2 * d[:, None, None])  # dA[k, i, j] = A_ij,k
+        c = np.einsum("ijk,j,k->i", np.transpose(dA, (1, 2, 0)) - 0.5 * dA, qdot, qdot)
+        B = ((x1[:n] - x1[n:]) / (2 * d[:, None])).T  # (n_x, n) frame analogs
+        xdot = B @ qdot
+        fm = self.sm.fm
+        F, Qd = fm.applied(t, x, xdot, q, qdot)
+        Q = B.T @ F + Qd
+        qdd = solve_mass(model.coordinate_names, A, Q - c, t, q)
+        p = fm.nonconservative_power(None, x, xdot, None, qdot, applied=(F, Qd))
+        return dict(x=x, xdot=xdot, B=B, A=A, c=c, Q=Q, Q_drive=Qd, qddot=qdd, power_nc=p)
 
 
 def friction_power(ms, ev) -> float:

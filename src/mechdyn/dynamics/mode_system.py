@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import scipy.linalg
 
-from ..errors import AssemblyError, LockupError
+from ..errors import AssemblyError, IntegrationError, LockupError
 from ..kernels import rows_numpy as RN
 from ..kinematics.assembly import newton
 from ..model.rows import concat
@@ -47,7 +47,7 @@ from .reactions import touches_ground
 if TYPE_CHECKING:
     from .modes import SwitchedModel
 
-__all__ = ["ModeSystem", "ModeEval", "mass_matrix_x", "fmt_mode"]
+__all__ = ["ModeSystem", "ModeEval", "mass_matrix_x", "fmt_mode", "solve_mass"]
 
 
 def fmt_mode(mode) -> str:
@@ -223,11 +223,6 @@ class ModeSystem:
         """All declared coordinates measured on a pose, shape (n_q,)."""
         return RN.values(self.model.coordinate_rows, x)
 
-    def residual_norm(self, x) -> float:
-        """Largest constraint residual of the mode at ``x`` (m or rad)."""
-        v = self.row_values(x)
-        return float(np.max(np.abs(v))) if v.size else 0.0
-
     # ------------------------------------------------------------------ positions
     def solve_position(self, qi, x_guess=None, t=None) -> np.ndarray:
         """Pose x (n_x,) at independent coordinates ``qi`` (n_i,), by Newton from ``x_guess``.
@@ -377,6 +372,9 @@ class ModeSystem:
         except np.linalg.LinAlgError:
             sol = None
         if sol is None:
+            A = B.T @ M @ B
+            if A.size and np.linalg.cond(A) > 1e14:  # no inertia on some coordinate
+                solve_mass(self.coord_names, A, A[:, 0], None, None)
             sol = self._redundant_solve(Ks, rhs * rs)
         return sol[:self.n_i], sol[self.n_i:]
 
@@ -415,6 +413,25 @@ class ModeSystem:
         F = F + G.T @ Qd
         M, h = self.sm.with_drive_inertia(*mass_matrix_x(self.model, x, xdot), G, quad_g)
         return dict(B=B, b=b, A=B.T @ M @ B, f=B.T @ (F - h - M @ b), M=M, F=F, h=h)
+
+
+def solve_mass(names, A, rhs, t, q) -> np.ndarray:
+    """A^-1 rhs by Cholesky; a mass matrix that is not positive definite names the
+    coordinates without inertia.
+
+    Raises
+    ------
+    IntegrationError
+    """
+    try:
+        return scipy.linalg.cho_solve(scipy.linalg.cho_factor(A), rhs)
+    except np.linalg.LinAlgError:
+        ev, vec = np.linalg.eigh(0.5 * (A + A.T))
+        names = [n for n, v in zip(names, vec[:, 0], strict=True) if abs(v) > 0.1]
+        raise IntegrationError(
+            f"the generalized mass matrix is singular or not positive definite "
+            f"(smallest eigenvalue {ev[0]:.3g}); coordinate(s) {', '.join(names)} have "
+            f"no inertia", t=t, q=q) from None
 
 
 def _independent_rows(Rs, tol=1e-9) -> np.ndarray:

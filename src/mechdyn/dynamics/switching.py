@@ -188,14 +188,12 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
     need_impact = bool(set(locks) - set(locks_before))
     if not need_impact and touch:
         # any touching constraint approaching?
-        free = ModeSystem(sm, locks, targets, x)
         for r in [r for r in sm.rows(frozenset(touch), targets) if r.unilateral]:
             X, V = extend(sm.model, x), extend(sm.model, xd)
             v = r.sign * r.measure.rate(X, V, sm.nb)
             if v < 0.0:
                 need_impact = True
                 break
-        del free
     if need_impact:
         imp = impact(sm, x, xd, locks_before, locks, targets, touch,
                      restitution={k: 0.0 for k in plastic},
