@@ -2,7 +2,7 @@
 
 >>> from mechdyn import examples
 >>> [name for name, _ in examples.list_examples()][:2]
-['andrews_squeezer', 'clutchless_press']
+['andrews_squeezer', 'bolt_buffer']
 >>> mech = examples.load("four_bar")
 """
 
