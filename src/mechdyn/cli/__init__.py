@@ -24,9 +24,7 @@ SUBCOMMAND_MODULES = ("demo", "examples", "kinematics", "simulate", "kinetostati
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every subcommand."""
     parser = argparse.ArgumentParser(
-        prog="mechdyn",
-        description="Kinematics, dynamics and kinetostatics of planar mechanisms.",
-    )
+        prog="mechdyn", description="Kinematics, dynamics and kinetostatics of planar mechanisms.")
     parser.add_argument("--version", action="version", version=f"mechdyn {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in SUBCOMMAND_MODULES:
@@ -46,7 +44,3 @@ def main(argv: list[str] | None = None) -> int:
     except (MechdynError, FileNotFoundError, IsADirectoryError, PermissionError) as exc:
         print(f"mechdyn {args.command}: error: {exc}", file=sys.stderr)
         return 2
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

@@ -12,6 +12,7 @@ singular mass matrix ...; the samples computed so far are written); 2 bad input.
 
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
 
@@ -76,11 +77,9 @@ def register(sub) -> None:
     p.add_argument("--plot", metavar="PNG", help="write a plot of q, q', q'' and the energies")
     p.add_argument("--backend", default="auto", choices=("auto", "numpy", "numba"),
                    help="right-hand side evaluation (default auto: compiled when possible)")
-    bar = p.add_mutually_exclusive_group()
-    bar.add_argument("--progress", dest="progress", action="store_true", default=None,
-                     help="always show a progress bar")
-    bar.add_argument("--no-progress", dest="progress", action="store_false",
-                     help="never show a progress bar")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="always (or never) show a progress bar (default: once a run takes "
+                        "more than 2 s)")
     p.set_defaults(func=run)
 
 

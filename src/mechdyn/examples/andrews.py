@@ -28,17 +28,10 @@ link6 (6)   H       Omega + epsilon              E = (zf, 0), com = (zf - fa, 0)
 link7 (7)   A       epsilon                      H = (0, -u), com = (ub, -ua)
 ==========  ======  ===========================  =====================================
 
-The ground points are O = (0, 0), A = (xa, ya), B = (xb, yb), C = (xc, yc).
-Rod 2, triangle 3, link 4 and link 6 meet at E (three revolutes: rod-triangle,
-triangle-link4, triangle-link6).  A spring (c0, free length l0) pulls D on the
-triangle towards C on the ground; the torque ``mom`` drives the crank; there
-is no gravity.
-
-Links 5 and 7 only turn about the fixed point A, so the Test Set's equations
-contain only the *distances* of their centres of mass from A,
-sqrt(ta^2 + tb^2) and sqrt(ua^2 + ub^2).  Their directions are not given
-there; here (ta, tb) and (ua, ub) are taken as "along the link, then to its
-left", which is an assumption that changes nothing in the dynamics.
+The ground points are O = (0, 0), A = (xa, ya), B = (xb, yb), C = (xc, yc).  The
+joints, the loads (spring D-C, torque ``mom`` on the crank; no gravity) and the
+assumed directions of the centres of mass of links 5 and 7 (the Test Set gives
+only their distances from A) are set out in the model file.
 """
 
 from __future__ import annotations
