@@ -70,3 +70,14 @@ def test_bad_options_are_exit_2(args, match, capsys):
     code = main(["simulate", "andrews_squeezer", *args])
     assert code == 2
     assert match in capsys.readouterr().err
+
+
+def test_switching_run_writes_its_events_beside_the_table(tmp_path, capsys):
+    out = tmp_path / "press.csv"
+    code = main(["simulate", "press_cycle", "--t-end", "0.02 s", "--integrator", "rk4",
+                 "--dt", "1ms", "-o", str(out)])
+    assert code == 0, capsys.readouterr()
+    ev = pd.read_csv(tmp_path / "press_events.csv")
+    assert list(ev.columns) == ["t_s", "kind", "element", "mode_before", "mode_after",
+                                "energy_lost_J", "phi_after", "psi_after", "p_after"]
+    assert ("close", "ram_stop@upper") in set(zip(ev["kind"], ev["element"], strict=True))

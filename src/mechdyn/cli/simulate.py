@@ -12,6 +12,7 @@ singular mass matrix ...; the samples computed so far are written); 2 bad input.
 
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
 
@@ -76,15 +77,14 @@ def register(sub) -> None:
     p.add_argument("--plot", metavar="PNG", help="write a plot of q, q', q'' and the energies")
     p.add_argument("--backend", default="auto", choices=("auto", "numpy", "numba"),
                    help="right-hand side evaluation (default auto: compiled when possible)")
-    bar = p.add_mutually_exclusive_group()
-    bar.add_argument("--progress", dest="progress", action="store_true", default=None,
-                     help="always show a progress bar")
-    bar.add_argument("--no-progress", dest="progress", action="store_false",
-                     help="never show a progress bar")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="always (or never) show a progress bar (default: once a run takes "
+                        "more than 2 s)")
     p.set_defaults(func=run)
 
 
-def _pairs(items, kind_of, model, what, parse):
+def _pairs(items, model, what, kinds):
+    """``COORD=VALUE`` items as {coordinate: SI value}; ``kinds`` = (angle kind, travel kind)."""
     out = {}
     for item in items:
         if "=" not in item:
@@ -92,7 +92,8 @@ def _pairs(items, kind_of, model, what, parse):
         name, value = (s.strip() for s in item.split("=", 1))
         if name not in model.coordinates:
             raise ModelError(f"{what}: " + did_you_mean(name, model.coordinates, "coordinate"))
-        out[name] = parse(value, kind_of(model.coordinates[name]), where=f"{what} {name}")
+        kind = kinds[0] if model.coordinates[name].is_angle else kinds[1]
+        out[name] = parse_quantity(value, kind, where=f"{what} {name}")
     return out
 
 
@@ -102,20 +103,10 @@ def run(args) -> int:
     t_end = parse_quantity(args.t_end, "time", where="--t-end")
     t0 = parse_quantity(args.t0, "time", where="--t0")
     dt = parse_quantity(args.dt, "time", where="--dt") if args.dt is not None else None
-
-    def torque(c):
-        return "torque" if c.is_angle else "force"
-
-    def position(c):
-        return "angle" if c.is_angle else "length"
-
-    def rate(c):
-        return "angular_velocity" if c.is_angle else "velocity"
-
-    for name, value in _pairs(args.drive, torque, mech, "--drive", parse_quantity).items():
+    for name, value in _pairs(args.drive, mech, "--drive", ("torque", "force")).items():
         mech.add(Drive(f"drive_{name}", name, value))
-    q0 = _pairs(args.q0, position, mech, "--q0", parse_quantity) or None
-    qdot0 = _pairs(args.qdot0, rate, mech, "--qdot0", parse_quantity) or None
+    q0 = _pairs(args.q0, mech, "--q0", ("angle", "length")) or None
+    qdot0 = _pairs(args.qdot0, mech, "--qdot0", ("angular_velocity", "velocity")) or None
     d = parse_quantity(args.d, "angle", where="--d") if args.d is not None else None
     t_eval = None
     if args.samples is not None:
@@ -141,7 +132,7 @@ def run(args) -> int:
         traj.to_dataframe(points=args.points).to_csv(args.output, index=False)
         print(f"wrote {args.output} ({traj.t.size} rows)")
         if traj.events:
-            ev_path = _events_path(args.output)
+            ev_path = Path(args.output).with_name(Path(args.output).stem + "_events.csv")
             _events_table(traj).to_csv(ev_path, index=False)
             print(f"wrote {ev_path} ({len(traj.events)} events)")
     if args.plot:
@@ -153,25 +144,17 @@ def run(args) -> int:
     return 0
 
 
-def _events_path(output: str):
-    p = Path(output)
-    return p.with_name(p.stem + "_events.csv")
-
-
 def _events_table(traj):
-    """One row per switching event: time, kind, element, modes, coordinates, energy lost."""
+    """One row per event: time, kind, element, modes, coordinates after, energy lost."""
     import pandas as pd
 
     rows = []
     for ev in traj.events:
-        row = {"t_s": getattr(ev, "t", np.nan), "kind": getattr(ev, "kind", type(ev).__name__),
-               "element": getattr(ev, "element", getattr(ev, "name", "")),
-               "mode_before": " ".join(sorted(getattr(ev, "mode_before", ()) or ())),
-               "mode_after": " ".join(sorted(getattr(ev, "mode_after", ()) or ())),
-               "energy_lost_J": getattr(ev, "energy_lost", 0.0)}
-        qa = getattr(ev, "q_after", None)
-        if qa is not None:
-            for n, v in zip(traj.coordinate_names, np.atleast_1d(qa), strict=False):
-                row[f"{n}_after"] = v
+        row = {"t_s": ev.t, "kind": ev.kind, "element": ev.element,
+               "mode_before": " ".join(sorted(ev.mode_before)),
+               "mode_after": " ".join(sorted(ev.mode_after)), "energy_lost_J": ev.energy_lost}
+        if ev.q_after is not None:
+            row.update({f"{n}_after": v for n, v in zip(traj.coordinate_names, ev.q_after,
+                                                        strict=False)})
         rows.append(row)
     return pd.DataFrame(rows)

@@ -1,8 +1,8 @@
-"""Bundled example mechanisms (TOML model files) and the Python-built Andrews squeezer.
+"""Bundled example mechanisms (TOML model files) and the modules that load and run them.
 
 >>> from mechdyn import examples
 >>> [name for name, _ in examples.list_examples()][:2]
-['andrews_squeezer', 'clutchless_press']
+['andrews_squeezer', 'bolt_buffer']
 >>> mech = examples.load("four_bar")
 """
 
@@ -34,12 +34,8 @@ def list_examples() -> list[tuple[str, str]]:
     """
     out = []
     for name in names():
-        text = _files().joinpath(f"{name}.toml").read_text(encoding="utf-8")
-        try:
-            desc = tomllib.loads(text).get("model", {}).get("description", "")
-        except tomllib.TOMLDecodeError:
-            desc = ""
-        out.append((name, " ".join(str(desc).split())))
+        doc = tomllib.loads(_files().joinpath(f"{name}.toml").read_text(encoding="utf-8"))
+        out.append((name, " ".join(str(doc.get("model", {}).get("description", "")).split())))
     return out
 
 

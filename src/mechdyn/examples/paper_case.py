@@ -4,21 +4,10 @@ The paper integrates the 2-DOF press (crank angle phi, rocker angle psi) over
 T = 0.05 s in N = 40 steps of the linear-acceleration method, from
 phi = -64.1 deg, psi = -46.34 deg, omega1 = 43.5 rad/s, rocker at rest
 (the bundled model file ``clutchless_press.toml`` holds the geometry, masses
-and that initial state).  The module was ``mechdyn.dynamics.paper_case``, which
-still re-exports it.  What the paper does not give is filled in here, and
-stated:
-
-* **drive**: a constant torque on the crank, ``DRIVE_TORQUE`` = 34.5 N m, the
-  nominal power of the 4A80B4U3 motor (1.5 kW) at the initial crank speed
-  43.5 rad/s, until a motor characteristic is available;
-* **idle support of the ram**: in idle mode "the slider is held at rest by
-  elastic elements"; they are modelled as one spring along the ram axis from a
-  ground point 1 m above the slider's pin C, stiffness ``SUPPORT_STIFFNESS`` =
-  1e7 N/m, with its free length chosen so that its tension at the initial
-  position carries the ram's weight (100 kg x 9.81 m/s^2).  Without it the
-  free ram falls, and within 0.05 s the 2-DOF mechanism reaches the position
-  where the connecting rod is normal to the ram axis, a singular position of
-  the coordinates (phi, psi).
+and that initial state).  What the paper does not give, the drive torque
+``DRIVE_TORQUE`` and the spring ``SUPPORT_STIFFNESS`` that holds the ram in
+idle, is filled in here as in ``clutchless_press_paper.toml`` (the same case as
+a model file), whose header gives the reasons.
 """
 
 from __future__ import annotations
@@ -58,7 +47,9 @@ def press_idle(mechanism=None, *, drive_torque=DRIVE_TORQUE,
         Torque on the crank coordinate ``phi``: constant (N m) or a characteristic
         (e.g. :func:`motor_curve`).
     support_stiffness : float or None
-        Stiffness of the ram's support spring, N/m; None leaves the ram free.
+        Stiffness of the ram's support spring, N/m (along the ram axis from a ground
+        point 1 m beyond the pin C, its free length set so that it carries the ram's
+        weight at the initial position); None leaves the ram free (it falls).
 
     Returns
     -------
