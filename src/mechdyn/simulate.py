@@ -33,6 +33,10 @@ from .simulate_events import needs_event_loop, simulate_events
 
 __all__ = ["simulate", "initial_state"]  # initial_state: re-exported from .initial_state
 
+#: the options of the segment loop that :func:`simulate` passes on (``**switching``)
+SWITCHING_OPTIONS = ("dt_out", "max_events", "small_velocity", "gap_tol", "zeno_time",
+                     "max_wall_time")
+
 
 def _keywords_without_effect(integrator, rtol, atol, formulation, d) -> float:
     """Warn (IntegratorWarning, naming them) about keywords that would have no effect;
@@ -57,29 +61,37 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
              events=None, t0: float = 0.0, mode=None, backend: str = "auto",
              iterations: int | None = None, tol: float | None = None,
              theta: float | None = None, first_step: float | None = None,
-             max_step: float | None = None) -> Trajectory:
-    """Simulate the motion of a mechanism under its loads and drives.
+             max_step: float | None = None, **switching) -> Trajectory:
+    """Simulate the motion of a mechanism under its loads and drives, through every
+    switch, impact and contact of a variable-structure mechanism.
 
     Parameters
     ----------
     mech_or_model : Mechanism or Model
+        Switchable elements (``switches``, ``stops``, ``contacts``,
+        ``coordinate_locks`` in ``extras``, weld :class:`~mechdyn.mechanism.joint.Lock`
+        joints) make it a variable-structure run, integrated mode by mode.
     t_end : float
         End time, s (>= ``t0``).
     integrator : str or Integrator
         ``"dop853"`` (default), ``"rk45"``, ``"rk23"``, ``"radau"``, ``"bdf"``,
         ``"lsoda"`` (adaptive, SciPy), ``"rk4"`` or ``"wilson"`` (fixed step; the
-        source paper's linear-acceleration method).
+        source paper's linear-acceleration method; they step on a grid of ``dt`` from
+        the start of every mode segment, its last step shortened to the event).
     steps, dt
-        Number of steps or step size (s) of the fixed-step integrators.
+        Number of steps over [t0, t_end] (default 100) or step size (s) of the
+        fixed-step integrators.
     rtol, atol
         Tolerances of the adaptive integrators (rtol default 1e-10, atol default
-        ``1e-3 rtol``, the same on every path; SI units
-        of q, q' and of the work W_nc in J).
+        ``1e-3 rtol``, the same on every path; SI units of q, scaled by the length
+        scale for travels, ten times that for q' and 1e3 atol for the work W_nc in J).
     q0, qdot0 : array_like (n_q,) or mapping {name: value}, optional
         Initial state; default from the model file's ``initial`` table, then the
-        sketch with zero rates.
+        sketch with zero rates.  Coordinates dependent in the initial mode are
+        re-measured.
     t_eval : array_like, optional
-        Output times (from the dense output); default every accepted step.
+        Output times (from the dense output); default every accepted step.  Samples
+        are also stored just before and just after every switching event.
     formulation : {"exact", "analogs"}
         Exact analogs (default) or the source paper's finite-difference analogs.
     d : float or array_like, optional
@@ -92,20 +104,40 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
     t0 : float
         Start time, s.
     mode : iterable of str, optional
-        Engaged locks (default: the model's initial mode).
+        Engaged locks at the start (default: as declared by the elements); stops and
+        contacts found touching are closed automatically.
     backend : {"auto", "numpy", "numba"}
         Evaluation of the right-hand side (see
         :class:`~mechdyn.dynamics.mode_equations.ModeEquations`).
     iterations, tol, theta
         Corrector passes, corrector tolerance and Wilson's theta (``wilson`` only).
     first_step, max_step
-        Step-size bounds of the adaptive integrators, s.
+        Step-size bounds of the adaptive integrators, s (after an event the first
+        step is 1e-7 of the run).
+    **switching
+        Options of the segment loop: ``dt_out`` (output interval, s, instead of
+        ``t_eval``); ``max_events`` (stop, status ``"too-many-events"``, after this
+        many switching instants; default 100000); ``small_velocity`` (approach speeds
+        below it are absorbed plastically, m/s; default 1e-6 length scale / s);
+        ``gap_tol`` (distance at which a stop or contact touches, also the
+        penetration tolerance, m; default 1e-9 length scale); ``zeno_time`` (a stop
+        or contact that impacts again within it is absorbed plastically, ending a
+        bouncing sequence, s; default 1e-4 (t_end - t0)); ``max_wall_time`` (stop,
+        status ``"timeout"``, after this many seconds of computing).
 
     Returns
     -------
     Trajectory
-        Also when the run stopped early: then ``status`` and ``message`` say why and
-        where, and the samples computed so far are kept.
+        ``t``, ``q``, ``qdot``, ``qddot`` (all declared coordinates), ``x``,
+        ``xdot``; ``events`` (an :class:`~mechdyn.integrate.events.EventRecord` per
+        switching instant and per caller's event); ``energy`` (kinetic, potential,
+        work_nc, balance = T + U - W_nc + impact losses, residual);
+        ``stats["variable_structure"]``
+        (:class:`~mechdyn.results.trajectory.SwitchedSamples`: the mode of each
+        sample, the force on the frame, the force of every joint, lock, stop and
+        contact, see :func:`mechdyn.dynamics.reactions.element_forces`).  Also when
+        the run stopped early: then ``status`` and ``message`` say why and where,
+        and the samples computed so far are kept.
 
     Raises
     ------
@@ -123,6 +155,11 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
     if not math.isfinite(t_end_f) or t_end_f < t0 or t_end_f < 0:
         raise IntegratorOptionError(f"`t_end` must be finite and >= t0 = {t0:g} s, "
                                     f"got {t_end!r}")
+    unknown = sorted(set(switching) - set(SWITCHING_OPTIONS))
+    if unknown:
+        raise IntegratorOptionError(f"simulate() got an unknown keyword {unknown[0]!r}; the "
+                                    "options of the segment loop are "
+                                    + ", ".join(SWITCHING_OPTIONS))
     rtol = _keywords_without_effect(integrator, rtol, atol, formulation, d)
     if formulation not in FORMULATIONS:
         raise IntegratorOptionError(f"unknown formulation {formulation!r}; valid formulations: "
@@ -138,4 +175,4 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
                            t_eval=sample_times(t0, t_end_f, t_eval), method=integrator,
                            progress=progress, dt=dt, steps=steps, iterations=iterations,
                            tol=tol, theta=theta, events=events, backend=backend,
-                           formulation=formulation, d=d)
+                           formulation=formulation, d=d, **switching)

@@ -34,9 +34,9 @@ import math
 import time
 
 import numpy as np
-from scipy.optimize import brentq
 
-from .dynamics.contact import ContactError, touching
+from .dynamics.contact import touching
+from .dynamics.dead_position import diagnose, status_of, turning_point
 from .dynamics.lagrange import kinetic_energy
 from .dynamics.mode_equations import ModeEquations
 from .dynamics.modes import (
@@ -47,20 +47,16 @@ from .dynamics.modes import (
 from .dynamics.reactions import element_forces, frame_forces
 from .dynamics.switching import apply_switch, event_functions
 from .errors import (
-    AssemblyError,
-    IntegrationError,
     LockupError,
     MechdynError,
     ModelError,
-    SingularPositionError,
     Status,
     did_you_mean,
 )
 from .initial_state import initial_state
-from .integrate.base import DEFAULT_RTOL, Integrator, IntegratorOptionError
-from .integrate.driver import INTEGRATORS, make_integrator
+from .integrate.base import DEFAULT_RTOL, IntegratorOptionError
+from .integrate.driver import segment_integrators
 from .integrate.events import EventRecord, as_events
-from .integrate.scipy_ivp import ScipyIntegrator
 from .integrate.segment import (
     Stop,
     arm,
@@ -69,7 +65,6 @@ from .integrate.segment import (
     user_event_records,
 )
 from .kernels import rows_numpy as RN
-from .kinematics.assembly import DEAD_RCOND
 from .kinematics.constraints import extend
 from .model import Model
 from .progress import Progress
@@ -104,96 +99,20 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                     first_step: float | None = None, events=None,
                     backend: str = "auto", formulation: str = "exact",
                     d=None) -> Trajectory:
-    """Simulate a variable-structure mechanism through all its switches.
-
-    Parameters
-    ----------
-    mech_or_model : Mechanism or Model
-        With ``extras`` ``switches``, ``stops``, ``contacts``, ``coordinate_locks``
-        (and/or weld :class:`~mechdyn.mechanism.joint.Lock` joints).
-    t_end : float
-        End time, s.
-    q0, qdot0 : array_like (n_q,) or mapping {name: value}, optional
-        Initial declared coordinates and rates (default: the model file's
-        ``initial`` table, then the sketch at rest).  Coordinates that are
-        dependent in the initial mode are re-measured.
-    t0 : float
-        Start time, s.
-    mode : iterable of str, optional
-        Engaged locks at the start (default: as declared by the elements).
-        Stops and contacts found touching are closed automatically.
-    rtol, atol : float
-        Tolerances of the adaptive integrators (defaults 1e-10 and 1e-3 rtol, as
-        :func:`mechdyn.simulate`; atol in SI units, scaled by the length scale for
-        travels).
-    max_step : float, optional
-        Largest step, s.
-    dt_out : float, optional
-        Output sampling interval, s (default: every accepted step, as a
-        fixed-structure run).  Samples are also stored just before and just after
-        every event.
-    t_eval : array_like, optional
-        Explicit output times (instead of ``dt_out``).
-    method : str or Integrator
-        Integrator used within a mode, any of :func:`mechdyn.simulate`'s: the adaptive
-        ``"dop853"`` (default), ``"rk45"``, ``"rk23"``, ``"radau"``, ``"bdf"``,
-        ``"lsoda"``, or the fixed-step ``"rk4"`` / ``"wilson"`` (or an instance), which
-        step on a grid of ``dt`` from the start of every mode segment (the last step of
-        a segment shortened to the event).
-    max_events : int
-        Stop (status ``"too-many-events"``) after this many switching instants.
-    small_velocity : float, optional
-        Approach speeds below this are absorbed plastically (m/s; default
-        1e-6 x length scale / s), which ends bouncing in finite time.
-    gap_tol : float, optional
-        Distance (m) at which a stop or contact counts as touching (default
-        1e-9 x length scale); it is also the penetration tolerance.
-    zeno_time : float, optional
-        A stop or contact that impacts again within this time (s; default
-        1e-4 x (t_end - t0)) is absorbed plastically: a bouncing sequence with
-        e < 1 has infinitely many impacts in finite time, and this ends it
-        where the bounces become shorter than ``zeno_time``.
-    max_wall_time : float, optional
-        Stop (status ``"timeout"``) after this many seconds of computing.
-    progress : bool or None
-        Progress bar on stderr: always, never, or (None) once a run takes > 2 s.
-    dt, steps : optional
-        Step size (s) of ``rk4`` / ``wilson``, or a number of steps over
-        [t0, t_end] (``dt = (t_end - t0) / steps``; default 100 steps).
-    iterations, tol, theta : optional
-        Corrector passes, corrector tolerance and theta of ``wilson``.
-    first_step : float, optional
-        First step of the adaptive integrators, s (after an event: 1e-7 of the run).
-    events : callable or list, optional
-        The caller's event functions ``g(t, q, qdot)`` over the declared coordinates
-        (:class:`mechdyn.integrate.Event`); each crossing is recorded in ``events``
-        as an :class:`~mechdyn.integrate.events.EventRecord`, a terminal one ends the
-        run with status ``"event"``.
-    backend : {"auto", "numpy", "numba"}
-        Evaluation of the equations in each mode (:class:`ModeEquations`).
-    formulation, d
-        ``"exact"`` or the source paper's ``"analogs"`` with its virtual displacement
-        (modes in which every declared coordinate is independent).
+    """The segment loop that runs every simulation: the keywords of
+    :func:`mechdyn.simulate` (``method`` is its ``integrator``) and its ``**switching``
+    options, without the checks of the keywords that :func:`mechdyn.simulate` makes.
 
     Returns
     -------
     Trajectory
-        ``t``, ``q``, ``qdot``, ``qddot`` (all declared coordinates), ``x``,
-        ``xdot``; ``events`` (list of :class:`SwitchEvent`); ``status``
-        (``"success"``, ``"assembly-failed"``, ``"singular-position"``,
-        ``"no-contact-solution"``, ``"lockup"``, ``"too-many-events"``,
-        ``"failed"``) and ``message``; ``energy`` (kinetic, potential,
-        work_nc, balance = T + U - W_nc + impact losses, residual); and
-        ``stats["variable_structure"]``: ``mode`` (list of frozensets per
-        sample), ``frame_force`` (n, 2) N, ``forces`` {element: (n,), (n, 2) or (n, 3)}
-        (joint and weld reactions at the joint point as in kinetostatics, see
-        :func:`mechdyn.dynamics.reactions.element_forces`),
-        ``modes`` (distinct modes in order), ``penetration`` (largest, m).
+        See :func:`mechdyn.simulate`.
     """
     wall0 = time.perf_counter()
     model = mech_or_model if isinstance(mech_or_model, Model) else mech_or_model.compile()
     sm = switched_model(model)
     L = model.length_scale
+    scale = np.where(model.coord_is_angle, 1.0, L)  # of the coordinates' tolerances
     t_end = float(t_end)
     t0 = float(t0)
     if not t_end >= t0:
@@ -219,7 +138,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     t_eval = np.asarray(t_eval, float)
     weight = float(np.sum(model.mass) * max(np.hypot(*model.gravity), 1.0))
     force_scale = max(weight, 1.0)
-    segment_integrator, method_name = _segment_integrators(
+    segment_integrator, method_name = segment_integrators(
         method, t0, t_end, rtol=rtol, atol=atol, dt=dt, steps=steps, iterations=iterations,
         tol=tol, theta=theta, first_step=first_step, max_step=max_step)
     user_events = as_events(events)
@@ -286,7 +205,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     except (MechdynError, np.linalg.LinAlgError) as exc:
         if isinstance(exc, ModelError):
             raise
-        return _finish(model, rec, events, stats, wall0, *_status_of(exc), sm)
+        return _finish(model, rec, events, stats, wall0, *status_of(exc), sm)
 
     qi, qdi = ms.independent(x, xd)
     just_fired: set = set()
@@ -341,7 +260,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                 if not np.all(np.isfinite(y)):
                     raise Stop(Status.NON_FINITE, f"non-finite state at t = {step.t:.9g} s "
                                f"after t = {good[0]:.9g} s")
-                turn = _turning_point(eqs, step, good[1].qdot[ms.coords], good[1].x)
+                turn = turning_point(eqs, step, good[1].qdot[ms.coords], good[1].x)
                 if turn is not None:
                     raise Stop(Status.SINGULAR_POSITION, turn)
                 ev = evaluate(step.t, y)
@@ -355,7 +274,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                 store(ts, ms, ev if ev is not None else evaluate(ts, y), float(y[-1]))
 
             hit, next_out = run_segment(
-                segment_integrator(ms, first), eqs, t, y0, t_end, efns, evaluate=evaluate,
+                segment_integrator(scale[ms.coords], first), eqs, t, y0, t_end, efns,
+                evaluate=evaluate,
                 after_step=after_step, sample=sample, t_eval=t_eval, next_out=next_out,
                 every_step=every_step, stats=stats, bar=bar,
                 deadline=None if max_wall_time is None else wall0 + max_wall_time)
@@ -427,7 +347,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         except (MechdynError, np.linalg.LinAlgError, ValueError, ArithmeticError) as exc:
             if isinstance(exc, IntegratorOptionError):
                 raise
-            status, message = _diagnose(exc, good)
+            status, message = diagnose(exc, good)
             break
         finally:
             stats["bifurcations"] += eqs.report()
@@ -435,66 +355,6 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         "numpy" if backends <= {"numpy"} else "numba+numpy")
     bar.close()
     return _finish(model, rec, events, stats, wall0, status, message, sm)
-
-
-def _segment_integrators(method, t0, t_end, *, rtol, atol, dt, steps, iterations, tol, theta,
-                         first_step, max_step):
-    """``(factory, name)``: ``factory(ms, first) -> Integrator`` for a mode segment.
-
-    Every integrator of the package is allowed (:data:`mechdyn.integrate.INTEGRATORS` or an
-    instance).  The fixed-step ones (``wilson``, ``rk4``) step on a grid of one ``dt``
-    from the start of every segment, the last step shortened to the event; the
-    adaptive ones get per-mode absolute tolerances (scaled by the length scale for
-    travels) and, after an event, a small first step.
-    """
-    fixed = dict(dt=dt, steps=steps, iterations=iterations, tol=tol, theta=theta)
-    if isinstance(method, Integrator):
-        if any(v is not None for v in fixed.values()):
-            raise IntegratorOptionError(
-                "options " + ", ".join(k for k, v in fixed.items() if v is not None)
-                + f" cannot be combined with an integrator instance ({method!r}); set them on "
-                "the instance")
-        if isinstance(method, ScipyIntegrator):
-            name, rtol, atol = method.name, method.rtol, method.atol
-            first_step = method.first_step if first_step is None else first_step
-            max_step = method.max_step if max_step is None else max_step
-        else:
-            name = method.name
-            fixed.update(dt=method.dt, steps=method.steps,
-                         **{k: getattr(method, k, None) for k in ("iterations", "tol", "theta")})
-    elif isinstance(method, str):
-        name = method.lower()
-    else:
-        raise IntegratorOptionError(f"unknown integrator {method!r}; valid integrator names: "
-                                    + ", ".join(INTEGRATORS))
-    if name in ("wilson", "rk4"):
-        # the same validation as a fixed-structure run (first_step, max_step are refused)
-        make_integrator(name, first_step=first_step, max_step=max_step, **fixed)
-        h = fixed["dt"] if fixed["dt"] is not None else (t_end - t0) / (fixed["steps"] or 100)
-        opts = {k: fixed[k] for k in ("iterations", "tol", "theta") if name == "wilson"}
-
-        def factory(ms, first):
-            return make_integrator(name, dt=h, **opts)
-
-        return factory, f"{name} (dt={h:.6g} s)"
-    make_integrator(name, rtol=rtol, atol=atol, first_step=first_step, max_step=max_step,
-                    **fixed)  # validates the options (steps/dt are refused here)
-
-    def factory(ms, first):
-        return make_integrator(name, rtol=rtol, atol=_atol(ms, atol, ms.model.length_scale),
-                               first_step=first_step if first_step is not None else first,
-                               max_step=max_step)
-
-    return factory, name
-
-
-def _atol(ms, atol, L):
-    n = ms.n_i
-    names = ms.coord_names
-    model = ms.model
-    sc = np.array([1.0 if model.coord_is_angle[model.coordinate_index(c)] else L for c in names])
-    return np.concatenate([atol * sc, atol * sc * 10, [atol * 1e3]]) if n else \
-        np.array([atol * 1e3])
 
 
 def _penetration(sm: SwitchedModel, x) -> float:
@@ -511,109 +371,6 @@ def _penetration(sm: SwitchedModel, x) -> float:
     for _n, (_ct, gap, _) in sm.contacts.items():
         worst = max(worst, float(np.max(-RN.values(gap.rows, x)[..., 0])))
     return worst
-
-
-def _where(ms, q) -> str:
-    return ", ".join(f"{n} = {v:.9g}" for n, v in zip(ms.model.coordinate_names, q,
-                                                      strict=True))
-
-
-def _dependent(rep) -> str:
-    return (f"coordinate(s) {', '.join(rep['coordinates']) or '-'} lose control, joints "
-            f"{', '.join(rep['joints']) or '-'} become dependent")
-
-
-#: a coordinate that turns back where sigma_min / sigma_max of the mode's scaled position
-#: Jacobian is below this, and which carries its null vector, has met a dead position (a
-#: fold: near it sigma_min grows like the square root of the distance, so a fixed step
-#: lands within about 1e-2 of it)
-TURN_RCOND = 1e-2
-
-
-def _turning_point(eqs, step, qd_old, x_good) -> str | None:
-    """A coordinate whose rate changes sign during the step may turn back at a dead
-    position (the rate of the driving coordinate vanishes there and the mechanism would
-    have to change assembly branch to go on): locate the turn on the dense output and
-    test the position there.  Returns the message of a dead position, or None."""
-    ms = eqs.ms
-    for k in np.flatnonzero(np.sign(qd_old) * np.sign(step.qdot) < 0):
-        try:
-            tk = brentq(lambda s, k=k: step.dense(s)[1][k], step.t_old, step.t, xtol=1e-14,
-                        rtol=4 * np.finfo(float).eps)
-        except ValueError:
-            continue
-        qk = step.dense(tk)[0]
-        if eqs.chart_at(qk) is not None:
-            continue  # a bifurcation: the branch goes on through it
-        kept = ms._x_last
-        try:
-            xk = ms.solve_position(qk, x_good)
-        except AssemblyError:
-            xk = None
-        finally:
-            ms._x_last = kept
-        rep = ms.singularity(x_good if xk is None else xk)
-        if xk is None or (rep["rcond"] < TURN_RCOND
-                          and ms.coord_names[k] in rep["coordinates"]):
-            q = ms.coordinates(x_good if xk is None else xk)
-            return (f"dead position reached near t = {tk:.9g} s at {_where(ms, q)}: "
-                    f"{ms.coord_names[k]} turns back where the position Jacobian is singular "
-                    f"(sigma_min/sigma_max {rep['rcond']:.2e}); {_dependent(rep)}; going on "
-                    f"would need the other assembly branch")
-    return None
-
-
-def _diagnose(exc, good):
-    """(status, message) of a run that stopped with ``exc`` after the accepted state
-    ``good`` = (t, ModeEval, ModeSystem)."""
-    if isinstance(exc, SingularPositionError) or good is None:
-        return _status_of(exc)
-    t_good, ev, ms = good
-    if isinstance(exc, AssemblyError) and exc.q is not None \
-            and np.size(exc.q) == ms.n_i:
-        # the solve failed between an assemblable q_good and q_bad: the segment leaves
-        # the assembly region, whose boundary is a singular position; bisect for it
-        q_good, q_bad = ev.q[ms.coords], np.asarray(exc.q, float)
-        t_bad = exc.t if exc.t is not None else t_good
-        lo, hi, x_lo = 0.0, 1.0, ev.x
-        while hi - lo > 1e-13:
-            mid = 0.5 * (lo + hi)
-            try:
-                x_lo, lo = ms.solve_position(q_good + mid * (q_bad - q_good), x_lo), mid
-            except AssemblyError:
-                hi = mid
-        rep = ms.singularity(x_lo)
-        if rep["rcond"] < DEAD_RCOND:
-            return Status.SINGULAR_POSITION, (
-                f"dead position reached near t = {t_good + lo * (t_bad - t_good):.9g} s at "
-                f"{_where(ms, ms.coordinates(x_lo))}: the mechanism cannot move past it in "
-                f"mode {sorted(ms.mode) or '(none)'} (sigma_min/sigma_max of the position "
-                f"Jacobian {rep['rcond']:.2e}); {_dependent(rep)}")
-        return Status.ASSEMBLY_FAILED, f"position solve failed at t = {t_bad:.9g} s: {exc}"
-    rep = ms.singularity(ev.x)
-    if rep["rcond"] < DEAD_RCOND:
-        return Status.SINGULAR_POSITION, (
-            f"dead position near t = {t_good:.9g} s at {_where(ms, ev.q)}: "
-            f"sigma_min/sigma_max = {rep['rcond']:.2e}; {_dependent(rep)} ({exc})")
-    return _status_of(exc)
-
-
-def _status_of(exc):
-    if isinstance(exc, SingularPositionError):
-        return Status.SINGULAR_POSITION, str(exc)
-    if isinstance(exc, AssemblyError):
-        return Status.ASSEMBLY_FAILED, str(exc)
-    if isinstance(exc, ContactError):
-        return Status.NO_CONTACT_SOLUTION, str(exc)
-    if isinstance(exc, LockupError):
-        return Status.LOCKUP, str(exc)
-    if isinstance(exc, IntegrationError) and "mass matrix" in str(exc):
-        return Status.SINGULAR_MASS_MATRIX, str(exc)
-    if isinstance(exc, ArithmeticError):
-        return Status.NON_FINITE, f"non-finite values: {exc}"
-    if isinstance(exc, np.linalg.LinAlgError):
-        return Status.FAILED, f"singular system: {exc}"
-    return Status.FAILED, str(exc)
 
 
 # ============================================================================ output

@@ -2,6 +2,7 @@
 
 ``make_integrator("wilson", steps=40)`` builds an integrator from its name and
 options (unknown names and misplaced options give errors naming them);
+:func:`segment_integrators` the integrator of every segment of a run;
 :func:`solve` runs one over [t0, t_end] with output times and events, the
 integrate-level analogue of ``scipy.integrate.solve_ivp`` for q'' = f(t, q, q').
 """
@@ -20,7 +21,8 @@ from .scipy_ivp import SCIPY_METHODS, ScipyIntegrator
 from .segment import Coordinates, run_to_end, user_event_functions
 from .wilson import Wilson
 
-__all__ = ["INTEGRATORS", "make_integrator", "solve", "Solution", "sample_times"]
+__all__ = ["INTEGRATORS", "make_integrator", "segment_integrators", "solve", "Solution",
+           "sample_times"]
 
 #: valid integrator names
 INTEGRATORS = ("wilson", "rk4", *SCIPY_METHODS)
@@ -98,6 +100,66 @@ class Solution:
     events: list = field(default_factory=list)
     stats: dict = field(default_factory=dict)
     status: str = "success"
+
+
+def segment_integrators(method, t0: float, t_end: float, *, rtol, atol, dt, steps, iterations,
+                         tol, theta, first_step, max_step):
+    """``(factory, name)``: ``factory(scale, first) -> Integrator`` for a segment of a run.
+
+    Every integrator of the package is allowed (:data:`mechdyn.integrate.INTEGRATORS` or an
+    instance).  The fixed-step ones (``wilson``, ``rk4``) step on a grid of one ``dt``
+    from the start of every segment, the last step shortened to the event; the
+    adaptive ones get absolute tolerances per state, ``atol * scale`` for the
+    coordinates (``scale``: 1 for angles, the length scale for travels), ten times that
+    for their rates and ``1e3 atol`` for the work, and, after an event, a small first
+    step ``first``.
+
+    Raises
+    ------
+    IntegratorOptionError
+        An unknown integrator or options that do not belong to it.
+    """
+    fixed = dict(dt=dt, steps=steps, iterations=iterations, tol=tol, theta=theta)
+    if isinstance(method, Integrator):
+        if any(v is not None for v in fixed.values()):
+            raise IntegratorOptionError(
+                "options " + ", ".join(k for k, v in fixed.items() if v is not None)
+                + f" cannot be combined with an integrator instance ({method!r}); set them on "
+                "the instance")
+        if isinstance(method, ScipyIntegrator):
+            name, rtol, atol = method.name, method.rtol, method.atol
+            first_step = method.first_step if first_step is None else first_step
+            max_step = method.max_step if max_step is None else max_step
+        else:
+            name = method.name
+            fixed.update(dt=method.dt, steps=method.steps,
+                         **{k: getattr(method, k, None) for k in ("iterations", "tol", "theta")})
+    elif isinstance(method, str):
+        name = method.lower()
+    else:
+        raise IntegratorOptionError(f"unknown integrator {method!r}; valid integrator names: "
+                                    + ", ".join(INTEGRATORS))
+    if name in ("wilson", "rk4"):
+        # the same validation as a fixed-structure run (first_step, max_step are refused)
+        make_integrator(name, first_step=first_step, max_step=max_step, **fixed)
+        h = fixed["dt"] if fixed["dt"] is not None else (t_end - t0) / (fixed["steps"] or 100)
+        opts = {k: fixed[k] for k in ("iterations", "tol", "theta") if name == "wilson"}
+
+        def factory(scale, first):
+            return make_integrator(name, dt=h, **opts)
+
+        return factory, f"{name} (dt={h:.6g} s)"
+    make_integrator(name, rtol=rtol, atol=atol, first_step=first_step, max_step=max_step,
+                    **fixed)  # validates the options (steps/dt are refused here)
+
+    def factory(scale, first):
+        sc = np.asarray(scale, float)
+        return make_integrator(name, rtol=rtol,
+                               atol=np.concatenate([atol * sc, atol * sc * 10, [atol * 1e3]]),
+                               first_step=first_step if first_step is not None else first,
+                               max_step=max_step)
+
+    return factory, name
 
 
 def sample_times(t0: float, t_end: float, t_eval) -> np.ndarray | None:
