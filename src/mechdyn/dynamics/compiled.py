@@ -28,7 +28,6 @@ from ..kernels.lagrange_numba import (
     W_VALID,
     first_order,
     full,
-    positions,
     work_size,
 )
 from ..kernels.loads_numba import LoadPacker, Unsupported
@@ -62,9 +61,6 @@ class CompiledKernel:
         Status of the last call (0 ok, 1 position solve failed, 2 singular mass
         matrix, 3 non-finite).
     """
-
-    STATUS = {0: "ok", 1: "position solve failed", 2: "mass matrix not positive definite",
-              3: "non-finite values"}
 
     def __init__(self, ip, fp, ri, rf, dims, n_x, compile_time):
         self.ip, self.fp, self.ri, self.rf, self.dims = ip, fp, ri, rf, dims
@@ -101,12 +97,6 @@ class CompiledKernel:
         """Restart the Newton continuation from pose x."""
         self.ws[:self.n_x] = x
         self.ws[-N_FLAGS + W_VALID] = 0.0
-
-    def positions(self, q):
-        """Solve the positions at q_I; returns x (a copy) or None on failure."""
-        self.status = positions(np.asarray(q, dtype=np.float64), self.ip, self.fp, self.ri,
-                                 self.rf, self.dims, self.ws)
-        return None if self.status else self.ws[:self.n_x].copy()
 
     def rhs(self, t, q, qdot):
         """(q_I'', array([P_nc])) or None on failure (see ``status``)."""
@@ -206,7 +196,6 @@ def _warm_up() -> float:
         ws[:n_x] = x0
         q, qd = np.array([0.3]), np.array([1.0])
         st = np.zeros(1, dtype=np.int64)
-        positions(q, ip, fp, ri, rf, dims, ws)
         first_order(0.0, np.concatenate([q, qd, [0.0]]), ip, fp, ri, rf, dims, ws, st)
         full(0.0, q, qd, ip, fp, ri, rf, dims, ws, np.empty(2 * ni + 1),
               np.empty(2 * n_x + 3 * nq + nc), st)

@@ -39,7 +39,7 @@ from .loads_numba import (
 )
 from .rows_numba import njit, rows_jacobian, rows_quad, rows_values
 
-__all__ = ["evaluate", "first_order", "full", "positions", "work_size", "D_NC", "D_NI",
+__all__ = ["evaluate", "first_order", "full", "work_size", "D_NC", "D_NI",
            "D_NQ", "D_NV", "W_VALID", "W_PIVOT", "W_COUNT", "N_FLAGS"]
 
 # dims: n_c (constraint rows), n_i (independent coordinates), n_q (declared coordinates),
@@ -355,13 +355,3 @@ def first_order(t, y, ip, fp, ri, rf, dims, ws, status):
 @njit
 def full(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, status):
     status[0] = evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, True)
-
-
-@njit
-def positions(qi, ip, fp, ri, rf, dims, ws):
-    nb = ip[H_NB]
-    nx = 3 * nb
-    J = np.empty((nx, nx))
-    piv = np.empty(nx, dtype=np.int64)
-    F = np.empty(nx)
-    return _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb)
