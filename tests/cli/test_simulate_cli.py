@@ -81,3 +81,28 @@ def test_switching_run_writes_its_events_beside_the_table(tmp_path, capsys):
     assert list(ev.columns) == ["t_s", "kind", "element", "mode_before", "mode_after",
                                 "energy_lost_J", "phi_after", "psi_after", "p_after"]
     assert ("close", "ram_stop@upper") in set(zip(ev["kind"], ev["element"], strict=True))
+
+
+def test_ctrl_c_writes_the_samples_so_far_and_exits_130(tmp_path, capsys, monkeypatch):
+    """Ctrl-C in the middle of a run: no traceback, the samples computed so far are
+    written, status "interrupted", exit code 130."""
+    from mechdyn.dynamics.mode_system import ModeSystem
+
+    calls = {"n": 0}
+    evaluate = ModeSystem.evaluate
+
+    def interrupted_later(self, *args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] > 400:
+            raise KeyboardInterrupt
+        return evaluate(self, *args, **kwargs)
+
+    monkeypatch.setattr(ModeSystem, "evaluate", interrupted_later)
+    out = tmp_path / "press.csv"
+    code = main(["simulate", "clutchless_press", "--t-end", "1 s", "--backend", "numpy",
+                 "-o", str(out)])
+    captured = capsys.readouterr()
+    assert code == 130
+    assert "interrupted" in captured.out and "Traceback" not in captured.err
+    df = pd.read_csv(out)
+    assert len(df) > 5 and 0.0 < df["t_s"].iloc[-1] < 1.0

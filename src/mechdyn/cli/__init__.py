@@ -33,7 +33,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; returns the exit code (0 ok, 1 analysis stopped, 2 bad input)."""
+    """Run the command line; returns the exit code (0 ok, 1 analysis stopped, 2 bad input,
+    130 interrupted by Ctrl-C)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
@@ -44,3 +45,6 @@ def main(argv: list[str] | None = None) -> int:
     except (MechdynError, FileNotFoundError, IsADirectoryError, PermissionError) as exc:
         print(f"mechdyn {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:  # outside a run (a run keeps its data and says so itself)
+        print(f"mechdyn {args.command}: interrupted", file=sys.stderr)
+        return 130

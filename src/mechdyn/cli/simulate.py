@@ -7,7 +7,8 @@ Examples::
         --drive phi="34.5 N*m" -o press.csv --plot press.png
 
 Exit codes: 0 done; 1 the run stopped early (dead position, assembly failure,
-singular mass matrix ...; the samples computed so far are written); 2 bad input.
+singular mass matrix ...; the samples computed so far are written); 2 bad input;
+130 interrupted by Ctrl-C (the samples computed so far are written).
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..dynamics.lagrange import FORMULATIONS
-from ..errors import ModelError, did_you_mean
+from ..errors import ModelError, Status, did_you_mean
 from ..integrate.base import DEFAULT_RTOL
 from ..integrate.driver import INTEGRATORS
 from ..mechanism import Drive
@@ -43,7 +44,7 @@ def register(sub) -> None:
                     "counters and the energy balance.",
         epilog="Quantities take units: 0.05 s, 20 ms, 34.5 N*m, -64.1 deg, 43.5 rad/s (a bare "
                "number is SI). Exit codes: 0 done, 1 stopped early (data so far written), "
-               "2 bad input.")
+               "2 bad input, 130 interrupted by Ctrl-C (data so far written).")
     p.add_argument("model", metavar="MODEL",
                    help="model file (.toml) or the name of a bundled example")
     p.add_argument("--t-end", required=True, metavar="TIME", help="end time, e.g. 0.05s")
@@ -140,7 +141,7 @@ def run(args) -> int:
         print(f"wrote {args.plot}")
     if not traj.success:
         print(f"mechdyn simulate: stopped early: {traj.status}: {traj.message}", file=sys.stderr)
-        return 1
+        return 130 if traj.status == Status.INTERRUPTED else 1
     return 0
 
 
