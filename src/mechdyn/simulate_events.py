@@ -67,6 +67,7 @@ from .integrate.segment import (
 from .kernels import rows_numpy as RN
 from .kinematics.constraints import extend
 from .model import Model
+from .model.workspace import Workspace
 from .progress import Progress
 from .results.events import format_events
 from .results.trajectory import SwitchedSamples, Trajectory
@@ -168,22 +169,24 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     q_init, qd_init, x_guess = initial_state(model, q0, qdot0, mode=welds)
     t = t0
     w_nc = 0.0
+    ws = Workspace()  # the run's caches, shared by the mode systems of the run
     try:
         x = x_guess
         if locks:
             try:  # the pose at which undeclared locks capture what they hold
-                free = ModeSystem(sm, frozenset(), targets, x_guess)
+                free = ModeSystem(sm, frozenset(), targets, x_guess, workspace=ws)
                 x = free.solve_position(q_init[free.coords], x_guess, t=t)
             except LockupError:  # the coordinates need the locks: the welded pose
                 pass
         for n in locks:
             sm.capture_target(n, x, targets)
-        ms = ModeSystem(sm, locks, targets, x)
+        ms = ModeSystem(sm, locks, targets, x, workspace=ws)
         x = ms.solve_position(q_init[ms.coords], x, t=t)
         # rates: given for the independent coordinates of the mode with every
         # touching stop and contact closed (the rest are dependent there)
         touch0 = touching(sm, ms, x, gap_tol=gap_tol)
-        ms_t = ModeSystem(sm, locks | frozenset(touch0), targets, x) if touch0 else ms
+        ms_t = ModeSystem(sm, locks | frozenset(touch0), targets, x, workspace=ws) \
+            if touch0 else ms
         B, _ = ms_t.velocity_analogs(x)
         xd = B @ qd_init[ms_t.coords]
         X = extend(model, x)

@@ -76,13 +76,13 @@ def turning_point(eqs, step, qd_old, x_good) -> str | None:
         qk = step.dense(tk)[0]
         if eqs.chart_at(qk) is not None:
             continue  # a bifurcation: the branch goes on through it
-        kept = ms._x_last
+        kept = ms.ws.x
         try:
             xk = ms.solve_position(qk, x_good)
         except AssemblyError:
             xk = None
         finally:
-            ms._x_last = kept
+            ms.ws.x = kept
         rep = ms.singularity(x_good if xk is None else xk)
         if xk is None or (rep["rcond"] < TURN_RCOND
                           and ms.coord_names[k] in rep["coordinates"]):

@@ -207,7 +207,7 @@ class EquationsOfMotion:
     def x(self) -> np.ndarray:
         """The last solved pose."""
         k = self.kernel
-        return k.x.copy() if k is not None else self.equations.ms._x_last.copy()
+        return k.x.copy() if k is not None else self.equations.ms.ws.x.copy()
 
     def reset(self, x) -> None:
         """Restart the Newton continuation from the pose ``x`` (n_x,)."""

@@ -261,13 +261,12 @@ class ModeEquations:
         if not self.watching or not self.book.due(s):
             return None
         k = self.kernel
-        x = k.x.copy() if k is not None and not k.status else self.ms._x_last
+        x = k.x.copy() if k is not None and not k.status else self.ms.ws.x
         ch = self.book.watch(s, x)
         return ch if ch is not None and ch.in_zone(s) else None
 
     def _reset(self, x) -> None:
-        self.ms._x_last = np.array(x, float)
-        self.ms._B_last = None
+        self.ms.ws.reset(x)
         if self.kernel is not None:
             self.kernel.reset(x)
 

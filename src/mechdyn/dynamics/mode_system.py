@@ -41,6 +41,7 @@ from ..kernels import rows_numpy as RN
 from ..kinematics.assembly import newton
 from ..model.rows import concat
 from ..model.state import Mode
+from ..model.workspace import Workspace
 from .inertia import mass_matrix_x
 from .reactions import touches_ground
 
@@ -102,6 +103,9 @@ class ModeSystem:
         Declared coordinates to keep independent if possible (the previous set).
     avoid : sequence of str
         Declared coordinates to drop first (``frees`` of the locks just engaged).
+    workspace : Workspace, optional
+        The run's per-run caches (last pose, predictor), restarted at ``x``; default a
+        new one.
 
     Attributes
     ----------
@@ -120,7 +124,8 @@ class ModeSystem:
         The mode leaves no freedom that the declared coordinates can describe.
     """
 
-    def __init__(self, sm: SwitchedModel, mode, targets: dict, x, *, prefer=(), avoid=()):
+    def __init__(self, sm: SwitchedModel, mode, targets: dict, x, *, prefer=(), avoid=(),
+                 workspace: Workspace | None = None):
         self.sm = sm
         model = sm.model
         self.model = model
@@ -149,13 +154,11 @@ class ModeSystem:
         # [independent rows; g_I - q_I] is the subset _sel of them
         self._all = concat(nb, self.rowset, model.coordinate_rows)
         self._sel = np.concatenate([self.independent_rows, self.n_rows + self.coords])
-        self._at = None  # (x, Parts, values) of the last pose solved
         self._eye_i = np.zeros((model.n_x, self.n_i))
         self._eye_i[len(self.independent_rows):, :] = np.eye(self.n_i)
         self._rs = np.tile([1.0, 1.0, 1.0 / L], nb)
-        self._x_last = self.x_ref.copy()
-        self._B_last = None
-        self._qi_last = None
+        self.ws = Workspace() if workspace is None else workspace
+        self.ws.reset(self.x_ref)
 
     def _choose_coordinates(self, Ri, colscale, prefer, avoid) -> np.ndarray:
         """Pivots of G N (G the scaled coordinate Jacobian, N the null space of the
@@ -236,12 +239,7 @@ class ModeSystem:
             Newton does not converge; the message names the open rows.
         """
         qi = np.asarray(qi, float)
-        if x_guess is None:
-            x = self._x_last.copy()
-            if self._B_last is not None and self.n_i:
-                x = x + self._B_last @ (qi - self._qi_last)
-        else:
-            x = np.array(x_guess, float)
+        x = self.ws.predict(qi) if x_guess is None else np.array(x_guess, float)
         n_r = len(self.independent_rows)
         tol = 1e-13 * max(self.model.length_scale, 1e-3)
         x, done = newton(self._all, x, np.concatenate([np.zeros(n_r), qi]), sel=self._sel,
@@ -254,8 +252,7 @@ class ModeSystem:
                 t=t, q=qi, residuals=res)
         p = RN.Parts(self._all, x)
         v = RN.values(self._all, x, p)
-        self._x_last = x
-        self._at = (x, p, v)
+        self.ws.x, self.ws.parts = x, (x, p, v)
         return x
 
     def velocity_analogs(self, x):
@@ -297,7 +294,7 @@ class ModeSystem:
         """(x, xdot, B) at independent coordinates and rates."""
         x = self.solve_position(qi, x_guess, t)
         B, _ = self.velocity_analogs(x)
-        self._B_last, self._qi_last = B, np.array(qi, float)
+        self.ws.B, self.ws.qi = B, np.array(qi, float)
         return x, B @ np.asarray(qdoti, float), B
 
     def independent(self, x, xdot):
@@ -311,7 +308,7 @@ class ModeSystem:
         the velocity analogs, xddot = B qddot_I + b (unless given), the coordinates'
         quadratic terms and values."""
         n_rows, allr = self.n_rows, self._all
-        at = self._at
+        at = self.ws.parts
         if at is not None and at[0] is x:  # the pose just solved: its parts and values
             p, v = at[1], at[2]
         else:
@@ -324,7 +321,7 @@ class ModeSystem:
             B = np.linalg.solve(J, self._eye_i) if J.size else np.zeros((self.model.n_x, 0))
         if xdot is None:
             xdot = B @ np.asarray(qdoti, float)
-            self._B_last = B
+            self.ws.B = B
         quad = RN.quad(allr, x, xdot, p)
         if b is None:
             b = np.linalg.solve(J, -quad[self._sel]) if J.size else np.zeros(0)
@@ -334,7 +331,7 @@ class ModeSystem:
         """Accelerations and every multiplier at a state of the mode."""
         x = self.solve_position(qi, x_guess, t)
         ev = self.evaluate_x(t, x, None, qdoti=qdoti)
-        self._qi_last = np.array(qi, float)
+        self.ws.qi = np.array(qi, float)
         return ev
 
     def evaluate_x(self, t, x, xdot, B=None, *, qdoti=None, b=None) -> ModeEval:

@@ -215,7 +215,8 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
         force_tol=1e-10 * force_scale, forced_open=forced_open, forced_slip=forced_slip,
         forced_stick=forced_stick)
     prefer = ms.coord_names
-    ms_new = ModeSystem(sm, mode_after, targets, x, prefer=prefer, avoid=frees)
+    ms_new = ModeSystem(sm, mode_after, targets, x, prefer=prefer, avoid=frees,
+                        workspace=ms.ws)
     # an engaging lock must hold the pose it engages at (no position jump)
     tol_pos = 1e-8 * sm.model.length_scale
     bad = {lab: float(v) for lab, v, el in zip(ms_new.row_labels(), ms_new.row_values(x),
