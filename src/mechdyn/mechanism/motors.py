@@ -287,11 +287,6 @@ class InductionMotor:
 
     # ------------------------------------------------------------------ curve
     @property
-    def critical_speed(self) -> float:
-        """Speed at the breakdown torque, omega_0 (1 - s_k), rad/s."""
-        return self.synchronous_speed * (1.0 - self.critical_slip)
-
-    @property
     def starting_torque(self) -> float:
         """Torque of the model at standstill (s = 1), N m."""
         return self.torque_at_slip(1.0)
@@ -321,16 +316,6 @@ class InductionMotor:
     def extra_inertia(self) -> float:
         """Rotor inertia added to the driven coordinate, kg m^2 (direct drive)."""
         return self.rotor_inertia
-
-    def describe(self) -> str:
-        """One-line summary with the fitted constants."""
-        rpm = 30.0 / math.pi
-        return (f"{self.name}: P_n = {self.rated_power / 1e3:.4g} kW, n_0 = "
-                f"{self.synchronous_speed * rpm:.5g} rpm, n_n = {self.rated_speed * rpm:.5g} rpm "
-                f"(s_n = {self.rated_slip:.4g}), M_n = {self.rated_torque:.4g} N m, M_k = "
-                f"{self.breakdown_torque:.4g} N m at s_k = {self.critical_slip:.4g}, "
-                f"M_start = {self.starting_torque:.4g} N m, a = {self.a:.4g} "
-                f"({self.characteristic}), J_rotor = {self.rotor_inertia:.4g} kg m^2")
 
 
 # ---------------------------------------------------------------------- DC motor
