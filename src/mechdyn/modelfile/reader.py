@@ -3,16 +3,8 @@
 Holds the document being read, the problems found in it so far and the names
 read from it (bodies and their points, sketch frames, joint types, coordinate
 kinds), with the helpers that read one value (a quantity, a vector, a body or
-point name, a direction) and record its problem instead of raising it.
-
-Private names
--------------
-_Reader
-    The base of the table readers (:mod:`.bodies_joints`, :mod:`.loads_drives`,
-    :mod:`.initial_assembly`), which :class:`mechdyn.modelfile.loader._Builder`
-    combines.
-_Failed
-    Raised when a value cannot be read; its problem is already recorded.
+point name, a direction) and record its problem instead of raising it
+(:class:`_Failed` then says the problem is recorded).
 """
 
 from __future__ import annotations
@@ -23,7 +15,7 @@ from typing import Any
 
 from ..errors import UnitError, did_you_mean
 from ..mechanism import GROUND
-from ..units import parse_quantity, parse_vector
+from ..units import KINDS, parse_quantity, parse_vector
 from .schema import locate
 
 
@@ -45,6 +37,8 @@ class _Reader:
         self.sketch_frames: dict[str, tuple[float, float, float]] = {}
         self.joint_types: dict[str, str] = {}
         self.coord_kinds: dict[str, str] = {}
+        #: a problem was recorded in the element being read
+        self.failed = False
 
     # ------------------------------------------------------------ helpers
     def where(self, *path) -> str:
@@ -65,26 +59,54 @@ class _Reader:
         clean = {k: v for k, v in spec.items() if not self.broken(*path, k)}
         if any(k not in clean for k in required):
             raise _Failed
+        self.failed = False
         try:
             el = fn(path[-1], clean)
         except (ValueError, TypeError) as exc:  # an element's own check; keep it readable
             self.problem(f"{self.where(*path)}: {exc}")
             raise _Failed from None
-        if self.broken(*path):
+        if self.failed or self.broken(*path):
             raise _Failed
         return el
+
+    def soft(self, fn, *args, default=None, **kwargs):
+        """``fn(*args, **kwargs)``, or ``default`` if it fails: the problem is recorded
+        and the element being read is marked :attr:`failed`."""
+        try:
+            return fn(*args, **kwargs)
+        except _Failed:
+            self.failed = True
+            return default
+
+    def check(self):
+        """Raise :class:`_Failed` if a problem was recorded in the element being read."""
+        if self.failed:
+            raise _Failed
+
+    def opt(self, spec: dict, key: str, kind, *path, default=0.0, read=None, **kwargs):
+        """``spec[key]`` read at ``path`` by ``read`` (default :meth:`quantity`) as ``kind``;
+        ``default`` if the key is absent or unreadable (then the element is failed)."""
+        if key not in spec:
+            return default
+        return self.soft(read or self.quantity, spec[key], kind, *path, key, default=default,
+                         **kwargs)
 
     def problem(self, msg: str):
         if msg not in self.problems:
             self.problems.append(msg)
 
-    def quantity(self, value: Any, kind: str, *path) -> float:
+    def quantity(self, value: Any, kind: str, *path, nonneg: bool = False) -> float:
         try:
-            return parse_quantity(value, kind, where=self.where(*path))
+            out = parse_quantity(value, kind, where=self.where(*path))
         except UnitError as exc:
             self.problem(str(exc))
             self.unit_problems.add(str(exc))
             raise _Failed from None
+        if nonneg and out < 0:
+            self.problem(f"{self.where(*path)}: {value!r}: {path[-1]} must be >= 0 "
+                         f"{KINDS[kind].si}")
+            raise _Failed
+        return out
 
     def vector(self, value: Any, kind, *path, size: int | None = None) -> tuple[float, ...]:
         try:
@@ -93,12 +115,6 @@ class _Reader:
             self.problem(str(exc))
             self.unit_problems.add(str(exc))
             raise _Failed from None
-
-    def nonneg(self, value: float, raw: Any, unit: str, *path) -> float:
-        if value < 0:
-            self.problem(f"{self.where(*path)}: {raw!r}: {path[-1]} must be >= 0 {unit}")
-            raise _Failed
-        return value
 
     def body_name(self, value: str, *path, ground_ok: bool = True) -> str:
         valid = [b for b in self.body_points if b != GROUND] + ([GROUND] if ground_ok else [])
