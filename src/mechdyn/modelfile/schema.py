@@ -21,7 +21,7 @@ __all__ = ["schema", "schema_problems", "locate", "toml_type"]
 #: top-level tables whose sub-tables are named elements ([bodies.NAME], ...)
 _NAMED_SECTIONS = ("bodies", "joints", "coordinates")
 #: top-level arrays of tables ([[loads]], ...)
-_ARRAY_SECTIONS = ("loads", "drives")
+_ARRAY_SECTIONS = ("loads", "drives", "coordinate_locks", "stops", "contacts", "switches")
 
 
 @lru_cache(maxsize=1)
@@ -105,7 +105,7 @@ def locate(fname: str, path: Sequence, doc: Any = None) -> str:
             key += f"[{p}]"
         else:
             key += ("." if key else "") + str(p)
-    return f"{fname}: {label}" + (f" {key}" if key else "")
+    return (f"{fname}: " if fname else "") + label + (f" {key}" if key else "")
 
 
 def _property_hint(sch: dict, key: str) -> str:
