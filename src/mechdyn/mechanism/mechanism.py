@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import ModelError, did_you_mean
 from .assembly_mode import AssemblyMode
 from .body import GROUND, Body, Ground
-from .coordinate import COORDINATE_KINDS, Coordinate
+from .coordinate import Coordinate, coordinate_problems
 from .joint import Joint, Lock, Prismatic, Revolute
 
 __all__ = ["Mechanism"]
@@ -186,30 +186,11 @@ class Mechanism:
                     out.append(f"{where}: axis must be a non-zero direction (x, y), "
                                f"got {j.axis!r}")
 
+        joint_types = {n: type(j).__name__.lower() for n, j in self.joints.items()}
         for c in self.coordinates.values():
-            where = f"coordinate {c.name!r}"
-            if c.kind not in COORDINATE_KINDS:
-                out.append(f"{where}: unknown kind {c.kind!r}; valid kinds: "
-                           + ", ".join(repr(k) for k in COORDINATE_KINDS))
-                continue
-            if c.kind == "angle":
-                if c.body is None:
-                    out.append(f"{where}: kind 'angle' needs a body")
-                elif c.body not in self.bodies:
-                    out.append(f"{where}: body: " + did_you_mean(c.body, self.bodies, "body"))
-            else:
-                want = Revolute if c.kind == "relative_angle" else Prismatic
-                if c.joint is None:
-                    out.append(f"{where}: kind {c.kind!r} needs a joint")
-                elif c.joint not in self.joints:
-                    out.append(f"{where}: joint: " + did_you_mean(c.joint, self.joints, "joint"))
-                elif not isinstance(self.joints[c.joint], want):
-                    valid = [n for n, jj in self.joints.items() if isinstance(jj, want)]
-                    out.append(f"{where}: kind {c.kind!r} needs a {want.__name__.lower()} "
-                               f"joint, but {c.joint!r} is a "
-                               f"{type(self.joints[c.joint]).__name__.lower()}; "
-                               f"{want.__name__.lower()} joints: "
-                               + (", ".join(repr(v) for v in valid) or "(none)"))
+            for key, msg in coordinate_problems(c.kind, c.body, c.joint, self.bodies,
+                                                joint_types):
+                out.append(f"coordinate {c.name!r}: " + (f"{key}: " if key else "") + msg)
         for am in self.extras.get("assembly", []):
             for role, (bname, ref) in zip("PQR", am.points, strict=True):
                 where = f"assembly mode {am.name!r}: point {role}"

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import math
 
-from ..errors import did_you_mean
-from ..mechanism import Body, Coordinate, Lock, Prismatic, Revolute
+from ..mechanism import GROUND, Body, Coordinate, Lock, Prismatic, Revolute
+from ..mechanism.coordinate import coordinate_problems
 from .reader import _Failed, _Reader
 
 _POSE_KINDS = ("length", "length", "angle")
@@ -136,42 +136,10 @@ class _BodiesJoints(_Reader):
     # ------------------------------------------------------------ coordinates
     def coordinate(self, cname: str, spec: dict) -> Coordinate:
         P = ("coordinates", cname)
-        kind = spec["kind"]
-        body = joint = None
-        if kind == "angle":
-            if "joint" in spec:
-                self.problem(f"{self.where(*P, 'joint')}: kind 'angle' measures a body; "
-                             "give 'body', not 'joint'")
-                raise _Failed
-            if "body" not in spec:
-                self.problem(f"{self.where(*P)}: missing key 'body' (kind 'angle' measures the "
-                             "absolute angle of a body)")
-                raise _Failed
-            body = self.body_name(spec["body"], *P, "body", ground_ok=False)
-        else:
-            want = "revolute" if kind == "relative_angle" else "prismatic"
-            if "body" in spec:
-                self.problem(f"{self.where(*P, 'body')}: kind {kind!r} measures a {want} "
-                             "joint; give 'joint', not 'body'")
-                raise _Failed
-            if "joint" not in spec:
-                self.problem(f"{self.where(*P)}: missing key 'joint' (kind {kind!r} needs a "
-                             f"{want} joint)")
-                raise _Failed
-            joint = spec["joint"]
-            if joint not in self.joint_types:
-                self.problem(f"{self.where(*P, 'joint')}: "
-                             + did_you_mean(joint, self.joint_types, "joint"))
-                raise _Failed
-            if self.joint_types[joint] != want:
-                valid = [n for n, t in self.joint_types.items() if t == want]
-                self.problem(f"{self.where(*P, 'joint')}: {joint!r} is a "
-                             f"{self.joint_types[joint]} joint, but kind {kind!r} needs a {want} "
-                             f"joint; {want} joints: "
-                             + (", ".join(repr(v) for v in valid) or "(none)"))
-                raise _Failed
-        offset = 0.0
-        if "offset" in spec:
-            qkind = "length" if kind == "travel" else "angle"
-            offset = self.quantity(spec["offset"], qkind, *P, "offset")
+        kind, body, joint = spec["kind"], spec.get("body"), spec.get("joint")
+        bodies = [b for b in self.body_points if b != GROUND]
+        for key, msg in coordinate_problems(kind, body, joint, bodies, self.joint_types):
+            self.problem(f"{self.where(*P, key)}: {msg}")
+            raise _Failed
+        offset = self.opt(spec, "offset", "length" if kind == "travel" else "angle", *P)
         return Coordinate(cname, kind, body, joint, offset)
