@@ -79,9 +79,10 @@ class CatalogueEntry:
     sources: dict = field(default_factory=dict)
     note: str = ""
 
-    def motor_kwargs(self) -> dict:
-        """Keyword arguments of :class:`~mechdyn.mechanism.motors.InductionMotor` (SI)."""
-        if self.rotor_inertia is None:
+    def motor_kwargs(self, warn: bool = True) -> dict:
+        """Keyword arguments of :class:`~mechdyn.mechanism.motors.InductionMotor` (SI);
+        ``warn``: warn when the rotor inertia is not in the catalogue (taken as 0)."""
+        if self.rotor_inertia is None and warn:
             warnings.warn(f"motor {self.designation}: the rotor inertia is not in the "
                           f"catalogue; it is taken as 0 - give rotor_inertia", stacklevel=3)
         return {"rated_power": self.rated_power,
@@ -158,12 +159,7 @@ def induction_motor(designation: str, characteristic: str = "kloss", **overrides
         Any InductionMotor field (SI), e.g. ``rotor_inertia=0.0035``.
     """
     entry = catalogue_entry(designation)
-    if "rotor_inertia" in overrides:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            kw = entry.motor_kwargs()
-    else:
-        kw = entry.motor_kwargs()
+    kw = entry.motor_kwargs(warn="rotor_inertia" not in overrides)
     kw.update(overrides)
     if "rated_speed" in overrides and "rated_slip" not in overrides:
         kw.pop("rated_slip")

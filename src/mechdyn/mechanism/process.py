@@ -173,11 +173,10 @@ def position_load(name: str, body: str, point, positions, values, *, coordinate:
     if coordinate not in _AXES:
         raise ValueError(f"position load {name!r}: coordinate must be 'x' or 'y', "
                          f"got {coordinate!r}")
-    pname = point if isinstance(point, str) else None
-    if pname is None:
+    if not isinstance(point, str):
         raise ValueError(f"position load {name!r}: the watched point must be a named point "
                          f"of body {body!r} (tables refer to 'body.point.{coordinate}')")
-    tab = Table(tuple(positions), tuple(values), f"{body}.{pname}.{coordinate}", outside)
+    tab = Table(tuple(positions), tuple(values), f"{body}.{point}.{coordinate}", outside)
     return Force(name, body, point, tab, tuple(direction), frame)
 
 

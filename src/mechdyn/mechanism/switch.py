@@ -69,9 +69,8 @@ class CoordinateLock:
     extra_kind = "coordinate_locks"
 
     def __post_init__(self):
-        if isinstance(self.frees, str):
-            object.__setattr__(self, "frees", (self.frees,))
-        object.__setattr__(self, "frees", tuple(str(f) for f in self.frees))
+        frees = (self.frees,) if isinstance(self.frees, str) else self.frees
+        object.__setattr__(self, "frees", tuple(str(f) for f in frees))
         if self.value is not None:
             object.__setattr__(self, "value", float(self.value))
 
@@ -121,11 +120,8 @@ class Switch:
         object.__setattr__(self, "times", tuple(sorted(float(t) for t in self.times)))
         object.__setattr__(self, "value", float(self.value))
         object.__setattr__(self, "direction", int(np.sign(self.direction)))
-        g = []
-        for item in self.guard:
-            var, op, val = item
-            g.append((str(var), str(op), float(val)))
-        object.__setattr__(self, "guard", tuple(g))
+        object.__setattr__(self, "guard", tuple((str(var), str(op), float(val))
+                                                for var, op, val in self.guard))
 
     @property
     def is_scheduled(self) -> bool:

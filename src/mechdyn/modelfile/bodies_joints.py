@@ -24,18 +24,8 @@ class _BodiesJoints(_Reader):
         P = ("bodies", bname)
         mass = self.opt(spec, "mass", "mass", *P, nonneg=True)
         inertia = self.opt(spec, "inertia", "inertia", *P, nonneg=True)
-        raw_points = self.doc["bodies"][bname].get("points", {})
-        points = {}
-        for pname, val in (raw_points if isinstance(raw_points, dict) else {}).items():
-            if pname == "com" and not self.broken(*P, "points", pname):
-                self.problem(f"{self.where(*P, 'points', pname)}: the point name 'com' is "
-                             "reserved for the centre of mass; use the key 'com' of the body")
-            if pname == "com" or self.broken(*P, "points", pname):
-                self.failed = True
-                continue
-            xy = self.soft(self.vector, val, "length", *P, "points", pname)
-            if xy is not None:
-                points[pname] = xy
+        points = self.points(self.doc["bodies"][bname].get("points"), *P, "points",
+                             hint=" for the centre of mass; use the key 'com' of the body")
         com = self.opt(spec, "com", "length", *P, default=(0.0, 0.0), read=self.vector)
 
         if spec.get("frame", "body") == "sketch":

@@ -95,13 +95,17 @@ class _Reader:
         if msg not in self.problems:
             self.problems.append(msg)
 
-    def quantity(self, value: Any, kind: str, *path, nonneg: bool = False) -> float:
+    def _units(self, parse, *args, **kwargs):
+        """``parse(*args, **kwargs)`` of :mod:`mechdyn.units`, its UnitError recorded."""
         try:
-            out = parse_quantity(value, kind, where=self.where(*path))
+            return parse(*args, **kwargs)
         except UnitError as exc:
             self.problem(str(exc))
             self.unit_problems.add(str(exc))
             raise _Failed from None
+
+    def quantity(self, value: Any, kind: str, *path, nonneg: bool = False) -> float:
+        out = self._units(parse_quantity, value, kind, where=self.where(*path))
         if nonneg and out < 0:
             self.problem(f"{self.where(*path)}: {value!r}: {path[-1]} must be >= 0 "
                          f"{KINDS[kind].si}")
@@ -109,12 +113,21 @@ class _Reader:
         return out
 
     def vector(self, value: Any, kind, *path, size: int | None = None) -> tuple[float, ...]:
-        try:
-            return parse_vector(value, kind, self.where(*path), size=size)
-        except UnitError as exc:
-            self.problem(str(exc))
-            self.unit_problems.add(str(exc))
-            raise _Failed from None
+        return self._units(parse_vector, value, kind, self.where(*path), size=size)
+
+    def points(self, raw: Any, *path, hint: str) -> dict[str, tuple[float, float]]:
+        """The named points of the table ``raw`` at ``path`` (m); ``"com"`` is reserved."""
+        pts = {}
+        for pname, val in (raw if isinstance(raw, dict) else {}).items():
+            if pname == "com" and not self.broken(*path, pname):
+                self.problem(f"{self.where(*path, pname)}: the point name 'com' is reserved{hint}")
+            if pname == "com" or self.broken(*path, pname):
+                self.failed = True
+                continue
+            xy = self.soft(self.vector, val, "length", *path, pname)
+            if xy is not None:
+                pts[pname] = xy
+        return pts
 
     def body_name(self, value: str, *path, ground_ok: bool = True) -> str:
         valid = [b for b in self.body_points if b != GROUND] + ([GROUND] if ground_ok else [])

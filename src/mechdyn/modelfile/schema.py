@@ -38,21 +38,13 @@ def _validator():
     return Draft202012Validator(schema())
 
 
+_TOML_TYPES = ((bool, "a boolean"), (int, "an integer"), (float, "a float"), (str, "a string"),
+               (dict, "a table"), (list, "an array"))
+
+
 def toml_type(value: Any) -> str:
     """How a value is called in TOML words (for messages)."""
-    if isinstance(value, bool):
-        return "a boolean"
-    if isinstance(value, int):
-        return "an integer"
-    if isinstance(value, float):
-        return "a float"
-    if isinstance(value, str):
-        return "a string"
-    if isinstance(value, dict):
-        return "a table"
-    if isinstance(value, list):
-        return "an array"
-    return type(value).__name__
+    return next((w for t, w in _TOML_TYPES if isinstance(value, t)), type(value).__name__)
 
 
 def _show(value: Any) -> str:
