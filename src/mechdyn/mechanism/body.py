@@ -13,9 +13,15 @@ from types import MappingProxyType
 
 import numpy as np
 
-__all__ = ["Body", "Ground", "GROUND"]
+__all__ = ["Body", "Ground", "GROUND", "unknown_point"]
 
 GROUND = "ground"
+
+
+def unknown_point(ref, body: str, valid) -> str:
+    """The message for a point ``ref`` that ``body``, with the point names ``valid``, lacks."""
+    return (f"unknown point {ref!r} of body {body!r}; valid point names: "
+            + ", ".join(repr(p) for p in valid))
 
 
 def _vec2(value, what: str) -> tuple[float, float]:

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import ModelError, did_you_mean
 from .assembly_mode import AssemblyMode
-from .body import GROUND, Body, Ground
+from .body import GROUND, Body, Ground, unknown_point
 from .coordinate import Coordinate, coordinate_problems
 from .joint import Joint, Lock, Prismatic, Revolute
 
@@ -168,18 +168,15 @@ class Mechanism:
 
         for j in self.joints.values():
             where = f"{type(j).__name__.lower()} joint {j.name!r}"
-            for role, bname in (("parent", j.parent), ("child", j.child)):
+            for role in ("parent", "child"):
+                bname, ref = getattr(j, role), getattr(j, f"{role}_point", None)
                 if bname not in names:
                     out.append(f"{where}: {role}: " + did_you_mean(bname, names, "body"))
+                elif isinstance(ref, str) and ref not in self.body(bname).point_names():
+                    out.append(f"{where}: {role}_point: "
+                               + unknown_point(ref, bname, self.body(bname).point_names()))
             if j.parent == j.child:
                 out.append(f"{where}: parent and child are the same body {j.parent!r}")
-            for role, bname, ref in self._point_refs(j):
-                if bname in names and isinstance(ref, str):
-                    body = self.body(bname)
-                    if ref not in body.point_names():
-                        out.append(f"{where}: {role}: unknown point {ref!r} of body "
-                                   f"{bname!r}; valid point names: "
-                                   + ", ".join(repr(p) for p in body.point_names()))
             if isinstance(j, Prismatic):
                 ax = np.asarray(j.axis, dtype=float)
                 if ax.shape != (2,) or not np.all(np.isfinite(ax)) or np.hypot(*ax) == 0:
@@ -197,9 +194,8 @@ class Mechanism:
                 if bname not in names:
                     out.append(f"{where}: " + did_you_mean(bname, names, "body"))
                 elif isinstance(ref, str) and ref not in self.body(bname).point_names():
-                    out.append(f"{where}: unknown point {ref!r} of body {bname!r}; valid "
-                               "point names: " + ", ".join(
-                                   repr(p) for p in self.body(bname).point_names()))
+                    out.append(f"{where}: "
+                               + unknown_point(ref, bname, self.body(bname).point_names()))
         if not self.bodies:
             out.append("the mechanism has no moving bodies")
         if not self.coordinates:
@@ -210,12 +206,6 @@ class Mechanism:
                 f"{self.n_equations} equations = {self.dof}, but {len(self.coordinates)} "
                 f"coordinate(s) are declared ({', '.join(self.coordinates)})")
         return out
-
-    @staticmethod
-    def _point_refs(j: Joint):
-        if isinstance(j, (Revolute, Prismatic)):
-            yield "parent_point", j.parent, j.parent_point
-            yield "child_point", j.child, j.child_point
 
     def validate(self) -> Mechanism:
         """Check the whole description and raise one :class:`ModelError` listing all problems.

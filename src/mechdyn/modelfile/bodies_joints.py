@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 from ..mechanism import GROUND, Body, Coordinate, Lock, Prismatic, Revolute
+from ..mechanism.body import unknown_point
 from ..mechanism.coordinate import coordinate_problems
 from .reader import _Failed, _Reader
 
@@ -38,9 +39,8 @@ class _BodiesJoints(_Reader):
             if fp is not None:
                 for k, pn in enumerate(fp):
                     if pn not in points:
-                        self.problem(f"{self.where(*P, 'frame_points')}[{k}]: unknown point "
-                                     f"{pn!r} of body {bname!r}; valid point names: "
-                                     + ", ".join(repr(p) for p in points))
+                        self.problem(f"{self.where(*P, 'frame_points')}[{k}]: "
+                                     + unknown_point(pn, bname, points))
                         self.failed = True
                 self.check()
                 (ox, oy), (x1, y1) = points[fp[0]], points[fp[1]]
@@ -63,9 +63,8 @@ class _BodiesJoints(_Reader):
         about = spec.get("inertia_about", "com")
         if about != "com" and not self.failed:
             if about not in points:
-                self.problem(f"{self.where(*P, 'inertia_about')}: unknown point {about!r} of "
-                             f"body {bname!r}; valid point names: "
-                             + ", ".join(repr(p) for p in ["com", *points]))
+                self.problem(f"{self.where(*P, 'inertia_about')}: "
+                             + unknown_point(about, bname, ["com", *points]))
                 raise _Failed
             d2 = (points[about][0] - com[0]) ** 2 + (points[about][1] - com[1]) ** 2
             jc = inertia - mass * d2
@@ -94,21 +93,14 @@ class _BodiesJoints(_Reader):
             return self.soft(self.point_ref, body, spec[key], *P, key, default=(0.0, 0.0))
 
         if spec["type"] == "revolute":
-            if "point" in spec:
-                both = spec["point"]
-                for role, body in (("parent_point", parent), ("child_point", child)):
-                    if role in spec:
-                        self.problem(f"{self.where(*P, role)}: give either 'point' or "
-                                     "'parent_point'/'child_point', not both")
-                        self.failed = True
-                    elif body is not None and both not in self.body_points.get(body, []):
-                        self.problem(f"{self.where(*P, 'point')}: unknown point {both!r} of "
-                                     f"body {body!r}; valid point names: "
-                                     + ", ".join(repr(p) for p in self.body_points[body]))
-                        self.failed = True
-                pp = cp = both
-            else:
-                pp, cp = ref(parent, "parent_point"), ref(child, "child_point")
+            both = "point" in spec  # one point name on both bodies
+            for role in ("parent_point", "child_point"):
+                if both and role in spec:
+                    self.problem(f"{self.where(*P, role)}: give either 'point' or "
+                                 "'parent_point'/'child_point', not both")
+                    self.failed = True
+            pp = ref(parent, "point" if both else "parent_point")
+            cp = ref(child, "point" if both else "child_point")
             self.check()
             return Revolute(jname, parent, child, pp, cp)
         if spec["type"] == "prismatic":

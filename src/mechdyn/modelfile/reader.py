@@ -14,7 +14,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from ..errors import UnitError, did_you_mean
-from ..mechanism import GROUND
+from ..mechanism.body import GROUND, unknown_point
 from ..units import KINDS, parse_quantity, parse_vector
 from .schema import locate
 
@@ -141,8 +141,7 @@ class _Reader:
         if isinstance(value, str) and not value.lstrip().startswith("("):
             names = self.body_points.get(body, [])
             if value not in names:
-                self.problem(f"{self.where(*path)}: unknown point {value!r} of body {body!r}; "
-                             "valid point names: " + ", ".join(repr(p) for p in names))
+                self.problem(f"{self.where(*path)}: " + unknown_point(value, body, names))
                 raise _Failed
             return value
         xy = self.vector(value, "length", *path)
