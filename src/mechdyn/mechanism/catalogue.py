@@ -101,13 +101,13 @@ class CatalogueEntry:
         return self.sources.get(fld, ("", "unknown"))[1]
 
 
-def _entry(designation, kw, slip, lam, start, j, conf, *, j_conf="unknown", rpm=None,
-           src=KRAVCHIK_1982, note=""):
+def _entry(designation, kw, slip, lam, start):
+    """A 4-pole motor of the 4A tables (confidence "medium"), rotor inertia not known."""
     fields = ("rated_power", "synchronous_rpm", "rated_slip", "breakdown_ratio",
               "starting_ratio")
-    sources = {f: (src, conf) for f in fields}
-    sources["rotor_inertia"] = (src if j is not None else "not known", j_conf)
-    return CatalogueEntry(designation, kw * 1e3, 1500.0, slip, lam, start, j, rpm, sources, note)
+    sources = {f: (KRAVCHIK_1982, "medium") for f in fields}
+    sources["rotor_inertia"] = ("not known", "unknown")
+    return CatalogueEntry(designation, kw * 1e3, 1500.0, slip, lam, start, None, None, sources)
 
 
 #: the motors, by designation
@@ -124,9 +124,9 @@ MOTORS: dict[str, CatalogueEntry] = {
         note="the motor of the source paper (press, METHOD.md §1). The slip 5.8 % gives "
              "1413 rpm; the quoted 1415 rpm is a rounded catalogue speed (slip 5.67 %). "
              "mechdyn uses the slip."),
-    "4A80A4U3": _entry("4A80A4U3", 1.1, 0.054, 2.2, 2.0, None, "medium"),
-    "4A90L4U3": _entry("4A90L4U3", 2.2, 0.051, 2.4, 2.1, None, "medium"),
-    "4A100S4U3": _entry("4A100S4U3", 3.0, 0.044, 2.4, 2.0, None, "medium"),
+    "4A80A4U3": _entry("4A80A4U3", 1.1, 0.054, 2.2, 2.0),
+    "4A90L4U3": _entry("4A90L4U3", 2.2, 0.051, 2.4, 2.1),
+    "4A100S4U3": _entry("4A100S4U3", 3.0, 0.044, 2.4, 2.0),
 }
 
 

@@ -84,13 +84,6 @@ def _floats(obj, *names):
             object.__setattr__(obj, name, float(getattr(obj, name)))
 
 
-def _torque_through_gear(m_motor, omega_driven, ratio, efficiency):
-    """Driven-side torque of a stage: losses always oppose the power flow."""
-    m = np.asarray(m_motor, dtype=float)
-    forward = m * np.asarray(omega_driven, dtype=float) >= 0.0  # power flows motor -> machine
-    return np.where(forward, efficiency * ratio * m, ratio * m / efficiency)
-
-
 # ---------------------------------------------------------------------- induction motor
 def kloss_critical_slip(rated_slip: float, breakdown_ratio: float) -> float:
     """Critical slip of Kloss's formula through the rated point.
@@ -159,8 +152,8 @@ def fit_extended_kloss(rated_slip: float, breakdown_ratio: float,
         q = _extended_q(sn, mu_n, sk)
         if q > -1.0 + 1e-12:
             roots.append((sk, q / sk))
+    sk_k = kloss_critical_slip(sn, lam)
     if not roots:
-        sk_k = kloss_critical_slip(sn, lam)
         m1 = 2 * lam / (1.0 / sk_k + sk_k)
         raise ModelError(
             f"no extended Kloss curve M = 2 M_k (1 + a s_k)/(s/s_k + s_k/s + 2 a s_k) passes "
@@ -169,7 +162,6 @@ def fit_extended_kloss(rated_slip: float, breakdown_ratio: float,
             f"s_n < s_k < 1 (Kloss's formula gives M_start = {m1:.4g} M_n); use "
             f"characteristic = 'kloss' or check the catalogue data")
     # several admissible roots are not expected; take the one closest to Kloss's s_k
-    sk_k = kloss_critical_slip(sn, lam)
     sk, a = min(roots, key=lambda r: abs(r[0] - sk_k))
     return float(sk), float(a)
 
@@ -545,10 +537,12 @@ class GearStage:
     def torque_at(self, omega):
         """Torque on the driven coordinate (N m) at its speed ``omega`` (rad/s)."""
         m = self.motor_torque(omega)
+        eta, i = self.efficiency, self.ratio  # the losses always oppose the power flow
         if isinstance(omega, float) and isinstance(m, float):
-            eta, i = self.efficiency, self.ratio
             return eta * i * m if m * omega >= 0.0 else i * m / eta
-        return _out(_torque_through_gear(m, omega, self.ratio, self.efficiency))
+        m = np.asarray(m, dtype=float)
+        forward = m * np.asarray(omega, dtype=float) >= 0.0  # power flows motor -> machine
+        return _out(np.where(forward, eta * i * m, i * m / eta))
 
     def extra_inertia(self) -> float:
         """``(J_motor + J_input) i^2 + J_output``, kg m^2, on the driven coordinate."""
