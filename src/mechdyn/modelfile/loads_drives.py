@@ -16,7 +16,6 @@ from ..errors import ModelError, UnitError, did_you_mean
 from ..mechanism import GROUND
 from ..mechanism.drive import Drive, TorqueSpeedCurve
 from ..mechanism.load import Force, RotarySpring, Spring, Table, Torque, pulse
-from ..model.variable import parse
 from .drives import drive_from_table
 from .reader import _Failed, _Reader
 
@@ -28,38 +27,6 @@ _LOAD_REQUIRED = {"spring": ("body1", "point1", "body2", "point2"),
 
 class _LoadsDrives(_Reader):
     """Reads the elements of the ``[[loads]]`` and ``[[drives]]`` tables."""
-
-    # ------------------------------------------------------------ loads and drives
-    def variable_kind(self, var: str, *path) -> str:
-        """Kind of quantity of a table's variable (:func:`mechdyn.model.variable.parse`):
-        time, a coordinate or its rate, a joint, an angle, a point coordinate, a distance."""
-        try:
-            v = parse(var, self.coord_kinds)
-        except ModelError:
-            valid = ["t", *self.coord_kinds, *(f"{c}_dot" for c in self.coord_kinds),
-                     "joint:NAME", "angle:BODY", "BODY.POINT.x", "BODY.POINT.y",
-                     "dist(BODY.POINT, BODY.POINT)"]
-            self.problem(f"{self.where(*path)}: {var!r}: unknown variable; valid variables: "
-                         + ", ".join(repr(v) for v in valid))
-            raise _Failed from None
-        if v.kind == "time":
-            return "time"
-        if v.kind == "coordinate":
-            return self.coord_value_kind(v.name, v.rate)
-        if v.kind == "joint":
-            kinds = {"revolute": "angle", "prismatic": "length"}
-            if self.joint_types.get(v.name) not in kinds:
-                self.problem(f"{self.where(*path)}: {var!r}: " + did_you_mean(
-                    v.name, [j for j, t in self.joint_types.items() if t in kinds],
-                    "revolute or prismatic joint"))
-                raise _Failed
-            return kinds[self.joint_types[v.name]]
-        if v.kind == "angle":
-            self.body_name(v.name, *path)
-            return "angle"
-        for body, point in v.points:
-            self.point_ref(self.body_name(body, *path), point, *path)
-        return "length"
 
     def value(self, raw: Any, kind: str, *path):
         """A constant, a ``{x, y, variable}`` table or a ``{pulse, start, duration}`` pulse

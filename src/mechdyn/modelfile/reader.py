@@ -13,8 +13,9 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from ..errors import UnitError, did_you_mean
+from ..errors import ModelError, UnitError, did_you_mean
 from ..mechanism.body import GROUND, unknown_point
+from ..model.variable import parse
 from ..units import KINDS, parse_quantity, parse_vector
 from .schema import locate
 
@@ -171,6 +172,40 @@ class _Reader:
         th = self.sketch_frames.get(body, (0.0, 0.0, 0.0))[2]
         c, s = math.cos(th), math.sin(th)
         return (c * d[0] + s * d[1], -s * d[0] + c * d[1])
+
+    def variable_kind(self, var, *path) -> str:
+        """Kind of quantity of a table's variable (:func:`mechdyn.model.variable.parse`):
+        time, a coordinate or its rate, a joint, an angle, a point coordinate, a distance."""
+        if not isinstance(var, str):
+            self.problem(f"{self.where(*path)}: expected a variable name (string), got {var!r}")
+            raise _Failed
+        try:
+            v = parse(var, self.coord_kinds)
+        except ModelError:
+            valid = ["t", *self.coord_kinds, *(f"{c}_dot" for c in self.coord_kinds),
+                     "joint:NAME", "angle:BODY", "BODY.POINT.x", "BODY.POINT.y",
+                     "dist(BODY.POINT, BODY.POINT)"]
+            self.problem(f"{self.where(*path)}: {var!r}: unknown variable; valid variables: "
+                         + ", ".join(repr(v) for v in valid))
+            raise _Failed from None
+        if v.kind == "time":
+            return "time"
+        if v.kind == "coordinate":
+            return self.coord_value_kind(v.name, v.rate)
+        if v.kind == "joint":
+            kinds = {"revolute": "angle", "prismatic": "length"}
+            if self.joint_types.get(v.name) not in kinds:
+                self.problem(f"{self.where(*path)}: {var!r}: " + did_you_mean(
+                    v.name, [j for j, t in self.joint_types.items() if t in kinds],
+                    "revolute or prismatic joint"))
+                raise _Failed
+            return kinds[self.joint_types[v.name]]
+        if v.kind == "angle":
+            self.body_name(v.name, *path)
+            return "angle"
+        for body, point in v.points:
+            self.point_ref(self.body_name(body, *path), point, *path)
+        return "length"
 
     def section(self, key: str, kind: type = dict):
         val = self.doc.get(key, kind())

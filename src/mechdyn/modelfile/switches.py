@@ -47,7 +47,7 @@ every problem found (it never raises for a problem of the file); the private
 
 from __future__ import annotations
 
-from ..errors import ModelError, did_you_mean
+from ..errors import did_you_mean
 from ..mechanism import Lock
 from ..mechanism.contact import Contact, Stop
 from ..mechanism.switch import GUARD_OPERATORS, SWITCH_ACTIONS, CoordinateLock, Switch
@@ -120,6 +120,8 @@ class _Switches(_Reader):
         super().__init__(doc, fname, ())
         self.mech = mech
         self.body_points = {n: b.point_names() for n, b in mech.all_bodies.items()}
+        self.joint_types = {n: type(j).__name__.lower() for n, j in mech.joints.items()}
+        self.coord_kinds = {n: c.kind for n, c in mech.coordinates.items()}
 
     def entries(self, table: str):
         """(index, entry) of each named entry of ``table``; unknown keys are problems."""
@@ -142,16 +144,8 @@ class _Switches(_Reader):
             yield (table, k), e
 
     def kind_of(self, var, *path) -> str | None:
-        """The quantity kind of a variable string (see :func:`variable_kind`)."""
-        if not isinstance(var, str):
-            self.problem(f"{self.where(*path)}: expected a variable name (string), got {var!r}")
-        else:
-            try:
-                return variable_kind(self.mech, var)
-            except ModelError as exc:
-                self.problem(f"{self.where(*path)}: {exc}")
-        self.failed = True
-        return None
+        """The quantity kind of a variable string; None if it has a problem (recorded)."""
+        return self.soft(self.variable_kind, var, *path)
 
     def add(self, cls, path: tuple, *args, **kwargs):
         """File ``cls(*args, **kwargs)`` in ``mech.extras``; its own check is a problem."""
