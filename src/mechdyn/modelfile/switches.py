@@ -1,48 +1,11 @@
 """Model-file tables of variable-structure elements: locks, stops, contacts, switches.
 
-The tables (arrays of tables, one entry per element; quantities with units)::
-
-    [[coordinate_locks]]           # a lock holding one measured quantity
-    name = "rocker_lock"
-    variable = "joint:C"           # coordinate, joint:NAME, angle:BODY, body.point.x|y
-    engaged = false                # default false
-    value = "0 deg"                # optional; default: the value when it engages
-    frees = ["psi"]                # optional: coordinates it makes dependent
-
-    [[stops]]
-    name = "ram_stop"
-    variable = "joint:guide"
-    upper = "28 mm"                # lower and/or upper
-    restitution = 0.2              # default 0 (plastic)
-
-    [[contacts]]
-    name = "piston_on_ram"
-    body = "piston"
-    point = [0, 0]                 # or a point name of the body
-    line_body = "slider"
-    line_point = "ear"             # default [0, 0]
-    line_direction = [0, -1]       # free side to the left of the direction
-    friction = 0.0                 # Coulomb mu
-    restitution = 0.0
-    compliance = 0.0               # (m/s^2)/N, regularizes indeterminate contact sets
-
-    [[switches]]
-    name = "lock_on"
-    action = "engage"              # engage | release | toggle
-    target = "rocker_lock"         # a [joints.X] lock or a [[coordinate_locks]] entry
-    variable = "psi"               # a crossing: variable, value, direction ...
-    value = "0 deg"
-    direction = "rising"           # rising | falling | both
-    guard = [["joint:guide", "<", "24.5 mm"]]
-    # times = ["0.1 s", "0.5 s"]   # ... or a command schedule instead of a crossing
-    once = false
-
-Values of ``value``, limits and guards carry the unit of their variable (an
-angle for angle coordinates and revolute joints, a length for travels and point
-coordinates, a time for ``t``, a speed for ``_dot`` rates).  A bare number is
-SI.  :func:`parse_switches` adds the elements to ``mech.extras`` and returns
-every problem found (it never raises for a problem of the file); the private
-:class:`_Switches` reads them on the loader's :class:`~.reader._Reader`.
+The four arrays of tables ``[[coordinate_locks]]``, ``[[stops]]``, ``[[contacts]]``
+and ``[[switches]]``, their keys and units are described in ``docs/model-file.md``
+("Switchable elements").  :func:`parse_switches` adds the elements to
+``mech.extras`` and returns every problem found (it never raises for a problem of
+the file); the private :class:`_Switches` reads them on the loader's
+:class:`~.reader._Reader`.
 """
 
 from __future__ import annotations
