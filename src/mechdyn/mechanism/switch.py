@@ -128,19 +128,20 @@ class Switch:
         """True for a command schedule (``times``), False for a crossing condition."""
         return self.variable is None
 
-    def problems(self) -> list[str]:
-        """Problems that can be found without the mechanism."""
+    def problems(self, where=None) -> list[str]:
+        """Problems that can be found without the mechanism; ``where(key)`` names the
+        place of a key in the messages (default ``"switch 'NAME': key"``)."""
+        where = where or (lambda key: f"switch {self.name!r}" + (f": {key}" if key else ""))
         out = []
-        where = f"switch {self.name!r}"
         if self.action not in SWITCH_ACTIONS:
-            out.append(f"{where}: action must be one of {', '.join(SWITCH_ACTIONS)}, "
+            out.append(f"{where('action')}: must be one of {', '.join(SWITCH_ACTIONS)}, "
                        f"got {self.action!r}")
         if (self.variable is None) == (not self.times):
-            out.append(f"{where}: give either a crossing 'variable' (with 'value' and "
+            out.append(f"{where('')}: give either a crossing 'variable' (with 'value' and "
                        "'direction') or a list of command 'times', not both or neither")
         for var, op, _ in self.guard:
             if op not in GUARD_OPERATORS:
-                out.append(f"{where}: guard on {var!r}: operator must be one of "
+                out.append(f"{where('guard')}: {var!r}: operator must be one of "
                            f"{', '.join(GUARD_OPERATORS)}, got {op!r}")
         return out
 

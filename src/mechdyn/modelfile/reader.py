@@ -148,13 +148,10 @@ class _Reader:
         xy = self.vector(value, "length", *path)
         return self.to_body_frame(body, xy)
 
-    def to_body_frame(self, body: str, xy) -> tuple[float, float]:
-        """Coordinates given in a body's input frame -> its body frame."""
-        fr = self.sketch_frames.get(body)
-        if fr is None:
-            return (float(xy[0]), float(xy[1]))
-        ox, oy, th = fr
-        dx, dy = xy[0] - ox, xy[1] - oy
+    def to_body_frame(self, body: str, xy, origin: bool = True) -> tuple[float, float]:
+        """Coordinates (a direction, without ``origin``) in a body's input frame -> its frame."""
+        ox, oy, th = self.sketch_frames.get(body, (0.0, 0.0, 0.0))
+        dx, dy = (float(xy[0]) - ox, float(xy[1]) - oy) if origin else xy
         c, s = math.cos(th), math.sin(th)
         return (c * dx + s * dy, -s * dx + c * dy)
 
@@ -162,16 +159,12 @@ class _Reader:
         """A direction: [x, y] numbers or an angle string, in the body's input frame."""
         if isinstance(value, str):
             a = self.quantity(value, "angle", *path)
-            d = (math.cos(a), math.sin(a))
-        else:
-            d = (float(value[0]), float(value[1]))
-            if not all(math.isfinite(v) for v in d) or math.hypot(*d) == 0:
-                self.problem(f"{self.where(*path)}: {value!r}: must be a non-zero direction "
-                             "[x, y]")
-                raise _Failed
-        th = self.sketch_frames.get(body, (0.0, 0.0, 0.0))[2]
-        c, s = math.cos(th), math.sin(th)
-        return (c * d[0] + s * d[1], -s * d[0] + c * d[1])
+            return self.to_body_frame(body, (math.cos(a), math.sin(a)), origin=False)
+        d = (float(value[0]), float(value[1]))
+        if not all(math.isfinite(v) for v in d) or math.hypot(*d) == 0:
+            self.problem(f"{self.where(*path)}: {value!r}: must be a non-zero direction [x, y]")
+            raise _Failed
+        return self.to_body_frame(body, d, origin=False)
 
     def variable_kind(self, var, *path) -> str:
         """Kind of quantity of a table's variable (:func:`mechdyn.model.variable.parse`):

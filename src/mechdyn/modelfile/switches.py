@@ -13,7 +13,7 @@ from __future__ import annotations
 from ..errors import did_you_mean
 from ..mechanism import Lock
 from ..mechanism.contact import Contact, Stop
-from ..mechanism.switch import GUARD_OPERATORS, SWITCH_ACTIONS, CoordinateLock, Switch
+from ..mechanism.switch import CoordinateLock, Switch
 from ..model.variable import parse, quantity
 from .reader import _Reader
 
@@ -168,34 +168,20 @@ class _Switches(_Reader):
         locks = {n for n, j in mech.joints.items() if isinstance(j, Lock)} | {
             c.name for c in mech.extras.get("coordinate_locks", [])}
         for P, e in self.entries("switches"):
-            action, target, var = e.get("action"), e.get("target"), e.get("variable")
-            if action not in SWITCH_ACTIONS:
-                self.problem(f"{self.where(*P, 'action')}: must be one of "
-                             f"{', '.join(SWITCH_ACTIONS)}, got {action!r}")
-                self.failed = True
+            target, var, dval = e.get("target"), e.get("variable"), e.get("direction", "both")
             if target not in locks:
                 self.problem(f"{self.where(*P, 'target')}: "
                              + did_you_mean(str(target), locks, "lock"))
                 self.failed = True
-            value, direction, times = 0.0, 0, ()
-            if (var is None) == ("times" not in e):
-                self.problem(f"{self.where(*P)}: give either 'variable' (with 'value' "
-                             "and 'direction') or 'times'")
+            kd = self.kind_of(var, *P, "variable") if var is not None else None
+            value = self.opt(e, "value", kd, *P) if kd is not None else 0.0
+            if dval not in _DIRECTIONS:
+                self.problem(f"{self.where(*P, 'direction')}: must be 'rising', "
+                             f"'falling' or 'both', got {dval!r}")
                 self.failed = True
-            elif var is not None:
-                kd = self.kind_of(var, *P, "variable")
-                if kd is not None:
-                    value = self.opt(e, "value", kd, *P)
-                dval = e.get("direction", "both")
-                if dval not in _DIRECTIONS:
-                    self.problem(f"{self.where(*P, 'direction')}: must be 'rising', "
-                                 f"'falling' or 'both', got {dval!r}")
-                    self.failed = True
-                else:
-                    direction = _DIRECTIONS[dval]
-            else:
-                raw = e["times"] if isinstance(e["times"], list) else [e["times"]]
-                times = tuple(self.soft(self.quantity, v, "time", *P, "times") for v in raw)
+            times = e.get("times", [])
+            times = [self.soft(self.quantity, t, "time", *P, "times")
+                     for t in (times if isinstance(times, list) else [times])]
             guards = []
             for g in e.get("guard", []):
                 if not (isinstance(g, list) and len(g) == 3):
@@ -204,12 +190,13 @@ class _Switches(_Reader):
                     self.failed = True
                     continue
                 kd = self.kind_of(g[0], *P, "guard")
-                if g[1] not in GUARD_OPERATORS:
-                    self.problem(f"{self.where(*P, 'guard')}: operator must be one of "
-                                 f"{', '.join(GUARD_OPERATORS)}, got {g[1]!r}")
-                    self.failed = True
-                if kd is not None:
-                    guards.append((g[0], g[1], self.soft(self.quantity, g[2], kd, *P, "guard")))
+                gv = self.soft(self.quantity, g[2], kd, *P, "guard") if kd is not None else None
+                guards.append((g[0], g[1], 0.0 if gv is None else gv))
+            sw = Switch(e["name"], e.get("action"), target, var, value,
+                        _DIRECTIONS.get(dval, 0), [t for t in times if t is not None],
+                        tuple(guards), bool(e.get("once", False)))
+            for p in sw.problems(lambda key, P=P: self.where(*P, key)):
+                self.problem(p)
+                self.failed = True
             if not self.failed:
-                self.add(Switch, P, e["name"], action, target, var, value, direction, times,
-                         tuple(guards), bool(e.get("once", False)))
+                self.mech.extras.setdefault("switches", []).append(sw)
