@@ -27,8 +27,7 @@ GearStage
 
 :func:`mechdyn.modelfile.drives.drive_from_table` builds a
 :class:`~mechdyn.mechanism.drive.Drive` with one of these from a model-file
-``[[drives]]`` table (see ``docs/reduction-and-drives.md``); the name is still
-importable from this module.
+``[[drives]]`` table (see ``docs/reduction-and-drives.md``).
 """
 
 from __future__ import annotations

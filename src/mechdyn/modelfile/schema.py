@@ -107,10 +107,6 @@ def _property_hint(sch: dict, key: str) -> str:
     return ""
 
 
-def _valid_keys(sch: dict) -> list[str]:
-    return [k for k in sch.get("properties", {})]
-
-
 def _message(err, fname: str, doc: Any) -> str:
     path = list(err.absolute_path)
     where = locate(fname, path, doc)
@@ -122,7 +118,7 @@ def _message(err, fname: str, doc: Any) -> str:
         what = "table" if not path else "key"
         return f"{where}: missing {what} {key!r}{_property_hint(err.schema, key)}"
     if v == "additionalProperties":
-        valid = _valid_keys(err.schema)
+        valid = list(err.schema.get("properties", {}))
         extra = [k for k in inst if k not in valid] if isinstance(inst, dict) else []
         what = "table" if not path else "key"
         names = ", ".join(repr(k) for k in extra) or "?"
