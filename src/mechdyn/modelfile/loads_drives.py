@@ -35,16 +35,12 @@ class _LoadsDrives(_Reader):
             return self.quantity(raw, kind, *path)
         var = raw.get("variable", "t")
         vkind = self.variable_kind(var, *path, "variable")
-        period, bad_period = None, False
-        if "period" in raw:
-            try:
-                period = self.quantity(raw["period"], vkind, *path, "period")
-            except _Failed:
-                bad_period = True
-            if period is not None and not period > 0:
-                self.problem(f"{self.where(*path, 'period')}: the period of the table over "
-                             f"{var!r} must be > 0, got {raw['period']!r}")
-                period, bad_period = None, True
+        period = self.opt(raw, "period", vkind, *path, default=None)
+        bad_period = "period" in raw and period is None
+        if period is not None and not period > 0:
+            self.problem(f"{self.where(*path, 'period')}: the period of the table over "
+                         f"{var!r} must be > 0, got {raw['period']!r}")
+            period, bad_period = None, True
         if "pulse" in raw:
             mag = self.quantity(raw["pulse"], kind, *path, "pulse")
             start = self.quantity(raw["start"], vkind, *path, "start")
@@ -63,9 +59,8 @@ class _LoadsDrives(_Reader):
                 raise _Failed
             return pulse(mag, start, dur, var, ramp, period)
         xs, ys = self.columns(raw, (("x", vkind), ("y", kind)), *path)
-        outside = None
-        if "outside" in raw:
-            outside = self.quantity(raw["outside"], kind, *path, "outside")
+        outside = (self.quantity(raw["outside"], kind, *path, "outside")
+                   if "outside" in raw else None)
         if bad_period or xs is None:
             raise _Failed
         if period is not None and len(xs) >= 2 and period < (xs[-1] - xs[0]) * (1 - 1e-12):
