@@ -164,30 +164,15 @@ class _Builder(_BodiesJoints, _LoadsDrives):
         if initial["q"] or initial["qdot"]:
             mech.extras["initial"] = initial
 
-        names: set[str] = set()
-        for section in ("loads", "drives"):
-            for k, spec in enumerate(self.section(section, list)):
-                if not isinstance(spec, dict):
-                    continue
-                if section == "loads" and ("type" not in spec
-                                           or self.broken(section, k, "type")):
-                    continue
-                try:
-                    if section == "loads":
-                        el = self.element(self.load, (section, k), spec,
-                                          _LOAD_REQUIRED.get(spec["type"], ()))
-                    else:
-                        el = self.element(self.drive, (section, k), spec,
-                                          ("coordinate", "type") if "type" in spec
-                                          else ("coordinate", "torque"))
-                except _Failed:
-                    continue
-                if el.name in names:
-                    self.problem(f"{self.where(section, k)}: name {el.name!r} is used by another "
-                                 "load or drive")
-                    continue
-                names.add(el.name)
-                mech.add(el)
+        names: set[str] = set()  # of the loads and drives
+        for k, spec in enumerate(self.section("loads", list)):
+            if isinstance(spec, dict) and "type" in spec and not self.broken("loads", k, "type"):
+                self.add(mech, self.load, ("loads", k), spec,
+                         _LOAD_REQUIRED.get(spec["type"], ()), names)
+        for k, spec in enumerate(self.section("drives", list)):
+            if isinstance(spec, dict):
+                self.add(mech, self.drive, ("drives", k), spec,
+                         ("coordinate", "type" if "type" in spec else "torque"), names)
         for k, spec in enumerate(self.section("assembly", list)):
             if isinstance(spec, dict) and not self.broken("assembly", k):
                 self.assembly_mode(mech, k, spec)
@@ -196,12 +181,19 @@ class _Builder(_BodiesJoints, _LoadsDrives):
                 self.problem(p)
         return mech
 
-    def add(self, mech: Mechanism, read, path: tuple, spec, required: tuple):
-        """Add the element ``read`` builds from the table ``spec`` (see :meth:`element`)."""
-        if isinstance(spec, dict):
-            el = self.soft(self.element, read, path, spec, required)
-            if el is not None:
-                mech.add(el)
+    def add(self, mech: Mechanism, read, path: tuple, spec, required: tuple,
+            names: set[str] | None = None):
+        """Add the element ``read`` builds from the table ``spec`` (see :meth:`element`);
+        ``names``: those taken by the loads and drives, which must differ."""
+        el = (self.soft(self.element, read, path, spec, required)
+              if isinstance(spec, dict) else None)
+        if el is not None and names is not None and el.name in names:
+            self.problem(f"{self.where(*path)}: name {el.name!r} is used by another load or "
+                         "drive")
+        elif el is not None:
+            mech.add(el)
+            if names is not None:
+                names.add(el.name)
 
     def initial(self, section: str, rate: bool) -> dict[str, float]:
         """The SI values by coordinate name of ``[initial]`` or ``[initial_speed]``."""
