@@ -114,12 +114,9 @@ def _entry(designation, kw, slip, lam, start):
 MOTORS: dict[str, CatalogueEntry] = {
     "4A80B4U3": CatalogueEntry(
         "4A80B4U3", 1500.0, 1500.0, 0.058, 2.2, 2.0, 0.0033, 1415.0,
-        {"rated_power": (_BRIEF, "stated"),
-         "synchronous_rpm": (_BRIEF, "stated"),
-         "rated_slip": (_BRIEF, "stated"),
-         "quoted_rated_rpm": (_BRIEF, "stated"),
-         "breakdown_ratio": (_BRIEF, "stated"),
-         "starting_ratio": (_BRIEF, "stated"),
+        {**{f: (_BRIEF, "stated") for f in ("rated_power", "synchronous_rpm", "rated_slip",
+                                            "quoted_rated_rpm", "breakdown_ratio",
+                                            "starting_ratio")},
          "rotor_inertia": ("estimate of about 0.0033 kg m^2 (task brief)", "unconfirmed")},
         note="the motor of the source paper (press, METHOD.md §1). The slip 5.8 % gives "
              "1413 rpm; the quoted 1415 rpm is a rounded catalogue speed (slip 5.67 %). "

@@ -149,10 +149,8 @@ def punch_load(name: str, body: str, point, magnitude: float, *, end: float,
     """
     win = StrokeWindow(float(magnitude), body, point, float(end), float(travel), coordinate,
                        int(towards), bool(approaching_only), float(ramp))
-    k = _AXES[coordinate]
-    d = [0.0, 0.0]
-    d[k] = -float(towards)
-    return Force(name, body, point, win, tuple(d), "ground")
+    d = (0.0, -float(towards)) if coordinate == "y" else (-float(towards), 0.0)
+    return Force(name, body, point, win, d, "ground")
 
 
 def position_load(name: str, body: str, point, positions, values, *, coordinate: str = "y",
