@@ -83,6 +83,14 @@ def _floats(obj, *names):
             object.__setattr__(obj, name, float(getattr(obj, name)))
 
 
+class _DirectDrive:
+    """A motor on the driven shaft itself: it adds its ``rotor_inertia``."""
+
+    def extra_inertia(self) -> float:
+        """Rotor inertia added to the driven coordinate, kg m^2 (direct drive)."""
+        return float(self.rotor_inertia)
+
+
 # ---------------------------------------------------------------------- induction motor
 def kloss_critical_slip(rated_slip: float, breakdown_ratio: float) -> float:
     """Critical slip of Kloss's formula through the rated point.
@@ -166,7 +174,7 @@ def fit_extended_kloss(rated_slip: float, breakdown_ratio: float,
 
 
 @dataclass(frozen=True)
-class InductionMotor:
+class InductionMotor(_DirectDrive):
     """A squirrel-cage induction motor from catalogue data.
 
     Parameters
@@ -314,14 +322,10 @@ class InductionMotor:
         """Shaft torque (N m) at shaft speed ``omega`` (rad/s); scalar or array."""
         return self.torque_at_slip(self.slip(omega))
 
-    def extra_inertia(self) -> float:
-        """Rotor inertia added to the driven coordinate, kg m^2 (direct drive)."""
-        return self.rotor_inertia
-
 
 # ---------------------------------------------------------------------- DC motor
 @dataclass(frozen=True)
-class DCMotor:
+class DCMotor(_DirectDrive):
     """A separately excited DC motor: ``M = M_stall (1 - omega / omega_0)``.
 
     Parameters
@@ -368,10 +372,6 @@ class DCMotor:
     def torque_at(self, omega):
         """Shaft torque (N m) at shaft speed ``omega`` (rad/s)."""
         return _out(self.stall_torque * (1.0 - np.asarray(omega, float) / self.no_load_speed))
-
-    def extra_inertia(self) -> float:
-        """Rotor inertia added to the driven coordinate, kg m^2."""
-        return float(self.rotor_inertia)
 
 
 # ---------------------------------------------------------------------- ideal drive
@@ -422,7 +422,7 @@ class ConstantSpeedDrive:
 
 # ---------------------------------------------------------------------- table
 @dataclass(frozen=True)
-class TabulatedMotor:
+class TabulatedMotor(_DirectDrive):
     """A mechanical characteristic M(omega) from a table, linearly interpolated.
 
     Parameters
@@ -473,10 +473,6 @@ class TabulatedMotor:
             out = np.where(om < w[0], m[0] + lo * (om - w[0]), out)
             out = np.where(om > w[-1], m[-1] + hi * (om - w[-1]), out)
         return _out(out)
-
-    def extra_inertia(self) -> float:
-        """Rotor inertia, kg m^2."""
-        return float(self.rotor_inertia)
 
 
 # ---------------------------------------------------------------------- gear stage
