@@ -310,13 +310,10 @@ class InductionMotor(_DirectDrive):
         """Electromagnetic torque at slip ``s`` (N m), written without the pole at s = 0:
         ``M = 2 M_k (1 + a s_k) s s_k / (s^2 + s_k^2 + 2 a s_k^2 s)``."""
         sk, a = self.critical_slip, self.a
-        if isinstance(s, float):  # fast path for the integrators' scalar calls
-            return (2.0 * self.breakdown_torque * (1.0 + a * sk) * s * sk
-                    / (s * s + sk * sk + 2.0 * a * sk * sk * s))
-        s = np.asarray(s, dtype=float)
-        num = 2.0 * self.breakdown_torque * (1.0 + a * sk) * s * sk
-        den = s * s + sk * sk + 2.0 * a * sk * sk * s
-        return _out(num / den)
+        x = s if isinstance(s, float) else np.asarray(s, dtype=float)  # floats: the fast path
+        m = (2.0 * self.breakdown_torque * (1.0 + a * sk) * x * sk
+             / (x * x + sk * sk + 2.0 * a * sk * sk * x))
+        return m if isinstance(s, float) else _out(m)
 
     def torque_at(self, omega):
         """Shaft torque (N m) at shaft speed ``omega`` (rad/s); scalar or array."""
