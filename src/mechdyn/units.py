@@ -233,10 +233,8 @@ def parse_vector(value: Any, kind: str | Sequence[str], where: str = "",
     UnitError
         Wrong number of components, or any component as in :func:`parse_quantity`.
     """
-    kinds = [kind] if isinstance(kind, str) else list(kind)
-    n = size if size is not None else (len(kinds) if not isinstance(kind, str) else 2)
-    if isinstance(kind, str):
-        kinds = [kind] * n
+    kinds = [kind] * (size or 2) if isinstance(kind, str) else list(kind)
+    n = size or len(kinds)
     names = ", ".join(dict.fromkeys(KINDS[k].name for k in kinds))
     example = "[" + ", ".join(KINDS[k].example.split(" or ")[0] for k in kinds) + "]"
     prefix = f"{where}: " if where else ""

@@ -13,9 +13,15 @@ from types import MappingProxyType
 
 import numpy as np
 
-__all__ = ["Body", "Ground", "GROUND"]
+__all__ = ["Body", "Ground", "GROUND", "unknown_point"]
 
 GROUND = "ground"
+
+
+def unknown_point(ref, body: str, valid) -> str:
+    """The message for a point ``ref`` that ``body``, with the point names ``valid``, lacks."""
+    return (f"unknown point {ref!r} of body {body!r}; valid point names: "
+            + ", ".join(repr(p) for p in valid))
 
 
 def _vec2(value, what: str) -> tuple[float, float]:
@@ -67,11 +73,6 @@ class Body:
         object.__setattr__(self, "mass", float(self.mass))
         object.__setattr__(self, "inertia", float(self.inertia))
 
-    @property
-    def is_ground(self) -> bool:
-        """True for the fixed frame."""
-        return False
-
     def point(self, name: str) -> tuple[float, float]:
         """Coordinates of a named point in the body frame (``"com"`` is the centre of mass)."""
         if name == "com":
@@ -81,13 +82,6 @@ class Body:
     def point_names(self) -> list[str]:
         """Names of the points of this body, ``"com"`` included."""
         return ["com", *self.points]
-
-    def sketch_point(self, name: str) -> tuple[float, float]:
-        """Where a named point is in the initial sketch (ground frame), m."""
-        sx, sy = self.point(name)
-        x, y, th = self.pose
-        c, s = np.cos(th), np.sin(th)
-        return (x + c * sx - s * sy, y + s * sx + c * sy)
 
 
 @dataclass(frozen=True)
@@ -99,7 +93,3 @@ class Ground(Body):
     def __post_init__(self):
         super().__post_init__()
         object.__setattr__(self, "pose", (0.0, 0.0, 0.0))
-
-    @property
-    def is_ground(self) -> bool:
-        return True

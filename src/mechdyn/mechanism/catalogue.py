@@ -79,9 +79,10 @@ class CatalogueEntry:
     sources: dict = field(default_factory=dict)
     note: str = ""
 
-    def motor_kwargs(self) -> dict:
-        """Keyword arguments of :class:`~mechdyn.mechanism.motors.InductionMotor` (SI)."""
-        if self.rotor_inertia is None:
+    def motor_kwargs(self, warn: bool = True) -> dict:
+        """Keyword arguments of :class:`~mechdyn.mechanism.motors.InductionMotor` (SI);
+        ``warn``: warn when the rotor inertia is not in the catalogue (taken as 0)."""
+        if self.rotor_inertia is None and warn:
             warnings.warn(f"motor {self.designation}: the rotor inertia is not in the "
                           f"catalogue; it is taken as 0 - give rotor_inertia", stacklevel=3)
         return {"rated_power": self.rated_power,
@@ -100,32 +101,29 @@ class CatalogueEntry:
         return self.sources.get(fld, ("", "unknown"))[1]
 
 
-def _entry(designation, kw, slip, lam, start, j, conf, *, j_conf="unknown", rpm=None,
-           src=KRAVCHIK_1982, note=""):
+def _entry(designation, kw, slip, lam, start):
+    """A 4-pole motor of the 4A tables (confidence "medium"), rotor inertia not known."""
     fields = ("rated_power", "synchronous_rpm", "rated_slip", "breakdown_ratio",
               "starting_ratio")
-    sources = {f: (src, conf) for f in fields}
-    sources["rotor_inertia"] = (src if j is not None else "not known", j_conf)
-    return CatalogueEntry(designation, kw * 1e3, 1500.0, slip, lam, start, j, rpm, sources, note)
+    sources = {f: (KRAVCHIK_1982, "medium") for f in fields}
+    sources["rotor_inertia"] = ("not known", "unknown")
+    return CatalogueEntry(designation, kw * 1e3, 1500.0, slip, lam, start, None, None, sources)
 
 
 #: the motors, by designation
 MOTORS: dict[str, CatalogueEntry] = {
     "4A80B4U3": CatalogueEntry(
         "4A80B4U3", 1500.0, 1500.0, 0.058, 2.2, 2.0, 0.0033, 1415.0,
-        {"rated_power": (_BRIEF, "stated"),
-         "synchronous_rpm": (_BRIEF, "stated"),
-         "rated_slip": (_BRIEF, "stated"),
-         "quoted_rated_rpm": (_BRIEF, "stated"),
-         "breakdown_ratio": (_BRIEF, "stated"),
-         "starting_ratio": (_BRIEF, "stated"),
+        {**{f: (_BRIEF, "stated") for f in ("rated_power", "synchronous_rpm", "rated_slip",
+                                            "quoted_rated_rpm", "breakdown_ratio",
+                                            "starting_ratio")},
          "rotor_inertia": ("estimate of about 0.0033 kg m^2 (task brief)", "unconfirmed")},
         note="the motor of the source paper (press, METHOD.md §1). The slip 5.8 % gives "
              "1413 rpm; the quoted 1415 rpm is a rounded catalogue speed (slip 5.67 %). "
              "mechdyn uses the slip."),
-    "4A80A4U3": _entry("4A80A4U3", 1.1, 0.054, 2.2, 2.0, None, "medium"),
-    "4A90L4U3": _entry("4A90L4U3", 2.2, 0.051, 2.4, 2.1, None, "medium"),
-    "4A100S4U3": _entry("4A100S4U3", 3.0, 0.044, 2.4, 2.0, None, "medium"),
+    "4A80A4U3": _entry("4A80A4U3", 1.1, 0.054, 2.2, 2.0),
+    "4A90L4U3": _entry("4A90L4U3", 2.2, 0.051, 2.4, 2.1),
+    "4A100S4U3": _entry("4A100S4U3", 3.0, 0.044, 2.4, 2.0),
 }
 
 
@@ -158,12 +156,7 @@ def induction_motor(designation: str, characteristic: str = "kloss", **overrides
         Any InductionMotor field (SI), e.g. ``rotor_inertia=0.0035``.
     """
     entry = catalogue_entry(designation)
-    if "rotor_inertia" in overrides:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            kw = entry.motor_kwargs()
-    else:
-        kw = entry.motor_kwargs()
+    kw = entry.motor_kwargs(warn="rotor_inertia" not in overrides)
     kw.update(overrides)
     if "rated_speed" in overrides and "rated_slip" not in overrides:
         kw.pop("rated_slip")

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -238,8 +238,3 @@ class Torque:
     body: str
     magnitude: object = 0.0
     reaction_body: str | None = None
-
-
-@dataclass(frozen=True)
-class _Extra:
-    data: dict = field(default_factory=dict)

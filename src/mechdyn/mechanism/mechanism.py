@@ -15,8 +15,8 @@ import numpy as np
 
 from ..errors import ModelError, did_you_mean
 from .assembly_mode import AssemblyMode
-from .body import GROUND, Body, Ground
-from .coordinate import COORDINATE_KINDS, Coordinate
+from .body import GROUND, Body, Ground, unknown_point
+from .coordinate import Coordinate, coordinate_problems
 from .joint import Joint, Lock, Prismatic, Revolute
 
 __all__ = ["Mechanism"]
@@ -168,57 +168,34 @@ class Mechanism:
 
         for j in self.joints.values():
             where = f"{type(j).__name__.lower()} joint {j.name!r}"
-            for role, bname in (("parent", j.parent), ("child", j.child)):
+            for role in ("parent", "child"):
+                bname, ref = getattr(j, role), getattr(j, f"{role}_point", None)
                 if bname not in names:
                     out.append(f"{where}: {role}: " + did_you_mean(bname, names, "body"))
+                elif isinstance(ref, str) and ref not in self.body(bname).point_names():
+                    out.append(f"{where}: {role}_point: "
+                               + unknown_point(ref, bname, self.body(bname).point_names()))
             if j.parent == j.child:
                 out.append(f"{where}: parent and child are the same body {j.parent!r}")
-            for role, bname, ref in self._point_refs(j):
-                if bname in names and isinstance(ref, str):
-                    body = self.body(bname)
-                    if ref not in body.point_names():
-                        out.append(f"{where}: {role}: unknown point {ref!r} of body "
-                                   f"{bname!r}; valid point names: "
-                                   + ", ".join(repr(p) for p in body.point_names()))
             if isinstance(j, Prismatic):
                 ax = np.asarray(j.axis, dtype=float)
                 if ax.shape != (2,) or not np.all(np.isfinite(ax)) or np.hypot(*ax) == 0:
                     out.append(f"{where}: axis must be a non-zero direction (x, y), "
                                f"got {j.axis!r}")
 
+        joint_types = {n: type(j).__name__.lower() for n, j in self.joints.items()}
         for c in self.coordinates.values():
-            where = f"coordinate {c.name!r}"
-            if c.kind not in COORDINATE_KINDS:
-                out.append(f"{where}: unknown kind {c.kind!r}; valid kinds: "
-                           + ", ".join(repr(k) for k in COORDINATE_KINDS))
-                continue
-            if c.kind == "angle":
-                if c.body is None:
-                    out.append(f"{where}: kind 'angle' needs a body")
-                elif c.body not in self.bodies:
-                    out.append(f"{where}: body: " + did_you_mean(c.body, self.bodies, "body"))
-            else:
-                want = Revolute if c.kind == "relative_angle" else Prismatic
-                if c.joint is None:
-                    out.append(f"{where}: kind {c.kind!r} needs a joint")
-                elif c.joint not in self.joints:
-                    out.append(f"{where}: joint: " + did_you_mean(c.joint, self.joints, "joint"))
-                elif not isinstance(self.joints[c.joint], want):
-                    valid = [n for n, jj in self.joints.items() if isinstance(jj, want)]
-                    out.append(f"{where}: kind {c.kind!r} needs a {want.__name__.lower()} "
-                               f"joint, but {c.joint!r} is a "
-                               f"{type(self.joints[c.joint]).__name__.lower()}; "
-                               f"{want.__name__.lower()} joints: "
-                               + (", ".join(repr(v) for v in valid) or "(none)"))
+            for key, msg in coordinate_problems(c.kind, c.body, c.joint, self.bodies,
+                                                joint_types):
+                out.append(f"coordinate {c.name!r}: " + (f"{key}: " if key else "") + msg)
         for am in self.extras.get("assembly", []):
             for role, (bname, ref) in zip("PQR", am.points, strict=True):
                 where = f"assembly mode {am.name!r}: point {role}"
                 if bname not in names:
                     out.append(f"{where}: " + did_you_mean(bname, names, "body"))
                 elif isinstance(ref, str) and ref not in self.body(bname).point_names():
-                    out.append(f"{where}: unknown point {ref!r} of body {bname!r}; valid "
-                               "point names: " + ", ".join(
-                                   repr(p) for p in self.body(bname).point_names()))
+                    out.append(f"{where}: "
+                               + unknown_point(ref, bname, self.body(bname).point_names()))
         if not self.bodies:
             out.append("the mechanism has no moving bodies")
         if not self.coordinates:
@@ -229,12 +206,6 @@ class Mechanism:
                 f"{self.n_equations} equations = {self.dof}, but {len(self.coordinates)} "
                 f"coordinate(s) are declared ({', '.join(self.coordinates)})")
         return out
-
-    @staticmethod
-    def _point_refs(j: Joint):
-        if isinstance(j, (Revolute, Prismatic)):
-            yield "parent_point", j.parent, j.parent_point
-            yield "child_point", j.child, j.child_point
 
     def validate(self) -> Mechanism:
         """Check the whole description and raise one :class:`ModelError` listing all problems.

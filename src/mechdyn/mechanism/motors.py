@@ -27,8 +27,7 @@ GearStage
 
 :func:`mechdyn.modelfile.drives.drive_from_table` builds a
 :class:`~mechdyn.mechanism.drive.Drive` with one of these from a model-file
-``[[drives]]`` table (see ``docs/reduction-and-drives.md``); the name is still
-importable from this module.
+``[[drives]]`` table (see ``docs/reduction-and-drives.md``).
 """
 
 from __future__ import annotations
@@ -61,16 +60,35 @@ def _finite(x) -> bool:
         return False
 
 
+def _at_least(p: list[str], name: str, value, low: float, unit: str = "",
+              strict: bool = True) -> bool:
+    """Whether ``value`` is a finite number > ``low`` (>= unless ``strict``); if not,
+    record ``"name must be > low unit, got value"`` in ``p``."""
+    if _finite(value) and (value > low if strict else value >= low):
+        return True
+    p.append(f"{name} must be {'>' if strict else '>='} {low:g}{' ' * bool(unit)}{unit}, "
+             f"got {value!r}")
+    return False
+
+
 def _raise(where: str, problems: list[str]):
     if problems:
         raise ModelError([f"{where}: {p}" for p in problems])
 
 
-def _torque_through_gear(m_motor, omega_driven, ratio, efficiency):
-    """Driven-side torque of a stage: losses always oppose the power flow."""
-    m = np.asarray(m_motor, dtype=float)
-    forward = m * np.asarray(omega_driven, dtype=float) >= 0.0  # power flows motor -> machine
-    return np.where(forward, efficiency * ratio * m, ratio * m / efficiency)
+def _floats(obj, *names):
+    """Store the fields ``names`` of a frozen dataclass as floats (None stays None)."""
+    for name in names:
+        if getattr(obj, name) is not None:
+            object.__setattr__(obj, name, float(getattr(obj, name)))
+
+
+class _DirectDrive:
+    """A motor on the driven shaft itself: it adds its ``rotor_inertia``."""
+
+    def extra_inertia(self) -> float:
+        """Rotor inertia added to the driven coordinate, kg m^2 (direct drive)."""
+        return float(self.rotor_inertia)
 
 
 # ---------------------------------------------------------------------- induction motor
@@ -141,8 +159,8 @@ def fit_extended_kloss(rated_slip: float, breakdown_ratio: float,
         q = _extended_q(sn, mu_n, sk)
         if q > -1.0 + 1e-12:
             roots.append((sk, q / sk))
+    sk_k = kloss_critical_slip(sn, lam)
     if not roots:
-        sk_k = kloss_critical_slip(sn, lam)
         m1 = 2 * lam / (1.0 / sk_k + sk_k)
         raise ModelError(
             f"no extended Kloss curve M = 2 M_k (1 + a s_k)/(s/s_k + s_k/s + 2 a s_k) passes "
@@ -151,13 +169,12 @@ def fit_extended_kloss(rated_slip: float, breakdown_ratio: float,
             f"s_n < s_k < 1 (Kloss's formula gives M_start = {m1:.4g} M_n); use "
             f"characteristic = 'kloss' or check the catalogue data")
     # several admissible roots are not expected; take the one closest to Kloss's s_k
-    sk_k = kloss_critical_slip(sn, lam)
     sk, a = min(roots, key=lambda r: abs(r[0] - sk_k))
     return float(sk), float(a)
 
 
 @dataclass(frozen=True)
-class InductionMotor:
+class InductionMotor(_DirectDrive):
     """A squirrel-cage induction motor from catalogue data.
 
     Parameters
@@ -224,36 +241,30 @@ class InductionMotor:
     def __post_init__(self):
         where = f"induction motor {self.name!r}"
         p: list[str] = []
-        if not _finite(self.rated_power) or self.rated_power <= 0:
-            p.append(f"rated_power must be > 0 W, got {self.rated_power!r}")
-        if not _finite(self.synchronous_speed) or self.synchronous_speed <= 0:
-            p.append(f"synchronous_speed must be > 0 rad/s, got {self.synchronous_speed!r}")
+        _at_least(p, "rated_power", self.rated_power, 0, "W")
+        _at_least(p, "synchronous_speed", self.synchronous_speed, 0, "rad/s")
         if (self.rated_slip is None) == (self.rated_speed is None):
             p.append("give exactly one of rated_slip and rated_speed "
                      f"(got rated_slip={self.rated_slip!r}, rated_speed={self.rated_speed!r})")
         if self.rated_slip is not None and (not _finite(self.rated_slip)
                                             or not 0.0 < self.rated_slip < 1.0):
             p.append(f"rated_slip must lie in (0, 1), got {self.rated_slip!r}")
-        if self.rated_speed is not None:
-            if not _finite(self.rated_speed) or self.rated_speed <= 0:
-                p.append(f"rated_speed must be > 0 rad/s, got {self.rated_speed!r}")
-            elif _finite(self.synchronous_speed) and self.rated_speed >= self.synchronous_speed:
+        if self.rated_speed is not None and _at_least(p, "rated_speed", self.rated_speed, 0,
+                                                      "rad/s"):
+            if _finite(self.synchronous_speed) and self.rated_speed >= self.synchronous_speed:
                 p.append(f"rated_speed {self.rated_speed:.6g} rad/s must be below the "
                          f"synchronous_speed {self.synchronous_speed:.6g} rad/s (a motor "
                          f"runs with positive slip)")
         if not _finite(self.breakdown_ratio) or self.breakdown_ratio <= 1.0:
             p.append(f"breakdown_ratio (M_k/M_n) must be > 1: the breakdown torque cannot be "
                      f"below the rated torque; got {self.breakdown_ratio!r}")
-        if self.starting_ratio is not None:
-            if not _finite(self.starting_ratio) or self.starting_ratio <= 0:
-                p.append(f"starting_ratio (M_start/M_n) must be > 0, got "
-                         f"{self.starting_ratio!r}")
-            elif _finite(self.breakdown_ratio) and self.starting_ratio >= self.breakdown_ratio:
+        if self.starting_ratio is not None and _at_least(p, "starting_ratio (M_start/M_n)",
+                                                         self.starting_ratio, 0):
+            if _finite(self.breakdown_ratio) and self.starting_ratio >= self.breakdown_ratio:
                 p.append(f"starting_ratio {self.starting_ratio!r} must be below "
                          f"breakdown_ratio {self.breakdown_ratio!r} (the breakdown torque is "
                          f"the maximum of the characteristic)")
-        if not _finite(self.rotor_inertia) or self.rotor_inertia < 0:
-            p.append(f"rotor_inertia must be >= 0 kg*m^2, got {self.rotor_inertia!r}")
+        _at_least(p, "rotor_inertia", self.rotor_inertia, 0, "kg*m^2", strict=False)
         if self.characteristic not in CHARACTERISTICS:
             p.append(f"characteristic must be one of {', '.join(map(repr, CHARACTERISTICS))}, "
                      f"got {self.characteristic!r}")
@@ -268,10 +279,8 @@ class InductionMotor:
         else:
             sn = float(self.rated_slip)
             object.__setattr__(self, "rated_speed", w0 * (1.0 - sn))
-        for name in ("rated_power", "synchronous_speed", "breakdown_ratio", "rotor_inertia"):
-            object.__setattr__(self, name, float(getattr(self, name)))
-        if self.starting_ratio is not None:
-            object.__setattr__(self, "starting_ratio", float(self.starting_ratio))
+        _floats(self, "rated_power", "synchronous_speed", "breakdown_ratio", "rotor_inertia",
+                "starting_ratio")
         mn = self.rated_power / self.rated_speed
         object.__setattr__(self, "rated_torque", mn)
         object.__setattr__(self, "breakdown_torque", self.breakdown_ratio * mn)
@@ -287,11 +296,6 @@ class InductionMotor:
 
     # ------------------------------------------------------------------ curve
     @property
-    def critical_speed(self) -> float:
-        """Speed at the breakdown torque, omega_0 (1 - s_k), rad/s."""
-        return self.synchronous_speed * (1.0 - self.critical_slip)
-
-    @property
     def starting_torque(self) -> float:
         """Torque of the model at standstill (s = 1), N m."""
         return self.torque_at_slip(1.0)
@@ -306,36 +310,19 @@ class InductionMotor:
         """Electromagnetic torque at slip ``s`` (N m), written without the pole at s = 0:
         ``M = 2 M_k (1 + a s_k) s s_k / (s^2 + s_k^2 + 2 a s_k^2 s)``."""
         sk, a = self.critical_slip, self.a
-        if isinstance(s, float):  # fast path for the integrators' scalar calls
-            return (2.0 * self.breakdown_torque * (1.0 + a * sk) * s * sk
-                    / (s * s + sk * sk + 2.0 * a * sk * sk * s))
-        s = np.asarray(s, dtype=float)
-        num = 2.0 * self.breakdown_torque * (1.0 + a * sk) * s * sk
-        den = s * s + sk * sk + 2.0 * a * sk * sk * s
-        return _out(num / den)
+        x = s if isinstance(s, float) else np.asarray(s, dtype=float)  # floats: the fast path
+        m = (2.0 * self.breakdown_torque * (1.0 + a * sk) * x * sk
+             / (x * x + sk * sk + 2.0 * a * sk * sk * x))
+        return m if isinstance(s, float) else _out(m)
 
     def torque_at(self, omega):
         """Shaft torque (N m) at shaft speed ``omega`` (rad/s); scalar or array."""
         return self.torque_at_slip(self.slip(omega))
 
-    def extra_inertia(self) -> float:
-        """Rotor inertia added to the driven coordinate, kg m^2 (direct drive)."""
-        return self.rotor_inertia
-
-    def describe(self) -> str:
-        """One-line summary with the fitted constants."""
-        rpm = 30.0 / math.pi
-        return (f"{self.name}: P_n = {self.rated_power / 1e3:.4g} kW, n_0 = "
-                f"{self.synchronous_speed * rpm:.5g} rpm, n_n = {self.rated_speed * rpm:.5g} rpm "
-                f"(s_n = {self.rated_slip:.4g}), M_n = {self.rated_torque:.4g} N m, M_k = "
-                f"{self.breakdown_torque:.4g} N m at s_k = {self.critical_slip:.4g}, "
-                f"M_start = {self.starting_torque:.4g} N m, a = {self.a:.4g} "
-                f"({self.characteristic}), J_rotor = {self.rotor_inertia:.4g} kg m^2")
-
 
 # ---------------------------------------------------------------------- DC motor
 @dataclass(frozen=True)
-class DCMotor:
+class DCMotor(_DirectDrive):
     """A separately excited DC motor: ``M = M_stall (1 - omega / omega_0)``.
 
     Parameters
@@ -357,13 +344,10 @@ class DCMotor:
     source: str = ""
 
     def __post_init__(self):
-        p = []
-        if not _finite(self.no_load_speed) or self.no_load_speed <= 0:
-            p.append(f"no_load_speed must be > 0 rad/s, got {self.no_load_speed!r}")
-        if not _finite(self.stall_torque) or self.stall_torque <= 0:
-            p.append(f"stall_torque must be > 0 N*m, got {self.stall_torque!r}")
-        if not _finite(self.rotor_inertia) or self.rotor_inertia < 0:
-            p.append(f"rotor_inertia must be >= 0 kg*m^2, got {self.rotor_inertia!r}")
+        p: list[str] = []
+        _at_least(p, "no_load_speed", self.no_load_speed, 0, "rad/s")
+        _at_least(p, "stall_torque", self.stall_torque, 0, "N*m")
+        _at_least(p, "rotor_inertia", self.rotor_inertia, 0, "kg*m^2", strict=False)
         _raise(f"DC motor {self.name!r}", p)
 
     @classmethod
@@ -371,12 +355,10 @@ class DCMotor:
                    no_load_speed: float, rotor_inertia: float = 0.0,
                    source: str = "") -> DCMotor:
         """From the rated point (P_n W, omega_n rad/s) and the no-load speed (rad/s)."""
-        p = []
-        if not _finite(rated_power) or rated_power <= 0:
-            p.append(f"rated_power must be > 0 W, got {rated_power!r}")
-        if not _finite(rated_speed) or rated_speed <= 0:
-            p.append(f"rated_speed must be > 0 rad/s, got {rated_speed!r}")
-        elif _finite(no_load_speed) and rated_speed >= no_load_speed:
+        p: list[str] = []
+        _at_least(p, "rated_power", rated_power, 0, "W")
+        if _at_least(p, "rated_speed", rated_speed, 0, "rad/s") and _finite(no_load_speed) \
+                and rated_speed >= no_load_speed:
             p.append(f"rated_speed {rated_speed!r} rad/s must be below no_load_speed "
                      f"{no_load_speed!r} rad/s")
         _raise(f"DC motor {name!r}", p)
@@ -387,10 +369,6 @@ class DCMotor:
     def torque_at(self, omega):
         """Shaft torque (N m) at shaft speed ``omega`` (rad/s)."""
         return _out(self.stall_torque * (1.0 - np.asarray(omega, float) / self.no_load_speed))
-
-    def extra_inertia(self) -> float:
-        """Rotor inertia added to the driven coordinate, kg m^2."""
-        return float(self.rotor_inertia)
 
 
 # ---------------------------------------------------------------------- ideal drive
@@ -418,11 +396,11 @@ class ConstantSpeedDrive:
     stiffness: float | None = None
 
     def __post_init__(self):
-        p = []
+        p: list[str] = []
         if not _finite(self.speed):
             p.append(f"speed must be a finite number in rad/s, got {self.speed!r}")
-        if self.stiffness is not None and (not _finite(self.stiffness) or self.stiffness <= 0):
-            p.append(f"stiffness must be > 0 N*m*s/rad, got {self.stiffness!r}")
+        if self.stiffness is not None:
+            _at_least(p, "stiffness", self.stiffness, 0, "N*m*s/rad")
         _raise(f"constant-speed drive {self.name!r}", p)
 
     def torque_at(self, omega):
@@ -441,7 +419,7 @@ class ConstantSpeedDrive:
 
 # ---------------------------------------------------------------------- table
 @dataclass(frozen=True)
-class TabulatedMotor:
+class TabulatedMotor(_DirectDrive):
     """A mechanical characteristic M(omega) from a table, linearly interpolated.
 
     Parameters
@@ -475,8 +453,7 @@ class TabulatedMotor:
             p.append("omega must increase strictly")
         if not (np.all(np.isfinite(w)) and np.all(np.isfinite(m))):
             p.append("omega and torque must be finite")
-        if not _finite(self.rotor_inertia) or self.rotor_inertia < 0:
-            p.append(f"rotor_inertia must be >= 0 kg*m^2, got {self.rotor_inertia!r}")
+        _at_least(p, "rotor_inertia", self.rotor_inertia, 0, "kg*m^2", strict=False)
         _raise(f"tabulated motor {self.name!r}", p)
         object.__setattr__(self, "omega", tuple(w))
         object.__setattr__(self, "torque", tuple(m))
@@ -493,10 +470,6 @@ class TabulatedMotor:
             out = np.where(om < w[0], m[0] + lo * (om - w[0]), out)
             out = np.where(om > w[-1], m[-1] + hi * (om - w[-1]), out)
         return _out(out)
-
-    def extra_inertia(self) -> float:
-        """Rotor inertia, kg m^2."""
-        return float(self.rotor_inertia)
 
 
 # ---------------------------------------------------------------------- gear stage
@@ -532,20 +505,16 @@ class GearStage:
     name: str = "gear"
 
     def __post_init__(self):
-        p = []
+        p: list[str] = []
         if not hasattr(self.motor, "torque_at"):
             p.append(f"motor must have a method torque_at(omega), got {type(self.motor)!r}")
-        if not _finite(self.ratio) or self.ratio <= 0:
-            p.append(f"ratio (omega_motor/omega_driven) must be > 0, got {self.ratio!r}")
+        _at_least(p, "ratio (omega_motor/omega_driven)", self.ratio, 0)
         if not _finite(self.efficiency) or not 0.0 < self.efficiency <= 1.0:
             p.append(f"efficiency must lie in (0, 1], got {self.efficiency!r}")
         for fld in ("input_inertia", "output_inertia"):
-            v = getattr(self, fld)
-            if not _finite(v) or v < 0:
-                p.append(f"{fld} must be >= 0 kg*m^2, got {v!r}")
+            _at_least(p, fld, getattr(self, fld), 0, "kg*m^2", strict=False)
         _raise(f"gear stage {self.name!r}", p)
-        for fld in ("ratio", "efficiency", "input_inertia", "output_inertia"):
-            object.__setattr__(self, fld, float(getattr(self, fld)))
+        _floats(self, "ratio", "efficiency", "input_inertia", "output_inertia")
 
     def motor_speed(self, omega):
         """Motor shaft speed (rad/s) at driven speed ``omega`` (rad/s)."""
@@ -560,10 +529,12 @@ class GearStage:
     def torque_at(self, omega):
         """Torque on the driven coordinate (N m) at its speed ``omega`` (rad/s)."""
         m = self.motor_torque(omega)
+        eta, i = self.efficiency, self.ratio  # the losses always oppose the power flow
         if isinstance(omega, float) and isinstance(m, float):
-            eta, i = self.efficiency, self.ratio
             return eta * i * m if m * omega >= 0.0 else i * m / eta
-        return _out(_torque_through_gear(m, omega, self.ratio, self.efficiency))
+        m = np.asarray(m, dtype=float)
+        forward = m * np.asarray(omega, dtype=float) >= 0.0  # power flows motor -> machine
+        return _out(np.where(forward, eta * i * m, i * m / eta))
 
     def extra_inertia(self) -> float:
         """``(J_motor + J_input) i^2 + J_output``, kg m^2, on the driven coordinate."""

@@ -149,10 +149,8 @@ def punch_load(name: str, body: str, point, magnitude: float, *, end: float,
     """
     win = StrokeWindow(float(magnitude), body, point, float(end), float(travel), coordinate,
                        int(towards), bool(approaching_only), float(ramp))
-    k = _AXES[coordinate]
-    d = [0.0, 0.0]
-    d[k] = -float(towards)
-    return Force(name, body, point, win, tuple(d), "ground")
+    d = (0.0, -float(towards)) if coordinate == "y" else (-float(towards), 0.0)
+    return Force(name, body, point, win, d, "ground")
 
 
 def position_load(name: str, body: str, point, positions, values, *, coordinate: str = "y",
@@ -173,11 +171,10 @@ def position_load(name: str, body: str, point, positions, values, *, coordinate:
     if coordinate not in _AXES:
         raise ValueError(f"position load {name!r}: coordinate must be 'x' or 'y', "
                          f"got {coordinate!r}")
-    pname = point if isinstance(point, str) else None
-    if pname is None:
+    if not isinstance(point, str):
         raise ValueError(f"position load {name!r}: the watched point must be a named point "
                          f"of body {body!r} (tables refer to 'body.point.{coordinate}')")
-    tab = Table(tuple(positions), tuple(values), f"{body}.{pname}.{coordinate}", outside)
+    tab = Table(tuple(positions), tuple(values), f"{body}.{point}.{coordinate}", outside)
     return Force(name, body, point, tab, tuple(direction), frame)
 
 

@@ -69,9 +69,8 @@ class CoordinateLock:
     extra_kind = "coordinate_locks"
 
     def __post_init__(self):
-        if isinstance(self.frees, str):
-            object.__setattr__(self, "frees", (self.frees,))
-        object.__setattr__(self, "frees", tuple(str(f) for f in self.frees))
+        frees = (self.frees,) if isinstance(self.frees, str) else self.frees
+        object.__setattr__(self, "frees", tuple(str(f) for f in frees))
         if self.value is not None:
             object.__setattr__(self, "value", float(self.value))
 
@@ -121,30 +120,28 @@ class Switch:
         object.__setattr__(self, "times", tuple(sorted(float(t) for t in self.times)))
         object.__setattr__(self, "value", float(self.value))
         object.__setattr__(self, "direction", int(np.sign(self.direction)))
-        g = []
-        for item in self.guard:
-            var, op, val = item
-            g.append((str(var), str(op), float(val)))
-        object.__setattr__(self, "guard", tuple(g))
+        object.__setattr__(self, "guard", tuple((str(var), str(op), float(val))
+                                                for var, op, val in self.guard))
 
     @property
     def is_scheduled(self) -> bool:
         """True for a command schedule (``times``), False for a crossing condition."""
         return self.variable is None
 
-    def problems(self) -> list[str]:
-        """Problems that can be found without the mechanism."""
+    def problems(self, where=None) -> list[str]:
+        """Problems that can be found without the mechanism; ``where(key)`` names the
+        place of a key in the messages (default ``"switch 'NAME': key"``)."""
+        where = where or (lambda key: f"switch {self.name!r}" + (f": {key}" if key else ""))
         out = []
-        where = f"switch {self.name!r}"
         if self.action not in SWITCH_ACTIONS:
-            out.append(f"{where}: action must be one of {', '.join(SWITCH_ACTIONS)}, "
+            out.append(f"{where('action')}: must be one of {', '.join(SWITCH_ACTIONS)}, "
                        f"got {self.action!r}")
         if (self.variable is None) == (not self.times):
-            out.append(f"{where}: give either a crossing 'variable' (with 'value' and "
+            out.append(f"{where('')}: give either a crossing 'variable' (with 'value' and "
                        "'direction') or a list of command 'times', not both or neither")
         for var, op, _ in self.guard:
             if op not in GUARD_OPERATORS:
-                out.append(f"{where}: guard on {var!r}: operator must be one of "
+                out.append(f"{where('guard')}: {var!r}: operator must be one of "
                            f"{', '.join(GUARD_OPERATORS)}, got {op!r}")
         return out
 

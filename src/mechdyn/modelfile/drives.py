@@ -42,10 +42,13 @@ _GEAR_KEYS = ("gear_ratio", "efficiency", "gear_input_inertia", "gear_output_ine
 _COMMON_KEYS = ("name", "coordinate", "type", "description")
 
 
-def _q(table, key, kind, where, default=None):
-    if key not in table:
-        return default
-    return parse_quantity(table[key], kind, where=f"{where}: {key}")
+#: the quantity kind of each key that holds one quantity
+_KINDS = {"rated_power": "power", "synchronous_speed": "angular_velocity",
+          "rated_speed": "angular_velocity", "rated_slip": "ratio", "breakdown_ratio": "ratio",
+          "starting_ratio": "ratio", "rotor_inertia": "inertia",
+          "no_load_speed": "angular_velocity", "stall_torque": "torque",
+          "speed": "angular_velocity", "stiffness": "rotational_damping", "gear_ratio": "ratio",
+          "efficiency": "ratio", "gear_input_inertia": "inertia", "gear_output_inertia": "inertia"}
 
 
 def drive_from_table(table: Mapping, where: str = "drives") -> Drive:
@@ -99,27 +102,26 @@ def drive_from_table(table: Mapping, where: str = "drives") -> Drive:
     if problems:
         raise ModelError(problems)
 
+    q = {k: parse_quantity(v, _KINDS[k], where=f"{where}: {k}")
+         for k, v in t.items() if k in _KINDS}
+    source = str(t.get("source", ""))
     if kind == "induction_motor":
-        motor = _induction_from_table(t, name, where)
+        motor = _induction_from_table(t, q, name, where)
     elif kind == "dc_motor":
-        jr = _q(t, "rotor_inertia", "inertia", where, 0.0)
-        w0 = _q(t, "no_load_speed", "angular_velocity", where)
-        if w0 is None:
+        if "no_load_speed" not in q:
             raise ModelError(f"{where}: no_load_speed: missing (rad/s, e.g. \"3000 rpm\")")
-        if "stall_torque" in t:
-            motor = DCMotor(name, w0, _q(t, "stall_torque", "torque", where), jr,
-                            str(t.get("source", "")))
+        jr = q.get("rotor_inertia", 0.0)
+        if "stall_torque" in q:
+            motor = DCMotor(name, q["no_load_speed"], q["stall_torque"], jr, source)
+        elif "rated_power" in q and "rated_speed" in q:
+            motor = DCMotor.from_rated(name, q["rated_power"], q["rated_speed"],
+                                       q["no_load_speed"], jr, source)
         else:
-            pn = _q(t, "rated_power", "power", where)
-            wn = _q(t, "rated_speed", "angular_velocity", where)
-            if pn is None or wn is None:
-                raise ModelError(f"{where}: give stall_torque, or rated_power and rated_speed")
-            motor = DCMotor.from_rated(name, pn, wn, w0, jr, str(t.get("source", "")))
+            raise ModelError(f"{where}: give stall_torque, or rated_power and rated_speed")
     elif kind == "constant_speed":
-        sp = _q(t, "speed", "angular_velocity", where)
-        if sp is None:
+        if "speed" not in q:
             raise ModelError(f"{where}: speed: missing (e.g. \"43.5 rad/s\")")
-        motor = ConstantSpeedDrive(name, sp, _q(t, "stiffness", "rotational_damping", where))
+        motor = ConstantSpeedDrive(name, q["speed"], q.get("stiffness"))
     else:
         om, tq = t.get("omega"), t.get("torque")
         if not isinstance(om, list) or not isinstance(tq, list):
@@ -128,27 +130,23 @@ def drive_from_table(table: Mapping, where: str = "drives") -> Drive:
              for k, v in enumerate(om)]
         m = [parse_quantity(v, "torque", where=f"{where}: torque[{k}]")
              for k, v in enumerate(tq)]
-        motor = TabulatedMotor(name, tuple(w), tuple(m), _q(t, "rotor_inertia", "inertia",
-                                                           where, 0.0),
-                               bool(t.get("extrapolate", True)), str(t.get("source", "")))
+        motor = TabulatedMotor(name, tuple(w), tuple(m), q.get("rotor_inertia", 0.0),
+                               bool(t.get("extrapolate", True)), source)
+    if not any(k in t for k in _GEAR_KEYS):
+        return Drive(name, str(t["coordinate"]), motor)
+    if "gear_ratio" not in t:
+        raise ModelError(f"{where}: gear_ratio: missing (the efficiency and gear "
+                         f"inertias need a gear ratio omega_motor/omega_driven)")
     try:
-        torque = motor
-        if "gear_ratio" in t or any(k in t for k in _GEAR_KEYS):
-            if "gear_ratio" not in t:
-                raise ModelError(f"{where}: gear_ratio: missing (the efficiency and gear "
-                                 f"inertias need a gear ratio omega_motor/omega_driven)")
-            torque = GearStage(motor, _q(t, "gear_ratio", "ratio", where),
-                               _q(t, "efficiency", "ratio", where, 1.0),
-                               _q(t, "gear_input_inertia", "inertia", where, 0.0),
-                               _q(t, "gear_output_inertia", "inertia", where, 0.0),
-                               name=f"{name} gear")
+        gear = GearStage(motor, q["gear_ratio"], q.get("efficiency", 1.0),
+                         q.get("gear_input_inertia", 0.0), q.get("gear_output_inertia", 0.0),
+                         name=f"{name} gear")
     except ModelError as exc:
-        raise ModelError([p if p.startswith(where) else f"{where}: {p}"
-                          for p in exc.problems]) from None
-    return Drive(name, str(t["coordinate"]), torque)
+        raise ModelError([f"{where}: {p}" for p in exc.problems]) from None
+    return Drive(name, str(t["coordinate"]), gear)
 
 
-def _induction_from_table(t, name, where) -> InductionMotor:
+def _induction_from_table(t, q, name, where) -> InductionMotor:
     data: dict = {}
     source = str(t.get("source", ""))
     if "catalogue" in t:
@@ -156,12 +154,7 @@ def _induction_from_table(t, name, where) -> InductionMotor:
         data = entry.motor_kwargs()
         name = str(t.get("name", entry.designation))
         source = source or entry.source_text()
-    spec = {"rated_power": "power", "synchronous_speed": "angular_velocity",
-            "rated_speed": "angular_velocity", "rated_slip": "ratio",
-            "breakdown_ratio": "ratio", "starting_ratio": "ratio", "rotor_inertia": "inertia"}
-    for key, kind in spec.items():
-        if key in t:
-            data[key] = _q(t, key, kind, where)
+    data.update((k, v) for k, v in q.items() if k in DRIVE_TYPES["induction_motor"])
     if "rated_speed" in t and "rated_slip" not in t:
         data.pop("rated_slip", None)  # the file's rated speed replaces the catalogue slip
     elif "rated_slip" in t and "rated_speed" not in t:

@@ -13,8 +13,9 @@ once in one :class:`~mechdyn.errors.ModelError`:
 The format is described in ``docs/model-file.md``.
 
 The tables are read by :mod:`.bodies_joints`, :mod:`.loads_drives` and
-:mod:`.initial_assembly`, on the shared reader of :mod:`.reader`; this module
-holds the entry points and the order of the passes.
+:mod:`.switches`, on the shared reader of :mod:`.reader`; this module holds the
+entry points, the order of the passes and the ``[initial]``, ``[initial_speed]``
+and ``[[assembly]]`` readers.
 """
 
 from __future__ import annotations
@@ -22,10 +23,9 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-from ..errors import MechdynError, ModelError, UnitError
+from ..errors import MechdynError, ModelError, UnitError, did_you_mean
 from ..mechanism import GROUND, Ground, Mechanism
 from .bodies_joints import _BodiesJoints
-from .initial_assembly import _InitialAssembly
 from .loads_drives import _LOAD_REQUIRED, _LoadsDrives
 from .reader import _Failed
 from .schema import schema_problems
@@ -113,7 +113,7 @@ def build(doc: dict, name: str = "<string>", *, default_title: str | None = None
     return mech
 
 
-class _Builder(_BodiesJoints, _LoadsDrives, _InitialAssembly):
+class _Builder(_BodiesJoints, _LoadsDrives):
     """Turns a document into mechanism elements, recording every problem."""
 
     # ------------------------------------------------------------ passes
@@ -122,28 +122,15 @@ class _Builder(_BodiesJoints, _LoadsDrives, _InitialAssembly):
         title = model.get("name") if isinstance(model.get("name"), str) else None
         desc = model.get("description") if isinstance(model.get("description"), str) else ""
         mech = Mechanism(name=title or default_title or "mechanism", description=desc)
-        if "gravity" in model and not self.broken("model", "gravity"):
-            try:
-                mech.gravity = self.vector(model["gravity"], "acceleration", "model", "gravity")
-            except _Failed:
-                pass
+        if not self.broken("model", "gravity"):
+            mech.gravity = self.opt(model, "gravity", "acceleration", "model",
+                                    default=mech.gravity, read=self.vector)
 
         ground = self.section("ground")
         gpoints = ground.get("points", {}) if isinstance(ground.get("points"), dict) else {}
-        pts = {}
-        for pname, val in gpoints.items():
-            if self.broken("ground", "points", pname):
-                continue
-            if pname == "com":
-                self.problem(f"{self.where('ground', 'points', pname)}: the point name 'com' is "
-                             "reserved; choose another name")
-                continue
-            try:
-                pts[pname] = self.vector(val, "length", "ground", "points", pname)
-            except _Failed:
-                pass
         self.body_points[GROUND] = ["com", *gpoints]
-        mech.add(Ground(points=pts))
+        mech.add(Ground(points=self.points(gpoints, "ground", "points",
+                                           hint="; choose another name")))
 
         bodies = self.section("bodies")
         # names first, so that joints may refer to any body
@@ -155,12 +142,8 @@ class _Builder(_BodiesJoints, _LoadsDrives, _InitialAssembly):
             self.problem(f"{self.where('bodies', GROUND)}: the name {GROUND!r} is reserved for "
                          "the fixed frame; put its points in [ground.points]")
         for bname, spec in bodies.items():
-            if bname == GROUND or not isinstance(spec, dict):
-                continue
-            try:
-                mech.add(self.element(self.body, ("bodies", bname), spec, ("mass", "inertia")))
-            except _Failed:
-                pass
+            if bname != GROUND:
+                self.add(mech, self.body, ("bodies", bname), spec, ("mass", "inertia"))
 
         for jname, spec in self.section("joints").items():
             if isinstance(spec, dict) and isinstance(spec.get("type"), str):
@@ -169,55 +152,27 @@ class _Builder(_BodiesJoints, _LoadsDrives, _InitialAssembly):
                 self.problem(f"{self.where('joints', jname)}: the name {jname!r} is already "
                              "used by a body; joints and bodies need different names")
                 continue
-            if not isinstance(spec, dict) or self.broken("joints", jname, "type") \
-                    or "type" not in spec:
-                continue
-            try:
-                mech.add(self.element(self.joint, ("joints", jname), spec,
-                                      ("type", "parent", "child")))
-            except _Failed:
-                pass
+            self.add(mech, self.joint, ("joints", jname), spec, ("type", "parent", "child"))
 
         for cname, spec in self.section("coordinates").items():
             if isinstance(spec, dict) and isinstance(spec.get("kind"), str):
                 self.coord_kinds[cname] = spec["kind"]
-            if not isinstance(spec, dict) or self.broken("coordinates", cname, "kind") \
-                    or "kind" not in spec:
-                continue
-            try:
-                mech.add(self.element(self.coordinate, ("coordinates", cname), spec, ("kind",)))
-            except _Failed:
-                pass
+            self.add(mech, self.coordinate, ("coordinates", cname), spec, ("kind",))
 
         initial = {"q": self.initial("initial", rate=False),
                    "qdot": self.initial("initial_speed", rate=True)}
         if initial["q"] or initial["qdot"]:
             mech.extras["initial"] = initial
 
-        names: set[str] = set()
-        for section in ("loads", "drives"):
-            for k, spec in enumerate(self.section(section, list)):
-                if not isinstance(spec, dict):
-                    continue
-                if section == "loads" and ("type" not in spec
-                                           or self.broken(section, k, "type")):
-                    continue
-                try:
-                    if section == "loads":
-                        el = self.element(self.load, (section, k), spec,
-                                          _LOAD_REQUIRED.get(spec["type"], ()))
-                    else:
-                        el = self.element(self.drive, (section, k), spec,
-                                          ("coordinate", "type") if "type" in spec
-                                          else ("coordinate", "torque"))
-                except _Failed:
-                    continue
-                if el.name in names:
-                    self.problem(f"{self.where(section, k)}: name {el.name!r} is used by another "
-                                 "load or drive")
-                    continue
-                names.add(el.name)
-                mech.add(el)
+        names: set[str] = set()  # of the loads and drives
+        for k, spec in enumerate(self.section("loads", list)):
+            if isinstance(spec, dict) and "type" in spec and not self.broken("loads", k, "type"):
+                self.add(mech, self.load, ("loads", k), spec,
+                         _LOAD_REQUIRED.get(spec["type"], ()), names)
+        for k, spec in enumerate(self.section("drives", list)):
+            if isinstance(spec, dict):
+                self.add(mech, self.drive, ("drives", k), spec,
+                         ("coordinate", "type" if "type" in spec else "torque"), names)
         for k, spec in enumerate(self.section("assembly", list)):
             if isinstance(spec, dict) and not self.broken("assembly", k):
                 self.assembly_mode(mech, k, spec)
@@ -225,3 +180,49 @@ class _Builder(_BodiesJoints, _LoadsDrives, _InitialAssembly):
             for p in parse_switches(self.doc, mech, self.fname):
                 self.problem(p)
         return mech
+
+    def add(self, mech: Mechanism, read, path: tuple, spec, required: tuple,
+            names: set[str] | None = None):
+        """Add the element ``read`` builds from the table ``spec`` (see :meth:`element`);
+        ``names``: those taken by the loads and drives, which must differ."""
+        el = (self.soft(self.element, read, path, spec, required)
+              if isinstance(spec, dict) else None)
+        if el is not None and names is not None and el.name in names:
+            self.problem(f"{self.where(*path)}: name {el.name!r} is used by another load or "
+                         "drive")
+        elif el is not None:
+            mech.add(el)
+            if names is not None:
+                names.add(el.name)
+
+    def initial(self, section: str, rate: bool) -> dict[str, float]:
+        """The SI values by coordinate name of ``[initial]`` or ``[initial_speed]``."""
+        out: dict[str, float] = {}
+        for cname, val in self.section(section).items():
+            if self.broken(section, cname):
+                continue
+            if cname not in self.coord_kinds:
+                self.problem(f"{self.where(section, cname)}: "
+                             + did_you_mean(cname, self.coord_kinds, "coordinate"))
+                continue
+            try:
+                out[cname] = self.quantity(val, self.coord_value_kind(cname, rate),
+                                           section, cname)
+            except _Failed:
+                pass
+        return out
+
+    def assembly_mode(self, mech: Mechanism, k: int, spec: dict) -> None:
+        """An [[assembly]] entry: points "body.point" P, Q, R and the turn at Q."""
+        pts = []
+        for i, text in enumerate(spec.get("points", [])):
+            body, _, point = str(text).partition(".")
+            if not point:
+                self.problem(f"{self.where('assembly', k, 'points', i)}: {text!r}: write a "
+                             "point as \"body.point\", e.g. \"rod.B\"")
+                return
+            pts.append((body, point))
+        if len(pts) != 3 or "turn" not in spec:
+            return
+        name = spec.get("name") or f"{pts[1][0]}.{pts[1][1]}"
+        mech.add_assembly_mode(name, *pts, turn=spec["turn"])

@@ -4,15 +4,8 @@ A load or drive value is a constant, a ``{x, y, variable}`` table (over time, a
 coordinate or its rate, a joint, a body angle, a point coordinate or a
 distance) or a ``{pulse, start, duration}`` pulse; a drive is a torque (or a
 torque-speed curve) on a coordinate, or a motor model read by
-:func:`mechdyn.modelfile.drives.drive_from_table`.
-
-Private names
--------------
-_LoadsDrives
-    The readers of one load (spring, damper, rotary spring or damper, force,
-    torque), one drive, and the values and tables in them.
-_LOAD_REQUIRED
-    The keys each type of load needs.
+:func:`mechdyn.modelfile.drives.drive_from_table`.  :class:`_LoadsDrives` reads
+one load or drive; ``_LOAD_REQUIRED`` holds the keys each type of load needs.
 """
 
 from __future__ import annotations
@@ -23,7 +16,6 @@ from ..errors import ModelError, UnitError, did_you_mean
 from ..mechanism import GROUND
 from ..mechanism.drive import Drive, TorqueSpeedCurve
 from ..mechanism.load import Force, RotarySpring, Spring, Table, Torque, pulse
-from ..model.variable import parse
 from .drives import drive_from_table
 from .reader import _Failed, _Reader
 
@@ -36,38 +28,6 @@ _LOAD_REQUIRED = {"spring": ("body1", "point1", "body2", "point2"),
 class _LoadsDrives(_Reader):
     """Reads the elements of the ``[[loads]]`` and ``[[drives]]`` tables."""
 
-    # ------------------------------------------------------------ loads and drives
-    def variable_kind(self, var: str, *path) -> str:
-        """Kind of quantity of a table's variable (:func:`mechdyn.model.variable.parse`):
-        time, a coordinate or its rate, a joint, an angle, a point coordinate, a distance."""
-        try:
-            v = parse(var, self.coord_kinds)
-        except ModelError:
-            valid = ["t", *self.coord_kinds, *(f"{c}_dot" for c in self.coord_kinds),
-                     "joint:NAME", "angle:BODY", "BODY.POINT.x", "BODY.POINT.y",
-                     "dist(BODY.POINT, BODY.POINT)"]
-            self.problem(f"{self.where(*path)}: {var!r}: unknown variable; valid variables: "
-                         + ", ".join(repr(v) for v in valid))
-            raise _Failed from None
-        if v.kind == "time":
-            return "time"
-        if v.kind == "coordinate":
-            return self.coord_value_kind(v.name, v.rate)
-        if v.kind == "joint":
-            kinds = {"revolute": "angle", "prismatic": "length"}
-            if self.joint_types.get(v.name) not in kinds:
-                self.problem(f"{self.where(*path)}: {var!r}: " + did_you_mean(
-                    v.name, [j for j, t in self.joint_types.items() if t in kinds],
-                    "revolute or prismatic joint"))
-                raise _Failed
-            return kinds[self.joint_types[v.name]]
-        if v.kind == "angle":
-            self.body_name(v.name, *path)
-            return "angle"
-        for body, point in v.points:
-            self.point_ref(self.body_name(body, *path), point, *path)
-        return "length"
-
     def value(self, raw: Any, kind: str, *path):
         """A constant, a ``{x, y, variable}`` table or a ``{pulse, start, duration}`` pulse
         (either with an optional ``period`` of the variable)."""
@@ -75,16 +35,12 @@ class _LoadsDrives(_Reader):
             return self.quantity(raw, kind, *path)
         var = raw.get("variable", "t")
         vkind = self.variable_kind(var, *path, "variable")
-        period, bad_period = None, False
-        if "period" in raw:
-            try:
-                period = self.quantity(raw["period"], vkind, *path, "period")
-            except _Failed:
-                bad_period = True
-            if period is not None and not period > 0:
-                self.problem(f"{self.where(*path, 'period')}: the period of the table over "
-                             f"{var!r} must be > 0, got {raw['period']!r}")
-                period, bad_period = None, True
+        period = self.opt(raw, "period", vkind, *path, default=None)
+        bad_period = "period" in raw and period is None
+        if period is not None and not period > 0:
+            self.problem(f"{self.where(*path, 'period')}: the period of the table over "
+                         f"{var!r} must be > 0, got {raw['period']!r}")
+            period, bad_period = None, True
         if "pulse" in raw:
             mag = self.quantity(raw["pulse"], kind, *path, "pulse")
             start = self.quantity(raw["start"], vkind, *path, "start")
@@ -102,32 +58,15 @@ class _LoadsDrives(_Reader):
                              + (f" + 2 x {raw['ramp']!r}" if "ramp" in raw else "") + ")")
                 raise _Failed
             return pulse(mag, start, dur, var, ramp, period)
-        xs, ys, failed = [], [], bad_period
-        for key, kk, out in (("x", vkind, xs), ("y", kind, ys)):
-            for i, v in enumerate(raw[key]):
-                try:
-                    out.append(self.quantity(v, kk, *path, key, i))
-                except _Failed:
-                    failed = True
-        outside = None
-        if "outside" in raw:
-            outside = self.quantity(raw["outside"], kind, *path, "outside")
-        if failed:
-            raise _Failed
-        return self.table(xs, ys, var, outside, *path, period=period,
-                          period_text=raw.get("period"))
-
-    def table(self, xs, ys, var, outside, *path, period=None, period_text=None):
-        if len(xs) != len(ys):
-            self.problem(f"{self.where(*path)}: x has {len(xs)} values but y has {len(ys)}")
-            raise _Failed
-        if any(b <= a for a, b in zip(xs, xs[1:], strict=False)):
-            self.problem(f"{self.where(*path, 'x')}: the values must increase strictly")
+        xs, ys = self.columns(raw, (("x", vkind), ("y", kind)), *path)
+        outside = (self.quantity(raw["outside"], kind, *path, "outside")
+                   if "outside" in raw else None)
+        if bad_period or xs is None:
             raise _Failed
         if period is not None and len(xs) >= 2 and period < (xs[-1] - xs[0]) * (1 - 1e-12):
             self.problem(f"{self.where(*path, 'period')}: the period of the table over {var!r} "
-                         f"({period_text!r} = {period:.6g} SI) is shorter than the table's "
-                         f"span x[-1] - x[0] = {xs[-1] - xs[0]:.6g} SI")
+                         f"({raw.get('period')!r} = {period:.6g} SI) is shorter than the "
+                         f"table's span x[-1] - x[0] = {xs[-1] - xs[0]:.6g} SI")
             raise _Failed
         try:
             return Table(tuple(xs), tuple(ys), var, outside, period)
@@ -135,54 +74,55 @@ class _LoadsDrives(_Reader):
             self.problem(f"{self.where(*path)}: {exc}")
             raise _Failed from None
 
+    def columns(self, raw: dict, cols, *path):
+        """The lists ``raw[key]`` of the two (key, kind) ``cols`` in SI, of equal length, the
+        first strictly increasing; (None, None) if a value could not be read."""
+        (kx, x_kind), (ky, y_kind) = cols
+        xs = [self.soft(self.quantity, v, x_kind, *path, kx, i) for i, v in enumerate(raw[kx])]
+        ys = [self.soft(self.quantity, v, y_kind, *path, ky, i) for i, v in enumerate(raw[ky])]
+        if None in xs or None in ys:
+            return None, None
+        if len(xs) != len(ys):
+            self.problem(f"{self.where(*path)}: {kx} has {len(xs)} values but {ky} has "
+                         f"{len(ys)}")
+            raise _Failed
+        if any(b <= a for a, b in zip(xs, xs[1:], strict=False)):
+            self.problem(f"{self.where(*path, kx)}: the values must increase strictly")
+            raise _Failed
+        return xs, ys
+
     def load(self, k: int, spec: dict):
         P = ("loads", k)
         typ = spec["type"]
         name = spec.get("name", f"{typ}_{k + 1}")
-        failed = False
 
-        def q(key, kind, default=0.0, nonneg=False, unit=""):
-            nonlocal failed
-            if key not in spec:
-                return default
-            try:
-                v = self.quantity(spec[key], kind, *P, key)
-                return self.nonneg(v, spec[key], unit, *P, key) if nonneg else v
-            except _Failed:
-                failed = True
-                return default
+        def q(key, kind, nonneg=False):
+            return self.opt(spec, key, kind, *P, nonneg=nonneg)
 
-        def body_point(bkey, pkey, default="com"):
-            nonlocal failed
-            try:
-                b = self.body_name(spec[bkey], *P, bkey)
-            except _Failed:
-                failed = True
-                return None, None
-            if pkey not in spec:
-                return b, default
-            try:
-                return b, self.point_ref(b, spec[pkey], *P, pkey)
-            except _Failed:
-                failed = True
-                return b, None
+        def body_point(bkey, pkey):
+            b = self.soft(self.body_name, spec[bkey], *P, bkey)
+            if b is None or pkey not in spec:
+                return b, (None if b is None else "com")
+            return b, self.soft(self.point_ref, b, spec[pkey], *P, pkey)
+
+        def no_stiffness(damper, spring, extra):
+            if typ == damper and "stiffness" in spec:
+                self.problem(f"{self.where(*P, 'stiffness')}: a {damper} has no stiffness; use "
+                             f"type = '{spring}' with a damping value{extra}")
+                self.failed = True
 
         if typ in ("spring", "damper"):
             b1, p1 = body_point("body1", "point1")
             b2, p2 = body_point("body2", "point2")
-            stiff = q("stiffness", "stiffness", nonneg=True, unit="N/m")
-            if typ == "damper" and "stiffness" in spec:
-                self.problem(f"{self.where(*P, 'stiffness')}: a damper has no stiffness; use "
-                             "type = 'spring' with a damping value for a spring-damper")
-                failed = True
-            free = q("free_length", "length", nonneg=True, unit="m")
-            damp = q("damping", "damping", nonneg=True, unit="N*s/m")
+            stiff = q("stiffness", "stiffness", nonneg=True)
+            no_stiffness("damper", "spring", " for a spring-damper")
+            free = q("free_length", "length", nonneg=True)
+            damp = q("damping", "damping", nonneg=True)
             pre = q("preload", "force")
             if b1 is not None and b1 == b2:
                 self.problem(f"{self.where(*P)}: body1 and body2 are the same body {b1!r}")
-                failed = True
-            if failed:
-                raise _Failed
+                self.failed = True
+            self.check()
             return Spring(name, b1, p1, b2, p2, stiff, free, damp, pre)
         if typ in ("rotary_spring", "rotary_damper"):
             joint = spec["joint"]
@@ -196,54 +136,30 @@ class _LoadsDrives(_Reader):
                 else:
                     self.problem(f"{self.where(*P, 'joint')}: "
                                  + did_you_mean(joint, revs, "revolute joint"))
-                failed = True
-            stiff = q("stiffness", "rotational_stiffness", nonneg=True, unit="N*m/rad")
-            if typ == "rotary_damper" and "stiffness" in spec:
-                self.problem(f"{self.where(*P, 'stiffness')}: a rotary_damper has no stiffness; "
-                             "use type = 'rotary_spring' with a damping value")
-                failed = True
+                self.failed = True
+            stiff = q("stiffness", "rotational_stiffness", nonneg=True)
+            no_stiffness("rotary_damper", "rotary_spring", "")
             free = q("free_angle", "angle")
-            damp = q("damping", "rotational_damping", nonneg=True, unit="N*m*s/rad")
+            damp = q("damping", "rotational_damping", nonneg=True)
             pre = q("preload", "torque")
-            if failed:
-                raise _Failed
+            self.check()
             return RotarySpring(name, joint, stiff, free, damp, pre)
         if typ == "force":
             b, p = body_point("body", "point")
-            mag = None
-            try:
-                mag = self.value(spec["magnitude"], "force", *P, "magnitude")
-            except _Failed:
-                failed = True
-            direction = (1.0, 0.0)
+            mag = self.soft(self.value, spec["magnitude"], "force", *P, "magnitude")
             frame = spec.get("frame", "ground")
+            direction = (1.0, 0.0)
             if "direction" in spec and b is not None:
-                try:
-                    direction = self.direction(b if frame == "body" else GROUND,
-                                               spec["direction"], *P, "direction")
-                except _Failed:
-                    failed = True
-            if failed:
-                raise _Failed
+                direction = self.soft(self.direction, b if frame == "body" else GROUND,
+                                      spec["direction"], *P, "direction", default=direction)
+            self.check()
             return Force(name, b, p, mag, direction, frame)
-        # torque
-        try:
-            b = self.body_name(spec["body"], *P, "body", ground_ok=False)
-        except _Failed:
-            b, failed = None, True
+        b = self.soft(self.body_name, spec["body"], *P, "body", ground_ok=False)
         rb = None
         if "reaction_body" in spec:
-            try:
-                rb = self.body_name(spec["reaction_body"], *P, "reaction_body")
-            except _Failed:
-                failed = True
-        mag = None
-        try:
-            mag = self.value(spec["magnitude"], "torque", *P, "magnitude")
-        except _Failed:
-            failed = True
-        if failed:
-            raise _Failed
+            rb = self.soft(self.body_name, spec["reaction_body"], *P, "reaction_body")
+        mag = self.soft(self.value, spec["magnitude"], "torque", *P, "magnitude")
+        self.check()
         return Torque(name, b, mag, rb)
 
     def drive(self, k: int, spec: dict) -> Drive:
@@ -255,10 +171,8 @@ class _LoadsDrives(_Reader):
                          + did_you_mean(coord, self.coord_kinds, "coordinate"))
             raise _Failed
         if "type" in spec:  # a motor model (induction motor, DC motor, ...)
-            table = dict(spec)
-            table.setdefault("name", name)
             try:
-                return drive_from_table(table, where=self.where(*P))
+                return drive_from_table({"name": name, **spec}, where=self.where(*P))
             except ModelError as exc:
                 for p in exc.problems:
                     self.problem(p)
@@ -270,22 +184,7 @@ class _LoadsDrives(_Reader):
         raw = spec["torque"]
         if isinstance(raw, dict) and "omega" in raw:
             wkind = "velocity" if travel else "angular_velocity"
-            ws, ms, failed = [], [], False
-            for key, kk, out in (("omega", wkind, ws), ("torque", tkind, ms)):
-                for i, v in enumerate(raw[key]):
-                    try:
-                        out.append(self.quantity(v, kk, *P, "torque", key, i))
-                    except _Failed:
-                        failed = True
-            if failed:
-                raise _Failed
-            if len(ws) != len(ms):
-                self.problem(f"{self.where(*P, 'torque')}: omega has {len(ws)} values but "
-                             f"torque has {len(ms)}")
-                raise _Failed
-            if any(b <= a for a, b in zip(ws, ws[1:], strict=False)):
-                self.problem(f"{self.where(*P, 'torque', 'omega')}: the speeds must increase "
-                             "strictly")
-                raise _Failed
+            ws, ms = self.columns(raw, (("omega", wkind), ("torque", tkind)), *P, "torque")
+            self.check()
             return Drive(name, coord, TorqueSpeedCurve(tuple(ws), tuple(ms)))
         return Drive(name, coord, self.value(raw, tkind, *P, "torque"))

@@ -3,16 +3,8 @@
 Holds the document being read, the problems found in it so far and the names
 read from it (bodies and their points, sketch frames, joint types, coordinate
 kinds), with the helpers that read one value (a quantity, a vector, a body or
-point name, a direction) and record its problem instead of raising it.
-
-Private names
--------------
-_Reader
-    The base of the table readers (:mod:`.bodies_joints`, :mod:`.loads_drives`,
-    :mod:`.initial_assembly`), which :class:`mechdyn.modelfile.loader._Builder`
-    combines.
-_Failed
-    Raised when a value cannot be read; its problem is already recorded.
+point name, a direction) and record its problem instead of raising it
+(:class:`_Failed` then says the problem is recorded).
 """
 
 from __future__ import annotations
@@ -21,9 +13,10 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from ..errors import UnitError, did_you_mean
-from ..mechanism import GROUND
-from ..units import parse_quantity, parse_vector
+from ..errors import ModelError, UnitError, did_you_mean
+from ..mechanism.body import GROUND, unknown_point
+from ..model.variable import parse
+from ..units import KINDS, parse_quantity, parse_vector
 from .schema import locate
 
 
@@ -45,6 +38,8 @@ class _Reader:
         self.sketch_frames: dict[str, tuple[float, float, float]] = {}
         self.joint_types: dict[str, str] = {}
         self.coord_kinds: dict[str, str] = {}
+        #: a problem was recorded in the element being read
+        self.failed = False
 
     # ------------------------------------------------------------ helpers
     def where(self, *path) -> str:
@@ -65,40 +60,75 @@ class _Reader:
         clean = {k: v for k, v in spec.items() if not self.broken(*path, k)}
         if any(k not in clean for k in required):
             raise _Failed
+        self.failed = False
         try:
             el = fn(path[-1], clean)
         except (ValueError, TypeError) as exc:  # an element's own check; keep it readable
             self.problem(f"{self.where(*path)}: {exc}")
             raise _Failed from None
-        if self.broken(*path):
+        if self.failed or self.broken(*path):
             raise _Failed
         return el
+
+    def soft(self, fn, *args, default=None, **kwargs):
+        """``fn(*args, **kwargs)``, or ``default`` if it fails: the problem is recorded
+        and the element being read is marked :attr:`failed`."""
+        try:
+            return fn(*args, **kwargs)
+        except _Failed:
+            self.failed = True
+            return default
+
+    def check(self):
+        """Raise :class:`_Failed` if a problem was recorded in the element being read."""
+        if self.failed:
+            raise _Failed
+
+    def opt(self, spec: dict, key: str, kind, *path, default=0.0, read=None, **kwargs):
+        """``spec[key]`` read at ``path`` by ``read`` (default :meth:`quantity`) as ``kind``;
+        ``default`` if the key is absent or unreadable (then the element is failed)."""
+        if key not in spec:
+            return default
+        return self.soft(read or self.quantity, spec[key], kind, *path, key, default=default,
+                         **kwargs)
 
     def problem(self, msg: str):
         if msg not in self.problems:
             self.problems.append(msg)
 
-    def quantity(self, value: Any, kind: str, *path) -> float:
+    def _units(self, parse, *args, **kwargs):
+        """``parse(*args, **kwargs)`` of :mod:`mechdyn.units`, its UnitError recorded."""
         try:
-            return parse_quantity(value, kind, where=self.where(*path))
+            return parse(*args, **kwargs)
         except UnitError as exc:
             self.problem(str(exc))
             self.unit_problems.add(str(exc))
             raise _Failed from None
+
+    def quantity(self, value: Any, kind: str, *path, nonneg: bool = False) -> float:
+        out = self._units(parse_quantity, value, kind, where=self.where(*path))
+        if nonneg and out < 0:
+            self.problem(f"{self.where(*path)}: {value!r}: {path[-1]} must be >= 0 "
+                         f"{KINDS[kind].si}")
+            raise _Failed
+        return out
 
     def vector(self, value: Any, kind, *path, size: int | None = None) -> tuple[float, ...]:
-        try:
-            return parse_vector(value, kind, self.where(*path), size=size)
-        except UnitError as exc:
-            self.problem(str(exc))
-            self.unit_problems.add(str(exc))
-            raise _Failed from None
+        return self._units(parse_vector, value, kind, self.where(*path), size=size)
 
-    def nonneg(self, value: float, raw: Any, unit: str, *path) -> float:
-        if value < 0:
-            self.problem(f"{self.where(*path)}: {raw!r}: {path[-1]} must be >= 0 {unit}")
-            raise _Failed
-        return value
+    def points(self, raw: Any, *path, hint: str) -> dict[str, tuple[float, float]]:
+        """The named points of the table ``raw`` at ``path`` (m); ``"com"`` is reserved."""
+        pts = {}
+        for pname, val in (raw if isinstance(raw, dict) else {}).items():
+            if pname == "com" and not self.broken(*path, pname):
+                self.problem(f"{self.where(*path, pname)}: the point name 'com' is reserved{hint}")
+            if pname == "com" or self.broken(*path, pname):
+                self.failed = True
+                continue
+            xy = self.soft(self.vector, val, "length", *path, pname)
+            if xy is not None:
+                pts[pname] = xy
+        return pts
 
     def body_name(self, value: str, *path, ground_ok: bool = True) -> str:
         valid = [b for b in self.body_points if b != GROUND] + ([GROUND] if ground_ok else [])
@@ -112,20 +142,16 @@ class _Reader:
         if isinstance(value, str) and not value.lstrip().startswith("("):
             names = self.body_points.get(body, [])
             if value not in names:
-                self.problem(f"{self.where(*path)}: unknown point {value!r} of body {body!r}; "
-                             "valid point names: " + ", ".join(repr(p) for p in names))
+                self.problem(f"{self.where(*path)}: " + unknown_point(value, body, names))
                 raise _Failed
             return value
         xy = self.vector(value, "length", *path)
         return self.to_body_frame(body, xy)
 
-    def to_body_frame(self, body: str, xy) -> tuple[float, float]:
-        """Coordinates given in a body's input frame -> its body frame."""
-        fr = self.sketch_frames.get(body)
-        if fr is None:
-            return (float(xy[0]), float(xy[1]))
-        ox, oy, th = fr
-        dx, dy = xy[0] - ox, xy[1] - oy
+    def to_body_frame(self, body: str, xy, origin: bool = True) -> tuple[float, float]:
+        """Coordinates (a direction, without ``origin``) in a body's input frame -> its frame."""
+        ox, oy, th = self.sketch_frames.get(body, (0.0, 0.0, 0.0))
+        dx, dy = (float(xy[0]) - ox, float(xy[1]) - oy) if origin else xy
         c, s = math.cos(th), math.sin(th)
         return (c * dx + s * dy, -s * dx + c * dy)
 
@@ -133,16 +159,46 @@ class _Reader:
         """A direction: [x, y] numbers or an angle string, in the body's input frame."""
         if isinstance(value, str):
             a = self.quantity(value, "angle", *path)
-            d = (math.cos(a), math.sin(a))
-        else:
-            d = (float(value[0]), float(value[1]))
-            if not all(math.isfinite(v) for v in d) or math.hypot(*d) == 0:
-                self.problem(f"{self.where(*path)}: {value!r}: must be a non-zero direction "
-                             "[x, y]")
+            return self.to_body_frame(body, (math.cos(a), math.sin(a)), origin=False)
+        d = (float(value[0]), float(value[1]))
+        if not all(math.isfinite(v) for v in d) or math.hypot(*d) == 0:
+            self.problem(f"{self.where(*path)}: {value!r}: must be a non-zero direction [x, y]")
+            raise _Failed
+        return self.to_body_frame(body, d, origin=False)
+
+    def variable_kind(self, var, *path) -> str:
+        """Kind of quantity of a table's variable (:func:`mechdyn.model.variable.parse`):
+        time, a coordinate or its rate, a joint, an angle, a point coordinate, a distance."""
+        if not isinstance(var, str):
+            self.problem(f"{self.where(*path)}: expected a variable name (string), got {var!r}")
+            raise _Failed
+        try:
+            v = parse(var, self.coord_kinds)
+        except ModelError:
+            valid = ["t", *self.coord_kinds, *(f"{c}_dot" for c in self.coord_kinds),
+                     "joint:NAME", "angle:BODY", "BODY.POINT.x", "BODY.POINT.y",
+                     "dist(BODY.POINT, BODY.POINT)"]
+            self.problem(f"{self.where(*path)}: {var!r}: unknown variable; valid variables: "
+                         + ", ".join(repr(v) for v in valid))
+            raise _Failed from None
+        if v.kind == "time":
+            return "time"
+        if v.kind == "coordinate":
+            return self.coord_value_kind(v.name, v.rate)
+        if v.kind == "joint":
+            kinds = {"revolute": "angle", "prismatic": "length"}
+            if self.joint_types.get(v.name) not in kinds:
+                self.problem(f"{self.where(*path)}: {var!r}: " + did_you_mean(
+                    v.name, [j for j, t in self.joint_types.items() if t in kinds],
+                    "revolute or prismatic joint"))
                 raise _Failed
-        th = self.sketch_frames.get(body, (0.0, 0.0, 0.0))[2]
-        c, s = math.cos(th), math.sin(th)
-        return (c * d[0] + s * d[1], -s * d[0] + c * d[1])
+            return kinds[self.joint_types[v.name]]
+        if v.kind == "angle":
+            self.body_name(v.name, *path)
+            return "angle"
+        for body, point in v.points:
+            self.point_ref(self.body_name(body, *path), point, *path)
+        return "length"
 
     def section(self, key: str, kind: type = dict):
         val = self.doc.get(key, kind())

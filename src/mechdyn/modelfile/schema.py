@@ -21,7 +21,7 @@ __all__ = ["schema", "schema_problems", "locate", "toml_type"]
 #: top-level tables whose sub-tables are named elements ([bodies.NAME], ...)
 _NAMED_SECTIONS = ("bodies", "joints", "coordinates")
 #: top-level arrays of tables ([[loads]], ...)
-_ARRAY_SECTIONS = ("loads", "drives")
+_ARRAY_SECTIONS = ("loads", "drives", "coordinate_locks", "stops", "contacts", "switches")
 
 
 @lru_cache(maxsize=1)
@@ -38,21 +38,13 @@ def _validator():
     return Draft202012Validator(schema())
 
 
+_TOML_TYPES = ((bool, "a boolean"), (int, "an integer"), (float, "a float"), (str, "a string"),
+               (dict, "a table"), (list, "an array"))
+
+
 def toml_type(value: Any) -> str:
     """How a value is called in TOML words (for messages)."""
-    if isinstance(value, bool):
-        return "a boolean"
-    if isinstance(value, int):
-        return "an integer"
-    if isinstance(value, float):
-        return "a float"
-    if isinstance(value, str):
-        return "a string"
-    if isinstance(value, dict):
-        return "a table"
-    if isinstance(value, list):
-        return "an array"
-    return type(value).__name__
+    return next((w for t, w in _TOML_TYPES if isinstance(value, t)), type(value).__name__)
 
 
 def _show(value: Any) -> str:
@@ -105,7 +97,7 @@ def locate(fname: str, path: Sequence, doc: Any = None) -> str:
             key += f"[{p}]"
         else:
             key += ("." if key else "") + str(p)
-    return f"{fname}: {label}" + (f" {key}" if key else "")
+    return (f"{fname}: " if fname else "") + label + (f" {key}" if key else "")
 
 
 def _property_hint(sch: dict, key: str) -> str:
@@ -113,10 +105,6 @@ def _property_hint(sch: dict, key: str) -> str:
     if isinstance(prop, dict) and prop.get("description"):
         return f" ({prop['description']})"
     return ""
-
-
-def _valid_keys(sch: dict) -> list[str]:
-    return [k for k in sch.get("properties", {})]
 
 
 def _message(err, fname: str, doc: Any) -> str:
@@ -130,7 +118,7 @@ def _message(err, fname: str, doc: Any) -> str:
         what = "table" if not path else "key"
         return f"{where}: missing {what} {key!r}{_property_hint(err.schema, key)}"
     if v == "additionalProperties":
-        valid = _valid_keys(err.schema)
+        valid = list(err.schema.get("properties", {}))
         extra = [k for k in inst if k not in valid] if isinstance(inst, dict) else []
         what = "table" if not path else "key"
         names = ", ".join(repr(k) for k in extra) or "?"
