@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import base64
 import html
-import io
 import tempfile
 from dataclasses import fields, is_dataclass
 from datetime import datetime
@@ -34,6 +33,7 @@ from .animate import animate, snapshot
 from .plot import plot_kinematic_sweep
 from .plot_dynamics import plot_trajectory
 from .plot_kinetostatics import plot_kinetostatics
+from .table import output_path, rate_text
 
 __all__ = ["write_report", "report_trajectory", "model_tables"]
 
@@ -60,41 +60,29 @@ def _esc(text) -> str:
     return html.escape(str(text))
 
 
-def _table(df, *, digits: int = 6) -> str:
-    """A DataFrame as an HTML table (numbers to ``digits`` significant digits)."""
-    return df.to_html(index=False, border=0, na_rep="",
-                      float_format=lambda v: f"{v:.{digits}g}")
+def _table(title: str | None, df, *, digits: int = 6) -> str:
+    """A heading (if any) and a DataFrame as an HTML table (``digits`` significant digits)."""
+    head = f"<h3>{_esc(title)}</h3>\n" if title else ""
+    return head + df.to_html(index=False, border=0, na_rep="",
+                             float_format=lambda v: f"{v:.{digits}g}")
 
 
-def _img_png(data: bytes, alt: str) -> str:
-    b64 = base64.b64encode(data).decode("ascii")
-    return f'<img alt="{_esc(alt)}" src="data:image/png;base64,{b64}">'
-
-
-def _img_gif(data: bytes, alt: str) -> str:
-    b64 = base64.b64encode(data).decode("ascii")
-    return f'<img alt="{_esc(alt)}" src="data:image/gif;base64,{b64}">'
-
-
-def _plot_png(fn, record, **kwargs) -> bytes:
-    """Run a ``plot_*(record, path, ...)`` function into a temporary PNG; its bytes."""
+def _img(draw, alt: str, kind: str = "png") -> str:
+    """An embedded image drawn by ``draw(path)`` into a temporary ``.png`` or ``.gif`` file."""
     with tempfile.TemporaryDirectory() as tmp:
-        p = Path(tmp) / "plot.png"
-        fn(record, p, **kwargs)
-        return p.read_bytes()
+        p = Path(tmp) / f"image.{kind}"
+        draw(p)
+        b64 = base64.b64encode(p.read_bytes()).decode("ascii")
+    return f'<img alt="{_esc(alt)}" src="data:image/{kind};base64,{b64}">'
 
 
-def _snapshot_png(record, index: int = 0, **kwargs) -> bytes:
-    buf = io.BytesIO()
-    snapshot(record, buf, index, **kwargs)
-    return buf.getvalue()
-
-
-def _animation_gif(record, frames: int = 72, **kwargs) -> bytes:
-    with tempfile.TemporaryDirectory() as tmp:
-        p = Path(tmp) / "motion.gif"
-        animate(record, p, frames=frames, dpi=60, **kwargs)
-        return p.read_bytes()
+def _drawing(record, alt: str, *, animation: bool, trace) -> list[str]:
+    """The first frame of a record's motion and, with ``animation``, the GIF of it."""
+    out = ["<h3>Drawing</h3>", _img(lambda p: snapshot(record, p, 0, trace=trace), alt)]
+    if animation:
+        out.append(_img(lambda p: animate(record, p, frames=72, dpi=60, trace=trace),
+                        "the motion", "gif"))
+    return out
 
 
 def _page(title: str, sections: list[str]) -> str:
@@ -109,9 +97,7 @@ def _page(title: str, sections: list[str]) -> str:
 
 
 def _write(path, text: str) -> Path:
-    path = Path(path)
-    if path.parent and not path.parent.exists():
-        path.parent.mkdir(parents=True, exist_ok=True)
+    path = output_path(path)
     path.write_text(text, encoding="utf-8")
     return path
 
@@ -204,17 +190,13 @@ def model_tables(model) -> dict:
     rows = []
     for name, j in mech.joints.items():
         kind = model.joint_kind(name)
-        row = {"joint": name, "type": kind, "parent": j.parent, "child": j.child}
-        if kind == "lock":
-            row["parent point"] = ""
-            row["child point"] = ""
-            row["axis / note"] = "engaged" if j.engaged else "released"
-        else:
-            row["parent point"] = _pt_text(j.parent_point)
-            row["child point"] = _pt_text(j.child_point)
-            row["axis / note"] = (f"({j.axis[0]:.4g}, {j.axis[1]:.4g})" if kind == "prismatic"
-                                  else "")
-        rows.append(row)
+        lock = kind == "lock"
+        note = ("engaged" if j.engaged else "released") if lock else (
+            f"({j.axis[0]:.4g}, {j.axis[1]:.4g})" if kind == "prismatic" else "")
+        rows.append({"joint": name, "type": kind, "parent": j.parent, "child": j.child,
+                     "parent point": "" if lock else _pt_text(j.parent_point),
+                     "child point": "" if lock else _pt_text(j.child_point),
+                     "axis / note": note})
     out["joints"] = pd.DataFrame(rows)
 
     try:
@@ -234,16 +216,11 @@ def model_tables(model) -> dict:
                      "initial rate": f"{rate * 30 / np.pi:.6g} rpm" if ang
                      else f"{rate:.6g} m/s"})
     out["coordinates"] = pd.DataFrame(rows)
-    if mech.loads:
-        out["loads"] = pd.DataFrame([{"kind": type(el).__name__,
-                                      "name": getattr(el, "name", ""),
+    for key, elements in (("loads", mech.loads), ("drives", mech.drives)):
+        if elements:
+            out[key] = pd.DataFrame([{"kind": type(el).__name__, "name": getattr(el, "name", ""),
                                       "parameters (SI)": _element_params(el)}
-                                     for el in mech.loads])
-    if mech.drives:
-        out["drives"] = pd.DataFrame([{"kind": type(el).__name__,
-                                       "name": getattr(el, "name", ""),
-                                       "parameters (SI)": _element_params(el)}
-                                      for el in mech.drives])
+                                     for el in elements])
     return out
 
 
@@ -257,9 +234,7 @@ def _model_section(model) -> str:
                  f"coordinates {', '.join(model.coordinate_names)} "
                  f"({mech.dof} degree(s) of freedom); gravity ({g[0]:.4g}, {g[1]:.4g}) "
                  f"m/s&sup2;.</p>")
-    for title, df in model_tables(model).items():
-        parts.append(f"<h3>{_esc(title.capitalize())}</h3>")
-        parts.append(_table(df))
+    parts += [_table(title.capitalize(), df) for title, df in model_tables(model).items()]
     return "\n".join(parts)
 
 
@@ -277,14 +252,11 @@ def _sweep_section(sw, *, animation: bool, trace) -> str:
     ang = sw.over_is_angle
     k = sw.over_index
     rate = float(sw.qdot[0, k]) if len(sw) else 1.0
-    unit_v = ("m/s", "m/s&sup2;")
     parts = ["<h2>Kinematics</h2>"]
     rng = (f"{_at_text(ang, sw.values[0])} to {_at_text(ang, sw.values[-1])}"
            if len(sw) else "no positions")
-    rate_txt = (f"{rate:.6g} rad/s ({rate * 30 / np.pi:.6g} rpm)" if ang
-                else f"{rate:.6g} m/s")
     parts.append(f"<p>Sweep of <code>{_esc(sw.over)}</code> over {rng}, {len(sw)} positions, "
-                 f"at a constant rate of {rate_txt}"
+                 f"at a constant rate of {rate_text(rate, ang)}"
                  + (" &mdash; velocities and accelerations are then the first- and "
                     "second-order velocity analogs." if rate == 1.0 else ".") + "</p>")
     parts.append(_status(sw.status, sw.ok, sw.message))
@@ -300,8 +272,7 @@ def _sweep_section(sw, *, animation: bool, trace) -> str:
                     row[f"{d.label} at"] = _at_text(ang, d.at)
                     row[f"{d.label} travel_mm"] = f"{_mm(d.travel):.4f}"
             rows.append(row)
-        parts.append("<h3>Strokes and dead centres</h3>")
-        parts.append(_table(pd.DataFrame(rows)))
+        parts.append(_table("Strokes and dead centres", pd.DataFrame(rows)))
     if summ.transmission:
         rows = []
         for t in summ.transmission:
@@ -311,14 +282,13 @@ def _sweep_section(sw, *, animation: bool, trace) -> str:
                          "at (min)": _at_text(ang, t.min_at), "mu_max_deg": f"{hi:.3f}",
                          "at (max)": _at_text(ang, t.max_at),
                          "largest deviation from 90 deg": f"{max(90 - lo, hi - 90):.3f}"})
-        parts.append("<h3>Transmission angles</h3>")
-        parts.append(_table(pd.DataFrame(rows)))
+        parts.append(_table("Transmission angles", pd.DataFrame(rows)))
     if summ.extremes:
-        rows = [{"point": f"{e.body}.{e.point}", f"v_max ({unit_v[0]})": e.v_max,
+        rows = [{"point": f"{e.body}.{e.point}", "v_max (m/s)": e.v_max,
                  "at (v)": _at_text(ang, e.v_max_at), "a_max (m/s²)": e.a_max,
                  "at (a)": _at_text(ang, e.a_max_at)} for e in summ.extremes]
-        parts.append("<h3>Extreme speeds and accelerations of the named points</h3>")
-        parts.append(_table(pd.DataFrame(rows)))
+        parts.append(_table("Extreme speeds and accelerations of the named points",
+                            pd.DataFrame(rows)))
     omegas = []
     for b in model.body_names:
         _, om, al = sw.angular(b)
@@ -326,14 +296,10 @@ def _sweep_section(sw, *, animation: bool, trace) -> str:
             omegas.append({"body": b, "omega_min_rad_s": om.min(), "omega_max_rad_s": om.max(),
                            "alpha_min_rad_s2": al.min(), "alpha_max_rad_s2": al.max()})
     if omegas:
-        parts.append("<h3>Angular velocities and accelerations of the bodies</h3>")
-        parts.append(_table(pd.DataFrame(omegas)))
-    parts.append("<h3>Drawing</h3>")
-    parts.append(_img_png(_snapshot_png(sw, 0, trace=trace), "the mechanism"))
-    if animation:
-        parts.append(_img_gif(_animation_gif(sw, trace=trace), "the motion"))
-    parts.append("<h3>Plot</h3>")
-    parts.append(_img_png(_plot_png(plot_kinematic_sweep, sw), "kinematics plot"))
+        parts.append(_table("Angular velocities and accelerations of the bodies",
+                            pd.DataFrame(omegas)))
+    parts += _drawing(sw, "the mechanism", animation=animation, trace=trace)
+    parts += ["<h3>Plot</h3>", _img(lambda p: plot_kinematic_sweep(sw, p), "kinematics plot")]
     return "\n".join(parts)
 
 
@@ -345,11 +311,9 @@ def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
     parts = ["<h2>Kinetostatics</h2>"]
     if ks.n:
         k = ks.coordinate_names.index(ks.over)
-        rate = float(ks.qdot[0, k])
-        rate_txt = (f"{rate:.6g} rad/s ({rate * 30 / np.pi:.6g} rpm)" if ang
-                    else f"{rate:.6g} m/s")
         parts.append(f"<p>Driven coordinate(s) {', '.join(ks.driven)} at constant "
-                     f"{_esc(ks.over)}-rate {rate_txt}, {ks.n} positions; forces include "
+                     f"{_esc(ks.over)}-rate {rate_text(float(ks.qdot[0, k]), ang)}, "
+                     f"{ks.n} positions; forces include "
                      "gravity, inertia and the model's loads.</p>")
     parts.append(_status(ks.status, ks.status in (Status.SUCCESS, Status.REDUNDANT), ks.message))
     if not ks.n:
@@ -363,8 +327,7 @@ def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
                      "at": _at_text(ang, d["peak_abs_at"]), f"max_{u}": d["max"],
                      f"min_{u}": d["min"], f"RMS_{u}": d["rms"], f"mean_{u}": d["mean"],
                      "peak power_W": d["peak_power"]})
-    parts.append("<h3>Driving torque</h3>")
-    parts.append(_table(pd.DataFrame(rows)))
+    parts.append(_table("Driving torque", pd.DataFrame(rows)))
     rows = []
     for j, d in p["joints"].items():
         row = {"joint": j, "type": ks.joint_kinds[j], "peak force_N": d["peak"],
@@ -372,11 +335,9 @@ def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
         if "peak_moment" in d:
             row["peak moment_Nm"] = d["peak_moment"]
         rows.append(row)
-    parts.append("<h3>Peak joint forces</h3>")
-    parts.append(_table(pd.DataFrame(rows)))
+    parts.append(_table("Peak joint forces", pd.DataFrame(rows)))
     fr = p["frame"]
-    parts.append("<h3>Frame (shaking) loads</h3>")
-    parts.append(_table(pd.DataFrame([
+    parts.append(_table("Frame (shaking) loads", pd.DataFrame([
         {"quantity": "|F| frame (N)", "min": np.nan, "max": fr["force_peak"],
          "peak at": _at_text(ang, fr["force_peak_at"])},
         {"quantity": "Fx frame (N)", "min": fr["Fx_min"], "max": fr["Fx_max"], "peak at": ""},
@@ -394,14 +355,12 @@ def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
             for c in ("Fx_frame_N", "Fy_frame_N", "M_frame_Nm"):  # round-off noise -> 0
                 a = h[c].to_numpy()
                 h[c] = np.where(np.abs(a) < 1e-9 * max(np.max(np.abs(a)), 1e-300), 0.0, a)
-            parts.append("<h3>Harmonics of the shaking force and moment</h3>")
-            parts.append('<p class="note">Amplitudes per order of the crank turn '
-                         "(order 0: the mean).</p>")
-            parts.append(_table(h))
+            parts += ["<h3>Harmonics of the shaking force and moment</h3>",
+                      '<p class="note">Amplitudes per order of the crank turn '
+                      "(order 0: the mean).</p>", _table(None, h)]
     for w in ks.warnings:
         parts.append(f'<p class="note">Warning: {_esc(w)}</p>')
-    parts.append("<h3>Plot</h3>")
-    parts.append(_img_png(_plot_png(plot_kinetostatics, ks), "kinetostatics plot"))
+    parts += ["<h3>Plot</h3>", _img(lambda p: plot_kinetostatics(ks, p), "kinetostatics plot")]
     return "\n".join(parts)
 
 
@@ -482,60 +441,46 @@ def report_trajectory(traj, path, *, title: str | None = None, animation: bool =
            "wall time_s": s.get("wall_time_s"), "samples": traj.n_samples}
     if traj.t.size:
         run["t start_s"], run["t end_s"] = float(traj.t[0]), float(traj.t[-1])
-    parts.append("<h3>Run</h3>")
-    parts.append(_table(pd.DataFrame([{"quantity": k, "value": v} for k, v in run.items()
-                                      if v is not None]).astype({"value": str})))
+    parts.append(_table("Run", pd.DataFrame([{"quantity": k, "value": v} for k, v in run.items()
+                                             if v is not None]).astype({"value": str})))
     if traj.t.size:
         rows = []
         for k, c in enumerate(traj.coordinate_names):
             ang = traj.coordinate_is_angle[k] if traj.coordinate_is_angle else True
             f, u, ur = (np.rad2deg(1.0), "deg", "rpm") if ang else (1e3, "mm", "m/s")
             fr = 30 / np.pi if ang else 1.0
+            qd = traj.qdot[:, k]
             rows.append({"coordinate": c, f"start ({u})": traj.q[0, k] * f,
-                         f"end ({u})": traj.q[-1, k] * f,
-                         f"start rate ({ur})": traj.qdot[0, k] * fr,
-                         f"end rate ({ur})": traj.qdot[-1, k] * fr,
-                         f"min rate ({ur})": traj.qdot[:, k].min() * fr,
-                         f"max rate ({ur})": traj.qdot[:, k].max() * fr})
-        parts.append("<h3>Coordinates</h3>")
-        parts.append(_table(pd.DataFrame(rows), digits=9))
+                         f"end ({u})": traj.q[-1, k] * f, f"start rate ({ur})": qd[0] * fr,
+                         f"end rate ({ur})": qd[-1] * fr, f"min rate ({ur})": qd.min() * fr,
+                         f"max rate ({ur})": qd.max() * fr})
+        parts.append(_table("Coordinates", pd.DataFrame(rows), digits=9))
     if traj.energy and traj.t.size:
         e = traj.energy
-        parts.append("<h3>Energy balance</h3>")
-        parts.append(_table(pd.DataFrame([
-            {"quantity": "kinetic energy T_J", "start": e["kinetic"][0], "end": e["kinetic"][-1]},
-            {"quantity": "potential energy U_J", "start": e["potential"][0],
-             "end": e["potential"][-1]},
-            {"quantity": "work of non-conservative forces W_nc_J", "start": e["work_nc"][0],
-             "end": e["work_nc"][-1]},
-            {"quantity": "balance T + U - W_nc_J", "start": e["balance"][0],
-             "end": e["balance"][-1]}]), digits=9))
+        rows = [{"quantity": q, "start": e[key][0], "end": e[key][-1]} for q, key in (
+            ("kinetic energy T_J", "kinetic"), ("potential energy U_J", "potential"),
+            ("work of non-conservative forces W_nc_J", "work_nc"),
+            ("balance T + U - W_nc_J", "balance"))]
+        parts.append(_table("Energy balance", pd.DataFrame(rows), digits=9))
         parts.append(f"<p>The balance drifts by at most {traj.energy_drift():.3e} J; the "
                      f"largest constraint residual is {np.max(e['residual']):.3e} "
                      "(m or rad).</p>")
     parts.append("<h3>Events</h3>")
     if traj.events:
-        rows = []
-        for ev in traj.events[:max_events]:
-            row = {"t_s": getattr(ev, "t", np.nan),
-                   "kind": getattr(ev, "kind", type(ev).__name__),
-                   "element": getattr(ev, "element", getattr(ev, "name", "")),
-                   "mode after": " ".join(sorted(getattr(ev, "mode_after", ()) or ())),
-                   "energy lost_J": getattr(ev, "energy_lost", 0.0)}
-            rows.append(row)
-        parts.append(_table(pd.DataFrame(rows), digits=9))
+        rows = [{"t_s": getattr(ev, "t", np.nan), "kind": getattr(ev, "kind", type(ev).__name__),
+                 "element": getattr(ev, "element", getattr(ev, "name", "")),
+                 "mode after": " ".join(sorted(getattr(ev, "mode_after", ()) or ())),
+                 "energy lost_J": getattr(ev, "energy_lost", 0.0)}
+                for ev in traj.events[:max_events]]
+        parts.append(_table(None, pd.DataFrame(rows), digits=9))
         if len(traj.events) > max_events:
             parts.append(f'<p class="note">{len(traj.events) - max_events} more events '
                          "not listed.</p>")
     else:
         parts.append("<p>No events.</p>")
     if model is not None and traj.t.size:
-        parts.append("<h3>Drawing</h3>")
-        parts.append(_img_png(_snapshot_png(traj, 0, trace=trace), "the mechanism at the start"))
-        if animation:
-            parts.append(_img_gif(_animation_gif(traj, trace=trace), "the motion"))
+        parts += _drawing(traj, "the mechanism at the start", animation=animation, trace=trace)
     if traj.t.size:
-        parts.append("<h3>Plot</h3>")
-        parts.append(_img_png(_plot_png(plot_trajectory, traj), "trajectory plot"))
+        parts += ["<h3>Plot</h3>", _img(lambda p: plot_trajectory(traj, p), "trajectory plot")]
     sections.append("\n".join(parts))
     return _write(path, _page(title or f"{name}: simulation report", sections))
