@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError
+from .table import deg_or_mm, output_path, rate_text
 
 __all__ = ["plot", "plot_kinematic_sweep", "PLOTTERS"]
 
@@ -31,9 +32,7 @@ def _figure(n_rows: int, width: float = 8.0, height: float = 2.6):
 
 
 def _save(fig, path, dpi) -> Path:
-    path = Path(path)
-    if path.parent and not path.parent.exists():
-        path.parent.mkdir(parents=True, exist_ok=True)
+    path = output_path(path)
     fig.savefig(path, dpi=dpi)
     return path
 
@@ -97,7 +96,7 @@ def plot_kinematic_sweep(sweep, path, points: Iterable | None = None, *,
     model = sweep.model
     pts = _parse_points(model, points) if points is not None else _default_points(model)
     angle = sweep.over_is_angle
-    xs = np.rad2deg(sweep.values) if angle else sweep.values * 1e3
+    xs, xunit = deg_or_mm(sweep.values, angle)
     fig, axes = _figure(3)
     scale = model.length_scale
     rows = [("position", "m", 0), ("velocity", "m/s", 1), ("acceleration", "m/s²", 2)]
@@ -114,13 +113,10 @@ def plot_kinematic_sweep(sweep, path, points: Iterable | None = None, *,
         ax.axhline(0.0, color="0.6", lw=0.6)
         if ax.lines[1:]:
             ax.legend(fontsize="small", loc="best")
-    axes[-1].set_xlabel(f"{sweep.over} ({'deg' if angle else 'mm'})")
-    k = sweep.over_index
-    rate = float(sweep.qdot[0, k]) if len(sweep) else 1.0
-    rate_txt = (f"{rate:.6g} rad/s ({rate * 30 / np.pi:.6g} rpm)" if angle
-                else f"{rate:.6g} m/s")
-    name = model.mechanism.name
-    fig.suptitle(title or f"{name}: kinematics at constant {sweep.over}-rate {rate_txt}")
+    axes[-1].set_xlabel(f"{sweep.over} ({xunit})")
+    rate = float(sweep.qdot[0, sweep.over_index]) if len(sweep) else 1.0
+    fig.suptitle(title or f"{model.mechanism.name}: kinematics at constant {sweep.over}-rate "
+                 f"{rate_text(rate, angle)}")
     if sweep.status != "success" and len(sweep):
         for ax in axes:
             ax.axvline(xs[-1], color="tab:red", ls="--", lw=1.0)

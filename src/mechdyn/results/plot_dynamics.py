@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .plot import _figure, _save
+
 __all__ = ["plot_trajectory"]
 
 
@@ -32,25 +34,21 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
     Path
         The file written.
     """
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
+    from matplotlib import rcParams
 
     names = list(coordinates) if coordinates is not None else list(traj.coordinate_names)
     idx = [traj.coordinate_names.index(n) for n in names]
     show_energy = bool(energy and traj.energy and traj.t.size)
     vs = traj.switching if traj.t.size else None
     rows = 3 + (1 if show_energy else 0) + (1 if vs else 0)
-    fig, axes = plt.subplots(rows, 1, figsize=(8.0, 2.4 * rows), sharex=True,
-                             constrained_layout=True)
+    fig, axes = _figure(rows, height=2.4)
     t = traj.t
     is_angle = [traj.coordinate_is_angle[k] if traj.coordinate_is_angle else True for k in idx]
     au = "deg" if degrees else "rad"
     fa = np.rad2deg(1.0) if degrees else 1.0
     # lengths (travels) in mm on a right-hand axis when angles share the panel
     twins = [ax.twinx() if (any(is_angle) and not all(is_angle)) else ax for ax in axes[:3]]
-    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    colours = rcParams["axes.prop_cycle"].by_key()["color"]
     for n, (k, name, ang) in enumerate(zip(idx, names, is_angle, strict=True)):
         c = colours[n % len(colours)]
         panel = axes[:3] if ang else twins
@@ -94,17 +92,16 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
     if not traj.success:
         head += f" - stopped: {traj.status}"
     fig.suptitle(head)
-    path = Path(path)
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
-    return path
+    return _save(fig, path, dpi)
 
 
 def _shade_modes(axes, t, mode_index, modes) -> None:
     """Shade the time spans of the modes of a variable-structure run (one tint per mode)."""
     if t.size < 2 or len(modes) < 2:
         return
-    cmap = __import__("matplotlib").colormaps["Pastel2"]
+    from matplotlib import colormaps
+
+    cmap = colormaps["Pastel2"]
     change = np.flatnonzero(np.diff(mode_index) != 0) + 1
     starts = np.concatenate([[0], change])
     ends = np.concatenate([change, [t.size - 1]])
