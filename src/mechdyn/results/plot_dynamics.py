@@ -49,32 +49,26 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
     # lengths (travels) in mm on a right-hand axis when angles share the panel
     twins = [ax.twinx() if (any(is_angle) and not all(is_angle)) else ax for ax in axes[:3]]
     colours = rcParams["axes.prop_cycle"].by_key()["color"]
+    panels = (("coordinate", "", "", traj.q), ("rate", "'", "/s", traj.qdot),
+              ("acceleration", "''", "/s^2", traj.qddot))
     for n, (k, name, ang) in enumerate(zip(idx, names, is_angle, strict=True)):
-        c = colours[n % len(colours)]
-        panel = axes[:3] if ang else twins
         f, u = (fa, au) if ang else (1e3, "mm")
-        panel[0].plot(t, traj.q[:, k] * f, color=c, label=f"{name} [{u}]")
-        panel[1].plot(t, traj.qdot[:, k] * f, color=c, label=f"{name}' [{u}/s]")
-        panel[2].plot(t, traj.qddot[:, k] * f, color=c, label=f"{name}'' [{u}/s^2]")
-    for ax, twin, what in zip(axes[:3], twins, ("coordinate", "rate", "acceleration"),
-                              strict=True):
+        for ax, (_, tick, per, data) in zip(axes[:3] if ang else twins, panels, strict=True):
+            ax.plot(t, data[:, k] * f, color=colours[n % len(colours)],
+                    label=f"{name}{tick} [{u}{per}]")
+    for ax, twin, (what, _, per, _) in zip(axes[:3], twins, panels, strict=True):
         if twin is ax:
-            unit = au if any(is_angle) else "mm"
-            ax.set_ylabel(f"{what} [{unit}{'' if what == 'coordinate' else '/s'}"
-                          f"{'^2' if what == 'acceleration' else ''}]")
+            ax.set_ylabel(f"{what} [{au if any(is_angle) else 'mm'}{per}]")
         else:
             ax.set_ylabel(f"{what}: angles")
             twin.set_ylabel(f"{what}: travels")
             lines = ax.get_lines() + twin.get_lines()
             ax.legend(lines, [ln.get_label() for ln in lines], loc="best", fontsize="small")
     if show_energy:
-        e = traj.energy
-        ax = axes[3]
-        ax.plot(t, e["kinetic"], label="T [J]")
-        ax.plot(t, e["potential"], label="U [J]")
-        ax.plot(t, e["work_nc"], label="W_nc [J]")
-        ax.plot(t, e["balance"], "k--", label="T + U - W_nc [J]")
-        ax.set_ylabel("energy [J]")
+        for key, style, label in (("kinetic", "-", "T"), ("potential", "-", "U"),
+                                  ("work_nc", "-", "W_nc"), ("balance", "k--", "T + U - W_nc")):
+            axes[3].plot(t, traj.energy[key], style, label=f"{label} [J]")
+        axes[3].set_ylabel("energy [J]")
     if vs:
         ax = axes[-1]
         frame = np.asarray(vs["frame_force"], float)
