@@ -37,7 +37,7 @@ import numpy as np
 from ..errors import MechdynError, ModelError
 from ..kernels import rows_numpy
 from ..kinematics.constraints import extend, travel_rows
-from .table import output_path
+from .table import deg_or_mm, output_path
 
 __all__ = ["animate", "snapshot", "frame_geometry", "frame_indices", "check_animation_path",
            "MechanismDrawing"]
@@ -183,13 +183,15 @@ def _extent(model, x: np.ndarray, pts: dict) -> float:
     return span if span > 0 else model.length_scale
 
 
-def _trace_spec(model, trace) -> tuple[str, object] | None:
+def _trace_spec(model, trace, what: str = "trace") -> tuple[str, object] | None:
+    """(body, point) of ``"BODY.POINT"`` or a pair, checked against the model; None for None."""
     if trace is None:
         return None
     if isinstance(trace, str):
         body, sep, point = trace.partition(".")
         if not sep or not point:
-            raise ModelError(f"trace {trace!r}: write it as BODY.POINT (e.g. 'rod.B')")
+            raise ModelError(f"{what} {trace!r}: write it as BODY.POINT (e.g. 'rod.B' or "
+                             "'rod.com')")
         trace = (body, point)
     body, point = trace
     model.point_local(body, point)  # clear error for unknown names
@@ -215,10 +217,9 @@ def _labels(record, idx: np.ndarray) -> list[str]:
     over = getattr(record, "over", None)
     t = getattr(record, "t", None)
     if over is not None and getattr(record, "values", None) is not None:
-        v = np.asarray(record.values)[idx]
-        if record.over_is_angle:
-            return [f"{over} = {np.rad2deg(a):8.2f} deg" for a in v]
-        return [f"{over} = {a * 1e3:8.3f} mm" for a in v]
+        v, unit = deg_or_mm(np.asarray(record.values)[idx], record.over_is_angle)
+        digits = 2 if record.over_is_angle else 3
+        return [f"{over} = {a:8.{digits}f} {unit}" for a in v]
     if t is not None:
         tt = np.asarray(t)[idx]
         span = float(np.ptp(np.asarray(t))) if np.size(t) else 0.0

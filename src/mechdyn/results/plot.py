@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ModelError
+from .animate import _trace_spec
 from .table import deg_or_mm, output_path, rate_text
 
 __all__ = ["plot", "plot_kinematic_sweep", "PLOTTERS"]
@@ -38,19 +38,9 @@ def _save(fig, path, dpi) -> Path:
 
 
 # ---------------------------------------------------------------- kinematic sweep
-def _parse_points(model, points) -> list[tuple[str, object]]:
-    out = []
-    for p in points:
-        if isinstance(p, str):
-            body, sep, name = p.partition(".")
-            if not sep:
-                raise ModelError(f"point {p!r}: write it as BODY.POINT (e.g. 'rod.B' or "
-                                 "'rod.com')")
-            p = (body, name)
-        body, name = p
-        model.point_local(body, name)  # a clear error for unknown names
-        out.append((body, name, _label(body, name)))
-    return out
+def _parse_points(model, points) -> list[tuple[str, object, str]]:
+    return [(body, name, _label(body, name))
+            for body, name in (_trace_spec(model, p, "point") for p in points)]
 
 
 def _default_points(model) -> list[tuple[str, object, str]]:
