@@ -299,11 +299,11 @@ def _geometry(model, x, drawing: MechanismDrawing, index, trace) -> dict:
     return g
 
 
-def _limits(model, x, drawing, trace) -> tuple[tuple[float, float], tuple[float, float]]:
-    g = _geometry(model, x, drawing, None, trace)
+def _limits(g: dict) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Axis limits around the geometry ``g`` of all frames (see :func:`frame_geometry`)."""
     arrs = [a.reshape(-1, 2) for a in g["bodies"].values()]
     arrs += [a.reshape(-1, 2) for a in g["guides"].values()]
-    s = drawing.size
+    s = g["size"]
     for a in g["anchors"].values():  # the anchor triangles and their ground lines
         arrs.append(np.asarray(a).reshape(1, 2) + [[-1.8 * s, -1.8 * s], [1.8 * s, 0.0]])
     if "trace" in g:
@@ -323,24 +323,20 @@ class _Scene:
         from matplotlib.figure import Figure
         from matplotlib.patches import Polygon
 
-        self.record = record
-        self.model, self.x = _record_parts(record)
-        self.trace = _trace_spec(self.model, trace)
-        self.drawing = d = _drawing(self.model, self.x)
-        (x0, x1), (y0, y1) = _limits(self.model, self.x, d, self.trace)
+        model, x = _record_parts(record)
+        self.trace = _trace_spec(model, trace)
+        d = _drawing(model, x)
+        self.g = g = _geometry(model, x, d, None, self.trace)  # every frame, drawn by update()
+        (x0, x1), (y0, y1) = _limits(g)
         # the figure's shape follows the drawing's (room for title and labels added)
         height = float(np.clip((width - 1.0) * (y1 - y0) / (x1 - x0) + 1.2, 3.0, 7.5))
         self.fig = fig = Figure(figsize=(width, height), layout="constrained")
         FigureCanvasAgg(fig)
         ax = self.ax = fig.add_subplot()
-        ax.set_xlim(x0, x1)
-        ax.set_ylim(y0, y1)
+        ax.set(xlim=(x0, x1), ylim=(y0, y1), xlabel="x (m)", ylabel="y (m)",
+               title=title if title is not None else getattr(model.mechanism, "name", "mechanism"))
         ax.set_aspect("equal", adjustable="box")
         ax.grid(True, alpha=0.25)
-        ax.set_xlabel("x (m)")
-        ax.set_ylabel("y (m)")
-        mech = self.model.mechanism
-        ax.set_title(title if title is not None else getattr(mech, "name", "mechanism"))
         s = d.size
         # static: anchors (hatched triangles) and ground guides
         for p in d.anchors.values():
@@ -353,13 +349,12 @@ class _Scene:
         self.guides = {j: ax.plot([], [], color="0.35", lw=2.5, alpha=0.6,
                                   solid_capstyle="butt", zorder=1)[0] for j in d.guides}
         if self.trace is not None:
-            gt = _geometry(self.model, self.x, d, None, self.trace)["trace"]
+            gt = g["trace"]
             ax.plot(gt[:, 0], gt[:, 1], color="tab:red", lw=0.8, ls=":", alpha=0.6, zorder=2)
             (self.trace_line,) = ax.plot([], [], color="tab:red", lw=1.4, zorder=2,
                                          label=f"path of {self.trace[0]}.{self.trace[1]}")
             (self.trace_dot,) = ax.plot([], [], "o", color="tab:red", ms=4, zorder=6)
             ax.legend(loc="upper right", fontsize="small")
-            self.trace_all = gt
         # moving bodies
         self.bodies = {}
         for k, (b, (local, style)) in enumerate(d.bodies.items()):
@@ -414,22 +409,23 @@ class _Scene:
 
     def update(self, i: int, label: str) -> None:
         """Move every artist to sample ``i``."""
-        g = _geometry(self.model, self.x, self.drawing, [i], self.trace)
+        g = self.g
         for b, (art, style) in self.bodies.items():
-            P = g["bodies"][b][0]
+            P = g["bodies"][b][i]
             if style in ("polygon", "block"):
                 art.set_xy(P)
             else:
                 art.set_data(P[:, 0], P[:, 1])
         for kind in ("revolutes", "locks"):
-            P = np.array([v[0] for v in g[kind].values()]).reshape(-1, 2)
+            P = np.array([v[i] for v in g[kind].values()]).reshape(-1, 2)
             getattr(self, kind).set_data(P[:, 0], P[:, 1])
         for j, ln in self.guides.items():
-            seg = g["guides"][j][0]
+            seg = g["guides"][j][i]
             ln.set_data(seg[:, 0], seg[:, 1])
         if self.trace is not None:
-            self.trace_line.set_data(self.trace_all[: i + 1, 0], self.trace_all[: i + 1, 1])
-            self.trace_dot.set_data([self.trace_all[i, 0]], [self.trace_all[i, 1]])
+            path = g["trace"]
+            self.trace_line.set_data(path[: i + 1, 0], path[: i + 1, 1])
+            self.trace_dot.set_data([path[i, 0]], [path[i, 1]])
         self.text.set_text(label)
 
 
