@@ -75,12 +75,8 @@ def run(args) -> int:
         return 0
 
     over, values = sweep_values(model, args.over, args.start, args.stop, args.steps)
-    k = model.coordinate_index(over)
-    speed = None
-    if args.speed is not None:
-        angle = bool(model.coord_is_angle[k])
-        speed = parse_quantity(args.speed, "angular_velocity" if angle else "velocity",
-                               where="--speed")
+    kind = "angular_velocity" if model.coord_is_angle[model.coordinate_index(over)] else "velocity"
+    speed = None if args.speed is None else parse_quantity(args.speed, kind, where="--speed")
     model, sw, ks = report_records(model, speed=speed, over=over, values=values)
     out = write_report(model, args.output, sweep=sw, kinetostatics=ks, title=args.title,
                        animation=args.animation, trace=args.trace)
@@ -142,8 +138,7 @@ def report_records(mech_or_model, *, speed: float | None = None, over: str | Non
     given_speed = speed is not None
     if speed is None:
         qd0 = (model.mechanism.extras.get("initial") or {}).get("qdot") or {}
-        speed = float(qd0.get(over, 0.0)) if isinstance(qd0, dict) else 0.0
-        speed = speed if speed != 0.0 else 1.0
+        speed = (float(qd0.get(over, 0.0)) if isinstance(qd0, dict) else 0.0) or 1.0
     sw = run_sweep(model, over, values, speed=float(speed))
     ks = None
     if given_speed or model.mechanism.dof == 1:
