@@ -46,11 +46,9 @@ def _parse_points(model, points) -> list[tuple[str, object, str]]:
 def _default_points(model) -> list[tuple[str, object, str]]:
     """The sliders' guided points, else the named points of the last body."""
     mech = model.mechanism
-    out = []
-    for jn in model.pri.names:
-        j = mech.joints[jn]
-        if j.child != "ground":
-            out.append((j.child, j.child_point, f"{j.child} on {jn!r}"))
+    sliders = [(jn, mech.joints[jn]) for jn in model.pri.names]
+    out = [(j.child, j.child_point, f"{j.child} on {jn!r}") for jn, j in sliders
+           if j.child != "ground"]
     if out:
         return out
     body = model.body_names[-1]
@@ -59,9 +57,7 @@ def _default_points(model) -> list[tuple[str, object, str]]:
 
 
 def _label(body, name) -> str:
-    if isinstance(name, str):
-        return f"{body}.{name}"
-    return f"{body}({name[0]:.4g}, {name[1]:.4g})"
+    return f"{body}.{name}" if isinstance(name, str) else f"{body}({name[0]:.4g}, {name[1]:.4g})"
 
 
 def plot_kinematic_sweep(sweep, path, points: Iterable | None = None, *,
@@ -89,15 +85,15 @@ def plot_kinematic_sweep(sweep, path, points: Iterable | None = None, *,
     xs, xunit = deg_or_mm(sweep.values, angle)
     fig, axes = _figure(3)
     scale = model.length_scale
-    rows = [("position", "m", 0), ("velocity", "m/s", 1), ("acceleration", "m/s²", 2)]
+    rows = [("position", "m"), ("velocity", "m/s"), ("acceleration", "m/s²")]
     for body, name, label in pts:
         data = sweep.point(body, name)
         for c, comp in enumerate("xy"):
             if len(sweep) == 0 or np.ptp(data[0][:, c]) <= 1e-12 * scale:
                 continue  # a constant component (e.g. y of a horizontal slider)
-            for ax, (_, _, k) in zip(axes, rows, strict=True):
-                ax.plot(xs, data[k][:, c], label=f"{comp} of {label}")
-    for ax, (what, unit, _) in zip(axes, rows, strict=True):
+            for ax, values in zip(axes, data, strict=True):  # position, velocity, acceleration
+                ax.plot(xs, values[:, c], label=f"{comp} of {label}")
+    for ax, (what, unit) in zip(axes, rows, strict=True):
         ax.set_ylabel(f"{what} ({unit})")
         ax.grid(True, alpha=0.3)
         ax.axhline(0.0, color="0.6", lw=0.6)
