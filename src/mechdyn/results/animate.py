@@ -8,23 +8,12 @@
 (with Pillow, as matplotlib's ``PillowWriter`` does) or an MP4 (only when ffmpeg is installed).
 :func:`snapshot` writes one frame as a PNG.
 
-What is drawn (the coordinates of every frame come from :func:`frame_geometry`,
-which the tests compare with :func:`mechdyn.kinematics.constraints.point_position`):
-
-* every moving body as the polygon (three or more points) or the bar (two points)
-  through its named points and the points of its joints; a slider block (a small
-  rectangle along the guide) for a body guided by a prismatic joint that has only
-  one point; a small disc for any other body with one point;
-* revolute joints as small open circles, locks as small squares;
-* the ground points of joints as hatched triangles (anchors);
-* prismatic guides as lines along their axis, spanning the travel of the slider
-  over the motion (they move with their parent body when it is not the ground);
-* optionally the path of one point (``trace``) -- faint for the whole motion,
-  solid up to the current frame;
-* the time (a trajectory) or the swept coordinate's value (a sweep) in the corner.
-
-The axis limits are fixed from the whole motion and the aspect ratio is equal.
-Figures are drawn on matplotlib's Agg canvas; pyplot is not used.
+What each frame shows (bodies through their points, joints, ground anchors, slider
+guides, an optional traced point, the time or swept value in the corner) is listed in
+``docs/results.md``; :func:`frame_geometry` gives its coordinates, which the tests compare
+with :func:`mechdyn.kinematics.constraints.point_position`.  The axis limits are fixed
+from the whole motion and the aspect ratio is equal.  Figures are drawn on matplotlib's
+Agg canvas; pyplot is not used.
 """
 
 from __future__ import annotations
