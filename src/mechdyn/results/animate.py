@@ -265,8 +265,10 @@ def frame_geometry(record, index=None, *, trace=None) -> dict:
         (ymin, ymax)) over the whole motion; ``size``: symbol size; all in m.
     """
     model, x = _record_parts(record)
-    drawing = _drawing(model, x)
-    return _geometry(model, x, drawing, index, _trace_spec(model, trace))
+    drawing, spec = _drawing(model, x), _trace_spec(model, trace)
+    g = _geometry(model, x, drawing, index, spec)
+    g["limits"] = _limits(g if index is None else _geometry(model, x, drawing, None, spec))
+    return g
 
 
 def _geometry(model, x, drawing: MechanismDrawing, index, trace) -> dict:
