@@ -78,12 +78,9 @@ def _describe(record) -> list[str]:
     model = getattr(record, "model", None)
     mech = getattr(model, "mechanism", None)
     lines = [f"mechdyn {kind}" + (f" of {mech.name!r}" if mech is not None else "")]
-    over = getattr(record, "over", None)
-    if over is not None:
-        lines.append(f"swept coordinate: {over}")
-    status = getattr(record, "status", None)
-    if status is not None:
-        lines.append(f"status: {status}")
+    for label, attr in (("swept coordinate", "over"), ("status", "status")):
+        if getattr(record, attr, None) is not None:
+            lines.append(f"{label}: {getattr(record, attr)}")
     message = getattr(record, "message", "")
     if message:
         lines.append("message: " + " ".join(str(message).split()))
