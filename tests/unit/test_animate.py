@@ -44,6 +44,10 @@ def test_drawn_joint_points_are_the_point_positions_of_the_record(four_bar_sweep
         body, pt = _joint_point(m, name)
         assert np.allclose(drawn, point_position(m, sw.x, body, pt), atol=1e-14)
     assert np.allclose(g["trace"], point_position(m, sw.x, "coupler", "P"), atol=1e-14)
+    (x0, x1), (y0, y1) = g["limits"]  # the whole motion fits inside the axis limits
+    drawn = np.concatenate([a.reshape(-1, 2) for a in g["bodies"].values()] + [g["trace"]])
+    assert x0 < drawn[:, 0].min() and drawn[:, 0].max() < x1
+    assert y0 < drawn[:, 1].min() and drawn[:, 1].max() < y1
     # each body outline passes through every named point of the body
     for b in m.body_names:
         for p in m.mechanism.bodies[b].points:

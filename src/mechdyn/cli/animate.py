@@ -39,21 +39,33 @@ def register(sub) -> None:
         epilog="Quantities take units: 0deg, 360 deg, 15 mm, 0.05s, 20 ms (a bare number is "
                "SI). Exit codes: 0 done, 1 the motion stopped early (frames so far written), "
                "2 bad input.")
+    d = add_motion_arguments(p, "FILE", "animation to write: .gif (or .mp4 with ffmpeg)",
+                             steps=121, verb="animate",
+                             title="title above the drawing (default: the model's name)")
+    d.add_argument("--fps", type=int, default=25, help="frames per second (default 25)")
+    d.add_argument("--frames", type=int, metavar="N",
+                   help="number of frames (default: all positions, at most 200)")
+    d.add_argument("--snapshot", metavar="PNG", help="also write the first frame as a PNG")
+    p.set_defaults(func=run)
+
+
+def add_motion_arguments(p, metavar: str, output: str, *, steps: int, verb: str, title: str):
+    """Add what ``mechdyn animate`` and ``report`` share: model, -o, sweep and simulation
+    groups; returns the drawing group (``--trace``, ``--title``)."""
     p.add_argument("model", metavar="MODEL",
                    help="model file (.toml) or the name of a bundled example")
-    p.add_argument("-o", "--output", required=True, metavar="FILE",
-                   help="animation to write: .gif (or .mp4 with ffmpeg)")
+    p.add_argument("-o", "--output", required=True, metavar=metavar, help=output)
     g = p.add_argument_group("sweep (default)")
     g.add_argument("--over", metavar="COORD", help="coordinate to sweep (default: the first)")
     g.add_argument("--from", dest="start", metavar="VALUE",
                    help="first value, e.g. 0deg (default: the initial value)")
     g.add_argument("--to", dest="stop", metavar="VALUE",
                    help="last value (default: one full turn after --from)")
-    g.add_argument("--steps", type=int, default=121, metavar="N",
-                   help="number of positions, ends included (default 121)")
+    g.add_argument("--steps", type=int, default=steps, metavar="N",
+                   help=f"number of positions, ends included (default {steps})")
     s = p.add_argument_group("simulation")
     s.add_argument("--simulate", action="store_true",
-                   help="animate a forward-dynamics run from the model's initial state")
+                   help=f"{verb} a forward-dynamics run from the model's initial state")
     s.add_argument("--t-end", metavar="TIME", help="end time of the run, e.g. 0.05s")
     s.add_argument("--integrator", default="dop853", metavar="NAME",
                    help="integrator (default dop853; see `mechdyn simulate --help`)")
@@ -61,12 +73,17 @@ def register(sub) -> None:
                    help="relative tolerance of the adaptive integrators (default 1e-10)")
     d = p.add_argument_group("drawing")
     d.add_argument("--trace", metavar="BODY.POINT", help="draw the path of this point")
-    d.add_argument("--fps", type=int, default=25, help="frames per second (default 25)")
-    d.add_argument("--frames", type=int, metavar="N",
-                   help="number of frames (default: all positions, at most 200)")
-    d.add_argument("--title", help="title above the drawing (default: the model's name)")
-    d.add_argument("--snapshot", metavar="PNG", help="also write the first frame as a PNG")
-    p.set_defaults(func=run)
+    d.add_argument("--title", help=title)
+    return d
+
+
+def simulate_from_args(model, args, samples: int):
+    """The forward-dynamics run of ``--simulate`` (needs ``--t-end``), ``samples`` samples."""
+    if args.t_end is None:
+        raise ModelError("--simulate needs --t-end, e.g. --t-end 0.05s")
+    t_end = parse_quantity(args.t_end, "time", where="--t-end")
+    return simulate(model, t_end, integrator=args.integrator, rtol=args.rtol, progress=False,
+                    t_eval=np.linspace(0.0, t_end, samples))
 
 
 def sweep_values(model, over: str | None, start: str | None, stop: str | None, steps: int):
@@ -102,12 +119,8 @@ def run(args) -> int:
     model = mech.compile()
     _trace_spec(model, args.trace)
     if args.simulate:
-        if args.t_end is None:
-            raise ModelError("--simulate needs --t-end, e.g. --t-end 0.05s")
-        t_end = parse_quantity(args.t_end, "time", where="--t-end")
         n = args.frames if args.frames is not None else 200
-        record = simulate(model, t_end, integrator=args.integrator, rtol=args.rtol,
-                          t_eval=np.linspace(0.0, t_end, max(int(n), 2)), progress=False)
+        record = simulate_from_args(model, args, max(int(n), 2))
         ok, why = record.success, f"{record.status}: {record.message}"
         print(f"{mech.name}: simulated to t = {record.t[-1] if record.t.size else 0:.6g} s "
               f"({record.status})")

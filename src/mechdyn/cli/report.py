@@ -34,9 +34,8 @@ from ..kinematics.sweep import initial_coordinates
 from ..kinematics.sweep import sweep as run_sweep
 from ..model import as_model
 from ..results.report import report_trajectory, write_report
-from ..simulate import simulate
 from ..units import parse_quantity
-from .animate import sweep_values
+from .animate import add_motion_arguments, simulate_from_args, sweep_values
 from .kinematics import load_model
 
 __all__ = ["register", "run", "report", "report_records"]
@@ -52,27 +51,12 @@ def register(sub) -> None:
                     "--speed, its kinetostatic cycle; with --simulate, a forward-dynamics run.",
         epilog="Quantities take units: 60rpm, 0deg, 360 deg, 0.05s (a bare number is SI). "
                "Exit codes: 0 done, 1 an analysis stopped early, 2 bad input.")
-    p.add_argument("model", metavar="MODEL",
-                   help="model file (.toml) or the name of a bundled example")
-    p.add_argument("-o", "--output", required=True, metavar="HTML", help="report to write")
+    d = add_motion_arguments(p, "HTML", "report to write", steps=361, verb="report",
+                             title="title of the report")
+    d.add_argument("--animation", action="store_true", help="embed an animated GIF")
     p.add_argument("--speed", metavar="RATE",
                    help="constant rate of the swept coordinate, e.g. 60rpm (default: the "
                         "model's initial rate, else 1 rad/s)")
-    p.add_argument("--over", metavar="COORD", help="coordinate to sweep (default: the first)")
-    p.add_argument("--from", dest="start", metavar="VALUE",
-                   help="first value (default: the initial value)")
-    p.add_argument("--to", dest="stop", metavar="VALUE",
-                   help="last value (default: one full turn after --from)")
-    p.add_argument("--steps", type=int, default=361, metavar="N",
-                   help="number of positions, ends included (default 361)")
-    p.add_argument("--animation", action="store_true", help="embed an animated GIF")
-    p.add_argument("--trace", metavar="BODY.POINT", help="draw the path of this point")
-    p.add_argument("--title", help="title of the report")
-    p.add_argument("--simulate", action="store_true",
-                   help="report a forward-dynamics run from the initial state instead")
-    p.add_argument("--t-end", metavar="TIME", help="end time of the run, e.g. 0.05s")
-    p.add_argument("--integrator", default="dop853", metavar="NAME",
-                   help="integrator of --simulate (default dop853)")
     p.set_defaults(func=run)
 
 
@@ -81,11 +65,7 @@ def run(args) -> int:
     mech = load_model(args.model)
     model = mech.compile()
     if args.simulate:
-        if args.t_end is None:
-            raise ModelError("--simulate needs --t-end, e.g. --t-end 0.05s")
-        t_end = parse_quantity(args.t_end, "time", where="--t-end")
-        traj = simulate(model, t_end, integrator=args.integrator, progress=False,
-                        t_eval=np.linspace(0.0, t_end, 401))
+        traj = simulate_from_args(model, args, 401)
         out = report_trajectory(traj, args.output, title=args.title, animation=args.animation,
                                 trace=args.trace)
         print(f"{mech.name}: simulation {traj.status}; report: {out}")
@@ -95,12 +75,8 @@ def run(args) -> int:
         return 0
 
     over, values = sweep_values(model, args.over, args.start, args.stop, args.steps)
-    k = model.coordinate_index(over)
-    speed = None
-    if args.speed is not None:
-        angle = bool(model.coord_is_angle[k])
-        speed = parse_quantity(args.speed, "angular_velocity" if angle else "velocity",
-                               where="--speed")
+    kind = "angular_velocity" if model.coord_is_angle[model.coordinate_index(over)] else "velocity"
+    speed = None if args.speed is None else parse_quantity(args.speed, kind, where="--speed")
     model, sw, ks = report_records(model, speed=speed, over=over, values=values)
     out = write_report(model, args.output, sweep=sw, kinetostatics=ks, title=args.title,
                        animation=args.animation, trace=args.trace)
@@ -162,8 +138,7 @@ def report_records(mech_or_model, *, speed: float | None = None, over: str | Non
     given_speed = speed is not None
     if speed is None:
         qd0 = (model.mechanism.extras.get("initial") or {}).get("qdot") or {}
-        speed = float(qd0.get(over, 0.0)) if isinstance(qd0, dict) else 0.0
-        speed = speed if speed != 0.0 else 1.0
+        speed = (float(qd0.get(over, 0.0)) if isinstance(qd0, dict) else 0.0) or 1.0
     sw = run_sweep(model, over, values, speed=float(speed))
     ks = None
     if given_speed or model.mechanism.dof == 1:

@@ -8,23 +8,12 @@
 (with Pillow, as matplotlib's ``PillowWriter`` does) or an MP4 (only when ffmpeg is installed).
 :func:`snapshot` writes one frame as a PNG.
 
-What is drawn (the coordinates of every frame come from :func:`frame_geometry`,
-which the tests compare with :func:`mechdyn.kinematics.constraints.point_position`):
-
-* every moving body as the polygon (three or more points) or the bar (two points)
-  through its named points and the points of its joints; a slider block (a small
-  rectangle along the guide) for a body guided by a prismatic joint that has only
-  one point; a small disc for any other body with one point;
-* revolute joints as small open circles, locks as small squares;
-* the ground points of joints as hatched triangles (anchors);
-* prismatic guides as lines along their axis, spanning the travel of the slider
-  over the motion (they move with their parent body when it is not the ground);
-* optionally the path of one point (``trace``) -- faint for the whole motion,
-  solid up to the current frame;
-* the time (a trajectory) or the swept coordinate's value (a sweep) in the corner.
-
-The axis limits are fixed from the whole motion and the aspect ratio is equal.
-Figures are drawn on matplotlib's Agg canvas; pyplot is not used.
+What each frame shows (bodies through their points, joints, ground anchors, slider
+guides, an optional traced point, the time or swept value in the corner) is listed in
+``docs/results.md``; :func:`frame_geometry` gives its coordinates, which the tests compare
+with :func:`mechdyn.kinematics.constraints.point_position`.  The axis limits are fixed
+from the whole motion and the aspect ratio is equal.  Figures are drawn on matplotlib's
+Agg canvas; pyplot is not used.
 """
 
 from __future__ import annotations
@@ -36,7 +25,8 @@ import numpy as np
 
 from ..errors import MechdynError, ModelError
 from ..kernels import rows_numpy
-from ..kinematics.constraints import travel_rows
+from ..kinematics.constraints import extend, travel_rows
+from .table import deg_or_mm, output_path
 
 __all__ = ["animate", "snapshot", "frame_geometry", "frame_indices", "check_animation_path",
            "MechanismDrawing"]
@@ -53,12 +43,6 @@ def _rot(theta: np.ndarray, s: np.ndarray) -> np.ndarray:
     c, sn = np.cos(theta)[:, None], np.sin(theta)[:, None]
     return np.stack([c * s[None, :, 0] - sn * s[None, :, 1],
                      sn * s[None, :, 0] + c * s[None, :, 1]], axis=-1)
-
-
-def _as_point(model, body: str, ref) -> np.ndarray:
-    if isinstance(ref, str):
-        return np.asarray(model._point(body, ref), dtype=float)
-    return np.asarray(ref, dtype=float).reshape(2)
 
 
 def _unique(points: list[np.ndarray], tol: float) -> list[np.ndarray]:
@@ -112,40 +96,33 @@ def _drawing(model, x: np.ndarray) -> MechanismDrawing:
     mech = model.mechanism
     ground = "ground"
     tol = 1e-9 * model.length_scale
-    pts: dict[str, list[np.ndarray]] = {b: [] for b in model.body_names}
-    for b in model.body_names:
-        pts[b] += [np.asarray(p, dtype=float) for p in mech.bodies[b].points.values()]
+    pts = {b: [np.asarray(p, dtype=float) for p in mech.bodies[b].points.values()]
+           for b in model.body_names}
     revolutes, locks, anchors, guides = {}, {}, {}, {}
-    guided: dict[str, tuple[np.ndarray, float]] = {}
+    guided: dict[str, np.ndarray] = {}
     for name, j in mech.joints.items():
         kind = model.joint_kind(name)
         if kind == "lock":
-            locks[name] = (j.child, np.zeros(2)) if j.child != ground else (j.parent, np.zeros(2))
+            locks[name] = (j.child if j.child != ground else j.parent, np.zeros(2))
             continue
-        pp = _as_point(model, j.parent, j.parent_point)
-        cp = _as_point(model, j.child, j.child_point)
+        pp = model.point_local(j.parent, j.parent_point)
+        cp = model.point_local(j.child, j.child_point)
         if j.parent != ground:
             pts[j.parent].append(pp)
         if j.child != ground:
             pts[j.child].append(cp)
         if kind == "revolute":
-            if j.child != ground:
-                revolutes[name] = (j.child, cp)
-            else:
-                revolutes[name] = (j.parent, pp)
+            revolutes[name] = (j.child, cp) if j.child != ground else (j.parent, pp)
             if ground in (j.parent, j.child):
                 anchors[name] = pp if j.parent == ground else cp
         else:  # prismatic: a guide line on the parent, a block on the child
             k = model.pri.names.index(name)
             u = model.pri.ui[k]
-            if j.child != ground:
-                a = -model.pri.angle[k]
-                ca, sa = np.cos(a), np.sin(a)
-                guided[j.child] = (np.array([ca * u[0] - sa * u[1], sa * u[0] + ca * u[1]]), 0.0)
+            if j.child != ground:  # the guide's direction in the child frame
+                guided[j.child] = _rot(-model.pri.angle[k:k + 1], u[None, :])[0, 0]
             guides[name] = (j.parent, pp, u, j.child)
 
-    span = _extent(model, x, pts)
-    size = 0.035 * span
+    size = 0.035 * _extent(model, x, pts)
     bodies = {}
     for b in model.body_names:
         p = _unique(pts[b], tol)
@@ -156,7 +133,7 @@ def _drawing(model, x: np.ndarray) -> MechanismDrawing:
         else:
             c = p[0] if p else np.asarray(model.com[model.body_index(b)], dtype=float)
             if b in guided:
-                u = guided[b][0]
+                u = guided[b]
                 n = np.array([-u[1], u[0]])
                 w, h = 1.6 * size, 0.9 * size
                 block = np.array([c + w * u + h * n, c - w * u + h * n,
@@ -178,10 +155,8 @@ def _drawing(model, x: np.ndarray) -> MechanismDrawing:
 
 def _world(model, x: np.ndarray, body: str, local: np.ndarray) -> np.ndarray:
     """Ground-frame positions (n, k, 2) of body-frame points ``local`` (k, 2) over ``x``."""
-    if body == "ground":
-        return np.broadcast_to(local[None], (x.shape[0],) + local.shape)
-    k = model.body_index(body)
-    return x[:, None, 3 * k:3 * k + 2] + _rot(x[:, 3 * k + 2], local)
+    pose = extend(model, x)[:, model.body_index(body)]
+    return pose[:, None, :2] + _rot(pose[:, 2], local)
 
 
 def _extent(model, x: np.ndarray, pts: dict) -> float:
@@ -197,13 +172,15 @@ def _extent(model, x: np.ndarray, pts: dict) -> float:
     return span if span > 0 else model.length_scale
 
 
-def _trace_spec(model, trace) -> tuple[str, object] | None:
+def _trace_spec(model, trace, what: str = "trace") -> tuple[str, object] | None:
+    """(body, point) of ``"BODY.POINT"`` or a pair, checked against the model; None for None."""
     if trace is None:
         return None
     if isinstance(trace, str):
         body, sep, point = trace.partition(".")
         if not sep or not point:
-            raise ModelError(f"trace {trace!r}: write it as BODY.POINT (e.g. 'rod.B')")
+            raise ModelError(f"{what} {trace!r}: write it as BODY.POINT (e.g. 'rod.B' or "
+                             "'rod.com')")
         trace = (body, point)
     body, point = trace
     model.point_local(body, point)  # clear error for unknown names
@@ -211,7 +188,7 @@ def _trace_spec(model, trace) -> tuple[str, object] | None:
 
 
 def _record_parts(record):
-    """(model, x (n, n_x), labels (n,) of the corner text, name)."""
+    """(model, x (n, n_x)) of a record, or a clear error."""
     model = getattr(record, "model", None)
     x = getattr(record, "x", None)
     if model is None or x is None:
@@ -229,10 +206,9 @@ def _labels(record, idx: np.ndarray) -> list[str]:
     over = getattr(record, "over", None)
     t = getattr(record, "t", None)
     if over is not None and getattr(record, "values", None) is not None:
-        v = np.asarray(record.values)[idx]
-        if record.over_is_angle:
-            return [f"{over} = {np.rad2deg(a):8.2f} deg" for a in v]
-        return [f"{over} = {a * 1e3:8.3f} mm" for a in v]
+        v, unit = deg_or_mm(np.asarray(record.values)[idx], record.over_is_angle)
+        digits = 2 if record.over_is_angle else 3
+        return [f"{over} = {a:8.{digits}f} {unit}" for a in v]
     if t is not None:
         tt = np.asarray(t)[idx]
         span = float(np.ptp(np.asarray(t))) if np.size(t) else 0.0
@@ -289,8 +265,10 @@ def frame_geometry(record, index=None, *, trace=None) -> dict:
         (ymin, ymax)) over the whole motion; ``size``: symbol size; all in m.
     """
     model, x = _record_parts(record)
-    drawing = _drawing(model, x)
-    return _geometry(model, x, drawing, index, _trace_spec(model, trace))
+    drawing, spec = _drawing(model, x), _trace_spec(model, trace)
+    g = _geometry(model, x, drawing, index, spec)
+    g["limits"] = _limits(g if index is None else _geometry(model, x, drawing, None, spec))
+    return g
 
 
 def _geometry(model, x, drawing: MechanismDrawing, index, trace) -> dict:
@@ -301,10 +279,9 @@ def _geometry(model, x, drawing: MechanismDrawing, index, trace) -> dict:
     for b, (local, style) in drawing.bodies.items():
         g["bodies"][b] = _world(model, xs, b, local)
         g["styles"][b] = style
-    for j, (b, p) in drawing.revolutes.items():
-        g["revolutes"][j] = _world(model, xs, b, p[None, :])[:, 0]
-    for j, (b, p) in drawing.locks.items():
-        g["locks"][j] = _world(model, xs, b, p[None, :])[:, 0]
+    for kind in ("revolutes", "locks"):
+        for j, (b, p) in getattr(drawing, kind).items():
+            g[kind][j] = _world(model, xs, b, p[None, :])[:, 0]
     for j, (b, seg) in drawing.guides.items():
         g["guides"][j] = np.array(_world(model, xs, b, seg))
     if trace is not None:
@@ -313,11 +290,11 @@ def _geometry(model, x, drawing: MechanismDrawing, index, trace) -> dict:
     return g
 
 
-def _limits(model, x, drawing, trace) -> tuple[tuple[float, float], tuple[float, float]]:
-    g = _geometry(model, x, drawing, None, trace)
+def _limits(g: dict) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Axis limits around the geometry ``g`` of all frames (see :func:`frame_geometry`)."""
     arrs = [a.reshape(-1, 2) for a in g["bodies"].values()]
     arrs += [a.reshape(-1, 2) for a in g["guides"].values()]
-    s = drawing.size
+    s = g["size"]
     for a in g["anchors"].values():  # the anchor triangles and their ground lines
         arrs.append(np.asarray(a).reshape(1, 2) + [[-1.8 * s, -1.8 * s], [1.8 * s, 0.0]])
     if "trace" in g:
@@ -337,24 +314,20 @@ class _Scene:
         from matplotlib.figure import Figure
         from matplotlib.patches import Polygon
 
-        self.record = record
-        self.model, self.x = _record_parts(record)
-        self.trace = _trace_spec(self.model, trace)
-        self.drawing = d = _drawing(self.model, self.x)
-        (x0, x1), (y0, y1) = self.limits = _limits(self.model, self.x, d, self.trace)
+        model, x = _record_parts(record)
+        self.trace = _trace_spec(model, trace)
+        d = _drawing(model, x)
+        self.g = g = _geometry(model, x, d, None, self.trace)  # every frame, drawn by update()
+        (x0, x1), (y0, y1) = _limits(g)
         # the figure's shape follows the drawing's (room for title and labels added)
         height = float(np.clip((width - 1.0) * (y1 - y0) / (x1 - x0) + 1.2, 3.0, 7.5))
         self.fig = fig = Figure(figsize=(width, height), layout="constrained")
         FigureCanvasAgg(fig)
         ax = self.ax = fig.add_subplot()
-        ax.set_xlim(x0, x1)
-        ax.set_ylim(y0, y1)
+        ax.set(xlim=(x0, x1), ylim=(y0, y1), xlabel="x (m)", ylabel="y (m)",
+               title=title if title is not None else getattr(model.mechanism, "name", "mechanism"))
         ax.set_aspect("equal", adjustable="box")
         ax.grid(True, alpha=0.25)
-        ax.set_xlabel("x (m)")
-        ax.set_ylabel("y (m)")
-        mech = self.model.mechanism
-        ax.set_title(title if title is not None else getattr(mech, "name", "mechanism"))
         s = d.size
         # static: anchors (hatched triangles) and ground guides
         for p in d.anchors.values():
@@ -363,41 +336,33 @@ class _Scene:
                                  hatch="////", lw=1.0, zorder=1))
             ax.plot([p[0] - 1.8 * s, p[0] + 1.8 * s], [p[1] - 1.8 * s] * 2, color="0.3",
                     lw=1.5, zorder=1)
-        g0 = _geometry(self.model, self.x, d, [0], self.trace)
-        self.guides = {}
-        for j, seg in g0["guides"].items():
-            (ln,) = ax.plot(seg[0, :, 0], seg[0, :, 1], color="0.35", lw=2.5, alpha=0.6,
-                            solid_capstyle="butt", zorder=1)
-            self.guides[j] = ln
+        # the moving artists start empty: update() places them
+        self.guides = {j: ax.plot([], [], color="0.35", lw=2.5, alpha=0.6,
+                                  solid_capstyle="butt", zorder=1)[0] for j in d.guides}
         if self.trace is not None:
-            gt = _geometry(self.model, self.x, d, None, self.trace)["trace"]
+            gt = g["trace"]
             ax.plot(gt[:, 0], gt[:, 1], color="tab:red", lw=0.8, ls=":", alpha=0.6, zorder=2)
             (self.trace_line,) = ax.plot([], [], color="tab:red", lw=1.4, zorder=2,
                                          label=f"path of {self.trace[0]}.{self.trace[1]}")
             (self.trace_dot,) = ax.plot([], [], "o", color="tab:red", ms=4, zorder=6)
             ax.legend(loc="upper right", fontsize="small")
-            self.trace_all = gt
         # moving bodies
         self.bodies = {}
-        for k, (b, (_, style)) in enumerate(d.bodies.items()):
+        for k, (b, (local, style)) in enumerate(d.bodies.items()):
             c = _COLORS[k % len(_COLORS)]
-            P = g0["bodies"][b][0]
             if style in ("polygon", "block"):
-                art = Polygon(P, closed=True, facecolor=c, alpha=0.45, edgecolor=c, lw=2.0,
+                art = Polygon(local, closed=True, facecolor=c, alpha=0.45, edgecolor=c, lw=2.0,
                               zorder=3, label=b)
                 ax.add_patch(art)
             elif style == "bar":
-                (art,) = ax.plot(P[:, 0], P[:, 1], color=c, lw=5.0, alpha=0.8,
-                                 solid_capstyle="round", zorder=3, label=b)
+                (art,) = ax.plot([], [], color=c, lw=5.0, alpha=0.8, solid_capstyle="round",
+                                 zorder=3, label=b)
             else:
-                (art,) = ax.plot(P[:, 0], P[:, 1], "o", color=c, ms=9, zorder=3, label=b)
+                (art,) = ax.plot([], [], "o", color=c, ms=9, zorder=3, label=b)
             self.bodies[b] = (art, style)
-        rv = np.array(list(g0["revolutes"].values())).reshape(-1, 2)
-        (self.revolutes,) = ax.plot(rv[:, 0], rv[:, 1], "o", ms=6, mfc="white", mec="black",
-                                    mew=1.3, zorder=5, ls="none")
-        lk = np.array(list(g0["locks"].values())).reshape(-1, 2)
-        (self.locks,) = ax.plot(lk[:, 0], lk[:, 1], "s", ms=6, mfc="0.2", mec="black",
-                                zorder=5, ls="none")
+        (self.revolutes,) = ax.plot([], [], "o", ms=6, mfc="white", mec="black", mew=1.3,
+                                    zorder=5, ls="none")
+        (self.locks,) = ax.plot([], [], "s", ms=6, mfc="0.2", mec="black", zorder=5, ls="none")
         self.text = ax.text(0.02, 0.97, "", transform=ax.transAxes, ha="left", va="top",
                             family="monospace", fontsize="medium",
                             bbox={"boxstyle": "round", "fc": "white", "ec": "0.7",
@@ -435,31 +400,24 @@ class _Scene:
 
     def update(self, i: int, label: str) -> None:
         """Move every artist to sample ``i``."""
-        g = _geometry(self.model, self.x, self.drawing, [i], self.trace)
+        g = self.g
         for b, (art, style) in self.bodies.items():
-            P = g["bodies"][b][0]
+            P = g["bodies"][b][i]
             if style in ("polygon", "block"):
                 art.set_xy(P)
             else:
                 art.set_data(P[:, 0], P[:, 1])
-        rv = np.array([v[0] for v in g["revolutes"].values()]).reshape(-1, 2)
-        self.revolutes.set_data(rv[:, 0], rv[:, 1])
-        lk = np.array([v[0] for v in g["locks"].values()]).reshape(-1, 2)
-        self.locks.set_data(lk[:, 0], lk[:, 1])
+        for kind in ("revolutes", "locks"):
+            P = np.array([v[i] for v in g[kind].values()]).reshape(-1, 2)
+            getattr(self, kind).set_data(P[:, 0], P[:, 1])
         for j, ln in self.guides.items():
-            seg = g["guides"][j][0]
+            seg = g["guides"][j][i]
             ln.set_data(seg[:, 0], seg[:, 1])
         if self.trace is not None:
-            self.trace_line.set_data(self.trace_all[: i + 1, 0], self.trace_all[: i + 1, 1])
-            self.trace_dot.set_data([self.trace_all[i, 0]], [self.trace_all[i, 1]])
+            path = g["trace"]
+            self.trace_line.set_data(path[: i + 1, 0], path[: i + 1, 1])
+            self.trace_dot.set_data([path[i, 0]], [path[i, 1]])
         self.text.set_text(label)
-
-
-def _check_path(path) -> Path:
-    path = Path(path)
-    if path.parent and not path.parent.exists():
-        path.parent.mkdir(parents=True, exist_ok=True)
-    return path
 
 
 def animate(record, path, *, fps: int = 25, frames: int | None = None, trace=None,
@@ -499,14 +457,13 @@ def animate(record, path, *, fps: int = 25, frames: int | None = None, trace=Non
     from matplotlib import animation
 
     path = check_animation_path(path)
-    suffix = path.suffix.lower()
     if fps <= 0:
         raise ModelError(f"fps must be positive, got {fps}")
     idx = frame_indices(record, frames)
     labels = _labels(record, idx)
     scene = _Scene(record, trace=trace, title=title)
-    path = _check_path(path)
-    if suffix == ".mp4":  # pragma: no cover - needs ffmpeg
+    path = output_path(path)
+    if path.suffix.lower() == ".mp4":  # pragma: no cover - needs ffmpeg
         writer = animation.FFMpegWriter(fps=fps)
         with writer.saving(scene.fig, str(path), dpi):
             for i, lab in zip(idx, labels, strict=True):
@@ -586,6 +543,6 @@ def snapshot(record, path, index: int = 0, *, trace=None, title: str | None = No
     if hasattr(path, "write"):
         scene.fig.savefig(path, dpi=dpi, format="png")
         return path
-    path = _check_path(path)
+    path = output_path(path)
     scene.fig.savefig(path, dpi=dpi)
     return path

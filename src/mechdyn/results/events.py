@@ -21,10 +21,10 @@ def format_events(events, coordinate_names=None, *, limit: int | None = None) ->
         return "no switching events"
     lines = [f"{len(evs)} switching event(s):",
              f"{'t [s]':>14}  {'kind':<9} {'element':<18} {'lost [J]':>10}  mode after"]
-    shown = list(enumerate(evs))
+    shown = evs
     if limit is not None and len(evs) > limit:
-        shown = shown[:max(limit - 1, 1)] + [(None, None)] + shown[-1:]
-    for k, e in shown:
+        shown = evs[:max(limit - 1, 1)] + [None] + evs[-1:]
+    for e in shown:
         if e is None:
             lines.append(f"{'...':>14}  ({len(evs) - limit} more)")
             continue
@@ -34,5 +34,4 @@ def format_events(events, coordinate_names=None, *, limit: int | None = None) ->
             line += "   " + ", ".join(f"{n}={v:.6g}" for n, v in
                                       zip(coordinate_names, e.q_after, strict=False))
         lines.append(line)
-        del k
     return "\n".join(lines)

@@ -15,7 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ModelError
+from .animate import _trace_spec
+from .table import deg_or_mm, output_path, rate_text
 
 __all__ = ["plot", "plot_kinematic_sweep", "PLOTTERS"]
 
@@ -31,37 +32,23 @@ def _figure(n_rows: int, width: float = 8.0, height: float = 2.6):
 
 
 def _save(fig, path, dpi) -> Path:
-    path = Path(path)
-    if path.parent and not path.parent.exists():
-        path.parent.mkdir(parents=True, exist_ok=True)
+    path = output_path(path)
     fig.savefig(path, dpi=dpi)
     return path
 
 
 # ---------------------------------------------------------------- kinematic sweep
-def _parse_points(model, points) -> list[tuple[str, object]]:
-    out = []
-    for p in points:
-        if isinstance(p, str):
-            body, sep, name = p.partition(".")
-            if not sep:
-                raise ModelError(f"point {p!r}: write it as BODY.POINT (e.g. 'rod.B' or "
-                                 "'rod.com')")
-            p = (body, name)
-        body, name = p
-        model.point_local(body, name)  # a clear error for unknown names
-        out.append((body, name, _label(body, name)))
-    return out
+def _parse_points(model, points) -> list[tuple[str, object, str]]:
+    return [(body, name, _label(body, name))
+            for body, name in (_trace_spec(model, p, "point") for p in points)]
 
 
 def _default_points(model) -> list[tuple[str, object, str]]:
     """The sliders' guided points, else the named points of the last body."""
     mech = model.mechanism
-    out = []
-    for jn in model.pri.names:
-        j = mech.joints[jn]
-        if j.child != "ground":
-            out.append((j.child, j.child_point, f"{j.child} on {jn!r}"))
+    sliders = [(jn, mech.joints[jn]) for jn in model.pri.names]
+    out = [(j.child, j.child_point, f"{j.child} on {jn!r}") for jn, j in sliders
+           if j.child != "ground"]
     if out:
         return out
     body = model.body_names[-1]
@@ -70,9 +57,7 @@ def _default_points(model) -> list[tuple[str, object, str]]:
 
 
 def _label(body, name) -> str:
-    if isinstance(name, str):
-        return f"{body}.{name}"
-    return f"{body}({name[0]:.4g}, {name[1]:.4g})"
+    return f"{body}.{name}" if isinstance(name, str) else f"{body}({name[0]:.4g}, {name[1]:.4g})"
 
 
 def plot_kinematic_sweep(sweep, path, points: Iterable | None = None, *,
@@ -97,30 +82,27 @@ def plot_kinematic_sweep(sweep, path, points: Iterable | None = None, *,
     model = sweep.model
     pts = _parse_points(model, points) if points is not None else _default_points(model)
     angle = sweep.over_is_angle
-    xs = np.rad2deg(sweep.values) if angle else sweep.values * 1e3
+    xs, xunit = deg_or_mm(sweep.values, angle)
     fig, axes = _figure(3)
     scale = model.length_scale
-    rows = [("position", "m", 0), ("velocity", "m/s", 1), ("acceleration", "m/s²", 2)]
+    rows = [("position", "m"), ("velocity", "m/s"), ("acceleration", "m/s²")]
     for body, name, label in pts:
         data = sweep.point(body, name)
         for c, comp in enumerate("xy"):
             if len(sweep) == 0 or np.ptp(data[0][:, c]) <= 1e-12 * scale:
                 continue  # a constant component (e.g. y of a horizontal slider)
-            for ax, (_, _, k) in zip(axes, rows, strict=True):
-                ax.plot(xs, data[k][:, c], label=f"{comp} of {label}")
-    for ax, (what, unit, _) in zip(axes, rows, strict=True):
+            for ax, values in zip(axes, data, strict=True):  # position, velocity, acceleration
+                ax.plot(xs, values[:, c], label=f"{comp} of {label}")
+    for ax, (what, unit) in zip(axes, rows, strict=True):
         ax.set_ylabel(f"{what} ({unit})")
         ax.grid(True, alpha=0.3)
         ax.axhline(0.0, color="0.6", lw=0.6)
         if ax.lines[1:]:
             ax.legend(fontsize="small", loc="best")
-    axes[-1].set_xlabel(f"{sweep.over} ({'deg' if angle else 'mm'})")
-    k = sweep.over_index
-    rate = float(sweep.qdot[0, k]) if len(sweep) else 1.0
-    rate_txt = (f"{rate:.6g} rad/s ({rate * 30 / np.pi:.6g} rpm)" if angle
-                else f"{rate:.6g} m/s")
-    name = model.mechanism.name
-    fig.suptitle(title or f"{name}: kinematics at constant {sweep.over}-rate {rate_txt}")
+    axes[-1].set_xlabel(f"{sweep.over} ({xunit})")
+    rate = float(sweep.qdot[0, sweep.over_index]) if len(sweep) else 1.0
+    fig.suptitle(title or f"{model.mechanism.name}: kinematics at constant {sweep.over}-rate "
+                 f"{rate_text(rate, angle)}")
     if sweep.status != "success" and len(sweep):
         for ax in axes:
             ax.axvline(xs[-1], color="tab:red", ls="--", lw=1.0)

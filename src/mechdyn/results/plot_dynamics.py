@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .plot import _figure, _save
+
 __all__ = ["plot_trajectory"]
 
 
@@ -32,51 +34,41 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
     Path
         The file written.
     """
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
+    from matplotlib import rcParams
 
     names = list(coordinates) if coordinates is not None else list(traj.coordinate_names)
     idx = [traj.coordinate_names.index(n) for n in names]
     show_energy = bool(energy and traj.energy and traj.t.size)
     vs = traj.switching if traj.t.size else None
     rows = 3 + (1 if show_energy else 0) + (1 if vs else 0)
-    fig, axes = plt.subplots(rows, 1, figsize=(8.0, 2.4 * rows), sharex=True,
-                             constrained_layout=True)
+    fig, axes = _figure(rows, height=2.4)
     t = traj.t
     is_angle = [traj.coordinate_is_angle[k] if traj.coordinate_is_angle else True for k in idx]
     au = "deg" if degrees else "rad"
     fa = np.rad2deg(1.0) if degrees else 1.0
     # lengths (travels) in mm on a right-hand axis when angles share the panel
     twins = [ax.twinx() if (any(is_angle) and not all(is_angle)) else ax for ax in axes[:3]]
-    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    colours = rcParams["axes.prop_cycle"].by_key()["color"]
+    panels = (("coordinate", "", "", traj.q), ("rate", "'", "/s", traj.qdot),
+              ("acceleration", "''", "/s^2", traj.qddot))
     for n, (k, name, ang) in enumerate(zip(idx, names, is_angle, strict=True)):
-        c = colours[n % len(colours)]
-        panel = axes[:3] if ang else twins
         f, u = (fa, au) if ang else (1e3, "mm")
-        panel[0].plot(t, traj.q[:, k] * f, color=c, label=f"{name} [{u}]")
-        panel[1].plot(t, traj.qdot[:, k] * f, color=c, label=f"{name}' [{u}/s]")
-        panel[2].plot(t, traj.qddot[:, k] * f, color=c, label=f"{name}'' [{u}/s^2]")
-    for ax, twin, what in zip(axes[:3], twins, ("coordinate", "rate", "acceleration"),
-                              strict=True):
+        for ax, (_, tick, per, data) in zip(axes[:3] if ang else twins, panels, strict=True):
+            ax.plot(t, data[:, k] * f, color=colours[n % len(colours)],
+                    label=f"{name}{tick} [{u}{per}]")
+    for ax, twin, (what, _, per, _) in zip(axes[:3], twins, panels, strict=True):
         if twin is ax:
-            unit = au if any(is_angle) else "mm"
-            ax.set_ylabel(f"{what} [{unit}{'' if what == 'coordinate' else '/s'}"
-                          f"{'^2' if what == 'acceleration' else ''}]")
+            ax.set_ylabel(f"{what} [{au if any(is_angle) else 'mm'}{per}]")
         else:
             ax.set_ylabel(f"{what}: angles")
             twin.set_ylabel(f"{what}: travels")
             lines = ax.get_lines() + twin.get_lines()
             ax.legend(lines, [ln.get_label() for ln in lines], loc="best", fontsize="small")
     if show_energy:
-        e = traj.energy
-        ax = axes[3]
-        ax.plot(t, e["kinetic"], label="T [J]")
-        ax.plot(t, e["potential"], label="U [J]")
-        ax.plot(t, e["work_nc"], label="W_nc [J]")
-        ax.plot(t, e["balance"], "k--", label="T + U - W_nc [J]")
-        ax.set_ylabel("energy [J]")
+        for key, style, label in (("kinetic", "-", "T"), ("potential", "-", "U"),
+                                  ("work_nc", "-", "W_nc"), ("balance", "k--", "T + U - W_nc")):
+            axes[3].plot(t, traj.energy[key], style, label=f"{label} [J]")
+        axes[3].set_ylabel("energy [J]")
     if vs:
         ax = axes[-1]
         frame = np.asarray(vs["frame_force"], float)
@@ -94,17 +86,16 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
     if not traj.success:
         head += f" - stopped: {traj.status}"
     fig.suptitle(head)
-    path = Path(path)
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
-    return path
+    return _save(fig, path, dpi)
 
 
 def _shade_modes(axes, t, mode_index, modes) -> None:
     """Shade the time spans of the modes of a variable-structure run (one tint per mode)."""
     if t.size < 2 or len(modes) < 2:
         return
-    cmap = __import__("matplotlib").colormaps["Pastel2"]
+    from matplotlib import colormaps
+
+    cmap = colormaps["Pastel2"]
     change = np.flatnonzero(np.diff(mode_index) != 0) + 1
     starts = np.concatenate([[0], change])
     ends = np.concatenate([change, [t.size - 1]])

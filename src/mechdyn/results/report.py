@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import base64
 import html
-import io
 import tempfile
 from dataclasses import fields, is_dataclass
 from datetime import datetime
@@ -34,6 +33,7 @@ from .animate import animate, snapshot
 from .plot import plot_kinematic_sweep
 from .plot_dynamics import plot_trajectory
 from .plot_kinetostatics import plot_kinetostatics
+from .table import output_path, rate_text
 
 __all__ = ["write_report", "report_trajectory", "model_tables"]
 
@@ -60,59 +60,51 @@ def _esc(text) -> str:
     return html.escape(str(text))
 
 
-def _table(df, *, digits: int = 6) -> str:
-    """A DataFrame as an HTML table (numbers to ``digits`` significant digits)."""
-    return df.to_html(index=False, border=0, na_rep="",
-                      float_format=lambda v: f"{v:.{digits}g}")
+def _table(title: str | None, rows, *, digits: int = 6) -> str:
+    """A heading (if any) and rows (dicts or a DataFrame) as an HTML table; "" without rows."""
+    import pandas as pd
+
+    if not len(rows):
+        return ""
+    head = f"<h3>{_esc(title)}</h3>\n" if title else ""
+    return head + pd.DataFrame(rows).to_html(index=False, border=0, na_rep="",
+                                             float_format=lambda v: f"{v:.{digits}g}")
 
 
-def _img_png(data: bytes, alt: str) -> str:
-    b64 = base64.b64encode(data).decode("ascii")
-    return f'<img alt="{_esc(alt)}" src="data:image/png;base64,{b64}">'
+def _join(parts: list[str]) -> str:
+    return "\n".join(p for p in parts if p)
 
 
-def _img_gif(data: bytes, alt: str) -> str:
-    b64 = base64.b64encode(data).decode("ascii")
-    return f'<img alt="{_esc(alt)}" src="data:image/gif;base64,{b64}">'
-
-
-def _plot_png(fn, record, **kwargs) -> bytes:
-    """Run a ``plot_*(record, path, ...)`` function into a temporary PNG; its bytes."""
+def _img(draw, alt: str, kind: str = "png") -> str:
+    """An embedded image drawn by ``draw(path)`` into a temporary ``.png`` or ``.gif`` file."""
     with tempfile.TemporaryDirectory() as tmp:
-        p = Path(tmp) / "plot.png"
-        fn(record, p, **kwargs)
-        return p.read_bytes()
+        p = Path(tmp) / f"image.{kind}"
+        draw(p)
+        b64 = base64.b64encode(p.read_bytes()).decode("ascii")
+    return f'<img alt="{_esc(alt)}" src="data:image/{kind};base64,{b64}">'
 
 
-def _snapshot_png(record, index: int = 0, **kwargs) -> bytes:
-    buf = io.BytesIO()
-    snapshot(record, buf, index, **kwargs)
-    return buf.getvalue()
+def _drawing(record, alt: str, *, animation: bool, trace) -> list[str]:
+    """The first frame of a record's motion and, with ``animation``, the GIF of it."""
+    out = ["<h3>Drawing</h3>", _img(lambda p: snapshot(record, p, 0, trace=trace), alt)]
+    if animation:
+        out.append(_img(lambda p: animate(record, p, frames=72, dpi=60, trace=trace),
+                        "the motion", "gif"))
+    return out
 
 
-def _animation_gif(record, frames: int = 72, **kwargs) -> bytes:
-    with tempfile.TemporaryDirectory() as tmp:
-        p = Path(tmp) / "motion.gif"
-        animate(record, p, frames=frames, dpi=60, **kwargs)
-        return p.read_bytes()
-
-
-def _page(title: str, sections: list[str]) -> str:
+def _write_page(path, title: str, sections: list[str]) -> Path:
+    """Write the HTML page of ``sections`` under ``title``."""
     stamp = datetime.now().strftime("%Y-%m-%d %H:%M")
-    return (f"<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-            f"<title>{_esc(title)}</title>\n<style>{_CSS}</style>\n</head>\n<body>\n"
-            f"<h1>{_esc(title)}</h1>\n"
-            f"<p class=\"note\">mechdyn {__version__}, {stamp}. SI units unless a column says "
-            f"otherwise; angles counter-clockwise positive; joint reactions are the force "
-            f"on the child body from the parent at the joint point, ground frame.</p>\n"
-            + "\n".join(sections) + "\n</body>\n</html>\n")
-
-
-def _write(path, text: str) -> Path:
-    path = Path(path)
-    if path.parent and not path.parent.exists():
-        path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(text, encoding="utf-8")
+    path = output_path(path)
+    path.write_text(
+        f"<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+        f"<title>{_esc(title)}</title>\n<style>{_CSS}</style>\n</head>\n<body>\n"
+        f"<h1>{_esc(title)}</h1>\n"
+        f"<p class=\"note\">mechdyn {__version__}, {stamp}. SI units unless a column says "
+        f"otherwise; angles counter-clockwise positive; joint reactions are the force "
+        f"on the child body from the parent at the joint point, ground frame.</p>\n"
+        + "\n".join(sections) + "\n</body>\n</html>\n", encoding="utf-8")
     return path
 
 
@@ -128,22 +120,17 @@ def _mm(v: float) -> float:
 
 
 def _pt_text(p) -> str:
-    if isinstance(p, str):
-        return p
-    return f"({_mm(p[0]):.6g}, {_mm(p[1]):.6g}) mm"
+    return p if isinstance(p, str) else f"({_mm(p[0]):.6g}, {_mm(p[1]):.6g}) mm"
 
 
 def _value_text(v) -> str:
     """Short text of a parameter value: numbers to 6 significant digits, sequences shortened."""
-    if isinstance(v, (bool, str)) or v is None:
-        return str(v)
-    if isinstance(v, (int, float, np.number)):
+    if isinstance(v, (int, float, np.number)) and not isinstance(v, bool):
         return f"{float(v):.6g}"
     if isinstance(v, (tuple, list, np.ndarray)):
         items = list(v)
         if len(items) > 8:
-            return (f"({len(items)} values: {_value_text(items[0])} .. "
-                    f"{_value_text(items[-1])})")
+            return f"({len(items)} values: {_value_text(items[0])} .. {_value_text(items[-1])})"
         return "(" + ", ".join(_value_text(a) for a in items) + ")"
     return str(v)
 
@@ -154,19 +141,15 @@ def _element_params(el, skip=("name",)) -> str:
         return _esc(repr(el))
     parts = []
     for f in fields(el):
-        if f.name in skip:
-            continue
         v = getattr(el, f.name)
-        if v is None or (isinstance(v, (int, float)) and not isinstance(v, bool) and v == 0
-                         and f.name in ("damping", "preload")):
+        if f.name in skip or v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)
+                                           and v == 0 and f.name in ("damping", "preload")):
             continue
         if is_dataclass(v):
             v = f"{type(v).__name__}({_element_params(v, skip=())})"
         elif callable(v):
             v = getattr(v, "__name__", "function")
-        else:
-            v = _value_text(v)
-        parts.append(f"{f.name} = {v}")
+        parts.append(f"{f.name} = {v if isinstance(v, str) else _value_text(v)}")
     return "; ".join(parts)
 
 
@@ -188,221 +171,167 @@ def model_tables(model) -> dict:
     import pandas as pd
 
     mech = model.mechanism
-    out = {}
-    rows = []
+    rows = {"bodies": [], "ground points": [], "joints": [], "coordinates": [], "loads": [],
+            "drives": []}
     for k, b in enumerate(model.body_names):
         body = mech.bodies[b]
-        rows.append({"body": b, "mass_kg": model.mass[k], "J_c_kg_m2": model.inertia[k],
-                     "com_x_mm": _mm(body.com[0]), "com_y_mm": _mm(body.com[1]),
-                     "points (body frame)": ", ".join(f"{n} {_pt_text(p)}"
-                                                      for n, p in body.points.items())})
-    out["bodies"] = pd.DataFrame(rows)
-    if mech.ground.points:
-        out["ground points"] = pd.DataFrame(
-            [{"point": n, "x_mm": _mm(p[0]), "y_mm": _mm(p[1])}
-             for n, p in mech.ground.points.items()])
-    rows = []
+        rows["bodies"].append({
+            "body": b, "mass_kg": model.mass[k], "J_c_kg_m2": model.inertia[k],
+            "com_x_mm": _mm(body.com[0]), "com_y_mm": _mm(body.com[1]),
+            "points (body frame)": ", ".join(f"{n} {_pt_text(p)}" for n, p in body.points.items())})
+    rows["ground points"] = [{"point": n, "x_mm": _mm(p[0]), "y_mm": _mm(p[1])}
+                             for n, p in mech.ground.points.items()]
     for name, j in mech.joints.items():
         kind = model.joint_kind(name)
-        row = {"joint": name, "type": kind, "parent": j.parent, "child": j.child}
-        if kind == "lock":
-            row["parent point"] = ""
-            row["child point"] = ""
-            row["axis / note"] = "engaged" if j.engaged else "released"
-        else:
-            row["parent point"] = _pt_text(j.parent_point)
-            row["child point"] = _pt_text(j.child_point)
-            row["axis / note"] = (f"({j.axis[0]:.4g}, {j.axis[1]:.4g})" if kind == "prismatic"
-                                  else "")
-        rows.append(row)
-    out["joints"] = pd.DataFrame(rows)
-
+        lock = kind == "lock"
+        note = ("engaged" if j.engaged else "released") if lock else (
+            f"({j.axis[0]:.4g}, {j.axis[1]:.4g})" if kind == "prismatic" else "")
+        rows["joints"].append({"joint": name, "type": kind, "parent": j.parent, "child": j.child,
+                               "parent point": "" if lock else _pt_text(j.parent_point),
+                               "child point": "" if lock else _pt_text(j.child_point),
+                               "axis / note": note})
     try:
         q0 = initial_coordinates(model)
     except Exception:  # noqa: BLE001 - the report still lists the coordinates
         q0 = np.full(model.n_q, np.nan)
     qd0 = (mech.extras.get("initial") or {}).get("qdot") or {}
-    rows = []
     for k, (name, c) in enumerate(mech.coordinates.items()):
         ang = c.is_angle
-        what = c.body if c.kind == "angle" else c.joint
         rate = float(qd0.get(name, 0.0)) if isinstance(qd0, dict) else 0.0
-        rows.append({"coordinate": name, "kind": c.kind, "of": what,
-                     "unit": "rad" if ang else "m",
-                     "initial": f"{np.rad2deg(q0[k]):.6g} deg" if ang
-                     else f"{_mm(q0[k]):.6g} mm",
-                     "initial rate": f"{rate * 30 / np.pi:.6g} rpm" if ang
-                     else f"{rate:.6g} m/s"})
-    out["coordinates"] = pd.DataFrame(rows)
-    if mech.loads:
-        out["loads"] = pd.DataFrame([{"kind": type(el).__name__,
-                                      "name": getattr(el, "name", ""),
-                                      "parameters (SI)": _element_params(el)}
-                                     for el in mech.loads])
-    if mech.drives:
-        out["drives"] = pd.DataFrame([{"kind": type(el).__name__,
-                                       "name": getattr(el, "name", ""),
-                                       "parameters (SI)": _element_params(el)}
-                                      for el in mech.drives])
-    return out
+        rows["coordinates"].append({
+            "coordinate": name, "kind": c.kind, "of": c.body if c.kind == "angle" else c.joint,
+            "unit": "rad" if ang else "m",
+            "initial": f"{np.rad2deg(q0[k]):.6g} deg" if ang else f"{_mm(q0[k]):.6g} mm",
+            "initial rate": f"{rate * 30 / np.pi:.6g} rpm" if ang else f"{rate:.6g} m/s"})
+    for key, elements in (("loads", mech.loads), ("drives", mech.drives)):
+        rows[key] = [{"kind": type(el).__name__, "name": getattr(el, "name", ""),
+                      "parameters (SI)": _element_params(el)} for el in elements]
+    return {key: pd.DataFrame(r) for key, r in rows.items()
+            if r or key in ("bodies", "joints", "coordinates")}
 
 
 def _model_section(model) -> str:
     mech = model.mechanism
-    parts = ["<h2>Model</h2>"]
-    if mech.description:
-        parts.append(f"<p>{_esc(mech.description)}</p>")
     g = model.gravity
-    parts.append(f"<p>{model.n_bodies} moving bodies, {len(model.joint_names)} joints, "
-                 f"coordinates {', '.join(model.coordinate_names)} "
-                 f"({mech.dof} degree(s) of freedom); gravity ({g[0]:.4g}, {g[1]:.4g}) "
-                 f"m/s&sup2;.</p>")
-    for title, df in model_tables(model).items():
-        parts.append(f"<h3>{_esc(title.capitalize())}</h3>")
-        parts.append(_table(df))
-    return "\n".join(parts)
+    return _join(["<h2>Model</h2>", mech.description and f"<p>{_esc(mech.description)}</p>",
+                  f"<p>{model.n_bodies} moving bodies, {len(model.joint_names)} joints, "
+                  f"coordinates {', '.join(model.coordinate_names)} "
+                  f"({mech.dof} degree(s) of freedom); gravity ({g[0]:.4g}, {g[1]:.4g}) "
+                  "m/s&sup2;.</p>"]
+                 + [_table(title.capitalize(), df) for title, df in model_tables(model).items()])
 
 
 # ------------------------------------------------------------------ kinematics
 def _at_text(over_is_angle: bool, v: float) -> str:
-    if over_is_angle:
-        return f"{np.rad2deg(v):.3f} deg"
-    return f"{_mm(v):.4f} mm"
+    return f"{np.rad2deg(v):.3f} deg" if over_is_angle else f"{_mm(v):.4f} mm"
+
+
+def _stroke_row(summ, ang: bool, joint: str, stroke: float) -> dict:
+    row = {"slider (joint)": joint, "stroke_mm": f"{_mm(stroke):.4f}"}
+    for d in summ.dead_centres:
+        if d.joint == joint:
+            row[f"{d.label} at"] = _at_text(ang, d.at)
+            row[f"{d.label} travel_mm"] = f"{_mm(d.travel):.4f}"
+    return row
 
 
 def _sweep_section(sw, *, animation: bool, trace) -> str:
-    import pandas as pd
-
-    model = sw.model
     ang = sw.over_is_angle
-    k = sw.over_index
-    rate = float(sw.qdot[0, k]) if len(sw) else 1.0
-    unit_v = ("m/s", "m/s&sup2;")
-    parts = ["<h2>Kinematics</h2>"]
+    rate = float(sw.qdot[0, sw.over_index]) if len(sw) else 1.0
     rng = (f"{_at_text(ang, sw.values[0])} to {_at_text(ang, sw.values[-1])}"
            if len(sw) else "no positions")
-    rate_txt = (f"{rate:.6g} rad/s ({rate * 30 / np.pi:.6g} rpm)" if ang
-                else f"{rate:.6g} m/s")
-    parts.append(f"<p>Sweep of <code>{_esc(sw.over)}</code> over {rng}, {len(sw)} positions, "
-                 f"at a constant rate of {rate_txt}"
-                 + (" &mdash; velocities and accelerations are then the first- and "
-                    "second-order velocity analogs." if rate == 1.0 else ".") + "</p>")
-    parts.append(_status(sw.status, sw.ok, sw.message))
+    parts = ["<h2>Kinematics</h2>",
+             f"<p>Sweep of <code>{_esc(sw.over)}</code> over {rng}, {len(sw)} positions, "
+             f"at a constant rate of {rate_text(rate, ang)}"
+             + (" &mdash; velocities and accelerations are then the first- and "
+                "second-order velocity analogs." if rate == 1.0 else ".") + "</p>",
+             _status(sw.status, sw.ok, sw.message)]
     if not len(sw):
-        return "\n".join(parts)
+        return _join(parts)
     summ = sw.summary()
-    if summ.strokes:
-        rows = []
-        for j, s in summ.strokes.items():
-            row = {"slider (joint)": j, "stroke_mm": f"{_mm(s):.4f}"}
-            for d in summ.dead_centres:
-                if d.joint == j:
-                    row[f"{d.label} at"] = _at_text(ang, d.at)
-                    row[f"{d.label} travel_mm"] = f"{_mm(d.travel):.4f}"
-            rows.append(row)
-        parts.append("<h3>Strokes and dead centres</h3>")
-        parts.append(_table(pd.DataFrame(rows)))
-    if summ.transmission:
-        rows = []
-        for t in summ.transmission:
-            lo, hi = np.rad2deg(t.min), np.rad2deg(t.max)
-            rows.append({"loop (coupler/rocker)": f"{t.loop.coupler}/{t.loop.rocker}",
-                         "joint": t.loop.joints[2], "mu_min_deg": f"{lo:.3f}",
-                         "at (min)": _at_text(ang, t.min_at), "mu_max_deg": f"{hi:.3f}",
-                         "at (max)": _at_text(ang, t.max_at),
-                         "largest deviation from 90 deg": f"{max(90 - lo, hi - 90):.3f}"})
-        parts.append("<h3>Transmission angles</h3>")
-        parts.append(_table(pd.DataFrame(rows)))
-    if summ.extremes:
-        rows = [{"point": f"{e.body}.{e.point}", f"v_max ({unit_v[0]})": e.v_max,
-                 "at (v)": _at_text(ang, e.v_max_at), "a_max (m/s²)": e.a_max,
-                 "at (a)": _at_text(ang, e.a_max_at)} for e in summ.extremes]
-        parts.append("<h3>Extreme speeds and accelerations of the named points</h3>")
-        parts.append(_table(pd.DataFrame(rows)))
-    omegas = []
-    for b in model.body_names:
-        _, om, al = sw.angular(b)
-        if np.ptp(om) > 0 or np.any(om):
-            omegas.append({"body": b, "omega_min_rad_s": om.min(), "omega_max_rad_s": om.max(),
-                           "alpha_min_rad_s2": al.min(), "alpha_max_rad_s2": al.max()})
-    if omegas:
-        parts.append("<h3>Angular velocities and accelerations of the bodies</h3>")
-        parts.append(_table(pd.DataFrame(omegas)))
-    parts.append("<h3>Drawing</h3>")
-    parts.append(_img_png(_snapshot_png(sw, 0, trace=trace), "the mechanism"))
-    if animation:
-        parts.append(_img_gif(_animation_gif(sw, trace=trace), "the motion"))
-    parts.append("<h3>Plot</h3>")
-    parts.append(_img_png(_plot_png(plot_kinematic_sweep, sw), "kinematics plot"))
-    return "\n".join(parts)
+    mu = [(t, np.rad2deg(t.min), np.rad2deg(t.max)) for t in summ.transmission]
+    omegas = [(b, *sw.angular(b)[1:]) for b in sw.model.body_names]
+    parts += [
+        _table("Strokes and dead centres",
+               [_stroke_row(summ, ang, j, s) for j, s in summ.strokes.items()]),
+        _table("Transmission angles", [
+            {"loop (coupler/rocker)": f"{t.loop.coupler}/{t.loop.rocker}",
+             "joint": t.loop.joints[2], "mu_min_deg": f"{lo:.3f}",
+             "at (min)": _at_text(ang, t.min_at), "mu_max_deg": f"{hi:.3f}",
+             "at (max)": _at_text(ang, t.max_at),
+             "largest deviation from 90 deg": f"{max(90 - lo, hi - 90):.3f}"}
+            for t, lo, hi in mu]),
+        _table("Extreme speeds and accelerations of the named points", [
+            {"point": f"{e.body}.{e.point}", "v_max (m/s)": e.v_max,
+             "at (v)": _at_text(ang, e.v_max_at), "a_max (m/s²)": e.a_max,
+             "at (a)": _at_text(ang, e.a_max_at)} for e in summ.extremes]),
+        _table("Angular velocities and accelerations of the bodies", [
+            {"body": b, "omega_min_rad_s": om.min(), "omega_max_rad_s": om.max(),
+             "alpha_min_rad_s2": al.min(), "alpha_max_rad_s2": al.max()}
+            for b, om, al in omegas if np.ptp(om) > 0 or np.any(om)])]
+    parts += _drawing(sw, "the mechanism", animation=animation, trace=trace)
+    parts += ["<h3>Plot</h3>", _img(lambda p: plot_kinematic_sweep(sw, p), "kinematics plot")]
+    return _join(parts)
 
 
 # ------------------------------------------------------------------ kinetostatics
-def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
-    import pandas as pd
+def _drive_row(ks, ang: bool, c: str, d: dict) -> dict:
+    sym, unit = ks._drive_unit(c)
+    u = "Nm" if unit == "Nm" else "N"
+    return {"drive": c, f"peak |{sym}|_{u}": abs(d["peak_abs"]),
+            "at": _at_text(ang, d["peak_abs_at"]), f"max_{u}": d["max"], f"min_{u}": d["min"],
+            f"RMS_{u}": d["rms"], f"mean_{u}": d["mean"], "peak power_W": d["peak_power"]}
 
+
+def _harmonics(ks, harmonics: int) -> list[str]:
+    """The shaking force and moment per order of the turn (round-off noise shown as 0)."""
+    try:
+        h = ks.harmonics(harmonics)
+    except ValueError as exc:
+        return [f'<p class="note">No harmonics: {_esc(exc)}</p>']
+    h = h[["order", "f_Hz", "Fx_frame_N", "Fy_frame_N", "M_frame_Nm"]].copy()
+    for c in ("Fx_frame_N", "Fy_frame_N", "M_frame_Nm"):
+        a = h[c].to_numpy()
+        h[c] = np.where(np.abs(a) < 1e-9 * max(np.max(np.abs(a)), 1e-300), 0.0, a)
+    return ["<h3>Harmonics of the shaking force and moment</h3>",
+            '<p class="note">Amplitudes per order of the crank turn (order 0: the mean).</p>',
+            _table(None, h)]
+
+
+def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
     ang = ks.over_is_angle
     parts = ["<h2>Kinetostatics</h2>"]
     if ks.n:
         k = ks.coordinate_names.index(ks.over)
-        rate = float(ks.qdot[0, k])
-        rate_txt = (f"{rate:.6g} rad/s ({rate * 30 / np.pi:.6g} rpm)" if ang
-                    else f"{rate:.6g} m/s")
         parts.append(f"<p>Driven coordinate(s) {', '.join(ks.driven)} at constant "
-                     f"{_esc(ks.over)}-rate {rate_txt}, {ks.n} positions; forces include "
-                     "gravity, inertia and the model's loads.</p>")
+                     f"{_esc(ks.over)}-rate {rate_text(float(ks.qdot[0, k]), ang)}, "
+                     f"{ks.n} positions; forces include gravity, inertia and the model's "
+                     "loads.</p>")
     parts.append(_status(ks.status, ks.status in (Status.SUCCESS, Status.REDUNDANT), ks.message))
     if not ks.n:
-        return "\n".join(parts)
+        return _join(parts)
     p = ks.peaks()
-    rows = []
-    for c, d in p["driving"].items():
-        sym, unit = ks._drive_unit(c)
-        u = "Nm" if unit == "Nm" else "N"
-        rows.append({"drive": c, f"peak |{sym}|_{u}": abs(d["peak_abs"]),
-                     "at": _at_text(ang, d["peak_abs_at"]), f"max_{u}": d["max"],
-                     f"min_{u}": d["min"], f"RMS_{u}": d["rms"], f"mean_{u}": d["mean"],
-                     "peak power_W": d["peak_power"]})
-    parts.append("<h3>Driving torque</h3>")
-    parts.append(_table(pd.DataFrame(rows)))
-    rows = []
-    for j, d in p["joints"].items():
-        row = {"joint": j, "type": ks.joint_kinds[j], "peak force_N": d["peak"],
+    joints = [{"joint": j, "type": ks.joint_kinds[j], "peak force_N": d["peak"],
                "at": _at_text(ang, d["peak_at"]), "RMS force_N": d["rms"]}
-        if "peak_moment" in d:
-            row["peak moment_Nm"] = d["peak_moment"]
-        rows.append(row)
-    parts.append("<h3>Peak joint forces</h3>")
-    parts.append(_table(pd.DataFrame(rows)))
+              | ({"peak moment_Nm": d["peak_moment"]} if "peak_moment" in d else {})
+              for j, d in p["joints"].items()]
     fr = p["frame"]
-    parts.append("<h3>Frame (shaking) loads</h3>")
-    parts.append(_table(pd.DataFrame([
-        {"quantity": "|F| frame (N)", "min": np.nan, "max": fr["force_peak"],
-         "peak at": _at_text(ang, fr["force_peak_at"])},
-        {"quantity": "Fx frame (N)", "min": fr["Fx_min"], "max": fr["Fx_max"], "peak at": ""},
-        {"quantity": "Fy frame (N)", "min": fr["Fy_min"], "max": fr["Fy_max"], "peak at": ""},
-        {"quantity": f"M frame about ({ks.frame_point[0]:.4g}, {ks.frame_point[1]:.4g}) m "
-                     "(N m)", "min": fr["M_min"], "max": fr["M_max"],
-         "peak at": _at_text(ang, fr["moment_peak_at"])}])))
+    parts += [
+        _table("Driving torque", [_drive_row(ks, ang, c, d) for c, d in p["driving"].items()]),
+        _table("Peak joint forces", joints),
+        _table("Frame (shaking) loads", [
+            {"quantity": "|F| frame (N)", "min": np.nan, "max": fr["force_peak"],
+             "peak at": _at_text(ang, fr["force_peak_at"])},
+            {"quantity": "Fx frame (N)", "min": fr["Fx_min"], "max": fr["Fx_max"], "peak at": ""},
+            {"quantity": "Fy frame (N)", "min": fr["Fy_min"], "max": fr["Fy_max"], "peak at": ""},
+            {"quantity": f"M frame about ({ks.frame_point[0]:.4g}, {ks.frame_point[1]:.4g}) m "
+                         "(N m)", "min": fr["M_min"], "max": fr["M_max"],
+             "peak at": _at_text(ang, fr["moment_peak_at"])}])]
     if harmonics > 0 and ang:
-        try:
-            h = ks.harmonics(harmonics)
-        except ValueError as exc:
-            parts.append(f'<p class="note">No harmonics: {_esc(exc)}</p>')
-        else:
-            h = h[["order", "f_Hz", "Fx_frame_N", "Fy_frame_N", "M_frame_Nm"]].copy()
-            for c in ("Fx_frame_N", "Fy_frame_N", "M_frame_Nm"):  # round-off noise -> 0
-                a = h[c].to_numpy()
-                h[c] = np.where(np.abs(a) < 1e-9 * max(np.max(np.abs(a)), 1e-300), 0.0, a)
-            parts.append("<h3>Harmonics of the shaking force and moment</h3>")
-            parts.append('<p class="note">Amplitudes per order of the crank turn '
-                         "(order 0: the mean).</p>")
-            parts.append(_table(h))
-    for w in ks.warnings:
-        parts.append(f'<p class="note">Warning: {_esc(w)}</p>')
-    parts.append("<h3>Plot</h3>")
-    parts.append(_img_png(_plot_png(plot_kinetostatics, ks), "kinetostatics plot"))
-    return "\n".join(parts)
+        parts += _harmonics(ks, harmonics)
+    parts += [f'<p class="note">Warning: {_esc(w)}</p>' for w in ks.warnings]
+    parts += ["<h3>Plot</h3>", _img(lambda p: plot_kinetostatics(ks, p), "kinetostatics plot")]
+    return _join(parts)
 
 
 # ------------------------------------------------------------------ public
@@ -440,7 +369,7 @@ def write_report(model, path, *, sweep=None, kinetostatics=None, title: str | No
         sections.append(_sweep_section(sweep, animation=animation, trace=trace))
     if kinetostatics is not None:
         sections.append(_kinetostatics_section(kinetostatics))
-    return _write(path, _page(title or f"{name}: report", sections))
+    return _write_page(path, title or f"{name}: report", sections)
 
 
 def report_trajectory(traj, path, *, title: str | None = None, animation: bool = False,
@@ -467,75 +396,53 @@ def report_trajectory(traj, path, *, title: str | None = None, animation: bool =
     Path
         The file written.
     """
-    import pandas as pd
-
     model = traj.model
     name = getattr(getattr(model, "mechanism", None), "name", "mechanism")
-    sections = []
-    if model is not None:
-        sections.append(_model_section(model))
+    sections = [] if model is None else [_model_section(model)]
     parts = ["<h2>Simulation</h2>", _status(traj.status, traj.success, traj.message)]
     s = traj.stats or {}
-    run = {"integrator": s.get("integrator"), "formulation": s.get("formulation"),
-           "backend": s.get("backend"), "steps": s.get("steps"),
-           "rejected steps": s.get("rejected"), "evaluations": s.get("evaluations"),
-           "wall time_s": s.get("wall_time_s"), "samples": traj.n_samples}
+    run = {label: s.get(key) for label, key in (
+        ("integrator", "integrator"), ("formulation", "formulation"), ("backend", "backend"),
+        ("steps", "steps"), ("rejected steps", "rejected"), ("evaluations", "evaluations"),
+        ("wall time_s", "wall_time_s"))}
+    run["samples"] = traj.n_samples
     if traj.t.size:
         run["t start_s"], run["t end_s"] = float(traj.t[0]), float(traj.t[-1])
-    parts.append("<h3>Run</h3>")
-    parts.append(_table(pd.DataFrame([{"quantity": k, "value": v} for k, v in run.items()
-                                      if v is not None]).astype({"value": str})))
+    parts.append(_table("Run", [{"quantity": k, "value": str(v)} for k, v in run.items()
+                                if v is not None]))
     if traj.t.size:
         rows = []
         for k, c in enumerate(traj.coordinate_names):
             ang = traj.coordinate_is_angle[k] if traj.coordinate_is_angle else True
             f, u, ur = (np.rad2deg(1.0), "deg", "rpm") if ang else (1e3, "mm", "m/s")
             fr = 30 / np.pi if ang else 1.0
+            qd = traj.qdot[:, k]
             rows.append({"coordinate": c, f"start ({u})": traj.q[0, k] * f,
-                         f"end ({u})": traj.q[-1, k] * f,
-                         f"start rate ({ur})": traj.qdot[0, k] * fr,
-                         f"end rate ({ur})": traj.qdot[-1, k] * fr,
-                         f"min rate ({ur})": traj.qdot[:, k].min() * fr,
-                         f"max rate ({ur})": traj.qdot[:, k].max() * fr})
-        parts.append("<h3>Coordinates</h3>")
-        parts.append(_table(pd.DataFrame(rows), digits=9))
+                         f"end ({u})": traj.q[-1, k] * f, f"start rate ({ur})": qd[0] * fr,
+                         f"end rate ({ur})": qd[-1] * fr, f"min rate ({ur})": qd.min() * fr,
+                         f"max rate ({ur})": qd.max() * fr})
+        parts.append(_table("Coordinates", rows, digits=9))
     if traj.energy and traj.t.size:
         e = traj.energy
-        parts.append("<h3>Energy balance</h3>")
-        parts.append(_table(pd.DataFrame([
-            {"quantity": "kinetic energy T_J", "start": e["kinetic"][0], "end": e["kinetic"][-1]},
-            {"quantity": "potential energy U_J", "start": e["potential"][0],
-             "end": e["potential"][-1]},
-            {"quantity": "work of non-conservative forces W_nc_J", "start": e["work_nc"][0],
-             "end": e["work_nc"][-1]},
-            {"quantity": "balance T + U - W_nc_J", "start": e["balance"][0],
-             "end": e["balance"][-1]}]), digits=9))
+        rows = [{"quantity": q, "start": e[key][0], "end": e[key][-1]} for q, key in (
+            ("kinetic energy T_J", "kinetic"), ("potential energy U_J", "potential"),
+            ("work of non-conservative forces W_nc_J", "work_nc"),
+            ("balance T + U - W_nc_J", "balance"))]
+        parts.append(_table("Energy balance", rows, digits=9))
         parts.append(f"<p>The balance drifts by at most {traj.energy_drift():.3e} J; the "
                      f"largest constraint residual is {np.max(e['residual']):.3e} "
                      "(m or rad).</p>")
-    parts.append("<h3>Events</h3>")
-    if traj.events:
-        rows = []
-        for ev in traj.events[:max_events]:
-            row = {"t_s": getattr(ev, "t", np.nan),
-                   "kind": getattr(ev, "kind", type(ev).__name__),
-                   "element": getattr(ev, "element", getattr(ev, "name", "")),
-                   "mode after": " ".join(sorted(getattr(ev, "mode_after", ()) or ())),
-                   "energy lost_J": getattr(ev, "energy_lost", 0.0)}
-            rows.append(row)
-        parts.append(_table(pd.DataFrame(rows), digits=9))
-        if len(traj.events) > max_events:
-            parts.append(f'<p class="note">{len(traj.events) - max_events} more events '
-                         "not listed.</p>")
-    else:
-        parts.append("<p>No events.</p>")
+    parts += ["<h3>Events</h3>", "" if traj.events else "<p>No events.</p>", _table(None, [
+        {"t_s": getattr(ev, "t", np.nan), "kind": getattr(ev, "kind", type(ev).__name__),
+         "element": getattr(ev, "element", getattr(ev, "name", "")),
+         "mode after": " ".join(sorted(getattr(ev, "mode_after", ()) or ())),
+         "energy lost_J": getattr(ev, "energy_lost", 0.0)} for ev in traj.events[:max_events]],
+        digits=9)]
+    if len(traj.events) > max_events:
+        parts.append(f'<p class="note">{len(traj.events) - max_events} more events not listed.</p>')
     if model is not None and traj.t.size:
-        parts.append("<h3>Drawing</h3>")
-        parts.append(_img_png(_snapshot_png(traj, 0, trace=trace), "the mechanism at the start"))
-        if animation:
-            parts.append(_img_gif(_animation_gif(traj, trace=trace), "the motion"))
+        parts += _drawing(traj, "the mechanism at the start", animation=animation, trace=trace)
     if traj.t.size:
-        parts.append("<h3>Plot</h3>")
-        parts.append(_img_png(_plot_png(plot_trajectory, traj), "trajectory plot"))
-    sections.append("\n".join(parts))
-    return _write(path, _page(title or f"{name}: simulation report", sections))
+        parts += ["<h3>Plot</h3>", _img(lambda p: plot_trajectory(traj, p), "trajectory plot")]
+    sections.append(_join(parts))
+    return _write_page(path, title or f"{name}: simulation report", sections)

@@ -11,7 +11,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["write_csv", "read_csv", "unit_of_column", "UNIT_SUFFIXES"]
+import numpy as np
+
+__all__ = ["write_csv", "read_csv", "unit_of_column", "UNIT_SUFFIXES", "output_path",
+           "deg_or_mm", "rate_text"]
 
 #: column-name suffix -> unit, longest suffixes first when matching
 UNIT_SUFFIXES: dict[str, str] = {
@@ -47,17 +50,37 @@ def unit_of_column(name: str) -> str:
     return ""
 
 
+def output_path(path) -> Path:
+    """``path`` as a :class:`~pathlib.Path`, its folder created if needed."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def deg_or_mm(values, is_angle: bool) -> tuple[np.ndarray, str]:
+    """Values of a coordinate in engineering units: angles in deg, lengths in mm.
+
+    Returns
+    -------
+    (ndarray, str)
+        The converted values and their unit, ``"deg"`` or ``"mm"``.
+    """
+    return (np.rad2deg(values), "deg") if is_angle else (np.asarray(values) * 1e3, "mm")
+
+
+def rate_text(rate: float, is_angle: bool) -> str:
+    """A constant rate as text: ``"157.08 rad/s (1500 rpm)"`` or ``"0.5 m/s"``."""
+    return f"{rate:.6g} rad/s ({rate * 30 / np.pi:.6g} rpm)" if is_angle else f"{rate:.6g} m/s"
+
+
 def _describe(record) -> list[str]:
     kind = type(record).__name__
     model = getattr(record, "model", None)
     mech = getattr(model, "mechanism", None)
     lines = [f"mechdyn {kind}" + (f" of {mech.name!r}" if mech is not None else "")]
-    over = getattr(record, "over", None)
-    if over is not None:
-        lines.append(f"swept coordinate: {over}")
-    status = getattr(record, "status", None)
-    if status is not None:
-        lines.append(f"status: {status}")
+    for label, attr in (("swept coordinate", "over"), ("status", "status")):
+        if getattr(record, attr, None) is not None:
+            lines.append(f"{label}: {getattr(record, attr)}")
     message = getattr(record, "message", "")
     if message:
         lines.append("message: " + " ".join(str(message).split()))
@@ -84,12 +107,10 @@ def write_csv(record, path, *, float_format: str = "%.12g") -> Path:
     Path
         The file written.
     """
-    path = Path(path)
     df = record.to_dataframe()
     lines = _describe(record)
     lines.append("units: " + ", ".join(f"{c} [{unit_of_column(c) or '-'}]" for c in df.columns))
-    if path.parent and not path.parent.exists():
-        path.parent.mkdir(parents=True, exist_ok=True)
+    path = output_path(path)
     with open(path, "w", encoding="utf-8", newline="") as fh:
         for line in lines:
             fh.write(f"# {line}\n")

@@ -206,23 +206,17 @@ class Trajectory:
                 cols[f"{name}_deg"] = np.rad2deg(self.q[:, k])
             cols[f"{name}_dot_{ud}"] = self.qdot[:, k]
             cols[f"{name}_ddot_{udd}"] = self.qddot[:, k]
-        if bodies:
-            for b, name in enumerate(self.body_names):
-                cols[f"x_{name}_m"] = self.x[:, 3 * b]
-                cols[f"y_{name}_m"] = self.x[:, 3 * b + 1]
-                cols[f"theta_{name}_rad"] = self.x[:, 3 * b + 2]
-                cols[f"vx_{name}_m_s"] = self.xdot[:, 3 * b]
-                cols[f"vy_{name}_m_s"] = self.xdot[:, 3 * b + 1]
-                cols[f"omega_{name}_rad_s"] = self.xdot[:, 3 * b + 2]
+        body_columns = (("x", "m"), ("y", "m"), ("theta", "rad"),
+                        ("vx", "m_s"), ("vy", "m_s"), ("omega", "rad_s"))
+        for b, name in enumerate(self.body_names if bodies else ()):
+            for i, (what, unit) in enumerate(body_columns):
+                cols[f"{what}_{name}_{unit}"] = (self.x if i < 3 else self.xdot)[:, 3 * b + i % 3]
         if points and self.model is not None and self.t.size:
             cols.update(self._point_columns())
         if energy and self.energy:
-            e = self.energy
-            cols["T_J"] = e["kinetic"]
-            cols["U_J"] = e["potential"]
-            cols["W_nc_J"] = e["work_nc"]
-            cols["E_balance_J"] = e["balance"]
-            cols["residual"] = e["residual"]
+            cols.update({col: self.energy[key] for col, key in (
+                ("T_J", "kinetic"), ("U_J", "potential"), ("W_nc_J", "work_nc"),
+                ("E_balance_J", "balance"), ("residual", "residual"))})
         vs = self.switching
         if vs and self.t.size:
             cols.update(_switched_columns(vs))
@@ -237,11 +231,7 @@ class Trajectory:
     def xddot(self) -> np.ndarray:
         """Body frame accelerations xddot = B q'' + b, shape (n, n_x) (needs ``model``)."""
         return accelerations(self.model, self.x, self.xdot, self.qddot,
-                             layout=self._layout())
-
-    def _layout(self):
-        mode = self.stats.get("mode")
-        return self.model.layout(mode)
+                             layout=self.model.layout(self.stats.get("mode")))
 
     def _point_columns(self) -> dict:
         m = self.model
@@ -251,12 +241,9 @@ class Trajectory:
             r = point_position(m, self.x, body, pt)
             v = point_velocity(m, self.x, self.xdot, body, pt)
             a = point_acceleration(m, self.x, self.xdot, xdd, body, pt)
-            for k, ax in enumerate("xy"):
-                out[f"{ax}_{body}_{pt}_m"] = r[:, k]
-            for k, ax in enumerate("xy"):
-                out[f"v{ax}_{body}_{pt}_m_s"] = v[:, k]
-            for k, ax in enumerate("xy"):
-                out[f"a{ax}_{body}_{pt}_m_s2"] = a[:, k]
+            for what, unit, val in (("", "m", r), ("v", "m_s", v), ("a", "m_s2", a)):
+                out[f"{what}x_{body}_{pt}_{unit}"] = val[:, 0]
+                out[f"{what}y_{body}_{pt}_{unit}"] = val[:, 1]
         return out
 
 
