@@ -138,6 +138,17 @@ class CompiledKernel:
                     F=ext[o + 3 * nq + nc:].copy(), qddot_i=out[n:2 * n].copy(),
                     power_nc=float(out[2 * n]))
 
+    def snapshot(self) -> np.ndarray:
+        """A copy of the workspace (last pose, analogs, flags), for :meth:`restore`."""
+        return self.ws.copy()
+
+    def restore(self, saved: np.ndarray) -> None:
+        """Put back a :meth:`snapshot` (the evaluation count goes on): evaluations made in
+        between (a dense output probed by a check) leave the run as it was."""
+        count = self.ws[-N_FLAGS + W_COUNT]
+        self.ws[:] = saved
+        self.ws[-N_FLAGS + W_COUNT] = count
+
     @property
     def evaluations(self) -> int:
         """Evaluations of the equations by this kernel so far."""

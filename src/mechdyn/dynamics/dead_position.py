@@ -66,8 +66,24 @@ def turning_point(eqs, step, qd_old, x_good) -> str | None:
     str or None
         The message of a dead position, or None.
     """
+    turns = np.flatnonzero(np.sign(qd_old) * np.sign(step.qdot) < 0)
+    if not turns.size:
+        return None
+    # the dense output and the solves below must leave the run as it is
+    kern, ws = eqs.kernel, eqs.ms.ws
+    saved = kern.snapshot() if kern is not None else None
+    kept = (ws.x, ws.B, ws.qi)
+    try:
+        return _dead_turn(eqs, step, turns, x_good)
+    finally:
+        ws.x, ws.B, ws.qi = kept
+        if saved is not None:
+            kern.restore(saved)
+
+
+def _dead_turn(eqs, step, turns, x_good) -> str | None:
     ms = eqs.ms
-    for k in np.flatnonzero(np.sign(qd_old) * np.sign(step.qdot) < 0):
+    for k in turns:
         try:
             tk = brentq(lambda s, k=k: step.dense(s)[1][k], step.t_old, step.t, xtol=1e-14,
                         rtol=4 * np.finfo(float).eps)
@@ -76,13 +92,10 @@ def turning_point(eqs, step, qd_old, x_good) -> str | None:
         qk = step.dense(tk)[0]
         if eqs.chart_at(qk) is not None:
             continue  # a bifurcation: the branch goes on through it
-        kept = ms.ws.x
         try:
             xk = ms.solve_position(qk, x_good)
         except AssemblyError:
             xk = None
-        finally:
-            ms.ws.x = kept
         rep = ms.singularity(x_good if xk is None else xk)
         if xk is None or (rep["rcond"] < TURN_RCOND
                           and ms.coord_names[k] in rep["coordinates"]):
