@@ -236,7 +236,7 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                            "(driving = the whole torque the drive must deliver)")
     over_values = q[:, model.coordinate_index(over_names[0])]
     stats = dict(core["stats"])
-    stats.update(positions=n, newton_iterations=pos.iterations,
+    stats.update(positions=n, position_solves=pos.solves,
                  bifurcations=pos.book.report() if pos.book is not None else [],
                  seconds=time.perf_counter() - t_start)
     status = core["status"]

@@ -219,7 +219,7 @@ def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
     head += (f" for a switched trajectory: {len(parts)} segment(s) in {len(modes)} mode(s)")
     stats = dict(positions=n, segments=seg_stats,
                  seconds=time.perf_counter() - t_start,
-                 newton_iterations=int(sum(r.stats["newton_iterations"] for r in done)),
+                 position_solves=int(sum(r.stats["position_solves"] for r in done)),
                  power_balance_rel=max([r.stats["power_balance_rel"] for r in done],
                                        default=float("nan")),
                  rcond_min=min([r.stats["rcond_min"] for r in done], default=float("nan")),

@@ -27,12 +27,12 @@ import warnings as _warnings
 import numpy as np
 
 from ..errors import Status
-from ..kinematics.assembly import SINGULAR_RCOND
+from ..kinematics.assembly import SINGULAR_RCOND, _scale
 from ..kinematics.constraints import _perp, coordinates_jacobian, extend
 from ..model import COORD_TRAVEL, ConstraintLayout, Model
 from .forces import applied_forces, cross, rotate
 from .inertia import inertia_forces
-from .prescribed_motion import REDUNDANT_RCOND, ModeRows, _col_scale, mode_jacobian
+from .prescribed_motion import REDUNDANT_RCOND, ModeRows, mode_jacobian
 
 __all__ = ["KinetostaticsWarning", "joint_reaction", "reaction_frame", "element_forces",
            "frame_forces", "touches_ground"]
@@ -55,7 +55,7 @@ def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
     """Number of dependent joint equations, the joints involved and row labels."""
     if lay.n_rows == 0:
         return 0, [], []
-    sc = _col_scale(model)
+    sc = _scale(model)
     x = np.asarray(x, dtype=float).reshape(-1, model.n_x)
     if x.shape[0] > 64:  # redundancy is structural: a sample of the positions suffices
         x = x[np.unique(np.linspace(0, x.shape[0] - 1, 64).astype(int))]

@@ -75,7 +75,7 @@ class Kinetostatics:
     message : str
     warnings : tuple of str
     stats : dict
-        Run figures: positions, seconds, Newton iterations, power-balance
+        Run figures: positions, seconds, position (Newton) solves, power-balance
         residual (relative), smallest rcond, ...; for a switched trajectory also
         ``segments`` (one dict per segment: mode, sample range, times, driven
         coordinates, status, power-balance residual).
