@@ -19,7 +19,17 @@ from .forces import force_model
 from .prescribed_motion import _independent_subset, _Positions
 from .reactions import _inverse
 
-__all__ = ["_kinetostatics"]
+__all__ = ["_kinetostatics", "MESSAGES"]
+
+#: the head of the record's message per status
+MESSAGES = {
+    Status.SUCCESS: "kinetostatic analysis completed",
+    Status.REDUNDANT: "completed; reactions of redundant joints are not unique (minimum-norm "
+                      "solution reported)",
+    Status.SINGULAR_POSITION: "completed with singular positions: the driven coordinates "
+                              "lose control there and the reactions are unbounded",
+    Status.PARTIAL: "completed in part: segments whose mode could not be analysed are NaN "
+                    "(see warnings)"}
 
 
 def _on_times(fn: Callable, tt, n_d: int) -> np.ndarray:
@@ -240,12 +250,7 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                  bifurcations=pos.book.report() if pos.book is not None else [],
                  seconds=time.perf_counter() - t_start)
     status = core["status"]
-    message = {Status.SUCCESS: "kinetostatic analysis completed",
-               Status.REDUNDANT: "completed; reactions of redundant joints are not unique "
-                            "(minimum-norm solution reported)",
-               Status.SINGULAR_POSITION:
-                   "completed with singular positions: the driven coordinates lose "
-                           "control there and the reactions are unbounded"}[status]
+    message = MESSAGES[status]
     if status == Status.SINGULAR_POSITION and not stats.get("singular_positions"):
         message = ("completed through bifurcation position(s): the mechanism stays on its "
                    "branch, the driving torques are the limits along it; the reactions are "

@@ -37,7 +37,8 @@ from ..errors import MechdynError, Status
 from ..model import Model
 from ..results.kinetostatics_record import Kinetostatics
 from .forces import force_model
-from .kinetostatics_mode import _kinetostatics
+from .kinetostatics_mode import MESSAGES, _kinetostatics
+from .mode_system import fmt_mode
 from .modes import SwitchedModel, mode_friction, mode_locks, switched_model
 from .prescribed_motion import ModeRows
 
@@ -53,10 +54,6 @@ def mode_segments(modes) -> list[tuple[int, int]]:
             out.append((a, k))
             a = k
     return out
-
-
-def _fmt(mode) -> str:
-    return "{" + ", ".join(sorted(mode)) + "}"
 
 
 def _mode_rows(model: Model, sm: SwitchedModel, mode: frozenset, x0):
@@ -136,87 +133,52 @@ def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
     def nan(*tail):
         return np.full((n, *tail), np.nan)
 
-    q, qdot, qddot = Q.copy(), Qd.copy(), Qdd.copy()
-    x, xdot, xddot = X.copy(), nan(model.n_x), nan(model.n_x)
+    def merged(attr, keys, *tail):
+        """Per key, the series of record attribute ``attr`` of every segment (NaN elsewhere)."""
+        out = {k: nan(*tail) for k in keys}
+        for a, b, _, r, _ in parts:
+            for k, v in (getattr(r, attr).items() if r is not None else ()):
+                out[k][a:b] = v
+        return out
+
     tx = getattr(trajectory, "xdot", None)
-    if tx is not None and np.shape(tx) == (n, model.n_x):
-        xdot = np.asarray(tx, dtype=float).copy()
+    arrays = dict(q=Q.copy(), qdot=Qd.copy(), qddot=Qdd.copy(), x=X.copy(),
+                  xdot=np.array(tx, dtype=float) if np.shape(tx) == (n, model.n_x)
+                  else nan(model.n_x), xddot=nan(model.n_x), frame_force=nan(2),
+                  frame_moment=nan())
+    multipliers = nan(max([r.multipliers.shape[1] for r in done], default=0))
     driven = [c for c in names if any(c in r.driven for r in done)]
     joints = [j for j in model.joint_names if any(j in r.reactions for r in done)]
     elements = list(dict.fromkeys(e for r in done for e in r.element_forces))
-    frame_keys = list(dict.fromkeys(k for r in done for k in r.frame_loads))
-    driving = {c: nan() for c in driven}
-    power = {c: nan() for c in driven}
-    reactions = {j: nan(2) for j in joints}
-    moments = {j: nan() for j in joints}
-    jframe = {j: nan(2) for j in joints}
-    jpoints = {j: nan(2) for j in joints}
-    element_forces = {e: nan() for e in elements}
-    frame_loads = {k: nan(3) for k in frame_keys}
-    frame_force, frame_moment = nan(2), nan()
-    n_rows = max([r.multipliers.shape[1] for r in done], default=0)
-    multipliers = nan(n_rows)
-    kinds: dict = {}
-    units: dict = {}
-    redundant: set = set()
+    kinds = {j: r.joint_kinds[j] for r in done for j in r.reactions}
+    units = {e: r.element_units.get(e, "N") for r in done for e in r.element_forces}
+    redundant = sorted({j for r in done for j in r.redundant_joints})
     warn: list[str] = []
     notes: list[str] = []
     seg_stats = []
-    statuses = set()
     for a, b, mode, r, exc in parts:
-        sl = slice(a, b)
         info = dict(mode=mode, start=a, stop=b, t_start=float(tt[a]), t_end=float(tt[b - 1]))
+        seg_stats.append(info)
         if r is None:
-            statuses.add(Status.PARTIAL)
             info.update(driven=(), status=f"not analysed: {exc}")
             warn.append(f"samples {a}..{b - 1} (t = {tt[a]:.6g} .. {tt[b - 1]:.6g} s, mode "
-                        f"{_fmt(mode)}) could not be analysed ({type(exc).__name__}: {exc}); "
+                        f"{fmt_mode(mode)}) could not be analysed ({type(exc).__name__}: {exc}); "
                         f"their forces are NaN")
-            seg_stats.append(info)
             continue
-        statuses.add(r.status)
-        q[sl], qdot[sl], qddot[sl] = r.q, r.qdot, r.qddot
-        x[sl], xdot[sl], xddot[sl] = r.x, r.xdot, r.xddot
-        for c in r.driven:
-            driving[c][sl] = r.driving[c]
-            power[c][sl] = r.power[c]
-        for j in r.reactions:
-            reactions[j][sl] = r.reactions[j]
-            moments[j][sl] = r.moments[j]
-            jframe[j][sl] = r.joint_frame[j]
-            jpoints[j][sl] = r.joint_points[j]
-            kinds[j] = r.joint_kinds[j]
-        for e, f in r.element_forces.items():
-            element_forces[e][sl] = f
-            units[e] = r.element_units.get(e, "N")
-        for k, v in r.frame_loads.items():
-            frame_loads[k][sl] = v
-        frame_force[sl], frame_moment[sl] = r.frame_force, r.frame_moment
-        multipliers[sl, :r.multipliers.shape[1]] = r.multipliers
-        redundant.update(r.redundant_joints)
-        for w in r.warnings:
-            w = f"mode {_fmt(mode)}: {w}"
-            if w not in warn:
-                warn.append(w)
-        for note in r.message.split("; ")[1:]:
-            if note not in notes:
-                notes.append(note)
+        for k, v in arrays.items():
+            v[a:b] = getattr(r, k)
+        multipliers[a:b, :r.multipliers.shape[1]] = r.multipliers
+        warn.extend(w for w in (f"mode {fmt_mode(mode)}: {w}" for w in r.warnings) if w not in warn)
+        notes.extend(nt for nt in r.message.split("; ")[1:] if nt not in notes)
         info.update(driven=r.driven, status=r.status,
                     power_balance_rel=r.stats["power_balance_rel"],
                     rcond_min=r.stats["rcond_min"])
-        seg_stats.append(info)
 
+    statuses = {Status.PARTIAL if r is None else r.status for *_, r, _ in parts}
     status = next((s for s in (Status.PARTIAL, Status.SINGULAR_POSITION, Status.REDUNDANT)
                    if s in statuses), Status.SUCCESS)
-    head = {Status.SUCCESS: "kinetostatic analysis completed",
-            Status.REDUNDANT: "completed; reactions of redundant joints are not unique "
-                         "(minimum-norm solution reported)",
-            Status.SINGULAR_POSITION:
-                "completed with singular positions: the driven coordinates lose "
-                        "control there and the reactions are unbounded",
-            Status.PARTIAL: "completed in part: segments whose mode could not be analysed are "
-                       "NaN (see warnings)"}[status]
-    head += (f" for a switched trajectory: {len(parts)} segment(s) in {len(modes)} mode(s)")
+    head = (f"{MESSAGES[status]} for a switched trajectory: {len(parts)} segment(s) in "
+            f"{len(modes)} mode(s)")
     stats = dict(positions=n, segments=seg_stats,
                  seconds=time.perf_counter() - t_start,
                  position_solves=int(sum(r.stats["position_solves"] for r in done)),
@@ -226,14 +188,18 @@ def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
                  redundant_equations=max([r.stats["redundant_equations"] for r in done],
                                          default=0),
                  singular_positions=int(sum(r.stats["singular_positions"] for r in done)))
+    q = arrays["q"]
     return Kinetostatics(
-        over=names[over_k], t=tt, values=q[:, over_k].copy(), q=q, qdot=qdot, qddot=qddot,
-        x=x, xdot=xdot, xddot=xddot, coordinate_names=tuple(names), driven=tuple(driven),
-        reactions=reactions, moments=moments, joint_frame=jframe, joint_points=jpoints,
-        driving=driving, power=power, frame_force=frame_force, frame_moment=frame_moment,
-        frame_point=np.asarray(point, dtype=float).copy(), frame_loads=frame_loads,
-        multipliers=multipliers, joint_kinds=kinds,
-        mode=frozenset().union(*sample_modes), redundant_joints=tuple(sorted(redundant)),
-        status=status, message="; ".join([head, *notes]), warnings=tuple(warn), stats=stats,
-        model=model, element_forces=element_forces, element_units=units,
+        over=names[over_k], t=tt, values=q[:, over_k].copy(), **arrays, multipliers=multipliers,
+        coordinate_names=tuple(names), driven=tuple(driven),
+        reactions=merged("reactions", joints, 2), moments=merged("moments", joints),
+        joint_frame=merged("joint_frame", joints, 2),
+        joint_points=merged("joint_points", joints, 2), driving=merged("driving", driven),
+        power=merged("power", driven), frame_point=np.asarray(point, dtype=float).copy(),
+        frame_loads=merged("frame_loads", dict.fromkeys(k for r in done for k in r.frame_loads),
+                           3),
+        joint_kinds=kinds, mode=frozenset().union(*sample_modes),
+        redundant_joints=tuple(redundant), status=status, message="; ".join([head, *notes]),
+        warnings=tuple(warn), stats=stats, model=model,
+        element_forces=merged("element_forces", elements), element_units=units,
         sample_modes=sample_modes, mode_index=mode_index, modes=modes)
