@@ -29,7 +29,7 @@ import numpy as np
 from ..errors import Status
 from ..kinematics.assembly import SINGULAR_RCOND, _scale
 from ..kinematics.constraints import _perp, coordinates_jacobian, extend
-from ..model import COORD_TRAVEL, ConstraintLayout, Model
+from ..model import ConstraintLayout, Model
 from .forces import applied_forces, cross, rotate
 from .inertia import inertia_forces
 from .prescribed_motion import REDUNDANT_RCOND, ModeRows, mode_jacobian
@@ -44,11 +44,6 @@ NEAR_SINGULAR_RCOND = 1e-6
 
 class KinetostaticsWarning(UserWarning):
     """Redundant constraints or singular positions in a kinetostatic analysis."""
-
-
-#: names of the equations of each joint kind (for the redundancy message)
-_ROW_LABELS = {"revolute": ("x", "y"), "prismatic": ("normal", "angle"),
-               "lock": ("x", "y", "angle")}
 
 
 def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
@@ -73,15 +68,9 @@ def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
     weight = np.sum(null**2, axis=1)
     rows = [i for i in range(lay.n_rows) if weight[i] > 1e-6]
     joints = sorted({str(lay.row_joint[i]) for i in rows})
-    labels = []
-    n_base = lay.n_base if isinstance(lay, ModeRows) else lay.n_rows
-    for i in rows:
-        if i >= n_base:
-            labels.append(lay.extra[i - n_base].label)
-            continue
-        j = str(lay.row_joint[i])
-        pos = int(np.flatnonzero(lay.rows[j] == i)[0])
-        labels.append(f"{j} ({_ROW_LABELS[model.joint_kind(j)][pos]})")
+    n_base = getattr(lay, "n_base", lay.n_rows)
+    labels = [lay.extra[i - n_base].label if i >= n_base else
+              "{} ({})".format(*lay.rowset.labels[i].rsplit(".", 1)) for i in rows]
     return n_red, joints, labels
 
 
@@ -198,19 +187,6 @@ def touches_ground(rows) -> bool:
     return bool(np.any(pts | ang))
 
 
-def _joint_geometry(model: Model, lay: ConstraintLayout):
-    """Per active joint and lock: kind, parent index, child index, parent axis."""
-    active = set(model.rev.names) | set(model.pri.names) | {
-        n for n, a in zip(model.lock.names, lay.lock_active, strict=True) if a}
-    out = {}
-    for n in model.joint_names:
-        if n in active:
-            kind, i, j, _ = reaction_frame(model, n)
-            ui = model.pri.ui[model.pri.names.index(n)] if kind == "prismatic" else None
-            out[n] = (kind, i, j, ui)
-    return out
-
-
 def _net_on_ground(model: Model, x, D) -> np.ndarray:
     """Minus the net force and moment about the ground origin of body forces D (n, n_x).
 
@@ -251,18 +227,7 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     # balance units: moment equations / L; moment-like unknowns scaled by L
     rs = np.ones(model.n_x)
     rs[2::3] = 1.0 / L
-    cs = np.ones(lay.n_rows + n_d)
-    for j, rows in lay.rows.items():
-        kind = model.joint_kind(j)
-        if kind == "prismatic":
-            cs[rows[1]] = L
-        elif kind == "lock":
-            cs[rows[2]] = L
-    if isinstance(lay, ModeRows):
-        cs[lay.n_base:lay.n_rows] = np.where(lay.row_is_angle, L, 1.0)
-    for i, k in enumerate(didx):
-        if model.coord_kind[k] != COORD_TRAVEL:
-            cs[lay.n_rows + i] = L
+    cs = np.where(np.concatenate([lay.rowset.is_angle, model.coord_is_angle[didx]]), L, 1.0)
     As = A * rs[:, None] * cs[None, :]
     bs = rhs * rs
     mask = charted[0] if charted is not None else np.zeros(n, dtype=bool)
@@ -324,23 +289,16 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     # ------------------------------------------------ joint reactions
     X = extend(model, x)
     C = -P * lam[:, :, None]  # row contributions to generalized forces (n, rows, n_x)
-    geo = _joint_geometry(model, lay)
     reactions, moments, jframe, jpoints, kinds = {}, {}, {}, {}, {}
     frame_loads: dict[str, np.ndarray] = {}
-    for name, (kind, i, j, ui) in geo.items():
+    for name in (n for n in model.joint_names if n in lay.rows):
+        kind, i, j, _ = reaction_frame(model, name)
         f, mP, Pt = joint_reaction(model, name, x, C[:, lay.rows[name], :].sum(axis=1))
-        reactions[name] = f
-        moments[name] = mP
-        jpoints[name] = Pt
-        kinds[name] = kind
-        thi = X[:, i, 2]
-        if kind == "prismatic":
-            u = rotate(thi, ui)
-            nrm = _perp(u)
-            jframe[name] = np.stack([np.sum(f * u, -1), np.sum(f * nrm, -1)], axis=-1)
-        else:
-            e1 = np.stack([np.cos(thi), np.sin(thi)], axis=-1)
-            jframe[name] = np.stack([np.sum(f * e1, -1), np.sum(f * _perp(e1), -1)], axis=-1)
+        reactions[name], moments[name], jpoints[name], kinds[name] = f, mP, Pt, kind
+        # prismatic: along and normal to the axis; else along the parent's x and y axes
+        u = rotate(X[:, i, 2], model.pri.ui[model.pri.names.index(name)]
+                   if kind == "prismatic" else (1.0, 0.0))
+        jframe[name] = np.stack([np.sum(f * u, -1), np.sum(f * _perp(u), -1)], axis=-1)
         if i == nb or j == nb:
             sgn = 1.0 if j == nb else -1.0  # what the frame receives
             ff, mm = sgn * f, sgn * mP
