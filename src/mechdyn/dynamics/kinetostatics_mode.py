@@ -79,8 +79,7 @@ def _integrate_speed(omega: Callable, t: np.ndarray, start: np.ndarray, n_d: int
         w = ev(nodes).reshape(a.size, xg.size, n_d)
         inc = np.einsum("k,nkd->nd", wg, w) * half[:, None]
         q[1:] = start + np.cumsum(inc, axis=0)
-    _, wd, wdd = _derivs(lambda s: ev(np.atleast_1d(s)), t, n_d)
-    return q, ev(t), wd
+    return q, *_derivs(ev, t, n_d)[:2]
 
 
 def _to_array(v, n_d: int, what: str) -> np.ndarray:
@@ -119,9 +118,7 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
             warn.append(f"load {getattr(ld, 'name', '?')!r} ({type(ld).__name__}) is an "
                         f"extension load that kinetostatics does not evaluate; it is left out")
     if x_start is None:
-        x_start = getattr(model, "x0", None)
-    if x_start is None:
-        x_start = model.x_sketch
+        x_start = model.x_sketch if getattr(model, "x0", None) is None else model.x0
     if x_guess is not None:
         xg = np.asarray(x_guess, dtype=float)
         if xg.ndim == 1:
@@ -130,12 +127,7 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
             x_guess = xg
 
     # ---------------------------------------------------------- the motion
-    if over is None:
-        over_names: list[str] = []
-    elif isinstance(over, str):
-        over_names = [over]
-    else:
-        over_names = list(over)
+    over_names = [] if over is None else [over] if isinstance(over, str) else list(over)
     over_idx = [model.coordinate_index(c) for c in over_names]
 
     if trajectory is not None:

@@ -152,18 +152,10 @@ class Kinetostatics:
     @property
     def over_is_angle(self) -> bool:
         """True when ``over`` is an angle coordinate."""
-        k = self.coordinate_names.index(self.over)
-        return self._is_angle(k)
+        return self._is_angle(self.coordinate_names.index(self.over))
 
     def _is_angle(self, k: int) -> bool:
-        if self.model is not None:
-            return bool(self.model.coord_is_angle[k])
-        return True
-
-    def _label(self, name: str) -> tuple[str, float]:
-        """Column of a coordinate value and the factor from SI."""
-        k = self.coordinate_names.index(name)
-        return (f"{name}_deg", np.rad2deg(1.0)) if self._is_angle(k) else (f"{name}_m", 1.0)
+        return self.model is None or bool(self.model.coord_is_angle[k])
 
     def _drive_unit(self, name: str) -> tuple[str, str]:
         k = self.coordinate_names.index(name)
@@ -188,10 +180,7 @@ class Kinetostatics:
     @property
     def driving_total_power(self) -> np.ndarray:
         """Sum of the driving powers, W, shape (n,)."""
-        out = np.zeros(self.n)
-        for p in self.power.values():
-            out = out + p
-        return out
+        return sum(self.power.values(), np.zeros(self.n))
 
     # ------------------------------------------------------------ tables
     def to_dataframe(self):
@@ -214,14 +203,12 @@ class Kinetostatics:
                                     dtype=object)
             cols["mode_index"] = np.asarray(self.mode_index)
         for k, c in enumerate(self.coordinate_names):
-            if self._is_angle(k):
-                cols[f"{c}_deg"] = np.rad2deg(self.q[:, k])
-                cols[f"{c}_dot_rad_s"] = self.qdot[:, k]
-                cols[f"{c}_ddot_rad_s2"] = self.qddot[:, k]
-            else:
-                cols[f"{c}_m"] = self.q[:, k]
-                cols[f"{c}_dot_m_s"] = self.qdot[:, k]
-                cols[f"{c}_ddot_m_s2"] = self.qddot[:, k]
+            ang = self._is_angle(k)
+            u = "rad" if ang else "m"
+            qk = self.q[:, k]
+            cols[f"{c}_deg" if ang else f"{c}_m"] = np.rad2deg(qk) if ang else qk
+            cols[f"{c}_dot_{u}_s"] = self.qdot[:, k]
+            cols[f"{c}_ddot_{u}_s2"] = self.qddot[:, k]
         for c in self.driven:
             sym, unit = self._drive_unit(c)
             cols[f"{sym}_drive_{c}_{unit}"] = self.driving[c]
@@ -255,11 +242,6 @@ class Kinetostatics:
         return pd.DataFrame(cols)
 
     # ------------------------------------------------------------ summaries
-    def _where(self, k: int) -> str:
-        lab, f = self._label(self.over)
-        unit = "deg" if lab.endswith("_deg") else "m"
-        return f"{self.over} = {self.values[k] * f:.4g} {unit}"
-
     def rms(self, series) -> float:
         """RMS of a series over the positions, weighted by time when time advances
         (trapezoidal rule), else by position count."""
@@ -329,8 +311,7 @@ class Kinetostatics:
         """Peak and RMS driving torque (motor sizing), peak force per joint and where,
         shaking force and moment extremes; warnings last."""
         p = self.peaks()
-        lab, f = self._label(self.over)
-        unit = "deg" if lab.endswith("_deg") else "m"
+        unit, f = ("deg", np.rad2deg(1.0)) if self.over_is_angle else ("m", 1.0)
         lines = [f"kinetostatics over {self.over}: {self.n} positions, "
                  f"{self.over} from {self.values[0] * f:.4g} to {self.values[-1] * f:.4g} "
                  f"{unit}; status {self.status}"]
