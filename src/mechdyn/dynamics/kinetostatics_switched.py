@@ -1,29 +1,12 @@
 """Kinetostatics of a switched (variable-structure) trajectory, segment by segment.
 
-A :class:`~mechdyn.results.trajectory.Trajectory` of ``mechdyn.simulate`` through
-switches records the mode of every sample in ``stats["variable_structure"]``.
-The samples are split into segments of constant mode (consecutive samples with
-the same mode; the samples at a switching instant appear twice, before and after,
-and fall into the two neighbouring segments).  Each segment is analysed in its own
-mode:
-
-* the rows of the mode are those of the forward dynamics
-  (:meth:`~mechdyn.dynamics.modes.SwitchedModel.rows`: weld and coordinate
-  locks, closed stops, closed contacts and sticking contacts) appended to the joint
-  rows (:class:`~mechdyn.dynamics.prescribed_motion.ModeRows`); the locks hold what
-  they held in the run (declared, or captured on the segment's first pose, as
-  :meth:`~mechdyn.dynamics.modes.SwitchedModel.capture_target` does); a
-  slipping contact's row carries its Coulomb friction as in the forward dynamics;
-  weld locks report as joints (reaction at the child frame origin), the others as
-  elements;
-* the driven coordinates are the independent coordinates of the mode, chosen in the
-  order: ``over``, the coordinates with a ``Drive``, the others, the ``frees`` of
-  the engaged locks last.
-
-The segments are concatenated into one
-:class:`~mechdyn.results.kinetostatics_record.Kinetostatics`; a joint, driving
-torque or element that is not part of a sample's mode is NaN there.  A segment that
-cannot be analysed gives NaN rows, a warning and status ``"partial"``.
+The samples are split into segments of constant recorded mode; each segment is the
+kinetostatics of its mode (:func:`~mechdyn.dynamics.kinetostatics_mode._kinetostatics`
+on the rows of the forward dynamics, :meth:`~mechdyn.dynamics.modes.SwitchedModel.rows`,
+with the values the locks held in the run), driving the independent coordinates of the
+mode; the segments are concatenated into one record, NaN where a joint, drive or
+element is not part of a sample's mode.  The rules are stated in
+``docs/kinetostatics.md``, section "Switched trajectories".
 """
 
 from __future__ import annotations

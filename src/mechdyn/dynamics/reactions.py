@@ -1,23 +1,7 @@
 """Reactions of joints and locks from multipliers (the one reporter, for forward runs,
-impacts and kinetostatics), and the driving torques of a prescribed motion: the batched
-solve for the Lagrange multipliers, the reactions in the ground and the joint frames,
-the loads the frame receives, and the redundancy check.
-
-The reaction of a joint or weld lock (:func:`joint_reaction`) is the force AND
-the moment on the CHILD body from the PARENT, at the joint point, in the ground
-frame: the child's point of a revolute joint (moment zero) or of a prismatic
-joint; for a weld lock the child frame origin, which the lock holds at its
-offset c in the parent frame.  The forward runs (:func:`element_forces`, per
-sample and per impact) and kinetostatics compute it here from the same
-multipliers.
-
-With the poses, rates and accelerations known, one linear system per position
-(batched over all positions at once)::
-
-    -Phi_x^T lambda + g_d,x^T tau = I(x, xdot, xddot) - F(t, x, xdot)
-
-gives the multipliers ``lambda`` and the driving torques ``tau``; the sign
-conventions are those of :mod:`mechdyn.dynamics.kinetostatics`.
+impacts and kinetostatics: :func:`joint_reaction`), and the batched kinetostatic solve
+for the multipliers and driving torques, the frame loads and the redundancy check (the
+equation and sign conventions of :mod:`mechdyn.dynamics.kinetostatics`).
 """
 
 from __future__ import annotations
