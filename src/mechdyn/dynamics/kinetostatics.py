@@ -123,10 +123,10 @@ def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
     model = as_model(mech_or_model)
     if model_drives not in ("replace", "load"):
         raise ValueError(f"model_drives must be 'replace' or 'load', got {model_drives!r}")
+    if trajectory is not None and any(v is not None for v in (speed, values, t, law)):
+        raise ValueError("give either trajectory= or speed/values/t/law, not both")
     vs = _variable_structure(trajectory)
     if vs is not None:
-        if any(v is not None for v in (speed, values, t, law)):
-            raise ValueError("give either trajectory= or speed/values/t/law, not both")
         if mode is not None:
             raise ValueError("mode= cannot be given with a variable-structure trajectory: "
                              "each sample is analysed in its recorded mode")

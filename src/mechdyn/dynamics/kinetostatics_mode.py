@@ -131,8 +131,6 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
     over_idx = [model.coordinate_index(c) for c in over_names]
 
     if trajectory is not None:
-        if any(v is not None for v in (speed, values, t, law)):
-            raise ValueError("give either trajectory= or speed/values/t/law, not both")
         tt = np.asarray(trajectory.t, dtype=float).reshape(-1)
         Q = np.asarray(trajectory.q, dtype=float).reshape(tt.size, model.n_q)
         Qd = np.asarray(trajectory.qdot, dtype=float).reshape(tt.size, model.n_q)

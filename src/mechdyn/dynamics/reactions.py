@@ -171,18 +171,13 @@ def touches_ground(rows) -> bool:
     return bool(np.any(pts | ang))
 
 
-def _net_on_ground(model: Model, x, D) -> np.ndarray:
-    """Minus the net force and moment about the ground origin of body forces D (n, n_x).
-
-    For a force element between the frame and the moving bodies, this is what
-    the frame receives (action and reaction).
-    """
-    n = D.shape[0]
-    Db = D.reshape(n, model.n_bodies, 3)
-    r = np.asarray(x, float).reshape(n, model.n_bodies, 3)[..., :2]
-    f = Db[..., :2].sum(axis=1)
+def _net_on_ground(model: Model, x, D, point) -> np.ndarray:
+    """Minus the net force and moment about ``point`` of body forces D (n, n_x): for a
+    force element between the frame and the moving bodies, what the frame receives."""
+    Db = D.reshape(-1, model.n_bodies, 3)
+    r = np.reshape(x, Db.shape)[..., :2] - point
     m = (Db[..., 2] + cross(r, Db[..., :2])).sum(axis=1)
-    return -np.concatenate([f, m[:, None]], axis=-1)
+    return -np.concatenate([Db[..., :2].sum(axis=1), m[:, None]], axis=-1)
 
 
 def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qdot, *,
@@ -300,18 +295,13 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
             el_forces[el] = -lam[:, idx[0]]
             Del = C[:, idx, :].sum(axis=1)
             p_el += np.einsum("nx,nx->n", Del, xdot)
-            fe = _net_on_ground(model, x, Del)
-            fe[:, 2] -= cross(np.broadcast_to(point, (n, 2)), fe[:, :2])
-            frame_loads[el] = fe
+            frame_loads[el] = _net_on_ground(model, x, Del, point)
 
     # ------------------------------------------------ drives' stator and ground-attached loads
     D = np.einsum("nd,ndx->nx", tau, Gd) + np.einsum("nq,nqx->nx", Qd_loads, G)
-    dr = _net_on_ground(model, x, D)
-    dr[:, 2] -= cross(np.broadcast_to(point, (n, 2)), dr[:, :2])
-    frame_loads["drives"] = dr
-    lg = F_ground.copy()
-    lg[:, 2] -= cross(np.broadcast_to(point, (n, 2)), lg[:, :2])
-    frame_loads["loads"] = lg
+    frame_loads["drives"] = _net_on_ground(model, x, D, point)
+    frame_loads["loads"] = F_ground - np.concatenate(
+        [np.zeros((n, 2)), cross(point, F_ground[:, :2])[:, None]], axis=-1)
     tot = sum(frame_loads.values())
     # ------------------------------------------------ power balance (self-check)
     # (p_el: power of the switchable rows, zero but for sliding friction)
