@@ -132,11 +132,10 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
 
     if trajectory is not None:
         tt = np.asarray(trajectory.t, dtype=float).reshape(-1)
-        Q = np.asarray(trajectory.q, dtype=float).reshape(tt.size, model.n_q)
-        Qd = np.asarray(trajectory.qdot, dtype=float).reshape(tt.size, model.n_q)
-        Qdd = np.asarray(trajectory.qddot, dtype=float).reshape(tt.size, model.n_q)
         didx = _independent_subset(model, lay, x_start, over_idx, candidates)
-        qd, qd_dot, qd_ddot = Q[:, didx], Qd[:, didx], Qdd[:, didx]
+        qd, qd_dot, qd_ddot = (np.asarray(getattr(trajectory, a), dtype=float)
+                               .reshape(tt.size, model.n_q)[:, didx]
+                               for a in ("q", "qdot", "qddot"))
         tx = getattr(trajectory, "x", None)
         if x_guess is None and tx is not None and np.shape(tx) == (tt.size, model.n_x):
             x_guess = np.asarray(tx, dtype=float)
@@ -180,19 +179,15 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                 raise ValueError("t= is used with law= or a callable speed, not with a "
                                  "constant speed (time follows from values and speed)")
         didx = _independent_subset(model, lay, x_start, over_idx)
-        n = tt.size
         extra = didx[n_o:]
-        held = coordinates(model, x_start)[extra] if extra else np.zeros(0)
         hold = dict(hold or {})
         for nm in hold:
-            model.coordinate_index(nm)
-        for i, k in enumerate(extra):
-            nm = model.coordinate_names[k]
-            if nm in hold:
-                held[i] = float(hold[nm])
-        qd = np.concatenate([qo, np.broadcast_to(held, (n, len(extra)))], axis=1)
-        qd_dot = np.concatenate([qo_d, np.zeros((n, len(extra)))], axis=1)
-        qd_ddot = np.concatenate([qo_dd, np.zeros((n, len(extra)))], axis=1)
+            model.coordinate_index(nm)  # an unknown name raises
+        q0 = coordinates(model, x_start)
+        held = np.array([hold.get(model.coordinate_names[k], q0[k]) for k in extra], float)
+        zero = np.zeros((tt.size, len(extra)))
+        qd = np.concatenate([qo, held + zero], axis=1)
+        qd_dot, qd_ddot = np.concatenate([qo_d, zero], axis=1), np.concatenate([qo_dd, zero], 1)
         if extra:
             warn.append("coordinate(s) " + ", ".join(
                 f"{model.coordinate_names[k]!r} = {h:.6g}" for k, h in zip(extra, held,

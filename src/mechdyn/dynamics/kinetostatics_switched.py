@@ -72,9 +72,8 @@ def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
     n = tt.size
     if n == 0:
         raise ValueError("no positions to analyse")
-    Q = np.asarray(trajectory.q, dtype=float).reshape(n, model.n_q)
-    Qd = np.asarray(trajectory.qdot, dtype=float).reshape(n, model.n_q)
-    Qdd = np.asarray(trajectory.qddot, dtype=float).reshape(n, model.n_q)
+    Q, Qd, Qdd = (np.asarray(getattr(trajectory, a), dtype=float).reshape(n, model.n_q)
+                  for a in ("q", "qdot", "qddot"))
     X = getattr(trajectory, "x", None)
     if X is None or np.shape(X) != (n, model.n_x):
         raise ValueError("a switched trajectory needs its body poses x (n, n_x) to be "
