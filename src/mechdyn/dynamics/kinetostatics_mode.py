@@ -221,7 +221,8 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                     skip=didx if model_drives == "replace" else (),
                     reacting=tuple(reacting_loads), point=np.asarray(point, dtype=float),
                     charted=pos.charted)
-    warn.extend(core["warnings"])
+    tau, status = core.pop("tau"), core.pop("status")
+    warn.extend(core.pop("warnings"))
     notes = []
     if model_drives == "replace":
         replaced = [dr.name for dr, k in fm.drives if k in set(didx.tolist())]
@@ -230,11 +231,10 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                          + " on driven coordinates are replaced by the prescribed motion "
                            "(driving = the whole torque the drive must deliver)")
     over_values = q[:, model.coordinate_index(over_names[0])]
-    stats = dict(core["stats"])
+    stats = core.pop("stats")
     stats.update(positions=n, position_solves=pos.solves,
                  bifurcations=pos.book.report() if pos.book is not None else [],
                  seconds=time.perf_counter() - t_start)
-    status = core["status"]
     message = MESSAGES[status]
     if status == Status.SINGULAR_POSITION and not stats.get("singular_positions"):
         message = ("completed through bifurcation position(s): the mechanism stays on its "
@@ -245,17 +245,11 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
     return Kinetostatics(
         over=over_names[0], t=tt, values=over_values, q=q, qdot=qdot, qddot=qddot, x=x,
         xdot=xdot, xddot=xddot, coordinate_names=tuple(names),
-        driven=tuple(names[k] for k in didx), reactions=core["reactions"],
-        moments=core["moments"], joint_frame=core["joint_frame"],
-        joint_points=core["joint_points"],
-        driving={names[k]: core["tau"][:, i] for i, k in enumerate(didx)},
-        power={names[k]: core["tau"][:, i] * qdot[:, k] for i, k in enumerate(didx)},
-        frame_force=core["frame_force"], frame_moment=core["frame_moment"],
-        frame_point=np.asarray(point, dtype=float).copy(), frame_loads=core["frame_loads"],
-        multipliers=core["lam"], joint_kinds=core["kinds"], mode=lay.mode,
-        redundant_joints=tuple(core["redundant"]), status=status, message=message,
-        warnings=tuple(warn), stats=stats, model=model,
-        element_forces=core["element_forces"],
+        driven=tuple(names[k] for k in didx),
+        driving={names[k]: tau[:, i] for i, k in enumerate(didx)},
+        power={names[k]: tau[:, i] * qdot[:, k] for i, k in enumerate(didx)},
+        frame_point=np.asarray(point, dtype=float).copy(), mode=lay.mode, status=status,
+        message=message, warnings=tuple(warn), stats=stats, model=model, **core,
         element_units={el: ("N m" if bool(lay.row_is_angle[idx[0] - lay.n_base]) else "N")
                        for el, idx in getattr(lay, "elements", {}).items()})
 

@@ -41,8 +41,6 @@ def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
     P = mode_jacobian(model, x, lay) * sc
     s = np.linalg.svd(P, compute_uv=False)
     r = np.sum(s > REDUNDANT_RCOND * s[..., :1], axis=-1)
-    if s.shape[-1] < lay.n_rows:  # more equations than unknowns
-        r = np.minimum(r, s.shape[-1])
     n_red = int(lay.n_rows - r.min())
     if n_red == 0:
         return 0, [], []
@@ -182,7 +180,9 @@ def _net_on_ground(model: Model, x, D, point) -> np.ndarray:
 
 def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qdot, *,
              skip, reacting, point, charted=None) -> dict:
-    """The batched inverse-dynamics solve and the reaction bookkeeping.
+    """The batched inverse-dynamics solve and the reaction bookkeeping: the record fields
+    it gives (named as in :class:`~mechdyn.results.kinetostatics_record.Kinetostatics`),
+    ``tau`` (n, n_d), ``status``, ``warnings`` and ``stats``.
 
     ``charted`` = (mask (n,), x' (m, n_x), x'' (m, n_x)): samples near a bifurcation
     position, where the system is (nearly) singular but the branch goes on; with one
@@ -234,10 +234,8 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     bif = singular & mask
     singular &= ~mask
     status = Status.SUCCESS
-    redundant: list[str] = []
     if n_red:
         status = Status.REDUNDANT
-        redundant = red_joints
         warn.append(f"{n_red} redundant joint equation(s): the equations "
                     + ", ".join(red_labels) + " are linearly dependent, so the reactions of "
                     "joints " + ", ".join(repr(j) for j in red_joints) + " are not unique; "
@@ -315,8 +313,8 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
              "singular_positions": int(singular.sum()),
              "bifurcation_positions": int(bif.sum())}
     return {"reactions": reactions, "moments": moments, "joint_frame": jframe,
-            "joint_points": jpoints, "kinds": kinds, "frame_loads": frame_loads,
-            "frame_force": tot[:, :2].copy(), "frame_moment": tot[:, 2].copy(), "tau": tau,
-            "lam": lam, "element_forces": el_forces, "status": status,
-            "warnings": warn, "redundant": redundant, "stats": stats}
+            "joint_points": jpoints, "joint_kinds": kinds, "frame_loads": frame_loads,
+            "frame_force": tot[:, :2].copy(), "frame_moment": tot[:, 2].copy(),
+            "multipliers": lam, "element_forces": el_forces, "redundant_joints": tuple(red_joints),
+            "tau": tau, "status": status, "warnings": warn, "stats": stats}
 
