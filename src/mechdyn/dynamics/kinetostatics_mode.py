@@ -52,9 +52,8 @@ def _derivs(law: Callable, t: np.ndarray, n_d: int):
 
     first = law(float(t[0])) if t.size else None
     if isinstance(first, tuple) and len(first) == 3:
-        parts = [np.array([np.asarray(law(float(s))[i], dtype=float).reshape(n_d) for s in t])
-                 for i in range(3)]
-        return parts[0], parts[1], parts[2]
+        return tuple(np.array([np.asarray(law(float(s))[i], dtype=float).reshape(n_d)
+                               for s in t]) for i in range(3))
     span = float(np.ptp(t)) if t.size > 1 else 1.0
     h = 1e-3 * (span if span > 0 else 1.0)
     y0 = ev(t)

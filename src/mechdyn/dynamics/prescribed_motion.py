@@ -227,11 +227,10 @@ class _Positions:
         if n == 1:
             return self._charts_after(qd, x)
         stride = max(1, n // 100)
-        anchors = list(range(0, n, stride))
-        if anchors[-1] != n - 1:
-            anchors.append(n - 1)
-        Ja = np.empty((len(anchors),) + self.jac(x[0]).shape)
-        Ja[0] = self.jac(x[0])
+        anchors = sorted({*range(0, n, stride), n - 1})
+        J0 = self.jac(x[0])
+        Ja = np.empty((len(anchors),) + J0.shape)
+        Ja[0] = J0
         for i, (a0, a1) in enumerate(zip(anchors[:-1], anchors[1:], strict=True)):
             x[a1], Ja[i + 1] = self.advance(qd[a0], x[a0], qd[a1], Ja[i])
         rest = np.setdiff1d(np.arange(n), anchors)

@@ -225,11 +225,8 @@ class Kinetostatics:
             if kind in ("prismatic", "lock"):
                 cols[f"M_{j}_Nm"] = self.moments[j]
         for el, f in self.element_forces.items():
-            key = el.replace("@", "_")
-            if self.element_units.get(el) == "N m":
-                cols[f"M_{key}_Nm"] = f
-            else:
-                cols[f"F_{key}_N"] = f
+            sym, unit = ("M", "Nm") if self.element_units.get(el) == "N m" else ("F", "N")
+            cols[f"{sym}_{el.replace('@', '_')}_{unit}"] = f
         for j, L in self.frame_loads.items():
             if j in self.reactions:
                 cols[f"Fx_frame_{j}_N"] = L[:, 0]
