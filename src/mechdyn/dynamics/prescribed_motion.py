@@ -144,11 +144,21 @@ class _Positions:
         return np.sign(np.linalg.det(J * self.scale))
 
     def first(self, qd, x_start):
-        """The first pose: continuation from the assembled start pose keeps its branch."""
+        """The first pose: continuation from the assembled start pose keeps its branch
+        (by :meth:`advance` in small steps when one coordinate varies, so that a
+        bifurcation on the way is charted)."""
         q_s = coordinates(self.model, x_start)[self.didx]
         if np.max(np.abs(self.residual(x_start, q_s)), initial=0.0) <= 1e3 * self.tol:
+            j, x, q = self._j, np.array(x_start, dtype=float), q_s
+            n_sub = 1
+            if self.book is not None and not np.delete(q_s - qd, j).any():
+                n_sub = max(1, int(np.ceil(abs(qd[j] - q_s[j]) / (0.1 * self.book.path.unit))))
             try:
-                return self.step(q_s, x_start, qd)[0]
+                for i in range(1, n_sub + 1):
+                    qn = q_s + (qd - q_s) * (i / n_sub)
+                    x = self.advance(q, x, qn)[0]
+                    q = qn
+                return x
             except (AssemblyError, SingularPositionError):
                 pass
         x, ok, _ = self.newton(qd, x_start, max_iter=60)
@@ -221,9 +231,7 @@ class _Positions:
             if np.all(ok):
                 return self._charts_after(qd, x)
         x = np.empty((n, self.model.n_x))
-        x[0] = self._reach(qd[0], x_start) if x_guess is None else None
-        if x_guess is not None or not np.all(np.isfinite(x[0])):
-            x[0] = self.first(qd[0], x_start if x_guess is None else x_guess[0])
+        x[0] = self.first(qd[0], x_start if x_guess is None else x_guess[0])
         if n == 1:
             return self._charts_after(qd, x)
         stride = max(1, n // 100)
@@ -294,30 +302,6 @@ class _Positions:
             if ok:
                 return x, J
         return self.step(qe, xe, qd_to)
-
-    def _reach(self, qd, x_start) -> np.ndarray:
-        """The first pose by :meth:`advance` in small steps along the varying coordinate
-        from the start pose (so that a bifurcation on the way is charted); NaN when
-        that does not apply (then :meth:`first` is used)."""
-        nan = np.full(self.model.n_x, np.nan)
-        if self.book is None:
-            return nan
-        j = self._j
-        q_s = coordinates(self.model, x_start)[self.didx]
-        F = self.residual(x_start, q_s)
-        if np.delete(q_s - qd, j).any() or np.max(np.abs(F), initial=0.0) > 1e3 * self.tol:
-            return nan
-        unit = self.book.path.unit
-        n_sub = max(1, int(np.ceil(abs(qd[j] - q_s[j]) / (0.1 * unit))))
-        x, q = np.array(x_start, dtype=float), q_s
-        try:
-            for i in range(1, n_sub + 1):
-                qn = q_s + (qd - q_s) * (i / n_sub)
-                x = self.advance(q, x, qn)[0]
-                q = qn
-        except (AssemblyError, SingularPositionError):
-            return nan
-        return x
 
     def _charts_after(self, qd, x):
         """Watch the solved poses for bifurcations (when they came from guesses), and
