@@ -174,10 +174,9 @@ class _Positions:
 
     def _error(self, qd, x, t=None):
         res = joint_residuals(self.model, x, self.lay)
-        if isinstance(self.lay, ModeRows) and self.lay.extra:
-            r = rows_numpy.values(self.lay.rowset, x)
-            for el, idx in self.lay.elements.items():
-                res[el] = float(np.linalg.norm(r[idx]))
+        r = rows_numpy.values(self.lay.rowset, x)
+        res.update({el: float(np.linalg.norm(r[idx]))
+                    for el, idx in getattr(self.lay, "elements", {}).items()})
         names = [self.model.coordinate_names[k] for k in self.didx]
         if max(res.values(), default=0.0) < 1e-6 * self.model.length_scale:
             return SingularPositionError(
