@@ -241,19 +241,16 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
                     "joints " + ", ".join(repr(j) for j in red_joints) + " are not unique; "
                     "the minimum-norm solution is reported (forces in N, moments in N m "
                     f"divided by the length scale {L:.4g} m)")
-    if bif.any():
-        status = Status.SINGULAR_POSITION
-        ks = np.flatnonzero(bif)
-        warn.append(f"{ks.size} bifurcation position(s) (first at index {ks[0]}, t = "
-                    f"{t[ks[0]]:.6g} s): the mechanism goes on on its branch and the driving "
-                    f"torque there is its limit along the branch, but the joint equations are "
-                    f"dependent: the reactions there are unbounded (least-squares values)")
-    if singular.any():
-        status = Status.SINGULAR_POSITION
-        ks = np.flatnonzero(singular)
-        warn.append(f"{ks.size} singular position(s) (first at index {ks[0]}, t = "
-                    f"{t[ks[0]]:.6g} s): the driven coordinates do not control the "
-                    f"mechanism there; reactions there are least-squares values")
+    for where, what, why in (
+            (bif, "bifurcation position(s)", "the mechanism goes on on its branch and the "
+             "driving torque there is its limit along the branch, but the joint equations are "
+             "dependent: the reactions there are unbounded (least-squares values)"),
+            (singular, "singular position(s)", "the driven coordinates do not control the "
+             "mechanism there; reactions there are least-squares values")):
+        if where.any():
+            status, k = Status.SINGULAR_POSITION, int(np.argmax(where))
+            warn.append(f"{int(where.sum())} {what} (first at index {k}, t = {t[k]:.6g} s): "
+                        + why)
     near = (rcond < NEAR_SINGULAR_RCOND) & ~singular & ~bif
     if near.any():
         k = int(np.argmin(np.where(near, rcond, np.inf)))
