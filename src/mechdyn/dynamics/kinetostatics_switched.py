@@ -11,6 +11,7 @@ element is not part of a sample's mode.  The rules are stated in
 
 from __future__ import annotations
 
+import itertools
 import time
 from types import SimpleNamespace
 
@@ -25,18 +26,7 @@ from .mode_system import fmt_mode
 from .modes import SwitchedModel, mode_friction, mode_locks, switched_model
 from .prescribed_motion import ModeRows
 
-__all__ = ["kinetostatics_switched", "mode_segments"]
-
-
-def mode_segments(modes) -> list[tuple[int, int]]:
-    """[start, stop) sample ranges of consecutive samples with the same mode."""
-    out = []
-    a = 0
-    for k in range(1, len(modes) + 1):
-        if k == len(modes) or modes[k] != modes[a]:
-            out.append((a, k))
-            a = k
-    return out
+__all__ = ["kinetostatics_switched"]
 
 
 def _mode_rows(model: Model, sm: SwitchedModel, mode: frozenset, x0):
@@ -94,7 +84,8 @@ def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
     mode_index = np.array([modes.index(m) for m in sample_modes], int)
 
     parts = []
-    for a, b in mode_segments(sample_modes):
+    ends = list(itertools.accumulate(len(list(g)) for _, g in itertools.groupby(sample_modes)))
+    for a, b in zip([0, *ends[:-1]], ends, strict=True):
         mode = sample_modes[a]
         seg = SimpleNamespace(t=tt[a:b], q=Q[a:b], qdot=Qd[a:b], qddot=Qdd[a:b], x=X[a:b])
         try:
