@@ -49,9 +49,8 @@ def per_position_loop(model, values):
         xdot, xddot = pos.motion(xs, np.array([[OMEGA]]), np.zeros((1, 1)))
         q = coordinates(model, xs)
         t = np.array([(values[k] - values[0]) / OMEGA])
-        core = _inverse(model, lay, didx, t, xs, xdot, xddot, q, q * 0 + OMEGA, skip=didx,
-                        reacting=(), point=np.zeros(2))
-        tau[k] = core["tau"][0, 0]
+        tau[k] = _inverse(model, lay, didx, t, xs, xdot, xddot, q, q * 0 + OMEGA, skip=didx,
+                          reacting=(), point=np.zeros(2))["tau"][0, 0]
     return tau
 
 

@@ -1,55 +1,23 @@
 """Kinetostatics (inverse dynamics for a given motion): driving torques, joint
 reactions, and the loads the frame and foundation receive.
 
-The generalized coordinates follow a prescribed motion (a constant speed, a law
-of time, or a trajectory from forward dynamics).  Driving constraints
-``g_d(x) - q_d(t) = 0`` are appended to the joint constraints ``Phi(x) = 0``;
-with the body poses ``x`` and their rates known, the Lagrange multipliers follow
-from one linear solve per position (batched over all positions at once)::
+Driving constraints ``g_d(x) - q_d(t) = 0`` are appended to the joint constraints
+``Phi(x) = 0``; with the poses and their rates known, one linear solve per position
+(batched over all positions) gives the multipliers and the driving torques::
 
     -Phi_x^T lambda + g_d,x^T tau = I(x, xdot, xddot) - F(t, x, xdot)
 
-* ``I`` are the inertia forces conjugate to the body-frame poses: for each body
-  ``m a_c`` and ``J_c alpha + a x m a_c`` (``a``: the centre of mass relative to
-  the frame origin) -- i.e. ``M_x xddot`` plus the centripetal terms of a
-  non-diagonal frame mass matrix ``M_x`` (:func:`frame_mass_matrix`).
-* ``F`` are the applied forces (gravity, springs, forces, torques, process
-  loads; force and moment about the body-frame origin).
-* ``-Phi_x^T lambda`` are the constraint forces on the bodies; a joint's rows
-  give its reaction.
-* ``tau`` is the torque (N m) or force (N) the drive must APPLY to each driven
-  coordinate -- positive when it acts in the positive sense of the coordinate.
+(``I`` the inertia forces, ``F`` the applied forces).  The sign conventions of
+reactions, driving torques and frame loads, and the two ways of treating ``Drive``
+elements (``model_drives``), are stated once, in ``docs/kinetostatics.md``, section
+"Reactions and driving torques".
 
-Sign conventions (also in ``docs/kinetostatics.md``, section "Reactions and
-driving torques"):
-
-* The reaction of a joint is the force ON THE CHILD body FROM THE PARENT, at the
-  joint point (revolute: the child point; prismatic: the child point; lock: the
-  child frame origin), in the ground frame; the parent receives the opposite.
-  Prismatic joints and locks also carry a moment on the child about that point.
-* ``Drive`` elements on a driven coordinate are REPLACED by the prescribed
-  motion (``model_drives="replace"``, default): ``driving`` is then the whole
-  torque the motor must deliver.  With ``model_drives="load"`` they act as
-  known loads and ``driving`` is the extra torque needed on top of them.
-  Drives on coordinates that are not driven always act as known loads.
-* The frame loads are what the FRAME RECEIVES from the mechanism: minus the
-  reaction of every joint to the ground, the reaction torque of the drives on
-  their stator (a drive of an absolute crank angle puts ``-tau`` on the frame),
-  and the ground ends of springs, rotary springs and torques attached to it.
-  Their sum is the shaking force and the shaking moment about ``point``.
-  ``Force`` loads (e.g. a punch force) are external: their reaction is not
-  carried by the frame unless named in ``reacting_loads``.
-
-Where the parts live: :func:`kinetostatics` here, the analysis in one mode (the
-motion specifications, the batched solve) in
-:mod:`~mechdyn.dynamics.kinetostatics_mode`;
-the applied loads in :mod:`~mechdyn.dynamics.forces` (the same batched code as
-forward dynamics); the inertia forces in :mod:`~mechdyn.dynamics.inertia`; poses,
-rates and accelerations of the prescribed motion in
-:mod:`~mechdyn.dynamics.prescribed_motion`; the multiplier solve, reactions and
-frame loads in :mod:`~mechdyn.dynamics.reactions`; the record
+Where the parts live: :func:`kinetostatics` here; the analysis in one mode in
+:mod:`~mechdyn.dynamics.kinetostatics_mode`, of a switched trajectory in
+:mod:`~mechdyn.dynamics.kinetostatics_switched`; poses, rates and accelerations in
+:mod:`~mechdyn.dynamics.prescribed_motion`; the multiplier solve, reactions and frame
+loads in :mod:`~mechdyn.dynamics.reactions`; the record
 :class:`~mechdyn.results.kinetostatics_record.Kinetostatics` in ``results``.
-All public names are importable from this module.
 """
 
 from __future__ import annotations
@@ -120,8 +88,9 @@ def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
     point : (float, float)
         Point of the frame moments (shaking moment), ground frame, m.
     model_drives : {"replace", "load"}
-        What to do with ``Drive`` elements on driven coordinates (see module
-        docstring).
+        ``Drive`` elements on driven coordinates: replaced by the prescribed motion
+        (``driving`` is the whole drive torque), or known loads (``driving`` is the
+        extra torque needed on top of them); drives on other coordinates are loads.
     reacting_loads : sequence of str
         ``Force`` loads whose reaction the frame carries (e.g. the punch force
         of a press whose bed is part of the frame).
@@ -154,10 +123,10 @@ def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
     model = as_model(mech_or_model)
     if model_drives not in ("replace", "load"):
         raise ValueError(f"model_drives must be 'replace' or 'load', got {model_drives!r}")
+    if trajectory is not None and any(v is not None for v in (speed, values, t, law)):
+        raise ValueError("give either trajectory= or speed/values/t/law, not both")
     vs = _variable_structure(trajectory)
     if vs is not None:
-        if any(v is not None for v in (speed, values, t, law)):
-            raise ValueError("give either trajectory= or speed/values/t/law, not both")
         if mode is not None:
             raise ValueError("mode= cannot be given with a variable-structure trajectory: "
                              "each sample is analysed in its recorded mode")

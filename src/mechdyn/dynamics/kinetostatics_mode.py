@@ -19,7 +19,17 @@ from .forces import force_model
 from .prescribed_motion import _independent_subset, _Positions
 from .reactions import _inverse
 
-__all__ = ["_kinetostatics"]
+__all__ = ["_kinetostatics", "MESSAGES"]
+
+#: the head of the record's message per status
+MESSAGES = {
+    Status.SUCCESS: "kinetostatic analysis completed",
+    Status.REDUNDANT: "completed; reactions of redundant joints are not unique (minimum-norm "
+                      "solution reported)",
+    Status.SINGULAR_POSITION: "completed with singular positions: the driven coordinates "
+                              "lose control there and the reactions are unbounded",
+    Status.PARTIAL: "completed in part: segments whose mode could not be analysed are NaN "
+                    "(see warnings)"}
 
 
 def _on_times(fn: Callable, tt, n_d: int) -> np.ndarray:
@@ -42,9 +52,8 @@ def _derivs(law: Callable, t: np.ndarray, n_d: int):
 
     first = law(float(t[0])) if t.size else None
     if isinstance(first, tuple) and len(first) == 3:
-        parts = [np.array([np.asarray(law(float(s))[i], dtype=float).reshape(n_d) for s in t])
-                 for i in range(3)]
-        return parts[0], parts[1], parts[2]
+        return tuple(np.array([np.asarray(law(float(s))[i], dtype=float).reshape(n_d)
+                               for s in t]) for i in range(3))
     span = float(np.ptp(t)) if t.size > 1 else 1.0
     h = 1e-3 * (span if span > 0 else 1.0)
     y0 = ev(t)
@@ -69,8 +78,7 @@ def _integrate_speed(omega: Callable, t: np.ndarray, start: np.ndarray, n_d: int
         w = ev(nodes).reshape(a.size, xg.size, n_d)
         inc = np.einsum("k,nkd->nd", wg, w) * half[:, None]
         q[1:] = start + np.cumsum(inc, axis=0)
-    _, wd, wdd = _derivs(lambda s: ev(np.atleast_1d(s)), t, n_d)
-    return q, ev(t), wd
+    return q, *_derivs(ev, t, n_d)[:2]
 
 
 def _to_array(v, n_d: int, what: str) -> np.ndarray:
@@ -109,9 +117,7 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
             warn.append(f"load {getattr(ld, 'name', '?')!r} ({type(ld).__name__}) is an "
                         f"extension load that kinetostatics does not evaluate; it is left out")
     if x_start is None:
-        x_start = getattr(model, "x0", None)
-    if x_start is None:
-        x_start = model.x_sketch
+        x_start = model.x_sketch if getattr(model, "x0", None) is None else model.x0
     if x_guess is not None:
         xg = np.asarray(x_guess, dtype=float)
         if xg.ndim == 1:
@@ -120,23 +126,15 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
             x_guess = xg
 
     # ---------------------------------------------------------- the motion
-    if over is None:
-        over_names: list[str] = []
-    elif isinstance(over, str):
-        over_names = [over]
-    else:
-        over_names = list(over)
+    over_names = [] if over is None else [over] if isinstance(over, str) else list(over)
     over_idx = [model.coordinate_index(c) for c in over_names]
 
     if trajectory is not None:
-        if any(v is not None for v in (speed, values, t, law)):
-            raise ValueError("give either trajectory= or speed/values/t/law, not both")
         tt = np.asarray(trajectory.t, dtype=float).reshape(-1)
-        Q = np.asarray(trajectory.q, dtype=float).reshape(tt.size, model.n_q)
-        Qd = np.asarray(trajectory.qdot, dtype=float).reshape(tt.size, model.n_q)
-        Qdd = np.asarray(trajectory.qddot, dtype=float).reshape(tt.size, model.n_q)
         didx = _independent_subset(model, lay, x_start, over_idx, candidates)
-        qd, qd_dot, qd_ddot = Q[:, didx], Qd[:, didx], Qdd[:, didx]
+        qd, qd_dot, qd_ddot = (np.asarray(getattr(trajectory, a), dtype=float)
+                               .reshape(tt.size, model.n_q)[:, didx]
+                               for a in ("q", "qdot", "qddot"))
         tx = getattr(trajectory, "x", None)
         if x_guess is None and tx is not None and np.shape(tx) == (tt.size, model.n_x):
             x_guess = np.asarray(tx, dtype=float)
@@ -180,19 +178,15 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                 raise ValueError("t= is used with law= or a callable speed, not with a "
                                  "constant speed (time follows from values and speed)")
         didx = _independent_subset(model, lay, x_start, over_idx)
-        n = tt.size
         extra = didx[n_o:]
-        held = coordinates(model, x_start)[extra] if extra else np.zeros(0)
         hold = dict(hold or {})
         for nm in hold:
-            model.coordinate_index(nm)
-        for i, k in enumerate(extra):
-            nm = model.coordinate_names[k]
-            if nm in hold:
-                held[i] = float(hold[nm])
-        qd = np.concatenate([qo, np.broadcast_to(held, (n, len(extra)))], axis=1)
-        qd_dot = np.concatenate([qo_d, np.zeros((n, len(extra)))], axis=1)
-        qd_ddot = np.concatenate([qo_dd, np.zeros((n, len(extra)))], axis=1)
+            model.coordinate_index(nm)  # an unknown name raises
+        q0 = coordinates(model, x_start)
+        held = np.array([hold.get(model.coordinate_names[k], q0[k]) for k in extra], float)
+        zero = np.zeros((tt.size, len(extra)))
+        qd = np.concatenate([qo, held + zero], axis=1)
+        qd_dot, qd_ddot = np.concatenate([qo_d, zero], axis=1), np.concatenate([qo_dd, zero], 1)
         if extra:
             warn.append("coordinate(s) " + ", ".join(
                 f"{model.coordinate_names[k]!r} = {h:.6g}" for k, h in zip(extra, held,
@@ -226,7 +220,8 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                     skip=didx if model_drives == "replace" else (),
                     reacting=tuple(reacting_loads), point=np.asarray(point, dtype=float),
                     charted=pos.charted)
-    warn.extend(core["warnings"])
+    tau, status = core.pop("tau"), core.pop("status")
+    warn.extend(core.pop("warnings"))
     notes = []
     if model_drives == "replace":
         replaced = [dr.name for dr, k in fm.drives if k in set(didx.tolist())]
@@ -235,17 +230,11 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                          + " on driven coordinates are replaced by the prescribed motion "
                            "(driving = the whole torque the drive must deliver)")
     over_values = q[:, model.coordinate_index(over_names[0])]
-    stats = dict(core["stats"])
-    stats.update(positions=n, newton_iterations=pos.iterations,
+    stats = core.pop("stats")
+    stats.update(positions=n, position_solves=pos.solves,
                  bifurcations=pos.book.report() if pos.book is not None else [],
                  seconds=time.perf_counter() - t_start)
-    status = core["status"]
-    message = {Status.SUCCESS: "kinetostatic analysis completed",
-               Status.REDUNDANT: "completed; reactions of redundant joints are not unique "
-                            "(minimum-norm solution reported)",
-               Status.SINGULAR_POSITION:
-                   "completed with singular positions: the driven coordinates lose "
-                           "control there and the reactions are unbounded"}[status]
+    message = MESSAGES[status]
     if status == Status.SINGULAR_POSITION and not stats.get("singular_positions"):
         message = ("completed through bifurcation position(s): the mechanism stays on its "
                    "branch, the driving torques are the limits along it; the reactions are "
@@ -255,17 +244,11 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
     return Kinetostatics(
         over=over_names[0], t=tt, values=over_values, q=q, qdot=qdot, qddot=qddot, x=x,
         xdot=xdot, xddot=xddot, coordinate_names=tuple(names),
-        driven=tuple(names[k] for k in didx), reactions=core["reactions"],
-        moments=core["moments"], joint_frame=core["joint_frame"],
-        joint_points=core["joint_points"],
-        driving={names[k]: core["tau"][:, i] for i, k in enumerate(didx)},
-        power={names[k]: core["tau"][:, i] * qdot[:, k] for i, k in enumerate(didx)},
-        frame_force=core["frame_force"], frame_moment=core["frame_moment"],
-        frame_point=np.asarray(point, dtype=float).copy(), frame_loads=core["frame_loads"],
-        multipliers=core["lam"], joint_kinds=core["kinds"], mode=lay.mode,
-        redundant_joints=tuple(core["redundant"]), status=status, message=message,
-        warnings=tuple(warn), stats=stats, model=model,
-        element_forces=core["element_forces"],
+        driven=tuple(names[k] for k in didx),
+        driving={names[k]: tau[:, i] for i, k in enumerate(didx)},
+        power={names[k]: tau[:, i] * qdot[:, k] for i, k in enumerate(didx)},
+        frame_point=np.asarray(point, dtype=float).copy(), mode=lay.mode, status=status,
+        message=message, warnings=tuple(warn), stats=stats, model=model, **core,
         element_units={el: ("N m" if bool(lay.row_is_angle[idx[0] - lay.n_base]) else "N")
                        for el, idx in getattr(lay, "elements", {}).items()})
 

@@ -1,33 +1,17 @@
 """Kinetostatics of a switched (variable-structure) trajectory, segment by segment.
 
-A :class:`~mechdyn.results.trajectory.Trajectory` of ``mechdyn.simulate`` through
-switches records the mode of every sample in ``stats["variable_structure"]``.
-The samples are split into segments of constant mode (consecutive samples with
-the same mode; the samples at a switching instant appear twice, before and after,
-and fall into the two neighbouring segments).  Each segment is analysed in its own
-mode:
-
-* the rows of the mode are those of the forward dynamics
-  (:meth:`~mechdyn.dynamics.modes.SwitchedModel.rows`: weld and coordinate
-  locks, closed stops, closed contacts and sticking contacts) appended to the joint
-  rows (:class:`~mechdyn.dynamics.prescribed_motion.ModeRows`); the locks hold what
-  they held in the run (declared, or captured on the segment's first pose, as
-  :meth:`~mechdyn.dynamics.modes.SwitchedModel.capture_target` does); a
-  slipping contact's row carries its Coulomb friction as in the forward dynamics;
-  weld locks report as joints (reaction at the child frame origin), the others as
-  elements;
-* the driven coordinates are the independent coordinates of the mode, chosen in the
-  order: ``over``, the coordinates with a ``Drive``, the others, the ``frees`` of
-  the engaged locks last.
-
-The segments are concatenated into one
-:class:`~mechdyn.results.kinetostatics_record.Kinetostatics`; a joint, driving
-torque or element that is not part of a sample's mode is NaN there.  A segment that
-cannot be analysed gives NaN rows, a warning and status ``"partial"``.
+The samples are split into segments of constant recorded mode; each segment is the
+kinetostatics of its mode (:func:`~mechdyn.dynamics.kinetostatics_mode._kinetostatics`
+on the rows of the forward dynamics, :meth:`~mechdyn.dynamics.modes.SwitchedModel.rows`,
+with the values the locks held in the run), driving the independent coordinates of the
+mode; the segments are concatenated into one record, NaN where a joint, drive or
+element is not part of a sample's mode.  The rules are stated in
+``docs/kinetostatics.md``, section "Switched trajectories".
 """
 
 from __future__ import annotations
 
+import itertools
 import time
 from types import SimpleNamespace
 
@@ -37,26 +21,12 @@ from ..errors import MechdynError, Status
 from ..model import Model
 from ..results.kinetostatics_record import Kinetostatics
 from .forces import force_model
-from .kinetostatics_mode import _kinetostatics
+from .kinetostatics_mode import MESSAGES, _kinetostatics
+from .mode_system import fmt_mode
 from .modes import SwitchedModel, mode_friction, mode_locks, switched_model
 from .prescribed_motion import ModeRows
 
-__all__ = ["kinetostatics_switched", "mode_segments"]
-
-
-def mode_segments(modes) -> list[tuple[int, int]]:
-    """[start, stop) sample ranges of consecutive samples with the same mode."""
-    out = []
-    a = 0
-    for k in range(1, len(modes) + 1):
-        if k == len(modes) or modes[k] != modes[a]:
-            out.append((a, k))
-            a = k
-    return out
-
-
-def _fmt(mode) -> str:
-    return "{" + ", ".join(sorted(mode)) + "}"
+__all__ = ["kinetostatics_switched"]
 
 
 def _mode_rows(model: Model, sm: SwitchedModel, mode: frozenset, x0):
@@ -92,9 +62,8 @@ def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
     n = tt.size
     if n == 0:
         raise ValueError("no positions to analyse")
-    Q = np.asarray(trajectory.q, dtype=float).reshape(n, model.n_q)
-    Qd = np.asarray(trajectory.qdot, dtype=float).reshape(n, model.n_q)
-    Qdd = np.asarray(trajectory.qddot, dtype=float).reshape(n, model.n_q)
+    Q, Qd, Qdd = (np.asarray(getattr(trajectory, a), dtype=float).reshape(n, model.n_q)
+                  for a in ("q", "qdot", "qddot"))
     X = getattr(trajectory, "x", None)
     if X is None or np.shape(X) != (n, model.n_x):
         raise ValueError("a switched trajectory needs its body poses x (n, n_x) to be "
@@ -115,7 +84,8 @@ def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
     mode_index = np.array([modes.index(m) for m in sample_modes], int)
 
     parts = []
-    for a, b in mode_segments(sample_modes):
+    ends = list(itertools.accumulate(len(list(g)) for _, g in itertools.groupby(sample_modes)))
+    for a, b in zip([0, *ends[:-1]], ends, strict=True):
         mode = sample_modes[a]
         seg = SimpleNamespace(t=tt[a:b], q=Q[a:b], qdot=Qd[a:b], qddot=Qdd[a:b], x=X[a:b])
         try:
@@ -136,104 +106,73 @@ def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
     def nan(*tail):
         return np.full((n, *tail), np.nan)
 
-    q, qdot, qddot = Q.copy(), Qd.copy(), Qdd.copy()
-    x, xdot, xddot = X.copy(), nan(model.n_x), nan(model.n_x)
+    def merged(attr, keys, *tail):
+        """Per key, the series of record attribute ``attr`` of every segment (NaN elsewhere)."""
+        out = {k: nan(*tail) for k in keys}
+        for a, b, _, r, _ in parts:
+            for k, v in (getattr(r, attr).items() if r is not None else ()):
+                out[k][a:b] = v
+        return out
+
     tx = getattr(trajectory, "xdot", None)
-    if tx is not None and np.shape(tx) == (n, model.n_x):
-        xdot = np.asarray(tx, dtype=float).copy()
+    arrays = dict(q=Q.copy(), qdot=Qd.copy(), qddot=Qdd.copy(), x=X.copy(),
+                  xdot=np.array(tx, dtype=float) if np.shape(tx) == (n, model.n_x)
+                  else nan(model.n_x), xddot=nan(model.n_x), frame_force=nan(2),
+                  frame_moment=nan())
+    multipliers = nan(max([r.multipliers.shape[1] for r in done], default=0))
     driven = [c for c in names if any(c in r.driven for r in done)]
     joints = [j for j in model.joint_names if any(j in r.reactions for r in done)]
     elements = list(dict.fromkeys(e for r in done for e in r.element_forces))
-    frame_keys = list(dict.fromkeys(k for r in done for k in r.frame_loads))
-    driving = {c: nan() for c in driven}
-    power = {c: nan() for c in driven}
-    reactions = {j: nan(2) for j in joints}
-    moments = {j: nan() for j in joints}
-    jframe = {j: nan(2) for j in joints}
-    jpoints = {j: nan(2) for j in joints}
-    element_forces = {e: nan() for e in elements}
-    frame_loads = {k: nan(3) for k in frame_keys}
-    frame_force, frame_moment = nan(2), nan()
-    n_rows = max([r.multipliers.shape[1] for r in done], default=0)
-    multipliers = nan(n_rows)
-    kinds: dict = {}
-    units: dict = {}
-    redundant: set = set()
+    kinds = {j: r.joint_kinds[j] for r in done for j in r.reactions}
+    units = {e: r.element_units.get(e, "N") for r in done for e in r.element_forces}
+    redundant = sorted({j for r in done for j in r.redundant_joints})
     warn: list[str] = []
     notes: list[str] = []
     seg_stats = []
-    statuses = set()
     for a, b, mode, r, exc in parts:
-        sl = slice(a, b)
         info = dict(mode=mode, start=a, stop=b, t_start=float(tt[a]), t_end=float(tt[b - 1]))
+        seg_stats.append(info)
         if r is None:
-            statuses.add(Status.PARTIAL)
             info.update(driven=(), status=f"not analysed: {exc}")
             warn.append(f"samples {a}..{b - 1} (t = {tt[a]:.6g} .. {tt[b - 1]:.6g} s, mode "
-                        f"{_fmt(mode)}) could not be analysed ({type(exc).__name__}: {exc}); "
+                        f"{fmt_mode(mode)}) could not be analysed ({type(exc).__name__}: {exc}); "
                         f"their forces are NaN")
-            seg_stats.append(info)
             continue
-        statuses.add(r.status)
-        q[sl], qdot[sl], qddot[sl] = r.q, r.qdot, r.qddot
-        x[sl], xdot[sl], xddot[sl] = r.x, r.xdot, r.xddot
-        for c in r.driven:
-            driving[c][sl] = r.driving[c]
-            power[c][sl] = r.power[c]
-        for j in r.reactions:
-            reactions[j][sl] = r.reactions[j]
-            moments[j][sl] = r.moments[j]
-            jframe[j][sl] = r.joint_frame[j]
-            jpoints[j][sl] = r.joint_points[j]
-            kinds[j] = r.joint_kinds[j]
-        for e, f in r.element_forces.items():
-            element_forces[e][sl] = f
-            units[e] = r.element_units.get(e, "N")
-        for k, v in r.frame_loads.items():
-            frame_loads[k][sl] = v
-        frame_force[sl], frame_moment[sl] = r.frame_force, r.frame_moment
-        multipliers[sl, :r.multipliers.shape[1]] = r.multipliers
-        redundant.update(r.redundant_joints)
-        for w in r.warnings:
-            w = f"mode {_fmt(mode)}: {w}"
-            if w not in warn:
-                warn.append(w)
-        for note in r.message.split("; ")[1:]:
-            if note not in notes:
-                notes.append(note)
+        for k, v in arrays.items():
+            v[a:b] = getattr(r, k)
+        multipliers[a:b, :r.multipliers.shape[1]] = r.multipliers
+        warn.extend(w for w in (f"mode {fmt_mode(mode)}: {w}" for w in r.warnings) if w not in warn)
+        notes.extend(nt for nt in r.message.split("; ")[1:] if nt not in notes)
         info.update(driven=r.driven, status=r.status,
                     power_balance_rel=r.stats["power_balance_rel"],
                     rcond_min=r.stats["rcond_min"])
-        seg_stats.append(info)
 
+    statuses = {Status.PARTIAL if r is None else r.status for *_, r, _ in parts}
     status = next((s for s in (Status.PARTIAL, Status.SINGULAR_POSITION, Status.REDUNDANT)
                    if s in statuses), Status.SUCCESS)
-    head = {Status.SUCCESS: "kinetostatic analysis completed",
-            Status.REDUNDANT: "completed; reactions of redundant joints are not unique "
-                         "(minimum-norm solution reported)",
-            Status.SINGULAR_POSITION:
-                "completed with singular positions: the driven coordinates lose "
-                        "control there and the reactions are unbounded",
-            Status.PARTIAL: "completed in part: segments whose mode could not be analysed are "
-                       "NaN (see warnings)"}[status]
-    head += (f" for a switched trajectory: {len(parts)} segment(s) in {len(modes)} mode(s)")
+    head = (f"{MESSAGES[status]} for a switched trajectory: {len(parts)} segment(s) in "
+            f"{len(modes)} mode(s)")
     stats = dict(positions=n, segments=seg_stats,
                  seconds=time.perf_counter() - t_start,
-                 newton_iterations=int(sum(r.stats["newton_iterations"] for r in done)),
+                 position_solves=int(sum(r.stats["position_solves"] for r in done)),
                  power_balance_rel=max([r.stats["power_balance_rel"] for r in done],
                                        default=float("nan")),
                  rcond_min=min([r.stats["rcond_min"] for r in done], default=float("nan")),
                  redundant_equations=max([r.stats["redundant_equations"] for r in done],
                                          default=0),
                  singular_positions=int(sum(r.stats["singular_positions"] for r in done)))
+    q = arrays["q"]
     return Kinetostatics(
-        over=names[over_k], t=tt, values=q[:, over_k].copy(), q=q, qdot=qdot, qddot=qddot,
-        x=x, xdot=xdot, xddot=xddot, coordinate_names=tuple(names), driven=tuple(driven),
-        reactions=reactions, moments=moments, joint_frame=jframe, joint_points=jpoints,
-        driving=driving, power=power, frame_force=frame_force, frame_moment=frame_moment,
-        frame_point=np.asarray(point, dtype=float).copy(), frame_loads=frame_loads,
-        multipliers=multipliers, joint_kinds=kinds,
-        mode=frozenset().union(*sample_modes), redundant_joints=tuple(sorted(redundant)),
-        status=status, message="; ".join([head, *notes]), warnings=tuple(warn), stats=stats,
-        model=model, element_forces=element_forces, element_units=units,
+        over=names[over_k], t=tt, values=q[:, over_k].copy(), **arrays, multipliers=multipliers,
+        coordinate_names=tuple(names), driven=tuple(driven),
+        reactions=merged("reactions", joints, 2), moments=merged("moments", joints),
+        joint_frame=merged("joint_frame", joints, 2),
+        joint_points=merged("joint_points", joints, 2), driving=merged("driving", driven),
+        power=merged("power", driven), frame_point=np.asarray(point, dtype=float).copy(),
+        frame_loads=merged("frame_loads", dict.fromkeys(k for r in done for k in r.frame_loads),
+                           3),
+        joint_kinds=kinds, mode=frozenset().union(*sample_modes),
+        redundant_joints=tuple(redundant), status=status, message="; ".join([head, *notes]),
+        warnings=tuple(warn), stats=stats, model=model,
+        element_forces=merged("element_forces", elements), element_units=units,
         sample_modes=sample_modes, mode_index=mode_index, modes=modes)

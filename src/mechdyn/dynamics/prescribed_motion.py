@@ -4,30 +4,25 @@ and the dead centres of a crank's turn.
 
 The driving constraints ``g_d(x) - q_d = 0`` are appended to the joint constraints
 ``Phi(x) = 0``; the poses are found by continuation (branch kept by the sign of the
-scaled Jacobian's determinant), the rates from ``[Phi_x; g_d,x] xdot = [0; qdot_d]``
-and the accelerations from the same matrix with the exact right-hand side gamma.
-Through a bifurcation position (two branches crossing, one driven coordinate
-varying) poses, rates and accelerations near it come from a branch chart
-(:mod:`mechdyn.kinematics.branch_chart`), the limit of the branch from both sides.
+scaled Jacobian's determinant) with the package's position Newton
+(:func:`mechdyn.kinematics.assembly.newton`), the rates from
+``[Phi_x; g_d,x] xdot = [0; qdot_d]`` and the accelerations from the same matrix with
+the exact right-hand side gamma.  Through a bifurcation position (two branches
+crossing, one driven coordinate varying) poses, rates and accelerations near it come
+from a branch chart (:mod:`mechdyn.kinematics.branch_chart`), the limit of the branch
+from both sides.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from scipy.optimize import least_squares
 
 from ..errors import AssemblyError, ModelError, SingularPositionError
 from ..kernels import rows_numpy
-from ..kinematics.assembly import joint_residuals
+from ..kinematics.assembly import _rank, _scale, joint_residuals, newton
 from ..kinematics.branch_chart import ChartBook, PathProblem
-from ..kinematics.constraints import (
-    coordinates,
-    coordinates_gamma,
-    coordinates_jacobian,
-    gamma,
-    jacobian,
-    point_position,
-    residual,
-)
+from ..kinematics.constraints import coordinates, coordinates_jacobian, point_position
 from ..model import ConstraintLayout, Model, as_model
 from ..model.rows import concat
 
@@ -63,16 +58,14 @@ class ModeRows:
         self.rows = dict(base.rows)
         self.elements: dict[str, list[int]] = {}
         welds = set(model.lock.names)
-        for k, r in enumerate(self.extra):
+        keys = [r.label if r.kind == "stick" else r.element for r in self.extra]
+        for k, (r, key) in enumerate(zip(self.extra, keys, strict=True)):
             if r.element in welds:
-                self.rows[r.element] = np.append(self.rows.get(r.element, np.zeros(0, int)),
-                                                 self.n_base + k)
+                self.rows[key] = np.append(self.rows.get(key, np.zeros(0, int)),
+                                           self.n_base + k)
             else:
-                key = r.label if r.kind == "stick" else r.element
                 self.elements.setdefault(key, []).append(self.n_base + k)
-        self.row_joint = np.array([*base.row_joint, *[r.label if r.kind == "stick" else
-                                                      r.element for r in self.extra]],
-                                  dtype=object)
+        self.row_joint = np.array([*base.row_joint, *keys], dtype=object)
         self.row_is_angle = self.rowset.is_angle[self.n_base:]
         slip = [(self.n_base + k, r.friction_rows) for k, r in enumerate(self.extra) if r.slip]
         self.slip_rows = np.array([k for k, _ in slip], int)
@@ -84,47 +77,34 @@ def mode_jacobian(model: Model, x, lay, *, friction: bool = False) -> np.ndarray
     With ``friction``, the rows of slipping contacts carry their Coulomb friction
     (R - mu s T_x, the force direction of the row, as in
     :meth:`mechdyn.dynamics.modes.ModeSystem.evaluate_x`)."""
-    J = jacobian(model, x, lay)
+    J = rows_numpy.jacobian(lay.rowset, x)
     if friction and isinstance(lay, ModeRows) and lay.slip_rows.size:
         J[..., lay.slip_rows, :] += rows_numpy.jacobian(lay.friction, x)
     return J
-
-
-def _col_scale(model: Model) -> np.ndarray:
-    s = np.ones(model.n_x)
-    s[2::3] = model.length_scale
-    return s
-
-
-def _kin_system(model, lay, didx, x, qd):
-    Phi = residual(model, x, lay)
-    g = coordinates(model, x)[..., didx]
-    F = np.concatenate([Phi, g - qd], axis=-1)
-    J = np.concatenate([mode_jacobian(model, x, lay),
-                        coordinates_jacobian(model, x)[..., didx, :]], axis=-2)
-    return F, J
 
 
 def _lin_solve(J, F):
     """Solve J dx = F (batched), least squares / minimum norm when not square or singular."""
     if J.shape[-1] == J.shape[-2]:
         try:
-            dx = np.linalg.solve(J, F[..., None])[..., 0]
+            dx = np.linalg.solve(J, F)
             if np.all(np.isfinite(dx)):
                 return dx
         except np.linalg.LinAlgError:
             pass
-    return (np.linalg.pinv(J, rcond=1e-12) @ F[..., None])[..., 0]
+    return np.linalg.pinv(J, rcond=1e-12) @ F
 
 
 class _Positions:
-    """Position, velocity and acceleration analysis with a subset of driven coordinates."""
+    """Position, velocity and acceleration analysis with a subset of driven coordinates:
+    the rows of the layout, then the driven coordinates' rows (:attr:`rows`)."""
 
     def __init__(self, model: Model, lay: ConstraintLayout, didx: np.ndarray):
         self.model, self.lay, self.didx = model, lay, didx
+        self.rows = concat(model.n_bodies, lay.rowset, model.coordinate_rows.take(didx))
         self.tol = 1e-12 * max(model.length_scale, 1e-3)
-        self.scale = _col_scale(model)
-        self.iterations = 0
+        self.scale = _scale(model)
+        self.solves = 0
         self.branch_changes: list = []
         #: branch charts of the bifurcation positions passed (one varying coordinate)
         self.book: ChartBook | None = None
@@ -132,39 +112,30 @@ class _Positions:
         #: samples in a chart's zone: mask (n,), x' and x'' along the varying coordinate
         self.charted = None
 
+    def residual(self, x, qd):
+        """[Phi; g_d - q_d] at x, shape (..., n_rows + n_d)."""
+        F = rows_numpy.values(self.rows, x)
+        F[..., self.lay.n_rows:] -= qd
+        return F
+
     def jac(self, x):
         """[Phi_x; g_d,x] at x, shape (..., n_rows + n_d, n_x)."""
-        return _kin_system(self.model, self.lay, self.didx, x,
-                           np.zeros(np.shape(x)[:-1] + (len(self.didx),)))[1]
+        return rows_numpy.jacobian(self.rows, x)
 
     def newton(self, qd, x, max_iter=30):
-        """Newton iterations (batched); returns x, converged flags, and J at x."""
-        x = np.array(x, dtype=float, copy=True)
-        for _ in range(max_iter):
-            F, J = _kin_system(self.model, self.lay, self.didx, x, qd)
-            err = np.max(np.abs(F), axis=-1) if F.shape[-1] else np.zeros(F.shape[:-1])
-            done = err <= self.tol
-            if np.all(done):
-                return x, done, J
-            self.iterations += 1
-            dx = _lin_solve(J, F)
-            if not np.all(np.isfinite(dx)):
-                break
-            x = x - np.where(done[..., None], 0.0, dx)
-        F, J = _kin_system(self.model, self.lay, self.didx, x, qd)
-        err = np.max(np.abs(F), axis=-1)
-        return x, err <= 1e3 * self.tol, J
+        """:func:`~mechdyn.kinematics.assembly.newton` (batched); returns x, converged
+        flags, and J at x."""
+        self.solves += 1
+        qd = np.asarray(qd, dtype=float)
+        target = np.concatenate([np.zeros(qd.shape[:-1] + (self.lay.n_rows,)), qd], axis=-1)
+        x, ok = newton(self.rows, x, target, tol=self.tol, max_iter=max_iter)
+        return x, ok, self.jac(x)
 
     def analogs(self, J):
         """dx/dq_d from the Jacobian J, shape (..., n_x, n_d)."""
         rhs = np.zeros(J.shape[:-2] + (J.shape[-2], len(self.didx)))
         rhs[..., self.lay.n_rows:, :] = np.eye(len(self.didx))
-        if J.shape[-1] == J.shape[-2]:
-            try:
-                return np.linalg.solve(J, rhs)
-            except np.linalg.LinAlgError:
-                pass
-        return np.linalg.pinv(J, rcond=1e-12) @ rhs
+        return _lin_solve(J, rhs)
 
     def det_sign(self, J):
         """Sign of det of the scaled J (ones when J is not square)."""
@@ -173,28 +144,29 @@ class _Positions:
         return np.sign(np.linalg.det(J * self.scale))
 
     def first(self, qd, x_start):
-        """The first pose: continuation from the assembled start pose keeps its branch."""
+        """The first pose: continuation from the assembled start pose keeps its branch
+        (by :meth:`advance` in small steps when one coordinate varies, so that a
+        bifurcation on the way is charted)."""
         q_s = coordinates(self.model, x_start)[self.didx]
-        F, _ = _kin_system(self.model, self.lay, self.didx, x_start, q_s)
-        if np.max(np.abs(F), initial=0.0) <= 1e3 * self.tol:
+        if np.max(np.abs(self.residual(x_start, q_s)), initial=0.0) <= 1e3 * self.tol:
+            j, x, q = self._j, np.array(x_start, dtype=float), q_s
+            n_sub = 1
+            if self.book is not None and not np.delete(q_s - qd, j).any():
+                n_sub = max(1, int(np.ceil(abs(qd[j] - q_s[j]) / (0.1 * self.book.path.unit))))
             try:
-                return self.step(q_s, x_start, qd)[0]
+                for i in range(1, n_sub + 1):
+                    qn = q_s + (qd - q_s) * (i / n_sub)
+                    x = self.advance(q, x, qn)[0]
+                    q = qn
+                return x
             except (AssemblyError, SingularPositionError):
                 pass
         x, ok, _ = self.newton(qd, x_start, max_iter=60)
         if ok:
             return x
-        from scipy.optimize import least_squares
-
-        def fun(xx):
-            return _kin_system(self.model, self.lay, self.didx, xx, qd)[0]
-
-        def jac(xx):
-            return _kin_system(self.model, self.lay, self.didx, xx, qd)[1]
-
-        sol = least_squares(fun, x_start, jac=jac, method="trf", xtol=1e-15, ftol=1e-15,
-                            gtol=1e-15, x_scale=self.scale / self.model.length_scale,
-                            max_nfev=2000)
+        sol = least_squares(self.residual, x_start, jac=lambda xx, qd: self.jac(xx),
+                            args=(qd,), method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                            x_scale=self.scale / self.model.length_scale, max_nfev=2000)
         x, ok, _ = self.newton(qd, sol.x)
         if not ok:
             raise self._error(qd, x)
@@ -202,10 +174,9 @@ class _Positions:
 
     def _error(self, qd, x, t=None):
         res = joint_residuals(self.model, x, self.lay)
-        if isinstance(self.lay, ModeRows) and self.lay.extra:
-            r = residual(self.model, x, self.lay)
-            for el, idx in self.lay.elements.items():
-                res[el] = float(np.linalg.norm(r[idx]))
+        r = rows_numpy.values(self.lay.rowset, x)
+        res.update({el: float(np.linalg.norm(r[idx]))
+                    for el, idx in getattr(self.lay, "elements", {}).items()})
         names = [self.model.coordinate_names[k] for k in self.didx]
         if max(res.values(), default=0.0) < 1e-6 * self.model.length_scale:
             return SingularPositionError(
@@ -259,17 +230,14 @@ class _Positions:
             if np.all(ok):
                 return self._charts_after(qd, x)
         x = np.empty((n, self.model.n_x))
-        x[0] = self._reach(qd[0], x_start) if x_guess is None else None
-        if x_guess is not None or not np.all(np.isfinite(x[0])):
-            x[0] = self.first(qd[0], x_start if x_guess is None else x_guess[0])
+        x[0] = self.first(qd[0], x_start if x_guess is None else x_guess[0])
         if n == 1:
             return self._charts_after(qd, x)
         stride = max(1, n // 100)
-        anchors = list(range(0, n, stride))
-        if anchors[-1] != n - 1:
-            anchors.append(n - 1)
-        Ja = np.empty((len(anchors),) + self.jac(x[0]).shape)
-        Ja[0] = self.jac(x[0])
+        anchors = sorted({*range(0, n, stride), n - 1})
+        J0 = self.jac(x[0])
+        Ja = np.empty((len(anchors),) + J0.shape)
+        Ja[0] = J0
         for i, (a0, a1) in enumerate(zip(anchors[:-1], anchors[1:], strict=True)):
             x[a1], Ja[i + 1] = self.advance(qd[a0], x[a0], qd[a1], Ja[i])
         rest = np.setdiff1d(np.arange(n), anchors)
@@ -334,30 +302,6 @@ class _Positions:
                 return x, J
         return self.step(qe, xe, qd_to)
 
-    def _reach(self, qd, x_start) -> np.ndarray:
-        """The first pose by :meth:`advance` in small steps along the varying coordinate
-        from the start pose (so that a bifurcation on the way is charted); NaN when
-        that does not apply (then :meth:`first` is used)."""
-        nan = np.full(self.model.n_x, np.nan)
-        if self.book is None:
-            return nan
-        j = self._j
-        q_s = coordinates(self.model, x_start)[self.didx]
-        F, _ = _kin_system(self.model, self.lay, self.didx, x_start, q_s)
-        if np.delete(q_s - qd, j).any() or np.max(np.abs(F), initial=0.0) > 1e3 * self.tol:
-            return nan
-        unit = self.book.path.unit
-        n_sub = max(1, int(np.ceil(abs(qd[j] - q_s[j]) / (0.1 * unit))))
-        x, q = np.array(x_start, dtype=float), q_s
-        try:
-            for i in range(1, n_sub + 1):
-                qn = q_s + (qd - q_s) * (i / n_sub)
-                x = self.advance(q, x, qn)[0]
-                q = qn
-        except (AssemblyError, SingularPositionError):
-            return nan
-        return x
-
     def _charts_after(self, qd, x):
         """Watch the solved poses for bifurcations (when they came from guesses), and
         take the poses in the charts' zones from the charts."""
@@ -377,16 +321,14 @@ class _Positions:
 
     def motion(self, x, qd_dot, qd_ddot):
         """Velocities and accelerations of the poses for driven rates (batched)."""
-        m, lay = self.model, self.lay
-        _, J = _kin_system(m, lay, self.didx, x, np.zeros(x.shape[:-1] + (len(self.didx),)))
-        rhs = np.zeros(x.shape[:-1] + (J.shape[-2],))
-        rhs[..., lay.n_rows:] = qd_dot
+        J, n_r = self.jac(x), self.lay.n_rows
+        rhs = np.zeros(J.shape[:-1])
+        rhs[..., n_r:] = qd_dot
         with np.errstate(all="ignore"):  # singular at a bifurcation: charted below
-            xdot = _lin_solve(J, rhs)
-            gam = np.concatenate([gamma(m, x, xdot, lay),
-                                  coordinates_gamma(m, x, xdot)[..., self.didx] + qd_ddot],
-                                 axis=-1)
-            xddot = _lin_solve(J, gam)
+            xdot = _lin_solve(J, rhs[..., None])[..., 0]
+            gam = -rows_numpy.quad(self.rows, x, xdot)
+            gam[..., n_r:] += qd_ddot
+            xddot = _lin_solve(J, gam[..., None])[..., 0]
         if self.charted is not None and x.ndim == 2:
             mask, xs, xss = self.charted
             held = np.delete(qd_dot[mask], self._j, axis=1)
@@ -401,33 +343,26 @@ class _Positions:
 def _independent_subset(model, lay, x0, first: list[int], candidates=None) -> list[int]:
     """Extend ``first`` with coordinates that add rank, up to the DOF of the layout
     (``candidates``: the order in which the others are tried; default declared order)."""
-    sc = _col_scale(model)
+    sc = _scale(model)
     P = mode_jacobian(model, x0, lay) * sc
     G = coordinates_jacobian(model, x0) * sc
-
-    def rank(A):
-        if A.size == 0:
-            return 0
-        s = np.linalg.svd(A, compute_uv=False)
-        return int(np.sum(s > REDUNDANT_RCOND * s[0])) if s[0] > 0 else 0
-
-    r_phi = rank(P)
+    r_phi = _rank(P, REDUNDANT_RCOND)
     dof = model.n_x - r_phi
     chosen: list[int] = []
+
+    def adds_rank(k):
+        A = np.concatenate([P, G[chosen + [k]]])
+        return _rank(A, REDUNDANT_RCOND) == r_phi + len(chosen) + 1
+
     for k in first:
-        if rank(np.concatenate([P, G[chosen + [k]]])) == r_phi + len(chosen) + 1:
-            chosen.append(k)
-        else:
+        if not adds_rank(k):
             raise ModelError(
                 f"coordinate {model.coordinate_names[k]!r} cannot be driven in mode "
                 f"{sorted(lay.mode)}: it is fixed by the other driven coordinates and the "
                 f"constraints ({dof} degree(s) of freedom)")
+        chosen.append(k)
     for k in (range(model.n_q) if candidates is None else candidates):
-        if len(chosen) >= dof:
-            break
-        if k in chosen:
-            continue
-        if rank(np.concatenate([P, G[chosen + [k]]])) == r_phi + len(chosen) + 1:
+        if len(chosen) < dof and k not in chosen and adds_rank(k):
             chosen.append(k)
     if len(chosen) < dof:
         raise ModelError(f"the mechanism has {dof} degrees of freedom in mode "

@@ -1,23 +1,7 @@
 """Reactions of joints and locks from multipliers (the one reporter, for forward runs,
-impacts and kinetostatics), and the driving torques of a prescribed motion: the batched
-solve for the Lagrange multipliers, the reactions in the ground and the joint frames,
-the loads the frame receives, and the redundancy check.
-
-The reaction of a joint or weld lock (:func:`joint_reaction`) is the force AND
-the moment on the CHILD body from the PARENT, at the joint point, in the ground
-frame: the child's point of a revolute joint (moment zero) or of a prismatic
-joint; for a weld lock the child frame origin, which the lock holds at its
-offset c in the parent frame.  The forward runs (:func:`element_forces`, per
-sample and per impact) and kinetostatics compute it here from the same
-multipliers.
-
-With the poses, rates and accelerations known, one linear system per position
-(batched over all positions at once)::
-
-    -Phi_x^T lambda + g_d,x^T tau = I(x, xdot, xddot) - F(t, x, xdot)
-
-gives the multipliers ``lambda`` and the driving torques ``tau``; the sign
-conventions are those of :mod:`mechdyn.dynamics.kinetostatics`.
+impacts and kinetostatics: :func:`joint_reaction`), and the batched kinetostatic solve
+for the multipliers and driving torques, the frame loads and the redundancy check (the
+equation and sign conventions of :mod:`mechdyn.dynamics.kinetostatics`).
 """
 
 from __future__ import annotations
@@ -27,12 +11,12 @@ import warnings as _warnings
 import numpy as np
 
 from ..errors import Status
-from ..kinematics.assembly import SINGULAR_RCOND
+from ..kinematics.assembly import SINGULAR_RCOND, _scale
 from ..kinematics.constraints import _perp, coordinates_jacobian, extend
-from ..model import COORD_TRAVEL, ConstraintLayout, Model
+from ..model import ConstraintLayout, Model
 from .forces import applied_forces, cross, rotate
 from .inertia import inertia_forces
-from .prescribed_motion import REDUNDANT_RCOND, ModeRows, _col_scale, mode_jacobian
+from .prescribed_motion import REDUNDANT_RCOND, ModeRows, mode_jacobian
 
 __all__ = ["KinetostaticsWarning", "joint_reaction", "reaction_frame", "element_forces",
            "frame_forces", "touches_ground"]
@@ -46,24 +30,17 @@ class KinetostaticsWarning(UserWarning):
     """Redundant constraints or singular positions in a kinetostatic analysis."""
 
 
-#: names of the equations of each joint kind (for the redundancy message)
-_ROW_LABELS = {"revolute": ("x", "y"), "prismatic": ("normal", "angle"),
-               "lock": ("x", "y", "angle")}
-
-
 def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
     """Number of dependent joint equations, the joints involved and row labels."""
     if lay.n_rows == 0:
         return 0, [], []
-    sc = _col_scale(model)
+    sc = _scale(model)
     x = np.asarray(x, dtype=float).reshape(-1, model.n_x)
     if x.shape[0] > 64:  # redundancy is structural: a sample of the positions suffices
         x = x[np.unique(np.linspace(0, x.shape[0] - 1, 64).astype(int))]
     P = mode_jacobian(model, x, lay) * sc
     s = np.linalg.svd(P, compute_uv=False)
     r = np.sum(s > REDUNDANT_RCOND * s[..., :1], axis=-1)
-    if s.shape[-1] < lay.n_rows:  # more equations than unknowns
-        r = np.minimum(r, s.shape[-1])
     n_red = int(lay.n_rows - r.min())
     if n_red == 0:
         return 0, [], []
@@ -73,15 +50,9 @@ def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
     weight = np.sum(null**2, axis=1)
     rows = [i for i in range(lay.n_rows) if weight[i] > 1e-6]
     joints = sorted({str(lay.row_joint[i]) for i in rows})
-    labels = []
-    n_base = lay.n_base if isinstance(lay, ModeRows) else lay.n_rows
-    for i in rows:
-        if i >= n_base:
-            labels.append(lay.extra[i - n_base].label)
-            continue
-        j = str(lay.row_joint[i])
-        pos = int(np.flatnonzero(lay.rows[j] == i)[0])
-        labels.append(f"{j} ({_ROW_LABELS[model.joint_kind(j)][pos]})")
+    n_base = getattr(lay, "n_base", lay.n_rows)
+    labels = [lay.extra[i - n_base].label if i >= n_base else
+              "{} ({})".format(*lay.rowset.labels[i].rsplit(".", 1)) for i in rows]
     return n_red, joints, labels
 
 
@@ -204,36 +175,20 @@ def touches_ground(rows) -> bool:
     return bool(np.any(pts | ang))
 
 
-def _joint_geometry(model: Model, lay: ConstraintLayout):
-    """Per active joint and lock: kind, parent index, child index, parent axis."""
-    active = set(model.rev.names) | set(model.pri.names) | {
-        n for n, a in zip(model.lock.names, lay.lock_active, strict=True) if a}
-    out = {}
-    for n in model.joint_names:
-        if n in active:
-            kind, i, j, _ = reaction_frame(model, n)
-            ui = model.pri.ui[model.pri.names.index(n)] if kind == "prismatic" else None
-            out[n] = (kind, i, j, ui)
-    return out
-
-
-def _net_on_ground(model: Model, x, D) -> np.ndarray:
-    """Minus the net force and moment about the ground origin of body forces D (n, n_x).
-
-    For a force element between the frame and the moving bodies, this is what
-    the frame receives (action and reaction).
-    """
-    n = D.shape[0]
-    Db = D.reshape(n, model.n_bodies, 3)
-    r = np.asarray(x, float).reshape(n, model.n_bodies, 3)[..., :2]
-    f = Db[..., :2].sum(axis=1)
+def _net_on_ground(model: Model, x, D, point) -> np.ndarray:
+    """Minus the net force and moment about ``point`` of body forces D (n, n_x): for a
+    force element between the frame and the moving bodies, what the frame receives."""
+    Db = D.reshape(-1, model.n_bodies, 3)
+    r = np.reshape(x, Db.shape)[..., :2] - point
     m = (Db[..., 2] + cross(r, Db[..., :2])).sum(axis=1)
-    return -np.concatenate([f, m[:, None]], axis=-1)
+    return -np.concatenate([Db[..., :2].sum(axis=1), m[:, None]], axis=-1)
 
 
 def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qdot, *,
              skip, reacting, point, charted=None) -> dict:
-    """The batched inverse-dynamics solve and the reaction bookkeeping.
+    """The batched inverse-dynamics solve and the reaction bookkeeping: the record fields
+    it gives (named as in :class:`~mechdyn.results.kinetostatics_record.Kinetostatics`),
+    ``tau`` (n, n_d), ``status``, ``warnings`` and ``stats``.
 
     ``charted`` = (mask (n,), x' (m, n_x), x'' (m, n_x)): samples near a bifurcation
     position, where the system is (nearly) singular but the branch goes on; with one
@@ -257,18 +212,7 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     # balance units: moment equations / L; moment-like unknowns scaled by L
     rs = np.ones(model.n_x)
     rs[2::3] = 1.0 / L
-    cs = np.ones(lay.n_rows + n_d)
-    for j, rows in lay.rows.items():
-        kind = model.joint_kind(j)
-        if kind == "prismatic":
-            cs[rows[1]] = L
-        elif kind == "lock":
-            cs[rows[2]] = L
-    if isinstance(lay, ModeRows):
-        cs[lay.n_base:lay.n_rows] = np.where(lay.row_is_angle, L, 1.0)
-    for i, k in enumerate(didx):
-        if model.coord_kind[k] != COORD_TRAVEL:
-            cs[lay.n_rows + i] = L
+    cs = np.where(np.concatenate([lay.rowset.is_angle, model.coord_is_angle[didx]]), L, 1.0)
     As = A * rs[:, None] * cs[None, :]
     bs = rhs * rs
     mask = charted[0] if charted is not None else np.zeros(n, dtype=bool)
@@ -296,28 +240,23 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     bif = singular & mask
     singular &= ~mask
     status = Status.SUCCESS
-    redundant: list[str] = []
     if n_red:
         status = Status.REDUNDANT
-        redundant = red_joints
         warn.append(f"{n_red} redundant joint equation(s): the equations "
                     + ", ".join(red_labels) + " are linearly dependent, so the reactions of "
                     "joints " + ", ".join(repr(j) for j in red_joints) + " are not unique; "
                     "the minimum-norm solution is reported (forces in N, moments in N m "
                     f"divided by the length scale {L:.4g} m)")
-    if bif.any():
-        status = Status.SINGULAR_POSITION
-        ks = np.flatnonzero(bif)
-        warn.append(f"{ks.size} bifurcation position(s) (first at index {ks[0]}, t = "
-                    f"{t[ks[0]]:.6g} s): the mechanism goes on on its branch and the driving "
-                    f"torque there is its limit along the branch, but the joint equations are "
-                    f"dependent: the reactions there are unbounded (least-squares values)")
-    if singular.any():
-        status = Status.SINGULAR_POSITION
-        ks = np.flatnonzero(singular)
-        warn.append(f"{ks.size} singular position(s) (first at index {ks[0]}, t = "
-                    f"{t[ks[0]]:.6g} s): the driven coordinates do not control the "
-                    f"mechanism there; reactions there are least-squares values")
+    for where, what, why in (
+            (bif, "bifurcation position(s)", "the mechanism goes on on its branch and the "
+             "driving torque there is its limit along the branch, but the joint equations are "
+             "dependent: the reactions there are unbounded (least-squares values)"),
+            (singular, "singular position(s)", "the driven coordinates do not control the "
+             "mechanism there; reactions there are least-squares values")):
+        if where.any():
+            status, k = Status.SINGULAR_POSITION, int(np.argmax(where))
+            warn.append(f"{int(where.sum())} {what} (first at index {k}, t = {t[k]:.6g} s): "
+                        + why)
     near = (rcond < NEAR_SINGULAR_RCOND) & ~singular & ~bif
     if near.any():
         k = int(np.argmin(np.where(near, rcond, np.inf)))
@@ -330,23 +269,16 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     # ------------------------------------------------ joint reactions
     X = extend(model, x)
     C = -P * lam[:, :, None]  # row contributions to generalized forces (n, rows, n_x)
-    geo = _joint_geometry(model, lay)
     reactions, moments, jframe, jpoints, kinds = {}, {}, {}, {}, {}
     frame_loads: dict[str, np.ndarray] = {}
-    for name, (kind, i, j, ui) in geo.items():
+    for name in (n for n in model.joint_names if n in lay.rows):
+        kind, i, j, _ = reaction_frame(model, name)
         f, mP, Pt = joint_reaction(model, name, x, C[:, lay.rows[name], :].sum(axis=1))
-        reactions[name] = f
-        moments[name] = mP
-        jpoints[name] = Pt
-        kinds[name] = kind
-        thi = X[:, i, 2]
-        if kind == "prismatic":
-            u = rotate(thi, ui)
-            nrm = _perp(u)
-            jframe[name] = np.stack([np.sum(f * u, -1), np.sum(f * nrm, -1)], axis=-1)
-        else:
-            e1 = np.stack([np.cos(thi), np.sin(thi)], axis=-1)
-            jframe[name] = np.stack([np.sum(f * e1, -1), np.sum(f * _perp(e1), -1)], axis=-1)
+        reactions[name], moments[name], jpoints[name], kinds[name] = f, mP, Pt, kind
+        # prismatic: along and normal to the axis; else along the parent's x and y axes
+        u = rotate(X[:, i, 2], model.pri.ui[model.pri.names.index(name)]
+                   if kind == "prismatic" else (1.0, 0.0))
+        jframe[name] = np.stack([np.sum(f * u, -1), np.sum(f * _perp(u), -1)], axis=-1)
         if i == nb or j == nb:
             sgn = 1.0 if j == nb else -1.0  # what the frame receives
             ff, mm = sgn * f, sgn * mP
@@ -364,18 +296,13 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
             el_forces[el] = -lam[:, idx[0]]
             Del = C[:, idx, :].sum(axis=1)
             p_el += np.einsum("nx,nx->n", Del, xdot)
-            fe = _net_on_ground(model, x, Del)
-            fe[:, 2] -= cross(np.broadcast_to(point, (n, 2)), fe[:, :2])
-            frame_loads[el] = fe
+            frame_loads[el] = _net_on_ground(model, x, Del, point)
 
     # ------------------------------------------------ drives' stator and ground-attached loads
     D = np.einsum("nd,ndx->nx", tau, Gd) + np.einsum("nq,nqx->nx", Qd_loads, G)
-    dr = _net_on_ground(model, x, D)
-    dr[:, 2] -= cross(np.broadcast_to(point, (n, 2)), dr[:, :2])
-    frame_loads["drives"] = dr
-    lg = F_ground.copy()
-    lg[:, 2] -= cross(np.broadcast_to(point, (n, 2)), lg[:, :2])
-    frame_loads["loads"] = lg
+    frame_loads["drives"] = _net_on_ground(model, x, D, point)
+    frame_loads["loads"] = F_ground - np.concatenate(
+        [np.zeros((n, 2)), cross(point, F_ground[:, :2])[:, None]], axis=-1)
     tot = sum(frame_loads.values())
     # ------------------------------------------------ power balance (self-check)
     # (p_el: power of the switchable rows, zero but for sliding friction)
@@ -389,8 +316,8 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
              "singular_positions": int(singular.sum()),
              "bifurcation_positions": int(bif.sum())}
     return {"reactions": reactions, "moments": moments, "joint_frame": jframe,
-            "joint_points": jpoints, "kinds": kinds, "frame_loads": frame_loads,
-            "frame_force": tot[:, :2].copy(), "frame_moment": tot[:, 2].copy(), "tau": tau,
-            "lam": lam, "element_forces": el_forces, "status": status,
-            "warnings": warn, "redundant": redundant, "stats": stats}
+            "joint_points": jpoints, "joint_kinds": kinds, "frame_loads": frame_loads,
+            "frame_force": tot[:, :2].copy(), "frame_moment": tot[:, 2].copy(),
+            "multipliers": lam, "element_forces": el_forces, "redundant_joints": tuple(red_joints),
+            "tau": tau, "status": status, "warnings": warn, "stats": stats}
 

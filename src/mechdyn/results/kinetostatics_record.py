@@ -75,7 +75,7 @@ class Kinetostatics:
     message : str
     warnings : tuple of str
     stats : dict
-        Run figures: positions, seconds, Newton iterations, power-balance
+        Run figures: positions, seconds, position (Newton) solves, power-balance
         residual (relative), smallest rcond, ...; for a switched trajectory also
         ``segments`` (one dict per segment: mode, sample range, times, driven
         coordinates, status, power-balance residual).
@@ -152,18 +152,10 @@ class Kinetostatics:
     @property
     def over_is_angle(self) -> bool:
         """True when ``over`` is an angle coordinate."""
-        k = self.coordinate_names.index(self.over)
-        return self._is_angle(k)
+        return self._is_angle(self.coordinate_names.index(self.over))
 
     def _is_angle(self, k: int) -> bool:
-        if self.model is not None:
-            return bool(self.model.coord_is_angle[k])
-        return True
-
-    def _label(self, name: str) -> tuple[str, float]:
-        """Column of a coordinate value and the factor from SI."""
-        k = self.coordinate_names.index(name)
-        return (f"{name}_deg", np.rad2deg(1.0)) if self._is_angle(k) else (f"{name}_m", 1.0)
+        return self.model is None or bool(self.model.coord_is_angle[k])
 
     def _drive_unit(self, name: str) -> tuple[str, str]:
         k = self.coordinate_names.index(name)
@@ -188,10 +180,7 @@ class Kinetostatics:
     @property
     def driving_total_power(self) -> np.ndarray:
         """Sum of the driving powers, W, shape (n,)."""
-        out = np.zeros(self.n)
-        for p in self.power.values():
-            out = out + p
-        return out
+        return sum(self.power.values(), np.zeros(self.n))
 
     # ------------------------------------------------------------ tables
     def to_dataframe(self):
@@ -214,14 +203,12 @@ class Kinetostatics:
                                     dtype=object)
             cols["mode_index"] = np.asarray(self.mode_index)
         for k, c in enumerate(self.coordinate_names):
-            if self._is_angle(k):
-                cols[f"{c}_deg"] = np.rad2deg(self.q[:, k])
-                cols[f"{c}_dot_rad_s"] = self.qdot[:, k]
-                cols[f"{c}_ddot_rad_s2"] = self.qddot[:, k]
-            else:
-                cols[f"{c}_m"] = self.q[:, k]
-                cols[f"{c}_dot_m_s"] = self.qdot[:, k]
-                cols[f"{c}_ddot_m_s2"] = self.qddot[:, k]
+            ang = self._is_angle(k)
+            u = "rad" if ang else "m"
+            qk = self.q[:, k]
+            cols[f"{c}_deg" if ang else f"{c}_m"] = np.rad2deg(qk) if ang else qk
+            cols[f"{c}_dot_{u}_s"] = self.qdot[:, k]
+            cols[f"{c}_ddot_{u}_s2"] = self.qddot[:, k]
         for c in self.driven:
             sym, unit = self._drive_unit(c)
             cols[f"{sym}_drive_{c}_{unit}"] = self.driving[c]
@@ -238,11 +225,8 @@ class Kinetostatics:
             if kind in ("prismatic", "lock"):
                 cols[f"M_{j}_Nm"] = self.moments[j]
         for el, f in self.element_forces.items():
-            key = el.replace("@", "_")
-            if self.element_units.get(el) == "N m":
-                cols[f"M_{key}_Nm"] = f
-            else:
-                cols[f"F_{key}_N"] = f
+            sym, unit = ("M", "Nm") if self.element_units.get(el) == "N m" else ("F", "N")
+            cols[f"{sym}_{el.replace('@', '_')}_{unit}"] = f
         for j, L in self.frame_loads.items():
             if j in self.reactions:
                 cols[f"Fx_frame_{j}_N"] = L[:, 0]
@@ -255,11 +239,6 @@ class Kinetostatics:
         return pd.DataFrame(cols)
 
     # ------------------------------------------------------------ summaries
-    def _where(self, k: int) -> str:
-        lab, f = self._label(self.over)
-        unit = "deg" if lab.endswith("_deg") else "m"
-        return f"{self.over} = {self.values[k] * f:.4g} {unit}"
-
     def rms(self, series) -> float:
         """RMS of a series over the positions, weighted by time when time advances
         (trapezoidal rule), else by position count."""
@@ -276,61 +255,47 @@ class Kinetostatics:
             return float(np.sqrt(np.trapezoid(y**2, v) / (v[-1] - v[0])))
         return float(np.sqrt(np.mean(y**2)))
 
+    def _peak(self, y, name: str = "peak", rank=None) -> dict:
+        """``name``, ``name_at`` (position) and ``name_t`` (time) of the sample of y where
+        ``rank`` (default y) is largest, NaN samples aside."""
+        k = _arg(y if rank is None else rank)
+        return {name: _at(y, k), f"{name}_at": _at(self.values, k), f"{name}_t": _at(self.t, k)}
+
     def peaks(self) -> dict:
-        """The figures of :meth:`summary` as a dict (SI units; positions in ``over``'s unit)."""
-        out: dict = {"driving": {}, "joints": {}, "frame": {}}
+        """The figures of :meth:`summary` as a dict (SI units; positions in ``over``'s unit;
+        ``*_at`` the positions and ``*_t`` the times of the extremes)."""
         # NaN marks samples where a drive, joint or element is not part of the mode
-        # (switched trajectories); extremes are taken over the others.  "*_t" are the
-        # times of the extremes.
-        t = self.t
+        # (switched trajectories); extremes are taken over the others
+        out: dict = {"driving": {}, "joints": {}, "elements": {}}
         for c in self.driven:
             m = self.driving[c]
-            ka, kmx, kmn = _arg(np.abs(m)), _arg(m), _arg(-m)
             out["driving"][c] = {
-                "peak_abs": _at(m, ka), "peak_abs_at": _at(self.values, ka),
-                "max": _at(m, kmx), "max_at": _at(self.values, kmx),
-                "min": _at(m, kmn), "min_at": _at(self.values, kmn),
-                "rms": self.rms(m), "mean": _nanmean(m),
-                "peak_power": _at(np.abs(self.power[c]), _arg(np.abs(self.power[c]))),
-                "peak_abs_t": _at(t, ka),
-            }
+                **self._peak(m, "peak_abs", np.abs(m)), **self._peak(m, "max"),
+                **self._peak(m, "min", -m), "rms": self.rms(m), "mean": _nanext(m, np.nanmean),
+                "peak_power": _nanext(np.abs(self.power[c]), np.nanmax)}
         for j in self.reactions:
             F = self.force_magnitude(j)
-            k = _arg(F)
-            out["joints"][j] = {"peak": _at(F, k), "peak_at": _at(self.values, k),
-                                "peak_t": _at(t, k), "rms": self.rms(F)}
+            out["joints"][j] = {**self._peak(F), "rms": self.rms(F)}
             if self.joint_kinds[j] != "revolute":
                 M = self.moments[j]
-                km = _arg(np.abs(M))
-                out["joints"][j].update(peak_moment=_at(M, km),
-                                        peak_moment_at=_at(self.values, km),
-                                        peak_moment_t=_at(t, km))
-        out["elements"] = {}
+                out["joints"][j].update(self._peak(M, "peak_moment", np.abs(M)))
         for el, f in self.element_forces.items():
-            k = _arg(np.abs(f))
-            out["elements"][el] = {"peak": _at(f, k), "peak_at": _at(self.values, k),
-                                   "peak_t": _at(t, k), "unit": self.element_units.get(el, "N")}
-        Ff = np.hypot(self.frame_force[:, 0], self.frame_force[:, 1])
-        k, km = _arg(Ff), _arg(np.abs(self.frame_moment))
-        out["frame"] = {
-            "force_peak": _at(Ff, k), "force_peak_at": _at(self.values, k),
-            "Fx_min": _nanext(self.frame_force[:, 0], np.nanmin),
-            "Fx_max": _nanext(self.frame_force[:, 0], np.nanmax),
-            "Fy_min": _nanext(self.frame_force[:, 1], np.nanmin),
-            "Fy_max": _nanext(self.frame_force[:, 1], np.nanmax),
-            "moment_peak": _at(self.frame_moment, km),
-            "moment_peak_at": _at(self.values, km),
-            "M_min": _nanext(self.frame_moment, np.nanmin),
-            "M_max": _nanext(self.frame_moment, np.nanmax),
-        }
+            out["elements"][el] = {**self._peak(f, rank=np.abs(f)),
+                                   "unit": self.element_units.get(el, "N")}
+        Ff, Mf = np.hypot(self.frame_force[:, 0], self.frame_force[:, 1]), self.frame_moment
+        out["frame"] = {**self._peak(Ff, "force_peak"),
+                        **self._peak(Mf, "moment_peak", np.abs(Mf))}
+        for key, y in (("Fx", self.frame_force[:, 0]), ("Fy", self.frame_force[:, 1]),
+                       ("M", Mf)):
+            out["frame"].update({f"{key}_min": _nanext(y, np.nanmin),
+                                 f"{key}_max": _nanext(y, np.nanmax)})
         return out
 
     def summary(self) -> str:
         """Peak and RMS driving torque (motor sizing), peak force per joint and where,
         shaking force and moment extremes; warnings last."""
         p = self.peaks()
-        lab, f = self._label(self.over)
-        unit = "deg" if lab.endswith("_deg") else "m"
+        unit, f = ("deg", np.rad2deg(1.0)) if self.over_is_angle else ("m", 1.0)
         lines = [f"kinetostatics over {self.over}: {self.n} positions, "
                  f"{self.over} from {self.values[0] * f:.4g} to {self.values[-1] * f:.4g} "
                  f"{unit}; status {self.status}"]
@@ -442,24 +407,15 @@ class Kinetostatics:
         return pd.DataFrame(cols)
 
 
-
 def _arg(y) -> int:
     """Index of the largest finite value (-1 when there is none)."""
     y = np.asarray(y, dtype=float)
     ok = np.isfinite(y)
-    if not ok.any():
-        return -1
-    return int(np.argmax(np.where(ok, y, -np.inf)))
+    return int(np.argmax(np.where(ok, y, -np.inf))) if ok.any() else -1
 
 
 def _at(y, k: int) -> float:
     return float(np.asarray(y)[k]) if k >= 0 else float("nan")
-
-
-def _nanmean(y) -> float:
-    y = np.asarray(y, dtype=float)
-    ok = np.isfinite(y)
-    return float(np.mean(y[ok])) if ok.any() else float("nan")
 
 
 def _nanext(y, fn) -> float:
