@@ -35,6 +35,7 @@ from ..errors import IntegrationError, ModelError
 from ..mechanism.drive import TorqueSpeedCurve
 from ..mechanism.load import Table
 from ..model import Model, as_model
+from .inertia import drive_inertia
 from .mode_mechanism import mode_mechanism
 from .reduced_kinematics import _ModelEvaluator
 from .reduced_run import ReducedRun, energy_speed, run_reduced
@@ -243,7 +244,7 @@ class ReducedMachine:
         model = as_model(model)  # a Mechanism is compiled (and validated) here
         ev = _ModelEvaluator(model, coordinate, mode=mode, x0=x0)
         if extra_inertia is None:
-            extra_inertia = ev.drive_inertia()
+            extra_inertia = float(drive_inertia(model)[0])
         drive = _single_drive(model, ev.coordinate)
         if period is None:
             period = TWO_PI if ev.is_angle else 1.0

@@ -54,9 +54,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError, Status
+from ..kinematics.constraints import _perp
 from ..model import Model, as_model
 from .flywheel import FlywheelSizing, SteadyCycle, size_flywheel, steady_state
-from .reduced_kinematics import _ModelEvaluator, _perp, _rot, reduced_kinematics
+from .forces import rotate
+from .inertia import drive_inertia
+from .reduced_kinematics import _inertia, _ModelEvaluator, reduced_kinematics
 from .reduced_machine import (
     TWO_PI,
     Member,
@@ -256,31 +259,24 @@ def reduce_model(model: Model, *, coordinate: str | None = None, link: str | Non
         phis = np.asarray(phi, dtype=float).reshape(-1)
         if phis.size < 1 or not np.all(np.isfinite(phis)):
             raise ModelError("phi must be a non-empty sequence of finite positions")
-    j_extra = ev.drive_inertia() if extra_inertia is None else _extra_inertia(extra_inertia)
-
-    xs = ev.poses(phis)
-    kin = reduced_kinematics(model, xs, ev.layout)
+    j_extra = float(drive_inertia(model)[0]) if extra_inertia is None else \
+        _extra_inertia(extra_inertia)
+    sw = ev.sweep(phis)
+    xs, B = sw.x, sw.B[..., 0]
+    J, dJ = _inertia(model, xs, B, sw.xddot)
     n = phis.size
     if link is None:
-        ratio = np.ones(n)
-        dratio = np.zeros(n)
-        link_angle = None
+        ratio, dratio, link_angle = np.ones(n), np.zeros(n), None
     else:
         k = model.body_index(link)
         if k >= model.n_bodies:
             raise ModelError(f"link of reduction: the ground cannot be the link; choose one of "
                              f"{', '.join(model.body_names)}")
-        ratio = kin["w"][:, k]
-        dratio = kin["al"][:, k]
-        link_angle = xs[:, 3 * k + 2]
-    J, dJ = kin["J"], kin["dJ"]
+        ratio, dratio, link_angle = B[:, 3 * k + 2], sw.xddot[:, 3 * k + 2], xs[:, 3 * k + 2]
     with np.errstate(divide="ignore", invalid="ignore"):
         qdot = float(omega) / ratio
-        mf = np.empty(n)
-        md = np.empty(n)
-        for i in range(n):
-            qd = qdot[i] if np.isfinite(qdot[i]) else 0.0
-            mf[i], md[i] = ev.generalized_forces(t, phis[i], qd, xs[i], kin["B"][i])
+        mf, md = ev.generalized_forces(float(t), phis, np.where(np.isfinite(qdot), qdot, 0.0),
+                                       xs, B)
         J_link = J / ratio**2
         dJ_link = (dJ / ratio**2 - 2.0 * J * dratio / ratio**3) / ratio
         J_extra = j_extra / ratio**2
@@ -289,10 +285,8 @@ def reduce_model(model: Model, *, coordinate: str | None = None, link: str | Non
     if point is not None:
         body, pt = point
         kb = model.body_index(body)
-        s = model.point_local(body, pt)
-        arm = _rot(xs[:, 3 * kb + 2][:, None], s[None, :])[:, 0, :]
-        v = np.stack([kin["B"][:, 3 * kb], kin["B"][:, 3 * kb + 1]], axis=-1) \
-            + kin["B"][:, 3 * kb + 2][:, None] * _perp(arm)
+        arm = rotate(xs[:, 3 * kb + 2], model.point_local(body, pt))
+        v = B[:, 3 * kb:3 * kb + 2] + B[:, 3 * kb + 2, None] * _perp(arm)
         v_ratio = np.hypot(v[:, 0], v[:, 1])
         with np.errstate(divide="ignore"):
             m_red = (J + j_extra) / v_ratio**2
