@@ -17,8 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..dynamics.reduced_machine import mode_mechanism
-from ..dynamics.reduction import reduce_model
+from ..dynamics.reduction import mode_mechanism, reduce_model
 from ..errors import ModelError
 from ..modelfile.drives import drive_from_table
 from ..results.plot_reduction import plot_reduction

@@ -18,8 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import IntegrationError, LockupError, ModelError
-from .reduced_machine import ReducedMachine
-from .reduced_run import _frozen
+from .reduced_machine import ReducedMachine, _frozen
 
 __all__ = ["SteadyCycle", "steady_state", "FlywheelSizing", "size_flywheel", "FLYWHEEL_METHODS"]
 

@@ -1,10 +1,7 @@
-"""The reduced 1-DOF machine and its equation of motion (lecture notes eq. 7.12).
+"""The reduced 1-DOF machine (lecture notes eq. 7.12).
 
 ``J(phi) domega/dt + 1/2 omega^2 dJ/dphi = M_red(phi, omega, t)`` with
-``J = J_red + J_extra`` (rotor and gears reduced to the link, flywheel).  Since
-``d(J omega^2 / 2) / dphi = M_red``, the *energy form* ``J omega^2 / 2 =
-J_0 omega_0^2 / 2 + integral M_red dphi`` holds when M_red depends on the
-position only.
+``J = J_red + J_extra`` (rotor and gears reduced to the link, flywheel).
 
 Public names
 ------------
@@ -12,13 +9,6 @@ ReducedMachine, Member, MemberLoad
     The reduced machine: from a model, from a :class:`~mechdyn.dynamics.reduction.Reduction`
     table, from a transmission of velocity ratios (belt drives, gear trains), or
     from plain functions.
-ReducedRun, run_reduced, energy_speed
-    Time integration of the reduced equation (with :mod:`mechdyn.integrate`) and
-    the energy form; defined in :mod:`mechdyn.dynamics.reduced_run`.
-mode_mechanism
-    A variable-structure mechanism in one mode (locks engaged, frozen
-    coordinates dropped), e.g. the press in its 1-DOF working mode; defined in
-    :mod:`mechdyn.dynamics.mode_mechanism`.
 """
 
 from __future__ import annotations
@@ -36,17 +26,20 @@ from ..mechanism.drive import TorqueSpeedCurve
 from ..mechanism.load import Table
 from ..model import Model, as_model
 from .inertia import drive_inertia
-from .mode_mechanism import mode_mechanism
 from .reduced_kinematics import _ModelEvaluator
-from .reduced_run import ReducedRun, energy_speed, run_reduced
 
 if TYPE_CHECKING:
     from .reduction import Reduction
 
-__all__ = ["ReducedMachine", "Member", "MemberLoad", "ReducedRun", "run_reduced",
-           "energy_speed", "mode_mechanism"]
+__all__ = ["ReducedMachine", "Member", "MemberLoad"]
 
 TWO_PI = 2.0 * math.pi
+
+
+def _frozen(a) -> np.ndarray:
+    a = np.array(a, dtype=float, copy=True)
+    a.setflags(write=False)
+    return a
 
 
 def _extra_inertia(value) -> float:
@@ -146,7 +139,7 @@ class ReducedMachine:
     drive : object, optional
         The drive on the link (an object with ``torque_at``; a
         :class:`~mechdyn.mechanism.motors.GearStage` also gives the motor-side
-        torque in :func:`~mechdyn.dynamics.startup.startup`).  Informational: its
+        torque in :func:`~mechdyn.dynamics.reduced_run.startup`).  Informational: its
         torque must already be part of ``torque``.
     period : float
         Angle of one cycle, rad (2 pi for a crank).

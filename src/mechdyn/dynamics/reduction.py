@@ -2,77 +2,48 @@
 
 A machine with one degree of freedom is replaced by one *link of reduction*
 turning with the generalized coordinate ``phi`` (or with a chosen link) that
-carries
-
-* the **reduced moment of inertia** ``J_red(phi) = 2 T / omega^2
-  = sum_k (m_k |v_ck / omega|^2 + J_ck (omega_k / omega)^2)``, kg m^2, from the
-  exact velocity analogs of the centres of mass, ``v_c / omega = B_r + B_theta
-  R(A c_k)`` (R: rotation by +90 deg, A c_k: the centre of mass offset turned
-  into the ground frame);
-* its derivative ``dJ_red/dphi = 2 sum_k (m_k v_c' . a_c' + J_ck w' alpha')``,
-  kg m^2/rad, exact: ``a_c'`` and ``alpha'`` are the acceleration bias of the
-  kinematics at unit speed (``d B / dphi = b(x, B)``, ``qdot = 1``);
-* the **reduced torque** ``M_red(phi, omega, t) = Q_phi = B^T F + M_drive``,
-  N m, by equal power of every applied force, moment and drive;
-* the **reduced mass** at a point P, ``m_red = 2 T / v_P^2 = J_red / |v_P/omega|^2``, kg.
-
-Its equation of motion (lecture notes eq. 7.12) is
-
-    J(phi) domega/dt + 1/2 omega^2 dJ/dphi = M_red(phi, omega, t),
-
-with ``J = J_red + J_extra`` (rotor and gears reduced to the coordinate,
-flywheel).  Since ``d(J omega^2 / 2) / dphi = M_red``, the *energy form*
-``J omega^2 / 2 = J_0 omega_0^2 / 2 + integral M_red dphi`` holds when M_red
-depends on the position only.
+carries the reduced moment of inertia ``J_red(phi) = 2 T / omega^2`` (kg m^2),
+its exact derivative ``dJ_red/dphi`` and the reduced torque ``M_red = B^T F +
+M_drive`` of all applied forces and drives by equal power (N m); its equation of
+motion (eq. 7.12) is ``J(phi) domega/dt + 1/2 omega^2 dJ/dphi = M_red(phi, omega, t)``
+with ``J = J_red + J_extra``.  The formulas and their use are in
+``docs/reduction-and-drives.md``.
 
 Public names
 ------------
-Reduction, reduce_model
-    The reduced quantities of a model tabulated over a cycle (this module).
+Reduction, reduce_model, mode_mechanism
+    The reduced quantities of a model tabulated over a cycle, and a
+    variable-structure mechanism in one mode as a 1-DOF mechanism (this module).
 reduced_kinematics
-    The exact transmission functions, J_red and dJ_red/dphi of solved poses
-    (:mod:`mechdyn.dynamics.reduced_kinematics`).
-ReducedMachine, Member, MemberLoad, ReducedRun, run_reduced, energy_speed, mode_mechanism
-    The reduced 1-DOF machine (from a model, from a table, from a transmission of
-    velocity ratios or from plain functions), its time integration and energy
-    form, and a variable-structure mechanism in one mode
-    (:mod:`mechdyn.dynamics.reduced_machine`).
+    :mod:`mechdyn.dynamics.reduced_kinematics`.
+ReducedMachine, Member, MemberLoad
+    :mod:`mechdyn.dynamics.reduced_machine`.
 SteadyCycle, steady_state, FlywheelSizing, size_flywheel
-    The periodic steady motion (shooting on omega at phi0) and its coefficient of
-    speed fluctuation; flywheel sizing by the energy method, confirmed by
-    simulation (:mod:`mechdyn.dynamics.flywheel`).
-StartupResult, startup
-    Start-up from rest and load transients (:mod:`mechdyn.dynamics.startup`).
+    :mod:`mechdyn.dynamics.flywheel`.
+ReducedRun, run_reduced, energy_speed, StartupResult, startup
+    :mod:`mechdyn.dynamics.reduced_run`.
 
 All of them are importable from this module.
 """
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ModelError, Status
+from ..errors import ModelError, Status, did_you_mean
 from ..kinematics.constraints import _perp
+from ..mechanism.joint import Lock
 from ..model import Model, as_model
 from .flywheel import FlywheelSizing, SteadyCycle, size_flywheel, steady_state
 from .forces import rotate
 from .inertia import drive_inertia
 from .reduced_kinematics import _inertia, _ModelEvaluator, reduced_kinematics
-from .reduced_machine import (
-    TWO_PI,
-    Member,
-    MemberLoad,
-    ReducedMachine,
-    ReducedRun,
-    _extra_inertia,
-    energy_speed,
-    mode_mechanism,
-    run_reduced,
-)
-from .reduced_run import _frozen
-from .startup import StartupResult, startup
+from .reduced_machine import TWO_PI, Member, MemberLoad, ReducedMachine, _extra_inertia, _frozen
+from .reduced_run import ReducedRun, StartupResult, energy_speed, run_reduced, startup
 
 __all__ = ["Reduction", "reduce_model", "ReducedMachine", "Member", "MemberLoad",
            "ReducedRun", "run_reduced", "energy_speed", "SteadyCycle", "steady_state",
@@ -309,3 +280,59 @@ def reduce_model(model: Model, *, coordinate: str | None = None, link: str | Non
         point=point, m_red=None if m_red is None else _frozen(m_red),
         v_ratio=None if v_ratio is None else _frozen(v_ratio), status=status,
         message=message, stats={"positions": n, "extra_inertia_coordinate": j_extra})
+
+
+def mode_mechanism(mechanism, *, engage: Sequence[str] = (), offsets: dict | None = None,
+                   drop: Sequence[str] = ()):
+    """A copy of a mechanism with locks engaged and the coordinates they freeze removed.
+
+    The reduction method needs one degree of freedom; a variable-structure
+    machine has it in some modes only (the clutchless press in its working mode:
+    rocker locked onto the slider).  This builds that mode as a mechanism of its
+    own.
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+    engage : sequence of str
+        Locks to engage.
+    offsets : dict, optional
+        Lock name -> pose (x m, y m, theta rad) of the child frame in the parent
+        frame held by the lock; default the lock's own offset (or the sketch).
+    drop : sequence of str
+        Coordinates to remove (those the engaged locks freeze).
+
+    Returns
+    -------
+    Mechanism
+        The original is not changed; initial values of dropped coordinates are
+        removed from ``extras["initial"]``.
+    """
+    offsets = dict(offsets or {})
+    joints = dict(mechanism.joints)
+    probs = []
+    for name in engage:
+        j = joints.get(name)
+        if not isinstance(j, Lock):
+            locks = [n for n, jj in joints.items() if isinstance(jj, Lock)]
+            probs.append(did_you_mean(name, locks, "lock"))
+            continue
+        off = offsets.pop(name, j.offset)
+        joints[name] = dataclasses.replace(j, engaged=True,
+                                           offset=None if off is None else tuple(map(float, off)))
+    for name in offsets:
+        probs.append(f"offsets: lock {name!r} is not in engage")
+    coords = {k: v for k, v in mechanism.coordinates.items() if k not in set(drop)}
+    for name in drop:
+        if name not in mechanism.coordinates:
+            probs.append(did_you_mean(name, mechanism.coordinates, "coordinate"))
+    if probs:
+        raise ModelError(probs)
+    extras = dict(mechanism.extras)
+    init = extras.get("initial")
+    if isinstance(init, dict):
+        extras["initial"] = {k: {c: v for c, v in dict(d or {}).items() if c in coords}
+                             for k, d in init.items()}
+    return dataclasses.replace(mechanism, joints=joints, coordinates=coords,
+                               loads=list(mechanism.loads), drives=list(mechanism.drives),
+                               extras=extras)

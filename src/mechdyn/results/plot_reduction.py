@@ -92,7 +92,7 @@ def plot_steady_cycle(cycle, path, *, title: str | None = None, dpi: int = 120) 
 
 
 def plot_startup(res, path, *, title: str | None = None, dpi: int = 120) -> Path:
-    """Speed and torques of a start-up (a :class:`~mechdyn.dynamics.startup.StartupResult`)."""
+    """Speed and torques of a start-up (a :class:`~mechdyn.dynamics.reduced_run.StartupResult`)."""
     run = res.run
     fig, ax = _figure(2)
     ax[0].plot(run.t, run.omega)
