@@ -94,9 +94,8 @@ class _Cycle:
 
     def __init__(self, machine: ReducedMachine, phi0: float, steps: int):
         self.m = machine
-        self.phi0 = float(phi0)
         self.steps = int(steps)
-        self.phi = self.phi0 + np.linspace(0.0, machine.period, self.steps + 1)
+        self.phi = float(phi0) + np.linspace(0.0, machine.period, self.steps + 1)
         self.h = machine.period / self.steps
         self.evaluations = 0
 
@@ -111,36 +110,27 @@ class _Cycle:
         w = math.sqrt(2.0 * e / j)
         return self.m.torque(t, p, w), 1.0 / w
 
-    def run(self, omega0: float, t0: float = 0.0, record: bool = False):
-        """Integrate one cycle from speed ``omega0``; returns (omega_end, t_end, record)."""
+    def run(self, omega0: float, t0: float = 0.0):
+        """Integrate one cycle from speed ``omega0``: (omega_end, E, t, M on the grid)."""
         if not (math.isfinite(omega0) and omega0 > 0):
             raise IntegrationError(f"cycle start speed must be > 0 rad/s, got {omega0!r}")
-        m, h, ph = self.m, self.h, self.phi
-        e = 0.5 * m.inertia(ph[0])[0] * omega0 * omega0
+        h, ph, f = self.h, self.phi, self._f
+        E, T, M = np.empty(ph.size), np.empty(ph.size), np.empty(ph.size)
+        e = 0.5 * self.m.inertia(ph[0])[0] * omega0 * omega0
         floor = 1e-10 * e
         t = float(t0)
-        f = self._f
-        if record:
-            E = np.empty(self.steps + 1)
-            T = np.empty(self.steps + 1)
-            M = np.empty(self.steps + 1)
         for k in range(self.steps):
             p = ph[k]
             m1, r1 = f(p, e, t, floor)
-            if record:
-                E[k], T[k], M[k] = e, t, m1
+            E[k], T[k], M[k] = e, t, m1
             m2, r2 = f(p + 0.5 * h, e + 0.5 * h * m1, t + 0.5 * h * r1, floor)
             m3, r3 = f(p + 0.5 * h, e + 0.5 * h * m2, t + 0.5 * h * r2, floor)
             m4, r4 = f(ph[k + 1], e + h * m3, t + h * r3, floor)
             e += h * (m1 + 2.0 * m2 + 2.0 * m3 + m4) / 6.0
             t += h * (r1 + 2.0 * r2 + 2.0 * r3 + r4) / 6.0
-        mend, _ = f(ph[-1], e, t, floor)
-        w1 = math.sqrt(2.0 * e / m.inertia(ph[-1])[0])
-        rec = None
-        if record:
-            E[-1], T[-1], M[-1] = e, t, mend
-            rec = (E, T, M)
-        return w1, t, rec
+        E[-1], T[-1] = e, t
+        M[-1], _ = f(ph[-1], e, t, floor)
+        return math.sqrt(2.0 * e / self.m.inertia(ph[-1])[0]), E, T, M
 
 
 def _omega_of(machine, phi, E):
@@ -203,7 +193,7 @@ def steady_state(machine: ReducedMachine, *, omega_guess: float | None = None,
     def g(w0):
         nonlocal iters
         iters += 1
-        w1, _, _ = cyc.run(w0, t0)
+        w1 = cyc.run(w0, t0)[0]
         return w1 - w0, w1
 
     if omega_mean is not None:
@@ -212,8 +202,7 @@ def steady_state(machine: ReducedMachine, *, omega_guess: float | None = None,
             raise ModelError(f"omega_mean must be > 0 rad/s, got {omega_mean!r}")
 
         def mean_err(w0):
-            _, _, (E, _, _) = cyc.run(w0, t0, record=True)
-            om, _ = _omega_of(machine, cyc.phi, E)
+            om, _ = _omega_of(machine, cyc.phi, cyc.run(w0, t0)[1])
             return 0.5 * (om.max() + om.min()) - target
 
         lo = hi = target
@@ -290,17 +279,8 @@ def _balance_speed(machine: ReducedMachine, t0: float, phi0: float) -> float:
     vals = np.array([mean_torque(w) for w in ws])
     tol = 1e-9 * max(float(np.max(np.abs(vals))), 1e-300)
     for k in range(len(ws) - 1):
-        if vals[k] > tol and vals[k + 1] <= tol:
-            lo, hi = ws[k], ws[k + 1]
-            if vals[k + 1] < -tol:
-                return brentq(mean_torque, lo, hi, rtol=1e-10)
-            for _ in range(80):  # the torque vanishes from some speed on: its first zero
-                mid = 0.5 * (lo + hi)
-                if mean_torque(mid) > tol:
-                    lo = mid
-                else:
-                    hi = mid
-            return hi
+        if vals[k] > tol and vals[k + 1] <= tol:  # the first speed where it vanishes
+            return brentq(lambda w: mean_torque(w) - tol, ws[k], ws[k + 1], rtol=1e-10)
     raise ModelError("steady_state needs omega_guess (rad/s): no speed between 0.01 and 1e5 "
                      "rad/s balances the mean torque over a cycle")
 
@@ -308,7 +288,8 @@ def _balance_speed(machine: ReducedMachine, t0: float, phi0: float) -> float:
 def _finish(machine, cyc: _Cycle, w0, t0, iters) -> SteadyCycle:
     from scipy.optimize import minimize_scalar
 
-    _, t1, (E, T, M) = cyc.run(w0, t0, record=True)
+    _, E, T, M = cyc.run(w0, t0)
+    t1 = T[-1]
     ph = cyc.phi
     om, J = _omega_of(machine, ph, E)
     dJ = np.array([machine.inertia(p)[1] for p in ph])

@@ -35,11 +35,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError, Status, did_you_mean
-from ..kinematics.constraints import _perp
 from ..mechanism.joint import Lock
 from ..model import Model, as_model
 from .flywheel import FlywheelSizing, SteadyCycle, size_flywheel, steady_state
-from .forces import rotate
 from .inertia import drive_inertia
 from .reduced_kinematics import _inertia, _ModelEvaluator, reduced_kinematics
 from .reduced_machine import TWO_PI, Member, MemberLoad, ReducedMachine, _extra_inertia, _frozen
@@ -238,12 +236,11 @@ def reduce_model(model: Model, *, coordinate: str | None = None, link: str | Non
     n = phis.size
     if link is None:
         ratio, dratio, link_angle = np.ones(n), np.zeros(n), None
+    elif model.body_index(link) >= model.n_bodies:
+        raise ModelError(f"link of reduction: the ground cannot be the link; choose one of "
+                         f"{', '.join(model.body_names)}")
     else:
-        k = model.body_index(link)
-        if k >= model.n_bodies:
-            raise ModelError(f"link of reduction: the ground cannot be the link; choose one of "
-                             f"{', '.join(model.body_names)}")
-        ratio, dratio, link_angle = B[:, 3 * k + 2], sw.xddot[:, 3 * k + 2], xs[:, 3 * k + 2]
+        link_angle, ratio, dratio = sw.angular(link)
     with np.errstate(divide="ignore", invalid="ignore"):
         qdot = float(omega) / ratio
         mf, md = ev.generalized_forces(float(t), phis, np.where(np.isfinite(qdot), qdot, 0.0),
@@ -254,17 +251,12 @@ def reduce_model(model: Model, *, coordinate: str | None = None, link: str | Non
         M_f, M_d = mf / ratio, md / ratio
     m_red = v_ratio = None
     if point is not None:
-        body, pt = point
-        kb = model.body_index(body)
-        arm = rotate(xs[:, 3 * kb + 2], model.point_local(body, pt))
-        v = B[:, 3 * kb:3 * kb + 2] + B[:, 3 * kb + 2, None] * _perp(arm)
-        v_ratio = np.hypot(v[:, 0], v[:, 1])
+        point = tuple(point)
+        v_ratio = np.linalg.norm(sw.point_analogs(*point)[..., 0], axis=-1)
         with np.errstate(divide="ignore"):
             m_red = (J + j_extra) / v_ratio**2
-        point = (body, pt)
     bad = ~np.isfinite(J_link) | (np.abs(ratio) <= 1e-9 * np.max(np.abs(ratio), initial=0.0))
-    message = ""
-    status = "success"
+    status, message = "success", ""
     if np.any(bad):
         status = Status.SINGULAR_POSITION
         message = (f"the angular-velocity analog of link {link!r} vanishes at "
