@@ -82,10 +82,8 @@ def run(args) -> int:
         raise ModelError("the driving torque does not depend on the speed, so the steady "
                          "speed is not determined by the machine: give the mean speed with "
                          "--speed (e.g. --speed 43.5rad/s)")
-    if dependent:
-        fs = size_flywheel(machine, delta, omega_guess=speed, method=args.method)
-    else:
-        fs = size_flywheel(machine, delta, omega_mean=speed, method=args.method)
+    speed_kw = "omega_guess" if dependent else "omega_mean"  # a motor picks its own speed
+    fs = size_flywheel(machine, delta, method=args.method, **{speed_kw: speed})
     rpm = 30.0 / 3.141592653589793
     print(f"{mech.name}: flywheel for delta = {delta:.4g} ({args.method} method)")
     print(f"  mean speed            {fs.omega_mean:.6g} rad/s = {fs.omega_mean * rpm:.6g} rpm")

@@ -21,7 +21,7 @@ from ..dynamics.reduction import mode_mechanism, reduce_model
 from ..errors import ModelError
 from ..modelfile.drives import drive_from_table
 from ..results.plot_reduction import plot_reduction
-from ..units import parse_quantity
+from ..units import parse_quantity, parse_vector
 from .kinematics import load_model
 
 __all__ = ["register", "run", "add_model_arguments", "prepare_model"]
@@ -58,9 +58,8 @@ def prepare_model(args):
             if len(parts) != 3:
                 raise ModelError(f"--engage {spec!r}: give the pose as X,Y,THETA, e.g. "
                                  f"{name}=0mm,0mm,0deg")
-            offsets[name] = (parse_quantity(parts[0], "length", where="--engage x"),
-                             parse_quantity(parts[1], "length", where="--engage y"),
-                             parse_quantity(parts[2], "angle", where="--engage theta"))
+            offsets[name] = parse_vector(parts, ("length", "length", "angle"),
+                                         where=f"--engage {name}")
     if engage or args.drop:
         mech = mode_mechanism(mech, engage=engage, offsets=offsets, drop=args.drop)
     if args.motor is None and (args.gear_ratio is not None or args.efficiency is not None):

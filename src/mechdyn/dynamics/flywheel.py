@@ -207,22 +207,19 @@ def steady_state(machine: ReducedMachine, *, omega_guess: float | None = None,
 
         lo = hi = target
         flo = mean_err(lo)
-        if flo == 0:
-            w0 = lo
+        step = 1.05 if flo < 0 else 1 / 1.05
+        for _ in range(200):
+            hi = hi * step
+            try:
+                fhi = mean_err(hi)
+            except LockupError:
+                continue
+            if np.sign(fhi) != np.sign(flo):
+                break
         else:
-            step = 1.05 if flo < 0 else 1 / 1.05
-            for _ in range(200):
-                hi = hi * step
-                try:
-                    fhi = mean_err(hi)
-                except LockupError:
-                    continue
-                if np.sign(fhi) != np.sign(flo):
-                    break
-            else:
-                raise IntegrationError(f"no cycle with mean speed {target:.6g} rad/s found")
-            w0 = brentq(mean_err, min(lo, hi), max(lo, hi), xtol=1e-13 * target,
-                        rtol=4 * np.finfo(float).eps)
+            raise IntegrationError(f"no cycle with mean speed {target:.6g} rad/s found")
+        w0 = brentq(mean_err, min(lo, hi), max(lo, hi), xtol=1e-13 * target,
+                    rtol=4 * np.finfo(float).eps)
         err, _ = g(w0)
         if abs(err) > max(tol, 1e-8) * w0:
             raise IntegrationError(

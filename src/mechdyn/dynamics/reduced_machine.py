@@ -241,10 +241,8 @@ class ReducedMachine:
         drive = _single_drive(model, ev.coordinate)
         if period is None:
             period = TWO_PI if ev.is_angle else 1.0
-        m = cls(ev.inertia, ev.torque, extra_inertia=extra_inertia, drive=drive, period=period,
-                name=model.mechanism.name, coordinate=ev.coordinate)
-        m.evaluator = ev
-        return m
+        return cls(ev.inertia, ev.torque, extra_inertia=extra_inertia, drive=drive,
+                   period=period, name=model.mechanism.name, coordinate=ev.coordinate)
 
     @classmethod
     def from_reduction(cls, red: Reduction, model: Model | None = None, *,
@@ -275,19 +273,12 @@ class ReducedMachine:
         xs = phi.tolist()
         mf = np.array(red.M_forces, dtype=float).tolist()
         n_int = len(xs) - 1
-        phi0 = xs[0]
-        h = period / n_int
-        uniform = bool(np.allclose(np.diff(phi), h, rtol=1e-12, atol=0.0))
         if drive is None and model is not None:
             drive = _speed_drive(model, red.coordinate)
 
         def locate(p):
-            u = phi0 + (p - phi0) % period
-            if uniform:
-                i = int((u - phi0) / h)
-            else:
-                i = bisect.bisect_right(xs, u) - 1
-            return u, min(max(i, 0), n_int - 1)
+            u = xs[0] + (p - xs[0]) % period
+            return u, min(max(bisect.bisect_right(xs, u) - 1, 0), n_int - 1)
 
         def inertia(p):
             u, i = locate(p)
