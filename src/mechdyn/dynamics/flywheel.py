@@ -283,37 +283,31 @@ def _balance_speed(machine: ReducedMachine, t0: float, phi0: float) -> float:
 
 
 def _finish(machine, cyc: _Cycle, w0, t0, iters) -> SteadyCycle:
+    from scipy.interpolate import CubicHermiteSpline
     from scipy.optimize import minimize_scalar
 
     _, E, T, M = cyc.run(w0, t0)
-    t1 = T[-1]
     ph = cyc.phi
     om, J = _omega_of(machine, ph, E)
     dJ = np.array([machine.inertia(p)[1] for p in ph])
     eps = (M - 0.5 * dJ * om**2) / J
-    h = cyc.h
+    energy = CubicHermiteSpline(ph, E, M)  # E between the samples (dE/dphi = M)
 
-    # refine the extremes between the samples: cubic Hermite of E (dE/dphi = M)
-    def speed(p, k):
-        u = (p - ph[k]) / h
-        h00, h10 = 2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u
-        h01, h11 = -2 * u**3 + 3 * u**2, u**3 - u**2
-        e = h00 * E[k] + h10 * h * M[k] + h01 * E[k + 1] + h11 * h * M[k + 1]
-        return math.sqrt(2.0 * max(e, 0.0) / machine.inertia(p)[0])
+    def speed(p):
+        return math.sqrt(2.0 * max(float(energy(p)), 0.0) / machine.inertia(p)[0])
 
-    ext = []
+    ext = []  # the extremes refined between the samples
     for k0, sign in ((int(np.argmax(om)), -1.0), (int(np.argmin(om)), 1.0)):
         best = (sign * om[k0], ph[k0])
         for k in (k0 - 1, k0):
             if 0 <= k < cyc.steps:
-                r = minimize_scalar(lambda p, k=k, s=sign: s * speed(p, k),
-                                    bounds=(ph[k], ph[k + 1]), method="bounded",
-                                    options={"xatol": 1e-12})
+                r = minimize_scalar(lambda p, s=sign: s * speed(p), bounds=(ph[k], ph[k + 1]),
+                                    method="bounded", options={"xatol": 1e-12})
                 best = min(best, (float(r.fun), float(r.x)))
         ext.append((sign * best[0], best[1]))
     (wmax, pmax), (wmin, pmin) = ext
     wmean = 0.5 * (wmax + wmin)
-    T_cyc = t1 - t0
+    T_cyc = T[-1] - t0
     return SteadyCycle(
         phi=_frozen(ph), t=_frozen(T - t0), omega=_frozen(om), epsilon=_frozen(eps),
         J=_frozen(J), M=_frozen(M), omega_max=float(wmax), omega_min=float(wmin),

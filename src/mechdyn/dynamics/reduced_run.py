@@ -260,15 +260,9 @@ def startup(machine: ReducedMachine, t_end: float, *, phi0: float = 0.0, omega0:
                       t_eval=te, **options)
     if steady is None:
         steady = steady_state(machine, omega_guess=max(run.omega[-1], 1e-6), phi0=phi0)
-    # deviation from the steady cycle at the same position
     per = machine.period
-
-    def wrap(p):  # the position within the steady cycle
-        return steady.phi[0] + (p - steady.phi[0]) % per
-
-    ref = np.interp(wrap(run.phi), steady.phi, steady.omega)
-    dev = np.abs(run.omega - ref) / steady.omega_mean
-    outside = np.flatnonzero(dev > tol)
+    ref = np.interp(run.phi, steady.phi, steady.omega, period=per)  # at the same position
+    outside = np.flatnonzero(np.abs(run.omega - ref) > tol * steady.omega_mean)
     if outside.size == 0:
         t_steady = float(run.t[0])
     elif outside[-1] == run.t.size - 1:
@@ -279,15 +273,12 @@ def startup(machine: ReducedMachine, t_end: float, *, phi0: float = 0.0, omega0:
         dip = steady.omega_max - steady.omega_min
         phi_dip = steady.phi_at_min
     else:
-        a, b = load_window
-        pa = wrap(a)
-        w_a = float(np.interp(pa, steady.phi, steady.omega))
-        pb = pa + ((b - a) % per) + 0.5 * per  # the minimum may come after the window
-        grid = np.linspace(pa, pb, 721)
-        w = np.interp(wrap(grid), steady.phi, steady.omega)
+        a, b = load_window  # the minimum may come after the window
+        grid = a + np.linspace(0.0, (b - a) % per + 0.5 * per, 721)
+        w = np.interp(grid, steady.phi, steady.omega, period=per)
         k = int(np.argmin(w))
-        dip = w_a - float(w[k])
-        phi_dip = float(wrap(grid[k]))
+        dip = w[0] - w[k]
+        phi_dip = steady.phi[0] + (grid[k] - steady.phi[0]) % per
     msg = "" if t_steady is not None else (f"the speed has not settled within {tol:.3g} of "
                                            f"the steady cycle by t = {t_end:g} s")
     pm = None if run.M_motor is None else float(np.max(run.M_motor))
