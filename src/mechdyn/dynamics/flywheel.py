@@ -13,19 +13,19 @@ FlywheelSizing, size_flywheel
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import IntegrationError, LockupError, ModelError
-from .reduced_machine import ReducedMachine, _frozen
+from .reduced_machine import ReducedMachine, _frozen, _Motion, _Record
 
 __all__ = ["SteadyCycle", "steady_state", "FlywheelSizing", "size_flywheel", "FLYWHEEL_METHODS"]
 
 
 # ============================================================================ steady cycle
 @dataclass(frozen=True)
-class SteadyCycle:
+class SteadyCycle(_Motion):
     """One cycle of the periodic steady motion of a reduced machine.
 
     Attributes
@@ -49,12 +49,6 @@ class SteadyCycle:
         Where the extremes occur, rad.
     """
 
-    phi: np.ndarray
-    t: np.ndarray
-    omega: np.ndarray
-    epsilon: np.ndarray
-    J: np.ndarray
-    M: np.ndarray
     omega_max: float
     omega_min: float
     omega_mean: float
@@ -64,23 +58,11 @@ class SteadyCycle:
     phi_at_max: float
     phi_at_min: float
     extra_inertia: float = 0.0
-    status: str = "success"
-    message: str = ""
-    events: tuple = ()
-    stats: dict = field(default_factory=dict)
 
     @property
     def delta_avg(self) -> float:
         """(omega_max - omega_min) / omega_avg, with the true average speed."""
         return (self.omega_max - self.omega_min) / self.omega_avg
-
-    def to_dataframe(self):
-        """Columns ``phi_deg, t_s, omega_rad_s, epsilon_rad_s2, J_total_kgm2, M_red_Nm``."""
-        import pandas as pd
-
-        return pd.DataFrame({"phi_deg": np.degrees(self.phi), "t_s": self.t,
-                             "omega_rad_s": self.omega, "epsilon_rad_s2": self.epsilon,
-                             "J_total_kgm2": self.J, "M_red_Nm": self.M})
 
 
 class _Cycle:
@@ -320,7 +302,7 @@ def _finish(machine, cyc: _Cycle, w0, t0, iters) -> SteadyCycle:
 
 # ============================================================================ flywheel
 @dataclass(frozen=True)
-class FlywheelSizing:
+class FlywheelSizing(_Record):
     """A flywheel for a target coefficient of speed fluctuation.
 
     Attributes
@@ -371,10 +353,6 @@ class FlywheelSizing:
     delta_without: float | None
     method: str
     cycle: SteadyCycle | None = None
-    status: str = "success"
-    message: str = ""
-    events: tuple = ()
-    stats: dict = field(default_factory=dict)
 
     def to_dataframe(self):
         """One row of the sizing figures with unit-suffixed columns."""

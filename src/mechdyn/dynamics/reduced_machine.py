@@ -16,7 +16,7 @@ from __future__ import annotations
 import bisect
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -40,6 +40,41 @@ def _frozen(a) -> np.ndarray:
     a = np.array(a, dtype=float, copy=True)
     a.setflags(write=False)
     return a
+
+
+@dataclass(frozen=True, kw_only=True)
+class _Record:
+    """The fields every record has: ``status``, ``message``, ``events``, ``stats``."""
+
+    status: str = "success"
+    message: str = ""
+    events: tuple = ()
+    stats: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class _Motion(_Record):
+    """Samples of a motion of the reduced machine (arrays of shape (n,))."""
+
+    t: np.ndarray
+    phi: np.ndarray
+    omega: np.ndarray
+    epsilon: np.ndarray
+    J: np.ndarray
+    M: np.ndarray
+
+    def to_dataframe(self):
+        """Columns ``t_s, phi_deg, phi_rad, omega_rad_s, epsilon_rad_s2, J_total_kgm2,
+        M_red_Nm`` (and ``M_drive_Nm``, ``M_motor_Nm`` of a run)."""
+        import pandas as pd
+
+        cols = {"t_s": self.t, "phi_deg": np.degrees(self.phi), "phi_rad": self.phi,
+                "omega_rad_s": self.omega, "epsilon_rad_s2": self.epsilon,
+                "J_total_kgm2": self.J, "M_red_Nm": self.M}
+        for name in ("M_drive", "M_motor"):
+            if getattr(self, name, None) is not None:
+                cols[f"{name}_Nm"] = getattr(self, name)
+        return pd.DataFrame(cols)
 
 
 def _extra_inertia(value) -> float:

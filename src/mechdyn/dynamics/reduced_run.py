@@ -18,20 +18,20 @@ StartupResult, startup
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import ModelError, Status
 from ..integrate import solve
 from .flywheel import SteadyCycle, steady_state
-from .reduced_machine import ReducedMachine, _frozen
+from .reduced_machine import ReducedMachine, _frozen, _Motion, _Record
 
 __all__ = ["ReducedRun", "run_reduced", "energy_speed", "StartupResult", "startup"]
 
 
 @dataclass(frozen=True)
-class ReducedRun:
+class ReducedRun(_Motion):
     """A time history of the reduced machine.
 
     Attributes
@@ -44,46 +44,16 @@ class ReducedRun:
         Motor-side torque through a gear stage, N m.
     """
 
-    t: np.ndarray
-    phi: np.ndarray
-    omega: np.ndarray
-    epsilon: np.ndarray
-    J: np.ndarray
-    M: np.ndarray
     M_drive: np.ndarray
     M_motor: np.ndarray | None = None
-    status: str = "success"
-    message: str = ""
-    events: tuple = ()
-    stats: dict = field(default_factory=dict)
-
-    def to_dataframe(self):
-        """Columns ``t_s, phi_deg, omega_rad_s, epsilon_rad_s2, J_kgm2, M_red_Nm, ...``."""
-        import pandas as pd
-
-        cols = {"t_s": self.t, "phi_deg": np.degrees(self.phi), "phi_rad": self.phi,
-                "omega_rad_s": self.omega, "epsilon_rad_s2": self.epsilon,
-                "J_total_kgm2": self.J, "M_red_Nm": self.M, "M_drive_Nm": self.M_drive}
-        if self.M_motor is not None:
-            cols["M_motor_Nm"] = self.M_motor
-        return pd.DataFrame(cols)
 
 
 def _history(machine: ReducedMachine, t, phi, omega, **kw) -> ReducedRun:
-    n = t.size
-    J = np.empty(n)
-    M = np.empty(n)
-    eps = np.empty(n)
-    md = np.empty(n)
-    mm = np.empty(n) if machine.drive is not None else None
-    for i in range(n):
-        j, dj = machine.inertia(phi[i])
-        J[i] = j
-        M[i] = machine.torque(t[i], phi[i], omega[i])
-        eps[i] = (M[i] - 0.5 * dj * omega[i] ** 2) / j
-        md[i] = machine.drive_torque(omega[i])
-        if mm is not None:
-            mm[i] = machine.motor_torque(omega[i])
+    J, dJ = np.array([machine.inertia(p) for p in phi], dtype=float).reshape(-1, 2).T
+    M = np.array([machine.torque(*s) for s in zip(t, phi, omega, strict=True)], dtype=float)
+    md = np.array([machine.drive_torque(w) for w in omega], dtype=float)
+    mm = None if machine.drive is None else np.array([machine.motor_torque(w) for w in omega])
+    eps = (M - 0.5 * dJ * omega**2) / J
     return ReducedRun(_frozen(t), _frozen(phi), _frozen(omega), _frozen(eps), _frozen(J),
                       _frozen(M), _frozen(md), None if mm is None else _frozen(mm), **kw)
 
@@ -170,7 +140,7 @@ def energy_speed(machine: ReducedMachine, phi, *, phi0: float = 0.0, omega0: flo
 
 
 @dataclass(frozen=True)
-class StartupResult:
+class StartupResult(_Record):
     """Start-up of a machine from rest by its motor, and its steady regime.
 
     Attributes
@@ -204,10 +174,6 @@ class StartupResult:
     phi_dip: float
     omega_mean: float
     tol: float
-    status: str = "success"
-    message: str = ""
-    events: tuple = ()
-    stats: dict = field(default_factory=dict)
 
     def to_dataframe(self):
         """The run's time history (see :meth:`ReducedRun.to_dataframe`)."""

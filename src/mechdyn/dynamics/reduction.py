@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -40,7 +40,15 @@ from ..model import Model, as_model
 from .flywheel import FlywheelSizing, SteadyCycle, size_flywheel, steady_state
 from .inertia import drive_inertia
 from .reduced_kinematics import _inertia, _ModelEvaluator, reduced_kinematics
-from .reduced_machine import TWO_PI, Member, MemberLoad, ReducedMachine, _extra_inertia, _frozen
+from .reduced_machine import (
+    TWO_PI,
+    Member,
+    MemberLoad,
+    ReducedMachine,
+    _extra_inertia,
+    _frozen,
+    _Record,
+)
 from .reduced_run import ReducedRun, StartupResult, energy_speed, run_reduced, startup
 
 __all__ = ["Reduction", "reduce_model", "ReducedMachine", "Member", "MemberLoad",
@@ -51,7 +59,7 @@ __all__ = ["Reduction", "reduce_model", "ReducedMachine", "Member", "MemberLoad"
 
 # ============================================================================ the table
 @dataclass(frozen=True)
-class Reduction:
+class Reduction(_Record):
     """Reduced quantities of a 1-DOF mechanism over a range of positions.
 
     All arrays have shape (n,) over the positions.  With a link of reduction the
@@ -113,10 +121,6 @@ class Reduction:
     point: tuple | None = None
     m_red: np.ndarray | None = None
     v_ratio: np.ndarray | None = None
-    status: str = "success"
-    message: str = ""
-    events: tuple = ()
-    stats: dict = field(default_factory=dict)
 
     @property
     def J_total(self) -> np.ndarray:
