@@ -427,32 +427,30 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
         raise ModelError(f"method must be one of {', '.join(map(repr, FLYWHEEL_METHODS))}, "
                          f"got {method!r}")
     dependent = machine.speed_dependent(t)
+    base = None
     if omega_mean is None:
         if not dependent:
             raise ModelError("the reduced torque does not depend on the speed, so the machine "
                              "does not choose its steady speed: give omega_mean")
         base = steady_state(machine, omega_guess=omega_guess, phi0=phi0)
         omega_mean = base.omega_mean
-    elif dependent:
-        base = steady_state(machine, omega_guess=omega_mean, phi0=phi0)
-    else:
-        base = steady_state(machine, omega_mean=omega_mean, phi0=phi0)
     wm = float(omega_mean)
     if not wm > 0:
         raise ModelError(f"omega_mean must be > 0 rad/s, got {omega_mean!r}")
+    kw = {"omega_guess": wm} if dependent else {"omega_mean": wm}
+    if base is None:
+        base = steady_state(machine, phi0=phi0, **kw)
     if gear_ratio is None:
         gear_ratio = getattr(machine.drive, "ratio", None)
     ph = phi0 + np.linspace(0.0, machine.period, int(points))
     M = np.array([machine.torque(t, p, wm) for p in ph])
     J = machine.inertia_along(ph)
     imbalance = float(np.mean(M[:-1]))  # mean torque over the cycle (uniform grid)
-    Mb = M - imbalance
-    W = cumulative_simpson(Mb, x=ph, initial=0.0)
+    W = cumulative_simpson(M - imbalance, x=ph, initial=0.0)
     W -= (W[-1] / machine.period) * (ph - ph[0])  # remove the residual quadrature drift
     dE = float(W.max() - W.min())
     jm = float(np.mean(J[:-1]))
-    E2 = (J - jm) * wm * wm / 2.0
-    WI = W - E2
+    WI = W - (J - jm) * wm * wm / 2.0  # less the kinetic energy of the variable part of J
     dE_ref = float(WI.max() - WI.min())
     need = 1.0 / (delta * wm * wm)
     j_basic = dE * need - jm
@@ -466,9 +464,7 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
         msgs.append(f"the machine's own inertia meets delta = {delta:g} (the estimate is "
                     f"{j_fly:.4g} kg m^2): no flywheel is needed")
         j_fly = 0.0
-    cycle = None
-    d_sim = None
-    kw = {"omega_guess": wm} if dependent else {"omega_mean": wm}
+    cycle = d_sim = None
 
     def dsim(jf):
         c = steady_state(machine.with_extra_inertia(jf), phi0=phi0, **kw)

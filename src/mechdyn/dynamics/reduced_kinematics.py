@@ -1,19 +1,12 @@
 """Exact reduced kinematics of a one-degree-of-freedom model (METHOD.md §2).
 
-The velocity analogs of the body frames, ``B = dx/dphi``, and their derivatives
-``b = d2x/dphi2`` (the acceleration bias at unit speed) give the reduced moment
-of inertia ``J_red = B^T M_x B`` (the generalized mass matrix of the 1-DOF
-model) and its exact derivative ``dJ_red/dphi = 2 B^T (M_x b + h)``.
+The velocity analogs ``B = dx/dphi`` and their derivatives ``b = d2x/dphi2`` (the
+acceleration bias at unit speed) give ``J_red = B^T M_x B`` (the generalized mass
+matrix of the 1-DOF model) and ``dJ_red/dphi = 2 B^T (M_x b + h)``.
 
-Public names
-------------
-reduced_kinematics
-    The transmission functions and J_red, dJ_red/dphi of solved poses (batched).
-
-The evaluator ``_ModelEvaluator`` (positions continued along the assembly
-branch by the kinematic sweep, the generalized force of loads and drives) serves
-:func:`~mechdyn.dynamics.reduction.reduce_model` and
-:meth:`~mechdyn.dynamics.reduced_machine.ReducedMachine.from_model`.
+Public name: :func:`reduced_kinematics`.  The private ``_ModelEvaluator`` (positions
+continued along the assembly branch, generalized forces of loads and drives) serves
+:func:`~mechdyn.dynamics.reduction.reduce_model` and ``ReducedMachine.from_model``.
 """
 
 from __future__ import annotations

@@ -14,6 +14,7 @@ ReducedMachine, Member, MemberLoad
 from __future__ import annotations
 
 import bisect
+import copy
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -252,8 +253,7 @@ class ReducedMachine:
 
     def with_extra_inertia(self, added: float) -> ReducedMachine:
         """A copy with ``added`` kg m^2 more on the link (a flywheel)."""
-        new = object.__new__(type(self))
-        new.__dict__.update(self.__dict__)
+        new = copy.copy(self)
         new.extra_inertia = self.extra_inertia + float(added)
         return new
 

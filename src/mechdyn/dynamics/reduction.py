@@ -153,17 +153,14 @@ class Reduction(_Record):
         if self.link is not None:
             cols[f"theta_{self.link}_deg"] = np.degrees(self.link_angle)
             cols["ratio"] = self.ratio
-        cols[f"J_red_{iu}"] = self.J_red
-        cols[f"dJ_red_dphi_{du}" + ("" if ang else "_per_m")] = self.dJ_red_dphi
-        cols[f"J_extra_{iu}"] = self.J_extra
-        cols[f"J_total_{iu}"] = self.J_total
-        cols[f"M_red_{tu}"] = self.M_red
-        cols[f"M_drive_{tu}"] = self.M_drive
-        cols[f"M_forces_{tu}"] = self.M_forces
-        cols["omega_rad_s" if ang else "v_m_s"] = self.omega
+        cols.update({f"J_red_{iu}": self.J_red,
+                     f"dJ_red_dphi_{du}" + ("" if ang else "_per_m"): self.dJ_red_dphi,
+                     f"J_extra_{iu}": self.J_extra, f"J_total_{iu}": self.J_total,
+                     f"M_red_{tu}": self.M_red, f"M_drive_{tu}": self.M_drive,
+                     f"M_forces_{tu}": self.M_forces,
+                     "omega_rad_s" if ang else "v_m_s": self.omega})
         if self.m_red is not None:
-            cols["m_red_kg"] = self.m_red
-            cols["v_ratio_m_rad"] = self.v_ratio
+            cols.update({"m_red_kg": self.m_red, "v_ratio_m_rad": self.v_ratio})
         return pd.DataFrame(cols)
 
     def machine(self, model: Model | None = None, **kwargs) -> ReducedMachine:
