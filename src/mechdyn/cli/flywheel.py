@@ -19,13 +19,13 @@ Exit codes: 0 done; 1 the simulated delta misses the target by more than 5 %;
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 from ..dynamics.flywheel import size_flywheel
 from ..dynamics.reduced_machine import ReducedMachine
 from ..dynamics.reduction import reduce_model
 from ..errors import ModelError
 from ..results.plot_reduction import plot_steady_cycle
+from ..results.table import write_csv
 from ..units import parse_quantity
 from .reduce import add_model_arguments, prepare_model
 
@@ -110,10 +110,7 @@ def run(args) -> int:
         print(f"  steady cycle          omega {c.omega_min:.6g} .. {c.omega_max:.6g} rad/s, "
               f"cycle time {c.cycle_time:.6g} s")
         if args.output:
-            out = Path(args.output)
-            out.parent.mkdir(parents=True, exist_ok=True)
-            c.to_dataframe().to_csv(out, index=False, float_format="%.10g")
-            print(f"  table: {out}")
+            print(f"  table: {write_csv(c, args.output)}")
         if args.plot:
             print(f"  plot: {plot_steady_cycle(c, args.plot)}")
     if fs.message:

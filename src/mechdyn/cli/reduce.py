@@ -13,7 +13,6 @@ reduction that stops); 2 bad input (one line on stderr).
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import numpy as np
 
@@ -21,6 +20,7 @@ from ..dynamics.reduction import mode_mechanism, reduce_model
 from ..errors import ModelError
 from ..modelfile.drives import drive_from_table
 from ..results.plot_reduction import plot_reduction
+from ..results.table import write_csv
 from ..units import parse_quantity, parse_vector
 from .kinematics import load_model
 
@@ -142,10 +142,7 @@ def run(args) -> int:
             print(f"  m_red at {args.point}: min {np.min(red.m_red[fin]):.6g}  max "
                   f"{np.max(red.m_red[fin]):.6g} kg")
     if args.output:
-        out = Path(args.output)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        red.to_dataframe().to_csv(out, index=False, float_format="%.10g")
-        print(f"  table: {out}")
+        print(f"  table: {write_csv(red, args.output)}")
     if args.plot:
         print(f"  plot: {plot_reduction(red, args.plot, title=f'{mech.name}: reduction')}")
     if red.status != "success":
