@@ -395,43 +395,34 @@ def _single_drive(model: Model, coordinate: str):
 
 
 class _SpeedDrives:
-    """The drives on one coordinate as one ``torque_at(omega)`` (constants, characteristics)."""
+    """The drives on one coordinate as one ``torque_at(omega)``: a sum of functions of omega."""
 
     def __init__(self, parts):
-        self.parts = list(parts)
+        self.parts = parts
 
     def torque_at(self, omega):
-        tot = 0.0
-        for p in self.parts:
-            if hasattr(p, "torque_at"):
-                tot += float(p.torque_at(omega))
-            elif callable(p):
-                tot += float(p(omega))
-            else:
-                tot += float(p)
-        return tot
+        return sum(float(p(omega)) for p in self.parts)
 
 
 def _speed_drive(model: Model, coordinate: str):
     """The drives of a coordinate as a function of its speed only (None without drives)."""
+    drives = [d for d in model.mechanism.drives if d.coordinate == coordinate]
     parts = []
-    for d in model.mechanism.drives:
-        if d.coordinate != coordinate:
-            continue
+    for d in drives:
         tq = d.torque
-        if hasattr(tq, "torque_at") or isinstance(tq, TorqueSpeedCurve):
+        if hasattr(tq, "torque_at"):
+            parts.append(tq.torque_at)
+        elif isinstance(tq, TorqueSpeedCurve):
             parts.append(tq)
         elif isinstance(tq, Table) or callable(tq):
             raise ModelError(f"drive {d.name!r}: its torque depends on more than the speed of "
                              f"{coordinate!r}; use the exact machine "
                              f"(ReducedMachine.from_model, or --exact on the command line)")
         else:
-            parts.append(float(tq))
-    if not parts:
-        return None
-    if len(parts) == 1 and hasattr(parts[0], "torque_at"):
-        return parts[0]
-    return _SpeedDrives(parts)
+            parts.append(lambda omega, v=float(tq): v)
+    if len(drives) == 1 and hasattr(drives[0].torque, "torque_at"):
+        return drives[0].torque
+    return _SpeedDrives(parts) if parts else None
 
 
 def _nominal(drive) -> float | None:

@@ -119,23 +119,19 @@ def energy_speed(machine: ReducedMachine, phi, *, phi0: float = 0.0, omega0: flo
     phi = np.asarray(phi, dtype=float).reshape(-1)
     j0, _ = machine.inertia(phi0)
     out = np.empty_like(phi)
-    for sign in (1.0, -1.0):
-        sel = (phi >= phi0) if sign > 0 else (phi < phi0)
-        if not np.any(sel):
-            continue
+    for sel in (phi >= phi0, phi < phi0):  # each side of phi0 from phi0 on
         target = phi[sel]
-        end = target.max() if sign > 0 else target.min()
-        if end == phi0:
-            w = np.zeros(target.size)
-        else:
+        end = target[np.argmax(np.abs(target - phi0))] if target.size else phi0
+        w = np.zeros(target.size)
+        if end != phi0:
             sol = solve_ivp(lambda p, y: [machine.torque(t, p, omega0)], (phi0, end), [0.0],
                             method="DOP853", rtol=rtol, atol=1e-12 * max(1.0, j0 * omega0**2),
                             dense_output=True)
             w = sol.sol(target)[0]
-        jt = machine.inertia_along(target)
         e2 = j0 * omega0**2 + 2.0 * w
         with np.errstate(invalid="ignore"):
-            out[sel] = np.where(e2 >= 0, np.sqrt(np.maximum(e2, 0) / jt), np.nan)
+            out[sel] = np.where(e2 >= 0, np.sqrt(np.maximum(e2, 0) / machine.inertia_along(target)),
+                                np.nan)
     return out
 
 
