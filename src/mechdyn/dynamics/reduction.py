@@ -132,6 +132,12 @@ class Reduction(_Record):
         """The position variable of the link of reduction: the link angle, or phi."""
         return self.phi if self.link_angle is None else self.link_angle
 
+    def work(self) -> np.ndarray:
+        """Work of M_red from the first position, integral M_red d(position), J (trapezoid)."""
+        from scipy.integrate import cumulative_trapezoid
+
+        return cumulative_trapezoid(self.M_red, self.position, initial=0.0)
+
     def to_dataframe(self):
         """The table with unit-suffixed columns (``phi_deg``, ``J_red_kgm2``, ``M_red_Nm`` ...)."""
         import pandas as pd
