@@ -193,12 +193,11 @@ class ReducedMachine:
     def __init__(self, inertia: Callable, torque: Callable, *, extra_inertia: float = 0.0,
                  drive=None, period: float = TWO_PI, name: str = "machine",
                  coordinate: str = "phi", nominal_speed: float | None = None):
-        ej = _extra_inertia(extra_inertia)
         if not (math.isfinite(float(period)) and period > 0):
             raise ModelError(f"period must be > 0 rad, got {period!r}")
         self._inertia = inertia
         self._torque = torque
-        self.extra_inertia = ej
+        self.extra_inertia = _extra_inertia(extra_inertia)
         self.drive = drive
         self.period = float(period)
         self.name = name

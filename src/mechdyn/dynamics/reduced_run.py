@@ -225,12 +225,8 @@ def startup(machine: ReducedMachine, t_end: float, *, phi0: float = 0.0, omega0:
     per = machine.period
     ref = np.interp(run.phi, steady.phi, steady.omega, period=per)  # at the same position
     outside = np.flatnonzero(np.abs(run.omega - ref) > tol * steady.omega_mean)
-    if outside.size == 0:
-        t_steady = float(run.t[0])
-    elif outside[-1] == run.t.size - 1:
-        t_steady = None
-    else:
-        t_steady = float(run.t[outside[-1] + 1])
+    k = outside[-1] + 1 if outside.size else 0  # the first sample after the last one outside
+    t_steady = float(run.t[k]) if k < run.t.size else None
     if load_window is None:
         dip = steady.omega_max - steady.omega_min
         phi_dip = steady.phi_at_min
