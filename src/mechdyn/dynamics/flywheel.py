@@ -115,11 +115,6 @@ class _Cycle:
         return math.sqrt(2.0 * e / self.m.inertia(ph[-1])[0]), E, T, M
 
 
-def _omega_of(machine, phi, E):
-    J = machine.inertia_along(phi)
-    return np.sqrt(2.0 * np.maximum(E, 0.0) / J), J
-
-
 def steady_state(machine: ReducedMachine, *, omega_guess: float | None = None,
                  omega_mean: float | None = None, phi0: float = 0.0, t0: float = 0.0,
                  steps: int = 720, tol: float = 1e-10, max_iter: int = 60) -> SteadyCycle:
@@ -184,7 +179,8 @@ def steady_state(machine: ReducedMachine, *, omega_guess: float | None = None,
             raise ModelError(f"omega_mean must be > 0 rad/s, got {omega_mean!r}")
 
         def mean_err(w0):
-            om, _ = _omega_of(machine, cyc.phi, cyc.run(w0, t0)[1])
+            E = cyc.run(w0, t0)[1]
+            om = np.sqrt(2.0 * np.maximum(E, 0.0) / machine.inertia_along(cyc.phi))
             return 0.5 * (om.max() + om.min()) - target
 
         lo = hi = target
@@ -270,8 +266,8 @@ def _finish(machine, cyc: _Cycle, w0, t0, iters) -> SteadyCycle:
 
     _, E, T, M = cyc.run(w0, t0)
     ph = cyc.phi
-    om, J = _omega_of(machine, ph, E)
-    dJ = np.array([machine.inertia(p)[1] for p in ph])
+    J, dJ = np.array([machine.inertia(p) for p in ph]).T
+    om = np.sqrt(2.0 * np.maximum(E, 0.0) / J)
     eps = (M - 0.5 * dJ * om**2) / J
     energy = CubicHermiteSpline(ph, E, M)  # E between the samples (dE/dphi = M)
 
