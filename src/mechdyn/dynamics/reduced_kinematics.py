@@ -17,7 +17,6 @@ import numpy as np
 
 from ..errors import ModelError, did_you_mean
 from ..kinematics.analogs import acceleration_bias, velocity_analogs
-from ..kinematics.assembly import assemble
 from ..kinematics.constraints import _perp, full_jacobian
 from ..kinematics.sweep import analyze, sweep
 from ..model import Model, as_model
@@ -86,11 +85,7 @@ class _ModelEvaluator:
         self.coordinate = model.coordinate_names[0]
         self.is_angle = bool(model.coord_is_angle[0])
         self.forces = force_model(model)
-        if x0 is None:
-            x0 = getattr(model, "x0", None)
-            if x0 is None:
-                x0 = assemble(model, layout=model.layout(mode))
-        self.x_last = np.array(x0, dtype=float)
+        self.x_last = None if x0 is None else np.array(x0, dtype=float)  # None: the sketch
         self.max_step = math.radians(5.0) if self.is_angle else 0.05 * model.length_scale
         self._last = None  # (phi, x, B, b, J, dJ) of the last position
 
