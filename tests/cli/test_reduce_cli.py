@@ -3,10 +3,10 @@
 import math
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from mechdyn.cli import main
+from mechdyn.results.table import read_csv
 
 PRESS = ["clutchless_press", "--engage", "rocker_lock=0mm,0mm,0deg", "--drop", "psi"]
 
@@ -32,7 +32,7 @@ def test_reduce_writes_a_table_with_units_and_a_plot(tmp_path, capsys):
     out = capsys.readouterr().out
     assert rc == 0
     assert "reduction to coordinate 'phi', 73 positions" in out and "J_red" in out
-    df = pd.read_csv(csv)
+    df = read_csv(csv)
     assert len(df) == 73
     for col in ("phi_deg", "J_red_kgm2", "dJ_red_dphi_kgm2", "M_red_Nm", "M_drive_Nm",
                 "M_forces_Nm", "m_red_kg"):
@@ -51,7 +51,7 @@ def test_reduce_to_a_link(tmp_path, capsys):
     err = capsys.readouterr().err
     assert rc == 1  # the rod stops at phi = 90 and 270 deg: J_red infinite there
     assert "vanishes" in err
-    df = pd.read_csv(csv)
+    df = read_csv(csv)
     assert {"theta_rod_deg", "ratio"} <= set(df.columns)
 
 
@@ -79,7 +79,7 @@ def test_flywheel_for_the_press(tmp_path, capsys):
     j_motor = float(out.split("J_fly on the motor")[1].split()[0])
     assert j_motor == pytest.approx(j_crank / 3.4**2, rel=1e-5)
     assert png.read_bytes()[:4] == b"\x89PNG"
-    assert "omega_rad_s" in pd.read_csv(csv).columns
+    assert "omega_rad_s" in read_csv(csv).columns
 
 
 def test_flywheel_with_constant_torque_needs_the_speed(tmp_path, capsys):

@@ -19,13 +19,13 @@ Exit codes: 0 done; 1 the simulated delta misses the target by more than 5 %;
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 from ..dynamics.flywheel import size_flywheel
 from ..dynamics.reduced_machine import ReducedMachine
 from ..dynamics.reduction import reduce_model
 from ..errors import ModelError
 from ..results.plot_reduction import plot_steady_cycle
+from ..results.table import write_csv
 from ..units import parse_quantity
 from .reduce import add_model_arguments, prepare_model
 
@@ -82,10 +82,8 @@ def run(args) -> int:
         raise ModelError("the driving torque does not depend on the speed, so the steady "
                          "speed is not determined by the machine: give the mean speed with "
                          "--speed (e.g. --speed 43.5rad/s)")
-    if dependent:
-        fs = size_flywheel(machine, delta, omega_guess=speed, method=args.method)
-    else:
-        fs = size_flywheel(machine, delta, omega_mean=speed, method=args.method)
+    speed_kw = "omega_guess" if dependent else "omega_mean"  # a motor picks its own speed
+    fs = size_flywheel(machine, delta, method=args.method, **{speed_kw: speed})
     rpm = 30.0 / 3.141592653589793
     print(f"{mech.name}: flywheel for delta = {delta:.4g} ({args.method} method)")
     print(f"  mean speed            {fs.omega_mean:.6g} rad/s = {fs.omega_mean * rpm:.6g} rpm")
@@ -112,10 +110,7 @@ def run(args) -> int:
         print(f"  steady cycle          omega {c.omega_min:.6g} .. {c.omega_max:.6g} rad/s, "
               f"cycle time {c.cycle_time:.6g} s")
         if args.output:
-            out = Path(args.output)
-            out.parent.mkdir(parents=True, exist_ok=True)
-            c.to_dataframe().to_csv(out, index=False, float_format="%.10g")
-            print(f"  table: {out}")
+            print(f"  table: {write_csv(c, args.output)}")
         if args.plot:
             print(f"  plot: {plot_steady_cycle(c, args.plot)}")
     if fs.message:

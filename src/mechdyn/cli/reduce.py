@@ -13,16 +13,15 @@ reduction that stops); 2 bad input (one line on stderr).
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import numpy as np
 
-from ..dynamics.reduced_machine import mode_mechanism
-from ..dynamics.reduction import reduce_model
+from ..dynamics.reduction import mode_mechanism, reduce_model
 from ..errors import ModelError
 from ..modelfile.drives import drive_from_table
 from ..results.plot_reduction import plot_reduction
-from ..units import parse_quantity
+from ..results.table import write_csv
+from ..units import parse_quantity, parse_vector
 from .kinematics import load_model
 
 __all__ = ["register", "run", "add_model_arguments", "prepare_model"]
@@ -59,9 +58,8 @@ def prepare_model(args):
             if len(parts) != 3:
                 raise ModelError(f"--engage {spec!r}: give the pose as X,Y,THETA, e.g. "
                                  f"{name}=0mm,0mm,0deg")
-            offsets[name] = (parse_quantity(parts[0], "length", where="--engage x"),
-                             parse_quantity(parts[1], "length", where="--engage y"),
-                             parse_quantity(parts[2], "angle", where="--engage theta"))
+            offsets[name] = parse_vector(parts, ("length", "length", "angle"),
+                                         where=f"--engage {name}")
     if engage or args.drop:
         mech = mode_mechanism(mech, engage=engage, offsets=offsets, drop=args.drop)
     if args.motor is None and (args.gear_ratio is not None or args.efficiency is not None):
@@ -144,10 +142,7 @@ def run(args) -> int:
             print(f"  m_red at {args.point}: min {np.min(red.m_red[fin]):.6g}  max "
                   f"{np.max(red.m_red[fin]):.6g} kg")
     if args.output:
-        out = Path(args.output)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        red.to_dataframe().to_csv(out, index=False, float_format="%.10g")
-        print(f"  table: {out}")
+        print(f"  table: {write_csv(red, args.output)}")
     if args.plot:
         print(f"  plot: {plot_reduction(red, args.plot, title=f'{mech.name}: reduction')}")
     if red.status != "success":

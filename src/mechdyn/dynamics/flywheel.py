@@ -13,20 +13,19 @@ FlywheelSizing, size_flywheel
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import IntegrationError, LockupError, ModelError
-from .reduced_machine import ReducedMachine
-from .reduced_run import _frozen
+from .reduced_machine import ReducedMachine, _frozen, _Motion, _Record
 
 __all__ = ["SteadyCycle", "steady_state", "FlywheelSizing", "size_flywheel", "FLYWHEEL_METHODS"]
 
 
 # ============================================================================ steady cycle
 @dataclass(frozen=True)
-class SteadyCycle:
+class SteadyCycle(_Motion):
     """One cycle of the periodic steady motion of a reduced machine.
 
     Attributes
@@ -50,12 +49,6 @@ class SteadyCycle:
         Where the extremes occur, rad.
     """
 
-    phi: np.ndarray
-    t: np.ndarray
-    omega: np.ndarray
-    epsilon: np.ndarray
-    J: np.ndarray
-    M: np.ndarray
     omega_max: float
     omega_min: float
     omega_mean: float
@@ -65,23 +58,11 @@ class SteadyCycle:
     phi_at_max: float
     phi_at_min: float
     extra_inertia: float = 0.0
-    status: str = "success"
-    message: str = ""
-    events: tuple = ()
-    stats: dict = field(default_factory=dict)
 
     @property
     def delta_avg(self) -> float:
         """(omega_max - omega_min) / omega_avg, with the true average speed."""
         return (self.omega_max - self.omega_min) / self.omega_avg
-
-    def to_dataframe(self):
-        """Columns ``phi_deg, t_s, omega_rad_s, epsilon_rad_s2, J_total_kgm2, M_red_Nm``."""
-        import pandas as pd
-
-        return pd.DataFrame({"phi_deg": np.degrees(self.phi), "t_s": self.t,
-                             "omega_rad_s": self.omega, "epsilon_rad_s2": self.epsilon,
-                             "J_total_kgm2": self.J, "M_red_Nm": self.M})
 
 
 class _Cycle:
@@ -95,9 +76,8 @@ class _Cycle:
 
     def __init__(self, machine: ReducedMachine, phi0: float, steps: int):
         self.m = machine
-        self.phi0 = float(phi0)
         self.steps = int(steps)
-        self.phi = self.phi0 + np.linspace(0.0, machine.period, self.steps + 1)
+        self.phi = float(phi0) + np.linspace(0.0, machine.period, self.steps + 1)
         self.h = machine.period / self.steps
         self.evaluations = 0
 
@@ -112,41 +92,27 @@ class _Cycle:
         w = math.sqrt(2.0 * e / j)
         return self.m.torque(t, p, w), 1.0 / w
 
-    def run(self, omega0: float, t0: float = 0.0, record: bool = False):
-        """Integrate one cycle from speed ``omega0``; returns (omega_end, t_end, record)."""
+    def run(self, omega0: float, t0: float = 0.0):
+        """Integrate one cycle from speed ``omega0``: (omega_end, E, t, M on the grid)."""
         if not (math.isfinite(omega0) and omega0 > 0):
             raise IntegrationError(f"cycle start speed must be > 0 rad/s, got {omega0!r}")
-        m, h, ph = self.m, self.h, self.phi
-        e = 0.5 * m.inertia(ph[0])[0] * omega0 * omega0
+        h, ph, f = self.h, self.phi, self._f
+        E, T, M = np.empty(ph.size), np.empty(ph.size), np.empty(ph.size)
+        e = 0.5 * self.m.inertia(ph[0])[0] * omega0 * omega0
         floor = 1e-10 * e
         t = float(t0)
-        f = self._f
-        if record:
-            E = np.empty(self.steps + 1)
-            T = np.empty(self.steps + 1)
-            M = np.empty(self.steps + 1)
         for k in range(self.steps):
             p = ph[k]
             m1, r1 = f(p, e, t, floor)
-            if record:
-                E[k], T[k], M[k] = e, t, m1
+            E[k], T[k], M[k] = e, t, m1
             m2, r2 = f(p + 0.5 * h, e + 0.5 * h * m1, t + 0.5 * h * r1, floor)
             m3, r3 = f(p + 0.5 * h, e + 0.5 * h * m2, t + 0.5 * h * r2, floor)
             m4, r4 = f(ph[k + 1], e + h * m3, t + h * r3, floor)
             e += h * (m1 + 2.0 * m2 + 2.0 * m3 + m4) / 6.0
             t += h * (r1 + 2.0 * r2 + 2.0 * r3 + r4) / 6.0
-        mend, _ = f(ph[-1], e, t, floor)
-        w1 = math.sqrt(2.0 * e / m.inertia(ph[-1])[0])
-        rec = None
-        if record:
-            E[-1], T[-1], M[-1] = e, t, mend
-            rec = (E, T, M)
-        return w1, t, rec
-
-
-def _omega_of(machine, phi, E):
-    J = machine.inertia_along(phi)
-    return np.sqrt(2.0 * np.maximum(E, 0.0) / J), J
+        E[-1], T[-1] = e, t
+        M[-1], _ = f(ph[-1], e, t, floor)
+        return math.sqrt(2.0 * e / self.m.inertia(ph[-1])[0]), E, T, M
 
 
 def steady_state(machine: ReducedMachine, *, omega_guess: float | None = None,
@@ -204,7 +170,7 @@ def steady_state(machine: ReducedMachine, *, omega_guess: float | None = None,
     def g(w0):
         nonlocal iters
         iters += 1
-        w1, _, _ = cyc.run(w0, t0)
+        w1 = cyc.run(w0, t0)[0]
         return w1 - w0, w1
 
     if omega_mean is not None:
@@ -213,28 +179,25 @@ def steady_state(machine: ReducedMachine, *, omega_guess: float | None = None,
             raise ModelError(f"omega_mean must be > 0 rad/s, got {omega_mean!r}")
 
         def mean_err(w0):
-            _, _, (E, _, _) = cyc.run(w0, t0, record=True)
-            om, _ = _omega_of(machine, cyc.phi, E)
+            E = cyc.run(w0, t0)[1]
+            om = np.sqrt(2.0 * np.maximum(E, 0.0) / machine.inertia_along(cyc.phi))
             return 0.5 * (om.max() + om.min()) - target
 
         lo = hi = target
         flo = mean_err(lo)
-        if flo == 0:
-            w0 = lo
+        step = 1.05 if flo < 0 else 1 / 1.05
+        for _ in range(200):
+            hi = hi * step
+            try:
+                fhi = mean_err(hi)
+            except LockupError:
+                continue
+            if np.sign(fhi) != np.sign(flo):
+                break
         else:
-            step = 1.05 if flo < 0 else 1 / 1.05
-            for _ in range(200):
-                hi = hi * step
-                try:
-                    fhi = mean_err(hi)
-                except LockupError:
-                    continue
-                if np.sign(fhi) != np.sign(flo):
-                    break
-            else:
-                raise IntegrationError(f"no cycle with mean speed {target:.6g} rad/s found")
-            w0 = brentq(mean_err, min(lo, hi), max(lo, hi), xtol=1e-13 * target,
-                        rtol=4 * np.finfo(float).eps)
+            raise IntegrationError(f"no cycle with mean speed {target:.6g} rad/s found")
+        w0 = brentq(mean_err, min(lo, hi), max(lo, hi), xtol=1e-13 * target,
+                    rtol=4 * np.finfo(float).eps)
         err, _ = g(w0)
         if abs(err) > max(tol, 1e-8) * w0:
             raise IntegrationError(
@@ -291,52 +254,38 @@ def _balance_speed(machine: ReducedMachine, t0: float, phi0: float) -> float:
     vals = np.array([mean_torque(w) for w in ws])
     tol = 1e-9 * max(float(np.max(np.abs(vals))), 1e-300)
     for k in range(len(ws) - 1):
-        if vals[k] > tol and vals[k + 1] <= tol:
-            lo, hi = ws[k], ws[k + 1]
-            if vals[k + 1] < -tol:
-                return brentq(mean_torque, lo, hi, rtol=1e-10)
-            for _ in range(80):  # the torque vanishes from some speed on: its first zero
-                mid = 0.5 * (lo + hi)
-                if mean_torque(mid) > tol:
-                    lo = mid
-                else:
-                    hi = mid
-            return hi
+        if vals[k] > tol and vals[k + 1] <= tol:  # the first speed where it vanishes
+            return brentq(lambda w: mean_torque(w) - tol, ws[k], ws[k + 1], rtol=1e-10)
     raise ModelError("steady_state needs omega_guess (rad/s): no speed between 0.01 and 1e5 "
                      "rad/s balances the mean torque over a cycle")
 
 
 def _finish(machine, cyc: _Cycle, w0, t0, iters) -> SteadyCycle:
+    from scipy.interpolate import CubicHermiteSpline
     from scipy.optimize import minimize_scalar
 
-    _, t1, (E, T, M) = cyc.run(w0, t0, record=True)
+    _, E, T, M = cyc.run(w0, t0)
     ph = cyc.phi
-    om, J = _omega_of(machine, ph, E)
-    dJ = np.array([machine.inertia(p)[1] for p in ph])
+    J, dJ = np.array([machine.inertia(p) for p in ph]).T
+    om = np.sqrt(2.0 * np.maximum(E, 0.0) / J)
     eps = (M - 0.5 * dJ * om**2) / J
-    h = cyc.h
+    energy = CubicHermiteSpline(ph, E, M)  # E between the samples (dE/dphi = M)
 
-    # refine the extremes between the samples: cubic Hermite of E (dE/dphi = M)
-    def speed(p, k):
-        u = (p - ph[k]) / h
-        h00, h10 = 2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u
-        h01, h11 = -2 * u**3 + 3 * u**2, u**3 - u**2
-        e = h00 * E[k] + h10 * h * M[k] + h01 * E[k + 1] + h11 * h * M[k + 1]
-        return math.sqrt(2.0 * max(e, 0.0) / machine.inertia(p)[0])
+    def speed(p):
+        return math.sqrt(2.0 * max(float(energy(p)), 0.0) / machine.inertia(p)[0])
 
-    ext = []
+    ext = []  # the extremes refined between the samples
     for k0, sign in ((int(np.argmax(om)), -1.0), (int(np.argmin(om)), 1.0)):
         best = (sign * om[k0], ph[k0])
         for k in (k0 - 1, k0):
             if 0 <= k < cyc.steps:
-                r = minimize_scalar(lambda p, k=k, s=sign: s * speed(p, k),
-                                    bounds=(ph[k], ph[k + 1]), method="bounded",
-                                    options={"xatol": 1e-12})
+                r = minimize_scalar(lambda p, s=sign: s * speed(p), bounds=(ph[k], ph[k + 1]),
+                                    method="bounded", options={"xatol": 1e-12})
                 best = min(best, (float(r.fun), float(r.x)))
         ext.append((sign * best[0], best[1]))
     (wmax, pmax), (wmin, pmin) = ext
     wmean = 0.5 * (wmax + wmin)
-    T_cyc = t1 - t0
+    T_cyc = T[-1] - t0
     return SteadyCycle(
         phi=_frozen(ph), t=_frozen(T - t0), omega=_frozen(om), epsilon=_frozen(eps),
         J=_frozen(J), M=_frozen(M), omega_max=float(wmax), omega_min=float(wmin),
@@ -349,7 +298,7 @@ def _finish(machine, cyc: _Cycle, w0, t0, iters) -> SteadyCycle:
 
 # ============================================================================ flywheel
 @dataclass(frozen=True)
-class FlywheelSizing:
+class FlywheelSizing(_Record):
     """A flywheel for a target coefficient of speed fluctuation.
 
     Attributes
@@ -400,10 +349,6 @@ class FlywheelSizing:
     delta_without: float | None
     method: str
     cycle: SteadyCycle | None = None
-    status: str = "success"
-    message: str = ""
-    events: tuple = ()
-    stats: dict = field(default_factory=dict)
 
     def to_dataframe(self):
         """One row of the sizing figures with unit-suffixed columns."""
@@ -478,32 +423,30 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
         raise ModelError(f"method must be one of {', '.join(map(repr, FLYWHEEL_METHODS))}, "
                          f"got {method!r}")
     dependent = machine.speed_dependent(t)
+    base = None
     if omega_mean is None:
         if not dependent:
             raise ModelError("the reduced torque does not depend on the speed, so the machine "
                              "does not choose its steady speed: give omega_mean")
         base = steady_state(machine, omega_guess=omega_guess, phi0=phi0)
         omega_mean = base.omega_mean
-    elif dependent:
-        base = steady_state(machine, omega_guess=omega_mean, phi0=phi0)
-    else:
-        base = steady_state(machine, omega_mean=omega_mean, phi0=phi0)
     wm = float(omega_mean)
     if not wm > 0:
         raise ModelError(f"omega_mean must be > 0 rad/s, got {omega_mean!r}")
+    kw = {"omega_guess": wm} if dependent else {"omega_mean": wm}
+    if base is None:
+        base = steady_state(machine, phi0=phi0, **kw)
     if gear_ratio is None:
         gear_ratio = getattr(machine.drive, "ratio", None)
     ph = phi0 + np.linspace(0.0, machine.period, int(points))
     M = np.array([machine.torque(t, p, wm) for p in ph])
     J = machine.inertia_along(ph)
     imbalance = float(np.mean(M[:-1]))  # mean torque over the cycle (uniform grid)
-    Mb = M - imbalance
-    W = cumulative_simpson(Mb, x=ph, initial=0.0)
+    W = cumulative_simpson(M - imbalance, x=ph, initial=0.0)
     W -= (W[-1] / machine.period) * (ph - ph[0])  # remove the residual quadrature drift
     dE = float(W.max() - W.min())
     jm = float(np.mean(J[:-1]))
-    E2 = (J - jm) * wm * wm / 2.0
-    WI = W - E2
+    WI = W - (J - jm) * wm * wm / 2.0  # less the kinetic energy of the variable part of J
     dE_ref = float(WI.max() - WI.min())
     need = 1.0 / (delta * wm * wm)
     j_basic = dE * need - jm
@@ -517,9 +460,7 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
         msgs.append(f"the machine's own inertia meets delta = {delta:g} (the estimate is "
                     f"{j_fly:.4g} kg m^2): no flywheel is needed")
         j_fly = 0.0
-    cycle = None
-    d_sim = None
-    kw = {"omega_guess": wm} if dependent else {"omega_mean": wm}
+    cycle = d_sim = None
 
     def dsim(jf):
         c = steady_state(machine.with_extra_inertia(jf), phi0=phi0, **kw)

@@ -1,10 +1,7 @@
-"""The reduced 1-DOF machine and its equation of motion (lecture notes eq. 7.12).
+"""The reduced 1-DOF machine (lecture notes eq. 7.12).
 
 ``J(phi) domega/dt + 1/2 omega^2 dJ/dphi = M_red(phi, omega, t)`` with
-``J = J_red + J_extra`` (rotor and gears reduced to the link, flywheel).  Since
-``d(J omega^2 / 2) / dphi = M_red``, the *energy form* ``J omega^2 / 2 =
-J_0 omega_0^2 / 2 + integral M_red dphi`` holds when M_red depends on the
-position only.
+``J = J_red + J_extra`` (rotor and gears reduced to the link, flywheel).
 
 Public names
 ------------
@@ -12,21 +9,15 @@ ReducedMachine, Member, MemberLoad
     The reduced machine: from a model, from a :class:`~mechdyn.dynamics.reduction.Reduction`
     table, from a transmission of velocity ratios (belt drives, gear trains), or
     from plain functions.
-ReducedRun, run_reduced, energy_speed
-    Time integration of the reduced equation (with :mod:`mechdyn.integrate`) and
-    the energy form; defined in :mod:`mechdyn.dynamics.reduced_run`.
-mode_mechanism
-    A variable-structure mechanism in one mode (locks engaged, frozen
-    coordinates dropped), e.g. the press in its 1-DOF working mode; defined in
-    :mod:`mechdyn.dynamics.mode_mechanism`.
 """
 
 from __future__ import annotations
 
 import bisect
+import copy
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -35,17 +26,56 @@ from ..errors import IntegrationError, ModelError
 from ..mechanism.drive import TorqueSpeedCurve
 from ..mechanism.load import Table
 from ..model import Model, as_model
-from .mode_mechanism import mode_mechanism
+from .inertia import drive_inertia
 from .reduced_kinematics import _ModelEvaluator
-from .reduced_run import ReducedRun, energy_speed, run_reduced
 
 if TYPE_CHECKING:
     from .reduction import Reduction
 
-__all__ = ["ReducedMachine", "Member", "MemberLoad", "ReducedRun", "run_reduced",
-           "energy_speed", "mode_mechanism"]
+__all__ = ["ReducedMachine", "Member", "MemberLoad"]
 
 TWO_PI = 2.0 * math.pi
+
+
+def _frozen(a) -> np.ndarray:
+    a = np.array(a, dtype=float, copy=True)
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True, kw_only=True)
+class _Record:
+    """The fields every record has: ``status``, ``message``, ``events``, ``stats``."""
+
+    status: str = "success"
+    message: str = ""
+    events: tuple = ()
+    stats: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class _Motion(_Record):
+    """Samples of a motion of the reduced machine (arrays of shape (n,))."""
+
+    t: np.ndarray
+    phi: np.ndarray
+    omega: np.ndarray
+    epsilon: np.ndarray
+    J: np.ndarray
+    M: np.ndarray
+
+    def to_dataframe(self):
+        """Columns ``t_s, phi_deg, phi_rad, omega_rad_s, epsilon_rad_s2, J_total_kgm2,
+        M_red_Nm`` (and ``M_drive_Nm``, ``M_motor_Nm`` of a run)."""
+        import pandas as pd
+
+        cols = {"t_s": self.t, "phi_deg": np.degrees(self.phi), "phi_rad": self.phi,
+                "omega_rad_s": self.omega, "epsilon_rad_s2": self.epsilon,
+                "J_total_kgm2": self.J, "M_red_Nm": self.M}
+        for name in ("M_drive", "M_motor"):
+            if getattr(self, name, None) is not None:
+                cols[f"{name}_Nm"] = getattr(self, name)
+        return pd.DataFrame(cols)
 
 
 def _extra_inertia(value) -> float:
@@ -145,7 +175,7 @@ class ReducedMachine:
     drive : object, optional
         The drive on the link (an object with ``torque_at``; a
         :class:`~mechdyn.mechanism.motors.GearStage` also gives the motor-side
-        torque in :func:`~mechdyn.dynamics.startup.startup`).  Informational: its
+        torque in :func:`~mechdyn.dynamics.reduced_run.startup`).  Informational: its
         torque must already be part of ``torque``.
     period : float
         Angle of one cycle, rad (2 pi for a crank).
@@ -163,12 +193,11 @@ class ReducedMachine:
     def __init__(self, inertia: Callable, torque: Callable, *, extra_inertia: float = 0.0,
                  drive=None, period: float = TWO_PI, name: str = "machine",
                  coordinate: str = "phi", nominal_speed: float | None = None):
-        ej = _extra_inertia(extra_inertia)
         if not (math.isfinite(float(period)) and period > 0):
             raise ModelError(f"period must be > 0 rad, got {period!r}")
         self._inertia = inertia
         self._torque = torque
-        self.extra_inertia = ej
+        self.extra_inertia = _extra_inertia(extra_inertia)
         self.drive = drive
         self.period = float(period)
         self.name = name
@@ -223,8 +252,7 @@ class ReducedMachine:
 
     def with_extra_inertia(self, added: float) -> ReducedMachine:
         """A copy with ``added`` kg m^2 more on the link (a flywheel)."""
-        new = object.__new__(type(self))
-        new.__dict__.update(self.__dict__)
+        new = copy.copy(self)
         new.extra_inertia = self.extra_inertia + float(added)
         return new
 
@@ -243,14 +271,12 @@ class ReducedMachine:
         model = as_model(model)  # a Mechanism is compiled (and validated) here
         ev = _ModelEvaluator(model, coordinate, mode=mode, x0=x0)
         if extra_inertia is None:
-            extra_inertia = ev.drive_inertia()
+            extra_inertia = float(drive_inertia(model)[0])
         drive = _single_drive(model, ev.coordinate)
         if period is None:
             period = TWO_PI if ev.is_angle else 1.0
-        m = cls(ev.inertia, ev.torque, extra_inertia=extra_inertia, drive=drive, period=period,
-                name=model.mechanism.name, coordinate=ev.coordinate)
-        m.evaluator = ev
-        return m
+        return cls(ev.inertia, ev.torque, extra_inertia=extra_inertia, drive=drive,
+                   period=period, name=model.mechanism.name, coordinate=ev.coordinate)
 
     @classmethod
     def from_reduction(cls, red: Reduction, model: Model | None = None, *,
@@ -281,19 +307,12 @@ class ReducedMachine:
         xs = phi.tolist()
         mf = np.array(red.M_forces, dtype=float).tolist()
         n_int = len(xs) - 1
-        phi0 = xs[0]
-        h = period / n_int
-        uniform = bool(np.allclose(np.diff(phi), h, rtol=1e-12, atol=0.0))
         if drive is None and model is not None:
             drive = _speed_drive(model, red.coordinate)
 
         def locate(p):
-            u = phi0 + (p - phi0) % period
-            if uniform:
-                i = int((u - phi0) / h)
-            else:
-                i = bisect.bisect_right(xs, u) - 1
-            return u, min(max(i, 0), n_int - 1)
+            u = xs[0] + (p - xs[0]) % period
+            return u, min(max(bisect.bisect_right(xs, u) - 1, 0), n_int - 1)
 
         def inertia(p):
             u, i = locate(p)
@@ -375,43 +394,34 @@ def _single_drive(model: Model, coordinate: str):
 
 
 class _SpeedDrives:
-    """The drives on one coordinate as one ``torque_at(omega)`` (constants, characteristics)."""
+    """The drives on one coordinate as one ``torque_at(omega)``: a sum of functions of omega."""
 
     def __init__(self, parts):
-        self.parts = list(parts)
+        self.parts = parts
 
     def torque_at(self, omega):
-        tot = 0.0
-        for p in self.parts:
-            if hasattr(p, "torque_at"):
-                tot += float(p.torque_at(omega))
-            elif callable(p):
-                tot += float(p(omega))
-            else:
-                tot += float(p)
-        return tot
+        return sum(float(p(omega)) for p in self.parts)
 
 
 def _speed_drive(model: Model, coordinate: str):
     """The drives of a coordinate as a function of its speed only (None without drives)."""
+    drives = [d for d in model.mechanism.drives if d.coordinate == coordinate]
     parts = []
-    for d in model.mechanism.drives:
-        if d.coordinate != coordinate:
-            continue
+    for d in drives:
         tq = d.torque
-        if hasattr(tq, "torque_at") or isinstance(tq, TorqueSpeedCurve):
+        if hasattr(tq, "torque_at"):
+            parts.append(tq.torque_at)
+        elif isinstance(tq, TorqueSpeedCurve):
             parts.append(tq)
         elif isinstance(tq, Table) or callable(tq):
             raise ModelError(f"drive {d.name!r}: its torque depends on more than the speed of "
                              f"{coordinate!r}; use the exact machine "
                              f"(ReducedMachine.from_model, or --exact on the command line)")
         else:
-            parts.append(float(tq))
-    if not parts:
-        return None
-    if len(parts) == 1 and hasattr(parts[0], "torque_at"):
-        return parts[0]
-    return _SpeedDrives(parts)
+            parts.append(lambda omega, v=float(tq): v)
+    if len(drives) == 1 and hasattr(drives[0].torque, "torque_at"):
+        return drives[0].torque
+    return _SpeedDrives(parts) if parts else None
 
 
 def _nominal(drive) -> float | None:

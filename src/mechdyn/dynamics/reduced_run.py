@@ -1,43 +1,37 @@
-"""Running the reduced equation of motion: time histories and the energy form.
+"""Running the reduced equation of motion in time: time histories, the energy form
+and the start-up from rest.
 
 ``J(phi) domega/dt + 1/2 omega^2 dJ/dphi = M_red(phi, omega, t)`` of a
-:class:`~mechdyn.dynamics.reduced_machine.ReducedMachine`, integrated in time
+:class:`~mechdyn.dynamics.reduced_machine.ReducedMachine` is integrated in time
 with :mod:`mechdyn.integrate`, or, when M_red depends on the position only,
 solved by its energy form ``J omega^2 / 2 = J_0 omega_0^2 / 2 + integral M_red dphi``.
 
 Public names
 ------------
-ReducedRun
-    A time history of the reduced machine (read-only arrays).
-run_reduced, energy_speed
-    Time integration of the reduced equation and the energy form.
-
-All three are importable from :mod:`mechdyn.dynamics.reduced_machine` as well.
+ReducedRun, run_reduced, energy_speed
+    A time history of the reduced machine, the time integration and the energy form.
+StartupResult, startup
+    The run from rest (or a given speed) by the motor, the time to settle on the
+    steady cycle, peak drive and motor torques and the speed dip under load.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+import math
+from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ModelError, Status
 from ..integrate import solve
+from .flywheel import SteadyCycle, steady_state
+from .reduced_machine import ReducedMachine, _frozen, _Motion, _Record
 
-if TYPE_CHECKING:
-    from .reduced_machine import ReducedMachine
-
-__all__ = ["ReducedRun", "run_reduced", "energy_speed"]
-
-
-def _frozen(a) -> np.ndarray:
-    a = np.array(a, dtype=float, copy=True)
-    a.setflags(write=False)
-    return a
+__all__ = ["ReducedRun", "run_reduced", "energy_speed", "StartupResult", "startup"]
 
 
 @dataclass(frozen=True)
-class ReducedRun:
+class ReducedRun(_Motion):
     """A time history of the reduced machine.
 
     Attributes
@@ -50,46 +44,16 @@ class ReducedRun:
         Motor-side torque through a gear stage, N m.
     """
 
-    t: np.ndarray
-    phi: np.ndarray
-    omega: np.ndarray
-    epsilon: np.ndarray
-    J: np.ndarray
-    M: np.ndarray
     M_drive: np.ndarray
     M_motor: np.ndarray | None = None
-    status: str = "success"
-    message: str = ""
-    events: tuple = ()
-    stats: dict = field(default_factory=dict)
-
-    def to_dataframe(self):
-        """Columns ``t_s, phi_deg, omega_rad_s, epsilon_rad_s2, J_kgm2, M_red_Nm, ...``."""
-        import pandas as pd
-
-        cols = {"t_s": self.t, "phi_deg": np.degrees(self.phi), "phi_rad": self.phi,
-                "omega_rad_s": self.omega, "epsilon_rad_s2": self.epsilon,
-                "J_total_kgm2": self.J, "M_red_Nm": self.M, "M_drive_Nm": self.M_drive}
-        if self.M_motor is not None:
-            cols["M_motor_Nm"] = self.M_motor
-        return pd.DataFrame(cols)
 
 
 def _history(machine: ReducedMachine, t, phi, omega, **kw) -> ReducedRun:
-    n = t.size
-    J = np.empty(n)
-    M = np.empty(n)
-    eps = np.empty(n)
-    md = np.empty(n)
-    mm = np.empty(n) if machine.drive is not None else None
-    for i in range(n):
-        j, dj = machine.inertia(phi[i])
-        J[i] = j
-        M[i] = machine.torque(t[i], phi[i], omega[i])
-        eps[i] = (M[i] - 0.5 * dj * omega[i] ** 2) / j
-        md[i] = machine.drive_torque(omega[i])
-        if mm is not None:
-            mm[i] = machine.motor_torque(omega[i])
+    J, dJ = np.array([machine.inertia(p) for p in phi], dtype=float).reshape(-1, 2).T
+    M = np.array([machine.torque(*s) for s in zip(t, phi, omega, strict=True)], dtype=float)
+    md = np.array([machine.drive_torque(w) for w in omega], dtype=float)
+    mm = None if machine.drive is None else np.array([machine.motor_torque(w) for w in omega])
+    eps = (M - 0.5 * dJ * omega**2) / J
     return ReducedRun(_frozen(t), _frozen(phi), _frozen(omega), _frozen(eps), _frozen(J),
                       _frozen(M), _frozen(md), None if mm is None else _frozen(mm), **kw)
 
@@ -155,21 +119,130 @@ def energy_speed(machine: ReducedMachine, phi, *, phi0: float = 0.0, omega0: flo
     phi = np.asarray(phi, dtype=float).reshape(-1)
     j0, _ = machine.inertia(phi0)
     out = np.empty_like(phi)
-    for sign in (1.0, -1.0):
-        sel = (phi >= phi0) if sign > 0 else (phi < phi0)
-        if not np.any(sel):
-            continue
+    for sel in (phi >= phi0, phi < phi0):  # each side of phi0 from phi0 on
         target = phi[sel]
-        end = target.max() if sign > 0 else target.min()
-        if end == phi0:
-            w = np.zeros(target.size)
-        else:
+        end = target[np.argmax(np.abs(target - phi0))] if target.size else phi0
+        w = np.zeros(target.size)
+        if end != phi0:
             sol = solve_ivp(lambda p, y: [machine.torque(t, p, omega0)], (phi0, end), [0.0],
                             method="DOP853", rtol=rtol, atol=1e-12 * max(1.0, j0 * omega0**2),
                             dense_output=True)
             w = sol.sol(target)[0]
-        jt = machine.inertia_along(target)
         e2 = j0 * omega0**2 + 2.0 * w
         with np.errstate(invalid="ignore"):
-            out[sel] = np.where(e2 >= 0, np.sqrt(np.maximum(e2, 0) / jt), np.nan)
+            out[sel] = np.where(e2 >= 0, np.sqrt(np.maximum(e2, 0) / machine.inertia_along(target)),
+                                np.nan)
     return out
+
+
+@dataclass(frozen=True)
+class StartupResult(_Record):
+    """Start-up of a machine from rest by its motor, and its steady regime.
+
+    Attributes
+    ----------
+    run : ReducedRun
+        The time history (t, phi, omega, torques).
+    steady : SteadyCycle
+        The steady cycle the run approaches.
+    t_steady : float or None
+        First time after which the speed stays within ``tol * omega_mean`` of the
+        steady cycle at the same position, s (None if not reached by t_end).
+    peak_drive_torque : float
+        Largest drive torque on the link during the run, N m.
+    peak_motor_torque : float or None
+        Largest motor-side torque (through the gear stage), N m.
+    speed_dip : float
+        omega_max - omega_min of the steady cycle, rad/s (the dip when the load
+        acts, or between ``load_window`` start and the minimum after it).
+    phi_dip : float
+        Position of the minimum speed of the steady cycle, rad.
+    omega_mean : float
+        Mean speed of the steady cycle, rad/s.
+    """
+
+    run: ReducedRun
+    steady: SteadyCycle
+    t_steady: float | None
+    peak_drive_torque: float
+    peak_motor_torque: float | None
+    speed_dip: float
+    phi_dip: float
+    omega_mean: float
+    tol: float
+
+    def to_dataframe(self):
+        """The run's time history (see :meth:`ReducedRun.to_dataframe`)."""
+        return self.run.to_dataframe()
+
+    def summary(self) -> dict:
+        """The headline figures in SI units."""
+        return {"t_steady_s": self.t_steady, "peak_drive_torque_Nm": self.peak_drive_torque,
+                "peak_motor_torque_Nm": self.peak_motor_torque,
+                "omega_mean_rad_s": self.omega_mean, "speed_dip_rad_s": self.speed_dip,
+                "phi_dip_deg": math.degrees(self.phi_dip), "delta": self.steady.delta}
+
+
+def startup(machine: ReducedMachine, t_end: float, *, phi0: float = 0.0, omega0: float = 0.0,
+            tol: float = 0.01, load_window: tuple[float, float] | None = None,
+            samples_per_second: float = 4000.0, integrator: str = "dop853",
+            steady: SteadyCycle | None = None, **options) -> StartupResult:
+    """Start the machine from rest (or ``omega0``) and measure the transient.
+
+    Parameters
+    ----------
+    machine : ReducedMachine
+        With a speed-dependent drive (a motor).
+    t_end : float
+        Length of the run, s.
+    phi0, omega0 : float
+        Initial position (rad) and speed (rad/s).
+    tol : float
+        Band around the steady cycle, as a fraction of its mean speed, that
+        defines "steady".
+    load_window : (float, float), optional
+        Positions (rad, within one period) where the working load acts; the speed
+        dip is then measured from the speed at the window start to the minimum
+        after it.  Default: omega_max - omega_min of the steady cycle.
+    samples_per_second : float
+        Output sampling, 1/s.
+    integrator : str
+        As for :func:`run_reduced` (options passed on).
+    steady : SteadyCycle, optional
+        A steady cycle computed before (else found here).
+
+    Returns
+    -------
+    StartupResult
+    """
+    if not t_end > 0:
+        raise ModelError(f"t_end must be > 0 s, got {t_end!r}")
+    te = np.linspace(0.0, float(t_end), max(2, int(samples_per_second * t_end) + 1))
+    run = run_reduced(machine, t_end, phi0=phi0, omega0=omega0, integrator=integrator,
+                      t_eval=te, **options)
+    if steady is None:
+        steady = steady_state(machine, omega_guess=max(run.omega[-1], 1e-6), phi0=phi0)
+    per = machine.period
+    ref = np.interp(run.phi, steady.phi, steady.omega, period=per)  # at the same position
+    outside = np.flatnonzero(np.abs(run.omega - ref) > tol * steady.omega_mean)
+    k = outside[-1] + 1 if outside.size else 0  # the first sample after the last one outside
+    t_steady = float(run.t[k]) if k < run.t.size else None
+    if load_window is None:
+        dip = steady.omega_max - steady.omega_min
+        phi_dip = steady.phi_at_min
+    else:
+        a, b = load_window  # the minimum may come after the window
+        grid = a + np.linspace(0.0, (b - a) % per + 0.5 * per, 721)
+        w = np.interp(grid, steady.phi, steady.omega, period=per)
+        k = int(np.argmin(w))
+        dip = w[0] - w[k]
+        phi_dip = steady.phi[0] + (grid[k] - steady.phi[0]) % per
+    msg = "" if t_steady is not None else (f"the speed has not settled within {tol:.3g} of "
+                                           f"the steady cycle by t = {t_end:g} s")
+    pm = None if run.M_motor is None else float(np.max(run.M_motor))
+    return StartupResult(run=run, steady=steady, t_steady=t_steady,
+                         peak_drive_torque=float(np.max(run.M_drive)), peak_motor_torque=pm,
+                         speed_dip=float(dip), phi_dip=float(phi_dip),
+                         omega_mean=steady.omega_mean, tol=float(tol),
+                         status=Status.SUCCESS if t_steady is not None else Status.NOT_SETTLED,
+                         message=msg, stats=dict(run.stats))

@@ -2,74 +2,54 @@
 
 A machine with one degree of freedom is replaced by one *link of reduction*
 turning with the generalized coordinate ``phi`` (or with a chosen link) that
-carries
-
-* the **reduced moment of inertia** ``J_red(phi) = 2 T / omega^2
-  = sum_k (m_k |v_ck / omega|^2 + J_ck (omega_k / omega)^2)``, kg m^2, from the
-  exact velocity analogs of the centres of mass, ``v_c / omega = B_r + B_theta
-  R(A c_k)`` (R: rotation by +90 deg, A c_k: the centre of mass offset turned
-  into the ground frame);
-* its derivative ``dJ_red/dphi = 2 sum_k (m_k v_c' . a_c' + J_ck w' alpha')``,
-  kg m^2/rad, exact: ``a_c'`` and ``alpha'`` are the acceleration bias of the
-  kinematics at unit speed (``d B / dphi = b(x, B)``, ``qdot = 1``);
-* the **reduced torque** ``M_red(phi, omega, t) = Q_phi = B^T F + M_drive``,
-  N m, by equal power of every applied force, moment and drive;
-* the **reduced mass** at a point P, ``m_red = 2 T / v_P^2 = J_red / |v_P/omega|^2``, kg.
-
-Its equation of motion (lecture notes eq. 7.12) is
-
-    J(phi) domega/dt + 1/2 omega^2 dJ/dphi = M_red(phi, omega, t),
-
-with ``J = J_red + J_extra`` (rotor and gears reduced to the coordinate,
-flywheel).  Since ``d(J omega^2 / 2) / dphi = M_red``, the *energy form*
-``J omega^2 / 2 = J_0 omega_0^2 / 2 + integral M_red dphi`` holds when M_red
-depends on the position only.
+carries the reduced moment of inertia ``J_red(phi) = 2 T / omega^2`` (kg m^2),
+its exact derivative ``dJ_red/dphi`` and the reduced torque ``M_red = B^T F +
+M_drive`` of all applied forces and drives by equal power (N m); its equation of
+motion (eq. 7.12) is ``J(phi) domega/dt + 1/2 omega^2 dJ/dphi = M_red(phi, omega, t)``
+with ``J = J_red + J_extra``.  The formulas and their use are in
+``docs/reduction-and-drives.md``.
 
 Public names
 ------------
-Reduction, reduce_model
-    The reduced quantities of a model tabulated over a cycle (this module).
+Reduction, reduce_model, mode_mechanism
+    The reduced quantities of a model tabulated over a cycle, and a
+    variable-structure mechanism in one mode as a 1-DOF mechanism (this module).
 reduced_kinematics
-    The exact transmission functions, J_red and dJ_red/dphi of solved poses
-    (:mod:`mechdyn.dynamics.reduced_kinematics`).
-ReducedMachine, Member, MemberLoad, ReducedRun, run_reduced, energy_speed, mode_mechanism
-    The reduced 1-DOF machine (from a model, from a table, from a transmission of
-    velocity ratios or from plain functions), its time integration and energy
-    form, and a variable-structure mechanism in one mode
-    (:mod:`mechdyn.dynamics.reduced_machine`).
+    :mod:`mechdyn.dynamics.reduced_kinematics`.
+ReducedMachine, Member, MemberLoad
+    :mod:`mechdyn.dynamics.reduced_machine`.
 SteadyCycle, steady_state, FlywheelSizing, size_flywheel
-    The periodic steady motion (shooting on omega at phi0) and its coefficient of
-    speed fluctuation; flywheel sizing by the energy method, confirmed by
-    simulation (:mod:`mechdyn.dynamics.flywheel`).
-StartupResult, startup
-    Start-up from rest and load transients (:mod:`mechdyn.dynamics.startup`).
+    :mod:`mechdyn.dynamics.flywheel`.
+ReducedRun, run_reduced, energy_speed, StartupResult, startup
+    :mod:`mechdyn.dynamics.reduced_run`.
 
 All of them are importable from this module.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ModelError, Status
+from ..errors import ModelError, Status, did_you_mean
+from ..mechanism.joint import Lock
 from ..model import Model, as_model
 from .flywheel import FlywheelSizing, SteadyCycle, size_flywheel, steady_state
-from .reduced_kinematics import _ModelEvaluator, _perp, _rot, reduced_kinematics
+from .inertia import drive_inertia
+from .reduced_kinematics import _inertia, _ModelEvaluator, reduced_kinematics
 from .reduced_machine import (
     TWO_PI,
     Member,
     MemberLoad,
     ReducedMachine,
-    ReducedRun,
     _extra_inertia,
-    energy_speed,
-    mode_mechanism,
-    run_reduced,
+    _frozen,
+    _Record,
 )
-from .reduced_run import _frozen
-from .startup import StartupResult, startup
+from .reduced_run import ReducedRun, StartupResult, energy_speed, run_reduced, startup
 
 __all__ = ["Reduction", "reduce_model", "ReducedMachine", "Member", "MemberLoad",
            "ReducedRun", "run_reduced", "energy_speed", "SteadyCycle", "steady_state",
@@ -79,7 +59,7 @@ __all__ = ["Reduction", "reduce_model", "ReducedMachine", "Member", "MemberLoad"
 
 # ============================================================================ the table
 @dataclass(frozen=True)
-class Reduction:
+class Reduction(_Record):
     """Reduced quantities of a 1-DOF mechanism over a range of positions.
 
     All arrays have shape (n,) over the positions.  With a link of reduction the
@@ -141,10 +121,6 @@ class Reduction:
     point: tuple | None = None
     m_red: np.ndarray | None = None
     v_ratio: np.ndarray | None = None
-    status: str = "success"
-    message: str = ""
-    events: tuple = ()
-    stats: dict = field(default_factory=dict)
 
     @property
     def J_total(self) -> np.ndarray:
@@ -177,17 +153,14 @@ class Reduction:
         if self.link is not None:
             cols[f"theta_{self.link}_deg"] = np.degrees(self.link_angle)
             cols["ratio"] = self.ratio
-        cols[f"J_red_{iu}"] = self.J_red
-        cols[f"dJ_red_dphi_{du}" + ("" if ang else "_per_m")] = self.dJ_red_dphi
-        cols[f"J_extra_{iu}"] = self.J_extra
-        cols[f"J_total_{iu}"] = self.J_total
-        cols[f"M_red_{tu}"] = self.M_red
-        cols[f"M_drive_{tu}"] = self.M_drive
-        cols[f"M_forces_{tu}"] = self.M_forces
-        cols["omega_rad_s" if ang else "v_m_s"] = self.omega
+        cols.update({f"J_red_{iu}": self.J_red,
+                     f"dJ_red_dphi_{du}" + ("" if ang else "_per_m"): self.dJ_red_dphi,
+                     f"J_extra_{iu}": self.J_extra, f"J_total_{iu}": self.J_total,
+                     f"M_red_{tu}": self.M_red, f"M_drive_{tu}": self.M_drive,
+                     f"M_forces_{tu}": self.M_forces,
+                     "omega_rad_s" if ang else "v_m_s": self.omega})
         if self.m_red is not None:
-            cols["m_red_kg"] = self.m_red
-            cols["v_ratio_m_rad"] = self.v_ratio
+            cols.update({"m_red_kg": self.m_red, "v_ratio_m_rad": self.v_ratio})
         return pd.DataFrame(cols)
 
     def machine(self, model: Model | None = None, **kwargs) -> ReducedMachine:
@@ -256,50 +229,35 @@ def reduce_model(model: Model, *, coordinate: str | None = None, link: str | Non
         phis = np.asarray(phi, dtype=float).reshape(-1)
         if phis.size < 1 or not np.all(np.isfinite(phis)):
             raise ModelError("phi must be a non-empty sequence of finite positions")
-    j_extra = ev.drive_inertia() if extra_inertia is None else _extra_inertia(extra_inertia)
-
-    xs = ev.poses(phis)
-    kin = reduced_kinematics(model, xs, ev.layout)
+    j_extra = float(drive_inertia(model)[0]) if extra_inertia is None else \
+        _extra_inertia(extra_inertia)
+    sw = ev.sweep(phis)
+    xs, B = sw.x, sw.B[..., 0]
+    J, dJ = _inertia(model, xs, B, sw.xddot)
     n = phis.size
     if link is None:
-        ratio = np.ones(n)
-        dratio = np.zeros(n)
-        link_angle = None
+        ratio, dratio, link_angle = np.ones(n), np.zeros(n), None
+    elif model.body_index(link) >= model.n_bodies:
+        raise ModelError(f"link of reduction: the ground cannot be the link; choose one of "
+                         f"{', '.join(model.body_names)}")
     else:
-        k = model.body_index(link)
-        if k >= model.n_bodies:
-            raise ModelError(f"link of reduction: the ground cannot be the link; choose one of "
-                             f"{', '.join(model.body_names)}")
-        ratio = kin["w"][:, k]
-        dratio = kin["al"][:, k]
-        link_angle = xs[:, 3 * k + 2]
-    J, dJ = kin["J"], kin["dJ"]
+        link_angle, ratio, dratio = sw.angular(link)
     with np.errstate(divide="ignore", invalid="ignore"):
         qdot = float(omega) / ratio
-        mf = np.empty(n)
-        md = np.empty(n)
-        for i in range(n):
-            qd = qdot[i] if np.isfinite(qdot[i]) else 0.0
-            mf[i], md[i] = ev.generalized_forces(t, phis[i], qd, xs[i], kin["B"][i])
+        mf, md = ev.generalized_forces(float(t), phis, np.where(np.isfinite(qdot), qdot, 0.0),
+                                       xs, B)
         J_link = J / ratio**2
         dJ_link = (dJ / ratio**2 - 2.0 * J * dratio / ratio**3) / ratio
         J_extra = j_extra / ratio**2
         M_f, M_d = mf / ratio, md / ratio
     m_red = v_ratio = None
     if point is not None:
-        body, pt = point
-        kb = model.body_index(body)
-        s = model.point_local(body, pt)
-        arm = _rot(xs[:, 3 * kb + 2][:, None], s[None, :])[:, 0, :]
-        v = np.stack([kin["B"][:, 3 * kb], kin["B"][:, 3 * kb + 1]], axis=-1) \
-            + kin["B"][:, 3 * kb + 2][:, None] * _perp(arm)
-        v_ratio = np.hypot(v[:, 0], v[:, 1])
+        point = tuple(point)
+        v_ratio = np.linalg.norm(sw.point_analogs(*point)[..., 0], axis=-1)
         with np.errstate(divide="ignore"):
             m_red = (J + j_extra) / v_ratio**2
-        point = (body, pt)
     bad = ~np.isfinite(J_link) | (np.abs(ratio) <= 1e-9 * np.max(np.abs(ratio), initial=0.0))
-    message = ""
-    status = "success"
+    status, message = "success", ""
     if np.any(bad):
         status = Status.SINGULAR_POSITION
         message = (f"the angular-velocity analog of link {link!r} vanishes at "
@@ -315,3 +273,59 @@ def reduce_model(model: Model, *, coordinate: str | None = None, link: str | Non
         point=point, m_red=None if m_red is None else _frozen(m_red),
         v_ratio=None if v_ratio is None else _frozen(v_ratio), status=status,
         message=message, stats={"positions": n, "extra_inertia_coordinate": j_extra})
+
+
+def mode_mechanism(mechanism, *, engage: Sequence[str] = (), offsets: dict | None = None,
+                   drop: Sequence[str] = ()):
+    """A copy of a mechanism with locks engaged and the coordinates they freeze removed.
+
+    The reduction method needs one degree of freedom; a variable-structure
+    machine has it in some modes only (the clutchless press in its working mode:
+    rocker locked onto the slider).  This builds that mode as a mechanism of its
+    own.
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+    engage : sequence of str
+        Locks to engage.
+    offsets : dict, optional
+        Lock name -> pose (x m, y m, theta rad) of the child frame in the parent
+        frame held by the lock; default the lock's own offset (or the sketch).
+    drop : sequence of str
+        Coordinates to remove (those the engaged locks freeze).
+
+    Returns
+    -------
+    Mechanism
+        The original is not changed; initial values of dropped coordinates are
+        removed from ``extras["initial"]``.
+    """
+    offsets = dict(offsets or {})
+    joints = dict(mechanism.joints)
+    probs = []
+    for name in engage:
+        j = joints.get(name)
+        if not isinstance(j, Lock):
+            locks = [n for n, jj in joints.items() if isinstance(jj, Lock)]
+            probs.append(did_you_mean(name, locks, "lock"))
+            continue
+        off = offsets.pop(name, j.offset)
+        joints[name] = dataclasses.replace(j, engaged=True,
+                                           offset=None if off is None else tuple(map(float, off)))
+    for name in offsets:
+        probs.append(f"offsets: lock {name!r} is not in engage")
+    coords = {k: v for k, v in mechanism.coordinates.items() if k not in set(drop)}
+    for name in drop:
+        if name not in mechanism.coordinates:
+            probs.append(did_you_mean(name, mechanism.coordinates, "coordinate"))
+    if probs:
+        raise ModelError(probs)
+    extras = dict(mechanism.extras)
+    init = extras.get("initial")
+    if isinstance(init, dict):
+        extras["initial"] = {k: {c: v for c, v in dict(d or {}).items() if c in coords}
+                             for k, d in init.items()}
+    return dataclasses.replace(mechanism, joints=joints, coordinates=coords,
+                               loads=list(mechanism.loads), drives=list(mechanism.drives),
+                               extras=extras)

@@ -10,24 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .plot import _figure, _save
+
 __all__ = ["plot_reduction", "plot_steady_cycle", "plot_startup", "plot_motor"]
-
-
-def _figure(n_rows: int, width: float = 8.0, height: float = 2.4):
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(width, height * n_rows), layout="constrained")
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(n_rows, 1, sharex=True, squeeze=False)[:, 0]
-    return fig, axes
-
-
-def _save(fig, path, dpi: int) -> Path:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=dpi)
-    return path
 
 
 def plot_reduction(red, path, *, title: str | None = None, dpi: int = 120) -> Path:
@@ -51,7 +36,7 @@ def plot_reduction(red, path, *, title: str | None = None, dpi: int = 120) -> Pa
     xlabel = (f"angle of {red.link} (deg)" if red.link else f"{red.coordinate} (deg)") if ang \
         else f"{red.coordinate} (mm)"
     iu, tu = ("kg m$^2$", "N m") if ang else ("kg", "N")
-    fig, ax = _figure(3)
+    fig, ax = _figure(3, height=2.4)
     ax[0].plot(x, red.J_red, label="$J_{red}$ (mechanism)")
     if np.any(red.J_extra):
         ax[0].plot(x, red.J_total, "--", label="$J_{red} + J_{extra}$")
@@ -76,7 +61,7 @@ def plot_steady_cycle(cycle, path, *, title: str | None = None, dpi: int = 120) 
     """Speed and reduced torque over one steady cycle (a
     :class:`~mechdyn.dynamics.flywheel.SteadyCycle`)."""
     x = np.degrees(cycle.phi)
-    fig, ax = _figure(2)
+    fig, ax = _figure(2, height=2.4)
     ax[0].plot(x, cycle.omega)
     for v, ls in ((cycle.omega_max, ":"), (cycle.omega_min, ":"), (cycle.omega_mean, "--")):
         ax[0].axhline(v, color="gray", ls=ls, lw=0.8)
@@ -92,9 +77,9 @@ def plot_steady_cycle(cycle, path, *, title: str | None = None, dpi: int = 120) 
 
 
 def plot_startup(res, path, *, title: str | None = None, dpi: int = 120) -> Path:
-    """Speed and torques of a start-up (a :class:`~mechdyn.dynamics.startup.StartupResult`)."""
+    """Speed and torques of a start-up (a :class:`~mechdyn.dynamics.reduced_run.StartupResult`)."""
     run = res.run
-    fig, ax = _figure(2)
+    fig, ax = _figure(2, height=2.4)
     ax[0].plot(run.t, run.omega)
     ax[0].axhline(res.omega_mean, color="gray", ls="--", lw=0.8)
     if res.t_steady is not None:
