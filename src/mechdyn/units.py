@@ -22,6 +22,14 @@ Rules
   non-angular kinds refuse angle units.  ``frequency`` accepts both ``"50 Hz"``
   and ``"3000 rpm"`` (= 50 Hz).
 * ``"%"`` (or ``percent``) is accepted for ``dimensionless``/``ratio``.
+* A model file is data, not code: a value is ONE number followed by a unit
+  (``"15 mm"``, ``"0.034 kg*m^2"``, ``"4.53 N/mm"``, ``"1e-3 s"``); the unit may
+  use ``*``, ``/``, ``^`` (or ``**``) with integer powers, nothing else.
+  Arithmetic (``"2*3 mm"``, ``"2**2**2 mm"``), a second number (``"250.5.5 mm"``),
+  quotes and brackets are refused with a :class:`UnitError`, and so are values
+  longer than :data:`MAX_TEXT` characters and numbers beyond the float range.
+  Text is Unicode-normalised (NFKC) first, so the compatibility character
+  ``"㎜"`` reads as ``"mm"``.
 
 Examples
 --------
@@ -37,13 +45,23 @@ from __future__ import annotations
 
 import math
 import re
+import unicodedata
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 from .errors import UnitError
 
-__all__ = ["KINDS", "Kind", "parse_quantity", "parse_vector", "format_quantity", "registry"]
+__all__ = ["KINDS", "Kind", "parse_quantity", "parse_vector", "format_quantity", "registry",
+           "MAX_TEXT"]
+
+#: the longest quantity text accepted, characters
+MAX_TEXT = 100
+#: one number, then optionally a unit: names (letters, µ, °, %) joined by *, / and
+#: integer powers (^ or **)
+_NUMBER = r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|nan|inf)"
+_NAME = r"(?:[^\W\d_]+|%|°)(?:\s*(?:\^|\*\*)\s*[+-]?\d+)?"
+_QUANTITY_RE = re.compile(rf"^(?P<num>{_NUMBER})\s*(?P<unit>{_NAME}(?:\s*[*/]?\s*{_NAME})*)?$")
 
 
 @dataclass(frozen=True)
@@ -146,48 +164,66 @@ def parse_quantity(value: Any, kind: str, *, where: str = "") -> float:
         raise _problem(where, value, k, f"not a number or a quantity string "
                        f"(got {type(value).__name__})")
     if isinstance(value, (int, float)):
-        out = float(value)
+        try:
+            out = float(value)
+        except OverflowError:
+            raise _problem(where, f"{str(value)[:20]}... ({len(str(value))} digits)", k,
+                           "too large a number") from None
         if not math.isfinite(out):
             raise _problem(where, value, k, "not a finite number")
         return out
-    text = value.strip()
+    text = unicodedata.normalize("NFKC", value).strip()
     if not text:
         raise _problem(where, value, k, "empty text")
+    if len(text) > MAX_TEXT:
+        raise _problem(where, value[:40] + "...", k, f"longer than {MAX_TEXT} characters")
     if any(c in text for c in ",;()[]{}"):
         raise _problem(where, value, k, "one quantity expected (no commas or brackets)")
     ureg = registry()
     import pint
 
+    m = _QUANTITY_RE.match(text)
+    if m is None:
+        why = ("expected one number followed by a unit (arithmetic, a second number and "
+               "quotes are not read)")
+        if re.fullmatch(r"[^\W\d_]+", text):
+            try:
+                ureg.parse_units(text)
+                why = "a unit without a number"
+            except pint.errors.UndefinedUnitError:
+                why = f"unknown unit ({text!r})"
+        raise _problem(where, value, k, f"cannot be read as a quantity: {why}")
+    number = float(m["num"])
+    if not math.isfinite(number):
+        raise _problem(where, value, k, "not a finite value")
+
     try:
-        q = ureg.Quantity(text)
+        q = ureg.Quantity(number, ureg.parse_units(m["unit"]) if m["unit"] else "")
     except Exception as exc:  # noqa: BLE001 - pint's parser raises many kinds; report them all
-        why = str(exc).strip() or "malformed expression"
+        why = str(exc).strip() or "malformed unit"
         if isinstance(exc, pint.errors.UndefinedUnitError):
             why = f"unknown unit ({why})"
         raise _problem(where, value, k, f"cannot be read as a quantity: {why}") from None
-    if not isinstance(q, ureg.Quantity):  # pint returns plain numbers for "2*3"
-        q = ureg.Quantity(q)
-    if not isinstance(q.magnitude, (int, float)):
-        raise _problem(where, value, k, "cannot be read as a single quantity")
-    if not q._units:  # a bare number in a string: SI
+    if not m["unit"]:  # a bare number in a string: SI
         out = float(q.magnitude)
     else:
+        shown = f"{q.units:~}" if q._units else m["unit"]  # units that cancel: the text
         root = q.to_root_units()
         rad_power = dict(root._units).get("radian", 0)
         target = ureg.Unit(k.si) if k.si else ureg.dimensionless
         if root.dimensionality != target.dimensionality:
             dim = _dimension_text(root)
-            raise _problem(where, value, k, f"the unit {q.units:~} is a {dim}")
+            raise _problem(where, value, k, f"the unit {shown} is a {dim}")
         if k.angle_power == 1 and rad_power != 1:
             raise _problem(where, value, k,
-                           f"the unit {q.units:~} has no angle unit (use rad, deg, turn or rpm; "
+                           f"the unit {shown} has no angle unit (use rad, deg, turn or rpm; "
                            "a frequency in Hz is not an angular velocity)")
         if k.angle_power == 0 and rad_power != 0:
-            raise _problem(where, value, k, f"the unit {q.units:~} carries an angle unit")
+            raise _problem(where, value, k, f"the unit {shown} carries an angle unit")
         if kind == "frequency" and rad_power == 1:
             out = float(root.magnitude) / (2.0 * math.pi)
         elif kind == "frequency" and rad_power not in (0, 1):
-            raise _problem(where, value, k, f"the unit {q.units:~} is not a frequency")
+            raise _problem(where, value, k, f"the unit {shown} is not a frequency")
         else:
             out = float(q.to(target).magnitude) if k.si else float(q.to("").magnitude)
     if not math.isfinite(out):

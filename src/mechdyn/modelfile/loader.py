@@ -86,12 +86,30 @@ def loads(text: str, name: str = "<string>", *, default_title: str | None = None
     return build(doc, name, default_title=default_title)
 
 
+#: tables and arrays nested deeper than this are refused (a model file needs about 4)
+MAX_DEPTH = 16
+
+
 def read_document(text: str, name: str = "<string>") -> dict:
-    """Parse TOML text, turning a syntax error into a :class:`ModelError`."""
+    """Parse TOML text, turning a syntax error, or tables and arrays nested deeper than
+    :data:`MAX_DEPTH`, into a :class:`ModelError`."""
     try:
-        return tomllib.loads(text)
+        doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ModelError(f"{name}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise ModelError(f"{name}: tables or arrays nested too deeply (more than "
+                         f"{MAX_DEPTH} levels)") from None
+    stack = [(doc, ())]
+    while stack:  # without recursion: the depth is what is being checked
+        node, path = stack.pop()
+        if len(path) > MAX_DEPTH:
+            raise ModelError(f"{name}: {'.'.join(map(str, path[:4]))}...: tables or arrays "
+                             f"nested deeper than {MAX_DEPTH} levels")
+        items = node.items() if isinstance(node, dict) else enumerate(node) \
+            if isinstance(node, list) else ()
+        stack.extend((v, (*path, k)) for k, v in items if isinstance(v, dict | list))
+    return doc
 
 
 def build(doc: dict, name: str = "<string>", *, default_title: str | None = None) -> Mechanism:

@@ -160,7 +160,10 @@ class _Reader:
         if isinstance(value, str):
             a = self.quantity(value, "angle", *path)
             return self.to_body_frame(body, (math.cos(a), math.sin(a)), origin=False)
-        d = (float(value[0]), float(value[1]))
+        try:
+            d = (float(value[0]), float(value[1]))
+        except OverflowError:
+            d = (math.inf, math.inf)
         if not all(math.isfinite(v) for v in d) or math.hypot(*d) == 0:
             self.problem(f"{self.where(*path)}: {value!r}: must be a non-zero direction [x, y]")
             raise _Failed

@@ -1,0 +1,52 @@
+"""Bad model files give named errors, never a traceback, a hang or a wrong number
+(the reproducers of the fuzzing campaign: nested tables, huge numbers, arithmetic in
+values, numbers and units that would be misread)."""
+
+import pytest
+from test_modelfile import SLIDER_CRANK, bad
+
+from mechdyn.errors import ModelError, UnitError
+from mechdyn.modelfile import loads
+from mechdyn.units import parse_quantity
+
+
+@pytest.mark.parametrize("depth", [40, 30000])
+def test_deeply_nested_tables_are_a_named_error(depth):
+    text = SLIDER_CRANK + "\n[extra]\njunk = " + "[" * depth + "1" + "]" * depth + "\n"
+    with pytest.raises(ModelError, match="nested"):
+        loads(text, name="deep.toml")
+    dotted = SLIDER_CRANK + "\n[" + ".".join(["deep"] * depth) + "]\nx = 1\n"
+    with pytest.raises(ModelError, match="nested"):
+        loads(dotted, name="deep.toml")
+
+
+def test_huge_integers_are_a_named_error():
+    with pytest.raises(UnitError, match=r"\[bodies.rod\] inertia.*too large a number"):
+        bad('inertia = "0.004 kg*m^2"', "inertia = " + "9" * 400)
+    with pytest.raises(ModelError, match=r"axis.*non-zero direction"):
+        bad("axis = [1, 0]", "axis = [" + "1" * 400 + ", 0]")
+
+
+@pytest.mark.parametrize("value", ["2**2**2**2**2 mm", "2*3 mm", "250.5.5 mm", '250 "mm"',
+                                   "1e3*1e3 mm", "50 mm mm 5"])
+def test_a_value_is_one_number_and_a_unit_not_an_expression(value):
+    with pytest.raises(UnitError, match=r"\[bodies.crank.points\] A.*one number followed by"):
+        bad('A = ["50 mm", "0 mm"]', f"A = ['{value}', \"0 mm\"]")
+
+
+def test_long_values_are_refused():
+    with pytest.raises(UnitError, match="longer than 100 characters"):
+        parse_quantity("1" + " " * 200 + "mm", "length", where="here")
+
+
+def test_units_that_cancel_are_not_taken_for_the_expected_dimension():
+    # "2 mm/mm" is a number, not a mass: not silently 2 kg
+    with pytest.raises(UnitError, match=r"\[bodies.crank\] mass: '2 mm/mm'.*expected a mass"):
+        bad('mass = "2 kg"', 'mass = "2 mm/mm"')
+    assert parse_quantity("2 mm/mm", "ratio") == 2.0
+
+
+def test_compatibility_characters_are_normalised():
+    # U+339C SQUARE MM reads as mm, not as a bare number (metres)
+    assert parse_quantity("250 \u339c", "length") == pytest.approx(0.25)
+    assert parse_quantity("45\u00b0", "angle") == pytest.approx(0.785398163397, rel=1e-12)
