@@ -50,3 +50,37 @@ def test_compatibility_characters_are_normalised():
     # U+339C SQUARE MM reads as mm, not as a bare number (metres)
     assert parse_quantity("250 \u339c", "length") == pytest.approx(0.25)
     assert parse_quantity("45\u00b0", "angle") == pytest.approx(0.785398163397, rel=1e-12)
+
+
+def _pendulum_with_a_spring_whose_ends_meet_at_zero():
+    from mechdyn import Mechanism
+    from mechdyn.mechanism import Spring
+
+    m = Mechanism("pendulum", gravity=(0.0, -9.81))
+    m.add_ground({"O": (0.0, 0.0), "S": (1.0, 0.0)})
+    m.add_body("bar", mass=1.0, inertia=0.1, com=(0.5, 0.0), points={"E": (1.0, 0.0)},
+               pose=(0.0, 0.0, 0.5))
+    m.add_revolute("O", "ground", "bar", "O", (0.0, 0.0))
+    m.add_coordinate("th", kind="angle", body="bar")
+    m.add(Spring("sp", "ground", "S", "bar", "E", stiffness=10.0))
+    return m
+
+
+def test_a_spring_whose_ends_meet_only_where_the_run_never_goes_is_simulated():
+    """The compiled kernels are never evaluated on the user's model at positions the run
+    does not visit (their warm-up uses a pendulum of their own)."""
+    from mechdyn import simulate
+
+    m = _pendulum_with_a_spring_whose_ends_meet_at_zero()
+    runs = [simulate(m, 1.0, q0=[1.0], backend=b, progress=False) for b in ("auto", "numpy")]
+    assert [r.status for r in runs] == ["success", "success"]
+    assert runs[0].q[-1, 0] == pytest.approx(runs[1].q[-1, 0], rel=1e-8)
+
+
+def test_where_the_spring_ends_meet_both_backends_name_the_spring():
+    from mechdyn import simulate
+
+    m = _pendulum_with_a_spring_whose_ends_meet_at_zero()
+    for backend in ("auto", "numpy"):
+        tr = simulate(m, 0.5, q0=[0.0], backend=backend, progress=False)
+        assert tr.status == "failed" and "spring 'sp': its two points coincide" in tr.message

@@ -104,8 +104,11 @@ class CompiledKernel:
         y = np.empty(2 * n + 1)
         y[:n] = q
         y[n:2 * n] = qdot
-        out = first_order(float(t), y, self.ip, self.fp, self.ri, self.rf, self.dims,
-                           self.ws, self._st)
+        try:
+            out = first_order(float(t), y, self.ip, self.fp, self.ri, self.rf, self.dims,
+                              self.ws, self._st)
+        except ZeroDivisionError:  # e.g. a spring whose ends meet: the NumPy path names it
+            self._st[0] = 3
         self.status = int(self._st[0])
         if self.status:
             return None
@@ -125,8 +128,11 @@ class CompiledKernel:
         nc = int(self.dims[D_NC])
         out = np.empty(2 * n + 1)
         ext = np.empty(nx + 3 * nq + nc + nx)
-        full(float(t), np.asarray(q, np.float64), np.asarray(qdot, np.float64), self.ip,
-              self.fp, self.ri, self.rf, self.dims, self.ws, out, ext, self._st)
+        try:
+            full(float(t), np.asarray(q, np.float64), np.asarray(qdot, np.float64), self.ip,
+                 self.fp, self.ri, self.rf, self.dims, self.ws, out, ext, self._st)
+        except ZeroDivisionError:
+            self._st[0] = 3
         self.status = int(self._st[0])
         if self.status:
             return None
@@ -163,7 +169,10 @@ class CompiledKernel:
         kern = first_order
 
         def fun(t, y):
-            out = kern(t, y, ip, fp, ri, rf, dims, ws, st)
+            try:
+                out = kern(t, y, ip, fp, ri, rf, dims, ws, st)
+            except ZeroDivisionError:  # the NumPy path (on_failure) names the cause
+                st[0] = 3
             if st[0]:
                 self.status = int(st[0])
                 return on_failure(t, y)
