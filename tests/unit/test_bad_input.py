@@ -84,3 +84,24 @@ def test_where_the_spring_ends_meet_both_backends_name_the_spring():
     for backend in ("auto", "numpy"):
         tr = simulate(m, 0.5, q0=[0.0], backend=backend, progress=False)
         assert tr.status == "failed" and "spring 'sp': its two points coincide" in tr.message
+
+
+@pytest.mark.parametrize(("old", "new", "match"), [
+    ('direction = "rising"\nguard = [["joint:guide"', 'direction = ["rising"]\nguard = '
+     '[["joint:guide"', r"\[\[switches\]\] #1 'lock_on' direction: \['rising'\]: wrong type"),
+    ('guard = [["p", ">", "-2.25 mm"]]', "guard = 5",
+     r"\[\[switches\]\] #2 'lock_off' guard: 5: wrong type: expected an array"),
+    ('frees = ["psi"]', "frees = 3",
+     r"\[\[coordinate_locks\]\] #1 'rocker_lock' frees: 3: wrong type: expected an array"),
+    ('frees = ["psi"]', 'frees = ["psi"]\nengaged = "yes"',
+     r"\[\[coordinate_locks\]\] #1 'rocker_lock' engaged: 'yes': wrong type: expected true"),
+    ("[[coordinate_locks]]", '[[stops]]\nname = "ram_stop"\nvariable = "joint:guide"\n'
+     'lower = "0 mm"\n\n[[coordinate_locks]]', r"'ram_stop' is already the name of an entry"),
+])
+def test_wrong_types_and_duplicate_names_in_the_switchable_tables(old, new, match):
+    from mechdyn import examples
+
+    text = examples.path("press_cycle").read_text(encoding="utf-8")
+    assert old in text
+    with pytest.raises(ModelError, match=match):
+        loads(text.replace(old, new, 1), name="press.toml")

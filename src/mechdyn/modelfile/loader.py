@@ -195,7 +195,7 @@ class _Builder(_BodiesJoints, _LoadsDrives):
             if isinstance(spec, dict) and not self.broken("assembly", k):
                 self.assembly_mode(mech, k, spec)
         if any(k in self.doc for k in SWITCH_TABLES):
-            for p in parse_switches(self.doc, mech, self.fname):
+            for p in parse_switches(self.doc, mech, self.fname, self.bad):
                 self.problem(p)
         return mech
 

@@ -44,7 +44,7 @@ def variable_kind(mech, variable: str) -> str:
     return quantity(parse(variable, mech.coordinates), mech)
 
 
-def parse_switches(doc: dict, mech, where: str = "") -> list[str]:
+def parse_switches(doc: dict, mech, where: str = "", bad_paths=()) -> list[str]:
     """Read the variable-structure tables of a model document into ``mech.extras``.
 
     Parameters
@@ -56,6 +56,9 @@ def parse_switches(doc: dict, mech, where: str = "") -> list[str]:
         coordinates must be there already).
     where : str
         The file name, used as the prefix of every message.
+    bad_paths : sequence of tuple
+        Paths where the schema found a problem (:func:`.schema.schema_problems`): those
+        entries are not read again.
 
     Returns
     -------
@@ -63,7 +66,7 @@ def parse_switches(doc: dict, mech, where: str = "") -> list[str]:
         One message per problem (empty when all is well); each names the file,
         the table, the entry and the key.
     """
-    reader = _Switches(doc, mech, where)
+    reader = _Switches(doc, mech, where, bad_paths)
     reader.locks()
     reader.stops()
     reader.contacts()
@@ -75,16 +78,19 @@ class _Switches(_Reader):
     """Reads the ``[[coordinate_locks]]``, ``[[stops]]``, ``[[contacts]]`` and
     ``[[switches]]`` of a document into a mechanism built from the rest of it."""
 
-    def __init__(self, doc: dict, mech, fname: str):
+    def __init__(self, doc: dict, mech, fname: str, bad_paths=()):
         doc = dict(doc)
         for table in TABLES:  # [table.NAME] sub-tables are read like [[table]] entries
             if isinstance(doc.get(table), dict):
                 doc[table] = [dict(v, name=v.get("name", n)) for n, v in doc[table].items()]
-        super().__init__(doc, fname, ())
+        super().__init__(doc, fname, bad_paths)
         self.mech = mech
         self.body_points = {n: b.point_names() for n, b in mech.all_bodies.items()}
         self.joint_types = {n: type(j).__name__.lower() for n, j in mech.joints.items()}
         self.coord_kinds = {n: c.kind for n, c in mech.coordinates.items()}
+        #: the table of each name read so far, and the names of each table
+        self.names: dict[str, str] = {}
+        self.seen: dict[str, set] = {t: set() for t in TABLES}
 
     def entries(self, table: str):
         """(index, entry) of each named entry of ``table``; unknown keys are problems."""
@@ -96,6 +102,8 @@ class _Switches(_Reader):
             if not isinstance(e, dict):
                 self.problem(f"{self.where(table, k)}: expected a table")
                 continue
+            if self.broken(table, k):  # the schema has named what is wrong with it
+                continue
             for key in e:
                 if key not in TABLES[table]:
                     self.problem(f"{self.where(table, k, key)}: unknown key; valid keys: "
@@ -103,6 +111,12 @@ class _Switches(_Reader):
             if not isinstance(e.get("name"), str) or not e.get("name"):
                 self.problem(f"{self.where(table, k, 'name')}: a name (string) is required")
                 continue
+            taken = self.names.setdefault(e["name"], table)
+            if taken != table or e["name"] in self.seen[table]:
+                self.problem(f"{self.where(table, k, 'name')}: {e['name']!r} is already the "
+                             f"name of an entry of [[{taken}]]; names must be unique")
+                continue
+            self.seen[table].add(e["name"])
             self.failed = False
             yield (table, k), e
 
