@@ -15,9 +15,11 @@ Use them only when ``rows_numba.NUMBA`` is True: without numba they run as
 
 from __future__ import annotations
 
+import numpy as np
+
 from .rows_numba import njit, rows_jacobian, rows_quad, rows_values
 
-__all__ = ["system1", "gamma1", "system_batch", "gamma_batch"]
+__all__ = ["system1", "gamma1", "system_batch", "gamma_batch", "lu_batch", "lu_solve_batch"]
 
 
 @njit
@@ -71,3 +73,73 @@ def gamma_batch(x, xdot, nb, ints, flts, out):
     """:func:`gamma1` at every pose of a batch: x, xdot (N, n_x), into out (N, n_eq)."""
     for i in range(x.shape[0]):
         gamma1(x[i], xdot[i], nb, ints, flts, out[i])
+
+
+@njit
+def lu_batch(A, piv, sign):
+    """LU factors with partial pivoting of every matrix of a batch, in place (LAPACK's
+    ``getrf`` layout: P A = L U, L unit lower).
+
+    Parameters
+    ----------
+    A : ndarray, shape (N, n, n)
+        The matrices, overwritten by their factors; an exactly zero pivot is stored as
+        NaN (the solves then return NaN instead of raising).
+    piv : ndarray of int, shape (N, n)
+        Output: the row swapped with row c at step c.
+    sign : ndarray, shape (N,)
+        Output: the sign of each determinant (0 for an exactly singular matrix).
+    """
+    n = A.shape[1]
+    for b in range(A.shape[0]):
+        M = A[b]
+        s = 1.0
+        for c in range(n):
+            p = c
+            for r in range(c + 1, n):
+                if abs(M[r, c]) > abs(M[p, c]):
+                    p = r
+            piv[b, c] = p
+            if p != c:
+                s = -s
+                for j in range(n):
+                    M[c, j], M[p, j] = M[p, j], M[c, j]
+            d = M[c, c]
+            if d == 0.0:
+                s = 0.0
+                d = M[c, c] = np.nan
+            elif d < 0.0:
+                s = -s
+            for r in range(c + 1, n):
+                if M[r, c] != 0.0:  # the Jacobians are sparse
+                    f = M[r, c] = M[r, c] / d
+                    for j in range(c + 1, n):
+                        M[r, j] -= f * M[c, j]
+        sign[b] = s
+
+
+@njit
+def lu_solve_batch(LU, piv, y):
+    """Solve with the factors of :func:`lu_batch`, in place: y (N, n, k) holds the
+    right-hand sides on entry and the solutions on return."""
+    n, k = y.shape[1], y.shape[2]
+    for b in range(y.shape[0]):
+        M, Y = LU[b], y[b]
+        for c in range(n):
+            p = piv[b, c]
+            if p != c:
+                for j in range(k):
+                    Y[c, j], Y[p, j] = Y[p, j], Y[c, j]
+        for c in range(n):
+            for r in range(c + 1, n):
+                if M[r, c] != 0.0:
+                    for j in range(k):
+                        Y[r, j] -= M[r, c] * Y[c, j]
+        for c in range(n - 1, -1, -1):
+            d = M[c, c]
+            for j in range(k):
+                Y[c, j] /= d
+            for r in range(c):
+                if M[r, c] != 0.0:
+                    for j in range(k):
+                        Y[r, j] -= M[r, c] * Y[c, j]

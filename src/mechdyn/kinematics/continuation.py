@@ -67,33 +67,33 @@ def _newton(kern: Kernel, x, q, tol, max_iter=_MAX_NEWTON):
 
 def _newton1(kern: Kernel, x, q, tol, max_iter=_MAX_NEWTON):
     """Newton for one position; returns x, converged, J at x and its LU factors."""
-    F, J = kern.system1(x, q)
+    F, J = kern.system(x, q)
     err = float(np.max(np.abs(F))) if F.size else 0.0
     first, prev = err, np.inf
     for _ in range(max_iter):
         if err <= tol:
             break
-        fac = kern.factor1(J, want_sign=False)
-        dx = kern.solve1(J, fac, F)
+        fac = kern.factor(J)
+        dx = kern.apply(J, fac, F)
         xn = x - dx
         if not np.all(np.isfinite(xn)):
             return x, False, J, None
         x = xn
-        F, J = kern.system1(x, q)
+        F, J = kern.system(x, q)
         prev, err = err, float(np.max(np.abs(F)))
         if not np.isfinite(err) or err > 1e3 * max(first, tol):
             return x, False, J, None
         if err >= 0.5 * prev and err <= 1e3 * tol:  # stagnating at round-off level
             break
     ok = err <= 1e3 * tol
-    return x, ok, J, kern.factor1(J) if ok else None
+    return x, ok, J, kern.factor(J) if ok else None
 
 
 def _polish(kern: Kernel, xp, Q, tol):
     """Newton from accurate predictions ``xp`` (N, n_x): one batched step, then more
     iterations only where needed.  Returns x, F and J at x, and the converged mask."""
     F, J = kern.system(xp, Q)
-    X = xp - kern.apply(J, kern.factor(J, want_sign=False), F[..., None])[..., 0]
+    X = xp - kern.apply(J, kern.factor(J), F[..., None])[..., 0]
     F, J = kern.system(X, Q)
     ok = np.max(np.abs(F), axis=1) <= tol
     if not ok.all():
@@ -106,10 +106,10 @@ def _polish(kern: Kernel, xp, Q, tol):
 def _node(kern: Kernel, x, q, k: int, J=None, fac=None) -> _Node:
     """Analogs, second derivative along coordinate ``k`` and branch sign at a solved pose."""
     if J is None:
-        _, J = kern.system1(x, q)
-        fac = kern.factor1(J)
-    B = kern.solve1(J, fac, kern.rhs_unit(1)[0])
-    H = kern.solve1(J, fac, kern.gamma1(x, B[:, k]))
+        _, J = kern.system(x, q)
+        fac = kern.factor(J)
+    B = kern.apply(J, fac, kern.rhs_unit(1)[0])
+    H = kern.apply(J, fac, kern.gamma(x, B[:, k]))
     sign = fac[2] if fac is not None else 1.0
     return _Node(q.copy(), x.copy(), B, H, sign)
 
@@ -144,9 +144,9 @@ def _chart_node(kern: Kernel, chart, q, k: int) -> _Node:
     derivative from the chart; the other columns of B by a direct solve at that pose."""
     x, xs, xss = chart.evaluate(q[k])
     with np.errstate(all="ignore"):
-        _, J = kern.system1(x, q)
+        _, J = kern.system(x, q)
         try:
-            B = kern.solve1(J, kern.factor1(J, want_sign=False), kern.rhs_unit(1)[0])
+            B = kern.apply(J, kern.factor(J), kern.rhs_unit(1)[0])
         except (np.linalg.LinAlgError, ZeroDivisionError):
             B = np.full((x.size, q.size), np.nan)
     B = np.array(B, dtype=float)

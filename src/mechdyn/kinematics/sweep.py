@@ -35,8 +35,8 @@ How it is computed (vectorized over the positions):
 The residual, Jacobian and acceleration right-hand side are the model's
 constraint and coordinate rows (:mod:`mechdyn.model.rows`), the equations of
 :mod:`mechdyn.kinematics.constraints`, evaluated by a private kernel
-(compiled when numba is installed) that also solves with the block-triangular
-structure of the Jacobian.
+(compiled when numba is installed) that also factors the Jacobians (sparse LU,
+which gives the branch sign too).
 
 This module holds the analyses :func:`sweep` and :func:`analyze`; the building
 blocks of the continuation are in :mod:`mechdyn.kinematics.continuation`, the
@@ -267,7 +267,7 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
         xp = _hermite5(t, h, xa[seg], da[seg], aa[seg], xa[seg + 1], da[seg + 1], aa[seg + 1])
         X, F, J, ok_f = _polish(kern, xp, Q, tol)
         fac = kern.factor(J)
-        sgn = fac.sign if fac is not None else kern.sign(J)
+        sgn = fac[2]
         near = np.max(np.abs((X - xp) * kern.col_scale), axis=1) <= 1e-3 * L
         ok_f &= (sgn == sg[seg]) & near
         bad_segments = np.unique(seg[~ok_f])
