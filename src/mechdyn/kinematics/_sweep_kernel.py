@@ -22,7 +22,7 @@ import numpy as np
 from ..kernels import rows_numpy
 from ..model import ConstraintLayout, Model
 from ..model.rows import concat
-from .assembly import _scale
+from .assembly import _dense_solve, _scale
 
 __all__ = ["Kernel"]
 
@@ -99,15 +99,6 @@ class Kernel:
         self._drivers.gamma_batch(_c(x), _c(xdot), self.nb, self._ints, self._flts, out)
         return out
 
-    def solve(self, J, rhs):
-        """y with J y = rhs by a dense solve (least squares if J is singular or not square)."""
-        if self.square:
-            try:
-                return np.linalg.solve(J, rhs)
-            except np.linalg.LinAlgError:
-                pass
-        return np.linalg.pinv(J) @ rhs
-
     def factor(self, J):
         """Factors of Jacobians J (N, n_eq, n_x) or (n_eq, n_x) for :meth:`apply`, and the
         signs of det [Phi_x; g_x] (the branch sign, as ``assembly.branch_sign``):
@@ -129,13 +120,13 @@ class Kernel:
         """y with J y = rhs, J (N, n_eq, n_x) and rhs (N, n_eq, k) -> (N, n_x, k), or one
         position (J 2-D, rhs 1-D or 2-D), with the factors of :meth:`factor`."""
         if fac is None or fac[0] is None:
-            return self.solve(J, rhs)
+            return _dense_solve(J, rhs)
         y = np.array(rhs, dtype=float)
         shape = y.shape
         y = y.reshape((-1,) + shape[-2:] if J.ndim == 3 else (1, self.n_eq, -1))
         self._drivers.lu_solve_batch(fac[0], fac[1], y)
         y = y.reshape(shape)
-        return y if np.all(np.isfinite(y)) else self.solve(J, rhs)
+        return y if np.all(np.isfinite(y)) else _dense_solve(J, rhs)
 
     def rhs_unit(self, N):
         """[0; I], the right-hand side of the velocity-analog equations, (N, n_eq, n_q)."""

@@ -57,7 +57,8 @@ def joint_residuals(model: Model, x, layout: ConstraintLayout | None = None) -> 
     return dict(sorted(res.items(), key=lambda kv: -kv[1]))
 
 
-def newton(rows: Rows, x_guess, target, *, sel=None, tol: float, max_iter: int = 40):
+def newton(rows: Rows, x_guess, target, *, sel=None, tol: float, max_iter: int = 40,
+           system=None, solve=None):
     """The one position Newton solve of the package: rows(x)[sel] = target (batched).
 
     Parameters
@@ -72,6 +73,13 @@ def newton(rows: Rows, x_guess, target, *, sel=None, tol: float, max_iter: int =
         The rows solved for (default all); their number must be n_x for a unique pose.
     tol : float
         Residual tolerance (m, or rad for angle rows).
+    system : callable, optional
+        ``system(x) -> (values, jacobian)`` of the selected rows at poses (..., n_x), for
+        another evaluator of the same rows (the compiled kernel of the sweep); default
+        :mod:`mechdyn.kernels.rows_numpy`.
+    solve : callable, optional
+        ``solve(J, F) -> dx`` with J dx = F, J (..., n_sel, n_x) and F (..., n_sel);
+        default a dense solve, least squares where J is singular or not square.
 
     Returns
     -------
@@ -92,31 +100,26 @@ def newton(rows: Rows, x_guess, target, *, sel=None, tol: float, max_iter: int =
     batch = np.broadcast_shapes(target.shape[:-1], x.shape[:-1])
     x = np.broadcast_to(x, batch + (rows.n_x,)).copy()
     sel = np.arange(len(rows)) if sel is None else np.asarray(sel)
-    prev = np.full(batch, np.inf)
-    done = np.zeros(batch, dtype=bool)
+    prev = np.inf
     for _ in range(max_iter):
-        p = rows_numpy.Parts(rows, x)
-        F = rows_numpy.values(rows, x, p)[..., sel] - target
+        if system is None:
+            p = rows_numpy.Parts(rows, x)
+            F = rows_numpy.values(rows, x, p)[..., sel] - target
+        else:
+            F, J = system(x)
+            F = F - target
         err = np.max(np.abs(F), axis=-1) if F.shape[-1] else np.zeros(batch)
-        err = np.where(np.isfinite(err), err, np.inf)
-        # converged, or stagnating at round-off level
+        # converged, or stagnating at round-off level (a NaN error is neither)
         done = (err <= tol) | ((err >= 0.5 * prev) & (err <= 1e3 * tol))
         if np.all(done) or not np.all(np.isfinite(x)):
             break
-        prev = np.where(done, prev, err)
-        J = rows_numpy.jacobian(rows, x, p)[..., sel, :]
-        if J.shape[-1] == J.shape[-2]:
-            try:
-                dx = np.linalg.solve(J, F[..., None])[..., 0]
-            except np.linalg.LinAlgError:
-                dx = _lstsq(J, F)
-        else:
-            dx = _lstsq(J, F)
-        if not np.all(np.isfinite(dx)):
-            dx = _lstsq(J, F)
+        prev = err
+        if system is None:
+            J = rows_numpy.jacobian(rows, x, p)[..., sel, :]
+        dx = solve(J, F) if solve else _dense_solve(J, F[..., None])[..., 0]
         x = x - np.where(done[..., None], 0.0, dx)
     else:
-        F = rows_numpy.values(rows, x)[..., sel] - target
+        F = (rows_numpy.values(rows, x)[..., sel] if system is None else system(x)[0]) - target
         done = np.max(np.abs(F), axis=-1) <= 1e3 * tol if F.shape[-1] else np.ones(batch, bool)
     return x, done
 
@@ -166,8 +169,16 @@ def solve_position(model: Model, q, x_guess, *, layout: ConstraintLayout | None 
     return x
 
 
-def _lstsq(J, F):
-    return (np.linalg.pinv(J) @ F[..., None])[..., 0]
+def _dense_solve(J, rhs):
+    """y with J y = rhs, rhs (..., n, k): dense, least squares (minimum norm) where J is
+    singular or not square."""
+    try:
+        y = np.linalg.solve(J, rhs)
+        if np.all(np.isfinite(y)):
+            return y
+    except np.linalg.LinAlgError:
+        pass
+    return np.linalg.pinv(J) @ rhs
 
 
 def _assembly_error(model, q, x_start, lay, t):

@@ -42,6 +42,8 @@ from numpy.polynomial import chebyshev as cheb
 
 from ..kernels import rows_numpy
 from ..model import ConstraintLayout, Model
+from ..model.rows import concat
+from .assembly import _scale, newton
 from .continuation import _hermite5
 
 __all__ = ["PathProblem", "BranchChart", "ChartBook", "bridge", "ZONE", "WINDOW", "REACH"]
@@ -117,68 +119,43 @@ class PathProblem:
             raise ValueError("a branch chart needs a square position system "
                              f"({layout.n_rows} joint rows + {self.idx.size} coordinates "
                              f"for {model.n_x} pose components)")
-        self.scale = np.ones(model.n_x)
-        self.scale[2::3] = model.length_scale
+        self.scale = _scale(model)
         angle = bool(model.coord_is_angle[self.idx[self.k]])
         #: unit of the path coordinate for the zone sizes: 1 rad, or the length scale
         self.unit = 1.0 if angle else float(model.length_scale)
         self.tol = 1e-14 * max(model.length_scale, 1e-3)
+        #: the joint rows, then the prescribed coordinates' rows
+        self.rows = concat(model.n_bodies, layout.rowset, model.coordinate_rows.take(self.idx))
         self._e = np.zeros(model.n_x)
         self._e[layout.n_rows + self.k] = 1.0
 
     # ------------------------------------------------------------------ equations
-    def system(self, x, s):
-        """Residual [Phi; g_idx - q(s)] and Jacobian, shapes (n_x,) and (n_x, n_x)."""
-        q = self.q_fixed.copy()
-        q[self.k] = s
-        v, J, _ = rows_numpy.evaluate(self.layout.rowset, x)
-        vg, Jg, _ = rows_numpy.evaluate(self.model.coordinate_rows, x)
-        return (np.concatenate([v, vg[self.idx] - q]),
-                np.concatenate([J, Jg[self.idx]]))
+    def target(self, s) -> np.ndarray:
+        """Values of the rows on the path at s: [0; q(s)], shape (n_x,)."""
+        t = np.zeros(self.model.n_x)
+        t[self.layout.n_rows:] = self.q_fixed
+        t[self.layout.n_rows + self.k] = s
+        return t
 
-    def _quad(self, x, v):
-        """The rows' velocity-quadratic terms at pose x for rates v: Phi_xx[v, v], (n_x,)."""
-        return np.concatenate([rows_numpy.quad(self.layout.rowset, x, v),
-                               rows_numpy.quad(self.model.coordinate_rows, x, v)[self.idx]])
-
-    def newton(self, x, s, max_iter: int = 12):
-        """Newton from ``x`` to the pose at s, converged to round-off; (x, J) or None."""
-        x = np.array(x, dtype=float)
-        prev = np.inf
-        for _ in range(max_iter):
-            F, J = self.system(x, s)
-            err = float(np.max(np.abs(F)))
-            if not np.isfinite(err):
-                return None
-            if err <= self.tol or (err >= 0.5 * prev and err <= 1e3 * self.tol):
-                return x, J
-            prev = err
-            try:
-                x = x - np.linalg.solve(J, F)
-            except np.linalg.LinAlgError:
-                return None
-        return None
+    def jacobian(self, x) -> np.ndarray:
+        """[Phi_x; g_idx,x] at x, shape (n_x, n_x)."""
+        return rows_numpy.jacobian(self.rows, x)
 
     def node(self, s, x, J=None) -> _Node:
         """Analogs x', x'' and the branch sign at a solved pose."""
         if J is None:
-            J = self.system(x, s)[1]
+            J = self.jacobian(x)
         xs = np.linalg.solve(J, self._e)
-        xss = np.linalg.solve(J, -self._quad(x, xs))
+        xss = np.linalg.solve(J, -rows_numpy.quad(self.rows, x, xs))
         sign = float(np.sign(np.linalg.det(J * self.scale)))
         return _Node(float(s), np.array(x, dtype=float), xs, xss, sign)
 
     def solve(self, s, x_guess) -> _Node | None:
         """The node at s by Newton from ``x_guess`` (None if it does not converge)."""
-        out = self.newton(x_guess, s)
-        return None if out is None else self.node(s, *out)
+        x, done = newton(self.rows, x_guess, self.target(s), tol=self.tol, max_iter=12)
+        return self.node(s, x) if done else None
 
     # ------------------------------------------------------------------ singular values
-    def jacobian(self, x) -> np.ndarray:
-        """[Phi_x; g_idx,x] at x, shape (n_x, n_x)."""
-        return np.concatenate([rows_numpy.jacobian(self.layout.rowset, x),
-                               rows_numpy.jacobian(self.model.coordinate_rows, x)[self.idx]])
-
     def singular_offset(self, x, xs=None) -> float:
         """Estimated offset s* - s of the nearest singular position from the pose x at s
         (``xs``: its analog dx/ds, computed if not given).
@@ -204,10 +181,10 @@ class PathProblem:
         return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
 
     # ------------------------------------------------------------------ continuation
-    def march(self, node: _Node, s_to: float, *, keep_sign: bool = True):
+    def march(self, node: _Node, s_to: float):
         """Continuation from ``node`` to s_to (second-order Taylor predictor, step
-        halving); returns (node reached, ok).  With ``keep_sign`` a change of the branch
-        sign is refused, so the march stops in front of a singular position."""
+        halving); returns (node reached, ok).  A change of the branch sign is refused,
+        so the march stops in front of a singular position."""
         h_max = _STEP * self.unit
         h_min = 1e-9 * self.unit
         h_try = h_max
@@ -216,7 +193,7 @@ class PathProblem:
             h = rem if abs(rem) <= h_try * (1 + 1e-9) else np.sign(rem) * h_try
             xp = node.x + node.xs * h + 0.5 * node.xss * h * h
             nn = self.solve(node.s + h if h != rem else s_to, xp)
-            ok = nn is not None and (not keep_sign or nn.sign == node.sign)
+            ok = nn is not None and nn.sign == node.sign
             if ok:
                 step = np.max(np.abs((nn.x - node.x) * self.scale))
                 corr = np.max(np.abs((nn.x - xp) * self.scale))

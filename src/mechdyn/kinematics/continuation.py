@@ -1,17 +1,16 @@
 """Numerical continuation along one coordinate: the building blocks of the sweep.
 
-Newton's method on a batch of positions (:func:`_newton`, :func:`_polish`) and on
-one position (:func:`_newton1`), the solved positions of the continuation
-(:class:`_Node`: pose, velocity analogs, second derivative along the swept
-coordinate and branch sign), their quintic Hermite predictor (:func:`_hermite5`,
-:func:`_predict`), the sequential step-halving march (:func:`_march`, through
-bifurcation positions with the branch charts of
-:mod:`mechdyn.kinematics.branch_chart`: :func:`_chart_node`), the choice
-of the anchors it visits (:func:`_anchor_indices`) and the per-model cache of the
+The position Newton of :mod:`mechdyn.kinematics.assembly` on the compiled kernel's
+equations, for a batch or one position (:func:`_newton`), the solved positions of
+the continuation (:class:`_Node`: pose, velocity analogs, second derivative along
+the swept coordinate and branch sign), their quintic Hermite predictor
+(:func:`_hermite5`, :func:`_predict`), the sequential step-halving march
+(:func:`_march`, through bifurcation positions with the branch charts of
+:mod:`mechdyn.kinematics.branch_chart`: :func:`_chart_node`), the choice of the
+anchors it visits (:func:`_anchor_indices`) and the per-model cache of the
 evaluation kernel (:func:`_kernel`).  The analyses that use them are in
 :mod:`mechdyn.kinematics.sweep`; the dead-centre refinement of
-:mod:`mechdyn.kinematics.figures` reuses :func:`_newton1` and :func:`_node`.
-"""
+:mod:`mechdyn.kinematics.figures` reuses :func:`_newton` and :func:`_node`."""
 
 from __future__ import annotations
 
@@ -21,6 +20,7 @@ import numpy as np
 
 from ..model import Model
 from ._sweep_kernel import Kernel
+from .assembly import newton
 
 #: Newton iterations allowed per step of the continuation / per batched polish
 _MAX_NEWTON = 10
@@ -38,80 +38,31 @@ class _Node:
 
 
 def _newton(kern: Kernel, x, q, tol, max_iter=_MAX_NEWTON):
-    """Newton on a batch from ``x``; returns x, converged (N,), last F and J (at x)."""
-    x = x.copy()
-    F, J = kern.system(x, q)
-    err = np.max(np.abs(F), axis=1)
-    prev = np.full(x.shape[0], np.inf)
-    ok = err <= tol
-    active = ~ok
-    it = 0
-    while active.any() and it < max_iter:
-        it += 1
-        idx = np.flatnonzero(active)
-        dx = kern.solve(J[idx], F[idx, :, None])[..., 0]
-        xi = x[idx] - dx
-        bad = ~np.all(np.isfinite(xi), axis=1)
-        xi[bad] = x[idx][bad]
-        x[idx] = xi
-        Fi, Ji = kern.system(xi, q[idx])
-        F[idx], J[idx] = Fi, Ji
-        e = np.max(np.abs(Fi), axis=1)
-        # converged, or stagnating at round-off level
-        ok[idx] = ~bad & ((e <= tol) | ((e >= 0.5 * prev[idx]) & (e <= 1e3 * tol)))
-        diverged = bad | ~np.isfinite(e) | (e > 1e3 * np.maximum(err[idx], tol))
-        prev[idx] = e
-        active[idx] = ~ok[idx] & ~diverged
-    return x, ok, F, J
+    """The one position Newton (:func:`~mechdyn.kinematics.assembly.newton`) on the
+    kernel's equations [Phi; g - q] = 0, from poses x (N, n_x) or one pose (1-D x, q);
+    returns x, converged, and the residual F and the Jacobian J at x."""
+    at = []
+
+    def system(xx):
+        at[:] = kern.system(xx, q)
+        return at[0], at[1]
+
+    def solve(J, F):
+        return kern.apply(J, kern.factor(J), F[..., None])[..., 0]
+
+    x, ok = newton(kern.rows, x, np.zeros(kern.n_eq), tol=tol, max_iter=max_iter,
+                   system=system, solve=solve)
+    return x, ok, at[0], at[1]
 
 
-def _newton1(kern: Kernel, x, q, tol, max_iter=_MAX_NEWTON):
-    """Newton for one position; returns x, converged, J at x and its LU factors."""
-    F, J = kern.system(x, q)
-    err = float(np.max(np.abs(F))) if F.size else 0.0
-    first, prev = err, np.inf
-    for _ in range(max_iter):
-        if err <= tol:
-            break
-        fac = kern.factor(J)
-        dx = kern.apply(J, fac, F)
-        xn = x - dx
-        if not np.all(np.isfinite(xn)):
-            return x, False, J, None
-        x = xn
-        F, J = kern.system(x, q)
-        prev, err = err, float(np.max(np.abs(F)))
-        if not np.isfinite(err) or err > 1e3 * max(first, tol):
-            return x, False, J, None
-        if err >= 0.5 * prev and err <= 1e3 * tol:  # stagnating at round-off level
-            break
-    ok = err <= 1e3 * tol
-    return x, ok, J, kern.factor(J) if ok else None
-
-
-def _polish(kern: Kernel, xp, Q, tol):
-    """Newton from accurate predictions ``xp`` (N, n_x): one batched step, then more
-    iterations only where needed.  Returns x, F and J at x, and the converged mask."""
-    F, J = kern.system(xp, Q)
-    X = xp - kern.apply(J, kern.factor(J), F[..., None])[..., 0]
-    F, J = kern.system(X, Q)
-    ok = np.max(np.abs(F), axis=1) <= tol
-    if not ok.all():
-        idx = np.flatnonzero(~ok)
-        x2, ok2, F2, J2 = _newton(kern, X[idx], Q[idx], tol, max_iter=4)
-        X[idx], F[idx], J[idx], ok[idx] = x2, F2, J2, ok2
-    return X, F, J, ok
-
-
-def _node(kern: Kernel, x, q, k: int, J=None, fac=None) -> _Node:
+def _node(kern: Kernel, x, q, k: int, J=None) -> _Node:
     """Analogs, second derivative along coordinate ``k`` and branch sign at a solved pose."""
     if J is None:
-        _, J = kern.system(x, q)
-        fac = kern.factor(J)
+        J = kern.system(x, q)[1]
+    fac = kern.factor(J)
     B = kern.apply(J, fac, kern.rhs_unit(1)[0])
     H = kern.apply(J, fac, kern.gamma(x, B[:, k]))
-    sign = fac[2] if fac is not None else 1.0
-    return _Node(q.copy(), x.copy(), B, H, sign)
+    return _Node(q.copy(), x.copy(), B, H, fac[2])
 
 
 @dataclass
@@ -191,11 +142,11 @@ def _march(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, t
             if book is not None:
                 win = book.window_chart(qn[k]) or book.window_chart(node.q[k])
             xp = win.evaluate(qn[k])[0] if win is not None else _predict(prev, node, k, h)
-            x, ok, J, fac = _newton1(kern, xp, qn, tol)
+            x, ok, _, J = _newton(kern, xp, qn, tol)
             accepted = False
             reason = "Newton's method does not converge"
             if ok:
-                nn = _node(kern, x, qn, k, J=J, fac=fac)
+                nn = _node(kern, x, qn, k, J=J)
                 step = _scaled_norm(kern, nn.x - node.x)
                 corr = _scaled_norm(kern, nn.x - xp)
                 expected = win.side_sign(qn[k]) if win is not None else node.sign

@@ -14,13 +14,14 @@ from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+from scipy.optimize import brentq
 
 from ..kernels import rows_numpy
 from ..mechanism.joint import Revolute
 from ..model import Model
 from .assembly import _position_tol
 from .constraints import point_position, travel_rows
-from .continuation import _kernel, _newton1, _node
+from .continuation import _kernel, _newton, _node
 
 if TYPE_CHECKING:
     from .records import KinematicSweep
@@ -265,57 +266,32 @@ def _summarize(sw: KinematicSweep) -> SweepSummary:
     return SweepSummary(sw.over, sw.over_is_angle, strokes, dcs, trans, ext)
 
 
-def _point_state(sw: KinematicSweep, q_over: float, x_guess):
-    """Solve one position on the sweep's path; returns the node (B, H along ``over``)."""
-    m = sw.model
-    kern = _kernel(m, m.layout(sw.stats.get("mode")))
-    k = sw.over_index
-    q = sw.q[0].copy()
-    q[k] = q_over
-    tol = _position_tol(m)
-    x, ok, J, fac = _newton1(kern, np.asarray(x_guess, float), q, tol)
-    if not ok:
-        return None
-    return _node(kern, x, q, k, J=J, fac=fac)
-
-
-def _travel_derivs(sw, jname, node):
-    s, ds, dds = _travel(sw.model, jname, node.x, node.B[:, sw.over_index], node.H)
-    return float(s), float(ds), float(dds)
-
-
 def _refine_dead_centre(sw: KinematicSweep, jname: str, i: int) -> tuple[float, float]:
-    """Root of ds/dq between positions i and i+1 by safeguarded Newton (exact s'')."""
-    k = sw.over_index
+    """Root of the exact travel rate ds/dq between positions i and i+1 (Brent's method,
+    each rate at a position solved from the last); returns (q there, travel there)."""
+    m, k = sw.model, sw.over_index
+    kern = _kernel(m, m.layout(sw.stats.get("mode")))
+    tol = _position_tol(m)
+    last = {"x": sw.x[i], "s": np.nan}
+
+    def rate(q_over):
+        q = sw.q[0].copy()
+        q[k] = q_over
+        x, ok, _, J = _newton(kern, np.array(last["x"], dtype=float), q, tol)
+        if not ok:
+            raise ArithmeticError(f"no position at {sw.over} = {q_over!r}")
+        node = _node(kern, x, q, k, J=J)
+        last["x"] = x
+        s, ds, _ = _travel(m, jname, x, node.B[:, k], node.H)
+        last["s"] = float(s)
+        return float(ds)
+
     a, b = float(sw.values[i]), float(sw.values[i + 1])
-    _, fa, _ = _travel(sw.model, jname, sw.x[i], sw.B[i, :, k], np.zeros(sw.model.n_x))
-    _, fb, _ = _travel(sw.model, jname, sw.x[i + 1], sw.B[i + 1, :, k],
-                       np.zeros(sw.model.n_x))
-    fa, fb = float(fa), float(fb)
-    q = a - fa * (b - a) / (fb - fa)
-    lo, hi, flo = a, b, fa
-    s_at = np.nan
-    xg = sw.x[i] if abs(q - a) <= abs(q - b) else sw.x[i + 1]
-    for _ in range(60):
-        node = _point_state(sw, q, xg)
-        if node is None:
-            break
-        xg = node.x
-        s_at, f, fp = _travel_derivs(sw, jname, node)
-        if f == 0.0:
-            break
-        if np.sign(f) == np.sign(flo):
-            lo, flo = q, f
-        else:
-            hi = q
-        qn = q - f / fp if fp != 0 else np.nan
-        if not (min(lo, hi) < qn < max(lo, hi)):
-            qn = 0.5 * (lo + hi)
-        if abs(qn - q) <= 1e-14 * max(1.0, abs(q)):
-            q = qn
-            break
-        q = qn
-    node = _point_state(sw, q, xg)
-    if node is not None:
-        s_at = _travel_derivs(sw, jname, node)[0]
-    return float(q), float(s_at)
+    try:
+        q = brentq(rate, min(a, b), max(a, b), xtol=1e-15, rtol=4 * np.finfo(float).eps)
+        rate(q)
+    except (ArithmeticError, ValueError):  # no solved root: interpolate the sampled rates
+        _, fa, _ = _travel(m, jname, sw.x[i], sw.B[i, :, k], np.zeros(m.n_x))
+        _, fb, _ = _travel(m, jname, sw.x[i + 1], sw.B[i + 1, :, k], np.zeros(m.n_x))
+        q = a - fa * (b - a) / (fb - fa)
+    return float(q), last["s"]

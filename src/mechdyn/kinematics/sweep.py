@@ -64,9 +64,7 @@ from .continuation import (
     _kernel,
     _march,
     _newton,
-    _newton1,
     _node,
-    _polish,
     _Stop,
 )
 from .figures import (
@@ -213,11 +211,11 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
     else:
         x0 = np.asarray(x_start, float).reshape(model.n_x)
         q_init = coordinates(model, x0)
-    x_init, ok, J0, fac0 = _newton1(kern, x0, q_init, tol)
+    x_init, ok, _, J0 = _newton(kern, x0, q_init, tol)
     if not ok:
         x_init = assemble(model, q_init, x_guess=x0, layout=lay)
-        J0 = fac0 = None
-    start = _node(kern, x_init, q_init, k, J=J0, fac=fac0)
+        J0 = None
+    start = _node(kern, x_init, q_init, k, J=J0)
     # bifurcation positions on the way are gone through on the branch (branch charts)
     book = None
     if lay.n_rows + model.n_q == model.n_x:
@@ -265,7 +263,7 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
         with np.errstate(invalid="ignore", divide="ignore"):
             t = np.where(h != 0, (values[:n_ok, None] - qa[seg, None]) / h, 0.0)
         xp = _hermite5(t, h, xa[seg], da[seg], aa[seg], xa[seg + 1], da[seg + 1], aa[seg + 1])
-        X, F, J, ok_f = _polish(kern, xp, Q, tol)
+        X, ok_f, F, J = _newton(kern, xp, Q, tol, max_iter=5)
         fac = kern.factor(J)
         sgn = fac[2]
         near = np.max(np.abs((X - xp) * kern.col_scale), axis=1) <= 1e-3 * L
@@ -417,12 +415,13 @@ def analyze(mech_or_model, q, qdot, qddot=None, x_guess=None, *, mode=None) -> K
         if x_guess is None:
             x_guess = assemble(model, layout=lay)
     tol = _position_tol(model)
-    x, ok, _, J = _newton(kern, np.asarray(x_guess, float)[None], q[None], tol)
-    if not ok[0]:
-        x = assemble(model, q, x_guess=x_guess, layout=lay)[None]
-        _, J = kern.system(x, q[None])
-    B = kern.solve(J, kern.rhs_unit(1))[0]
+    x, ok, _, J = _newton(kern, np.asarray(x_guess, float), q, tol)
+    if not ok:
+        x = assemble(model, q, x_guess=x_guess, layout=lay)
+        J = kern.system(x, q)[1]
+    fac = kern.factor(J)
+    B = kern.apply(J, fac, kern.rhs_unit(1)[0])
     xdot = B @ qdot
-    xddot = B @ qddot + kern.solve(J, kern.gamma(x, xdot[None])[..., None])[0, :, 0]
+    xddot = B @ qddot + kern.apply(J, fac, kern.gamma(x, xdot))
     return KinematicPoint(q=_ro(q.copy()), qdot=_ro(qdot.copy()), qddot=_ro(qddot.copy()),
-                          x=_ro(x[0]), xdot=_ro(xdot), xddot=_ro(xddot), B=_ro(B), model=model)
+                          x=_ro(x), xdot=_ro(xdot), xddot=_ro(xddot), B=_ro(B), model=model)
