@@ -8,8 +8,8 @@ import pytest
 from mechdyn import Mechanism, ModelError, SingularPositionError
 from mechdyn.kernels import rows_numba
 from mechdyn.kinematics import branch_sign, residual
-from mechdyn.kinematics._sweep_kernel import Kernel
 from mechdyn.kinematics.constraints import coordinates
+from mechdyn.kinematics.continuation import Kernel
 from mechdyn.kinematics.sweep import (
     KinematicSweep,
     _anchor_indices,
