@@ -184,22 +184,9 @@ def _dense_solve(J, rhs):
 def _assembly_error(model, q, x_start, lay, t):
     """Find the closest configuration by least squares and say which joints stay open."""
     q = np.asarray(q, float)
-    w = 1e3  # the coordinates are honoured much more strongly than the joints
-
-    def fun(x):
-        F, _ = system(model, x, q, lay)
-        F[lay.n_rows:] *= w
-        return F
-
-    def jac(x):
-        _, J = system(model, x, q, lay)
-        J[lay.n_rows:] *= w
-        return J
-
     x = x_start if np.all(np.isfinite(x_start)) else model.x_sketch
-    try:
-        sol = least_squares(fun, x, jac=jac, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15)
-        x = sol.x
+    try:  # the coordinates are honoured much more strongly than the joints
+        x = _least_squares(model, x, q, lay, weight=1e3, method="lm")
     except Exception:  # noqa: BLE001 - keep the Newton iterate for the report
         pass
     res = joint_residuals(model, x, lay)
@@ -384,18 +371,23 @@ def _assemble_near(model: Model, q=None, *, x_guess=None, layout=None, t=None) -
         return solve_position(model, q, x, layout=lay, t=t, check_singular=False, max_iter=8)
     except AssemblyError:
         pass
+    x = _least_squares(model, x, q, lay, method="trf", max_nfev=2000,
+                       x_scale=_scale(model) / model.length_scale)
+    return solve_position(model, q, x, layout=lay, t=t, check_singular=False)
+
+
+def _least_squares(model, x, q, lay, weight: float = 1.0, **options) -> np.ndarray:
+    """The pose nearest to [Phi; weight (g - q)] = 0 from x, by SciPy's least_squares."""
+    w = np.ones(lay.n_rows + model.n_q)
+    w[lay.n_rows:] = weight
 
     def fun(xx):
-        F, _ = system(model, xx, q, lay)
-        return F
+        return system(model, xx, q, lay)[0] * w
 
     def jac(xx):
-        _, J = system(model, xx, q, lay)
-        return J
+        return system(model, xx, q, lay)[1] * w[:, None]
 
-    sol = least_squares(fun, x, jac=jac, method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15,
-                        x_scale=_scale(model) / model.length_scale, max_nfev=2000)
-    return solve_position(model, q, sol.x, layout=lay, t=t, check_singular=False)
+    return least_squares(fun, x, jac=jac, xtol=1e-15, ftol=1e-15, gtol=1e-15, **options).x
 
 
 def rank_report(model: Model, x, layout=None) -> dict:
@@ -403,7 +395,6 @@ def rank_report(model: Model, x, layout=None) -> dict:
     lay = layout or model.layout()
     sc = _scale(model)
     P = jacobian(model, x, lay) * sc
-    G = np.concatenate([P, np.zeros((0, model.n_x))])
     Gq = coordinates_jacobian(model, x) * sc
     tol_rel = 1e-9
     rank_phi = _rank(P, tol_rel)
@@ -415,13 +406,12 @@ def rank_report(model: Model, x, layout=None) -> dict:
         null = u[:, int(np.sum(s > tol_rel * smax)):]
         weight = np.sum(null**2, axis=1)
         redundant = sorted({lay.row_joint[r] for r in range(lay.n_rows) if weight[r] > 1e-6})
-    full = np.concatenate([G, Gq])
+    rank_full = _rank(np.concatenate([P, Gq]), tol_rel)
     dep = []
-    if model.n_q and _rank(full, tol_rel) < rank_phi + model.n_q:
-        for c in range(model.n_q):
-            others = np.concatenate([P, np.delete(Gq, c, axis=0)])
-            if _rank(np.concatenate([others, Gq[c:c + 1]]), tol_rel) == _rank(others, tol_rel):
-                dep.append(model.coordinate_names[c])
+    if model.n_q and rank_full < rank_phi + model.n_q:
+        # coordinate c depends on the others if dropping its row keeps the rank
+        dep = [model.coordinate_names[c] for c in range(model.n_q)
+               if _rank(np.concatenate([P, np.delete(Gq, c, axis=0)]), tol_rel) == rank_full]
     return {"rank_phi": rank_phi, "redundant_joints": redundant, "dependent_coordinates": dep}
 
 

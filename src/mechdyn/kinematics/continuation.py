@@ -13,7 +13,7 @@ Jacobian [Phi_x; g_x] and gamma = -quad of the model's rows, evaluated and facto
 (sparse LU with partial pivoting, which gives the branch sign too) by the compiled
 drivers of :mod:`mechdyn.kernels.rows_sweep`, one position or a whole batch per call
 (NumPy's per-call overhead and temporaries would dominate), or without numba by
-:mod:`mechdyn.kernels.rows_numpy` and dense solves.  The analyses that use them are in
+:mod:`mechdyn.kinematics.constraints` and dense solves.  The analyses that use them are in
 :mod:`mechdyn.kinematics.sweep`; the dead-centre refinement of
 :mod:`mechdyn.kinematics.figures` reuses :func:`_newton` and :func:`_node`.
 """
@@ -24,10 +24,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..kernels import rows_numpy
 from ..model import ConstraintLayout, Model
-from ..model.rows import concat
 from .assembly import _dense_solve, _scale, newton
+from .constraints import full_gamma, system
 
 #: Newton iterations allowed per step of the continuation
 _MAX_NEWTON = 10
@@ -66,7 +65,7 @@ class Kernel:
         self.square = self.n_eq == self.n_x
         self.col_scale = _scale(model)
         #: the rows of F: the layout's constraint rows, then the coordinate rows
-        self.rows = concat(nb, layout.rowset, model.coordinate_rows)
+        self.rows = layout.position_rows
         self._ints, self._flts = self.rows.packed()
         from ..kernels import rows_numba, rows_sweep  # numba is imported only here
 
@@ -85,10 +84,7 @@ class Kernel:
             F, J = self.system(x[None], q[None])
             return F[0], J[0]
         if not self.compiled:
-            p = rows_numpy.parts(self.rows, x)
-            F = rows_numpy.values(self.rows, x, p)
-            F[..., self.n_rows:] -= q
-            return F, rows_numpy.jacobian(self.rows, x, p)
+            return system(self.model, x, q, self.lay)
         F = np.empty((x.shape[0], self.n_eq))
         J = np.zeros((x.shape[0], self.n_eq, self.n_x))
         self._drivers.system_batch(_c(x), _c(q), self.nb, self._ints, self._flts,
@@ -100,7 +96,7 @@ class Kernel:
         if x.ndim == 1:
             return self.gamma(x[None], xdot[None])[0]
         if not self.compiled:
-            return -rows_numpy.quad(self.rows, x, xdot)
+            return full_gamma(self.model, x, xdot, self.lay)
         out = np.empty((x.shape[0], self.n_eq))
         self._drivers.gamma_batch(_c(x), _c(xdot), self.nb, self._ints, self._flts, out)
         return out

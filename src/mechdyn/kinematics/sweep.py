@@ -242,15 +242,11 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
     t_coarse = time.perf_counter() - t_coarse
     # ---- 2. batched solve of every value between solved anchors
     n_ok = int(anchors[n_anch - 1]) + 1 if n_anch else 0
-    Q = np.broadcast_to(q_init, (n_ok, model.n_q)).copy()
-    Q[:, k] = values[:n_ok]
     X = np.empty((n_ok, model.n_x))
-    F = J = fac = None
+    F = fac = None  # F, J and the factors at X, while they are current
     fallback = 0
     if n_anch == 1:
         X[:] = anodes[0].x
-        F, J = kern.system(X, Q)
-        fac = kern.factor(J)
     elif n_anch > 1:
         a_idx = anchors[:n_anch]
         seg = np.clip(np.searchsorted(a_idx, np.arange(n_ok), side="right") - 1, 0, n_anch - 2)
@@ -263,7 +259,7 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
         with np.errstate(invalid="ignore", divide="ignore"):
             t = np.where(h != 0, (values[:n_ok, None] - qa[seg, None]) / h, 0.0)
         xp = _hermite5(t, h, xa[seg], da[seg], aa[seg], xa[seg + 1], da[seg + 1], aa[seg + 1])
-        X, ok_f, F, J = _newton(kern, xp, Q, tol, max_iter=5)
+        X, ok_f, F, J = _newton(kern, xp, _coords(q_init, k, values[:n_ok]), tol, max_iter=5)
         fac = kern.factor(J)
         sgn = fac[2]
         near = np.max(np.abs((X - xp) * kern.col_scale), axis=1) <= 1e-3 * L
@@ -280,12 +276,11 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
             if st is not None:  # only if a singular position lies between two anchors
                 stop = st
                 n_ok = i0 + 1 + len(nodes)
-                X, Q = X[:n_ok], Q[:n_ok]
+                X = X[:n_ok]
                 anodes, n_anch = anodes[:m_ + 1], -1
                 break
         if bad_segments.size:
-            F, J = kern.system(X, Q)
-            fac = kern.factor(J)
+            F = None
 
     # ---- 3. past the last anchor: go on point by point up to the dead position
     if stop is not None and n_anch >= 0 and n_ok < n_req:
@@ -298,19 +293,19 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
             stop = _Stop(nodes[-1], nodes[-1].q, "the continuation could not reach "
                          f"{over} = {values[nxt]:.9g}")
         if nodes:
-            Xn = np.array([nd.x for nd in nodes])
-            Qn = np.broadcast_to(q_init, (len(nodes), model.n_q)).copy()
-            Qn[:, k] = values[n_ok:n_ok + len(nodes)]
-            X, Q = np.concatenate([X, Xn]), np.concatenate([Q, Qn])
+            X = np.concatenate([X, [nd.x for nd in nodes]])
             n_ok += len(nodes)
-            F, J = kern.system(X, Q)
-            fac = kern.factor(J)
+            F = None
 
     # ---- 4. velocities and accelerations in one batch
     N = n_ok
+    Q = _coords(q_init, k, values[:N])
     qdot = np.broadcast_to(qdot_c, (N, model.n_q)).copy()
     qddot = np.zeros((N, model.n_q))
     if N:
+        if F is None:
+            F, J = kern.system(X, Q)
+            fac = kern.factor(J)
         with np.errstate(all="ignore"):  # a Jacobian singular at a bifurcation: charted
             rhs = np.concatenate([F[..., None], kern.rhs_unit(N)], axis=-1)
             sol = kern.apply(J, fac, rhs)
@@ -343,6 +338,13 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
         over=over, values=_ro(values[:N].copy()), q=_ro(Q), qdot=_ro(qdot), qddot=_ro(qddot),
         x=_ro(X), xdot=_ro(xdot), xddot=_ro(xddot), B=_ro(B), status=status, message=message,
         stats=stats, events=events, error=error, model=model)
+
+
+def _coords(q_init, k: int, values) -> np.ndarray:
+    """Coordinates (n, n_q): q_init with coordinate k at the values."""
+    Q = np.tile(q_init, (len(values), 1))
+    Q[:, k] = values
+    return Q
 
 
 def _charted(book: ChartBook, k: int, Q, qdot, X, B, xdot, xddot):
