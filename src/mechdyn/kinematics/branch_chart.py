@@ -40,11 +40,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.polynomial import chebyshev as cheb
 
-from ..kernels import rows_numpy
 from ..model import ConstraintLayout, Model
-from ..model.rows import concat
-from .assembly import _scale, newton
-from .continuation import _hermite5
+from .assembly import _scale
+from .continuation import Kernel, _hermite5, _march, _newton, _node
+from .continuation import _Node as _SweepNode
 
 __all__ = ["PathProblem", "BranchChart", "ChartBook", "bridge", "ZONE", "WINDOW", "REACH"]
 
@@ -124,36 +123,33 @@ class PathProblem:
         #: unit of the path coordinate for the zone sizes: 1 rad, or the length scale
         self.unit = 1.0 if angle else float(model.length_scale)
         self.tol = 1e-14 * max(model.length_scale, 1e-3)
-        #: the joint rows, then the prescribed coordinates' rows
-        self.rows = concat(model.n_bodies, layout.rowset, model.coordinate_rows.take(self.idx))
+        #: the equations [Phi; g_idx - q] (the compiled kernel of the sweep)
+        self.kernel = Kernel(model, layout, self.idx)
         self._e = np.zeros(model.n_x)
         self._e[layout.n_rows + self.k] = 1.0
 
     # ------------------------------------------------------------------ equations
-    def target(self, s) -> np.ndarray:
-        """Values of the rows on the path at s: [0; q(s)], shape (n_x,)."""
-        t = np.zeros(self.model.n_x)
-        t[self.layout.n_rows:] = self.q_fixed
-        t[self.layout.n_rows + self.k] = s
-        return t
+    def _q(self, s) -> np.ndarray:
+        q = self.q_fixed.copy()
+        q[self.k] = s
+        return q
 
     def jacobian(self, x) -> np.ndarray:
         """[Phi_x; g_idx,x] at x, shape (n_x, n_x)."""
-        return rows_numpy.jacobian(self.rows, x)
+        return self.kernel.system(np.asarray(x, dtype=float), self.q_fixed)[1]
 
     def node(self, s, x, J=None) -> _Node:
         """Analogs x', x'' and the branch sign at a solved pose."""
-        if J is None:
-            J = self.jacobian(x)
-        xs = np.linalg.solve(J, self._e)
-        xss = np.linalg.solve(J, -rows_numpy.quad(self.rows, x, xs))
-        sign = float(np.sign(np.linalg.det(J * self.scale)))
-        return _Node(float(s), np.array(x, dtype=float), xs, xss, sign)
+        return self._node(_node(self.kernel, np.asarray(x, dtype=float), self._q(s), self.k, J))
+
+    def _node(self, nd) -> _Node:
+        return _Node(float(nd.q[self.k]), nd.x, nd.B[:, self.k], nd.H, float(nd.sign))
 
     def solve(self, s, x_guess) -> _Node | None:
         """The node at s by Newton from ``x_guess`` (None if it does not converge)."""
-        x, done = newton(self.rows, x_guess, self.target(s), tol=self.tol, max_iter=12)
-        return self.node(s, x) if done else None
+        x, ok, _, J = _newton(self.kernel, np.asarray(x_guess, dtype=float), self._q(s),
+                              self.tol, max_iter=12)
+        return self.node(s, x, J) if ok else None
 
     # ------------------------------------------------------------------ singular values
     def singular_offset(self, x, xs=None) -> float:
@@ -182,30 +178,15 @@ class PathProblem:
 
     # ------------------------------------------------------------------ continuation
     def march(self, node: _Node, s_to: float):
-        """Continuation from ``node`` to s_to (second-order Taylor predictor, step
-        halving); returns (node reached, ok).  A change of the branch sign is refused,
-        so the march stops in front of a singular position."""
-        h_max = _STEP * self.unit
-        h_min = 1e-9 * self.unit
-        h_try = h_max
-        while node.s != s_to:
-            rem = s_to - node.s
-            h = rem if abs(rem) <= h_try * (1 + 1e-9) else np.sign(rem) * h_try
-            xp = node.x + node.xs * h + 0.5 * node.xss * h * h
-            nn = self.solve(node.s + h if h != rem else s_to, xp)
-            ok = nn is not None and nn.sign == node.sign
-            if ok:
-                step = np.max(np.abs((nn.x - node.x) * self.scale))
-                corr = np.max(np.abs((nn.x - xp) * self.scale))
-                ok = corr <= 0.25 * step + 1e-9 * self.model.length_scale
-            if not ok:
-                h_try = abs(h) / 2
-                if h_try < h_min:
-                    return node, False
-                continue
-            node = nn
-            h_try = min(2 * h_try, h_max)
-        return node, True
+        """Continuation from ``node`` to s_to (the sweep's march, without charts); returns
+        (node reached, ok).  A change of the branch sign is refused, so the march stops
+        in front of a singular position."""
+        B = np.zeros((node.x.size, self.idx.size))
+        B[:, self.k] = node.xs
+        start = _SweepNode(self._q(node.s), node.x, B, node.xss, node.sign)
+        out, stop = _march(self.kernel, start, self.k, [s_to], max_step=_STEP * self.unit,
+                           min_step=1e-9 * self.unit, tol=self.tol, counter={})
+        return self._node(stop.node if stop is not None else out[-1]), stop is None
 
 
 @dataclass
@@ -465,24 +446,16 @@ class ChartBook:
 
     def zone_chart(self, s) -> BranchChart | None:
         """The chart whose zone holds s, else None."""
-        for ch in self.charts:
-            if ch.in_zone(s):
-                return ch
-        return None
+        return next((ch for ch in self.charts if ch.in_zone(s)), None)
 
     def window_chart(self, s) -> BranchChart | None:
         """The chart whose window holds s, else None."""
-        for ch in self.charts:
-            if ch.in_window(s):
-                return ch
-        return None
+        return next((ch for ch in self.charts if ch.in_window(s)), None)
 
     def crossed(self, s_from, s_to) -> BranchChart | None:
         """A chart whose centre lies between s_from and s_to, else None."""
-        for ch in self.charts:
-            if (s_from - ch.centre) * (s_to - ch.centre) < 0:
-                return ch
-        return None
+        return next((ch for ch in self.charts
+                     if (s_from - ch.centre) * (s_to - ch.centre) < 0), None)
 
     def due(self, s: float) -> bool:
         """Whether a pose at s would be checked by :meth:`watch` (cheap)."""

@@ -13,9 +13,9 @@ Jacobian [Phi_x; g_x] and gamma = -quad of the model's rows, evaluated and facto
 (sparse LU with partial pivoting, which gives the branch sign too) by the compiled
 drivers of :mod:`mechdyn.kernels.rows_sweep`, one position or a whole batch per call
 (NumPy's per-call overhead and temporaries would dominate), or without numba by
-:mod:`mechdyn.kinematics.constraints` and dense solves.  The analyses that use them are in
+:mod:`mechdyn.kernels.rows_numpy` and dense solves.  The analyses that use them are in
 :mod:`mechdyn.kinematics.sweep`; the dead-centre refinement of
-:mod:`mechdyn.kinematics.figures` reuses :func:`_newton` and :func:`_node`.
+:mod:`mechdyn.kinematics.records` reuses :func:`_newton` and :func:`_node`.
 """
 
 from __future__ import annotations
@@ -24,9 +24,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..kernels import rows_numpy
 from ..model import ConstraintLayout, Model
+from ..model.rows import concat
 from .assembly import _dense_solve, _scale, newton
-from .constraints import full_gamma, system
 
 #: Newton iterations allowed per step of the continuation
 _MAX_NEWTON = 10
@@ -52,20 +53,23 @@ class Kernel:
     model : Model
     layout : ConstraintLayout
         The mode's row layout (``layout.rowset``).
+    idx : sequence of int, optional
+        The coordinates q stands for (default all; a branch chart's path prescribes some).
     """
 
-    def __init__(self, model: Model, layout: ConstraintLayout):
+    def __init__(self, model: Model, layout: ConstraintLayout, idx=None):
         self.model = model
         self.lay = layout
         nb = self.nb = model.n_bodies
         self.n_x = 3 * nb
         self.n_rows = layout.n_rows
-        self.n_q = model.n_q
-        self.n_eq = layout.n_rows + model.n_q
+        #: the rows of F: the layout's constraint rows, then the coordinate rows
+        self.rows = layout.position_rows if idx is None else concat(
+            nb, layout.rowset, model.coordinate_rows.take(idx))
+        self.n_eq = len(self.rows)
+        self.n_q = self.n_eq - self.n_rows
         self.square = self.n_eq == self.n_x
         self.col_scale = _scale(model)
-        #: the rows of F: the layout's constraint rows, then the coordinate rows
-        self.rows = layout.position_rows
         self._ints, self._flts = self.rows.packed()
         from ..kernels import rows_numba, rows_sweep  # numba is imported only here
 
@@ -84,7 +88,9 @@ class Kernel:
             F, J = self.system(x[None], q[None])
             return F[0], J[0]
         if not self.compiled:
-            return system(self.model, x, q, self.lay)
+            F, J, _ = rows_numpy.evaluate(self.rows, x)
+            F[..., self.n_rows:] -= q
+            return F, J
         F = np.empty((x.shape[0], self.n_eq))
         J = np.zeros((x.shape[0], self.n_eq, self.n_x))
         self._drivers.system_batch(_c(x), _c(q), self.nb, self._ints, self._flts,
@@ -96,7 +102,7 @@ class Kernel:
         if x.ndim == 1:
             return self.gamma(x[None], xdot[None])[0]
         if not self.compiled:
-            return full_gamma(self.model, x, xdot, self.lay)
+            return -rows_numpy.quad(self.rows, x, xdot)
         out = np.empty((x.shape[0], self.n_eq))
         self._drivers.gamma_batch(_c(x), _c(xdot), self.nb, self._ints, self._flts, out)
         return out
@@ -206,12 +212,8 @@ def _chart_node(kern: Kernel, chart, q, k: int) -> _Node:
     derivative from the chart; the other columns of B by a direct solve at that pose."""
     x, xs, xss = chart.evaluate(q[k])
     with np.errstate(all="ignore"):
-        _, J = kern.system(x, q)
-        try:
-            B = kern.apply(J, kern.factor(J), kern.rhs_unit(1)[0])
-        except (np.linalg.LinAlgError, ZeroDivisionError):
-            B = np.full((x.size, q.size), np.nan)
-    B = np.array(B, dtype=float)
+        J = kern.system(x, q)[1]
+        B = kern.apply(J, kern.factor(J), kern.rhs_unit(1)[0])  # a new array
     B[:, k] = xs
     return _Node(np.array(q, dtype=float), x, B, xss, chart.side_sign(q[k]))
 

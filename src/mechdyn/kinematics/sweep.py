@@ -40,10 +40,10 @@ which gives the branch sign too).
 
 This module holds the analyses :func:`sweep` and :func:`analyze`; the building
 blocks of the continuation are in :mod:`mechdyn.kinematics.continuation`, the
-records :class:`KinematicSweep` and :class:`KinematicPoint` in
-:mod:`mechdyn.kinematics.records` and the derived figures (:class:`SweepSummary`,
-dead centres, strokes, four-bar loops and transmission angles, extremes) in
-:mod:`mechdyn.kinematics.figures`; all their public names are importable from here.
+records :class:`KinematicSweep` and :class:`KinematicPoint` and their derived
+figures (:class:`SweepSummary`: dead centres, strokes, four-bar loops and
+transmission angles, extremes) in :mod:`mechdyn.kinematics.records`; all their
+public names are importable from here.
 """
 
 from __future__ import annotations
@@ -67,15 +67,17 @@ from .continuation import (
     _node,
     _Stop,
 )
-from .figures import (
+from .records import (
     DeadCentre,
     FourBarLoop,
+    KinematicPoint,
+    KinematicSweep,
     PointExtremes,
     SweepSummary,
     TransmissionAngle,
+    _ro,
     four_bar_loops,
 )
-from .records import KinematicPoint, KinematicSweep, _ro
 
 __all__ = ["sweep", "analyze", "initial_coordinates", "KinematicSweep", "KinematicPoint",
            "SweepSummary", "DeadCentre", "TransmissionAngle", "PointExtremes", "FourBarLoop",
