@@ -353,17 +353,12 @@ def assemble(model: Model, q=None, *, x_guess=None, layout=None, t=None) -> np.n
     return x
 
 
-def _assemble_near(model: Model, q=None, *, x_guess=None, layout=None, t=None) -> np.ndarray:
-    """Assemble the mechanism from the sketch (or ``x_guess``) at coordinates ``q``.
-
-    With ``q`` None the coordinates are measured on the sketch.  A least-squares
-    solve pulls the sketch onto the constraints (choosing the branch nearest to
-    the sketch), then Newton polishes.
-    """
+def _assemble_near(model: Model, q, *, x_guess=None, layout=None, t=None) -> np.ndarray:
+    """Assemble the mechanism from the sketch (or ``x_guess``) at coordinates ``q``: a
+    least-squares solve pulls the sketch onto the constraints (choosing the branch
+    nearest to the sketch), then Newton polishes."""
     lay = layout or model.layout()
     x = np.array(model.x_sketch if x_guess is None else x_guess, dtype=float)
-    if q is None:
-        q = coordinates(model, x)
     q = np.asarray(q, dtype=float)
     if model.n_x == 0:
         return x
