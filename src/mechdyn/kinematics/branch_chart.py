@@ -42,7 +42,7 @@ from numpy.polynomial import chebyshev as cheb
 
 from ..model import ConstraintLayout, Model
 from .assembly import _scale
-from .continuation import Kernel, _hermite5, _march, _newton, _node
+from .continuation import _hermite5, _kernel, _march, _newton, _node
 from .continuation import _Node as _SweepNode
 
 __all__ = ["PathProblem", "BranchChart", "ChartBook", "bridge", "ZONE", "WINDOW", "REACH"]
@@ -124,7 +124,7 @@ class PathProblem:
         self.unit = 1.0 if angle else float(model.length_scale)
         self.tol = 1e-14 * max(model.length_scale, 1e-3)
         #: the equations [Phi; g_idx - q] (the compiled kernel of the sweep)
-        self.kernel = Kernel(model, layout, self.idx)
+        self.kernel = _kernel(model, layout, self.idx)
         self._e = np.zeros(model.n_x)
         self._e[layout.n_rows + self.k] = 1.0
 
