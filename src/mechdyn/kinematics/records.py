@@ -20,7 +20,7 @@ from ..kernels import rows_numpy
 from ..mechanism.joint import Revolute
 from ..model import Model
 from .assembly import _position_tol
-from .constraints import _point_kinematics, point_position, travel_rows
+from .constraints import _point_kinematics, point_position, point_velocity, travel_rows
 from .continuation import _kernel, _newton, _node
 
 __all__ = ["KinematicSweep", "KinematicPoint", "SweepSummary", "DeadCentre", "TransmissionAngle",
@@ -157,15 +157,9 @@ class KinematicSweep:
 
     def point_analogs(self, body: str, name) -> np.ndarray:
         """Velocity analogs dr/dq of a body point, shape (n, 2, n_q) (m/rad or m/m)."""
-        m = self.model
-        k = m.body_index(body)
-        s = m.point_local(body, name)
-        th = self.x[:, 3 * k + 2]
-        ax = np.cos(th) * s[0] - np.sin(th) * s[1]
-        ay = np.sin(th) * s[0] + np.cos(th) * s[1]
-        Bk = self.B[:, 3 * k:3 * k + 3, :]
-        return np.stack([Bk[:, 0] - ay[:, None] * Bk[:, 2],
-                         Bk[:, 1] + ax[:, None] * Bk[:, 2]], axis=1)
+        # the point's velocity per unit rate of each coordinate (linear in xdot)
+        v = point_velocity(self.model, self.x, np.moveaxis(self.B, -1, 0), body, name)
+        return np.moveaxis(v, 0, -1)
 
     def angular(self, body: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Angle (rad), angular velocity (rad/s), angular acceleration (rad/s^2), (n,) each."""
