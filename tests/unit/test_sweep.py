@@ -8,8 +8,8 @@ import pytest
 from mechdyn import Mechanism, ModelError, SingularPositionError
 from mechdyn.kernels import rows_numba
 from mechdyn.kinematics import branch_sign, residual
-from mechdyn.kinematics._sweep_kernel import Kernel
 from mechdyn.kinematics.constraints import coordinates
+from mechdyn.kinematics.continuation import Kernel
 from mechdyn.kinematics.sweep import (
     KinematicSweep,
     _anchor_indices,
@@ -281,27 +281,30 @@ def test_kernel_paths_agree_single_and_batched_compiled_and_numpy():
         assert np.allclose(Fc, F, rtol=0, atol=1e-15) and np.allclose(Jc, J, rtol=0, atol=1e-15)
         assert np.allclose(kern.gamma(x, v), g, rtol=0, atol=1e-14)
         for k in range(3):
-            F1, J1 = kern.system1(x[k], q[k])
+            F1, J1 = kern.system(x[k], q[k])
             assert np.allclose(F1, F[k], rtol=0, atol=1e-15)
             assert np.allclose(J1, J[k], rtol=0, atol=1e-15)
-            assert np.allclose(kern.gamma1(x[k], v[k]), g[k], rtol=0, atol=1e-14)
+            assert np.allclose(kern.gamma(x[k], v[k]), g[k], rtol=0, atol=1e-14)
 
 
-def test_block_triangular_solve_and_sign_equal_dense_ones():
+@pytest.mark.parametrize("compiled", sorted({False, rows_numba.NUMBA}))
+def test_kernel_solves_and_signs_equal_dense_ones(compiled):
     model = every_joint_model()
     lay = model.layout()
     kern = Kernel(model, lay)
-    assert kern.square and kern.blocks is not None
+    kern.compiled = compiled
+    assert kern.square
     rng = np.random.default_rng(6)
     x = rng.normal(size=(50, model.n_x))
     _, J = kern.system(x, np.zeros((50, model.n_q)))
     rhs = rng.normal(size=(50, kern.n_eq, 3))
-    assert np.allclose(kern.solve(J, rhs), np.linalg.solve(J, rhs), rtol=1e-9, atol=1e-9)
-    assert np.array_equal(kern.sign(J), branch_sign(model, x, lay))
+    fac = kern.factor(J)
+    assert np.allclose(kern.apply(J, fac, rhs), np.linalg.solve(J, rhs), rtol=1e-9, atol=1e-9)
+    assert np.array_equal(fac[2], branch_sign(model, x, lay))
     for k in range(5):
-        fac = kern.factor1(J[k])
+        fac = kern.factor(J[k])
         assert fac[2] == branch_sign(model, x[k], lay)
-        assert np.allclose(kern.solve1(J[k], fac, rhs[k]), np.linalg.solve(J[k], rhs[k]))
+        assert np.allclose(kern.apply(J[k], fac, rhs[k]), np.linalg.solve(J[k], rhs[k]))
 
 
 # ---------------------------------------------------------------- tables and plots
@@ -339,16 +342,19 @@ def test_csv_and_png_are_written(tmp_path):
 
 
 @pytest.mark.parametrize("s", [1, 2, 3, 4, 5])
-def test_small_block_inverses_and_determinant_signs(s):
-    from mechdyn.kinematics._sweep_kernel import _small_inverse
+def test_lu_factors_solve_and_give_determinant_signs(s):
+    from mechdyn.kernels.rows_sweep import lu_batch, lu_solve_batch
 
     rng = np.random.default_rng(s)
-    A = rng.normal(size=(200, 2, s, s))
-    inv, sign = _small_inverse(A, True)
-    if s == 1:
-        inv = inv[..., None, None]
-    assert np.allclose(inv, np.linalg.inv(A), rtol=1e-9, atol=1e-9)
-    assert np.array_equal(sign, np.sign(np.linalg.det(A)))
+    A = rng.normal(size=(200, s, s))
+    A[0] = 0.0  # exactly singular: sign 0, NaN solutions instead of an exception
+    lu, piv, sign = A.copy(), np.empty((200, s), dtype=np.intp), np.empty(200)
+    lu_batch(lu, piv, sign)
+    y = rng.normal(size=(200, s, 2))
+    x = y.copy()
+    lu_solve_batch(lu, piv, x)
+    assert np.allclose(x[1:], np.linalg.solve(A[1:], y[1:]), rtol=1e-9, atol=1e-9)
+    assert np.array_equal(sign, np.sign(np.linalg.det(A))) and np.isnan(x[0]).all()
 
 
 def test_x_start_chooses_the_branch():

@@ -30,10 +30,12 @@ def _solve(J, rhs):
     return np.linalg.pinv(J) @ rhs
 
 
-def velocity_analogs(model: Model, x, layout: ConstraintLayout | None = None) -> np.ndarray:
-    """Exact velocity analogs B = dx/dq, shape (..., n_x, n_q)."""
+def velocity_analogs(model: Model, x, layout: ConstraintLayout | None = None,
+                     J=None) -> np.ndarray:
+    """Exact velocity analogs B = dx/dq, shape (..., n_x, n_q) (``J``: [Phi_x; g_x] at x)."""
     lay = layout or model.layout()
-    J = full_jacobian(model, x, lay)
+    if J is None:
+        J = full_jacobian(model, x, lay)
     rhs = np.zeros(J.shape[:-2] + (J.shape[-2], model.n_q))
     rhs[..., lay.n_rows:, :] = np.eye(model.n_q)
     return _solve(J, rhs)
@@ -60,9 +62,7 @@ def accelerations(model: Model, x, xdot, qddot, layout=None, B=None) -> np.ndarr
     lay = layout or model.layout()
     J = full_jacobian(model, x, lay)
     if B is None:
-        rhs = np.zeros(J.shape[:-2] + (J.shape[-2], model.n_q))
-        rhs[..., lay.n_rows:, :] = np.eye(model.n_q)
-        B = _solve(J, rhs)
+        B = velocity_analogs(model, x, lay, J=J)
     return (B @ np.asarray(qddot, float)[..., None])[..., 0] + acceleration_bias(
         model, x, xdot, lay, J=J)
 

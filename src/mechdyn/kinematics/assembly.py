@@ -57,7 +57,8 @@ def joint_residuals(model: Model, x, layout: ConstraintLayout | None = None) -> 
     return dict(sorted(res.items(), key=lambda kv: -kv[1]))
 
 
-def newton(rows: Rows, x_guess, target, *, sel=None, tol: float, max_iter: int = 40):
+def newton(rows: Rows, x_guess, target, *, sel=None, tol: float, max_iter: int = 40,
+           system=None, solve=None):
     """The one position Newton solve of the package: rows(x)[sel] = target (batched).
 
     Parameters
@@ -72,6 +73,13 @@ def newton(rows: Rows, x_guess, target, *, sel=None, tol: float, max_iter: int =
         The rows solved for (default all); their number must be n_x for a unique pose.
     tol : float
         Residual tolerance (m, or rad for angle rows).
+    system : callable, optional
+        ``system(x) -> (values, jacobian)`` of the selected rows at poses (..., n_x), for
+        another evaluator of the same rows (the compiled kernel of the sweep); default
+        :mod:`mechdyn.kernels.rows_numpy`.
+    solve : callable, optional
+        ``solve(J, F) -> dx`` with J dx = F, J (..., n_sel, n_x) and F (..., n_sel);
+        default a dense solve, least squares where J is singular or not square.
 
     Returns
     -------
@@ -92,31 +100,26 @@ def newton(rows: Rows, x_guess, target, *, sel=None, tol: float, max_iter: int =
     batch = np.broadcast_shapes(target.shape[:-1], x.shape[:-1])
     x = np.broadcast_to(x, batch + (rows.n_x,)).copy()
     sel = np.arange(len(rows)) if sel is None else np.asarray(sel)
-    prev = np.full(batch, np.inf)
-    done = np.zeros(batch, dtype=bool)
+    prev = np.inf
     for _ in range(max_iter):
-        p = rows_numpy.Parts(rows, x)
-        F = rows_numpy.values(rows, x, p)[..., sel] - target
+        if system is None:
+            p = rows_numpy.Parts(rows, x)
+            F = rows_numpy.values(rows, x, p)[..., sel] - target
+        else:
+            F, J = system(x)
+            F = F - target
         err = np.max(np.abs(F), axis=-1) if F.shape[-1] else np.zeros(batch)
-        err = np.where(np.isfinite(err), err, np.inf)
-        # converged, or stagnating at round-off level
+        # converged, or stagnating at round-off level (a NaN error is neither)
         done = (err <= tol) | ((err >= 0.5 * prev) & (err <= 1e3 * tol))
         if np.all(done) or not np.all(np.isfinite(x)):
             break
-        prev = np.where(done, prev, err)
-        J = rows_numpy.jacobian(rows, x, p)[..., sel, :]
-        if J.shape[-1] == J.shape[-2]:
-            try:
-                dx = np.linalg.solve(J, F[..., None])[..., 0]
-            except np.linalg.LinAlgError:
-                dx = _lstsq(J, F)
-        else:
-            dx = _lstsq(J, F)
-        if not np.all(np.isfinite(dx)):
-            dx = _lstsq(J, F)
+        prev = err
+        if system is None:
+            J = rows_numpy.jacobian(rows, x, p)[..., sel, :]
+        dx = solve(J, F) if solve else _dense_solve(J, F[..., None])[..., 0]
         x = x - np.where(done[..., None], 0.0, dx)
     else:
-        F = rows_numpy.values(rows, x)[..., sel] - target
+        F = (rows_numpy.values(rows, x)[..., sel] if system is None else system(x)[0]) - target
         done = np.max(np.abs(F), axis=-1) <= 1e3 * tol if F.shape[-1] else np.ones(batch, bool)
     return x, done
 
@@ -166,29 +169,24 @@ def solve_position(model: Model, q, x_guess, *, layout: ConstraintLayout | None 
     return x
 
 
-def _lstsq(J, F):
-    return (np.linalg.pinv(J) @ F[..., None])[..., 0]
+def _dense_solve(J, rhs):
+    """y with J y = rhs, rhs (..., n, k): dense, least squares (minimum norm) where J is
+    singular or not square."""
+    try:
+        y = np.linalg.solve(J, rhs)
+        if np.all(np.isfinite(y)):
+            return y
+    except np.linalg.LinAlgError:
+        pass
+    return np.linalg.pinv(J) @ rhs
 
 
 def _assembly_error(model, q, x_start, lay, t):
     """Find the closest configuration by least squares and say which joints stay open."""
     q = np.asarray(q, float)
-    w = 1e3  # the coordinates are honoured much more strongly than the joints
-
-    def fun(x):
-        F, _ = system(model, x, q, lay)
-        F[lay.n_rows:] *= w
-        return F
-
-    def jac(x):
-        _, J = system(model, x, q, lay)
-        J[lay.n_rows:] *= w
-        return J
-
     x = x_start if np.all(np.isfinite(x_start)) else model.x_sketch
-    try:
-        sol = least_squares(fun, x, jac=jac, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15)
-        x = sol.x
+    try:  # the coordinates are honoured much more strongly than the joints
+        x = _least_squares(model, x, q, lay, weight=1e3, method="lm")
     except Exception:  # noqa: BLE001 - keep the Newton iterate for the report
         pass
     res = joint_residuals(model, x, lay)
@@ -355,17 +353,12 @@ def assemble(model: Model, q=None, *, x_guess=None, layout=None, t=None) -> np.n
     return x
 
 
-def _assemble_near(model: Model, q=None, *, x_guess=None, layout=None, t=None) -> np.ndarray:
-    """Assemble the mechanism from the sketch (or ``x_guess``) at coordinates ``q``.
-
-    With ``q`` None the coordinates are measured on the sketch.  A least-squares
-    solve pulls the sketch onto the constraints (choosing the branch nearest to
-    the sketch), then Newton polishes.
-    """
+def _assemble_near(model: Model, q, *, x_guess=None, layout=None, t=None) -> np.ndarray:
+    """Assemble the mechanism from the sketch (or ``x_guess``) at coordinates ``q``: a
+    least-squares solve pulls the sketch onto the constraints (choosing the branch
+    nearest to the sketch), then Newton polishes."""
     lay = layout or model.layout()
     x = np.array(model.x_sketch if x_guess is None else x_guess, dtype=float)
-    if q is None:
-        q = coordinates(model, x)
     q = np.asarray(q, dtype=float)
     if model.n_x == 0:
         return x
@@ -373,18 +366,23 @@ def _assemble_near(model: Model, q=None, *, x_guess=None, layout=None, t=None) -
         return solve_position(model, q, x, layout=lay, t=t, check_singular=False, max_iter=8)
     except AssemblyError:
         pass
+    x = _least_squares(model, x, q, lay, method="trf", max_nfev=2000,
+                       x_scale=_scale(model) / model.length_scale)
+    return solve_position(model, q, x, layout=lay, t=t, check_singular=False)
+
+
+def _least_squares(model, x, q, lay, weight: float = 1.0, **options) -> np.ndarray:
+    """The pose nearest to [Phi; weight (g - q)] = 0 from x, by SciPy's least_squares."""
+    w = np.ones(lay.n_rows + model.n_q)
+    w[lay.n_rows:] = weight
 
     def fun(xx):
-        F, _ = system(model, xx, q, lay)
-        return F
+        return system(model, xx, q, lay)[0] * w
 
     def jac(xx):
-        _, J = system(model, xx, q, lay)
-        return J
+        return system(model, xx, q, lay)[1] * w[:, None]
 
-    sol = least_squares(fun, x, jac=jac, method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15,
-                        x_scale=_scale(model) / model.length_scale, max_nfev=2000)
-    return solve_position(model, q, sol.x, layout=lay, t=t, check_singular=False)
+    return least_squares(fun, x, jac=jac, xtol=1e-15, ftol=1e-15, gtol=1e-15, **options).x
 
 
 def rank_report(model: Model, x, layout=None) -> dict:
@@ -392,7 +390,6 @@ def rank_report(model: Model, x, layout=None) -> dict:
     lay = layout or model.layout()
     sc = _scale(model)
     P = jacobian(model, x, lay) * sc
-    G = np.concatenate([P, np.zeros((0, model.n_x))])
     Gq = coordinates_jacobian(model, x) * sc
     tol_rel = 1e-9
     rank_phi = _rank(P, tol_rel)
@@ -404,13 +401,12 @@ def rank_report(model: Model, x, layout=None) -> dict:
         null = u[:, int(np.sum(s > tol_rel * smax)):]
         weight = np.sum(null**2, axis=1)
         redundant = sorted({lay.row_joint[r] for r in range(lay.n_rows) if weight[r] > 1e-6})
-    full = np.concatenate([G, Gq])
+    rank_full = _rank(np.concatenate([P, Gq]), tol_rel)
     dep = []
-    if model.n_q and _rank(full, tol_rel) < rank_phi + model.n_q:
-        for c in range(model.n_q):
-            others = np.concatenate([P, np.delete(Gq, c, axis=0)])
-            if _rank(np.concatenate([others, Gq[c:c + 1]]), tol_rel) == _rank(others, tol_rel):
-                dep.append(model.coordinate_names[c])
+    if model.n_q and rank_full < rank_phi + model.n_q:
+        # coordinate c depends on the others if dropping its row keeps the rank
+        dep = [model.coordinate_names[c] for c in range(model.n_q)
+               if _rank(np.concatenate([P, np.delete(Gq, c, axis=0)]), tol_rel) == rank_full]
     return {"rank_phi": rank_phi, "redundant_joints": redundant, "dependent_coordinates": dep}
 
 

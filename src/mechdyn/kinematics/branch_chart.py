@@ -40,9 +40,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.polynomial import chebyshev as cheb
 
-from ..kernels import rows_numpy
 from ..model import ConstraintLayout, Model
-from .continuation import _hermite5
+from .assembly import _scale
+from .continuation import _hermite5, _kernel, _march, _newton, _node
+from .continuation import _Node as _SweepNode
 
 __all__ = ["PathProblem", "BranchChart", "ChartBook", "bridge", "ZONE", "WINDOW", "REACH"]
 
@@ -117,68 +118,40 @@ class PathProblem:
             raise ValueError("a branch chart needs a square position system "
                              f"({layout.n_rows} joint rows + {self.idx.size} coordinates "
                              f"for {model.n_x} pose components)")
-        self.scale = np.ones(model.n_x)
-        self.scale[2::3] = model.length_scale
+        self.scale = _scale(model)
         angle = bool(model.coord_is_angle[self.idx[self.k]])
         #: unit of the path coordinate for the zone sizes: 1 rad, or the length scale
         self.unit = 1.0 if angle else float(model.length_scale)
         self.tol = 1e-14 * max(model.length_scale, 1e-3)
+        #: the equations [Phi; g_idx - q] (the compiled kernel of the sweep)
+        self.kernel = _kernel(model, layout, self.idx)
         self._e = np.zeros(model.n_x)
         self._e[layout.n_rows + self.k] = 1.0
 
     # ------------------------------------------------------------------ equations
-    def system(self, x, s):
-        """Residual [Phi; g_idx - q(s)] and Jacobian, shapes (n_x,) and (n_x, n_x)."""
+    def _q(self, s) -> np.ndarray:
         q = self.q_fixed.copy()
         q[self.k] = s
-        v, J, _ = rows_numpy.evaluate(self.layout.rowset, x)
-        vg, Jg, _ = rows_numpy.evaluate(self.model.coordinate_rows, x)
-        return (np.concatenate([v, vg[self.idx] - q]),
-                np.concatenate([J, Jg[self.idx]]))
+        return q
 
-    def _quad(self, x, v):
-        """The rows' velocity-quadratic terms at pose x for rates v: Phi_xx[v, v], (n_x,)."""
-        return np.concatenate([rows_numpy.quad(self.layout.rowset, x, v),
-                               rows_numpy.quad(self.model.coordinate_rows, x, v)[self.idx]])
-
-    def newton(self, x, s, max_iter: int = 12):
-        """Newton from ``x`` to the pose at s, converged to round-off; (x, J) or None."""
-        x = np.array(x, dtype=float)
-        prev = np.inf
-        for _ in range(max_iter):
-            F, J = self.system(x, s)
-            err = float(np.max(np.abs(F)))
-            if not np.isfinite(err):
-                return None
-            if err <= self.tol or (err >= 0.5 * prev and err <= 1e3 * self.tol):
-                return x, J
-            prev = err
-            try:
-                x = x - np.linalg.solve(J, F)
-            except np.linalg.LinAlgError:
-                return None
-        return None
+    def jacobian(self, x) -> np.ndarray:
+        """[Phi_x; g_idx,x] at x, shape (n_x, n_x)."""
+        return self.kernel.system(np.asarray(x, dtype=float), self.q_fixed)[1]
 
     def node(self, s, x, J=None) -> _Node:
         """Analogs x', x'' and the branch sign at a solved pose."""
-        if J is None:
-            J = self.system(x, s)[1]
-        xs = np.linalg.solve(J, self._e)
-        xss = np.linalg.solve(J, -self._quad(x, xs))
-        sign = float(np.sign(np.linalg.det(J * self.scale)))
-        return _Node(float(s), np.array(x, dtype=float), xs, xss, sign)
+        return self._node(_node(self.kernel, np.asarray(x, dtype=float), self._q(s), self.k, J))
+
+    def _node(self, nd) -> _Node:
+        return _Node(float(nd.q[self.k]), nd.x, nd.B[:, self.k], nd.H, float(nd.sign))
 
     def solve(self, s, x_guess) -> _Node | None:
         """The node at s by Newton from ``x_guess`` (None if it does not converge)."""
-        out = self.newton(x_guess, s)
-        return None if out is None else self.node(s, *out)
+        x, ok, _, J = _newton(self.kernel, np.asarray(x_guess, dtype=float), self._q(s),
+                              self.tol, max_iter=12)
+        return self.node(s, x, J) if ok else None
 
     # ------------------------------------------------------------------ singular values
-    def jacobian(self, x) -> np.ndarray:
-        """[Phi_x; g_idx,x] at x, shape (n_x, n_x)."""
-        return np.concatenate([rows_numpy.jacobian(self.layout.rowset, x),
-                               rows_numpy.jacobian(self.model.coordinate_rows, x)[self.idx]])
-
     def singular_offset(self, x, xs=None) -> float:
         """Estimated offset s* - s of the nearest singular position from the pose x at s
         (``xs``: its analog dx/ds, computed if not given).
@@ -204,31 +177,16 @@ class PathProblem:
         return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
 
     # ------------------------------------------------------------------ continuation
-    def march(self, node: _Node, s_to: float, *, keep_sign: bool = True):
-        """Continuation from ``node`` to s_to (second-order Taylor predictor, step
-        halving); returns (node reached, ok).  With ``keep_sign`` a change of the branch
-        sign is refused, so the march stops in front of a singular position."""
-        h_max = _STEP * self.unit
-        h_min = 1e-9 * self.unit
-        h_try = h_max
-        while node.s != s_to:
-            rem = s_to - node.s
-            h = rem if abs(rem) <= h_try * (1 + 1e-9) else np.sign(rem) * h_try
-            xp = node.x + node.xs * h + 0.5 * node.xss * h * h
-            nn = self.solve(node.s + h if h != rem else s_to, xp)
-            ok = nn is not None and (not keep_sign or nn.sign == node.sign)
-            if ok:
-                step = np.max(np.abs((nn.x - node.x) * self.scale))
-                corr = np.max(np.abs((nn.x - xp) * self.scale))
-                ok = corr <= 0.25 * step + 1e-9 * self.model.length_scale
-            if not ok:
-                h_try = abs(h) / 2
-                if h_try < h_min:
-                    return node, False
-                continue
-            node = nn
-            h_try = min(2 * h_try, h_max)
-        return node, True
+    def march(self, node: _Node, s_to: float):
+        """Continuation from ``node`` to s_to (the sweep's march, without charts); returns
+        (node reached, ok).  A change of the branch sign is refused, so the march stops
+        in front of a singular position."""
+        B = np.zeros((node.x.size, self.idx.size))
+        B[:, self.k] = node.xs
+        start = _SweepNode(self._q(node.s), node.x, B, node.xss, node.sign)
+        out, stop = _march(self.kernel, start, self.k, [s_to], max_step=_STEP * self.unit,
+                           min_step=1e-9 * self.unit, tol=self.tol, counter={})
+        return self._node(stop.node if stop is not None else out[-1]), stop is None
 
 
 @dataclass
@@ -488,24 +446,16 @@ class ChartBook:
 
     def zone_chart(self, s) -> BranchChart | None:
         """The chart whose zone holds s, else None."""
-        for ch in self.charts:
-            if ch.in_zone(s):
-                return ch
-        return None
+        return next((ch for ch in self.charts if ch.in_zone(s)), None)
 
     def window_chart(self, s) -> BranchChart | None:
         """The chart whose window holds s, else None."""
-        for ch in self.charts:
-            if ch.in_window(s):
-                return ch
-        return None
+        return next((ch for ch in self.charts if ch.in_window(s)), None)
 
     def crossed(self, s_from, s_to) -> BranchChart | None:
         """A chart whose centre lies between s_from and s_to, else None."""
-        for ch in self.charts:
-            if (s_from - ch.centre) * (s_to - ch.centre) < 0:
-                return ch
-        return None
+        return next((ch for ch in self.charts
+                     if (s_from - ch.centre) * (s_to - ch.centre) < 0), None)
 
     def due(self, s: float) -> bool:
         """Whether a pose at s would be checked by :meth:`watch` (cheap)."""

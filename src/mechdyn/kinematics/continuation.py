@@ -1,16 +1,21 @@
 """Numerical continuation along one coordinate: the building blocks of the sweep.
 
-Newton's method on a batch of positions (:func:`_newton`, :func:`_polish`) and on
-one position (:func:`_newton1`), the solved positions of the continuation
-(:class:`_Node`: pose, velocity analogs, second derivative along the swept
-coordinate and branch sign), their quintic Hermite predictor (:func:`_hermite5`,
-:func:`_predict`), the sequential step-halving march (:func:`_march`, through
-bifurcation positions with the branch charts of
-:mod:`mechdyn.kinematics.branch_chart`: :func:`_chart_node`), the choice
-of the anchors it visits (:func:`_anchor_indices`) and the per-model cache of the
-evaluation kernel (:func:`_kernel`).  The analyses that use them are in
+The position Newton of :mod:`mechdyn.kinematics.assembly` on the compiled kernel's
+equations, for a batch or one position (:func:`_newton`), the solved positions of
+the continuation (:class:`_Node`: pose, velocity analogs, second derivative along
+the swept coordinate and branch sign), their quintic Hermite predictor
+(:func:`_hermite5`, :func:`_predict`), the sequential step-halving march
+(:func:`_march`, through bifurcation positions with the branch charts of
+:mod:`mechdyn.kinematics.branch_chart`: :func:`_chart_node`), the choice of the
+anchors it visits (:func:`_anchor_indices`) and the per-model cache of the
+evaluation kernel (:class:`Kernel`, :func:`_kernel`): the residual [Phi; g - q], the
+Jacobian [Phi_x; g_x] and gamma = -quad of the model's rows, evaluated and factored
+(sparse LU with partial pivoting, which gives the branch sign too) by the compiled
+drivers of :mod:`mechdyn.kernels.rows_sweep`, one position or a whole batch per call
+(NumPy's per-call overhead and temporaries would dominate), or without numba by
+:mod:`mechdyn.kernels.rows_numpy` and dense solves.  The analyses that use them are in
 :mod:`mechdyn.kinematics.sweep`; the dead-centre refinement of
-:mod:`mechdyn.kinematics.figures` reuses :func:`_newton1` and :func:`_node`.
+:mod:`mechdyn.kinematics.records` reuses :func:`_newton` and :func:`_node`.
 """
 
 from __future__ import annotations
@@ -19,11 +24,123 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model import Model
-from ._sweep_kernel import Kernel
+from ..kernels import rows_numpy
+from ..model import ConstraintLayout, Model
+from ..model.rows import concat
+from .assembly import _dense_solve, _scale, newton
 
-#: Newton iterations allowed per step of the continuation / per batched polish
+#: Newton iterations allowed per step of the continuation
 _MAX_NEWTON = 10
+
+
+def _c(a) -> np.ndarray:
+    """A C-contiguous float array (one compiled specialization for every caller)."""
+    return np.ascontiguousarray(a, dtype=float)
+
+
+class Kernel:
+    """Residual, Jacobian and gamma of the position problem of one model and layout.
+
+    The equations are the rows of the layout (joints, then engaged locks) followed
+    by the coordinate rows, F(x) = [Phi(x); g(x) - q], evaluated by the compiled
+    drivers of :mod:`mechdyn.kernels.rows_sweep` (or, when numba is not installed
+    or ``compiled`` is set to False, by :mod:`mechdyn.kernels.rows_numpy`).
+    The methods take a batch (``x`` (N, n_x), ``q`` (N, n_q)) or one position
+    (1-D arrays).
+
+    Parameters
+    ----------
+    model : Model
+    layout : ConstraintLayout
+        The mode's row layout (``layout.rowset``).
+    idx : sequence of int, optional
+        The coordinates q stands for (default all; a branch chart's path prescribes some).
+    """
+
+    def __init__(self, model: Model, layout: ConstraintLayout, idx=None):
+        self.model = model
+        self.lay = layout
+        nb = self.nb = model.n_bodies
+        self.n_x = 3 * nb
+        self.n_rows = layout.n_rows
+        #: the rows of F: the layout's constraint rows, then the coordinate rows
+        self.rows = layout.position_rows if idx is None else concat(
+            nb, layout.rowset, model.coordinate_rows.take(idx))
+        self.n_eq = len(self.rows)
+        self.n_q = self.n_eq - self.n_rows
+        self.square = self.n_eq == self.n_x
+        self.col_scale = _scale(model)
+        self._ints, self._flts = self.rows.packed()
+        from ..kernels import rows_numba, rows_sweep  # numba is imported only here
+
+        self._drivers = rows_sweep
+        #: evaluate and factor with the compiled drivers (numba installed), else NumPy
+        self.compiled = rows_numba.NUMBA
+        if self.compiled:
+            with rows_numba.compiling("numba kernels of the kinematic sweep"):
+                x = np.random.default_rng(1).normal(size=(1, self.n_x))
+                J = self.system(x, np.zeros((1, self.n_q)))[1]
+                self.apply(J, self.factor(J), J[..., :1])
+
+    def system(self, x, q):
+        """F (N, n_eq) (m or rad) and J (N, n_eq, n_x) at poses x (N, n_x), q (N, n_q)."""
+        if x.ndim == 1:
+            F, J = self.system(x[None], q[None])
+            return F[0], J[0]
+        if not self.compiled:
+            F, J, _ = rows_numpy.evaluate(self.rows, x)
+            F[..., self.n_rows:] -= q
+            return F, J
+        F = np.empty((x.shape[0], self.n_eq))
+        J = np.zeros((x.shape[0], self.n_eq, self.n_x))
+        self._drivers.system_batch(_c(x), _c(q), self.nb, self._ints, self._flts,
+                                   self.n_rows, F, J)
+        return F, J
+
+    def gamma(self, x, xdot):
+        """[gamma; gamma_g] (N, n_eq): [Phi_x; g_x] xddot = this + [0; qddot]."""
+        if x.ndim == 1:
+            return self.gamma(x[None], xdot[None])[0]
+        if not self.compiled:
+            return -rows_numpy.quad(self.rows, x, xdot)
+        out = np.empty((x.shape[0], self.n_eq))
+        self._drivers.gamma_batch(_c(x), _c(xdot), self.nb, self._ints, self._flts, out)
+        return out
+
+    def factor(self, J):
+        """Factors of Jacobians J (N, n_eq, n_x) or (n_eq, n_x) for :meth:`apply`, and the
+        signs of det [Phi_x; g_x] (the branch sign, as ``assembly.branch_sign``):
+        ``(lu, piv, sign)``, ``lu`` None where the solves are dense."""
+        one = J.ndim == 2
+        Jb = J[None] if one else J
+        lu = piv = None
+        if not self.square:
+            sign = np.ones(Jb.shape[0])
+        elif not self.compiled:
+            sign = np.sign(np.linalg.det(Jb))
+        else:
+            lu, piv = np.array(Jb, dtype=float), np.empty(Jb.shape[:2], dtype=np.intp)
+            sign = np.empty(Jb.shape[0])
+            self._drivers.lu_batch(lu, piv, sign)
+        return (lu, piv, float(sign[0]) if one else sign)
+
+    def apply(self, J, fac, rhs):
+        """y with J y = rhs, J (N, n_eq, n_x) and rhs (N, n_eq, k) -> (N, n_x, k), or one
+        position (J 2-D, rhs 1-D or 2-D), with the factors of :meth:`factor`."""
+        if fac is None or fac[0] is None:
+            return _dense_solve(J, rhs)
+        y = np.array(rhs, dtype=float)
+        shape = y.shape
+        y = y.reshape((-1,) + shape[-2:] if J.ndim == 3 else (1, self.n_eq, -1))
+        self._drivers.lu_solve_batch(fac[0], fac[1], y)
+        y = y.reshape(shape)
+        return y if np.all(np.isfinite(y)) else _dense_solve(J, rhs)
+
+    def rhs_unit(self, N):
+        """[0; I], the right-hand side of the velocity-analog equations, (N, n_eq, n_q)."""
+        E = np.zeros((N, self.n_eq, self.n_q))
+        E[:, self.n_rows:, :] = np.eye(self.n_q)
+        return E
 
 
 @dataclass
@@ -38,80 +155,31 @@ class _Node:
 
 
 def _newton(kern: Kernel, x, q, tol, max_iter=_MAX_NEWTON):
-    """Newton on a batch from ``x``; returns x, converged (N,), last F and J (at x)."""
-    x = x.copy()
-    F, J = kern.system(x, q)
-    err = np.max(np.abs(F), axis=1)
-    prev = np.full(x.shape[0], np.inf)
-    ok = err <= tol
-    active = ~ok
-    it = 0
-    while active.any() and it < max_iter:
-        it += 1
-        idx = np.flatnonzero(active)
-        dx = kern.solve(J[idx], F[idx, :, None])[..., 0]
-        xi = x[idx] - dx
-        bad = ~np.all(np.isfinite(xi), axis=1)
-        xi[bad] = x[idx][bad]
-        x[idx] = xi
-        Fi, Ji = kern.system(xi, q[idx])
-        F[idx], J[idx] = Fi, Ji
-        e = np.max(np.abs(Fi), axis=1)
-        # converged, or stagnating at round-off level
-        ok[idx] = ~bad & ((e <= tol) | ((e >= 0.5 * prev[idx]) & (e <= 1e3 * tol)))
-        diverged = bad | ~np.isfinite(e) | (e > 1e3 * np.maximum(err[idx], tol))
-        prev[idx] = e
-        active[idx] = ~ok[idx] & ~diverged
-    return x, ok, F, J
+    """The one position Newton (:func:`~mechdyn.kinematics.assembly.newton`) on the
+    kernel's equations [Phi; g - q] = 0, from poses x (N, n_x) or one pose (1-D x, q);
+    returns x, converged, and the residual F and the Jacobian J at x."""
+    at = []
+
+    def system(xx):
+        at[:] = kern.system(xx, q)
+        return at[0], at[1]
+
+    def solve(J, F):
+        return kern.apply(J, kern.factor(J), F[..., None])[..., 0]
+
+    x, ok = newton(kern.rows, x, np.zeros(kern.n_eq), tol=tol, max_iter=max_iter,
+                   system=system, solve=solve)
+    return x, ok, at[0], at[1]
 
 
-def _newton1(kern: Kernel, x, q, tol, max_iter=_MAX_NEWTON):
-    """Newton for one position; returns x, converged, J at x and its LU factors."""
-    F, J = kern.system1(x, q)
-    err = float(np.max(np.abs(F))) if F.size else 0.0
-    first, prev = err, np.inf
-    for _ in range(max_iter):
-        if err <= tol:
-            break
-        fac = kern.factor1(J, want_sign=False)
-        dx = kern.solve1(J, fac, F)
-        xn = x - dx
-        if not np.all(np.isfinite(xn)):
-            return x, False, J, None
-        x = xn
-        F, J = kern.system1(x, q)
-        prev, err = err, float(np.max(np.abs(F)))
-        if not np.isfinite(err) or err > 1e3 * max(first, tol):
-            return x, False, J, None
-        if err >= 0.5 * prev and err <= 1e3 * tol:  # stagnating at round-off level
-            break
-    ok = err <= 1e3 * tol
-    return x, ok, J, kern.factor1(J) if ok else None
-
-
-def _polish(kern: Kernel, xp, Q, tol):
-    """Newton from accurate predictions ``xp`` (N, n_x): one batched step, then more
-    iterations only where needed.  Returns x, F and J at x, and the converged mask."""
-    F, J = kern.system(xp, Q)
-    X = xp - kern.apply(J, kern.factor(J, want_sign=False), F[..., None])[..., 0]
-    F, J = kern.system(X, Q)
-    ok = np.max(np.abs(F), axis=1) <= tol
-    if not ok.all():
-        idx = np.flatnonzero(~ok)
-        x2, ok2, F2, J2 = _newton(kern, X[idx], Q[idx], tol, max_iter=4)
-        X[idx], F[idx], J[idx], ok[idx] = x2, F2, J2, ok2
-    return X, F, J, ok
-
-
-def _node(kern: Kernel, x, q, k: int, J=None, fac=None) -> _Node:
+def _node(kern: Kernel, x, q, k: int, J=None) -> _Node:
     """Analogs, second derivative along coordinate ``k`` and branch sign at a solved pose."""
     if J is None:
-        _, J = kern.system1(x, q)
-        fac = kern.factor1(J)
-    B = kern.solve1(J, fac, kern.rhs_unit(1)[0])
-    H = kern.solve1(J, fac, kern.gamma1(x, B[:, k]))
-    sign = fac[2] if fac is not None else 1.0
-    return _Node(q.copy(), x.copy(), B, H, sign)
+        J = kern.system(x, q)[1]
+    fac = kern.factor(J)
+    B = kern.apply(J, fac, kern.rhs_unit(1)[0])
+    H = kern.apply(J, fac, kern.gamma(x, B[:, k]))
+    return _Node(q.copy(), x.copy(), B, H, fac[2])
 
 
 @dataclass
@@ -144,12 +212,8 @@ def _chart_node(kern: Kernel, chart, q, k: int) -> _Node:
     derivative from the chart; the other columns of B by a direct solve at that pose."""
     x, xs, xss = chart.evaluate(q[k])
     with np.errstate(all="ignore"):
-        _, J = kern.system1(x, q)
-        try:
-            B = kern.solve1(J, kern.factor1(J, want_sign=False), kern.rhs_unit(1)[0])
-        except (np.linalg.LinAlgError, ZeroDivisionError):
-            B = np.full((x.size, q.size), np.nan)
-    B = np.array(B, dtype=float)
+        J = kern.system(x, q)[1]
+        B = kern.apply(J, kern.factor(J), kern.rhs_unit(1)[0])  # a new array
     B[:, k] = xs
     return _Node(np.array(q, dtype=float), x, B, xss, chart.side_sign(q[k]))
 
@@ -191,11 +255,11 @@ def _march(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, t
             if book is not None:
                 win = book.window_chart(qn[k]) or book.window_chart(node.q[k])
             xp = win.evaluate(qn[k])[0] if win is not None else _predict(prev, node, k, h)
-            x, ok, J, fac = _newton1(kern, xp, qn, tol)
+            x, ok, _, J = _newton(kern, xp, qn, tol)
             accepted = False
             reason = "Newton's method does not converge"
             if ok:
-                nn = _node(kern, x, qn, k, J=J, fac=fac)
+                nn = _node(kern, x, qn, k, J=J)
                 step = _scaled_norm(kern, nn.x - node.x)
                 corr = _scaled_norm(kern, nn.x - xp)
                 expected = win.side_sign(qn[k]) if win is not None else node.sign
@@ -275,11 +339,13 @@ def _anchor_indices(values, max_step) -> np.ndarray:
     return np.array(anchors, dtype=int)
 
 
-def _kernel(model: Model, layout) -> Kernel:
-    """The evaluation kernel of a model in a mode, cached on the model itself (so that
-    it goes away with the model)."""
+def _kernel(model: Model, layout, idx=None) -> Kernel:
+    """The evaluation kernel of a model in a mode (for the coordinates ``idx``, default
+    all), cached on the model itself (so that it goes away with the model)."""
+    if idx is not None and np.array_equal(idx, np.arange(model.n_q)):
+        idx = None
+    key = (layout.mode, None if idx is None else tuple(int(i) for i in idx))
     per = model.memo.setdefault("sweep_kernels", {})
-    kern = per.get(layout.mode)
-    if kern is None:
-        kern = per[layout.mode] = Kernel(model, layout)
-    return kern
+    if key not in per or per[key].lay is not layout:
+        per[key] = Kernel(model, layout, idx)
+    return per[key]

@@ -1,21 +1,30 @@
 """Records of the kinematic analyses: :class:`KinematicSweep` and :class:`KinematicPoint`.
 
 Read-only arrays of positions, velocities, accelerations and velocity analogs,
-with point and body accessors and :meth:`KinematicSweep.to_dataframe`; the derived
-figures of :meth:`KinematicSweep.summary` are in :mod:`mechdyn.kinematics.figures`.
+with point and body accessors and :meth:`KinematicSweep.to_dataframe`, and the
+derived figures of :meth:`KinematicSweep.summary` (:func:`_summarize`,
+:class:`SweepSummary`): the stroke and the dead centres (TDC/BDC, refined on the
+exact travel rate) of every slider, the range of the transmission angle of every
+four-bar loop (:func:`four_bar_loops`) and the largest speed and acceleration of
+every named point.  :func:`_travel` is the travel of a prismatic joint and its rates.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
+from scipy.optimize import brentq
 
+from ..kernels import rows_numpy
+from ..mechanism.joint import Revolute
 from ..model import Model
-from .constraints import _point_kinematics
-from .figures import SweepSummary, _summarize, _travel
+from .assembly import _position_tol
+from .constraints import _point_kinematics, point_position, point_velocity, travel_rows
+from .continuation import _kernel, _newton, _node
 
-__all__ = ["KinematicSweep", "KinematicPoint"]
+__all__ = ["KinematicSweep", "KinematicPoint", "SweepSummary", "DeadCentre", "TransmissionAngle",
+           "PointExtremes", "FourBarLoop", "four_bar_loops"]
 
 
 def _ro(a):
@@ -148,15 +157,9 @@ class KinematicSweep:
 
     def point_analogs(self, body: str, name) -> np.ndarray:
         """Velocity analogs dr/dq of a body point, shape (n, 2, n_q) (m/rad or m/m)."""
-        m = self.model
-        k = m.body_index(body)
-        s = m.point_local(body, name)
-        th = self.x[:, 3 * k + 2]
-        ax = np.cos(th) * s[0] - np.sin(th) * s[1]
-        ay = np.sin(th) * s[0] + np.cos(th) * s[1]
-        Bk = self.B[:, 3 * k:3 * k + 3, :]
-        return np.stack([Bk[:, 0] - ay[:, None] * Bk[:, 2],
-                         Bk[:, 1] + ax[:, None] * Bk[:, 2]], axis=1)
+        # the point's velocity per unit rate of each coordinate (linear in xdot)
+        v = point_velocity(self.model, self.x, np.moveaxis(self.B, -1, 0), body, name)
+        return np.moveaxis(v, 0, -1)
 
     def angular(self, body: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Angle (rad), angular velocity (rad/s), angular acceleration (rad/s^2), (n,) each."""
@@ -221,3 +224,270 @@ class KinematicSweep:
         """Strokes and dead centres of the sliders, transmission angles of the four-bar
         loops, and the extreme speed and acceleration of every named point."""
         return _summarize(self)
+
+
+@dataclass(frozen=True)
+class DeadCentre:
+    """A dead centre of a slider: its travel along the guide has an extremum there.
+
+    Attributes
+    ----------
+    joint : str
+        The prismatic joint.
+    label : {"TDC", "BDC"}
+        ``"TDC"`` at the maximum travel along the joint's axis direction, ``"BDC"``
+        at the minimum (point the axis away from the crank for the engine convention).
+    at : float
+        Value of the swept coordinate there (rad or m).
+    travel : float
+        Travel of the slider point along the axis there, m.
+    """
+
+    joint: str
+    label: str
+    at: float
+    travel: float
+
+
+@dataclass(frozen=True)
+class FourBarLoop:
+    """A loop ground - crank - coupler - rocker - ground joined by four revolutes.
+
+    ``joints`` = (ground-crank, crank-coupler, coupler-rocker, rocker-ground).
+    """
+
+    crank: str
+    coupler: str
+    rocker: str
+    joints: tuple[str, str, str, str]
+
+
+@dataclass(frozen=True)
+class TransmissionAngle:
+    """Range of the transmission angle of a four-bar loop over the sweep.
+
+    The transmission angle mu is the angle between the coupler and the rocker at
+    their common joint, in [0, pi] (rad); 90 deg transmits best.
+    """
+
+    loop: FourBarLoop
+    min: float
+    min_at: float
+    max: float
+    max_at: float
+
+
+@dataclass(frozen=True)
+class PointExtremes:
+    """Largest speed (m/s) and acceleration magnitude (m/s^2) of a point, and where."""
+
+    body: str
+    point: str
+    v_max: float
+    v_max_at: float
+    a_max: float
+    a_max_at: float
+
+
+@dataclass(frozen=True)
+class SweepSummary:
+    """Derived figures of a :class:`~mechdyn.kinematics.records.KinematicSweep`.
+
+    Attributes
+    ----------
+    over : str
+        The swept coordinate; ``*_at`` values are in its unit (rad or m).
+    strokes : dict of str to float
+        Stroke (max - min travel over the sweep) of each slider, by prismatic joint, m.
+    dead_centres : list of DeadCentre
+    transmission : list of TransmissionAngle
+    extremes : list of PointExtremes
+    """
+
+    over: str
+    over_is_angle: bool
+    strokes: dict
+    dead_centres: list
+    transmission: list
+    extremes: list
+
+    def as_dict(self) -> dict:
+        """Plain nested dict (for JSON)."""
+        return asdict(self)
+
+    def lines(self) -> list[str]:
+        """Human-readable lines (angles in degrees)."""
+        def at(v):
+            if not self.over_is_angle:
+                return f"{self.over} = {v * 1e3:.4f} mm"
+            deg = np.rad2deg(v)
+            wrapped = deg % 360.0
+            extra = f" = {wrapped:.4f} deg mod 360" if abs(wrapped - deg) > 1e-9 else ""
+            return f"{self.over} = {deg:.4f} deg{extra}"
+
+        out = []
+        for j, s in self.strokes.items():
+            out.append(f"stroke of slider {j!r}: {s * 1e3:.6g} mm")
+        for d in self.dead_centres:
+            out.append(f"dead centre {d.label} of {d.joint!r} at {at(d.at)} "
+                       f"(travel {d.travel * 1e3:.6g} mm)")
+        for t in self.transmission:
+            lp = t.loop
+            out.append(f"transmission angle {lp.coupler}/{lp.rocker} at {lp.joints[2]!r}: "
+                       f"{np.rad2deg(t.min):.3f} deg ({at(t.min_at)}) .. "
+                       f"{np.rad2deg(t.max):.3f} deg ({at(t.max_at)})")
+        return out
+
+    def __str__(self) -> str:
+        return "\n".join(self.lines())
+
+
+def _travel(model: Model, joint: str, x, xdot, xddot):
+    """Travel s of a prismatic joint's child point along the parent's axis, and its rates.
+
+    s = u . (r_P - r_O) (the joint's travel row, :func:`~.constraints.travel_rows`),
+    s' = s_x xdot and s'' = s_x xddot + quad, at poses x (..., n_x); each (...,), in m,
+    m/s and m/s^2 (or per unit and per unit squared of a coordinate for analogs).
+    """
+    xdot, xddot = np.asarray(xdot, float), np.asarray(xddot, float)
+    s, s_x, quad = rows_numpy.evaluate(travel_rows(model, joint), x, xdot)
+    s_x = s_x[..., 0, :]
+    return s[..., 0], np.sum(s_x * xdot, axis=-1), np.sum(s_x * xddot, axis=-1) + quad[..., 0]
+
+
+def four_bar_loops(model: Model, over: str | None = None) -> list[FourBarLoop]:
+    """Four-bar loops ground-crank-coupler-rocker-ground joined by revolutes only.
+
+    The crank is the link driven by coordinate ``over`` when it drives one of the
+    two grounded links of a loop; otherwise the grounded link added first.
+    """
+    mech = model.mechanism
+
+    revs = [j for j in mech.joints.values() if isinstance(j, Revolute)]
+    adj: dict[str, list[tuple[str, str]]] = {}
+    for j in revs:
+        adj.setdefault(j.parent, []).append((j.child, j.name))
+        adj.setdefault(j.child, []).append((j.parent, j.name))
+    driven: set[str] = set()
+    if over is not None and over in mech.coordinates:
+        c = mech.coordinates[over]
+        if c.kind == "angle" and c.body:
+            driven.add(c.body)
+        elif c.kind == "relative_angle" and c.joint in mech.joints:
+            jj = mech.joints[c.joint]
+            driven.update({jj.parent, jj.child} - {"ground"})
+    order = {b: k for k, b in enumerate(model.body_names)}
+    seen: set[frozenset] = set()
+    loops = []
+    for a, j0 in adj.get("ground", []):
+        for c, j1 in adj.get(a, []):
+            if c in ("ground", a) or j1 == j0:
+                continue
+            for d, j2 in adj.get(c, []):
+                if d in ("ground", a, c) or j2 == j1:
+                    continue
+                for g, j3 in adj.get(d, []):
+                    if g != "ground" or j3 == j0:
+                        continue
+                    key = frozenset((j0, j1, j2, j3))
+                    if key in seen:
+                        continue
+                    seen.add(key)
+                    forward = FourBarLoop(a, c, d, (j0, j1, j2, j3))
+                    backward = FourBarLoop(d, c, a, (j3, j2, j1, j0))
+                    if d in driven and a not in driven:
+                        loops.append(backward)
+                    elif a in driven or order[a] <= order[d]:
+                        loops.append(forward)
+                    else:
+                        loops.append(backward)
+    return loops
+
+
+def _joint_point(model: Model, name: str, x) -> np.ndarray:
+    """Ground-frame position of a revolute joint (its child point), (..., 2)."""
+    jn = model.mechanism.joints[name]
+    if jn.child != "ground":
+        return point_position(model, x, jn.child, jn.child_point)
+    return point_position(model, x, jn.parent, jn.parent_point)
+
+
+def _summarize(sw: KinematicSweep) -> SweepSummary:
+    m = sw.model
+    k = sw.over_index
+    strokes, dcs = {}, []
+    n = len(sw)
+    for jname in m.pri.names:
+        # travel and its analog (per unit of the swept coordinate)
+        s, ds, _ = _travel(m, jname, sw.x, sw.B[..., k], np.zeros_like(sw.x))
+        if n == 0:
+            continue
+        found = []
+        for i in np.flatnonzero(np.sign(ds[:-1]) * np.sign(ds[1:]) < 0):
+            q_at, s_at = _refine_dead_centre(sw, jname, i)
+            # a maximum where the travel rate goes from + to - along the sweep direction
+            is_max = (ds[i] > 0) == (sw.values[i + 1] > sw.values[i])
+            found.append((q_at, s_at, is_max))
+        for i in np.flatnonzero(ds == 0.0):  # exactly on a sample: keep it if an extremum
+            j0, j1 = max(i - 1, 0), min(i + 1, n - 1)
+            hi, lo = s[i] >= max(s[j0], s[j1]), s[i] <= min(s[j0], s[j1])
+            if hi != lo:
+                found.append((float(sw.values[i]), float(s[i]), bool(hi)))
+        allvals = np.concatenate([s, [f[1] for f in found]])
+        strokes[jname] = float(np.max(allvals) - np.min(allvals))
+        for q_at, s_at, is_max in sorted(found):
+            dcs.append(DeadCentre(jname, "TDC" if is_max else "BDC", q_at, s_at))
+    trans = []
+    for lp in four_bar_loops(m, sw.over):
+        if n == 0:
+            continue
+        B_ = _joint_point(m, lp.joints[1], sw.x)
+        C_ = _joint_point(m, lp.joints[2], sw.x)
+        D_ = _joint_point(m, lp.joints[3], sw.x)
+        u, v = B_ - C_, D_ - C_
+        mu = np.arctan2(np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]),
+                        u[:, 0] * v[:, 0] + u[:, 1] * v[:, 1])
+        i0, i1 = int(np.argmin(mu)), int(np.argmax(mu))
+        trans.append(TransmissionAngle(lp, float(mu[i0]), float(sw.values[i0]),
+                                       float(mu[i1]), float(sw.values[i1])))
+    ext = []
+    for b, p in m.named_points():
+        if n == 0:
+            continue
+        _, v, a = sw.point(b, p)
+        vn, an = np.hypot(v[:, 0], v[:, 1]), np.hypot(a[:, 0], a[:, 1])
+        iv, ia = int(np.argmax(vn)), int(np.argmax(an))
+        ext.append(PointExtremes(b, p, float(vn[iv]), float(sw.values[iv]), float(an[ia]),
+                                 float(sw.values[ia])))
+    return SweepSummary(sw.over, sw.over_is_angle, strokes, dcs, trans, ext)
+
+
+def _refine_dead_centre(sw: KinematicSweep, jname: str, i: int) -> tuple[float, float]:
+    """Root of the exact travel rate ds/dq between positions i and i+1 (Brent's method,
+    each rate at a position solved from the last); returns (q there, travel there)."""
+    m, k = sw.model, sw.over_index
+    kern = _kernel(m, m.layout(sw.stats.get("mode")))
+    tol = _position_tol(m)
+    last = {"x": sw.x[i], "s": np.nan}
+
+    def rate(q_over):
+        q = sw.q[0].copy()
+        q[k] = q_over
+        x, ok, _, J = _newton(kern, np.array(last["x"], dtype=float), q, tol)
+        if not ok:
+            raise ArithmeticError(f"no position at {sw.over} = {q_over!r}")
+        node = _node(kern, x, q, k, J=J)
+        last["x"] = x
+        s, ds, _ = _travel(m, jname, x, node.B[:, k], node.H)
+        last["s"] = float(s)
+        return float(ds)
+
+    a, b = float(sw.values[i]), float(sw.values[i + 1])
+    try:
+        q = brentq(rate, min(a, b), max(a, b), xtol=1e-15, rtol=4 * np.finfo(float).eps)
+        rate(q)
+    except (ArithmeticError, ValueError):  # no solved root: interpolate the sampled rates
+        _, fa, _ = _travel(m, jname, sw.x[i], sw.B[i, :, k], np.zeros(m.n_x))
+        _, fb, _ = _travel(m, jname, sw.x[i + 1], sw.B[i + 1, :, k], np.zeros(m.n_x))
+        q = a - fa * (b - a) / (fb - fa)
+    return float(q), last["s"]

@@ -35,15 +35,15 @@ How it is computed (vectorized over the positions):
 The residual, Jacobian and acceleration right-hand side are the model's
 constraint and coordinate rows (:mod:`mechdyn.model.rows`), the equations of
 :mod:`mechdyn.kinematics.constraints`, evaluated by a private kernel
-(compiled when numba is installed) that also solves with the block-triangular
-structure of the Jacobian.
+(compiled when numba is installed) that also factors the Jacobians (sparse LU,
+which gives the branch sign too).
 
 This module holds the analyses :func:`sweep` and :func:`analyze`; the building
 blocks of the continuation are in :mod:`mechdyn.kinematics.continuation`, the
-records :class:`KinematicSweep` and :class:`KinematicPoint` in
-:mod:`mechdyn.kinematics.records` and the derived figures (:class:`SweepSummary`,
-dead centres, strokes, four-bar loops and transmission angles, extremes) in
-:mod:`mechdyn.kinematics.figures`; all their public names are importable from here.
+records :class:`KinematicSweep` and :class:`KinematicPoint` and their derived
+figures (:class:`SweepSummary`: dead centres, strokes, four-bar loops and
+transmission angles, extremes) in :mod:`mechdyn.kinematics.records`; all their
+public names are importable from here.
 """
 
 from __future__ import annotations
@@ -64,20 +64,20 @@ from .continuation import (
     _kernel,
     _march,
     _newton,
-    _newton1,
     _node,
-    _polish,
     _Stop,
 )
-from .figures import (
+from .records import (
     DeadCentre,
     FourBarLoop,
+    KinematicPoint,
+    KinematicSweep,
     PointExtremes,
     SweepSummary,
     TransmissionAngle,
+    _ro,
     four_bar_loops,
 )
-from .records import KinematicPoint, KinematicSweep, _ro
 
 __all__ = ["sweep", "analyze", "initial_coordinates", "KinematicSweep", "KinematicPoint",
            "SweepSummary", "DeadCentre", "TransmissionAngle", "PointExtremes", "FourBarLoop",
@@ -213,11 +213,11 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
     else:
         x0 = np.asarray(x_start, float).reshape(model.n_x)
         q_init = coordinates(model, x0)
-    x_init, ok, J0, fac0 = _newton1(kern, x0, q_init, tol)
+    x_init, ok, _, J0 = _newton(kern, x0, q_init, tol)
     if not ok:
         x_init = assemble(model, q_init, x_guess=x0, layout=lay)
-        J0 = fac0 = None
-    start = _node(kern, x_init, q_init, k, J=J0, fac=fac0)
+        J0 = None
+    start = _node(kern, x_init, q_init, k, J=J0)
     # bifurcation positions on the way are gone through on the branch (branch charts)
     book = None
     if lay.n_rows + model.n_q == model.n_x:
@@ -244,15 +244,11 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
     t_coarse = time.perf_counter() - t_coarse
     # ---- 2. batched solve of every value between solved anchors
     n_ok = int(anchors[n_anch - 1]) + 1 if n_anch else 0
-    Q = np.broadcast_to(q_init, (n_ok, model.n_q)).copy()
-    Q[:, k] = values[:n_ok]
     X = np.empty((n_ok, model.n_x))
-    F = J = fac = None
+    F = fac = None  # F, J and the factors at X, while they are current
     fallback = 0
     if n_anch == 1:
         X[:] = anodes[0].x
-        F, J = kern.system(X, Q)
-        fac = kern.factor(J)
     elif n_anch > 1:
         a_idx = anchors[:n_anch]
         seg = np.clip(np.searchsorted(a_idx, np.arange(n_ok), side="right") - 1, 0, n_anch - 2)
@@ -265,9 +261,9 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
         with np.errstate(invalid="ignore", divide="ignore"):
             t = np.where(h != 0, (values[:n_ok, None] - qa[seg, None]) / h, 0.0)
         xp = _hermite5(t, h, xa[seg], da[seg], aa[seg], xa[seg + 1], da[seg + 1], aa[seg + 1])
-        X, F, J, ok_f = _polish(kern, xp, Q, tol)
+        X, ok_f, F, J = _newton(kern, xp, _coords(q_init, k, values[:n_ok]), tol, max_iter=5)
         fac = kern.factor(J)
-        sgn = fac.sign if fac is not None else kern.sign(J)
+        sgn = fac[2]
         near = np.max(np.abs((X - xp) * kern.col_scale), axis=1) <= 1e-3 * L
         ok_f &= (sgn == sg[seg]) & near
         bad_segments = np.unique(seg[~ok_f])
@@ -282,12 +278,11 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
             if st is not None:  # only if a singular position lies between two anchors
                 stop = st
                 n_ok = i0 + 1 + len(nodes)
-                X, Q = X[:n_ok], Q[:n_ok]
+                X = X[:n_ok]
                 anodes, n_anch = anodes[:m_ + 1], -1
                 break
         if bad_segments.size:
-            F, J = kern.system(X, Q)
-            fac = kern.factor(J)
+            F = None
 
     # ---- 3. past the last anchor: go on point by point up to the dead position
     if stop is not None and n_anch >= 0 and n_ok < n_req:
@@ -300,19 +295,19 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
             stop = _Stop(nodes[-1], nodes[-1].q, "the continuation could not reach "
                          f"{over} = {values[nxt]:.9g}")
         if nodes:
-            Xn = np.array([nd.x for nd in nodes])
-            Qn = np.broadcast_to(q_init, (len(nodes), model.n_q)).copy()
-            Qn[:, k] = values[n_ok:n_ok + len(nodes)]
-            X, Q = np.concatenate([X, Xn]), np.concatenate([Q, Qn])
+            X = np.concatenate([X, [nd.x for nd in nodes]])
             n_ok += len(nodes)
-            F, J = kern.system(X, Q)
-            fac = kern.factor(J)
+            F = None
 
     # ---- 4. velocities and accelerations in one batch
     N = n_ok
+    Q = _coords(q_init, k, values[:N])
     qdot = np.broadcast_to(qdot_c, (N, model.n_q)).copy()
     qddot = np.zeros((N, model.n_q))
     if N:
+        if F is None:
+            F, J = kern.system(X, Q)
+            fac = kern.factor(J)
         with np.errstate(all="ignore"):  # a Jacobian singular at a bifurcation: charted
             rhs = np.concatenate([F[..., None], kern.rhs_unit(N)], axis=-1)
             sol = kern.apply(J, fac, rhs)
@@ -345,6 +340,13 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
         over=over, values=_ro(values[:N].copy()), q=_ro(Q), qdot=_ro(qdot), qddot=_ro(qddot),
         x=_ro(X), xdot=_ro(xdot), xddot=_ro(xddot), B=_ro(B), status=status, message=message,
         stats=stats, events=events, error=error, model=model)
+
+
+def _coords(q_init, k: int, values) -> np.ndarray:
+    """Coordinates (n, n_q): q_init with coordinate k at the values."""
+    Q = np.tile(q_init, (len(values), 1))
+    Q[:, k] = values
+    return Q
 
 
 def _charted(book: ChartBook, k: int, Q, qdot, X, B, xdot, xddot):
@@ -417,12 +419,13 @@ def analyze(mech_or_model, q, qdot, qddot=None, x_guess=None, *, mode=None) -> K
         if x_guess is None:
             x_guess = assemble(model, layout=lay)
     tol = _position_tol(model)
-    x, ok, _, J = _newton(kern, np.asarray(x_guess, float)[None], q[None], tol)
-    if not ok[0]:
-        x = assemble(model, q, x_guess=x_guess, layout=lay)[None]
-        _, J = kern.system(x, q[None])
-    B = kern.solve(J, kern.rhs_unit(1))[0]
+    x, ok, _, J = _newton(kern, np.asarray(x_guess, float), q, tol)
+    if not ok:
+        x = assemble(model, q, x_guess=x_guess, layout=lay)
+        J = kern.system(x, q)[1]
+    fac = kern.factor(J)
+    B = kern.apply(J, fac, kern.rhs_unit(1)[0])
     xdot = B @ qdot
-    xddot = B @ qddot + kern.solve(J, kern.gamma(x, xdot[None])[..., None])[0, :, 0]
+    xddot = B @ qddot + kern.apply(J, fac, kern.gamma(x, xdot))
     return KinematicPoint(q=_ro(q.copy()), qdot=_ro(qdot.copy()), qddot=_ro(qddot.copy()),
-                          x=_ro(x[0]), xdot=_ro(xdot), xddot=_ro(xddot), B=_ro(B), model=model)
+                          x=_ro(x), xdot=_ro(xdot), xddot=_ro(xddot), B=_ro(B), model=model)
