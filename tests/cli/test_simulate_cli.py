@@ -106,3 +106,23 @@ def test_ctrl_c_writes_the_samples_so_far_and_exits_130(tmp_path, capsys, monkey
     assert "interrupted" in captured.out and "Traceback" not in captured.err
     df = pd.read_csv(out)
     assert len(df) > 5 and 0.0 < df["t_s"].iloc[-1] < 1.0
+
+
+@pytest.mark.parametrize(("option", "value", "why"), [
+    ("-o", "", "the path is empty"),
+    ("--plot", "out.txt", "unknown image type '.txt'"),
+    ("-o", ".", "is a folder"),
+])
+def test_output_paths_are_checked_before_the_run(option, value, why, tmp_path, capsys,
+                                                 monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code = main(["simulate", "clutchless_press", "--t-end", "1 ms", option, value])
+    err = capsys.readouterr().err
+    assert code == 2 and why in err and "Traceback" not in err
+
+
+@pytest.mark.skipif(not __import__("os").path.exists("/dev/full"), reason="needs /dev/full")
+def test_a_full_disk_is_a_named_error(capsys):
+    code = main(["simulate", "clutchless_press", "--t-end", "1 ms", "-o", "/dev/full"])
+    err = capsys.readouterr().err
+    assert code == 2 and "cannot write the output" in err and "Traceback" not in err

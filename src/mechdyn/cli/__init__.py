@@ -9,12 +9,14 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
+from pathlib import Path
 
 from .._version import __version__
-from ..errors import MechdynError
+from ..errors import MechdynError, ModelError
 
-__all__ = ["main", "SUBCOMMAND_MODULES"]
+__all__ = ["main", "SUBCOMMAND_MODULES", "check_outputs", "PLOT_SUFFIXES"]
 
 #: modules of this package that define subcommands, in the order of ``mechdyn --help``
 SUBCOMMAND_MODULES = ("demo", "examples", "kinematics", "simulate", "kinetostatics", "reduce",
@@ -32,6 +34,39 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: image types the plots can be written as
+PLOT_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg")
+
+
+def check_outputs(args) -> None:
+    """Check every output path of a command before it runs: not empty, not a folder, an
+    image type for plots, and a folder that can be written into (or created).
+
+    Raises
+    ------
+    ModelError
+        Naming the option, the path and what is wrong.
+    """
+    for attr, flag in (("output", "-o"), ("plot", "--plot"), ("snapshot", "--snapshot")):
+        value = getattr(args, attr, None)
+        if value is None:
+            continue
+        if not str(value).strip():
+            raise ModelError(f"{flag}: the path is empty")
+        path = Path(value)
+        if path.is_dir():
+            raise ModelError(f"{flag} {value}: is a folder, not a file")
+        if attr != "output" and path.suffix.lower() not in PLOT_SUFFIXES:
+            raise ModelError(f"{flag} {value}: unknown image type {path.suffix or '(none)'!r}; "
+                             f"use one of {', '.join(PLOT_SUFFIXES)}")
+        folder = path.resolve().parent
+        while not folder.exists():
+            folder = folder.parent
+        if not os.access(folder, os.W_OK):
+            raise ModelError(f"{flag} {value}: cannot write into {folder} (no permission or "
+                             f"a read-only file system)")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code (0 ok, 1 analysis stopped, 2 bad input,
     130 interrupted by Ctrl-C)."""
@@ -41,9 +76,14 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return 0
     try:
+        check_outputs(args)
         return int(args.func(args) or 0)
     except (MechdynError, FileNotFoundError, IsADirectoryError, PermissionError) as exc:
         print(f"mechdyn {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # a full disk, a device that refuses the data ...
+        print(f"mechdyn {args.command}: error: cannot write the output: {exc}",
+              file=sys.stderr)
         return 2
     except KeyboardInterrupt:  # outside a run (a run keeps its data and says so itself)
         print(f"mechdyn {args.command}: interrupted", file=sys.stderr)
