@@ -165,6 +165,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     unknown = [n for n in locks if n not in sm.lock_names]
     if unknown:
         raise ModelError("mode: " + did_you_mean(unknown[0], sm.lock_names, "lock"))
+    stats["mode"] = sorted(locks)  # the engaged locks at the start
     welds = sorted(locks & set(sm.welds))
     q_init, qd_init, x_guess = initial_state(model, q0, qdot0, mode=welds)
     t = t0

@@ -219,7 +219,7 @@ class Trajectory:
                 ("E_balance_J", "balance"), ("residual", "residual"))})
         vs = self.switching
         if vs and self.t.size:
-            cols.update(_switched_columns(vs))
+            cols.update(_switched_columns(vs, getattr(self.model, "has_switching", True)))
         return pd.DataFrame(cols)
 
     @property
@@ -247,14 +247,15 @@ class Trajectory:
         return out
 
 
-def _switched_columns(vs: dict) -> dict:
-    """Columns of a variable-structure run: the mode of each sample, the force on the
-    frame and the force of every lock, stop and contact (see ``docs/variable-structure.md``).
-    """
-    cols: dict[str, np.ndarray] = {
-        "mode": np.array([" ".join(sorted(m)) or "-" for m in vs["mode"]], dtype=object),
-        "mode_index": np.asarray(vs["mode_index"]),
-    }
+def _switched_columns(vs: dict, modes: bool = True) -> dict:
+    """Columns of the forces of a run: the mode of each sample (with ``modes``: the model
+    has switchable elements), the force on the frame and the force of every joint, lock, stop and
+    contact (see ``docs/variable-structure.md``)."""
+    cols: dict[str, np.ndarray] = {}
+    if modes:  # a model without switchable elements has one mode: no mode column
+        cols["mode"] = np.array([" ".join(sorted(m)) or "-" for m in vs["mode"]],
+                                dtype=object)
+        cols["mode_index"] = np.asarray(vs["mode_index"])
     frame = np.asarray(vs["frame_force"], float)
     cols["Fx_frame_N"] = frame[:, 0]
     cols["Fy_frame_N"] = frame[:, 1]
