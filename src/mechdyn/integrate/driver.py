@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -18,7 +19,7 @@ from .base import DEFAULT_RTOL, Integrator, IntegratorOptionError
 from .events import as_events
 from .runge_kutta import RungeKutta4
 from .scipy_ivp import SCIPY_METHODS, ScipyIntegrator
-from .segment import Coordinates, run_to_end, user_event_functions
+from .segment import Coordinates, arm, run_segment, user_event_functions, user_event_records
 from .wilson import Wilson
 
 __all__ = ["INTEGRATORS", "make_integrator", "segment_integrators", "solve", "Solution",
@@ -213,7 +214,7 @@ def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end
         out_w.append(y[2 * n:].copy())
         out_a.append(rhs(t, y[:n], y[n:2 * n])[0] if a is None else np.array(a))
 
-    eqs = _Equations(rhs)
+    eqs = SimpleNamespace(rhs=rhs, first_order_function=lambda: None)
     y = np.concatenate([q0, v0, wz])
     if te is None:
         push(t0, y)
@@ -222,25 +223,28 @@ def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end
             push(t0, y)
         te = te[te > t0]
     counts = {"steps": 0, "rejected": 0, "evaluations": 0}
-    t, y_end, records, terminal = run_to_end(
-        integ, eqs, t0, y, t_end, efns, evaluate=lambda t_, y_: Coordinates(y_, n),
-        after_step=lambda step, y_: None,
-        sample=lambda ts, y_, step, ev: push(ts, y_, step.qddot if ts == step.t else None),
-        t_eval=te, every_step=te is None, stats=counts, n=n)
-    if y_end is not None and te is None:
-        push(t, y_end)
-    status = "event" if terminal is not None else "success"
+    t, fresh, next_out, records, status = t0, set(), 0, [], "success"
+    while True:  # segments, restarted at each of the caller's events
+        arm(efns, t, Coordinates(y, n), fresh)
+        hit, next_out = run_segment(
+            integ, eqs, t, y, t_end, efns, evaluate=lambda t_, y_: Coordinates(y_, n),
+            after_step=lambda step, y_: None,
+            sample=lambda ts, y_, step, ev: push(ts, y_, step.qddot if ts == step.t else None),
+            t_eval=np.zeros(0) if te is None else te, next_out=next_out,
+            every_step=te is None, stats=counts, n=n)
+        if hit is None:
+            break
+        t, fired, dense = hit
+        y = dense(t)
+        records.extend(user_event_records(fired, t, y, n))
+        fresh = {(e.kind, e.key) for e in fired}
+        terminal = any(e.data.terminal for e in fired)
+        if terminal or t >= t_end:
+            status = "event" if terminal else "success"
+            if te is None:
+                push(t, y)
+            break
     return Solution(np.array(out_t), np.array(out_q).reshape(-1, n),
                     np.array(out_v).reshape(-1, n), np.array(out_a).reshape(-1, n),
                     np.array(out_w).reshape(len(out_t), -1), records,
                     {"integrator": integ.name, **counts}, status)
-
-
-class _Equations:
-    """A plain right-hand side as the segment integrator calls it."""
-
-    def __init__(self, rhs):
-        self.rhs = rhs
-
-    def first_order_function(self):
-        return None
