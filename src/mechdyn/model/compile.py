@@ -101,40 +101,21 @@ class Model:
         self.gravity = np.asarray(mechanism.gravity, dtype=float)
         self.x_sketch = np.array([v for b in bodies for v in b.pose], dtype=float)
 
-        revs = [j for j in mechanism.joints.values() if isinstance(j, Revolute)]
-        pris = [j for j in mechanism.joints.values() if isinstance(j, Prismatic)]
-        locks = [j for j in mechanism.joints.values() if isinstance(j, Lock)]
-        self.rev = RevoluteRows(
-            tuple(j.name for j in revs),
-            np.array([self._bindex[j.parent] for j in revs], dtype=int),
-            np.array([self._bindex[j.child] for j in revs], dtype=int),
-            np.array([self._point(j.parent, j.parent_point) for j in revs]).reshape(-1, 2),
-            np.array([self._point(j.child, j.child_point) for j in revs]).reshape(-1, 2),
-        )
-        ui = np.array([np.asarray(j.axis, float) / np.hypot(*j.axis) for j in pris]).reshape(-1, 2)
+        revs, pris, locks = ([j for j in mechanism.joints.values() if isinstance(j, kind)]
+                             for kind in (Revolute, Prismatic, Lock))
+        self.rev = RevoluteRows(*self._ends(revs), self._points(revs, "parent"),
+                                self._points(revs, "child"))
         self.pri = PrismaticRows(
-            tuple(j.name for j in pris),
-            np.array([self._bindex[j.parent] for j in pris], dtype=int),
-            np.array([self._bindex[j.child] for j in pris], dtype=int),
-            np.array([self._point(j.parent, j.parent_point) for j in pris]).reshape(-1, 2),
-            ui,
-            np.array([self._point(j.child, j.child_point) for j in pris]).reshape(-1, 2),
+            *self._ends(pris), self._points(pris, "parent"),
+            np.array([np.asarray(j.axis, float) / np.hypot(*j.axis) for j in pris]).reshape(-1, 2),
+            self._points(pris, "child"),
             np.array([self._sketch_angle(j) if j.angle is None else j.angle for j in pris],
-                     dtype=float),
-        )
-        lock_c, lock_a = [], []
-        for j in locks:
-            off = self._sketch_offset(j) if j.offset is None else j.offset
-            lock_c.append(off[:2])
-            lock_a.append(off[2])
-        self.lock = LockRows(
-            tuple(j.name for j in locks),
-            np.array([self._bindex[j.parent] for j in locks], dtype=int),
-            np.array([self._bindex[j.child] for j in locks], dtype=int),
-            np.array(lock_c, dtype=float).reshape(-1, 2),
-            np.array(lock_a, dtype=float),
-            np.array([j.engaged for j in locks], dtype=bool),
-        )
+                     dtype=float))
+        offsets = [self._sketch_offset(j) if j.offset is None else j.offset for j in locks]
+        self.lock = LockRows(*self._ends(locks),
+                             np.array([o[:2] for o in offsets], dtype=float).reshape(-1, 2),
+                             np.array([o[2] for o in offsets], dtype=float),
+                             np.array([j.engaged for j in locks], dtype=bool))
         self.joint_names = tuple(mechanism.joints)
         self._jkind = {n: type(j).__name__.lower() for n, j in mechanism.joints.items()}
 
@@ -145,17 +126,10 @@ class Model:
         self.coord_is_angle = np.array([c.is_angle for c in coords], dtype=bool)
         self.coord_offset = np.array([c.offset for c in coords], dtype=float)
         # body for 'angle'; joint index into rev / pri tables otherwise
-        cb, cj = [], []
-        for c in coords:
-            if c.kind == "angle":
-                cb.append(self._bindex[c.body])
-                cj.append(-1)
-            elif c.kind == "relative_angle":
-                cb.append(-1)
-                cj.append(self.rev.names.index(c.joint))
-            else:
-                cb.append(-1)
-                cj.append(self.pri.names.index(c.joint))
+        cb = [self._bindex[c.body] if c.kind == "angle" else -1 for c in coords]
+        cj = [-1 if c.kind == "angle" else
+              (self.rev if c.kind == "relative_angle" else self.pri).names.index(c.joint)
+              for c in coords]
         self.coord_body = np.array(cb, dtype=int)
         self.coord_joint = np.array(cj, dtype=int)
 
@@ -167,9 +141,7 @@ class Model:
 
         self._lower_rows()
 
-        self.mass_diag = np.repeat(self.mass, 3).reshape(nb, 3)
-        self.mass_diag[:, 2] = self.inertia
-        self.mass_diag = self.mass_diag.reshape(-1)
+        self.mass_diag = np.stack([self.mass, self.mass, self.inertia], axis=1).reshape(-1)
         self.initial_mode = self.mode_of(self.lock.engaged)
         #: declared assembly modes: (AssemblyMode, ((body index, local point) for P, Q, R))
         self.assembly_modes = [
@@ -224,6 +196,17 @@ class Model:
         return self
 
     # ------------------------------------------------------------------ lookups
+    def _ends(self, joints) -> tuple:
+        """(names, parent indices, child indices) of some joints."""
+        return (tuple(j.name for j in joints),
+                *(np.array([self._bindex[getattr(j, end)] for j in joints], dtype=int)
+                  for end in ("parent", "child")))
+
+    def _points(self, joints, end: str) -> np.ndarray:
+        """The (n, 2) points of some joints on their ``end`` ("parent" or "child") body."""
+        return np.array([self._point(getattr(j, end), getattr(j, end + "_point"))
+                         for j in joints]).reshape(-1, 2)
+
     def _point(self, body: str, ref) -> tuple[float, float]:
         if isinstance(ref, str):
             return self._bodies[body].point(ref)
@@ -298,29 +281,15 @@ class ConstraintLayout:
 
     def __init__(self, model: Model, mode: frozenset):
         self.mode = mode
-        rows: dict[str, np.ndarray] = {}
-        k = 0
-        for n in model.rev.names:
-            rows[n] = np.arange(k, k + 2)
-            k += 2
-        for n in model.pri.names:
-            rows[n] = np.arange(k, k + 2)
-            k += 2
-        active = np.array([n in mode for n in model.lock.names], dtype=bool)
-        for n, a in zip(model.lock.names, active, strict=True):
-            if a:
-                rows[n] = np.arange(k, k + 3)
-                k += 3
-        self.lock_active = active
-        self.rows = rows
-        self.n_rows = k
-        self.row_joint = np.empty(k, dtype=object)
-        for n, r in rows.items():
-            self.row_joint[r] = n
+        self.lock_active = np.array([n in mode for n in model.lock.names], dtype=bool)
         #: the constraint rows of the mode (joints, then engaged locks), as data
         self.rowset = R.concat(model.n_bodies, model.joint_rows,
                                *[model.weld_rows[n] for n, a in
-                                 zip(model.lock.names, active, strict=True) if a])
+                                 zip(model.lock.names, self.lock_active, strict=True) if a])
+        self.n_rows = len(self.rowset)
+        self.row_joint = np.array(self.rowset.elements, dtype=object)
+        self.rows = {n: np.flatnonzero(self.row_joint == n)
+                     for n in dict.fromkeys(self.rowset.elements)}
         #: the rows of the position problem [Phi(x); g(x)] = [0; q]
         self.position_rows = R.concat(model.n_bodies, self.rowset, model.coordinate_rows)
 
