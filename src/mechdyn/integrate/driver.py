@@ -121,25 +121,17 @@ def segment_integrators(method, t0: float, t_end: float, *, rtol, atol, dt, step
         An unknown integrator or options that do not belong to it.
     """
     fixed = dict(dt=dt, steps=steps, iterations=iterations, tol=tol, theta=theta)
+    name = method.lower() if isinstance(method, str) else method  # make_integrator checks it
     if isinstance(method, Integrator):
-        if any(v is not None for v in fixed.values()):
-            raise IntegratorOptionError(
-                "options " + ", ".join(k for k, v in fixed.items() if v is not None)
-                + f" cannot be combined with an integrator instance ({method!r}); set them on "
-                "the instance")
+        make_integrator(method, **fixed)  # refuses options beside an instance
+        name = method.name
         if isinstance(method, ScipyIntegrator):
-            name, rtol, atol = method.name, method.rtol, method.atol
+            rtol, atol = method.rtol, method.atol
             first_step = method.first_step if first_step is None else first_step
             max_step = method.max_step if max_step is None else max_step
         else:
-            name = method.name
             fixed.update(dt=method.dt, steps=method.steps,
                          **{k: getattr(method, k, None) for k in ("iterations", "tol", "theta")})
-    elif isinstance(method, str):
-        name = method.lower()
-    else:
-        raise IntegratorOptionError(f"unknown integrator {method!r}; valid integrator names: "
-                                    + ", ".join(INTEGRATORS))
     if name in ("wilson", "rk4"):
         # the same validation as a fixed-structure run (first_step, max_step are refused)
         make_integrator(name, first_step=first_step, max_step=max_step, **fixed)

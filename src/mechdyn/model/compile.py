@@ -171,17 +171,30 @@ class Model:
               for k, n in enumerate(pr.names)])
         self.weld_rows = {n: R.weld(n, lk.i[k], lk.c[k], lk.j[k], lk.angle[k], nb=nb)
                           for k, n in enumerate(lk.names)}
-        coords = []
-        for k, name in enumerate(self.coordinate_names):
-            kind, off, jj = self.coord_kind[k], self.coord_offset[k], self.coord_joint[k]
-            if kind == COORD_ANGLE:
-                coords.append(R.angle(name, self.coord_body[k], off, nb=nb))
-            elif kind == COORD_RELATIVE:
-                coords.append(R.relative_angle(name, rv.i[jj], rv.j[jj], off, nb=nb))
-            else:
-                coords.append(R.line(name, pr.j[jj], pr.sj[jj], pr.i[jj], pr.si[jj], pr.ui[jj],
-                                     normal=False, offset=off, nb=nb))
+        coords = [R.angle(c.name, self._bindex[c.body], c.offset, nb=nb) if c.kind == "angle"
+                  else self.joint_variable(c.name, c.joint, c.offset)
+                  for c in self.mechanism.coordinates.values()]
         self.coordinate_rows = R.concat(nb, *coords)
+
+    def joint_variable(self, label: str, joint: str, offset: float = 0.0) -> R.Rows:
+        """The row of the relative angle theta_child - theta_parent of a revolute joint (rad)
+        or of the travel of a prismatic joint along its axis (m), plus ``offset``.
+
+        Raises
+        ------
+        ModelError
+            ``joint`` is neither (the message lists the valid names).
+        """
+        rv, pr, nb = self.rev, self.pri, self.n_bodies
+        if joint in rv.names:
+            k = rv.names.index(joint)
+            return R.relative_angle(label, rv.i[k], rv.j[k], offset, nb=nb)
+        if joint in pr.names:
+            k = pr.names.index(joint)
+            return R.line(label, pr.j[k], pr.sj[k], pr.i[k], pr.si[k], pr.ui[k], normal=False,
+                          offset=offset, nb=nb)
+        raise ModelError(did_you_mean(joint, (*rv.names, *pr.names),
+                                      "revolute or prismatic joint"))
 
     def __setattr__(self, name, value):
         if self.__dict__.get("_frozen", False):
