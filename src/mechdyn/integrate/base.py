@@ -34,8 +34,7 @@ import numpy as np
 from ..errors import MechdynError
 
 __all__ = ["Integrator", "FixedStep", "IntegratorStats", "Step", "hermite_dense",
-           "check_positive", "IntegratorOptionError", "IntegratorWarning", "fixed_grid",
-           "DEFAULT_RTOL"]
+           "check_positive", "IntegratorOptionError", "IntegratorWarning", "DEFAULT_RTOL"]
 
 
 class IntegratorOptionError(MechdynError, ValueError):
@@ -233,23 +232,6 @@ class Integrator(ABC):
         return f"{type(self).__name__}({s})"
 
 
-def fixed_grid(t0: float, t_end: float, steps: int | None, dt: float | None,
-               default_steps: int = 100) -> np.ndarray:
-    """Step end points of a fixed-step integration: ``steps`` equal steps, or steps of
-    ``dt`` (the last one shortened to land on ``t_end``)."""
-    if steps is not None and dt is not None:
-        raise IntegratorOptionError("give either `steps` or `dt`, not both")
-    if t_end == t0:
-        return np.array([t0])
-    if dt is not None:
-        n = max(1, int(math.ceil((t_end - t0) / dt - 1e-9)))
-        grid = t0 + dt * np.arange(n + 1)
-        grid[-1] = t_end
-        return grid
-    n = default_steps if steps is None else steps
-    return np.linspace(t0, t_end, n + 1)
-
-
 class FixedStep(Integrator):
     """Base class of the fixed-step integrators: ``steps`` equal steps over [t0, t_end]
     (default 100 when ``dt`` is not given), or steps of ``dt`` (s; the last one shortened
@@ -274,7 +256,14 @@ class FixedStep(Integrator):
         at ``t``."""
 
     def _steps(self, rhs, t0, q0, qdot0, w0, t_end, first_order=None) -> Iterator[Step]:
-        grid = fixed_grid(t0, t_end, self.steps, self.dt)
+        if t_end == t0:
+            grid = np.array([t0])
+        elif self.dt is not None:
+            n = max(1, int(math.ceil((t_end - t0) / self.dt - 1e-9)))
+            grid = t0 + self.dt * np.arange(n + 1)
+            grid[-1] = t_end
+        else:
+            grid = np.linspace(t0, t_end, (100 if self.steps is None else self.steps) + 1)
         q, v, w = q0, qdot0, w0
         a, p = rhs(t0, q, v)
         t = t0

@@ -272,7 +272,8 @@ def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
     if not cholesky_solve(A, rhs, ni):
         return 2
     if full:
-        _reactions(x, v, bb, rhs, q, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, ni, nq, ext)
+        _reactions(x, v, bb, rhs, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, ni, nq,
+                   ext)
     ok = P == P
     for c in range(ni):
         out[c] = qdi[c]
@@ -285,7 +286,8 @@ def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
 
 
 @njit
-def _reactions(x, v, bb, qdd, q, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, ni, nq, ext):
+def _reactions(x, v, bb, qdd, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, ni, nq,
+               ext):
     """Fill ``ext`` (see :func:`evaluate`) after the solve for q_I''."""
     nx = 3 * nb
     ls = fp[2]
@@ -296,19 +298,14 @@ def _reactions(x, v, bb, qdd, q, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, 
             s += Bl[r * ni + c] * qdd[c]
         xdd[r] = s
     o = nx
-    rows_q = ext[o:o + nq]
-    rows_v = ext[o + nq:o + 2 * nq]
+    ext[o:o + nq] = q
+    ext[o + nq:o + 2 * nq] = qdot
     rows_a = ext[o + 2 * nq:o + 3 * nq]
     for k in range(nq):
         s = Gb[k]
         for c in range(ni):
             s += GB[k, c] * qdd[c]
         rows_a[k] = s
-        rows_q[k] = q[k]
-        sq = 0.0
-        for r in range(nx):
-            sq += G[k, r] * v[r]
-        rows_v[k] = sq
     # residual of the free bodies: M x'' + h - F (F with the drives on their coordinates)
     z = np.empty(nx)
     Ftot = ext[o + 3 * nq + nc:o + 3 * nq + nc + nx]

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..mechanism.drive import TorqueSpeedCurve
 from ..mechanism.load import Force, RotarySpring, Spring, Table, Torque
-from .rows_numba import njit
+from .rows_numba import body_pose, njit
 
 __all__ = ["LoadPacker", "Unsupported", "forces", "load_value", "interp", "H_NB", "H_NQ",
            "H_NDRV", "H_IOFF", "H_FOFF", "S_BODY", "S_DRV", "FR_BODY", "IR_DRV", "FR_DRV",
@@ -256,14 +256,10 @@ def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv):
         i = ip[oi + IR_SPR * k]
         j = ip[oi + IR_SPR * k + 1]
         f0 = of + FR_SPR * k
-        xi = yi = ti = vxi = vyi = wi = 0.0
-        if i < nb:
-            xi, yi, ti = x[3 * i], x[3 * i + 1], x[3 * i + 2]
-            vxi, vyi, wi = v[3 * i], v[3 * i + 1], v[3 * i + 2]
-        xj = yj = tj = vxj = vyj = wj = 0.0
-        if j < nb:
-            xj, yj, tj = x[3 * j], x[3 * j + 1], x[3 * j + 2]
-            vxj, vyj, wj = v[3 * j], v[3 * j + 1], v[3 * j + 2]
+        xi, yi, ti = body_pose(x, nb, i)
+        vxi, vyi, wi = body_pose(v, nb, i)
+        xj, yj, tj = body_pose(x, nb, j)
+        vxj, vyj, wj = body_pose(v, nb, j)
         ci, si = np.cos(ti), np.sin(ti)
         cj, sj = np.cos(tj), np.sin(tj)
         aix, aiy = ci * fp[f0] - si * fp[f0 + 1], si * fp[f0] + ci * fp[f0 + 1]

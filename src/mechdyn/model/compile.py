@@ -73,9 +73,6 @@ class Model:
         kg and kg m^2 (about the centre of mass).
     com : ndarray, shape (n_bodies, 2)
         Centres of mass in the body frames, m.
-    mass_diag : ndarray, shape (n_x,)
-        (m, m, J_c) per body: the diagonal mass matrix in centre-of-mass coordinates
-        (kg, kg, kg m^2); dynamics maps the body-frame analogs to the centres of mass.
     x_sketch : ndarray, shape (n_x,)
         The sketch poses, which choose the assembly branch.
     length_scale : float
@@ -124,14 +121,6 @@ class Model:
         self.n_q = len(coords)
         self.coord_kind = np.array([_KIND_CODE[c.kind] for c in coords], dtype=int)
         self.coord_is_angle = np.array([c.is_angle for c in coords], dtype=bool)
-        self.coord_offset = np.array([c.offset for c in coords], dtype=float)
-        # body for 'angle'; joint index into rev / pri tables otherwise
-        cb = [self._bindex[c.body] if c.kind == "angle" else -1 for c in coords]
-        cj = [-1 if c.kind == "angle" else
-              (self.rev if c.kind == "relative_angle" else self.pri).names.index(c.joint)
-              for c in coords]
-        self.coord_body = np.array(cb, dtype=int)
-        self.coord_joint = np.array(cj, dtype=int)
 
         pts = [np.hypot(*p) for b in mechanism.all_bodies.values()
                for p in [b.com, *b.points.values()]]
@@ -141,8 +130,9 @@ class Model:
 
         self._lower_rows()
 
-        self.mass_diag = np.stack([self.mass, self.mass, self.inertia], axis=1).reshape(-1)
-        self.initial_mode = self.mode_of(self.lock.engaged)
+        #: the engaged locks at the start (frozenset of lock names)
+        self.initial_mode = frozenset(n for n, e in zip(self.lock.names, self.lock.engaged,
+                                                        strict=True) if e)
         #: declared assembly modes: (AssemblyMode, ((body index, local point) for P, Q, R))
         self.assembly_modes = [
             (am, tuple((self._bindex[b], np.asarray(self._point(b, ref), dtype=float))
@@ -271,11 +261,6 @@ class Model:
             raise ModelError(did_you_mean(name, self.coordinate_names, "coordinate")) from None
 
     # ------------------------------------------------------------------ modes
-    def mode_of(self, engaged) -> frozenset:
-        """The mode (frozenset of engaged lock names) for a boolean array over ``lock.names``."""
-        return frozenset(n for n, e in zip(self.lock.names, np.asarray(engaged, bool), strict=True)
-                         if e)
-
     def layout(self, mode=None) -> ConstraintLayout:
         """Row layout of the constraint equations in a mode (cached)."""
         mode = self.initial_mode if mode is None else frozenset(mode)
