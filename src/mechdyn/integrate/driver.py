@@ -19,7 +19,7 @@ from .base import DEFAULT_RTOL, Integrator, IntegratorOptionError
 from .events import as_events
 from .runge_kutta import RungeKutta4
 from .scipy_ivp import SCIPY_METHODS, ScipyIntegrator
-from .segment import Coordinates, arm, run_segment, user_event_functions, user_event_records
+from .segment import arm, run_segment, user_event_functions, user_event_records
 from .wilson import Wilson
 
 __all__ = ["INTEGRATORS", "make_integrator", "segment_integrators", "solve", "Solution",
@@ -27,7 +27,6 @@ __all__ = ["INTEGRATORS", "make_integrator", "segment_integrators", "solve", "So
 
 #: valid integrator names
 INTEGRATORS = ("wilson", "rk4", *SCIPY_METHODS)
-_FIXED_OPTIONS = ("steps", "dt")
 _WILSON_OPTIONS = ("iterations", "tol", "theta")
 _ADAPTIVE_OPTIONS = ("first_step", "max_step")
 
@@ -73,12 +72,9 @@ def make_integrator(name: str | Integrator = "dop853", *, steps: int | None = No
         bad = [k for k in options if k not in allowed]
         if bad:
             raise IntegratorOptionError(
-                f"integrator {key!r} does not take option(s) {', '.join(bad)}"
-                + (f"; its options: steps, dt, {', '.join(allowed)}" if allowed
-                   else "; its options: steps, dt"))
-        if key == "wilson":
-            return Wilson(steps, dt, **options)
-        return RungeKutta4(steps, dt)
+                f"integrator {key!r} does not take option(s) {', '.join(bad)}; its options: "
+                + ", ".join(("steps", "dt", *allowed)))
+        return Wilson(steps, dt, **options) if key == "wilson" else RungeKutta4(steps, dt)
     given = [k for k, v in (("steps", steps), ("dt", dt)) if v is not None]
     bad = given + [k for k in options if k not in _ADAPTIVE_OPTIONS]
     if bad:
@@ -216,10 +212,14 @@ def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end
         te = te[te > t0]
     counts = {"steps": 0, "rejected": 0, "evaluations": 0}
     t, fresh, next_out, records, status = t0, set(), 0, [], "success"
+
+    def coordinates(t_, y_):  # what the caller's event functions read
+        return SimpleNamespace(q=y_[:n], qdot=y_[n:2 * n])
+
     while True:  # segments, restarted at each of the caller's events
-        arm(efns, t, Coordinates(y, n), fresh)
+        arm(efns, t, coordinates(t, y), fresh)
         hit, next_out = run_segment(
-            integ, eqs, t, y, t_end, efns, evaluate=lambda t_, y_: Coordinates(y_, n),
+            integ, eqs, t, y, t_end, efns, evaluate=coordinates,
             after_step=lambda step, y_: None,
             sample=lambda ts, y_, step, ev: push(ts, y_, step.qddot if ts == step.t else None),
             t_eval=np.zeros(0) if te is None else te, next_out=next_out,

@@ -9,7 +9,7 @@ caller's checks: singular positions, non-finite values), watches the event
 functions, locates the first crossing by Brent's method on the step's dense
 output, and hands the output samples to the caller.  Nothing here knows bodies.
 
-Event functions fire when they fall to zero or below (``_EventFn``): a
+Event functions fire when they fall to zero or below (:class:`EventFunction`): a
 switch condition, a gap, a force, a caller's event ``g(t, q, qdot)`` (rising ones
 watched as -g); after a firing they re-arm only once positive again.
 """
@@ -27,7 +27,7 @@ from ..errors import Status
 from .events import EventRecord
 
 __all__ = ["EventFunction", "Stop", "run_segment", "locate",
-           "user_event_functions", "arm", "user_event_records", "Coordinates"]
+           "user_event_functions", "arm", "user_event_records"]
 
 
 class Stop(Exception):
@@ -71,16 +71,6 @@ class EventFunction:
     armed: bool = False
     arm: float = 0.0
     fresh: bool = False
-
-
-class Coordinates:
-    """(q, qdot) of a state vector y = (q, q', w) with n coordinates, as the caller's
-    event functions read them (``ev.q``, ``ev.qdot``)."""
-
-    __slots__ = ("q", "qdot")
-
-    def __init__(self, y, n: int):
-        self.q, self.qdot = y[:n], y[n:2 * n]
 
 
 def user_event_functions(user_events) -> list[EventFunction]:
