@@ -74,10 +74,11 @@ def _system(x, qi, ri, rf, dims, nb, F, J):
 
 
 @njit
-def _scale_cols(J, nx, ls):
-    for r in range(nx):
-        for b in range(nx // 3):
-            J[r, 3 * b + 2] *= ls
+def _solve_scaled(J, piv, col, nx, nb, ls):
+    """Solve with the LU of the Jacobian with scaled rotation columns (col overwritten)."""
+    lu_solve(J, piv, col, nx)
+    for b in range(nb):
+        col[3 * b + 2] *= ls
 
 
 @njit
@@ -110,7 +111,9 @@ def _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb):
             a = abs(F[r])
             if not a <= err:  # catches NaN
                 err = a if a == a else np.inf
-        _scale_cols(J, nx, ls)
+        for r in range(nx):  # rotation columns scaled by the length scale
+            for b in range(nb):
+                J[r, 3 * b + 2] *= ls
         flags[W_PIVOT] = lu_factor(J, piv, nx)
         flags[W_ITER] = it
         flags[W_ERR] = err
@@ -120,9 +123,7 @@ def _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb):
         if not err < np.inf or flags[W_PIVOT] == 0.0:
             break
         prev = err
-        lu_solve(J, piv, F, nx)
-        for b in range(nb):
-            F[3 * b + 2] *= ls
+        _solve_scaled(J, piv, F, nx, nb, ls)
         for r in range(nx):
             x[r] -= F[r]
     if status == 0:
@@ -145,13 +146,6 @@ def _body_inertia(fp, ob, b, x):
     th = x[3 * b + 2]
     co, si = np.cos(th), np.sin(th)
     return m, Jc, co * cx - si * cy, si * cx + co * cy
-
-
-@njit
-def _solve_scaled(J, piv, col, nx, nb, ls):
-    lu_solve(J, piv, col, nx)
-    for b in range(nb):
-        col[3 * b + 2] *= ls
 
 
 @njit
