@@ -162,15 +162,11 @@ class Rows:
         return np.ascontiguousarray(ints, np.int64), np.ascontiguousarray(flts, float)
 
 
-def _one(nb, b1=None, s1=(0.0, 0.0), b2=None, s2=(0.0, 0.0), d=None, u=(0.0, 0.0),
-         a=None, ka=0.0, bb=None, kb=0.0, c=0.0, label="", element="", is_angle=False):
-    g = nb
-    return dict(b1=g if b1 is None else b1, s1=tuple(map(float, s1)),
-                b2=g if b2 is None else b2, s2=tuple(map(float, s2)),
-                d=g if d is None else d, u=tuple(map(float, u)),
-                a=g if a is None else a, ka=float(ka), bb=g if bb is None else bb,
-                kb=float(kb), c=float(c), label=label, element=element or label,
-                is_angle=bool(is_angle))
+def _one(nb, *, label: str, element: str = "", is_angle: bool = False, **row) -> dict:
+    """One row: the ground (index ``nb``) and zeros wherever ``row`` gives nothing."""
+    return {"b1": nb, "s1": (0.0, 0.0), "b2": nb, "s2": (0.0, 0.0), "d": nb, "u": (0.0, 0.0),
+            "a": nb, "ka": 0.0, "bb": nb, "kb": 0.0, "c": 0.0, **row, "label": label,
+            "element": element or label, "is_angle": is_angle}
 
 
 def _rows(nb: int, recs: list[dict]) -> Rows:
