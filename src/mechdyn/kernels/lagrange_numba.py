@@ -25,7 +25,6 @@ import numpy as np
 
 from .linalg import cholesky_solve, lu_factor, lu_solve, lu_solve_transposed
 from .loads_numba import (
-    FR_BODY,
     FR_DRV,
     H_FOFF,
     H_IOFF,
@@ -35,6 +34,7 @@ from .loads_numba import (
     IR_VAL,
     S_BODY,
     S_DRV,
+    body_inertia,
     forces,
 )
 from .rows_numba import njit, rows_jacobian, rows_quad, rows_values
@@ -137,18 +137,6 @@ def _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb):
 
 
 @njit
-def _body_inertia(fp, ob, b, x):
-    """Mass, inertia about the centre of mass and the centre-of-mass arm A(theta) c
-    (ground frame) of body b at pose x."""
-    m = fp[ob + FR_BODY * b]
-    Jc = fp[ob + FR_BODY * b + 1]
-    cx, cy = fp[ob + FR_BODY * b + 2], fp[ob + FR_BODY * b + 3]
-    th = x[3 * b + 2]
-    co, si = np.cos(th), np.sin(th)
-    return m, Jc, co * cx - si * cy, si * cx + co * cy
-
-
-@njit
 def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
     """q_I'' and P_nc at (t, q_I, q_I'); out = [q_I' | q_I'' | P_nc].  Status: 0 ok,
     1 position solve failed, 2 mass matrix not positive definite, 3 non-finite.
@@ -219,7 +207,7 @@ def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
     bcx = np.empty(ni)
     bcy = np.empty(ni)
     for b in range(nb):
-        m, Jc, ax, ay = _body_inertia(fp, ob, b, x)
+        m, Jc, ax, ay = body_inertia(fp, ob, b, x)
         w = v[3 * b + 2]
         for i in range(ni):
             bcx[i] = Bl[(3 * b) * ni + i] - ay * Bl[(3 * b + 2) * ni + i]
@@ -310,7 +298,7 @@ def _reactions(x, v, bb, qdd, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb
             s += G[k, r] * Qd[k]
         Ftot[r] = s
     for b in range(nb):
-        m, Jc, ax, ay = _body_inertia(fp, ob, b, x)
+        m, Jc, ax, ay = body_inertia(fp, ob, b, x)
         w = v[3 * b + 2]
         al = xdd[3 * b + 2]
         acx = xdd[3 * b] - al * ay - w * w * ax

@@ -18,9 +18,9 @@ from ..mechanism.drive import TorqueSpeedCurve
 from ..mechanism.load import Force, RotarySpring, Spring, Table, Torque
 from .rows_numba import body_pose, njit
 
-__all__ = ["LoadPacker", "Unsupported", "forces", "load_value", "interp", "H_NB", "H_NQ",
-           "H_NDRV", "H_IOFF", "H_FOFF", "S_BODY", "S_DRV", "FR_BODY", "IR_DRV", "FR_DRV",
-           "IR_VAL"]
+__all__ = ["LoadPacker", "Unsupported", "forces", "body_inertia", "load_value", "interp",
+           "H_NB", "H_NQ", "H_NDRV", "H_IOFF", "H_FOFF", "S_BODY", "S_DRV", "FR_BODY", "IR_DRV",
+           "FR_DRV", "IR_VAL"]
 
 # header of the int array: counts, then section offsets
 H_NB, H_NQ, H_NSPR, H_NROT, H_NFOR, H_NTOR, H_NDRV = range(7)
@@ -226,6 +226,18 @@ def load_value(ip, fp, irec, fval, t, q, qdot, varv):
 
 
 @njit
+def body_inertia(fp, ob, b, x):
+    """Mass, inertia about the centre of mass and the centre-of-mass arm A(theta) c
+    (ground frame) of body b at pose x."""
+    m = fp[ob + FR_BODY * b]
+    Jc = fp[ob + FR_BODY * b + 1]
+    cx, cy = fp[ob + FR_BODY * b + 2], fp[ob + FR_BODY * b + 3]
+    th = x[3 * b + 2]
+    co, si = np.cos(th), np.sin(th)
+    return m, Jc, co * cx - si * cy, si * cx + co * cy
+
+
+@njit
 def _apply(F, b, nb, armx, army, fx, fy):
     if b < nb:
         F[3 * b] += fx
@@ -246,11 +258,8 @@ def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv):
     for c in range(nq):
         Qd[c] = 0.0
     for b in range(nb):
-        m = fp[ob + FR_BODY * b]
-        cx, cy = fp[ob + FR_BODY * b + 2], fp[ob + FR_BODY * b + 3]
-        th = x[3 * b + 2]
-        c, s = np.cos(th), np.sin(th)
-        _apply(F, b, nb, c * cx - s * cy, s * cx + c * cy, m * gx, m * gy)
+        m, _, ax, ay = body_inertia(fp, ob, b, x)
+        _apply(F, b, nb, ax, ay, m * gx, m * gy)
     oi, of = ip[H_IOFF + S_SPR], ip[H_FOFF + S_SPR]
     for k in range(ip[H_NSPR]):
         i = ip[oi + IR_SPR * k]
