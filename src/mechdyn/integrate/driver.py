@@ -187,7 +187,7 @@ def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end
     v0 = np.asarray(qdot0, float).reshape(-1)
     n = q0.size
     wz = np.zeros(0) if w0 is None else np.asarray(w0, float).reshape(-1)
-    out_t, out_q, out_v, out_a, out_w = [], [], [], [], []
+    out_t, out_y, out_a = [], [], []  # samples: t, y = (q, q', w), q''
 
     def rhs(t, q, v):
         r = f(t, q, v)
@@ -197,9 +197,7 @@ def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end
 
     def push(t, y, a=None):
         out_t.append(t)
-        out_q.append(y[:n].copy())
-        out_v.append(y[n:2 * n].copy())
-        out_w.append(y[2 * n:].copy())
+        out_y.append(np.array(y, float))
         out_a.append(rhs(t, y[:n], y[n:2 * n])[0] if a is None else np.array(a))
 
     eqs = SimpleNamespace(rhs=rhs, first_order_function=lambda: None)
@@ -236,7 +234,6 @@ def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end
             if te is None:
                 push(t, y)
             break
-    return Solution(np.array(out_t), np.array(out_q).reshape(-1, n),
-                    np.array(out_v).reshape(-1, n), np.array(out_a).reshape(-1, n),
-                    np.array(out_w).reshape(len(out_t), -1), records,
-                    {"integrator": integ.name, **counts}, status)
+    Y = np.array(out_y).reshape(len(out_t), -1)
+    return Solution(np.array(out_t), Y[:, :n], Y[:, n:2 * n], np.array(out_a).reshape(-1, n),
+                    Y[:, 2 * n:], records, {"integrator": integ.name, **counts}, status)
