@@ -62,19 +62,13 @@ def compile_mechanism(mechanism) -> Model:
     1
     """
     probs = mechanism.problems()
-    if mechanism.bodies and mechanism.coordinates and probs and any(
-            p.startswith(_GRUEBLER) for p in probs):
-        # A Gruebler mismatch may be a redundant constraint set; decide by rank below.
-        rest = [p for p in probs if not p.startswith(_GRUEBLER)]
-        if rest:
-            raise ModelError(probs)
-        model = Model(mechanism)
-        check_rank(model, gruebler_message=probs[-1])
-        return check_loads(model).freeze()
-    if probs:
+    # A Gruebler mismatch may be a redundant constraint set: decided by rank below.
+    gruebler = [p for p in probs if p.startswith(_GRUEBLER)]
+    if probs and not (mechanism.bodies and mechanism.coordinates and gruebler
+                      and len(gruebler) == len(probs)):
         raise ModelError(probs)
     model = Model(mechanism)
-    check_rank(model)
+    check_rank(model, gruebler_message=probs[-1] if probs else None)
     return check_loads(model).freeze()
 
 

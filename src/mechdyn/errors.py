@@ -12,18 +12,9 @@ from enum import StrEnum
 
 import numpy as np
 
-__all__ = [
-    "Status",
-    "MechdynError",
-    "ModelError",
-    "UnitError",
-    "AssemblyError",
-    "SingularPositionError",
-    "BranchJumpError",
-    "LockupError",
-    "IntegrationError",
-    "did_you_mean",
-]
+__all__ = ["Status", "MechdynError", "ModelError", "UnitError", "AssemblyError",
+           "SingularPositionError", "BranchJumpError", "LockupError", "IntegrationError",
+           "did_you_mean"]
 
 
 class Status(StrEnum):
@@ -92,27 +83,16 @@ class ModelError(MechdynError, ValueError):
     """
 
     def __init__(self, problems: str | Sequence[str]):
-        if isinstance(problems, str):
-            problems = [problems]
-        self.problems = list(problems)
+        self.problems = [problems] if isinstance(problems, str) else list(problems)
         if len(self.problems) == 1:
-            text = self.problems[0]
+            super().__init__(self.problems[0])
         else:
-            text = f"{len(self.problems)} problems in the model:\n" + "\n".join(
-                f"  - {p}" for p in self.problems
-            )
-        super().__init__(text)
+            super().__init__(f"{len(self.problems)} problems in the model:\n"
+                             + "\n".join(f"  - {p}" for p in self.problems))
 
 
 class UnitError(ModelError):
     """A quantity has a unit of the wrong dimension, or cannot be parsed."""
-
-
-def _fmt_q(q) -> str:
-    if q is None:
-        return "?"
-    q = np.atleast_1d(np.asarray(q, dtype=float))
-    return "[" + ", ".join(f"{v:.6g}" for v in q) + "]"
 
 
 class _WhereError(MechdynError):
@@ -125,7 +105,7 @@ class _WhereError(MechdynError):
         if t is not None:
             where.append(f"t = {t:.9g} s")
         if q is not None:
-            where.append(f"q = {_fmt_q(q)}")
+            where.append("q = [" + ", ".join(f"{v:.6g}" for v in np.atleast_1d(self.q)) + "]")
         self.message = message
         super().__init__(message + (f" (at {', '.join(where)})" if where else ""))
 

@@ -72,10 +72,7 @@ def initial_state(model: Model, q0=None, qdot0=None, *, mode=None):
     if x_sk is None:
         x_sk = assemble(model, layout=layout)
     q_sk = coordinates(model, x_sk)
-    init = {}
-    extras = getattr(model.mechanism, "extras", None) or {}
-    if isinstance(extras, Mapping):
-        init = extras.get("initial", {}) or {}
+    init = model.mechanism.extras.get("initial") or {}
     q = _values(model, init.get("q"), q_sk, "initial q")
     qd = _values(model, init.get("qdot"), np.zeros(model.n_q), "initial qdot")
     q = _values(model, q0, q, "q0")

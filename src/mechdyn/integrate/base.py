@@ -18,7 +18,8 @@ How to write a new integrator:
 2. validate every setting in ``__init__`` and raise ``ValueError`` naming it;
 3. implement ``_steps(rhs, t0, q0, qdot0, w0, t_end)`` yielding :class:`Step`,
    calling ``rhs`` (which counts evaluations) and incrementing
-   ``self.stats.steps`` / ``self.stats.rejected``.
+   ``self.stats.steps`` / ``self.stats.rejected``; or, for a fixed-step method,
+   subclass :class:`FixedStep` and implement ``_advance`` over one step.
 """
 
 from __future__ import annotations
@@ -32,8 +33,8 @@ import numpy as np
 
 from ..errors import MechdynError
 
-__all__ = ["Integrator", "IntegratorStats", "Step", "hermite_dense", "check_positive",
-           "IntegratorOptionError", "IntegratorWarning", "fixed_grid", "DEFAULT_RTOL"]
+__all__ = ["Integrator", "FixedStep", "IntegratorStats", "Step", "hermite_dense",
+           "check_positive", "IntegratorOptionError", "IntegratorWarning", "DEFAULT_RTOL"]
 
 
 class IntegratorOptionError(MechdynError, ValueError):
@@ -81,10 +82,6 @@ class IntegratorStats:
     steps: int = 0
     rejected: int = 0
     evaluations: int = 0
-
-    def as_dict(self) -> dict:
-        return {"steps": self.steps, "rejected": self.rejected,
-                "evaluations": self.evaluations}
 
 
 @dataclass
@@ -235,18 +232,44 @@ class Integrator(ABC):
         return f"{type(self).__name__}({s})"
 
 
-def fixed_grid(t0: float, t_end: float, steps: int | None, dt: float | None,
-               default_steps: int = 100) -> np.ndarray:
-    """Step end points of a fixed-step integration: ``steps`` equal steps, or steps of
-    ``dt`` (the last one shortened to land on ``t_end``)."""
-    if steps is not None and dt is not None:
-        raise IntegratorOptionError("give either `steps` or `dt`, not both")
-    if t_end == t0:
-        return np.array([t0])
-    if dt is not None:
-        n = max(1, int(math.ceil((t_end - t0) / dt - 1e-9)))
-        grid = t0 + dt * np.arange(n + 1)
-        grid[-1] = t_end
-        return grid
-    n = default_steps if steps is None else steps
-    return np.linspace(t0, t_end, n + 1)
+class FixedStep(Integrator):
+    """Base class of the fixed-step integrators: ``steps`` equal steps over [t0, t_end]
+    (default 100 when ``dt`` is not given), or steps of ``dt`` (s; the last one shortened
+    to land on ``t_end``).  A subclass implements :meth:`_advance`; the dense output over
+    each step is :func:`hermite_dense`."""
+
+    adaptive = False
+
+    def __init__(self, steps: int | None = None, dt: float | None = None):
+        super().__init__()
+        self.steps = check_positive("steps", steps, integer=True, allow_none=True)
+        self.dt = check_positive("dt", dt, allow_none=True)
+        if self.steps is not None and self.dt is not None:
+            raise IntegratorOptionError("give either `steps` or `dt`, not both")
+
+    def settings(self) -> dict:
+        return {"steps": self.steps, "dt": self.dt}
+
+    @abstractmethod
+    def _advance(self, rhs, t, t1, q, v, w, a, p):
+        """``(q, q', w, q'', p)`` at ``t1`` from the state and ``(a, p) = rhs(t, q, v)``
+        at ``t``."""
+
+    def _steps(self, rhs, t0, q0, qdot0, w0, t_end, first_order=None) -> Iterator[Step]:
+        if t_end == t0:
+            grid = np.array([t0])
+        elif self.dt is not None:
+            n = max(1, int(math.ceil((t_end - t0) / self.dt - 1e-9)))
+            grid = t0 + self.dt * np.arange(n + 1)
+            grid[-1] = t_end
+        else:
+            grid = np.linspace(t0, t_end, (100 if self.steps is None else self.steps) + 1)
+        q, v, w = q0, qdot0, w0
+        a, p = rhs(t0, q, v)
+        t = t0
+        for t1 in grid[1:]:
+            q1, v1, w1, a1, p1 = self._advance(rhs, t, t1, q, v, w, a, p)
+            dense = hermite_dense(t, q, v, a, w, p, t1, q1, v1, a1, w1, p1)
+            self.stats.steps += 1
+            yield Step(t, float(t1), q1, v1, a1, w1, dense)
+            t, q, v, w, a, p = float(t1), q1, v1, w1, a1, p1

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -18,7 +19,7 @@ from .base import DEFAULT_RTOL, Integrator, IntegratorOptionError
 from .events import as_events
 from .runge_kutta import RungeKutta4
 from .scipy_ivp import SCIPY_METHODS, ScipyIntegrator
-from .segment import Coordinates, run_to_end, user_event_functions
+from .segment import arm, run_segment, user_event_functions, user_event_records
 from .wilson import Wilson
 
 __all__ = ["INTEGRATORS", "make_integrator", "segment_integrators", "solve", "Solution",
@@ -26,7 +27,6 @@ __all__ = ["INTEGRATORS", "make_integrator", "segment_integrators", "solve", "So
 
 #: valid integrator names
 INTEGRATORS = ("wilson", "rk4", *SCIPY_METHODS)
-_FIXED_OPTIONS = ("steps", "dt")
 _WILSON_OPTIONS = ("iterations", "tol", "theta")
 _ADAPTIVE_OPTIONS = ("first_step", "max_step")
 
@@ -72,12 +72,9 @@ def make_integrator(name: str | Integrator = "dop853", *, steps: int | None = No
         bad = [k for k in options if k not in allowed]
         if bad:
             raise IntegratorOptionError(
-                f"integrator {key!r} does not take option(s) {', '.join(bad)}"
-                + (f"; its options: steps, dt, {', '.join(allowed)}" if allowed
-                   else "; its options: steps, dt"))
-        if key == "wilson":
-            return Wilson(steps, dt, **options)
-        return RungeKutta4(steps, dt)
+                f"integrator {key!r} does not take option(s) {', '.join(bad)}; its options: "
+                + ", ".join(("steps", "dt", *allowed)))
+        return Wilson(steps, dt, **options) if key == "wilson" else RungeKutta4(steps, dt)
     given = [k for k, v in (("steps", steps), ("dt", dt)) if v is not None]
     bad = given + [k for k in options if k not in _ADAPTIVE_OPTIONS]
     if bad:
@@ -120,25 +117,17 @@ def segment_integrators(method, t0: float, t_end: float, *, rtol, atol, dt, step
         An unknown integrator or options that do not belong to it.
     """
     fixed = dict(dt=dt, steps=steps, iterations=iterations, tol=tol, theta=theta)
+    name = method.lower() if isinstance(method, str) else method  # make_integrator checks it
     if isinstance(method, Integrator):
-        if any(v is not None for v in fixed.values()):
-            raise IntegratorOptionError(
-                "options " + ", ".join(k for k, v in fixed.items() if v is not None)
-                + f" cannot be combined with an integrator instance ({method!r}); set them on "
-                "the instance")
+        make_integrator(method, **fixed)  # refuses options beside an instance
+        name = method.name
         if isinstance(method, ScipyIntegrator):
-            name, rtol, atol = method.name, method.rtol, method.atol
+            rtol, atol = method.rtol, method.atol
             first_step = method.first_step if first_step is None else first_step
             max_step = method.max_step if max_step is None else max_step
         else:
-            name = method.name
             fixed.update(dt=method.dt, steps=method.steps,
                          **{k: getattr(method, k, None) for k in ("iterations", "tol", "theta")})
-    elif isinstance(method, str):
-        name = method.lower()
-    else:
-        raise IntegratorOptionError(f"unknown integrator {method!r}; valid integrator names: "
-                                    + ", ".join(INTEGRATORS))
     if name in ("wilson", "rk4"):
         # the same validation as a fixed-structure run (first_step, max_step are refused)
         make_integrator(name, first_step=first_step, max_step=max_step, **fixed)
@@ -198,7 +187,7 @@ def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end
     v0 = np.asarray(qdot0, float).reshape(-1)
     n = q0.size
     wz = np.zeros(0) if w0 is None else np.asarray(w0, float).reshape(-1)
-    out_t, out_q, out_v, out_a, out_w = [], [], [], [], []
+    out_t, out_y, out_a = [], [], []  # samples: t, y = (q, q', w), q''
 
     def rhs(t, q, v):
         r = f(t, q, v)
@@ -208,12 +197,10 @@ def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end
 
     def push(t, y, a=None):
         out_t.append(t)
-        out_q.append(y[:n].copy())
-        out_v.append(y[n:2 * n].copy())
-        out_w.append(y[2 * n:].copy())
+        out_y.append(np.array(y, float))
         out_a.append(rhs(t, y[:n], y[n:2 * n])[0] if a is None else np.array(a))
 
-    eqs = _Equations(rhs)
+    eqs = SimpleNamespace(rhs=rhs, first_order_function=lambda: None)
     y = np.concatenate([q0, v0, wz])
     if te is None:
         push(t0, y)
@@ -222,25 +209,31 @@ def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end
             push(t0, y)
         te = te[te > t0]
     counts = {"steps": 0, "rejected": 0, "evaluations": 0}
-    t, y_end, records, terminal = run_to_end(
-        integ, eqs, t0, y, t_end, efns, evaluate=lambda t_, y_: Coordinates(y_, n),
-        after_step=lambda step, y_: None,
-        sample=lambda ts, y_, step, ev: push(ts, y_, step.qddot if ts == step.t else None),
-        t_eval=te, every_step=te is None, stats=counts, n=n)
-    if y_end is not None and te is None:
-        push(t, y_end)
-    status = "event" if terminal is not None else "success"
-    return Solution(np.array(out_t), np.array(out_q).reshape(-1, n),
-                    np.array(out_v).reshape(-1, n), np.array(out_a).reshape(-1, n),
-                    np.array(out_w).reshape(len(out_t), -1), records,
-                    {"integrator": integ.name, **counts}, status)
+    t, fresh, next_out, records, status = t0, set(), 0, [], "success"
 
+    def coordinates(t_, y_):  # what the caller's event functions read
+        return SimpleNamespace(q=y_[:n], qdot=y_[n:2 * n])
 
-class _Equations:
-    """A plain right-hand side as the segment integrator calls it."""
-
-    def __init__(self, rhs):
-        self.rhs = rhs
-
-    def first_order_function(self):
-        return None
+    while True:  # segments, restarted at each of the caller's events
+        arm(efns, t, coordinates(t, y), fresh)
+        hit, next_out = run_segment(
+            integ, eqs, t, y, t_end, efns, evaluate=coordinates,
+            after_step=lambda step, y_: None,
+            sample=lambda ts, y_, step, ev: push(ts, y_, step.qddot if ts == step.t else None),
+            t_eval=np.zeros(0) if te is None else te, next_out=next_out,
+            every_step=te is None, stats=counts, n=n)
+        if hit is None:
+            break
+        t, fired, dense = hit
+        y = dense(t)
+        records.extend(user_event_records(fired, t, y, n))
+        fresh = {(e.kind, e.key) for e in fired}
+        terminal = any(e.data.terminal for e in fired)
+        if terminal or t >= t_end:
+            status = "event" if terminal else "success"
+            if te is None:
+                push(t, y)
+            break
+    Y = np.array(out_y).reshape(len(out_t), -1)
+    return Solution(np.array(out_t), Y[:, :n], Y[:, n:2 * n], np.array(out_a).reshape(-1, n),
+                    Y[:, 2 * n:], records, {"integrator": integ.name, **counts}, status)

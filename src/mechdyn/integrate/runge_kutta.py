@@ -7,14 +7,12 @@ evaluation at the end of a step is the first stage of the next one.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
-from .base import Integrator, IntegratorOptionError, Step, check_positive, fixed_grid, hermite_dense
+from .base import FixedStep
 
 __all__ = ["RungeKutta4"]
 
 
-class RungeKutta4(Integrator):
+class RungeKutta4(FixedStep):
     """Classical Runge-Kutta method of order 4, fixed step.
 
     Parameters
@@ -27,37 +25,17 @@ class RungeKutta4(Integrator):
 
     name = "rk4"
     order = 4
-    adaptive = False
 
-    def __init__(self, steps: int | None = None, dt: float | None = None):
-        super().__init__()
-        self.steps = check_positive("steps", steps, integer=True, allow_none=True)
-        self.dt = check_positive("dt", dt, allow_none=True)
-        if self.steps is not None and self.dt is not None:
-            raise IntegratorOptionError("give either `steps` or `dt`, not both")
-
-    def settings(self) -> dict:
-        return {"steps": self.steps, "dt": self.dt}
-
-    def _steps(self, rhs, t0, q0, qdot0, w0, t_end, first_order=None) -> Iterator[Step]:
-        grid = fixed_grid(t0, t_end, self.steps, self.dt)
-        q, v, w = q0, qdot0, w0
-        a, p = rhs(t0, q, v)
-        t = t0
-        for t1 in grid[1:]:
-            h = t1 - t
-            k1q, k1v, k1w = v, a, p
-            a2, p2 = rhs(t + h / 2, q + h / 2 * k1q, v + h / 2 * k1v)
-            k2q, k2v, k2w = v + h / 2 * k1v, a2, p2
-            a3, p3 = rhs(t + h / 2, q + h / 2 * k2q, v + h / 2 * k2v)
-            k3q, k3v, k3w = v + h / 2 * k2v, a3, p3
-            a4, p4 = rhs(t1, q + h * k3q, v + h * k3v)
-            k4q, k4v, k4w = v + h * k3v, a4, p4
-            q1 = q + h / 6 * (k1q + 2 * k2q + 2 * k3q + k4q)
-            v1 = v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)
-            w1 = w + h / 6 * (k1w + 2 * k2w + 2 * k3w + k4w)
-            a1, p1 = rhs(t1, q1, v1)
-            dense = hermite_dense(t, q, v, a, w, p, t1, q1, v1, a1, w1, p1)
-            self.stats.steps += 1
-            yield Step(t, float(t1), q1, v1, a1, w1, dense)
-            t, q, v, w, a, p = float(t1), q1, v1, w1, a1, p1
+    def _advance(self, rhs, t, t1, q, v, w, a, p):
+        h = t1 - t
+        k1q, k1v, k1w = v, a, p
+        a2, p2 = rhs(t + h / 2, q + h / 2 * k1q, v + h / 2 * k1v)
+        k2q, k2v, k2w = v + h / 2 * k1v, a2, p2
+        a3, p3 = rhs(t + h / 2, q + h / 2 * k2q, v + h / 2 * k2v)
+        k3q, k3v, k3w = v + h / 2 * k2v, a3, p3
+        a4, p4 = rhs(t1, q + h * k3q, v + h * k3v)
+        k4q, k4v, k4w = v + h * k3v, a4, p4
+        q1 = q + h / 6 * (k1q + 2 * k2q + 2 * k3q + k4q)
+        v1 = v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)
+        w1 = w + h / 6 * (k1w + 2 * k2w + 2 * k3w + k4w)
+        return q1, v1, w1, *rhs(t1, q1, v1)

@@ -71,18 +71,13 @@ class ScipyIntegrator(Integrator):
                 "first_step": self.first_step, "max_step": self.max_step}
 
     def _steps(self, rhs, t0, q0, qdot0, w0, t_end, first_order=None) -> Iterator[Step]:
-        n, nw = q0.size, w0.size
+        n = q0.size
         if t_end == t0:
             return
         stats = self.stats
 
         def wrapped(t, y):
-            a, p = rhs(t, y[:n], y[n:2 * n])
-            out = np.empty(2 * n + nw)
-            out[:n] = y[n:2 * n]
-            out[n:2 * n] = a
-            out[2 * n:] = p
-            return out
+            return np.concatenate([y[n:2 * n], *rhs(t, y[:n], y[n:2 * n])])
 
         fun = wrapped if first_order is None else first_order
         y0 = np.concatenate([q0, qdot0, w0])
@@ -91,13 +86,10 @@ class ScipyIntegrator(Integrator):
             raise IntegratorOptionError(
                 f"`atol` has {np.size(atol)} components but the state (q, q', w) has "
                 f"{y0.size}")
-        kw = {"rtol": self.rtol, "atol": atol}
-        if self.first_step is not None:
-            kw["first_step"] = self.first_step
-        if self.max_step is not None:
-            kw["max_step"] = self.max_step
-        cls = getattr(si, self.method)
-        solver = cls(fun, t0, y0, t_end, vectorized=False, **kw)
+        kw = {k: v for k, v in (("first_step", self.first_step), ("max_step", self.max_step))
+              if v is not None}
+        solver = getattr(si, self.method)(fun, t0, y0, t_end, vectorized=False,
+                                          rtol=self.rtol, atol=atol, **kw)
         fsal = self.method in _FSAL
         base_count = stats.evaluations
         while solver.status == "running":

@@ -9,7 +9,7 @@ caller's checks: singular positions, non-finite values), watches the event
 functions, locates the first crossing by Brent's method on the step's dense
 output, and hands the output samples to the caller.  Nothing here knows bodies.
 
-Event functions fire when they fall to zero or below (``_EventFn``): a
+Event functions fire when they fall to zero or below (:class:`EventFunction`): a
 switch condition, a gap, a force, a caller's event ``g(t, q, qdot)`` (rising ones
 watched as -g); after a firing they re-arm only once positive again.
 """
@@ -26,8 +26,8 @@ from scipy.optimize import brentq
 from ..errors import Status
 from .events import EventRecord
 
-__all__ = ["EventFunction", "Stop", "run_segment", "run_to_end", "locate",
-           "user_event_functions", "arm", "user_event_records", "Coordinates"]
+__all__ = ["EventFunction", "Stop", "run_segment", "locate",
+           "user_event_functions", "arm", "user_event_records"]
 
 
 class Stop(Exception):
@@ -71,16 +71,6 @@ class EventFunction:
     armed: bool = False
     arm: float = 0.0
     fresh: bool = False
-
-
-class Coordinates:
-    """(q, qdot) of a state vector y = (q, q', w) with n coordinates, as the caller's
-    event functions read them (``ev.q``, ``ev.qdot``)."""
-
-    __slots__ = ("q", "qdot")
-
-    def __init__(self, y, n: int):
-        self.q, self.qdot = y[:n], y[n:2 * n]
 
 
 def user_event_functions(user_events) -> list[EventFunction]:
@@ -237,44 +227,3 @@ def run_segment(integ, eqs, t: float, y0, t_end: float, efns: list[EventFunction
         stats["evaluations"] += integ.stats.evaluations
     return hit, next_out
 
-
-def run_to_end(integ, eqs, t: float, y, t_end: float, efns: list[EventFunction], *,
-               evaluate: Callable, after_step: Callable, sample: Callable, t_eval,
-               every_step: bool, stats: dict, n: int, bar=None, restart: Callable = None,
-               records: list | None = None):
-    """Segments of one set of equations from ``t`` to ``t_end``, restarted at each of the
-    caller's events (a fixed-structure run, or :func:`mechdyn.integrate.solve`).
-
-    The arguments are those of :func:`run_segment`; ``restart(t, y)`` is called before a
-    segment restarts after an event; the caller's events are appended to ``records`` as
-    they fire (so that a run stopped by an error keeps them).
-
-    Returns
-    -------
-    t, y : float, ndarray
-        Where the run ended (``t_end``, or the time of a terminal event).
-    records : list of EventRecord
-        The caller's events that fired.
-    terminal : EventFunction or None
-        The terminal event that ended the run.
-    """
-    t_eval = np.zeros(0) if t_eval is None else t_eval
-    records = [] if records is None else records
-    fresh, next_out = set(), 0
-    while True:
-        arm(efns, t, evaluate(t, y), fresh)
-        hit, next_out = run_segment(integ, eqs, t, y, t_end, efns, evaluate=evaluate,
-                                    after_step=after_step, sample=sample, t_eval=t_eval,
-                                    next_out=next_out, every_step=every_step, stats=stats,
-                                    bar=bar, n=n)
-        if hit is None:
-            return t_end, None, records, None
-        t, fired, dense = hit
-        y = dense(t)
-        records.extend(user_event_records(fired, t, y, n))
-        fresh = {(e.kind, e.key) for e in fired}
-        terminal = next((e for e in fired if e.data.terminal), None)
-        if terminal is not None or t >= t_end:
-            return t, y, records, terminal
-        if restart is not None:
-            restart(t, y)

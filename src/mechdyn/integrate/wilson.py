@@ -22,11 +22,9 @@ with the linear variation of the acceleration.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
 import numpy as np
 
-from .base import Integrator, IntegratorOptionError, Step, check_positive, fixed_grid, hermite_dense
+from .base import FixedStep, IntegratorOptionError, check_positive
 
 __all__ = ["Wilson"]
 
@@ -34,7 +32,7 @@ __all__ = ["Wilson"]
 THETA_MIN = 1.37
 
 
-class Wilson(Integrator):
+class Wilson(FixedStep):
     """Linear-acceleration predictor-corrector (optionally Wilson-theta), fixed step.
 
     Parameters
@@ -54,15 +52,10 @@ class Wilson(Integrator):
 
     name = "wilson"
     order = 2
-    adaptive = False
 
     def __init__(self, steps: int | None = None, dt: float | None = None, *,
                  iterations: int = 4, tol: float | None = 1e-12, theta: float = 1.0):
-        super().__init__()
-        self.steps = check_positive("steps", steps, integer=True, allow_none=True)
-        self.dt = check_positive("dt", dt, allow_none=True)
-        if self.steps is not None and self.dt is not None:
-            raise IntegratorOptionError("give either `steps` or `dt`, not both")
+        super().__init__(steps, dt)
         self.iterations = check_positive("iterations", iterations, integer=True)
         self.tol = check_positive("tol", tol, allow_none=True)
         theta = float(theta)
@@ -73,41 +66,31 @@ class Wilson(Integrator):
         self.theta = theta
 
     def settings(self) -> dict:
-        return {"steps": self.steps, "dt": self.dt, "iterations": self.iterations,
-                "tol": self.tol, "theta": self.theta}
+        return {**super().settings(), "iterations": self.iterations, "tol": self.tol,
+                "theta": self.theta}
 
-    def _steps(self, rhs, t0, q0, qdot0, w0, t_end, first_order=None) -> Iterator[Step]:
-        grid = fixed_grid(t0, t_end, self.steps, self.dt)
+    def _advance(self, rhs, t, t1, q, v, w, a, p):
         th = self.theta
-        q, v, w = q0, qdot0, w0
-        a, p = rhs(t0, q, v)
-        t = t0
-        for t1 in grid[1:]:
-            h = t1 - t
-            tau = th * h
-            # predictor: constant acceleration over tau
-            qt = q + v * tau + a * (tau * tau / 2)
-            vt = v + a * tau
-            for _ in range(self.iterations):
-                at, _pt = rhs(t + tau, qt, vt)
-                qn = q + v * tau + (2 * a + at) * (tau * tau / 6)
-                vn = v + (a + at) * (tau / 2)
-                change = max(np.max(np.abs(qn - qt), initial=0.0),
-                             np.max(np.abs(vn - vt), initial=0.0))
-                size = 1.0 + max(np.max(np.abs(qn), initial=0.0),
-                                 np.max(np.abs(vn), initial=0.0))
-                qt, vt = qn, vn
-                if self.tol is not None and change <= self.tol * size:
-                    break
-            if th == 1.0:
-                q1, v1 = qt, vt
-            else:
-                a_end = a + (at - a) / th
-                q1 = q + v * h + (2 * a + a_end) * (h * h / 6)
-                v1 = v + (a + a_end) * (h / 2)
-            a1, p1 = rhs(t1, q1, v1)
-            w1 = w + (p + p1) * (h / 2)
-            dense = hermite_dense(t, q, v, a, w, p, t1, q1, v1, a1, w1, p1)
-            self.stats.steps += 1
-            yield Step(t, float(t1), q1, v1, a1, w1, dense)
-            t, q, v, w, a, p = float(t1), q1, v1, w1, a1, p1
+        h = t1 - t
+        tau = th * h
+        # predictor: constant acceleration over tau
+        qt = q + v * tau + a * (tau * tau / 2)
+        vt = v + a * tau
+        for _ in range(self.iterations):
+            at, _pt = rhs(t + tau, qt, vt)
+            qn = q + v * tau + (2 * a + at) * (tau * tau / 6)
+            vn = v + (a + at) * (tau / 2)
+            change = max(np.max(np.abs(qn - qt), initial=0.0),
+                         np.max(np.abs(vn - vt), initial=0.0))
+            size = 1.0 + max(np.max(np.abs(qn), initial=0.0), np.max(np.abs(vn), initial=0.0))
+            qt, vt = qn, vn
+            if self.tol is not None and change <= self.tol * size:
+                break
+        if th == 1.0:
+            q1, v1 = qt, vt
+        else:
+            a_end = a + (at - a) / th
+            q1 = q + v * h + (2 * a + a_end) * (h * h / 6)
+            v1 = v + (a + a_end) * (h / 2)
+        a1, p1 = rhs(t1, q1, v1)
+        return q1, v1, w + (p + p1) * (h / 2), a1, p1

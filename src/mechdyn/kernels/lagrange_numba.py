@@ -25,7 +25,6 @@ import numpy as np
 
 from .linalg import cholesky_solve, lu_factor, lu_solve, lu_solve_transposed
 from .loads_numba import (
-    FR_BODY,
     FR_DRV,
     H_FOFF,
     H_IOFF,
@@ -35,6 +34,7 @@ from .loads_numba import (
     IR_VAL,
     S_BODY,
     S_DRV,
+    body_inertia,
     forces,
 )
 from .rows_numba import njit, rows_jacobian, rows_quad, rows_values
@@ -74,10 +74,11 @@ def _system(x, qi, ri, rf, dims, nb, F, J):
 
 
 @njit
-def _scale_cols(J, nx, ls):
-    for r in range(nx):
-        for b in range(nx // 3):
-            J[r, 3 * b + 2] *= ls
+def _solve_scaled(J, piv, col, nx, nb, ls):
+    """Solve with the LU of the Jacobian with scaled rotation columns (col overwritten)."""
+    lu_solve(J, piv, col, nx)
+    for b in range(nb):
+        col[3 * b + 2] *= ls
 
 
 @njit
@@ -110,7 +111,9 @@ def _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb):
             a = abs(F[r])
             if not a <= err:  # catches NaN
                 err = a if a == a else np.inf
-        _scale_cols(J, nx, ls)
+        for r in range(nx):  # rotation columns scaled by the length scale
+            for b in range(nb):
+                J[r, 3 * b + 2] *= ls
         flags[W_PIVOT] = lu_factor(J, piv, nx)
         flags[W_ITER] = it
         flags[W_ERR] = err
@@ -120,9 +123,7 @@ def _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb):
         if not err < np.inf or flags[W_PIVOT] == 0.0:
             break
         prev = err
-        lu_solve(J, piv, F, nx)
-        for b in range(nb):
-            F[3 * b + 2] *= ls
+        _solve_scaled(J, piv, F, nx, nb, ls)
         for r in range(nx):
             x[r] -= F[r]
     if status == 0:
@@ -133,25 +134,6 @@ def _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb):
             x[r] = xg[r]
     flags[W_VALID] = 0.0
     return status
-
-
-@njit
-def _body_inertia(fp, ob, b, x):
-    """Mass, inertia about the centre of mass and the centre-of-mass arm A(theta) c
-    (ground frame) of body b at pose x."""
-    m = fp[ob + FR_BODY * b]
-    Jc = fp[ob + FR_BODY * b + 1]
-    cx, cy = fp[ob + FR_BODY * b + 2], fp[ob + FR_BODY * b + 3]
-    th = x[3 * b + 2]
-    co, si = np.cos(th), np.sin(th)
-    return m, Jc, co * cx - si * cy, si * cx + co * cy
-
-
-@njit
-def _solve_scaled(J, piv, col, nx, nb, ls):
-    lu_solve(J, piv, col, nx)
-    for b in range(nb):
-        col[3 * b + 2] *= ls
 
 
 @njit
@@ -225,7 +207,7 @@ def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
     bcx = np.empty(ni)
     bcy = np.empty(ni)
     for b in range(nb):
-        m, Jc, ax, ay = _body_inertia(fp, ob, b, x)
+        m, Jc, ax, ay = body_inertia(fp, ob, b, x)
         w = v[3 * b + 2]
         for i in range(ni):
             bcx[i] = Bl[(3 * b) * ni + i] - ay * Bl[(3 * b + 2) * ni + i]
@@ -272,7 +254,8 @@ def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
     if not cholesky_solve(A, rhs, ni):
         return 2
     if full:
-        _reactions(x, v, bb, rhs, q, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, ni, nq, ext)
+        _reactions(x, v, bb, rhs, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, ni, nq,
+                   ext)
     ok = P == P
     for c in range(ni):
         out[c] = qdi[c]
@@ -285,7 +268,8 @@ def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
 
 
 @njit
-def _reactions(x, v, bb, qdd, q, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, ni, nq, ext):
+def _reactions(x, v, bb, qdd, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, ni, nq,
+               ext):
     """Fill ``ext`` (see :func:`evaluate`) after the solve for q_I''."""
     nx = 3 * nb
     ls = fp[2]
@@ -296,19 +280,14 @@ def _reactions(x, v, bb, qdd, q, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, 
             s += Bl[r * ni + c] * qdd[c]
         xdd[r] = s
     o = nx
-    rows_q = ext[o:o + nq]
-    rows_v = ext[o + nq:o + 2 * nq]
+    ext[o:o + nq] = q
+    ext[o + nq:o + 2 * nq] = qdot
     rows_a = ext[o + 2 * nq:o + 3 * nq]
     for k in range(nq):
         s = Gb[k]
         for c in range(ni):
             s += GB[k, c] * qdd[c]
         rows_a[k] = s
-        rows_q[k] = q[k]
-        sq = 0.0
-        for r in range(nx):
-            sq += G[k, r] * v[r]
-        rows_v[k] = sq
     # residual of the free bodies: M x'' + h - F (F with the drives on their coordinates)
     z = np.empty(nx)
     Ftot = ext[o + 3 * nq + nc:o + 3 * nq + nc + nx]
@@ -319,7 +298,7 @@ def _reactions(x, v, bb, qdd, q, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, 
             s += G[k, r] * Qd[k]
         Ftot[r] = s
     for b in range(nb):
-        m, Jc, ax, ay = _body_inertia(fp, ob, b, x)
+        m, Jc, ax, ay = body_inertia(fp, ob, b, x)
         w = v[3 * b + 2]
         al = xdd[3 * b + 2]
         acx = xdd[3 * b] - al * ay - w * w * ax

@@ -16,11 +16,11 @@ import numpy as np
 
 from ..mechanism.drive import TorqueSpeedCurve
 from ..mechanism.load import Force, RotarySpring, Spring, Table, Torque
-from .rows_numba import njit
+from .rows_numba import body_pose, njit
 
-__all__ = ["LoadPacker", "Unsupported", "forces", "load_value", "interp", "H_NB", "H_NQ",
-           "H_NDRV", "H_IOFF", "H_FOFF", "S_BODY", "S_DRV", "FR_BODY", "IR_DRV", "FR_DRV",
-           "IR_VAL"]
+__all__ = ["LoadPacker", "Unsupported", "forces", "body_inertia", "load_value", "interp",
+           "H_NB", "H_NQ", "H_NDRV", "H_IOFF", "H_FOFF", "S_BODY", "S_DRV", "FR_BODY", "IR_DRV",
+           "FR_DRV", "IR_VAL"]
 
 # header of the int array: counts, then section offsets
 H_NB, H_NQ, H_NSPR, H_NROT, H_NFOR, H_NTOR, H_NDRV = range(7)
@@ -226,6 +226,18 @@ def load_value(ip, fp, irec, fval, t, q, qdot, varv):
 
 
 @njit
+def body_inertia(fp, ob, b, x):
+    """Mass, inertia about the centre of mass and the centre-of-mass arm A(theta) c
+    (ground frame) of body b at pose x."""
+    m = fp[ob + FR_BODY * b]
+    Jc = fp[ob + FR_BODY * b + 1]
+    cx, cy = fp[ob + FR_BODY * b + 2], fp[ob + FR_BODY * b + 3]
+    th = x[3 * b + 2]
+    co, si = np.cos(th), np.sin(th)
+    return m, Jc, co * cx - si * cy, si * cx + co * cy
+
+
+@njit
 def _apply(F, b, nb, armx, army, fx, fy):
     if b < nb:
         F[3 * b] += fx
@@ -246,24 +258,17 @@ def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv):
     for c in range(nq):
         Qd[c] = 0.0
     for b in range(nb):
-        m = fp[ob + FR_BODY * b]
-        cx, cy = fp[ob + FR_BODY * b + 2], fp[ob + FR_BODY * b + 3]
-        th = x[3 * b + 2]
-        c, s = np.cos(th), np.sin(th)
-        _apply(F, b, nb, c * cx - s * cy, s * cx + c * cy, m * gx, m * gy)
+        m, _, ax, ay = body_inertia(fp, ob, b, x)
+        _apply(F, b, nb, ax, ay, m * gx, m * gy)
     oi, of = ip[H_IOFF + S_SPR], ip[H_FOFF + S_SPR]
     for k in range(ip[H_NSPR]):
         i = ip[oi + IR_SPR * k]
         j = ip[oi + IR_SPR * k + 1]
         f0 = of + FR_SPR * k
-        xi = yi = ti = vxi = vyi = wi = 0.0
-        if i < nb:
-            xi, yi, ti = x[3 * i], x[3 * i + 1], x[3 * i + 2]
-            vxi, vyi, wi = v[3 * i], v[3 * i + 1], v[3 * i + 2]
-        xj = yj = tj = vxj = vyj = wj = 0.0
-        if j < nb:
-            xj, yj, tj = x[3 * j], x[3 * j + 1], x[3 * j + 2]
-            vxj, vyj, wj = v[3 * j], v[3 * j + 1], v[3 * j + 2]
+        xi, yi, ti = body_pose(x, nb, i)
+        vxi, vyi, wi = body_pose(v, nb, i)
+        xj, yj, tj = body_pose(x, nb, j)
+        vxj, vyj, wj = body_pose(v, nb, j)
         ci, si = np.cos(ti), np.sin(ti)
         cj, sj = np.cos(tj), np.sin(tj)
         aix, aiy = ci * fp[f0] - si * fp[f0 + 1], si * fp[f0] + ci * fp[f0 + 1]

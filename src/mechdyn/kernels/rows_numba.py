@@ -16,8 +16,8 @@ from contextlib import contextmanager
 
 import numpy as np
 
-__all__ = ["rows_values", "rows_jacobian", "rows_quad", "njit", "NUMBA", "compiling",
-           "ANNOUNCE_AFTER"]
+__all__ = ["rows_values", "rows_jacobian", "rows_quad", "body_pose", "njit", "NUMBA",
+           "compiling", "ANNOUNCE_AFTER"]
 
 #: seconds after which a compilation is announced on stderr
 ANNOUNCE_AFTER = 2.0
@@ -70,7 +70,8 @@ def njit(fn):
 
 
 @njit
-def _pose(x, nb, b):
+def body_pose(x, nb, b):
+    """(x, y, theta) of body b in x (or its rates in xdot); the ground (b >= nb) is zero."""
     if b < nb:
         return x[3 * b], x[3 * b + 1], x[3 * b + 2]
     return 0.0, 0.0, 0.0
@@ -79,9 +80,9 @@ def _pose(x, nb, b):
 @njit
 def _row_parts(x, nb, ints, flts, k):
     """th_b1, th_b2, rotated s1, rotated s2, w, separation d of row k."""
-    x1, y1, t1 = _pose(x, nb, ints[k, 0])
-    x2, y2, t2 = _pose(x, nb, ints[k, 1])
-    _, _, td = _pose(x, nb, ints[k, 2])
+    x1, y1, t1 = body_pose(x, nb, ints[k, 0])
+    x2, y2, t2 = body_pose(x, nb, ints[k, 1])
+    _, _, td = body_pose(x, nb, ints[k, 2])
     c1, s1 = np.cos(t1), np.sin(t1)
     c2, s2 = np.cos(t2), np.sin(t2)
     cd, sd = np.cos(td), np.sin(td)
@@ -139,9 +140,9 @@ def rows_quad(x, v, nb, ints, flts, out, row0):
         if wx == 0.0 and wy == 0.0:
             out[row0 + k] = 0.0
             continue
-        vx1, vy1, w1 = _pose(v, nb, ints[k, 0])
-        vx2, vy2, w2 = _pose(v, nb, ints[k, 1])
-        _, _, wd = _pose(v, nb, ints[k, 2])
+        vx1, vy1, w1 = body_pose(v, nb, ints[k, 0])
+        vx2, vy2, w2 = body_pose(v, nb, ints[k, 1])
+        _, _, wd = body_pose(v, nb, ints[k, 2])
         ddx = vx1 - w1 * r1y - vx2 + w2 * r2y
         ddy = vy1 + w1 * r1x - vy2 - w2 * r2x
         out[row0 + k] = (-wd * wd * (wx * dx + wy * dy) + 2.0 * wd * (wx * ddy - wy * ddx)

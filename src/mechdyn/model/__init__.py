@@ -5,17 +5,7 @@ the lowering rules that turn every joint, coordinate, lock, stop and contact
 into constraint rows of one form.
 """
 
-from .compile import (
-    COORD_ANGLE,
-    COORD_RELATIVE,
-    COORD_TRAVEL,
-    ConstraintLayout,
-    LockRows,
-    Model,
-    PrismaticRows,
-    RevoluteRows,
-    as_model,
-)
+from .compile import COORD_ANGLE, COORD_RELATIVE, COORD_TRAVEL, ConstraintLayout, Model, as_model
 
-__all__ = ["Model", "RevoluteRows", "PrismaticRows", "LockRows", "ConstraintLayout", "as_model",
-           "COORD_ANGLE", "COORD_RELATIVE", "COORD_TRAVEL"]
+__all__ = ["Model", "ConstraintLayout", "as_model", "COORD_ANGLE", "COORD_RELATIVE",
+           "COORD_TRAVEL"]

@@ -73,9 +73,6 @@ class Model:
         kg and kg m^2 (about the centre of mass).
     com : ndarray, shape (n_bodies, 2)
         Centres of mass in the body frames, m.
-    mass_diag : ndarray, shape (n_x,)
-        (m, m, J_c) per body: the diagonal mass matrix in centre-of-mass coordinates
-        (kg, kg, kg m^2); dynamics maps the body-frame analogs to the centres of mass.
     x_sketch : ndarray, shape (n_x,)
         The sketch poses, which choose the assembly branch.
     length_scale : float
@@ -101,40 +98,21 @@ class Model:
         self.gravity = np.asarray(mechanism.gravity, dtype=float)
         self.x_sketch = np.array([v for b in bodies for v in b.pose], dtype=float)
 
-        revs = [j for j in mechanism.joints.values() if isinstance(j, Revolute)]
-        pris = [j for j in mechanism.joints.values() if isinstance(j, Prismatic)]
-        locks = [j for j in mechanism.joints.values() if isinstance(j, Lock)]
-        self.rev = RevoluteRows(
-            tuple(j.name for j in revs),
-            np.array([self._bindex[j.parent] for j in revs], dtype=int),
-            np.array([self._bindex[j.child] for j in revs], dtype=int),
-            np.array([self._point(j.parent, j.parent_point) for j in revs]).reshape(-1, 2),
-            np.array([self._point(j.child, j.child_point) for j in revs]).reshape(-1, 2),
-        )
-        ui = np.array([np.asarray(j.axis, float) / np.hypot(*j.axis) for j in pris]).reshape(-1, 2)
+        revs, pris, locks = ([j for j in mechanism.joints.values() if isinstance(j, kind)]
+                             for kind in (Revolute, Prismatic, Lock))
+        self.rev = RevoluteRows(*self._ends(revs), self._points(revs, "parent"),
+                                self._points(revs, "child"))
         self.pri = PrismaticRows(
-            tuple(j.name for j in pris),
-            np.array([self._bindex[j.parent] for j in pris], dtype=int),
-            np.array([self._bindex[j.child] for j in pris], dtype=int),
-            np.array([self._point(j.parent, j.parent_point) for j in pris]).reshape(-1, 2),
-            ui,
-            np.array([self._point(j.child, j.child_point) for j in pris]).reshape(-1, 2),
+            *self._ends(pris), self._points(pris, "parent"),
+            np.array([np.asarray(j.axis, float) / np.hypot(*j.axis) for j in pris]).reshape(-1, 2),
+            self._points(pris, "child"),
             np.array([self._sketch_angle(j) if j.angle is None else j.angle for j in pris],
-                     dtype=float),
-        )
-        lock_c, lock_a = [], []
-        for j in locks:
-            off = self._sketch_offset(j) if j.offset is None else j.offset
-            lock_c.append(off[:2])
-            lock_a.append(off[2])
-        self.lock = LockRows(
-            tuple(j.name for j in locks),
-            np.array([self._bindex[j.parent] for j in locks], dtype=int),
-            np.array([self._bindex[j.child] for j in locks], dtype=int),
-            np.array(lock_c, dtype=float).reshape(-1, 2),
-            np.array(lock_a, dtype=float),
-            np.array([j.engaged for j in locks], dtype=bool),
-        )
+                     dtype=float))
+        offsets = [self._sketch_offset(j) if j.offset is None else j.offset for j in locks]
+        self.lock = LockRows(*self._ends(locks),
+                             np.array([o[:2] for o in offsets], dtype=float).reshape(-1, 2),
+                             np.array([o[2] for o in offsets], dtype=float),
+                             np.array([j.engaged for j in locks], dtype=bool))
         self.joint_names = tuple(mechanism.joints)
         self._jkind = {n: type(j).__name__.lower() for n, j in mechanism.joints.items()}
 
@@ -143,21 +121,6 @@ class Model:
         self.n_q = len(coords)
         self.coord_kind = np.array([_KIND_CODE[c.kind] for c in coords], dtype=int)
         self.coord_is_angle = np.array([c.is_angle for c in coords], dtype=bool)
-        self.coord_offset = np.array([c.offset for c in coords], dtype=float)
-        # body for 'angle'; joint index into rev / pri tables otherwise
-        cb, cj = [], []
-        for c in coords:
-            if c.kind == "angle":
-                cb.append(self._bindex[c.body])
-                cj.append(-1)
-            elif c.kind == "relative_angle":
-                cb.append(-1)
-                cj.append(self.rev.names.index(c.joint))
-            else:
-                cb.append(-1)
-                cj.append(self.pri.names.index(c.joint))
-        self.coord_body = np.array(cb, dtype=int)
-        self.coord_joint = np.array(cj, dtype=int)
 
         pts = [np.hypot(*p) for b in mechanism.all_bodies.values()
                for p in [b.com, *b.points.values()]]
@@ -167,10 +130,9 @@ class Model:
 
         self._lower_rows()
 
-        self.mass_diag = np.repeat(self.mass, 3).reshape(nb, 3)
-        self.mass_diag[:, 2] = self.inertia
-        self.mass_diag = self.mass_diag.reshape(-1)
-        self.initial_mode = self.mode_of(self.lock.engaged)
+        #: the engaged locks at the start (frozenset of lock names)
+        self.initial_mode = frozenset(n for n, e in zip(self.lock.names, self.lock.engaged,
+                                                        strict=True) if e)
         #: declared assembly modes: (AssemblyMode, ((body index, local point) for P, Q, R))
         self.assembly_modes = [
             (am, tuple((self._bindex[b], np.asarray(self._point(b, ref), dtype=float))
@@ -199,17 +161,30 @@ class Model:
               for k, n in enumerate(pr.names)])
         self.weld_rows = {n: R.weld(n, lk.i[k], lk.c[k], lk.j[k], lk.angle[k], nb=nb)
                           for k, n in enumerate(lk.names)}
-        coords = []
-        for k, name in enumerate(self.coordinate_names):
-            kind, off, jj = self.coord_kind[k], self.coord_offset[k], self.coord_joint[k]
-            if kind == COORD_ANGLE:
-                coords.append(R.angle(name, self.coord_body[k], off, nb=nb))
-            elif kind == COORD_RELATIVE:
-                coords.append(R.relative_angle(name, rv.i[jj], rv.j[jj], off, nb=nb))
-            else:
-                coords.append(R.line(name, pr.j[jj], pr.sj[jj], pr.i[jj], pr.si[jj], pr.ui[jj],
-                                     normal=False, offset=off, nb=nb))
+        coords = [R.angle(c.name, self._bindex[c.body], c.offset, nb=nb) if c.kind == "angle"
+                  else self.joint_variable(c.name, c.joint, c.offset)
+                  for c in self.mechanism.coordinates.values()]
         self.coordinate_rows = R.concat(nb, *coords)
+
+    def joint_variable(self, label: str, joint: str, offset: float = 0.0) -> R.Rows:
+        """The row of the relative angle theta_child - theta_parent of a revolute joint (rad)
+        or of the travel of a prismatic joint along its axis (m), plus ``offset``.
+
+        Raises
+        ------
+        ModelError
+            ``joint`` is neither (the message lists the valid names).
+        """
+        rv, pr, nb = self.rev, self.pri, self.n_bodies
+        if joint in rv.names:
+            k = rv.names.index(joint)
+            return R.relative_angle(label, rv.i[k], rv.j[k], offset, nb=nb)
+        if joint in pr.names:
+            k = pr.names.index(joint)
+            return R.line(label, pr.j[k], pr.sj[k], pr.i[k], pr.si[k], pr.ui[k], normal=False,
+                          offset=offset, nb=nb)
+        raise ModelError(did_you_mean(joint, (*rv.names, *pr.names),
+                                      "revolute or prismatic joint"))
 
     def __setattr__(self, name, value):
         if self.__dict__.get("_frozen", False):
@@ -224,6 +199,17 @@ class Model:
         return self
 
     # ------------------------------------------------------------------ lookups
+    def _ends(self, joints) -> tuple:
+        """(names, parent indices, child indices) of some joints."""
+        return (tuple(j.name for j in joints),
+                *(np.array([self._bindex[getattr(j, end)] for j in joints], dtype=int)
+                  for end in ("parent", "child")))
+
+    def _points(self, joints, end: str) -> np.ndarray:
+        """The (n, 2) points of some joints on their ``end`` ("parent" or "child") body."""
+        return np.array([self._point(getattr(j, end), getattr(j, end + "_point"))
+                         for j in joints]).reshape(-1, 2)
+
     def _point(self, body: str, ref) -> tuple[float, float]:
         if isinstance(ref, str):
             return self._bodies[body].point(ref)
@@ -275,11 +261,6 @@ class Model:
             raise ModelError(did_you_mean(name, self.coordinate_names, "coordinate")) from None
 
     # ------------------------------------------------------------------ modes
-    def mode_of(self, engaged) -> frozenset:
-        """The mode (frozenset of engaged lock names) for a boolean array over ``lock.names``."""
-        return frozenset(n for n, e in zip(self.lock.names, np.asarray(engaged, bool), strict=True)
-                         if e)
-
     def layout(self, mode=None) -> ConstraintLayout:
         """Row layout of the constraint equations in a mode (cached)."""
         mode = self.initial_mode if mode is None else frozenset(mode)
@@ -298,29 +279,15 @@ class ConstraintLayout:
 
     def __init__(self, model: Model, mode: frozenset):
         self.mode = mode
-        rows: dict[str, np.ndarray] = {}
-        k = 0
-        for n in model.rev.names:
-            rows[n] = np.arange(k, k + 2)
-            k += 2
-        for n in model.pri.names:
-            rows[n] = np.arange(k, k + 2)
-            k += 2
-        active = np.array([n in mode for n in model.lock.names], dtype=bool)
-        for n, a in zip(model.lock.names, active, strict=True):
-            if a:
-                rows[n] = np.arange(k, k + 3)
-                k += 3
-        self.lock_active = active
-        self.rows = rows
-        self.n_rows = k
-        self.row_joint = np.empty(k, dtype=object)
-        for n, r in rows.items():
-            self.row_joint[r] = n
+        self.lock_active = np.array([n in mode for n in model.lock.names], dtype=bool)
         #: the constraint rows of the mode (joints, then engaged locks), as data
         self.rowset = R.concat(model.n_bodies, model.joint_rows,
                                *[model.weld_rows[n] for n, a in
-                                 zip(model.lock.names, active, strict=True) if a])
+                                 zip(model.lock.names, self.lock_active, strict=True) if a])
+        self.n_rows = len(self.rowset)
+        self.row_joint = np.array(self.rowset.elements, dtype=object)
+        self.rows = {n: np.flatnonzero(self.row_joint == n)
+                     for n in dict.fromkeys(self.rowset.elements)}
         #: the rows of the position problem [Phi(x); g(x)] = [0; q]
         self.position_rows = R.concat(model.n_bodies, self.rowset, model.coordinate_rows)
 

@@ -28,7 +28,7 @@ Lowering rules (parent i, child j):
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 import numpy as np
@@ -37,6 +37,8 @@ __all__ = ["Rows", "concat", "revolute", "prismatic", "weld", "angle", "relative
            "point", "line", "EX", "EY"]
 
 EX, EY = (1.0, 0.0), (0.0, 1.0)
+#: the per-row arrays of a :class:`Rows`
+ARRAYS = ("b1", "s1", "b2", "s2", "d", "u", "a", "ka", "bb", "kb", "c", "is_angle")
 
 
 @dataclass(frozen=True, eq=False)
@@ -116,24 +118,21 @@ class Rows:
     def take(self, index) -> Rows:
         """The rows at ``index`` (an index array or a boolean mask), in that order."""
         idx = np.arange(len(self))[index]
-        return Rows(self.nb, self.b1[idx], self.s1[idx], self.b2[idx], self.s2[idx],
-                    self.d[idx], self.u[idx], self.a[idx], self.ka[idx], self.bb[idx],
-                    self.kb[idx], self.c[idx], tuple(self.labels[k] for k in idx),
-                    tuple(self.elements[k] for k in idx), self.is_angle[idx])
+        return replace(self, **{k: getattr(self, k)[idx] for k in ARRAYS},
+                       labels=tuple(self.labels[k] for k in idx),
+                       elements=tuple(self.elements[k] for k in idx))
 
     def scaled(self, sign: float = 1.0, shift: float = 0.0) -> Rows:
         """sign * (m(x) + shift): a unilateral row's orientation and its held value."""
-        return Rows(self.nb, self.b1, self.s1, self.b2, self.s2, self.d, sign * self.u,
-                    self.a, sign * self.ka, self.bb, sign * self.kb,
-                    sign * (self.c + shift), self.labels, self.elements, self.is_angle)
+        return replace(self, u=sign * self.u, ka=sign * self.ka, kb=sign * self.kb,
+                       c=sign * (self.c + shift))
 
     def renamed(self, labels, elements=None) -> Rows:
         """The same rows with other labels (and elements)."""
         labels = (labels,) * len(self) if isinstance(labels, str) else tuple(labels)
         elements = labels if elements is None else (
             (elements,) * len(self) if isinstance(elements, str) else tuple(elements))
-        return Rows(self.nb, self.b1, self.s1, self.b2, self.s2, self.d, self.u, self.a,
-                    self.ka, self.bb, self.kb, self.c, labels, elements, self.is_angle)
+        return replace(self, labels=labels, elements=elements)
 
     @cached_property
     def columns(self) -> tuple[np.ndarray, ...]:
@@ -163,25 +162,18 @@ class Rows:
         return np.ascontiguousarray(ints, np.int64), np.ascontiguousarray(flts, float)
 
 
-def _one(nb, b1=None, s1=(0.0, 0.0), b2=None, s2=(0.0, 0.0), d=None, u=(0.0, 0.0),
-         a=None, ka=0.0, bb=None, kb=0.0, c=0.0, label="", element="", is_angle=False):
-    g = nb
-    return dict(b1=g if b1 is None else b1, s1=tuple(map(float, s1)),
-                b2=g if b2 is None else b2, s2=tuple(map(float, s2)),
-                d=g if d is None else d, u=tuple(map(float, u)),
-                a=g if a is None else a, ka=float(ka), bb=g if bb is None else bb,
-                kb=float(kb), c=float(c), label=label, element=element or label,
-                is_angle=bool(is_angle))
+def _one(nb, *, label: str, element: str = "", is_angle: bool = False, **row) -> dict:
+    """One row: the ground (index ``nb``) and zeros wherever ``row`` gives nothing."""
+    return {"b1": nb, "s1": (0.0, 0.0), "b2": nb, "s2": (0.0, 0.0), "d": nb, "u": (0.0, 0.0),
+            "a": nb, "ka": 0.0, "bb": nb, "kb": 0.0, "c": 0.0, **row, "label": label,
+            "element": element or label, "is_angle": is_angle}
 
 
 def _rows(nb: int, recs: list[dict]) -> Rows:
     if not recs:
-        z = np.zeros(0)
-        return Rows(nb, z, z, z, z, z, z, z, z, z, z, z, (), (), np.zeros(0, bool))
-    col = {k: [r[k] for r in recs] for k in recs[0]}
-    return Rows(nb, col["b1"], col["s1"], col["b2"], col["s2"], col["d"], col["u"], col["a"],
-                col["ka"], col["bb"], col["kb"], col["c"], tuple(col["label"]),
-                tuple(col["element"]), col["is_angle"])
+        return Rows(nb, **{k: np.zeros(0, bool if k == "is_angle" else float) for k in ARRAYS})
+    return Rows(nb, **{k: [r[k] for r in recs] for k in ARRAYS},
+                labels=tuple(r["label"] for r in recs), elements=tuple(r["element"] for r in recs))
 
 
 def concat(nb: int, *parts: Rows) -> Rows:
@@ -191,12 +183,9 @@ def concat(nb: int, *parts: Rows) -> Rows:
         return _rows(nb, [])
     if any(p.nb != nb for p in parts):
         raise ValueError("Rows of different models cannot be joined")
-    cat = {k: np.concatenate([getattr(p, k) for p in parts])
-           for k in ("b1", "s1", "b2", "s2", "d", "u", "a", "ka", "bb", "kb", "c", "is_angle")}
-    return Rows(nb, cat["b1"], cat["s1"], cat["b2"], cat["s2"], cat["d"], cat["u"], cat["a"],
-                cat["ka"], cat["bb"], cat["kb"], cat["c"],
-                sum((p.labels for p in parts), ()), sum((p.elements for p in parts), ()),
-                cat["is_angle"])
+    return Rows(nb, **{k: np.concatenate([getattr(p, k) for p in parts]) for k in ARRAYS},
+                labels=sum((p.labels for p in parts), ()),
+                elements=sum((p.elements for p in parts), ()))
 
 
 # ----------------------------------------------------------------------------- lowering rules

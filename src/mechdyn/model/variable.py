@@ -44,7 +44,7 @@ from . import rows as R
 from .rows import Rows
 
 __all__ = ["Variable", "parse", "quantity", "lower", "FORMS", "Measure", "RateMeasure",
-           "DistanceMeasure", "TimeMeasure", "parse_variable", "coordinate_measure"]
+           "DistanceMeasure", "TimeMeasure", "parse_variable"]
 
 #: the forms of a variable, for messages
 FORMS = ("'<coordinate>', '<coordinate>_dot', 'joint:NAME', 'angle:BODY', 'body.point.x', "
@@ -194,16 +194,7 @@ def lower(model, var: Variable) -> Rows | None:
     if var.kind == "coordinate":
         return model.coordinate_rows.take([model.coordinate_index(var.name)])
     if var.kind == "joint":
-        if var.name in model.rev.names:
-            k = model.rev.names.index(var.name)
-            return R.relative_angle(var.text, model.rev.i[k], model.rev.j[k], nb=nb)
-        if var.name in model.pri.names:
-            p = model.pri
-            k = p.names.index(var.name)
-            return R.line(var.text, p.j[k], p.sj[k], p.i[k], p.si[k], p.ui[k], normal=False,
-                          nb=nb)
-        raise ModelError(did_you_mean(var.name, (*model.rev.names, *model.pri.names),
-                                      "revolute or prismatic joint"))
+        return model.joint_variable(var.text, var.name)
     if var.kind == "angle":
         return R.angle(var.text, model.body_index(var.name), nb=nb)
     if var.kind == "point":
@@ -291,11 +282,6 @@ class TimeMeasure:
     label = "t"
     is_angle = False
     needs_velocity = False
-
-
-def coordinate_measure(model, k: int) -> Measure:
-    """The measure of declared coordinate number ``k``."""
-    return Measure(model.coordinate_rows.take([k]))
 
 
 def parse_variable(model, spec: str, *, allow_time: bool = False, allow_rate: bool = False,
