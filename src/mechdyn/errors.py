@@ -55,6 +55,11 @@ class Status(StrEnum):
     TOO_MANY_EVENTS = "too-many-events"
     #: the wall-time limit was reached
     TIMEOUT = "timeout"
+    #: the step size fell below the smallest allowed (the motion is too fast for the
+    #: requested tolerance)
+    STEP_TOO_SMALL = "step-too-small"
+    #: the step budget of the run was used up
+    BUDGET = "budget-exhausted"
     #: stopped by the user (Ctrl-C); the data so far is kept
     INTERRUPTED = "interrupted"
     #: a transient did not reach its steady state in the time given

@@ -39,12 +39,24 @@ def _values(model: Model, given, base: np.ndarray, what: str) -> np.ndarray:
     return arr
 
 
+#: the most continuation steps from the sketch to the initial coordinates (about 16 turns)
+MAX_WALK = 2000
+
+
 def _continue_to(model: Model, q_from, x_from, q_to, layout) -> np.ndarray:
     """Newton continuation from a solved pose to new coordinates (keeps the branch)."""
     q_from = np.asarray(q_from, float)
     dq = np.asarray(q_to, float) - q_from
     size = np.where(model.coord_is_angle, np.abs(dq) / 0.05,
                     np.abs(dq) / (0.05 * model.length_scale))
+    if float(np.max(size, initial=0.0)) > MAX_WALK:
+        k = int(np.argmax(size))
+        unit = "deg" if model.coord_is_angle[k] else "mm"
+        far = np.rad2deg(q_to[k]) if model.coord_is_angle[k] else 1e3 * q_to[k]
+        raise ModelError(f"initial {model.coordinate_names[k]} = {far:.6g} {unit} is too far "
+                         f"from the sketch to be reached by continuation (more than "
+                         f"{MAX_WALK} steps of 0.05 rad or 0.05 length scale); give it "
+                         "within a few turns of the sketch (angles modulo 360 deg)")
     n = max(1, int(math.ceil(float(np.max(size, initial=0.0)))))
     x = np.array(x_from, float)
     for k in range(1, n + 1):

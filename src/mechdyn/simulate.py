@@ -35,7 +35,7 @@ __all__ = ["simulate", "initial_state"]  # initial_state: re-exported from .init
 
 #: the options of the segment loop that :func:`simulate` passes on (``**switching``)
 SWITCHING_OPTIONS = ("dt_out", "max_events", "small_velocity", "gap_tol", "zeno_time",
-                     "max_wall_time")
+                     "max_wall_time", "max_steps", "min_step")
 
 
 def _keywords_without_effect(integrator, rtol, atol, formulation, d) -> float:
@@ -123,7 +123,13 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
         penetration tolerance, m; default 1e-9 length scale); ``zeno_time`` (a stop
         or contact that impacts again within it is absorbed plastically, ending a
         bouncing sequence, s; default 1e-4 (t_end - t0)); ``max_wall_time`` (stop,
-        status ``"timeout"``, after this many seconds of computing).
+        status ``"timeout"``, after this many seconds of computing); ``max_steps`` (stop,
+        status ``"budget-exhausted"``, after this many accepted steps; default 200 000,
+        or twice the grid of a fixed-step integrator); ``min_step`` (stop, status
+        ``"step-too-small"``, when an adaptive step falls below it, s; default
+        1e-13 (t_end - t0)).  A run whose steps shrink below 1e-7 (t_end - t0) where the
+        position Jacobian is nearly singular (sigma_min/sigma_max < 1e-5) stops at once
+        as a dead position approached.
 
     Returns
     -------

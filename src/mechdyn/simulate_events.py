@@ -93,7 +93,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                     t_eval=None, method="dop853", max_events: int = 100000,
                     small_velocity: float | None = None, gap_tol: float | None = None,
                     zeno_time: float | None = None,
-                    max_wall_time: float | None = None,
+                    max_wall_time: float | None = None, max_steps: int | None = None,
+                    min_step: float | None = None,
                     progress: bool | None = None, dt: float | None = None,
                     steps: int | None = None, iterations: int | None = None,
                     tol: float | None = None, theta: float | None = None,
@@ -126,6 +127,13 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         gap_tol = 1e-9 * L
     if zeno_time is None:
         zeno_time = 1e-4 * (t_end - t0)
+    span = t_end - t0
+    if min_step is None:
+        min_step = 1e-13 * span
+    if max_steps is None:
+        grid = (span / dt if dt else steps or 0) if str(method).lower() in ("wilson", "rk4") \
+            else 0
+        max_steps = max(200_000, 2 * int(grid))
     last_impact: dict = {}
     every_step = t_eval is None and dt_out is None  # as a fixed-structure run
     if every_step:
@@ -139,6 +147,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     t_eval = np.asarray(t_eval, float)
     weight = float(np.sum(model.mass) * max(np.hypot(*model.gravity), 1.0))
     force_scale = max(weight, 1.0)
+    fixed_step = str(getattr(method, "name", method)).lower() in ("wilson", "rk4")
     segment_integrator, method_name = segment_integrators(
         method, t0, t_end, rtol=rtol, atol=atol, dt=dt, steps=steps, iterations=iterations,
         tol=tol, theta=theta, first_step=first_step, max_step=max_step)
@@ -269,6 +278,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                     raise Stop(Status.SINGULAR_POSITION, turn)
                 ev = evaluate(step.t, y)
                 eqs.check_position(step.t, ev.x, ev.q)
+                _budget(step, ev, ms, stats, span, min_step, max_steps, fixed_step)
                 good = (step.t, ev, ms)
                 return ev
 
@@ -359,6 +369,38 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         "numpy" if backends <= {"numpy"} else "numba+numpy")
     bar.close()
     return _finish(model, rec, events, stats, wall0, status, message, sm)
+
+
+#: steps below this fraction of the run, where sigma_min/sigma_max of the position
+#: Jacobian is below APPROACH_RCOND, are a dead position being approached
+STALL, APPROACH_RCOND = 1e-7, 1e-5
+
+
+def _budget(step, ev, ms, stats, span, min_step, max_steps, fixed_step) -> None:
+    """Stop a run whose steps became too small or too many (with the data kept).
+
+    Raises
+    ------
+    Stop
+        ``"step-too-small"``, ``"budget-exhausted"`` or, where the steps shrink at a
+        nearly singular position, ``"singular-position"``.
+    """
+    h = step.t - step.t_old
+    where = f"at t = {step.t:.9g} s"
+    if not fixed_step and 0 < h < STALL * span:
+        rep = ms.singularity(ev.x)
+        if rep["rcond"] < APPROACH_RCOND:
+            raise Stop(Status.SINGULAR_POSITION, (
+                f"dead position approached {where}: the step size fell to {h:.3g} s where "
+                f"sigma_min/sigma_max of the position Jacobian is {rep['rcond']:.2e}; "
+                f"coordinate(s) {', '.join(rep['coordinates']) or '-'} lose control"))
+        if h < min_step:
+            raise Stop(Status.STEP_TOO_SMALL, (
+                f"step size fell below {min_step:.3g} s {where} (h = {h:.3g} s): the "
+                f"motion is too fast for the requested tolerance"))
+    if stats["steps"] > max_steps:  # the steps within the budget are all recorded
+        raise Stop(Status.BUDGET, f"step budget exhausted after t = {step.t_old:.9g} s "
+                                  f"({max_steps} steps; raise max_steps to go on)")
 
 
 def _penetration(sm: SwitchedModel, x) -> float:

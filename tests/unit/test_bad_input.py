@@ -105,3 +105,50 @@ def test_wrong_types_and_duplicate_names_in_the_switchable_tables(old, new, matc
     assert old in text
     with pytest.raises(ModelError, match=match):
         loads(text.replace(old, new, 1), name="press.toml")
+
+
+def _bar(gravity=-9.81):
+    from mechdyn import Mechanism
+
+    m = Mechanism("bar", gravity=(0.0, gravity))
+    m.add_body("bar", mass=1.0, inertia=1 / 12, com=(0.5, 0.0))
+    m.add_revolute("O", "ground", "bar")
+    m.add_coordinate("th", kind="angle", body="bar")
+    return m
+
+
+def test_a_motion_too_fast_for_the_tolerance_stops_at_once_with_its_data():
+    from mechdyn import simulate
+
+    tr = simulate(_bar(gravity=-1e30), 1.0, progress=False)
+    assert tr.status == "step-too-small" and "too fast" in tr.message and tr.t.size >= 1
+
+
+def test_the_step_budget_stops_a_run_with_its_data():
+    from mechdyn import simulate
+
+    tr = simulate(_bar(), 10.0, max_steps=25, progress=False)
+    assert tr.status == "budget-exhausted" and tr.t.size == 26  # the start and 25 steps
+
+
+def test_an_initial_angle_far_from_the_sketch_is_a_named_error():
+    from mechdyn import simulate
+
+    with pytest.raises(ModelError, match=r"initial th = 1e\+06 deg is too far from the sketch"):
+        simulate(_bar(), 0.1, q0=[1e6 * 3.141592653589793 / 180], progress=False)
+
+
+def test_a_dead_position_is_met_promptly():
+    """A four-bar driven from its rocker into the rocker's dead position stops there in a
+    few hundred steps (the shrinking steps at a nearly singular position say so)."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "physics"))
+    from test_dynamics_dead_position import rocker_driven
+
+    from mechdyn import simulate
+
+    tr = simulate(rocker_driven(), 1.0, progress=False)
+    assert tr.status == "singular-position" and 0.29 < tr.t[-1] < 0.32
+    assert tr.stats["steps"] < 1000

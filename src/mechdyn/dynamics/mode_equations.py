@@ -80,8 +80,8 @@ class ModeEquations:
     note : str
         Why the compiled path is not used, or ``""``.
     book : ChartBook or None
-        The branch charts of a one-coordinate mode of the joints alone (exact
-        formulation), else None.
+        The branch charts of a one-coordinate mode of the joints alone with a closed
+        loop (exact formulation), else None (an open chain has no bifurcation).
     watching : bool
         Whether evaluations look out for bifurcations (off while a caller samples
         dense output, so that output times do not change the run).
@@ -129,7 +129,8 @@ class ModeEquations:
                 raise ModelError(f"the compiled (numba) backend is not available: {self.note}")
         if self.kernel is not None:
             self.kernel.reset(ms.x_ref)
-        if (formulation == "exact" and not ms.rows and model.n_q == ms.n_i == 1
+        loops = len(model.rev.names) + len(model.pri.names) > model.n_bodies  # not a tree
+        if (formulation == "exact" and loops and not ms.rows and model.n_q == ms.n_i == 1
                 and len(ms.independent_rows) == ms.n_rows == model.n_x - 1):
             lay = model.layout(sorted(ms.mode.locks))
             self.book = ChartBook(PathProblem(model, lay, [0], [0.0], 0))
