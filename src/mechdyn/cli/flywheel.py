@@ -27,7 +27,7 @@ from ..errors import ModelError
 from ..results.plot_reduction import plot_steady_cycle
 from ..results.table import write_csv
 from ..units import parse_quantity
-from .reduce import add_model_arguments, prepare_model
+from .options import add_files, add_model_arguments, prepare_model
 
 __all__ = ["register", "run"]
 
@@ -58,10 +58,8 @@ def register(sub) -> None:
     p.add_argument("--exact", action="store_true",
                    help="evaluate the mechanism exactly at every step instead of interpolating "
                         "the table (slower; needed for time- or speed-dependent loads)")
-    p.add_argument("-o", "--output", metavar="CSV",
-                   help="write the steady cycle with the flywheel to this CSV file")
-    p.add_argument("--plot", metavar="PNG", help="plot the steady cycle with the flywheel")
-    p.set_defaults(func=run)
+    add_files(p, plot="plot the steady cycle with the flywheel",
+              table="write the steady cycle with the flywheel to this CSV file")
 
 
 def run(args) -> int:

@@ -34,9 +34,7 @@ from ..kinematics.sweep import initial_coordinates
 from ..kinematics.sweep import sweep as run_sweep
 from ..model import as_model
 from ..results.report import report_trajectory, write_report
-from ..units import parse_quantity
-from .animate import add_motion_arguments, simulate_from_args, sweep_values
-from .kinematics import load_model
+from .options import add_motion_arguments, open_model, parse_speed, simulate_from_args, sweep_values
 
 __all__ = ["register", "run", "report", "report_records"]
 
@@ -57,13 +55,11 @@ def register(sub) -> None:
     p.add_argument("--speed", metavar="RATE",
                    help="constant rate of the swept coordinate, e.g. 60rpm (default: the "
                         "model's initial rate, else 1 rad/s)")
-    p.set_defaults(func=run)
 
 
 def run(args) -> int:
     """Run ``mechdyn report``; returns the exit code."""
-    mech = load_model(args.model)
-    model = mech.compile()
+    mech, model = open_model(args)
     if args.simulate:
         traj = simulate_from_args(model, args, 401)
         out = report_trajectory(traj, args.output, title=args.title, animation=args.animation,
@@ -74,9 +70,8 @@ def run(args) -> int:
             return 1
         return 0
 
-    over, values = sweep_values(model, args.over, args.start, args.stop, args.steps)
-    kind = "angular_velocity" if model.coord_is_angle[model.coordinate_index(over)] else "velocity"
-    speed = None if args.speed is None else parse_quantity(args.speed, kind, where="--speed")
+    over, values = sweep_values(model, args)
+    speed = parse_speed(model, over, args.speed)
     model, sw, ks = report_records(model, speed=speed, over=over, values=values)
     out = write_report(model, args.output, sweep=sw, kinetostatics=ks, title=args.title,
                        animation=args.animation, trace=args.trace)

@@ -28,7 +28,7 @@ from ..results.plot_dynamics import plot_trajectory
 from ..simulate import simulate
 from ..simulate_events import format_events
 from ..units import parse_quantity
-from .kinematics import load_model
+from .options import add_files, add_model, load_model
 
 __all__ = ["register", "run"]
 
@@ -45,8 +45,7 @@ def register(sub) -> None:
         epilog="Quantities take units: 0.05 s, 20 ms, 34.5 N*m, -64.1 deg, 43.5 rad/s (a bare "
                "number is SI). Exit codes: 0 done, 1 stopped early (data so far written), "
                "2 bad input, 130 interrupted by Ctrl-C (data so far written).")
-    p.add_argument("model", metavar="MODEL",
-                   help="model file (.toml) or the name of a bundled example")
+    add_model(p)
     p.add_argument("--t-end", required=True, metavar="TIME", help="end time, e.g. 0.05s")
     p.add_argument("--t0", default="0", metavar="TIME", help="start time (default 0 s)")
     p.add_argument("--integrator", default="dop853", metavar="NAME",
@@ -74,14 +73,12 @@ def register(sub) -> None:
                    help="write N equally spaced samples (dense output) instead of every step")
     p.add_argument("--points", action="store_true",
                    help="add the positions, velocities, accelerations of every named point")
-    p.add_argument("-o", "--output", metavar="CSV", help="write the table to this CSV file")
-    p.add_argument("--plot", metavar="PNG", help="write a plot of q, q', q'' and the energies")
+    add_files(p, plot="write a plot of q, q', q'' and the energies")
     p.add_argument("--backend", default="auto", choices=("auto", "numpy", "numba"),
                    help="right-hand side evaluation (default auto: compiled when possible)")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="always (or never) show a progress bar (default: once a run takes "
                         "more than 2 s)")
-    p.set_defaults(func=run)
 
 
 def _pairs(items, model, what, kinds):
