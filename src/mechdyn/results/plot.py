@@ -22,12 +22,15 @@ __all__ = ["plot", "plot_kinematic_sweep", "PLOTTERS"]
 
 
 def _figure(n_rows: int, width: float = 8.0, height: float = 2.6):
+    """A figure on the Agg canvas with ``n_rows`` gridded panels sharing x: (fig, axes)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(width, height * n_rows), layout="constrained")
     FigureCanvasAgg(fig)
     axes = fig.subplots(n_rows, 1, sharex=True, squeeze=False)[:, 0]
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
     return fig, axes
 
 
@@ -95,7 +98,6 @@ def plot_kinematic_sweep(sweep, path, points: Iterable | None = None, *,
                 ax.plot(xs, values[:, c], label=f"{comp} of {label}")
     for ax, (what, unit) in zip(axes, rows, strict=True):
         ax.set_ylabel(f"{what} ({unit})")
-        ax.grid(True, alpha=0.3)
         ax.axhline(0.0, color="0.6", lw=0.6)
         if ax.lines[1:]:
             ax.legend(fontsize="small", loc="best")

@@ -51,8 +51,6 @@ def plot_reduction(red, path, *, title: str | None = None, dpi: int = 120) -> Pa
     ax[2].set_ylabel(f"reduced torque ({tu})")
     ax[2].legend(loc="best", fontsize="small")
     ax[2].set_xlabel(xlabel)
-    for a in ax:
-        a.grid(True, alpha=0.3)
     ax[0].set_title(title or f"reduction to {red.link or red.coordinate}")
     return _save(fig, path, dpi)
 
@@ -71,8 +69,6 @@ def plot_steady_cycle(cycle, path, *, title: str | None = None, dpi: int = 120) 
     ax[1].plot(x, cycle.M)
     ax[1].set_ylabel("reduced torque (N m)")
     ax[1].set_xlabel("position (deg)")
-    for a in ax:
-        a.grid(True, alpha=0.3)
     return _save(fig, path, dpi)
 
 
@@ -92,8 +88,6 @@ def plot_startup(res, path, *, title: str | None = None, dpi: int = 120) -> Path
     ax[1].set_ylabel("torque (N m)")
     ax[1].set_xlabel("time (s)")
     ax[1].legend(loc="best", fontsize="small")
-    for a in ax:
-        a.grid(True, alpha=0.3)
     return _save(fig, path, dpi)
 
 
@@ -109,6 +103,5 @@ def plot_motor(motor, path, *, points: int = 401, title: str | None = None,
     ax[0].plot(m, w)
     ax[0].set_xlabel("torque (N m)")
     ax[0].set_ylabel("speed (rad/s)")
-    ax[0].grid(True, alpha=0.3)
     ax[0].set_title(title or f"characteristic of {getattr(motor, 'name', 'motor')}")
     return _save(fig, path, dpi)
