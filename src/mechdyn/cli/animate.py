@@ -53,7 +53,7 @@ def run(args) -> int:
         print(f"{mech.name}: simulated to t = {record.t[-1] if record.t.size else 0:.6g} s "
               f"({record.status})")
     else:
-        over, values = sweep_values(model, args)
+        over, values, _ = sweep_values(model, args)
         record = sweep(model, over, values)
         ok, why = record.ok, record.message
         print(f"{mech.name}: {len(record)} of {values.size} positions of {over}")

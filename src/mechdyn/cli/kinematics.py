@@ -13,8 +13,8 @@ from __future__ import annotations
 
 from ..kinematics.sweep import sweep
 from ..results.plot import plot_kinematic_sweep
-from ..results.table import deg_or_mm, rate_text, write_csv
-from .options import add_files, add_model, add_range, finish, open_model, parse_speed, sweep_values
+from ..results.table import deg_or_mm, rate_text
+from .options import add_files, add_model, add_range, finish, open_model, sweep_values, write_files
 
 __all__ = ["register", "run"]
 
@@ -49,8 +49,7 @@ def _text(value: float, angle: bool) -> str:
 def run(args) -> int:
     """Run ``mechdyn kinematics``; returns the exit code."""
     mech, model = open_model(args)
-    over, values = sweep_values(model, args, only=True)
-    speed = parse_speed(model, over, args.speed)
+    over, values, speed = sweep_values(model, args, only=True)
     sw = sweep(model, over, values, speed=speed)
     angle = sw.over_is_angle
     print(f"{mech.name}: {len(sw)} of {values.size} positions, {over} from "
@@ -58,8 +57,5 @@ def run(args) -> int:
           f"{rate_text(1.0 if speed is None else speed, angle)}")
     for line in sw.summary().lines():
         print("  " + line)
-    if args.output:
-        print(f"  table: {write_csv(sw, args.output)}")
-    if args.plot:
-        print(f"  plot: {plot_kinematic_sweep(sw, args.plot, points=args.points)}")
+    write_files(args, sw, plot_kinematic_sweep, points=args.points)
     return finish(args, sw.status == "success", sw.message)

@@ -18,7 +18,7 @@ from ..errors import Status, UnitError
 from ..results.plot_kinetostatics import plot_kinetostatics
 from ..results.table import rate_text
 from ..units import parse_quantity
-from .options import add_files, add_model, add_range, finish, open_model, parse_speed, sweep_values
+from .options import add_files, add_model, add_range, finish, open_model, sweep_values
 
 __all__ = ["register", "run"]
 
@@ -67,8 +67,7 @@ def _point(text: str):
 def run(args) -> int:
     """Run ``mechdyn kinetostatics``; returns the exit code."""
     mech, model = open_model(args)
-    over, values = sweep_values(model, args, start=0.0)
-    speed = parse_speed(model, over, args.speed)
+    over, values, speed = sweep_values(model, args, start=0.0)
     point = _point(args.point)
     mode = None
     if args.mode is not None:

@@ -11,15 +11,18 @@ import numpy as np
 from .. import examples
 from ..dynamics.reduction import mode_mechanism
 from ..errors import ModelError
+from ..integrate.base import DEFAULT_RTOL
+from ..integrate.driver import INTEGRATORS
 from ..kinematics.sweep import initial_coordinates
 from ..modelfile import load
 from ..modelfile.drives import drive_from_table
+from ..results.table import write_csv
 from ..simulate import simulate
 from ..units import parse_quantity, parse_vector
 
 __all__ = ["add_model", "add_files", "add_range", "add_motion_arguments", "add_model_arguments",
-           "load_model", "open_model", "prepare_model", "sweep_values", "parse_speed",
-           "simulate_from_args", "finish"]
+           "add_run", "load_model", "open_model", "prepare_model", "sweep_values",
+           "simulate_from_args", "write_files", "finish"]
 
 
 def add_model(p) -> None:
@@ -46,6 +49,17 @@ def add_range(p, *, steps: int, over: str = "coordinate to sweep (default: the f
                    help=f"number of positions, ends included (default {steps})")
 
 
+def add_run(p, *, required: bool) -> None:
+    """Add what a forward-dynamics run needs: ``--t-end``, ``--integrator``, ``--rtol``."""
+    p.add_argument("--t-end", required=required, metavar="TIME",
+                   help="end time of the run, e.g. 0.05s")
+    p.add_argument("--integrator", default="dop853", metavar="NAME",
+                   help=f"one of {', '.join(INTEGRATORS)} (default dop853)")
+    p.add_argument("--rtol", type=float,
+                   help=f"relative tolerance of the adaptive integrators (default "
+                        f"{DEFAULT_RTOL:g})")
+
+
 def add_motion_arguments(p, metavar: str, output: str, *, steps: int, verb: str, title: str):
     """Add what ``mechdyn animate`` and ``report`` share: model, -o, sweep and simulation
     groups; returns the drawing group (``--trace``, ``--title``)."""
@@ -55,11 +69,7 @@ def add_motion_arguments(p, metavar: str, output: str, *, steps: int, verb: str,
     s = p.add_argument_group("simulation")
     s.add_argument("--simulate", action="store_true",
                    help=f"{verb} a forward-dynamics run from the model's initial state")
-    s.add_argument("--t-end", metavar="TIME", help="end time of the run, e.g. 0.05s")
-    s.add_argument("--integrator", default="dop853", metavar="NAME",
-                   help="integrator (default dop853; see `mechdyn simulate --help`)")
-    s.add_argument("--rtol", type=float,
-                   help="relative tolerance of the adaptive integrators (default 1e-10)")
+    add_run(s, required=False)
     d = p.add_argument_group("drawing")
     d.add_argument("--trace", metavar="BODY.POINT", help="draw the path of this point")
     d.add_argument("--title", help=title)
@@ -134,16 +144,17 @@ def prepare_model(args):
 
 
 def sweep_values(model, args, *, start: float | None = None, only: bool = False):
-    """The swept coordinate and its values from ``--over/--from/--to/--steps`` (units parsed).
+    """The swept coordinate, its values and its rate from ``--over/--from/--to/--steps``
+    and ``--speed`` (units parsed).
 
     Without ``--from`` the range starts at ``start`` (default: the coordinate's initial
     value); with ``only`` and no ``--over`` the model must have one coordinate.
 
     Returns
     -------
-    (str, ndarray)
-        The coordinate's name and ``steps`` values to ``--to`` (default one turn after
-        the first; required for a travel).
+    (str, ndarray, float or None)
+        The coordinate's name; ``steps`` values to ``--to`` (default one turn after the
+        first; required for a travel); ``--speed`` in rad/s or m/s (None if not given).
     """
     if args.over is None and only and model.n_q != 1:
         raise ModelError("the model has several coordinates; choose one with --over: "
@@ -164,15 +175,11 @@ def sweep_values(model, args, *, start: float | None = None, only: bool = False)
         stop = start + 2 * np.pi
     else:
         raise ModelError(f"coordinate {over!r} is a travel: give the range with --from and --to")
-    return over, np.linspace(start, stop, args.steps)
-
-
-def parse_speed(model, over: str, text: str | None) -> float | None:
-    """``--speed`` as the rate of ``over`` (rad/s of an angle, m/s of a travel); None for None."""
-    if text is None:
-        return None
-    angle = model.coord_is_angle[model.coordinate_index(over)]
-    return parse_quantity(text, "angular_velocity" if angle else "velocity", where="--speed")
+    speed = getattr(args, "speed", None)  # animate has no --speed
+    if speed is not None:
+        speed = parse_quantity(speed, "angular_velocity" if angle else "velocity",
+                               where="--speed")
+    return over, np.linspace(start, stop, args.steps), speed
 
 
 def simulate_from_args(model, args, samples: int):
@@ -182,6 +189,14 @@ def simulate_from_args(model, args, samples: int):
     t_end = parse_quantity(args.t_end, "time", where="--t-end")
     return simulate(model, t_end, integrator=args.integrator, rtol=args.rtol, progress=False,
                     t_eval=np.linspace(0.0, t_end, samples))
+
+
+def write_files(args, record, plot, **kwargs) -> None:
+    """Write the record's table (``-o``, CSV with a header of units) and ``--plot`` if given."""
+    if args.output:
+        print(f"  table: {write_csv(record, args.output)}")
+    if args.plot:
+        print(f"  plot: {plot(record, args.plot, **kwargs)}")
 
 
 def finish(args, ok: bool, message: str) -> int:

@@ -18,9 +18,8 @@ from ..dynamics.reduction import reduce_model
 from ..errors import ModelError
 from ..results.animate import _trace_spec
 from ..results.plot_reduction import plot_reduction
-from ..results.table import write_csv
 from ..units import parse_quantity
-from .options import add_files, add_model_arguments, finish, prepare_model
+from .options import add_files, add_model_arguments, finish, prepare_model, write_files
 
 __all__ = ["register", "run"]
 
@@ -79,8 +78,5 @@ def run(args) -> int:
         if red.m_red is not None:
             print(f"  m_red at {args.point}: min {np.min(red.m_red[fin]):.6g}  max "
                   f"{np.max(red.m_red[fin]):.6g} kg")
-    if args.output:
-        print(f"  table: {write_csv(red, args.output)}")
-    if args.plot:
-        print(f"  plot: {plot_reduction(red, args.plot, title=f'{mech.name}: reduction')}")
+    write_files(args, red, plot_reduction, title=f"{mech.name}: reduction")
     return finish(args, red.status == "success", red.message)

@@ -34,7 +34,7 @@ from ..kinematics.sweep import initial_coordinates
 from ..kinematics.sweep import sweep as run_sweep
 from ..model import as_model
 from ..results.report import report_trajectory, write_report
-from .options import add_motion_arguments, open_model, parse_speed, simulate_from_args, sweep_values
+from .options import add_motion_arguments, open_model, simulate_from_args, sweep_values
 
 __all__ = ["register", "run", "report", "report_records"]
 
@@ -70,8 +70,7 @@ def run(args) -> int:
             return 1
         return 0
 
-    over, values = sweep_values(model, args)
-    speed = parse_speed(model, over, args.speed)
+    over, values, speed = sweep_values(model, args)
     model, sw, ks = report_records(model, speed=speed, over=over, values=values)
     out = write_report(model, args.output, sweep=sw, kinetostatics=ks, title=args.title,
                        animation=args.animation, trace=args.trace)

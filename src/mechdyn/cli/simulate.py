@@ -21,14 +21,12 @@ import numpy as np
 
 from ..dynamics.lagrange import FORMULATIONS
 from ..errors import ModelError, Status, did_you_mean
-from ..integrate.base import DEFAULT_RTOL
-from ..integrate.driver import INTEGRATORS
 from ..mechanism import Drive
 from ..results.plot_dynamics import plot_trajectory
 from ..simulate import simulate
 from ..simulate_events import format_events
 from ..units import parse_quantity
-from .options import add_files, add_model, load_model
+from .options import add_files, add_model, add_run, load_model
 
 __all__ = ["register", "run"]
 
@@ -46,15 +44,10 @@ def register(sub) -> None:
                "number is SI). Exit codes: 0 done, 1 stopped early (data so far written), "
                "2 bad input, 130 interrupted by Ctrl-C (data so far written).")
     add_model(p)
-    p.add_argument("--t-end", required=True, metavar="TIME", help="end time, e.g. 0.05s")
+    add_run(p, required=True)
     p.add_argument("--t0", default="0", metavar="TIME", help="start time (default 0 s)")
-    p.add_argument("--integrator", default="dop853", metavar="NAME",
-                   help=f"one of {', '.join(INTEGRATORS)} (default dop853)")
     p.add_argument("--steps", type=int, metavar="N", help="steps of wilson / rk4")
     p.add_argument("--dt", metavar="TIME", help="step size of wilson / rk4")
-    p.add_argument("--rtol", type=float,
-                   help=f"relative tolerance of the adaptive integrators (default "
-                   f"{DEFAULT_RTOL:g})")
     p.add_argument("--atol", type=float, help="absolute tolerance (default 1e-3 rtol)")
     p.add_argument("--theta", type=float, help="Wilson theta (1 or >= 1.37)")
     p.add_argument("--iterations", type=int, help="corrector passes of wilson (default 4)")

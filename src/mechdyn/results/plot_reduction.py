@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from .plot import _figure, _save
+from .table import deg_or_mm
 
 __all__ = ["plot_reduction", "plot_steady_cycle", "plot_startup", "plot_motor"]
 
@@ -31,11 +32,9 @@ def plot_reduction(red, path, *, title: str | None = None, dpi: int = 120) -> Pa
     -------
     Path
     """
-    ang = red.is_angle or red.link is not None
-    x = np.degrees(red.position) if ang else np.asarray(red.position) * 1e3
-    xlabel = (f"angle of {red.link} (deg)" if red.link else f"{red.coordinate} (deg)") if ang \
-        else f"{red.coordinate} (mm)"
-    iu, tu = ("kg m$^2$", "N m") if ang else ("kg", "N")
+    x, unit = deg_or_mm(red.position, red.is_angle or red.link is not None)
+    xlabel = f"angle of {red.link} ({unit})" if red.link else f"{red.coordinate} ({unit})"
+    iu, tu = ("kg m$^2$", "N m") if unit == "deg" else ("kg", "N")
     fig, ax = _figure(3, height=2.4)
     ax[0].plot(x, red.J_red, label="$J_{red}$ (mechanism)")
     if np.any(red.J_extra):
