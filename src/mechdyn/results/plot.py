@@ -41,11 +41,6 @@ def _save(fig, path, dpi) -> Path:
 
 
 # ---------------------------------------------------------------- kinematic sweep
-def _parse_points(model, points) -> list[tuple[str, object, str]]:
-    return [(body, name, _label(body, name))
-            for body, name in (_trace_spec(model, p, "point") for p in points)]
-
-
 def _default_points(model) -> list[tuple[str, object, str]]:
     """The sliders' guided points, else the named points of the last body."""
     mech = model.mechanism
@@ -83,7 +78,8 @@ def plot_kinematic_sweep(sweep, path, points: Iterable | None = None, *,
     Path
     """
     model = sweep.model
-    pts = _parse_points(model, points) if points is not None else _default_points(model)
+    pts = _default_points(model) if points is None else [
+        (b, n, _label(b, n)) for b, n in (_trace_spec(model, p, "point") for p in points)]
     angle = sweep.over_is_angle
     xs, xunit = deg_or_mm(sweep.values, angle)
     fig, axes = _figure(3)
