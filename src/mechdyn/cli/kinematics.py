@@ -42,19 +42,15 @@ def register(sub) -> None:
                    help="points to plot (default: the sliders' points)")
 
 
-def _text(value: float, angle: bool) -> str:
-    return "{:.6g} {}".format(*deg_or_mm(value, angle))
-
-
 def run(args) -> int:
     """Run ``mechdyn kinematics``; returns the exit code."""
     mech, model = open_model(args)
     over, values, speed = sweep_values(model, args, only=True)
     sw = sweep(model, over, values, speed=speed)
-    angle = sw.over_is_angle
+    ends, unit = deg_or_mm(values[[0, -1]], sw.over_is_angle)
     print(f"{mech.name}: {len(sw)} of {values.size} positions, {over} from "
-          f"{_text(values[0], angle)} to {_text(values[-1], angle)} at "
-          f"{rate_text(1.0 if speed is None else speed, angle)}")
+          f"{ends[0]:.6g} {unit} to {ends[1]:.6g} {unit} at "
+          f"{rate_text(1.0 if speed is None else speed, sw.over_is_angle)}")
     for line in sw.summary().lines():
         print("  " + line)
     write_files(args, sw, plot_kinematic_sweep, points=args.points)

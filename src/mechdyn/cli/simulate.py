@@ -23,6 +23,7 @@ from ..dynamics.lagrange import FORMULATIONS
 from ..errors import ModelError, Status, did_you_mean
 from ..mechanism import Drive
 from ..results.plot_dynamics import plot_trajectory
+from ..results.table import deg_or_mm
 from ..simulate import simulate
 from ..simulate_events import format_events
 from ..units import parse_quantity
@@ -114,10 +115,8 @@ def run(args) -> int:
     if traj.events:
         print(format_events(traj.events, traj.coordinate_names, limit=40))
     if traj.t.size:
-        last = ", ".join(
-            f"{n} = {np.rad2deg(v):.9g} deg" if a else f"{n} = {v * 1e3:.9g} mm"
-            for n, v, a in zip(traj.coordinate_names, traj.q[-1], traj.coordinate_is_angle,
-                               strict=True))
+        last = ", ".join("{} = {:.9g} {}".format(n, *deg_or_mm(v, a)) for n, v, a in zip(
+            traj.coordinate_names, traj.q[-1], traj.coordinate_is_angle, strict=True))
         print(f"at t = {traj.t[-1]:.9g} s: {last}")
     if args.output:
         traj.to_dataframe(points=args.points).to_csv(args.output, index=False)
