@@ -34,7 +34,7 @@ from ..kinematics.sweep import initial_coordinates
 from ..kinematics.sweep import sweep as run_sweep
 from ..model import as_model
 from ..results.report import report_trajectory, write_report
-from .options import add_motion_arguments, open_model, simulate_from_args, sweep_values
+from .options import add_motion_arguments, finish, open_model, simulate_from_args, sweep_values
 
 __all__ = ["register", "run", "report", "report_records"]
 
@@ -65,10 +65,7 @@ def run(args) -> int:
         out = report_trajectory(traj, args.output, title=args.title, animation=args.animation,
                                 trace=args.trace)
         print(f"{mech.name}: simulation {traj.status}; report: {out}")
-        if not traj.success:
-            print(f"mechdyn report: warning: {traj.status}: {traj.message}", file=sys.stderr)
-            return 1
-        return 0
+        return finish(args, traj.success, f"{traj.status}: {traj.message}")
 
     over, values, speed = sweep_values(model, args)
     model, sw, ks = report_records(model, speed=speed, over=over, values=values)
