@@ -82,3 +82,17 @@ def test_a_dead_position_writes_what_was_computed_and_exits_1(rocker_driven_four
     df = pd.read_csv(csv, comment="#")
     assert 1 <= len(df) < 361
     assert "status: singular-position" in csv.read_text()
+
+
+def test_several_coordinates_need_over(capsys):
+    rc = main(["kinematics", "clutchless_press"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "choose one with --over: phi, psi" in err
+
+
+@pytest.mark.parametrize("command", [["kinematics"], ["kinetostatics", "--speed", "1rpm"],
+                                     ["animate", "-o", "x.gif"], ["report", "-o", "x.html"]])
+def test_every_sweeping_command_reads_the_range_alike(command, capsys):
+    rc = main([command[0], "slider_crank", *command[1:], "--steps", "0"])
+    err = capsys.readouterr().err
+    assert rc == 2 and f"mechdyn {command[0]}: error: --steps must be at least 1, got 0" in err

@@ -1,8 +1,8 @@
 """The ``mechdyn`` command line: it composes analyses, it does not compute.
 
 Each subcommand lives in its own module of this package exposing
-``register(subparsers)``; the module adds its parser and sets ``func`` to a
-function ``run(args) -> int``.
+``register(subparsers)``, which adds its parser, and ``run(args) -> int``; the
+options several subcommands share are in :mod:`mechdyn.cli.options`.
 """
 
 from __future__ import annotations
@@ -30,7 +30,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"mechdyn {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in SUBCOMMAND_MODULES:
-        importlib.import_module(f"{__name__}.{name}").register(sub)
+        module = importlib.import_module(f"{__name__}.{name}")
+        module.register(sub)
+        sub.choices[name].set_defaults(func=module.run)
     return parser
 
 

@@ -12,18 +12,11 @@ that stopped; the frames computed so far are written); 2 bad input.
 
 from __future__ import annotations
 
-import sys
-
-import numpy as np
-
-from ..errors import ModelError
-from ..kinematics.sweep import initial_coordinates, sweep
+from ..kinematics.sweep import sweep
 from ..results.animate import _trace_spec, animate, check_animation_path, snapshot
-from ..simulate import simulate
-from ..units import parse_quantity
-from .kinematics import load_model
+from .options import add_motion_arguments, finish, open_model, simulate_from_args, sweep_values
 
-__all__ = ["register", "run", "sweep_values"]
+__all__ = ["register", "run"]
 
 
 def register(sub) -> None:
@@ -46,77 +39,12 @@ def register(sub) -> None:
     d.add_argument("--frames", type=int, metavar="N",
                    help="number of frames (default: all positions, at most 200)")
     d.add_argument("--snapshot", metavar="PNG", help="also write the first frame as a PNG")
-    p.set_defaults(func=run)
-
-
-def add_motion_arguments(p, metavar: str, output: str, *, steps: int, verb: str, title: str):
-    """Add what ``mechdyn animate`` and ``report`` share: model, -o, sweep and simulation
-    groups; returns the drawing group (``--trace``, ``--title``)."""
-    p.add_argument("model", metavar="MODEL",
-                   help="model file (.toml) or the name of a bundled example")
-    p.add_argument("-o", "--output", required=True, metavar=metavar, help=output)
-    g = p.add_argument_group("sweep (default)")
-    g.add_argument("--over", metavar="COORD", help="coordinate to sweep (default: the first)")
-    g.add_argument("--from", dest="start", metavar="VALUE",
-                   help="first value, e.g. 0deg (default: the initial value)")
-    g.add_argument("--to", dest="stop", metavar="VALUE",
-                   help="last value (default: one full turn after --from)")
-    g.add_argument("--steps", type=int, default=steps, metavar="N",
-                   help=f"number of positions, ends included (default {steps})")
-    s = p.add_argument_group("simulation")
-    s.add_argument("--simulate", action="store_true",
-                   help=f"{verb} a forward-dynamics run from the model's initial state")
-    s.add_argument("--t-end", metavar="TIME", help="end time of the run, e.g. 0.05s")
-    s.add_argument("--integrator", default="dop853", metavar="NAME",
-                   help="integrator (default dop853; see `mechdyn simulate --help`)")
-    s.add_argument("--rtol", type=float,
-                   help="relative tolerance of the adaptive integrators (default 1e-10)")
-    d = p.add_argument_group("drawing")
-    d.add_argument("--trace", metavar="BODY.POINT", help="draw the path of this point")
-    d.add_argument("--title", help=title)
-    return d
-
-
-def simulate_from_args(model, args, samples: int):
-    """The forward-dynamics run of ``--simulate`` (needs ``--t-end``), ``samples`` samples."""
-    if args.t_end is None:
-        raise ModelError("--simulate needs --t-end, e.g. --t-end 0.05s")
-    t_end = parse_quantity(args.t_end, "time", where="--t-end")
-    return simulate(model, t_end, integrator=args.integrator, rtol=args.rtol, progress=False,
-                    t_eval=np.linspace(0.0, t_end, samples))
-
-
-def sweep_values(model, over: str | None, start: str | None, stop: str | None, steps: int):
-    """The swept coordinate and its values from command-line text (units parsed).
-
-    Returns
-    -------
-    (str, ndarray)
-        The coordinate's name and ``steps`` values from ``start`` (default its
-        initial value) to ``stop`` (default one turn later; required for a travel).
-    """
-    over = over if over is not None else model.coordinate_names[0]
-    k = model.coordinate_index(over)
-    angle = bool(model.coord_is_angle[k])
-    kind = "angle" if angle else "length"
-    if steps < 1:
-        raise ModelError(f"--steps must be at least 1, got {steps}")
-    a = (parse_quantity(start, kind, where="--from") if start is not None
-         else float(initial_coordinates(model)[k]))
-    if stop is not None:
-        b = parse_quantity(stop, kind, where="--to")
-    elif angle:
-        b = a + 2 * np.pi
-    else:
-        raise ModelError(f"coordinate {over!r} is a travel: give the range with --from and --to")
-    return over, np.linspace(a, b, steps)
 
 
 def run(args) -> int:
     """Run ``mechdyn animate``; returns the exit code."""
     check_animation_path(args.output)  # before any computing
-    mech = load_model(args.model)
-    model = mech.compile()
+    mech, model = open_model(args)
     _trace_spec(model, args.trace)
     if args.simulate:
         n = args.frames if args.frames is not None else 200
@@ -125,7 +53,7 @@ def run(args) -> int:
         print(f"{mech.name}: simulated to t = {record.t[-1] if record.t.size else 0:.6g} s "
               f"({record.status})")
     else:
-        over, values = sweep_values(model, args.over, args.start, args.stop, args.steps)
+        over, values, _ = sweep_values(model, args)
         record = sweep(model, over, values)
         ok, why = record.ok, record.message
         print(f"{mech.name}: {len(record)} of {values.size} positions of {over}")
@@ -135,7 +63,4 @@ def run(args) -> int:
     if args.snapshot:
         still = snapshot(record, args.snapshot, 0, trace=args.trace, title=args.title)
         print(f"  snapshot: {still}")
-    if not ok:
-        print(f"mechdyn animate: warning: the motion stopped early: {why}", file=sys.stderr)
-        return 1
-    return 0
+    return finish(args, ok, f"the motion stopped early: {why}")

@@ -31,7 +31,6 @@ def register(sub) -> None:
                                    "dynamics; write CSV tables and PNG plots into a folder.")
     p.add_argument("-d", "--dir", default="mechdyn-demo", metavar="FOLDER",
                    help="output folder (default ./mechdyn-demo)")
-    p.set_defaults(func=run)
 
 
 def run(args) -> int:

@@ -10,7 +10,6 @@ def register(sub) -> None:
                        description="List the bundled example models (use a name wherever a "
                                    "MODEL.toml is expected).")
     p.add_argument("--path", metavar="NAME", help="print the file path of one example")
-    p.set_defaults(func=run)
 
 
 def run(args) -> int:

@@ -18,16 +18,14 @@ Exit codes: 0 done; 1 the simulated delta misses the target by more than 5 %;
 
 from __future__ import annotations
 
-import sys
-
 from ..dynamics.flywheel import size_flywheel
 from ..dynamics.reduced_machine import ReducedMachine
 from ..dynamics.reduction import reduce_model
 from ..errors import ModelError
 from ..results.plot_reduction import plot_steady_cycle
-from ..results.table import write_csv
+from ..results.table import rate_text
 from ..units import parse_quantity
-from .reduce import add_model_arguments, prepare_model
+from .options import add_files, add_model_arguments, finish, prepare_model, write_files
 
 __all__ = ["register", "run"]
 
@@ -58,10 +56,8 @@ def register(sub) -> None:
     p.add_argument("--exact", action="store_true",
                    help="evaluate the mechanism exactly at every step instead of interpolating "
                         "the table (slower; needed for time- or speed-dependent loads)")
-    p.add_argument("-o", "--output", metavar="CSV",
-                   help="write the steady cycle with the flywheel to this CSV file")
-    p.add_argument("--plot", metavar="PNG", help="plot the steady cycle with the flywheel")
-    p.set_defaults(func=run)
+    add_files(p, plot="plot the steady cycle with the flywheel",
+              table="write the steady cycle with the flywheel to this CSV file")
 
 
 def run(args) -> int:
@@ -84,9 +80,8 @@ def run(args) -> int:
                          "--speed (e.g. --speed 43.5rad/s)")
     speed_kw = "omega_guess" if dependent else "omega_mean"  # a motor picks its own speed
     fs = size_flywheel(machine, delta, method=args.method, **{speed_kw: speed})
-    rpm = 30.0 / 3.141592653589793
     print(f"{mech.name}: flywheel for delta = {delta:.4g} ({args.method} method)")
-    print(f"  mean speed            {fs.omega_mean:.6g} rad/s = {fs.omega_mean * rpm:.6g} rpm")
+    print(f"  mean speed            {rate_text(fs.omega_mean, True)}")
     if fs.delta_without is not None:
         print(f"  delta without flywheel {fs.delta_without:.6g}")
     print(f"  J_red (drive incl.)   mean {fs.J_red_mean:.6g}, min {fs.J_red_min:.6g}, "
@@ -109,16 +104,11 @@ def run(args) -> int:
         c = fs.cycle
         print(f"  steady cycle          omega {c.omega_min:.6g} .. {c.omega_max:.6g} rad/s, "
               f"cycle time {c.cycle_time:.6g} s")
-        if args.output:
-            print(f"  table: {write_csv(c, args.output)}")
-        if args.plot:
-            print(f"  plot: {plot_steady_cycle(c, args.plot)}")
+        write_files(args, c, plot_steady_cycle)
     if fs.message:
         print(f"  note: {fs.message}")
-    if fs.delta_simulated is not None and fs.J_fly > 0 and \
-            abs(fs.delta_simulated / delta - 1.0) > 0.05:
-        print("mechdyn flywheel: warning: the simulated delta misses the target by more than "
-              "5 %; try --method simulation", file=sys.stderr)
-        return 1
-    return 0
+    missed = fs.delta_simulated is not None and fs.J_fly > 0 and \
+        abs(fs.delta_simulated / delta - 1.0) > 0.05
+    return finish(args, not missed, "the simulated delta misses the target by more than 5 %; "
+                                    "try --method simulation")
 

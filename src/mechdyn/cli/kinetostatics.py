@@ -11,16 +11,14 @@ Exit codes: 0 done; 1 done with a warning that matters (singular positions);
 
 from __future__ import annotations
 
-import sys
 import warnings
 
-import numpy as np
-
 from ..dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
-from ..errors import ModelError, Status, UnitError
+from ..errors import Status, UnitError
 from ..results.plot_kinetostatics import plot_kinetostatics
+from ..results.table import rate_text
 from ..units import parse_quantity
-from .kinematics import load_model
+from .options import add_files, add_model, add_range, finish, open_model, sweep_values
 
 __all__ = ["register", "run"]
 
@@ -37,20 +35,12 @@ def register(sub) -> None:
                     "columns and optionally a plot; print peaks, RMS torque and harmonics.",
         epilog="Quantities take units: 0deg, 360 deg, 40rpm, 4.2 rad/s, 15 mm (a bare number "
                "is SI: rad, m, rad/s). Exit codes: 0 done, 1 singular positions, 2 bad input.")
-    p.add_argument("model", metavar="MODEL",
-                   help="model file (.toml) or the name of a bundled example "
-                        "(see `mechdyn examples`)")
-    p.add_argument("--over", metavar="COORD",
-                   help="driven coordinate (default: the first); other independent "
-                        "coordinates are held at their initial values")
+    add_model(p)
+    add_range(p, steps=361, start="first position (default 0deg)",
+              over="driven coordinate (default: the first); other independent coordinates "
+                   "are held at their initial values")
     p.add_argument("--speed", required=True, metavar="RATE",
                    help="constant speed of the driven coordinate, e.g. 60rpm (0 for statics)")
-    p.add_argument("--from", dest="start", default=None, metavar="VALUE",
-                   help="first position (default 0deg)")
-    p.add_argument("--to", dest="stop", default=None, metavar="VALUE",
-                   help="last position (default one full turn after --from)")
-    p.add_argument("--steps", type=int, default=361, metavar="N",
-                   help="number of positions, ends included (default 361)")
     p.add_argument("--point", default="0,0", metavar="X,Y",
                    help="point of the frame moments (shaking moment), e.g. 0,0 or "
                         "'100mm,-50mm' (default 0,0)")
@@ -60,13 +50,11 @@ def register(sub) -> None:
     p.add_argument("--bed", nargs="+", default=(), metavar="LOAD",
                    help="force loads whose reaction the frame carries (e.g. the punch force "
                         "on a press bed)")
-    p.add_argument("-o", "--output", metavar="CSV", help="write the table to this CSV file")
-    p.add_argument("--plot", metavar="PNG", help="write a plot (torque, pin forces, shaking)")
+    add_files(p, plot="write a plot (torque, pin forces, shaking)")
     p.add_argument("--joints", nargs="+", metavar="JOINT",
                    help="joints whose forces are plotted (default: all)")
     p.add_argument("--harmonics", type=int, default=6, metavar="K",
                    help="print the shaking-force harmonics up to order K (default 6; 0: none)")
-    p.set_defaults(func=run)
 
 
 def _point(text: str):
@@ -78,44 +66,27 @@ def _point(text: str):
 
 def run(args) -> int:
     """Run ``mechdyn kinetostatics``; returns the exit code."""
-    mech = load_model(args.model)
-    model = mech.compile()
-    over = args.over if args.over is not None else model.coordinate_names[0]
-    k = model.coordinate_index(over)
-    angle = bool(model.coord_is_angle[k])
-    kind = "angle" if angle else "length"
-    if args.steps < 1:
-        raise ModelError(f"--steps must be at least 1, got {args.steps}")
-    start = parse_quantity(args.start, kind, where="--from") if args.start is not None else 0.0
-    if args.stop is not None:
-        stop = parse_quantity(args.stop, kind, where="--to")
-    elif angle:
-        stop = start + 2 * np.pi
-    else:
-        raise ModelError(f"coordinate {over!r} is a travel: give the range with --from and --to")
-    speed = parse_quantity(args.speed, "angular_velocity" if angle else "velocity",
-                           where="--speed")
+    mech, model = open_model(args)
+    over, values, speed = sweep_values(model, args, start=0.0)
     point = _point(args.point)
     mode = None
     if args.mode is not None:
         mode = (frozenset() if args.mode.strip().lower() == "none"
                 else frozenset(m.strip() for m in args.mode.split(",") if m.strip()))
-    values = np.linspace(start, stop, args.steps)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", KinetostaticsWarning)  # printed below
         res = kinetostatics(model, over=over, speed=speed, values=values, point=point,
                             mode=mode, reacting_loads=tuple(args.bed))
-    rate = (f"{speed:.6g} rad/s = {speed * 30 / np.pi:.6g} rpm" if angle
-            else f"{speed:.6g} m/s")
-    print(f"{mech.name}: kinetostatics at {rate}")
+    angle = res.over_is_angle
+    print(f"{mech.name}: kinetostatics at {rate_text(speed, angle)}")
     for line in res.summary().splitlines():
         print("  " + line if not line.startswith("  ") else line)
     if args.harmonics > 0 and angle and speed != 0:
         try:
             h = res.harmonics(args.harmonics)
         except ValueError:
-            h = None
-        if h is not None:
+            pass  # not one uniformly sampled turn
+        else:
             print("  shaking harmonics (order: |Fx| |Fy| N, |M| N m):")
             for _, row in h.iterrows():
                 print(f"    {int(row['order']):3d} ({row['f_Hz']:.4g} Hz): "
@@ -126,7 +97,4 @@ def run(args) -> int:
         print(f"  table: {args.output}")
     if args.plot:
         print(f"  plot: {plot_kinetostatics(res, args.plot, joints=args.joints)}")
-    if res.status == Status.SINGULAR_POSITION:
-        print(f"mechdyn kinetostatics: warning: {res.message}", file=sys.stderr)
-        return 1
-    return 0
+    return finish(args, res.status != Status.SINGULAR_POSITION, res.message)

@@ -34,9 +34,7 @@ from ..kinematics.sweep import initial_coordinates
 from ..kinematics.sweep import sweep as run_sweep
 from ..model import as_model
 from ..results.report import report_trajectory, write_report
-from ..units import parse_quantity
-from .animate import add_motion_arguments, simulate_from_args, sweep_values
-from .kinematics import load_model
+from .options import add_motion_arguments, finish, open_model, simulate_from_args, sweep_values
 
 __all__ = ["register", "run", "report", "report_records"]
 
@@ -57,26 +55,19 @@ def register(sub) -> None:
     p.add_argument("--speed", metavar="RATE",
                    help="constant rate of the swept coordinate, e.g. 60rpm (default: the "
                         "model's initial rate, else 1 rad/s)")
-    p.set_defaults(func=run)
 
 
 def run(args) -> int:
     """Run ``mechdyn report``; returns the exit code."""
-    mech = load_model(args.model)
-    model = mech.compile()
+    mech, model = open_model(args)
     if args.simulate:
         traj = simulate_from_args(model, args, 401)
         out = report_trajectory(traj, args.output, title=args.title, animation=args.animation,
                                 trace=args.trace)
         print(f"{mech.name}: simulation {traj.status}; report: {out}")
-        if not traj.success:
-            print(f"mechdyn report: warning: {traj.status}: {traj.message}", file=sys.stderr)
-            return 1
-        return 0
+        return finish(args, traj.success, f"{traj.status}: {traj.message}")
 
-    over, values = sweep_values(model, args.over, args.start, args.stop, args.steps)
-    kind = "angular_velocity" if model.coord_is_angle[model.coordinate_index(over)] else "velocity"
-    speed = None if args.speed is None else parse_quantity(args.speed, kind, where="--speed")
+    over, values, speed = sweep_values(model, args)
     model, sw, ks = report_records(model, speed=speed, over=over, values=values)
     out = write_report(model, args.output, sweep=sw, kinetostatics=ks, title=args.title,
                        animation=args.animation, trace=args.trace)

@@ -21,14 +21,13 @@ import numpy as np
 
 from ..dynamics.lagrange import FORMULATIONS
 from ..errors import ModelError, Status, did_you_mean
-from ..integrate.base import DEFAULT_RTOL
-from ..integrate.driver import INTEGRATORS
 from ..mechanism import Drive
 from ..results.plot_dynamics import plot_trajectory
+from ..results.table import deg_or_mm
 from ..simulate import simulate
 from ..simulate_events import format_events
 from ..units import parse_quantity
-from .kinematics import load_model
+from .options import add_files, add_model, add_run, load_model
 
 __all__ = ["register", "run"]
 
@@ -45,17 +44,11 @@ def register(sub) -> None:
         epilog="Quantities take units: 0.05 s, 20 ms, 34.5 N*m, -64.1 deg, 43.5 rad/s (a bare "
                "number is SI). Exit codes: 0 done, 1 stopped early (data so far written), "
                "2 bad input, 130 interrupted by Ctrl-C (data so far written).")
-    p.add_argument("model", metavar="MODEL",
-                   help="model file (.toml) or the name of a bundled example")
-    p.add_argument("--t-end", required=True, metavar="TIME", help="end time, e.g. 0.05s")
+    add_model(p)
+    add_run(p, required=True)
     p.add_argument("--t0", default="0", metavar="TIME", help="start time (default 0 s)")
-    p.add_argument("--integrator", default="dop853", metavar="NAME",
-                   help=f"one of {', '.join(INTEGRATORS)} (default dop853)")
     p.add_argument("--steps", type=int, metavar="N", help="steps of wilson / rk4")
     p.add_argument("--dt", metavar="TIME", help="step size of wilson / rk4")
-    p.add_argument("--rtol", type=float,
-                   help=f"relative tolerance of the adaptive integrators (default "
-                   f"{DEFAULT_RTOL:g})")
     p.add_argument("--atol", type=float, help="absolute tolerance (default 1e-3 rtol)")
     p.add_argument("--theta", type=float, help="Wilson theta (1 or >= 1.37)")
     p.add_argument("--iterations", type=int, help="corrector passes of wilson (default 4)")
@@ -74,14 +67,12 @@ def register(sub) -> None:
                    help="write N equally spaced samples (dense output) instead of every step")
     p.add_argument("--points", action="store_true",
                    help="add the positions, velocities, accelerations of every named point")
-    p.add_argument("-o", "--output", metavar="CSV", help="write the table to this CSV file")
-    p.add_argument("--plot", metavar="PNG", help="write a plot of q, q', q'' and the energies")
+    add_files(p, plot="write a plot of q, q', q'' and the energies")
     p.add_argument("--backend", default="auto", choices=("auto", "numpy", "numba"),
                    help="right-hand side evaluation (default auto: compiled when possible)")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="always (or never) show a progress bar (default: once a run takes "
                         "more than 2 s)")
-    p.set_defaults(func=run)
 
 
 def _pairs(items, model, what, kinds):
@@ -124,10 +115,8 @@ def run(args) -> int:
     if traj.events:
         print(format_events(traj.events, traj.coordinate_names, limit=40))
     if traj.t.size:
-        last = ", ".join(
-            f"{n} = {np.rad2deg(v):.9g} deg" if a else f"{n} = {v * 1e3:.9g} mm"
-            for n, v, a in zip(traj.coordinate_names, traj.q[-1], traj.coordinate_is_angle,
-                               strict=True))
+        last = ", ".join("{} = {:.9g} {}".format(n, *deg_or_mm(v, a)) for n, v, a in zip(
+            traj.coordinate_names, traj.q[-1], traj.coordinate_is_angle, strict=True))
         print(f"at t = {traj.t[-1]:.9g} s: {last}")
     if args.output:
         traj.to_dataframe(points=args.points).to_csv(args.output, index=False)

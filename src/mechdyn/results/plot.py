@@ -22,12 +22,15 @@ __all__ = ["plot", "plot_kinematic_sweep", "PLOTTERS"]
 
 
 def _figure(n_rows: int, width: float = 8.0, height: float = 2.6):
+    """A figure on the Agg canvas with ``n_rows`` gridded panels sharing x: (fig, axes)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(width, height * n_rows), layout="constrained")
     FigureCanvasAgg(fig)
     axes = fig.subplots(n_rows, 1, sharex=True, squeeze=False)[:, 0]
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
     return fig, axes
 
 
@@ -38,11 +41,6 @@ def _save(fig, path, dpi) -> Path:
 
 
 # ---------------------------------------------------------------- kinematic sweep
-def _parse_points(model, points) -> list[tuple[str, object, str]]:
-    return [(body, name, _label(body, name))
-            for body, name in (_trace_spec(model, p, "point") for p in points)]
-
-
 def _default_points(model) -> list[tuple[str, object, str]]:
     """The sliders' guided points, else the named points of the last body."""
     mech = model.mechanism
@@ -80,7 +78,8 @@ def plot_kinematic_sweep(sweep, path, points: Iterable | None = None, *,
     Path
     """
     model = sweep.model
-    pts = _parse_points(model, points) if points is not None else _default_points(model)
+    pts = _default_points(model) if points is None else [
+        (b, n, _label(b, n)) for b, n in (_trace_spec(model, p, "point") for p in points)]
     angle = sweep.over_is_angle
     xs, xunit = deg_or_mm(sweep.values, angle)
     fig, axes = _figure(3)
@@ -95,7 +94,6 @@ def plot_kinematic_sweep(sweep, path, points: Iterable | None = None, *,
                 ax.plot(xs, values[:, c], label=f"{comp} of {label}")
     for ax, (what, unit) in zip(axes, rows, strict=True):
         ax.set_ylabel(f"{what} ({unit})")
-        ax.grid(True, alpha=0.3)
         ax.axhline(0.0, color="0.6", lw=0.6)
         if ax.lines[1:]:
             ax.legend(fontsize="small", loc="best")

@@ -77,7 +77,6 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
         ax.set_ylabel("force on the frame [kN]")
         _shade_modes(axes, t, np.asarray(vs["mode_index"]), vs["modes"])
     for ax in axes:
-        ax.grid(True, alpha=0.3)
         if ax.get_legend() is None:
             ax.legend(loc="best", fontsize="small")
     axes[-1].set_xlabel("t [s]")

@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
+from .plot import _figure, _save
+from .table import deg_or_mm
 
 __all__ = ["plot_kinetostatics"]
 
@@ -34,21 +36,12 @@ def plot_kinetostatics(record, path, *, joints: Sequence[str] | None = None,
     Path
         The file written.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    path = Path(path)
     names = list(record.reactions) if joints is None else list(joints)
     for j in names:
         if j not in record.reactions:
             raise ModelError(did_you_mean(j, record.reactions, "joint"))
-    if record.over_is_angle:
-        xv, xlabel = np.rad2deg(record.values), f"{record.over} (deg)"
-    else:
-        xv, xlabel = record.values * 1e3, f"{record.over} (mm)"
-    fig, axes = plt.subplots(3, 1, figsize=(8.0, 9.0), sharex=True)
+    xv, xunit = deg_or_mm(record.values, record.over_is_angle)
+    fig, axes = _figure(3, height=3.0)
     ax = axes[0]
     for c in record.driven:
         sym, unit = record._drive_unit(c)
@@ -69,16 +62,11 @@ def plot_kinetostatics(record, path, *, joints: Sequence[str] | None = None,
     ax.plot(xv, ff[:, 1], label="Fy frame")
     ax.plot(xv, np.hypot(ff[:, 0], ff[:, 1]), "k", lw=1.0, label="|F| frame")
     ax.set_ylabel("shaking force (N)")
-    ax.set_xlabel(xlabel)
+    ax.set_xlabel(f"{record.over} ({xunit})")
     ax2 = ax.twinx()
     ax2.plot(xv, record.frame_moment, "--", color="tab:red", lw=1.0, label="M frame")
     ax2.set_ylabel("shaking moment (N m)", color="tab:red")
     h1, l1 = ax.get_legend_handles_labels()
     h2, l2 = ax2.get_legend_handles_labels()
     ax.legend(h1 + h2, l1 + l2, loc="best", fontsize="small")
-    for a in axes:
-        a.grid(True, alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
-    return path
+    return _save(fig, path, dpi)

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from .plot import _figure, _save
+from .table import deg_or_mm
 
 __all__ = ["plot_reduction", "plot_steady_cycle", "plot_startup", "plot_motor"]
 
@@ -31,11 +32,9 @@ def plot_reduction(red, path, *, title: str | None = None, dpi: int = 120) -> Pa
     -------
     Path
     """
-    ang = red.is_angle or red.link is not None
-    x = np.degrees(red.position) if ang else np.asarray(red.position) * 1e3
-    xlabel = (f"angle of {red.link} (deg)" if red.link else f"{red.coordinate} (deg)") if ang \
-        else f"{red.coordinate} (mm)"
-    iu, tu = ("kg m$^2$", "N m") if ang else ("kg", "N")
+    x, unit = deg_or_mm(red.position, red.is_angle or red.link is not None)
+    xlabel = f"angle of {red.link} ({unit})" if red.link else f"{red.coordinate} ({unit})"
+    iu, tu = ("kg m$^2$", "N m") if unit == "deg" else ("kg", "N")
     fig, ax = _figure(3, height=2.4)
     ax[0].plot(x, red.J_red, label="$J_{red}$ (mechanism)")
     if np.any(red.J_extra):
@@ -51,8 +50,6 @@ def plot_reduction(red, path, *, title: str | None = None, dpi: int = 120) -> Pa
     ax[2].set_ylabel(f"reduced torque ({tu})")
     ax[2].legend(loc="best", fontsize="small")
     ax[2].set_xlabel(xlabel)
-    for a in ax:
-        a.grid(True, alpha=0.3)
     ax[0].set_title(title or f"reduction to {red.link or red.coordinate}")
     return _save(fig, path, dpi)
 
@@ -71,8 +68,6 @@ def plot_steady_cycle(cycle, path, *, title: str | None = None, dpi: int = 120) 
     ax[1].plot(x, cycle.M)
     ax[1].set_ylabel("reduced torque (N m)")
     ax[1].set_xlabel("position (deg)")
-    for a in ax:
-        a.grid(True, alpha=0.3)
     return _save(fig, path, dpi)
 
 
@@ -92,8 +87,6 @@ def plot_startup(res, path, *, title: str | None = None, dpi: int = 120) -> Path
     ax[1].set_ylabel("torque (N m)")
     ax[1].set_xlabel("time (s)")
     ax[1].legend(loc="best", fontsize="small")
-    for a in ax:
-        a.grid(True, alpha=0.3)
     return _save(fig, path, dpi)
 
 
@@ -109,6 +102,5 @@ def plot_motor(motor, path, *, points: int = 401, title: str | None = None,
     ax[0].plot(m, w)
     ax[0].set_xlabel("torque (N m)")
     ax[0].set_ylabel("speed (rad/s)")
-    ax[0].grid(True, alpha=0.3)
     ax[0].set_title(title or f"characteristic of {getattr(motor, 'name', 'motor')}")
     return _save(fig, path, dpi)

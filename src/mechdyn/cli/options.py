@@ -1,0 +1,207 @@
+"""Options the subcommands share, and their reading: the model, the swept range, the
+speed, the output files, the mode and drive of a reduction, a simulation, the exit."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .. import examples
+from ..dynamics.reduction import mode_mechanism
+from ..errors import ModelError
+from ..integrate.base import DEFAULT_RTOL
+from ..integrate.driver import INTEGRATORS
+from ..kinematics.sweep import initial_coordinates
+from ..modelfile import load
+from ..modelfile.drives import drive_from_table
+from ..results.table import write_csv
+from ..simulate import simulate
+from ..units import parse_quantity, parse_vector
+
+__all__ = ["add_model", "add_files", "add_range", "add_motion_arguments", "add_model_arguments",
+           "add_run", "load_model", "open_model", "prepare_model", "sweep_values",
+           "simulate_from_args", "write_files", "finish"]
+
+
+def add_model(p) -> None:
+    """Add the ``MODEL`` argument."""
+    p.add_argument("model", metavar="MODEL",
+                   help="model file (.toml) or the name of a bundled example "
+                        "(see `mechdyn examples`)")
+
+
+def add_files(p, plot: str, table: str = "write the table to this CSV file") -> None:
+    """Add ``-o/--output CSV`` and ``--plot PNG`` with these help texts."""
+    p.add_argument("-o", "--output", metavar="CSV", help=table)
+    p.add_argument("--plot", metavar="PNG", help=plot)
+
+
+def add_range(p, *, steps: int, over: str = "coordinate to sweep (default: the first)",
+              start: str = "first value, e.g. 0deg (default: the initial value)") -> None:
+    """Add the swept range: ``--over``, ``--from``, ``--to``, ``--steps``."""
+    p.add_argument("--over", metavar="COORD", help=over)
+    p.add_argument("--from", dest="start", metavar="VALUE", help=start)
+    p.add_argument("--to", dest="stop", metavar="VALUE",
+                   help="last value (default: one full turn after --from)")
+    p.add_argument("--steps", type=int, default=steps, metavar="N",
+                   help=f"number of positions, ends included (default {steps})")
+
+
+def add_run(p, *, required: bool) -> None:
+    """Add what a forward-dynamics run needs: ``--t-end``, ``--integrator``, ``--rtol``."""
+    p.add_argument("--t-end", required=required, metavar="TIME",
+                   help="end time of the run, e.g. 0.05s")
+    p.add_argument("--integrator", default="dop853", metavar="NAME",
+                   help=f"one of {', '.join(INTEGRATORS)} (default dop853)")
+    p.add_argument("--rtol", type=float,
+                   help=f"relative tolerance of the adaptive integrators (default "
+                        f"{DEFAULT_RTOL:g})")
+
+
+def add_motion_arguments(p, metavar: str, output: str, *, steps: int, verb: str, title: str):
+    """Add what ``mechdyn animate`` and ``report`` share: model, -o, sweep and simulation
+    groups; returns the drawing group (``--trace``, ``--title``)."""
+    add_model(p)
+    p.add_argument("-o", "--output", required=True, metavar=metavar, help=output)
+    add_range(p.add_argument_group("sweep (default)"), steps=steps)
+    s = p.add_argument_group("simulation")
+    s.add_argument("--simulate", action="store_true",
+                   help=f"{verb} a forward-dynamics run from the model's initial state")
+    add_run(s, required=False)
+    d = p.add_argument_group("drawing")
+    d.add_argument("--trace", metavar="BODY.POINT", help="draw the path of this point")
+    d.add_argument("--title", help=title)
+    return d
+
+
+def add_model_arguments(p) -> None:
+    """Arguments shared by ``reduce`` and ``flywheel``: the model, its mode and its drive."""
+    add_model(p)
+    p.add_argument("--engage", action="append", default=[], metavar="LOCK[=X,Y,THETA]",
+                   help="engage a lock (repeatable), optionally with the pose it holds, "
+                        "e.g. rocker_lock=0mm,0mm,0deg")
+    p.add_argument("--drop", action="append", default=[], metavar="COORD",
+                   help="remove a coordinate frozen by the engaged locks (repeatable)")
+    p.add_argument("--motor", metavar="DESIGNATION",
+                   help="replace the drives by a catalogue induction motor, e.g. 4A80B4U3")
+    p.add_argument("--characteristic", choices=("kloss", "extended"), default="kloss",
+                   help="form of the motor characteristic (default kloss)")
+    p.add_argument("--gear-ratio", metavar="I",
+                   help="ratio omega_motor/omega_crank of a gear stage after the motor")
+    p.add_argument("--efficiency", metavar="ETA", help="efficiency of the gear stage (0..1]")
+
+
+def load_model(spec: str):
+    """A :class:`~mechdyn.mechanism.Mechanism` from a file path or a bundled example name."""
+    path = Path(spec)
+    if path.is_file():
+        return load(path)
+    if path.suffix == ".toml" or path.parent != Path("."):
+        raise FileNotFoundError(f"no model file {spec!r}")
+    return examples.load(spec)  # a ModelError lists the bundled examples
+
+
+def open_model(args):
+    """(mechanism, compiled model) of the ``MODEL`` argument."""
+    mech = load_model(args.model)
+    return mech, mech.compile()
+
+
+def prepare_model(args):
+    """(mechanism, model) from the arguments of :func:`add_model_arguments`: load, mode,
+    drive; compiled."""
+    mech = load_model(args.model)
+    engage, offsets = [], {}
+    for spec in args.engage:
+        name, sep, pose = spec.partition("=")
+        engage.append(name)
+        if sep:
+            parts = pose.split(",")
+            if len(parts) != 3:
+                raise ModelError(f"--engage {spec!r}: give the pose as X,Y,THETA, e.g. "
+                                 f"{name}=0mm,0mm,0deg")
+            offsets[name] = parse_vector(parts, ("length", "length", "angle"),
+                                         where=f"--engage {name}")
+    if engage or args.drop:
+        mech = mode_mechanism(mech, engage=engage, offsets=offsets, drop=args.drop)
+    if args.motor is None and (args.gear_ratio is not None or args.efficiency is not None):
+        raise ModelError("--gear-ratio and --efficiency need --motor")
+    if args.motor is not None:
+        coords = list(mech.coordinates)
+        if len(coords) != 1:
+            raise ModelError(f"--motor: the model has coordinates {', '.join(coords)}; "
+                             f"reduce it to one (--engage LOCK --drop COORD)")
+        table = {"type": "induction_motor", "name": "motor", "coordinate": coords[0],
+                 "catalogue": args.motor, "characteristic": args.characteristic}
+        if args.gear_ratio is not None:
+            table["gear_ratio"] = args.gear_ratio
+        if args.efficiency is not None:
+            table["efficiency"] = args.efficiency
+        mech.drives[:] = [drive_from_table(table, "--motor")]
+    return mech, mech.compile()
+
+
+def sweep_values(model, args, *, start: float | None = None, only: bool = False):
+    """The swept coordinate, its values and its rate from ``--over/--from/--to/--steps``
+    and ``--speed`` (units parsed).
+
+    Without ``--from`` the range starts at ``start`` (default: the coordinate's initial
+    value); with ``only`` and no ``--over`` the model must have one coordinate.
+
+    Returns
+    -------
+    (str, ndarray, float or None)
+        The coordinate's name; ``steps`` values to ``--to`` (default one turn after the
+        first; required for a travel); ``--speed`` in rad/s or m/s (None if not given).
+    """
+    if args.over is None and only and model.n_q != 1:
+        raise ModelError("the model has several coordinates; choose one with --over: "
+                         + ", ".join(model.coordinate_names))
+    over = args.over if args.over is not None else model.coordinate_names[0]
+    k = model.coordinate_index(over)
+    angle = bool(model.coord_is_angle[k])
+    kind = "angle" if angle else "length"
+    if args.steps < 1:
+        raise ModelError(f"--steps must be at least 1, got {args.steps}")
+    if args.start is not None:
+        start = parse_quantity(args.start, kind, where="--from")
+    elif start is None:
+        start = float(initial_coordinates(model)[k])
+    if args.stop is not None:
+        stop = parse_quantity(args.stop, kind, where="--to")
+    elif angle:
+        stop = start + 2 * np.pi
+    else:
+        raise ModelError(f"coordinate {over!r} is a travel: give the range with --from and --to")
+    speed = getattr(args, "speed", None)  # animate has no --speed
+    if speed is not None:
+        speed = parse_quantity(speed, "angular_velocity" if angle else "velocity",
+                               where="--speed")
+    return over, np.linspace(start, stop, args.steps), speed
+
+
+def simulate_from_args(model, args, samples: int):
+    """The forward-dynamics run of ``--simulate`` (needs ``--t-end``), ``samples`` samples."""
+    if args.t_end is None:
+        raise ModelError("--simulate needs --t-end, e.g. --t-end 0.05s")
+    t_end = parse_quantity(args.t_end, "time", where="--t-end")
+    return simulate(model, t_end, integrator=args.integrator, rtol=args.rtol, progress=False,
+                    t_eval=np.linspace(0.0, t_end, samples))
+
+
+def write_files(args, record, plot, **kwargs) -> None:
+    """Write the record's table (``-o``, CSV with a header of units) and ``--plot`` if given."""
+    if args.output:
+        print(f"  table: {write_csv(record, args.output)}")
+    if args.plot:
+        print(f"  plot: {plot(record, args.plot, **kwargs)}")
+
+
+def finish(args, ok: bool, message: str) -> int:
+    """The exit code of a run: 0 if ``ok``, else 1 after a warning line on stderr."""
+    if ok:
+        return 0
+    print(f"mechdyn {args.command}: warning: {message}", file=sys.stderr)
+    return 1
