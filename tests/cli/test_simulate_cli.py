@@ -126,3 +126,32 @@ def test_a_full_disk_is_a_named_error(capsys):
     code = main(["simulate", "clutchless_press", "--t-end", "1 ms", "-o", "/dev/full"])
     err = capsys.readouterr().err
     assert code == 2 and "cannot write the output" in err and "Traceback" not in err
+
+
+def test_sigterm_writes_the_samples_so_far_atomically_and_exits_143(tmp_path, capsys,
+                                                                     monkeypatch):
+    """SIGTERM ends a run as Ctrl-C does (exit 143); the table replaces an older one only
+    once written completely."""
+    import os
+    import signal
+
+    from mechdyn.dynamics.mode_system import ModeSystem
+
+    calls = {"n": 0}
+    evaluate = ModeSystem.evaluate
+
+    def terminated_later(self, *args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] == 300:
+            os.kill(os.getpid(), signal.SIGTERM)
+        return evaluate(self, *args, **kwargs)
+
+    monkeypatch.setattr(ModeSystem, "evaluate", terminated_later)
+    out = tmp_path / "press.csv"
+    out.write_text("stale\n")
+    code = main(["simulate", "clutchless_press", "--t-end", "1 s", "--backend", "numpy",
+                 "-o", str(out)])
+    assert code == 143
+    df = pd.read_csv(out)
+    assert len(df) > 5 and df["t_s"].iloc[-1] < 1.0
+    assert not list(tmp_path.glob(".*part*"))  # no temporary file left

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import signal
 import sys
 from pathlib import Path
 
@@ -71,15 +72,26 @@ def check_outputs(args) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code (0 ok, 1 analysis stopped, 2 bad input,
-    130 interrupted by Ctrl-C)."""
+    130 interrupted by Ctrl-C, 143 by SIGTERM; an interrupted run writes its data)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()
         return 0
+    terminated = []
+
+    def on_term(signum, frame):  # SIGTERM ends a run as Ctrl-C does: the data is kept
+        terminated.append(signum)
+        raise KeyboardInterrupt
+
+    try:
+        previous = signal.signal(signal.SIGTERM, on_term)
+    except ValueError:  # not the main thread: no handler
+        previous = None
     try:
         check_outputs(args)
-        return int(args.func(args) or 0)
+        code = int(args.func(args) or 0)
+        return 143 if terminated and code == 130 else code
     except (MechdynError, FileNotFoundError, IsADirectoryError, PermissionError) as exc:
         print(f"mechdyn {args.command}: error: {exc}", file=sys.stderr)
         return 2
@@ -89,4 +101,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except KeyboardInterrupt:  # outside a run (a run keeps its data and says so itself)
         print(f"mechdyn {args.command}: interrupted", file=sys.stderr)
-        return 130
+        return 143 if terminated else 130
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)

@@ -16,7 +16,7 @@ import warnings
 from ..dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
 from ..errors import Status, UnitError
 from ..results.plot_kinetostatics import plot_kinetostatics
-from ..results.table import rate_text
+from ..results.table import rate_text, written
 from ..units import parse_quantity
 from .options import add_files, add_model, add_range, finish, open_model, sweep_values
 
@@ -93,7 +93,8 @@ def run(args) -> int:
                       f"{row['Fx_frame_N']:.6g} {row['Fy_frame_N']:.6g} "
                       f"{row['M_frame_Nm']:.6g}")
     if args.output:
-        res.to_dataframe().to_csv(args.output, index=False)
+        with written(args.output) as tmp:
+            res.to_dataframe().to_csv(tmp, index=False)
         print(f"  table: {args.output}")
     if args.plot:
         print(f"  plot: {plot_kinetostatics(res, args.plot, joints=args.joints)}")

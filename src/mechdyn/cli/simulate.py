@@ -23,7 +23,7 @@ from ..dynamics.lagrange import FORMULATIONS
 from ..errors import ModelError, Status, did_you_mean
 from ..mechanism import Drive
 from ..results.plot_dynamics import plot_trajectory
-from ..results.table import deg_or_mm
+from ..results.table import deg_or_mm, written
 from ..simulate import simulate
 from ..simulate_events import format_events
 from ..units import parse_quantity
@@ -119,11 +119,13 @@ def run(args) -> int:
             traj.coordinate_names, traj.q[-1], traj.coordinate_is_angle, strict=True))
         print(f"at t = {traj.t[-1]:.9g} s: {last}")
     if args.output:
-        traj.to_dataframe(points=args.points).to_csv(args.output, index=False)
+        with written(args.output) as tmp:  # never a half-written or stale table
+            traj.to_dataframe(points=args.points).to_csv(tmp, index=False)
         print(f"wrote {args.output} ({traj.t.size} rows)")
         if traj.events:
             ev_path = Path(args.output).with_name(Path(args.output).stem + "_events.csv")
-            _events_table(traj).to_csv(ev_path, index=False)
+            with written(ev_path) as tmp:
+                _events_table(traj).to_csv(tmp, index=False)
             print(f"wrote {ev_path} ({len(traj.events)} events)")
     if args.plot:
         plot_trajectory(traj, args.plot)

@@ -26,7 +26,7 @@ import numpy as np
 from ..errors import MechdynError, ModelError
 from ..kernels import rows_numpy
 from ..kinematics.constraints import extend, travel_rows
-from .table import deg_or_mm, output_path
+from .table import deg_or_mm, output_path, written
 
 __all__ = ["animate", "snapshot", "frame_geometry", "frame_indices", "check_animation_path",
            "MechanismDrawing"]
@@ -544,5 +544,6 @@ def snapshot(record, path, index: int = 0, *, trace=None, title: str | None = No
         scene.fig.savefig(path, dpi=dpi, format="png")
         return path
     path = output_path(path)
-    scene.fig.savefig(path, dpi=dpi)
+    with written(path) as tmp:
+        scene.fig.savefig(tmp, dpi=dpi)
     return path

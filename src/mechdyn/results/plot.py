@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .animate import _trace_spec
-from .table import deg_or_mm, output_path, rate_text
+from .table import deg_or_mm, output_path, rate_text, written
 
 __all__ = ["plot", "plot_kinematic_sweep", "PLOTTERS"]
 
@@ -36,7 +36,8 @@ def _figure(n_rows: int, width: float = 8.0, height: float = 2.6):
 
 def _save(fig, path, dpi) -> Path:
     path = output_path(path)
-    fig.savefig(path, dpi=dpi)
+    with written(path) as tmp:
+        fig.savefig(tmp, dpi=dpi)
     return path
 
 

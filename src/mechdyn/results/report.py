@@ -33,7 +33,7 @@ from .animate import animate, snapshot
 from .plot import plot_kinematic_sweep
 from .plot_dynamics import plot_trajectory
 from .plot_kinetostatics import plot_kinetostatics
-from .table import output_path, rate_text
+from .table import output_path, rate_text, written
 
 __all__ = ["write_report", "report_trajectory", "model_tables"]
 
@@ -97,14 +97,15 @@ def _write_page(path, title: str, sections: list[str]) -> Path:
     """Write the HTML page of ``sections`` under ``title``."""
     stamp = datetime.now().strftime("%Y-%m-%d %H:%M")
     path = output_path(path)
-    path.write_text(
-        f"<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-        f"<title>{_esc(title)}</title>\n<style>{_CSS}</style>\n</head>\n<body>\n"
-        f"<h1>{_esc(title)}</h1>\n"
-        f"<p class=\"note\">mechdyn {__version__}, {stamp}. SI units unless a column says "
-        f"otherwise; angles counter-clockwise positive; joint reactions are the force "
-        f"on the child body from the parent at the joint point, ground frame.</p>\n"
-        + "\n".join(sections) + "\n</body>\n</html>\n", encoding="utf-8")
+    with written(path) as tmp:
+        tmp.write_text(
+            f"<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+            f"<title>{_esc(title)}</title>\n<style>{_CSS}</style>\n</head>\n<body>\n"
+            f"<h1>{_esc(title)}</h1>\n"
+            f"<p class=\"note\">mechdyn {__version__}, {stamp}. SI units unless a column says "
+            f"otherwise; angles counter-clockwise positive; joint reactions are the force "
+            f"on the child body from the parent at the joint point, ground frame.</p>\n"
+            + "\n".join(sections) + "\n</body>\n</html>\n", encoding="utf-8")
     return path
 
 

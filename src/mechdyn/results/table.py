@@ -9,11 +9,14 @@ column in words.  :func:`read_csv` reads it back.
 
 from __future__ import annotations
 
+import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["write_csv", "read_csv", "unit_of_column", "UNIT_SUFFIXES", "output_path",
+__all__ = ["write_csv", "read_csv", "unit_of_column", "UNIT_SUFFIXES", "output_path", "written",
            "deg_or_mm", "rate_text"]
 
 #: column-name suffix -> unit, longest suffixes first when matching
@@ -55,6 +58,34 @@ def output_path(path) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     return path
+
+
+@contextmanager
+def written(path) -> Iterator[Path]:
+    """Write a file atomically: yields a temporary path beside ``path`` (same suffix),
+    which replaces ``path`` only once the block has completed; a failed or interrupted
+    write leaves no half-written file and an earlier ``path`` untouched.  A path that
+    is not a regular file (a device, a pipe) is written directly.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> out = pathlib.Path(tempfile.mkdtemp()) / "t.csv"
+    >>> with written(out) as tmp:
+    ...     _ = tmp.write_text("a,b\\n")
+    >>> out.read_text()
+    'a,b\\n'
+    """
+    path = output_path(path)
+    if path.exists() and not path.is_file():  # a device or a pipe: written as it is
+        yield path
+        return
+    tmp = path.with_name(f".{path.stem}.part{path.suffix}")
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
 def deg_or_mm(values, is_angle: bool) -> tuple[np.ndarray, str]:
@@ -111,7 +142,7 @@ def write_csv(record, path, *, float_format: str = "%.12g") -> Path:
     lines = _describe(record)
     lines.append("units: " + ", ".join(f"{c} [{unit_of_column(c) or '-'}]" for c in df.columns))
     path = output_path(path)
-    with open(path, "w", encoding="utf-8", newline="") as fh:
+    with written(path) as tmp, open(tmp, "w", encoding="utf-8", newline="") as fh:
         for line in lines:
             fh.write(f"# {line}\n")
         df.to_csv(fh, index=False, float_format=float_format, lineterminator="\n")
