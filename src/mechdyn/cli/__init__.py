@@ -20,8 +20,8 @@ from ..errors import MechdynError, ModelError
 __all__ = ["main", "SUBCOMMAND_MODULES", "check_outputs", "PLOT_SUFFIXES"]
 
 #: modules of this package that define subcommands, in the order of ``mechdyn --help``
-SUBCOMMAND_MODULES = ("demo", "examples", "kinematics", "simulate", "kinetostatics", "reduce",
-                      "flywheel", "animate", "report")
+SUBCOMMAND_MODULES = ("demo", "examples", "check", "kinematics", "simulate", "kinetostatics",
+                      "reduce", "flywheel", "animate", "report")
 
 
 def build_parser() -> argparse.ArgumentParser:
