@@ -96,3 +96,16 @@ def test_every_sweeping_command_reads_the_range_alike(command, capsys):
     rc = main([command[0], "slider_crank", *command[1:], "--steps", "0"])
     err = capsys.readouterr().err
     assert rc == 2 and f"mechdyn {command[0]}: error: --steps must be at least 1, got 0" in err
+
+
+def test_negative_values_need_no_equals_sign(capsys):
+    """--from -46deg is a value, not an option (issue: the press starts at -64.1 deg)."""
+    assert main(["kinematics", "toggle_press", "--from", "-46deg", "--to", "30deg",
+                 "--steps", "5"]) == 0
+    assert "phi = -46.0000 deg" in capsys.readouterr().out
+
+
+def test_a_bare_number_for_a_speed_says_how_it_was_read(capsys):
+    assert main(["kinematics", "slider_crank", "--speed", "60", "--steps", "3"]) == 0
+    err = capsys.readouterr().err
+    assert "--speed 60 has no unit: taken as 60 rad/s (= 572.958 rpm)" in err

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import signal
 import sys
 from pathlib import Path
@@ -35,6 +36,25 @@ def build_parser() -> argparse.ArgumentParser:
         module.register(sub)
         sub.choices[name].set_defaults(func=module.run)
     return parser
+
+
+def negative_values(argv: list[str]) -> list[str]:
+    """``--from -46deg`` as ``--from=-46deg``: a value that starts with a minus sign and a
+    digit is joined to the option before it (argparse would take it for an option).
+
+    Examples
+    --------
+    >>> negative_values(["sweep", "--from", "-64.1deg", "--to", "30deg"])
+    ['sweep', '--from=-64.1deg', '--to', '30deg']
+    """
+    out: list[str] = []
+    for arg in argv:
+        if (re.match(r"-\.?\d", arg) and out and out[-1].startswith("--")
+                and "=" not in out[-1]):
+            out[-1] = f"{out[-1]}={arg}"
+        else:
+            out.append(arg)
+    return out
 
 
 #: image types the plots can be written as
@@ -74,7 +94,7 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code (0 ok, 1 analysis stopped, 2 bad input,
     130 interrupted by Ctrl-C, 143 by SIGTERM; an interrupted run writes its data)."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(negative_values(sys.argv[1:] if argv is None else argv))
     if not getattr(args, "func", None):
         parser.print_help()
         return 0

@@ -25,7 +25,14 @@ from ..errors import ModelError
 from ..results.plot_reduction import plot_steady_cycle
 from ..results.table import rate_text
 from ..units import parse_quantity
-from .options import add_files, add_model_arguments, finish, prepare_model, write_files
+from .options import (
+    add_files,
+    add_model_arguments,
+    finish,
+    prepare_model,
+    quantity,
+    write_files,
+)
 
 __all__ = ["register", "run"]
 
@@ -64,8 +71,7 @@ def run(args) -> int:
     """Run ``mechdyn flywheel``; returns the exit code."""
     mech, model = prepare_model(args)
     delta = parse_quantity(args.delta, "ratio", where="--delta")
-    speed = None if args.speed is None else parse_quantity(args.speed, "angular_velocity",
-                                                           where="--speed")
+    speed = None if args.speed is None else quantity(args.speed, "angular_velocity", "--speed")
     if args.steps < 9:
         raise ModelError(f"--steps must be at least 9, got {args.steps}")
     if args.exact:

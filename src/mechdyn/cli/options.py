@@ -3,6 +3,7 @@ speed, the output files, the mode and drive of a reduction, a simulation, the ex
 
 from __future__ import annotations
 
+import re
 import sys
 from pathlib import Path
 
@@ -20,9 +21,28 @@ from ..results.table import write_csv
 from ..simulate import simulate
 from ..units import parse_quantity, parse_vector
 
-__all__ = ["add_model", "add_files", "add_range", "add_motion_arguments", "add_model_arguments",
-           "add_run", "load_model", "open_model", "prepare_model", "sweep_values",
-           "simulate_from_args", "write_files", "finish"]
+__all__ = ["quantity", "add_model", "add_files", "add_range", "add_motion_arguments",
+           "add_model_arguments", "add_run", "load_model", "open_model", "prepare_model",
+           "sweep_values", "simulate_from_args", "write_files", "finish"]
+
+
+#: kinds whose bare numbers are SI radians, easily mistaken for degrees or rpm
+_ANGULAR = {"angle": ("rad", 180 / np.pi, "deg"),
+            "angular_velocity": ("rad/s", 30 / np.pi, "rpm"),
+            "angular_acceleration": ("rad/s^2", 180 / np.pi, "deg/s^2")}
+
+
+def quantity(value, kind: str, flag: str) -> float:
+    """A command-line quantity in SI (:func:`mechdyn.units.parse_quantity`); a bare number
+    for an angle or an angular speed is taken in rad (rad/s) and says so on stderr."""
+    out = parse_quantity(value, kind, where=flag)
+    text = str(value).strip()
+    if kind in _ANGULAR and re.fullmatch(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?", text):
+        si, factor, other = _ANGULAR[kind]
+        print(f"mechdyn: note: {flag} {text} has no unit: taken as {out:g} {si} "
+              f"(= {out * factor:.6g} {other}); write the unit, e.g. {text}{other.split('^')[0]}",
+              file=sys.stderr)
+    return out
 
 
 def add_model(p) -> None:
@@ -166,19 +186,18 @@ def sweep_values(model, args, *, start: float | None = None, only: bool = False)
     if args.steps < 1:
         raise ModelError(f"--steps must be at least 1, got {args.steps}")
     if args.start is not None:
-        start = parse_quantity(args.start, kind, where="--from")
+        start = quantity(args.start, kind, "--from")
     elif start is None:
         start = float(initial_coordinates(model)[k])
     if args.stop is not None:
-        stop = parse_quantity(args.stop, kind, where="--to")
+        stop = quantity(args.stop, kind, "--to")
     elif angle:
         stop = start + 2 * np.pi
     else:
         raise ModelError(f"coordinate {over!r} is a travel: give the range with --from and --to")
     speed = getattr(args, "speed", None)  # animate has no --speed
     if speed is not None:
-        speed = parse_quantity(speed, "angular_velocity" if angle else "velocity",
-                               where="--speed")
+        speed = quantity(speed, "angular_velocity" if angle else "velocity", "--speed")
     return over, np.linspace(start, stop, args.steps), speed
 
 

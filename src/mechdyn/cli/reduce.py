@@ -18,8 +18,14 @@ from ..dynamics.reduction import reduce_model
 from ..errors import ModelError
 from ..results.animate import _trace_spec
 from ..results.plot_reduction import plot_reduction
-from ..units import parse_quantity
-from .options import add_files, add_model_arguments, finish, prepare_model, write_files
+from .options import (
+    add_files,
+    add_model_arguments,
+    finish,
+    prepare_model,
+    quantity,
+    write_files,
+)
 
 __all__ = ["register", "run"]
 
@@ -56,9 +62,8 @@ def run(args) -> int:
     if args.steps < 2:
         raise ModelError(f"--steps must be at least 2, got {args.steps}")
     point = _trace_spec(model, args.point, "--point")
-    speed = 1.0 if args.speed is None else parse_quantity(args.speed, "angular_velocity",
-                                                          where="--speed")
-    start = parse_quantity(args.start, "angle", where="--start")
+    speed = 1.0 if args.speed is None else quantity(args.speed, "angular_velocity", "--speed")
+    start = quantity(args.start, "angle", "--start")
     red = reduce_model(model, link=args.link, point=point, steps=args.steps, start=start,
                        omega=speed)
     fin = np.isfinite(red.J_total)

@@ -27,7 +27,7 @@ from ..results.table import deg_or_mm, written
 from ..simulate import simulate
 from ..simulate_events import format_events
 from ..units import parse_quantity
-from .options import add_files, add_model, add_run, load_model
+from .options import add_files, add_model, add_run, load_model, quantity
 
 __all__ = ["register", "run"]
 
@@ -85,7 +85,7 @@ def _pairs(items, model, what, kinds):
         if name not in model.coordinates:
             raise ModelError(f"{what}: " + did_you_mean(name, model.coordinates, "coordinate"))
         kind = kinds[0] if model.coordinates[name].is_angle else kinds[1]
-        out[name] = parse_quantity(value, kind, where=f"{what} {name}")
+        out[name] = quantity(value, kind, f"{what} {name}")
     return out
 
 
@@ -99,7 +99,7 @@ def run(args) -> int:
         mech.add(Drive(f"drive_{name}", name, value))
     q0 = _pairs(args.q0, mech, "--q0", ("angle", "length")) or None
     qdot0 = _pairs(args.qdot0, mech, "--qdot0", ("angular_velocity", "velocity")) or None
-    d = parse_quantity(args.d, "angle", where="--d") if args.d is not None else None
+    d = quantity(args.d, "angle", "--d") if args.d is not None else None
     t_eval = None
     if args.samples is not None:
         if args.samples < 2:
