@@ -18,6 +18,7 @@ $(STAMP): $(BIN)/python pyproject.toml
 
 demo: $(STAMP)
 	$(BIN)/mechdyn demo
+	@echo "the command line: $(BIN)/mechdyn (or: source $(BIN)/activate; mechdyn --help)"
 
 test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks
