@@ -1,123 +1,69 @@
 """Plots of result records, written to PNG files.
 
-One function per kind of record (``plot_<record>``), and :func:`plot`, which
-picks the function for a record.  Figures are drawn with matplotlib's Agg
-canvas directly, so nothing here needs a screen or changes pyplot's backend.
+One function per kind of record (``plot_<record>``, in the ``plot_*`` modules beside this
+one, all importable from here), and :func:`plot`, which picks the function for a record.
+Figures are drawn with matplotlib's Agg canvas directly (:mod:`mechdyn.results.figure`),
+so nothing here needs a screen or changes pyplot's backend.
 
-Add a record kind by writing ``plot_<kind>(record, path, ...) -> Path`` below
-and an entry in ``PLOTTERS``.
+Add a record kind by writing ``plot_<kind>(record, path, ...) -> Path`` and an entry in
+``PLOTTERS``.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from pathlib import Path
 
-import numpy as np
+from .plot_dynamics import plot_trajectory
+from .plot_kinematics import plot_kinematic_sweep
+from .plot_kinetostatics import plot_kinetostatics
+from .plot_reduction import plot_motor, plot_reduction, plot_startup, plot_steady_cycle
 
-from .animate import _trace_spec
-from .table import deg_or_mm, output_path, rate_text, written
-
-__all__ = ["plot", "plot_kinematic_sweep", "PLOTTERS"]
-
-
-def _figure(n_rows: int, width: float = 8.0, height: float = 2.6):
-    """A figure on the Agg canvas with ``n_rows`` gridded panels sharing x: (fig, axes)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(width, height * n_rows), layout="constrained")
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(n_rows, 1, sharex=True, squeeze=False)[:, 0]
-    for ax in axes:
-        ax.grid(True, alpha=0.3)
-    return fig, axes
-
-
-def _save(fig, path, dpi) -> Path:
-    path = output_path(path)
-    with written(path) as tmp:
-        fig.savefig(tmp, dpi=dpi)
-    return path
-
-
-# ---------------------------------------------------------------- kinematic sweep
-def _default_points(model) -> list[tuple[str, object, str]]:
-    """The sliders' guided points, else the named points of the last body."""
-    mech = model.mechanism
-    sliders = [(jn, mech.joints[jn]) for jn in model.pri.names]
-    out = [(j.child, j.child_point, f"{j.child} on {jn!r}") for jn, j in sliders
-           if j.child != "ground"]
-    if out:
-        return out
-    body = model.body_names[-1]
-    names = [p for p in mech.bodies[body].points] or ["com"]
-    return [(body, p, _label(body, p)) for p in names]
-
-
-def _label(body, name) -> str:
-    return f"{body}.{name}" if isinstance(name, str) else f"{body}({name[0]:.4g}, {name[1]:.4g})"
-
-
-def plot_kinematic_sweep(sweep, path, points: Iterable | None = None, *,
-                         title: str | None = None, dpi: int = 120) -> Path:
-    """Position, velocity and acceleration of points against the swept coordinate.
-
-    Parameters
-    ----------
-    sweep : KinematicSweep
-    path : str or Path
-        PNG file to write.
-    points : iterable of "BODY.POINT" or (body, point), optional
-        Default: the guided point of every slider, else the named points of the
-        last body.  Components that stay constant over the sweep are left out.
-    title : str, optional
-    dpi : int
-
-    Returns
-    -------
-    Path
-    """
-    model = sweep.model
-    pts = _default_points(model) if points is None else [
-        (b, n, _label(b, n)) for b, n in (_trace_spec(model, p, "point") for p in points)]
-    angle = sweep.over_is_angle
-    xs, xunit = deg_or_mm(sweep.values, angle)
-    fig, axes = _figure(3)
-    scale = model.length_scale
-    rows = [("position", "m"), ("velocity", "m/s"), ("acceleration", "m/s²")]
-    for body, name, label in pts:
-        data = sweep.point(body, name)
-        for c, comp in enumerate("xy"):
-            if len(sweep) == 0 or np.ptp(data[0][:, c]) <= 1e-12 * scale:
-                continue  # a constant component (e.g. y of a horizontal slider)
-            for ax, values in zip(axes, data, strict=True):  # position, velocity, acceleration
-                ax.plot(xs, values[:, c], label=f"{comp} of {label}")
-    for ax, (what, unit) in zip(axes, rows, strict=True):
-        ax.set_ylabel(f"{what} ({unit})")
-        ax.axhline(0.0, color="0.6", lw=0.6)
-        if ax.lines[1:]:
-            ax.legend(fontsize="small", loc="best")
-    axes[-1].set_xlabel(f"{sweep.over} ({xunit})")
-    rate = float(sweep.qdot[0, sweep.over_index]) if len(sweep) else 1.0
-    fig.suptitle(title or f"{model.mechanism.name}: kinematics at constant {sweep.over}-rate "
-                 f"{rate_text(rate, angle)}")
-    if sweep.status != "success" and len(sweep):
-        for ax in axes:
-            ax.axvline(xs[-1], color="tab:red", ls="--", lw=1.0)
-        axes[0].annotate("dead position", (xs[-1], 0.98), xycoords=("data", "axes fraction"),
-                         color="tab:red", ha="right", va="top", fontsize="small")
-    return _save(fig, path, dpi)
+__all__ = ["plot", "PLOTTERS", "plot_kinematic_sweep", "plot_trajectory", "plot_kinetostatics",
+           "plot_reduction", "plot_steady_cycle", "plot_startup", "plot_motor"]
 
 
 #: record class name -> plotting function
 PLOTTERS: dict[str, Callable] = {
     "KinematicSweep": plot_kinematic_sweep,
+    "Trajectory": plot_trajectory,
+    "Kinetostatics": plot_kinetostatics,
+    "Reduction": plot_reduction,
+    "SteadyCycle": plot_steady_cycle,
+    "StartupResult": plot_startup,
 }
 
 
 def plot(record, path, **kwargs) -> Path:
-    """Plot any result record with the function registered for its kind (PNG)."""
+    """Plot any result record with the function registered for its kind.
+
+    Parameters
+    ----------
+    record
+        A :class:`~mechdyn.kinematics.sweep.KinematicSweep`, ``Trajectory``,
+        ``Kinetostatics``, ``Reduction``, ``SteadyCycle`` or ``StartupResult``.
+    path : str or Path
+        The image file (PNG, PDF, SVG ... by its suffix); its folder is created.
+    **kwargs
+        Options of the record's plotting function (``PLOTTERS[kind]``).
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    TypeError
+        No plot for records of that kind (the message lists the kinds).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib, mechdyn
+    >>> tr = mechdyn.simulate(mechdyn.examples.load("four_bar"), 0.05, progress=False)
+    >>> plot(tr, pathlib.Path(tempfile.mkdtemp()) / "run.png").suffix
+    '.png'
+    """
     kind = type(record).__name__
     try:
         fn = PLOTTERS[kind]

@@ -6,7 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .plot import _figure, _save
+from .figure import figure as _figure
+from .figure import save as _save
 
 __all__ = ["plot_trajectory"]
 

@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
-from .plot import _figure, _save
+from .figure import figure as _figure
+from .figure import save as _save
 from .table import deg_or_mm
 
 __all__ = ["plot_kinetostatics"]

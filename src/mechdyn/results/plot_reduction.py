@@ -10,7 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .plot import _figure, _save
+from .figure import figure as _figure
+from .figure import save as _save
 from .table import deg_or_mm
 
 __all__ = ["plot_reduction", "plot_steady_cycle", "plot_startup", "plot_motor"]

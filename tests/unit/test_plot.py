@@ -1,0 +1,17 @@
+"""``mechdyn.results.plot.plot`` draws every kind of record it lists."""
+
+import mechdyn
+from mechdyn.dynamics.reduction import reduce_model
+from mechdyn.results.plot import PLOTTERS, plot, plot_trajectory  # noqa: F401
+
+
+def test_plot_dispatches_every_record_kind(tmp_path):
+    model = mechdyn.examples.load("slider_crank").compile()
+    records = [mechdyn.simulate(model, 0.05, progress=False),
+               mechdyn.kinetostatics(model, speed=10.0),
+               mechdyn.kinematics.sweep.sweep(model),
+               reduce_model(model, steps=73)]
+    for rec in records:
+        out = plot(rec, tmp_path / f"{type(rec).__name__}.png")
+        assert out.stat().st_size > 1000, type(rec).__name__
+    assert {type(r).__name__ for r in records} <= set(PLOTTERS)
