@@ -317,7 +317,7 @@ class ModeEquations:
 
     # ------------------------------------------------------------------ analogs
     def analogs_terms(self, t: float, q, qdot, x=None) -> dict:
-        """The terms of A q'' + c = Q by the source paper's method (METHOD.md section 1)
+        """The terms of A q'' + c = Q by the method of reference [1] (docs/references.md)
         at a state of the mode: velocity analogs of the *partial systems* by central
         differences with the virtual displacement d, A_ij = sum over links of
         m v*_ci . v*_cj + J_c w*_i w*_j (plus the drives' rotor and gear inertia),

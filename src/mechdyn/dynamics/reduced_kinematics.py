@@ -1,4 +1,4 @@
-"""Exact reduced kinematics of a one-degree-of-freedom model (METHOD.md §2).
+"""Exact reduced kinematics of a one-degree-of-freedom model (reference [2], docs/references.md).
 
 The velocity analogs ``B = dx/dphi`` and their derivatives ``b = d2x/dphi2`` (the
 acceleration bias at unit speed) give ``J_red = B^T M_x B`` (the generalized mass

@@ -1,4 +1,4 @@
-"""The reduction method for one-degree-of-freedom machines (lecture notes, METHOD.md §2).
+"""The reduction method for 1-DOF machines (lecture notes, docs/references.md [2]).
 
 A machine with one degree of freedom is replaced by one *link of reduction*
 turning with the generalized coordinate ``phi`` (or with a chosen link) that

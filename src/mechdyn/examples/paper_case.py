@@ -1,4 +1,4 @@
-"""The source paper's dynamic case: the clutchless press in idle mode (METHOD.md section 1).
+"""The source paper's dynamic case: the clutchless press idling (docs/references.md [1]).
 
 The paper integrates the 2-DOF press (crank angle phi, rocker angle psi) over
 T = 0.05 s in N = 40 steps of the linear-acceleration method, from

@@ -1,4 +1,4 @@
-"""The whole working cycle of the clutchless crank press (source paper, METHOD.md section 1).
+"""The working cycle of the clutchless crank press (source paper, docs/references.md [1]).
 
 Idle, engaging, locking, work stroke and release of the press, with its stops,
 contact, lock and switches: the machine and every value the paper does not give

@@ -1,6 +1,6 @@
 """The linear-acceleration method (Wilson, 1962), as the source paper uses it.
 
-Step i -> i+1 with step h (METHOD.md section 1):
+Step i -> i+1 with step h (reference [1], docs/references.md):
 
 1. q''_i = f(t_i, q_i, q'_i);
 2. predict with constant acceleration:

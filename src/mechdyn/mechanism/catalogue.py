@@ -2,7 +2,7 @@
 
 The 4A series is the Soviet/CIS standard series of squirrel-cage induction motors
 (GOST 19523-81); the source paper of mechdyn (the clutchless press, §1 of
-``METHOD.md``) drives its crank with the motor **4A80B4U3**.  The reference for
+docs/references.md [1]) drives its crank with the motor **4A80B4U3**.  The reference for
 the series is the handbook
 
     A. E. Kravchik, M. M. Shlaf, V. I. Afonin, E. A. Sobolenskaya,
@@ -39,7 +39,7 @@ __all__ = ["CatalogueEntry", "MOTORS", "catalogue_entry", "induction_motor", "li
 KRAVCHIK_1982 = ("Kravchik A. E. et al., Asinkhronnye dvigateli serii 4A: Spravochnik, "
                  "Moscow: Energoizdat, 1982 (not consulted; values from memory of the "
                  "standard 4A tables)")
-_BRIEF = "mechdyn task brief for the source paper's motor (press paper, METHOD.md §1)"
+_BRIEF = "mechdyn task brief for the source paper's motor (press paper, docs/references.md [1])"
 
 _RPM = math.pi / 30.0
 
@@ -118,7 +118,8 @@ MOTORS: dict[str, CatalogueEntry] = {
                                             "quoted_rated_rpm", "breakdown_ratio",
                                             "starting_ratio")},
          "rotor_inertia": ("estimate of about 0.0033 kg m^2 (task brief)", "unconfirmed")},
-        note="the motor of the source paper (press, METHOD.md §1). The slip 5.8 % gives "
+        note="the motor of the source paper (press, docs/references.md [1]). The slip "
+             "5.8 % gives "
              "1413 rpm; the quoted 1415 rpm is a rounded catalogue speed (slip 5.67 %). "
              "mechdyn uses the slip."),
     "4A80A4U3": _entry("4A80A4U3", 1.1, 0.054, 2.2, 2.0),
