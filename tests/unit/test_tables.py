@@ -148,3 +148,14 @@ def test_periodic_table_in_a_simulation_matches_the_compiled_kernel():
         w = (t - 0.005) % 0.1 + 0.005
         tick = 3.0 * np.clip(min((w - 0.005) / 0.005, (0.035 - w) / 0.005), 0.0, 1.0)
         assert a2[0] == pytest.approx((cam + 0.3 * tick) / J, abs=1e-9)
+
+
+def test_every_column_of_a_reduction_table_has_its_unit():
+    import mechdyn
+    from mechdyn.dynamics.reduction import reduce_model
+    from mechdyn.results.table import unit_of_column
+
+    red = reduce_model(mechdyn.examples.load("slider_crank").compile(), steps=5)
+    units = {c: unit_of_column(c) for c in red.to_dataframe().columns}
+    assert units["J_red_kgm2"] == units["dJ_red_dphi_kgm2"] == "kg*m^2"
+    assert all(units.values()), units

@@ -36,6 +36,7 @@ UNIT_SUFFIXES: dict[str, str] = {
     "_Nm": "N*m",
     "_N": "N",
     "_kg_m2": "kg*m^2",
+    "_kgm2": "kg*m^2",
     "_kg": "kg",
     "_J": "J",
     "_W": "W",
