@@ -155,3 +155,13 @@ def test_sigterm_writes_the_samples_so_far_atomically_and_exits_143(tmp_path, ca
     df = pd.read_csv(out)
     assert len(df) > 5 and df["t_s"].iloc[-1] < 1.0
     assert not list(tmp_path.glob(".*part*"))  # no temporary file left
+
+
+def test_the_table_is_a_uniform_grid_by_default_and_steps_on_request(tmp_path, capsys):
+    out = tmp_path / "fb.csv"
+    assert main(["simulate", "four_bar", "--t-end", "0.1 s", "-o", str(out)]) == 0
+    t = pd.read_csv(out)["t_s"].to_numpy()
+    assert t.size == 1001 and np.allclose(np.diff(t), 1e-4)
+    assert main(["simulate", "four_bar", "--t-end", "0.1 s", "--every-step", "-o",
+                 str(out)]) == 0
+    assert 2 < len(pd.read_csv(out)) < 200  # the integrator's own steps

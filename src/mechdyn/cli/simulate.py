@@ -63,8 +63,13 @@ def register(sub) -> None:
                    help="initial value of a coordinate, e.g. phi=-64.1deg (repeatable)")
     p.add_argument("--qdot0", action="append", default=[], metavar="COORD=RATE",
                    help="initial rate of a coordinate, e.g. phi=43.5rad/s (repeatable)")
-    p.add_argument("--samples", type=int, metavar="N",
-                   help="write N equally spaced samples (dense output) instead of every step")
+    out = p.add_mutually_exclusive_group()
+    out.add_argument("--samples", type=int, metavar="N",
+                     help="write N equally spaced samples from the dense output (default "
+                          "1001 for the adaptive integrators; wilson and rk4 write their "
+                          "uniform steps)")
+    out.add_argument("--every-step", action="store_true",
+                     help="write one row per integrator step instead")
     p.add_argument("--points", action="store_true",
                    help="add the positions, velocities, accelerations of every named point")
     add_files(p, plot="write a plot of q, q', q'' and the energies")
@@ -101,11 +106,13 @@ def run(args) -> int:
     qdot0 = _pairs(args.qdot0, mech, "--qdot0", ("angular_velocity", "velocity")) or None
     d = quantity(args.d, "angle", "--d") if args.d is not None else None
     t_eval = None
+    fixed = args.integrator.lower() in ("wilson", "rk4")
+    if args.samples is None and not (fixed or args.every_step):
+        args.samples = 1001
     if args.samples is not None:
         if args.samples < 2:
             raise ModelError(f"--samples must be >= 2, got {args.samples}")
         t_eval = np.linspace(t0, t_end, args.samples)
-    fixed = args.integrator.lower() in ("wilson", "rk4")
     traj = simulate(mech, t_end, t0=t0, integrator=args.integrator, steps=args.steps, dt=dt,
                     rtol=args.rtol, atol=args.atol, q0=q0, qdot0=qdot0, t_eval=t_eval,
                     formulation=args.formulation, d=d, progress=args.progress,
