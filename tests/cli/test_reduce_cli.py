@@ -1,6 +1,7 @@
 """``mechdyn reduce`` and ``mechdyn flywheel`` end to end, through ``mechdyn.cli.main``."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -112,3 +113,27 @@ def test_bad_input_exits_2_with_one_line(argv, msg, capsys):
     err = capsys.readouterr().err
     assert rc == 2
     assert msg in err
+
+
+def _flywheel(delta: str, capsys):
+    code = main(["flywheel", "slider_crank", "--delta", delta, "--motor", "4A80B4U3",
+                 "--gear-ratio", "3.4"])
+    out = capsys.readouterr().out
+    values = {m[1]: float(m[2]) for m in re.finditer(
+        r"^\s*(J_fly on the crank|delta simulated|delta without flywheel)\s+([-0-9.e+]+)",
+        out, re.M)}
+    return code, out, values
+
+
+def test_the_default_flywheel_agrees_with_the_simulated_steady_cycle(capsys):
+    """With a motor the default method is consistent with the simulated steady cycle: the
+    recommended flywheel gives the target delta within 2 %, and none is recommended when
+    the machine meets the target as it is (the energy estimate is shown beside)."""
+    code, out, v = _flywheel("0.5%", capsys)
+    assert code == 0 and "(simulation method)" in out
+    assert v["J_fly on the crank"] > 0
+    assert abs(v["delta simulated"] / 0.005 - 1) < 0.02
+    code, out, v = _flywheel("2%", capsys)
+    assert code == 0 and v["delta without flywheel"] <= 0.02
+    assert v["J_fly on the crank"] == 0.0 and "no flywheel is needed" in out
+    assert "J_fly energy method" in out

@@ -55,9 +55,10 @@ def register(sub) -> None:
     p.add_argument("--speed", metavar="RATE",
                    help="mean speed of the crank (needed for a constant driving torque; with a "
                         "motor the start of the steady-state search)")
-    p.add_argument("--method", choices=("energy", "refined", "simulation"), default="refined",
+    p.add_argument("--method", choices=("energy", "refined", "simulation"),
                    help="energy method (basic or refined for a variable J_red) or iterate on "
-                        "the simulated steady cycle (default refined)")
+                        "the simulated steady cycle (default: simulation with a motor, whose "
+                        "slope smooths the speed; refined with a constant torque)")
     p.add_argument("--steps", type=int, default=721, metavar="N",
                    help="positions of the reduction table over one turn (default 721)")
     p.add_argument("--exact", action="store_true",
@@ -86,7 +87,7 @@ def run(args) -> int:
                          "--speed (e.g. --speed 43.5rad/s)")
     speed_kw = "omega_guess" if dependent else "omega_mean"  # a motor picks its own speed
     fs = size_flywheel(machine, delta, method=args.method, **{speed_kw: speed})
-    print(f"{mech.name}: flywheel for delta = {delta:.4g} ({args.method} method)")
+    print(f"{mech.name}: flywheel for delta = {delta:.4g} ({fs.method} method)")
     print(f"  mean speed            {rate_text(fs.omega_mean, True)}")
     if fs.delta_without is not None:
         print(f"  delta without flywheel {fs.delta_without:.6g}")

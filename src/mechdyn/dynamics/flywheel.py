@@ -369,7 +369,7 @@ FLYWHEEL_METHODS = ("energy", "refined", "simulation")
 
 def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | None = None,
                   omega_guess: float | None = None, gear_ratio: float | None = None,
-                  method: str = "refined", confirm: bool = True, phi0: float = 0.0,
+                  method: str | None = None, confirm: bool = True, phi0: float = 0.0,
                   t: float = 0.0, points: int = 2001, rtol: float = 1e-3) -> FlywheelSizing:
     """Size a flywheel for a coefficient of speed fluctuation ``delta``.
 
@@ -384,6 +384,8 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
     ``(J_red - J_red_mean) omega_mean^2 / 2``, before taking the swing.
     ``method="simulation"`` starts from the refined value and corrects it
     (secant) until the simulated steady cycle meets ``delta`` within ``rtol``.
+    When the steady cycle without a flywheel already meets ``delta``, the answer is
+    zero whatever the method (the energy estimates are still reported beside it).
 
     Parameters
     ----------
@@ -398,7 +400,10 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
     gear_ratio : float, optional
         i = omega_motor / omega_link, to report the flywheel on the motor shaft
         (``J_fly / i^2``); default the machine's gear stage ratio if any.
-    method : {"energy", "refined", "simulation"}
+    method : {"energy", "refined", "simulation"}, optional
+        Default ``"simulation"`` when the reduced torque depends on the speed (a motor:
+        its slope smooths the speed, which the energy method does not see), else
+        ``"refined"``.
     confirm : bool
         Simulate the steady cycle with the flywheel and report its delta.
     phi0 : float
@@ -419,10 +424,12 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
     if not (isinstance(delta, (int, float)) and 0 < delta < 2):
         raise ModelError(f"delta (coefficient of speed fluctuation) must lie in (0, 2), "
                          f"got {delta!r}")
+    dependent = machine.speed_dependent(t)
+    if method is None:
+        method = "simulation" if dependent else "refined"
     if method not in FLYWHEEL_METHODS:
         raise ModelError(f"method must be one of {', '.join(map(repr, FLYWHEEL_METHODS))}, "
                          f"got {method!r}")
-    dependent = machine.speed_dependent(t)
     base = None
     if omega_mean is None:
         if not dependent:
@@ -461,12 +468,21 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
                     f"{j_fly:.4g} kg m^2): no flywheel is needed")
         j_fly = 0.0
     cycle = d_sim = None
+    met = base.delta <= delta  # the machine as it is meets the target
+    if met:
+        msgs = [m for m in msgs if "no flywheel is needed" not in m]
+        msgs.append(f"the steady cycle without a flywheel has delta = {base.delta:.4g} <= "
+                    f"{delta:g}: no flywheel is needed (energy estimates: {j_basic:.4g}, "
+                    f"refined {j_ref:.4g} kg m^2)")
+        j_fly, cycle, d_sim = 0.0, base, base.delta
 
     def dsim(jf):
         c = steady_state(machine.with_extra_inertia(jf), phi0=phi0, **kw)
         return c.delta, c
 
-    if method == "simulation":
+    if met:
+        pass
+    elif method == "simulation":
         # 1/delta is nearly linear in the total inertia: secant on 1/delta - 1/target
         ja = max(j_fly, 0.0)
         da, cycle = dsim(ja)
