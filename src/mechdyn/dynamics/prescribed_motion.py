@@ -22,7 +22,9 @@ from ..errors import AssemblyError, ModelError, SingularPositionError
 from ..kernels import rows_numpy
 from ..kinematics.assembly import _rank, _scale, joint_residuals, newton
 from ..kinematics.branch_chart import ChartBook, PathProblem
-from ..kinematics.constraints import coordinates, coordinates_jacobian, point_position
+from ..kinematics.constraints import _point_kinematics, coordinates, coordinates_jacobian
+from ..kinematics.records import _refine_root
+from ..kinematics.sweep import sweep
 from ..model import ConstraintLayout, Model, as_model
 from ..model.rows import concat
 
@@ -391,33 +393,24 @@ def dead_centres(mech_or_model, body: str, point, *, coordinate: str = "y",
         ``{"min": (angle_rad, value_m), "max": (angle_rad, value_m)}`` with the
         angle in [0, 2 pi) and the extreme refined to about 1e-10 rad.
     """
-    from scipy.optimize import minimize_scalar
-
     model = as_model(mech_or_model)
-    lay = model.layout(mode)
     x_start = getattr(model, "x0", model.x_sketch)
     over_idx = [model.coordinate_index(over)] if over else []
-    didx = np.asarray(_independent_subset(model, lay, x_start, over_idx), dtype=int)
-    held = coordinates(model, x_start)[didx[1:]]
-    pos = _Positions(model, lay, didx)
-    ang = np.linspace(0.0, 2 * np.pi, n + 1)
-    qd = np.concatenate([ang[:, None], np.broadcast_to(held, (n + 1, held.size))], axis=1)
-    xs = pos.solve(qd, np.asarray(x_start, float))
-    k = 0 if coordinate == "x" else 1
-    c = point_position(model, xs, body, point)[:, k]
+    k = _independent_subset(model, model.layout(mode), x_start, over_idx)[0]
+    sw = sweep(model, model.coordinate_names[k], np.linspace(0.0, 2 * np.pi, n + 1),
+               x_start=x_start, mode=mode).raise_for_status()
+    c = 0 if coordinate == "x" else 1
+
+    def quantity(x, xs, xss):  # the point's coordinate and its derivatives along the crank
+        return [v[..., c] for v in _point_kinematics(model, x, xs, xss, body, point)]
+
+    y, dy, _ = quantity(sw.x, sw.B[..., k], sw.x * 0.0)
     out = {}
-    for key, sgn in (("min", 1.0), ("max", -1.0)):
-        i = int(np.argmin(sgn * c[:-1]))
-        xi = xs[i]
-
-        def f(a, xi=xi, sgn=sgn):
-            qq = np.concatenate([[a], held])
-            xa, _, _ = pos.newton(qq, xi)
-            return sgn * point_position(model, xa, body, point)[k]
-
-        h = ang[1] - ang[0]
-        res = minimize_scalar(f, bracket=(ang[i] - h, ang[i], ang[i] + h),
-                              options={"xtol": 1e-12})
-        a = float(np.mod(res.x, 2 * np.pi))
-        out[key] = (a, float(sgn * res.fun))
+    for key, i in (("min", int(np.argmin(y[:-1]))), ("max", int(np.argmax(y[:-1])))):
+        # the sample interval where the rate changes sign (the turn is closed)
+        j = i if i == 0 or np.sign(dy[i - 1]) == np.sign(dy[i]) else i - 1
+        if i == 0 and np.sign(dy[0]) == np.sign(dy[1]):
+            j = n - 1
+        a, v = _refine_root(sw, j, quantity)
+        out[key] = (float(np.mod(a, 2 * np.pi)), v)
     return out
