@@ -201,14 +201,7 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
     # ---------------------------------------------------------- kinematics
     pos = _Positions(model, lay, didx)
     x = pos.solve(qd, np.asarray(x_start, dtype=float), x_guess)
-    xdot, xddot = pos.motion(x, qd_dot, qd_ddot)
-    if pos.branch_changes:
-        names = [model.coordinate_names[k] for k in didx]
-        at = ", ".join(f"{nm} = {v:.6g}" for nm, v in zip(names, pos.branch_changes[0],
-                                                          strict=True))
-        warn.append(f"the assembly branch changes near {at} ({len(pos.branch_changes)} "
-                    f"time(s)): the motion passes a singular (change or dead) position; "
-                    f"results beyond it belong to another assembly mode")
+    x, xdot, xddot = pos.motion(x, qd, qd_dot, qd_ddot)
     G = coordinates_jacobian(model, x)
     q = coordinates(model, x)
     qdot = np.einsum("nqx,nx->nq", G, xdot)
@@ -231,7 +224,8 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                            "(driving = the whole torque the drive must deliver)")
     over_values = q[:, model.coordinate_index(over_names[0])]
     stats = core.pop("stats")
-    stats.update(positions=n, position_solves=pos.solves,
+    stats.update(positions=n,
+                 position_solves=pos.counter["solves"] + pos.counter.get("coarse_steps", 0),
                  bifurcations=pos.book.report() if pos.book is not None else [],
                  seconds=time.perf_counter() - t_start)
     message = MESSAGES[status]

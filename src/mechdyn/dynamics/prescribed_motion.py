@@ -3,14 +3,12 @@ a prescribed motion (batched over positions), the choice of the driven coordinat
 and the dead centres of a crank's turn.
 
 The driving constraints ``g_d(x) - q_d = 0`` are appended to the joint constraints
-``Phi(x) = 0``; the poses are found by continuation (branch kept by the sign of the
-scaled Jacobian's determinant) with the package's position Newton
-(:func:`mechdyn.kinematics.assembly.newton`), the rates from
+``Phi(x) = 0`` (the kernel of :mod:`mechdyn.kinematics.continuation` with the driven
+coordinates prescribed); the poses are found by the kinematic sweep's continuation
+(branch kept by the sign of det [Phi_x; g_d,x], through bifurcation positions with the
+branch charts of :mod:`mechdyn.kinematics.branch_chart`), the rates from
 ``[Phi_x; g_d,x] xdot = [0; qdot_d]`` and the accelerations from the same matrix with
-the exact right-hand side gamma.  Through a bifurcation position (two branches
-crossing, one driven coordinate varying) poses, rates and accelerations near it come
-from a branch chart (:mod:`mechdyn.kinematics.branch_chart`), the limit of the branch
-from both sides.
+the exact right-hand side gamma.  The dead centres are refined on a sweep of the crank.
 """
 
 from __future__ import annotations
@@ -20,12 +18,13 @@ from scipy.optimize import least_squares
 
 from ..errors import AssemblyError, ModelError, SingularPositionError
 from ..kernels import rows_numpy
-from ..kinematics.assembly import _rank, _scale, joint_residuals, newton
+from ..kinematics.assembly import _rank, _scale, joint_residuals
 from ..kinematics.branch_chart import ChartBook, PathProblem
 from ..kinematics.constraints import _point_kinematics, coordinates, coordinates_jacobian
+from ..kinematics.continuation import Kernel, _kernel, _march, _newton, _node
 from ..kinematics.records import _refine_root
-from ..kinematics.sweep import sweep
-from ..model import ConstraintLayout, Model, as_model
+from ..kinematics.sweep import DEFAULT_MAX_STEP, DEFAULT_MIN_STEP, _motion, _path, sweep
+from ..model import Model, as_model
 from ..model.rows import concat
 
 __all__ = ["dead_centres", "ModeRows"]
@@ -85,94 +84,75 @@ def mode_jacobian(model: Model, x, lay, *, friction: bool = False) -> np.ndarray
     return J
 
 
-def _lin_solve(J, F):
-    """Solve J dx = F (batched), least squares / minimum norm when not square or singular."""
-    if J.shape[-1] == J.shape[-2]:
-        try:
-            dx = np.linalg.solve(J, F)
-            if np.all(np.isfinite(dx)):
-                return dx
-        except np.linalg.LinAlgError:
-            pass
-    return np.linalg.pinv(J, rcond=1e-12) @ F
-
-
 class _Positions:
-    """Position, velocity and acceleration analysis with a subset of driven coordinates:
-    the rows of the layout, then the driven coordinates' rows (:attr:`rows`)."""
+    """Poses, velocities and accelerations with the driven coordinates ``didx`` prescribed,
+    on the kinematics continuation: the kernel of the rows of the layout then the driven
+    coordinates' rows (:class:`~mechdyn.kinematics.continuation.Kernel`) and the sweep's
+    continuation (:func:`~mechdyn.kinematics.sweep._path`) along the one varying driven
+    coordinate, through bifurcation positions with a chart book; coordinate by coordinate
+    (:func:`~mechdyn.kinematics.continuation._march`) when several vary."""
 
-    def __init__(self, model: Model, lay: ConstraintLayout, didx: np.ndarray):
-        self.model, self.lay, self.didx = model, lay, didx
-        self.rows = concat(model.n_bodies, lay.rowset, model.coordinate_rows.take(didx))
+    def __init__(self, model: Model, lay, didx):
+        self.model, self.lay, self.didx = model, lay, np.asarray(didx, dtype=int)
+        self.kern = (Kernel(model, lay, self.didx) if isinstance(lay, ModeRows)
+                     else _kernel(model, lay, self.didx))
         self.tol = 1e-12 * max(model.length_scale, 1e-3)
-        self.scale = _scale(model)
-        self.solves = 0
-        self.branch_changes: list = []
+        #: step counts of the continuation (``coarse_steps`` ...) and batched solves
+        self.counter: dict = {"solves": 0}
         #: branch charts of the bifurcation positions passed (one varying coordinate)
         self.book: ChartBook | None = None
-        self._j = 0
-        #: samples in a chart's zone: mask (n,), x' and x'' along the varying coordinate
+        #: samples in a chart's zone (mask (n,), x', x'' along the varying coordinate)
         self.charted = None
+        self._j, self._system = 0, None
 
-    def residual(self, x, qd):
-        """[Phi; g_d - q_d] at x, shape (..., n_rows + n_d)."""
-        F = rows_numpy.values(self.rows, x)
-        F[..., self.lay.n_rows:] -= qd
-        return F
+    def _newton(self, qd, x, max_iter=30):
+        self.counter["solves"] += 1
+        return _newton(self.kern, np.asarray(x, dtype=float), qd, self.tol, max_iter)
 
-    def jac(self, x):
-        """[Phi_x; g_d,x] at x, shape (..., n_rows + n_d, n_x)."""
-        return rows_numpy.jacobian(self.rows, x)
+    def _steps(self, c: int) -> dict:
+        """The march's step limits for driven coordinate c (those of the sweep)."""
+        L = 1.0 if self.model.coord_is_angle[self.didx[c]] else self.model.length_scale
+        return {"max_step": (DEFAULT_MAX_STEP if L == 1.0 else 0.05 * L),
+                "min_step": DEFAULT_MIN_STEP * L, "tol": self.tol, "counter": self.counter}
 
-    def newton(self, qd, x, max_iter=30):
-        """:func:`~mechdyn.kinematics.assembly.newton` (batched); returns x, converged
-        flags, and J at x."""
-        self.solves += 1
-        qd = np.asarray(qd, dtype=float)
-        target = np.concatenate([np.zeros(qd.shape[:-1] + (self.lay.n_rows,)), qd], axis=-1)
-        x, ok = newton(self.rows, x, target, tol=self.tol, max_iter=max_iter)
-        return x, ok, self.jac(x)
+    def _move(self, node, c: int, target: float):
+        """March node's coordinate c to target (no chart book); raises where it stalls."""
+        if node.q[c] == target:
+            return node
+        nodes, stop = _march(self.kern, _node(self.kern, node.x, node.q, c), c, [target],
+                             **self._steps(c))
+        if stop is not None:
+            raise self._error(stop.q_try, stop.node.x)
+        return nodes[-1]
 
-    def analogs(self, J):
-        """dx/dq_d from the Jacobian J, shape (..., n_x, n_d)."""
-        rhs = np.zeros(J.shape[:-2] + (J.shape[-2], len(self.didx)))
-        rhs[..., self.lay.n_rows:, :] = np.eye(len(self.didx))
-        return _lin_solve(J, rhs)
-
-    def det_sign(self, J):
-        """Sign of det of the scaled J (ones when J is not square)."""
-        if J.shape[-1] != J.shape[-2]:
-            return np.ones(J.shape[:-2])
-        return np.sign(np.linalg.det(J * self.scale))
-
-    def first(self, qd, x_start):
-        """The first pose: continuation from the assembled start pose keeps its branch
-        (by :meth:`advance` in small steps when one coordinate varies, so that a
-        bifurcation on the way is charted)."""
+    def _start(self, q0, x_start):
+        """The node at the held coordinates of q0 (the varying one as at x_start), by
+        continuation from the pose x_start when it is assembled, else by Newton's method
+        (least squares first when that fails) at q0."""
         q_s = coordinates(self.model, x_start)[self.didx]
-        if np.max(np.abs(self.residual(x_start, q_s)), initial=0.0) <= 1e3 * self.tol:
-            j, x, q = self._j, np.array(x_start, dtype=float), q_s
-            n_sub = 1
-            if self.book is not None and not np.delete(q_s - qd, j).any():
-                n_sub = max(1, int(np.ceil(abs(qd[j] - q_s[j]) / (0.1 * self.book.path.unit))))
+        x, ok, _, J = self._newton(q_s, x_start, max_iter=60)
+        if ok:
             try:
-                for i in range(1, n_sub + 1):
-                    qn = q_s + (qd - q_s) * (i / n_sub)
-                    x = self.advance(q, x, qn)[0]
-                    q = qn
-                return x
+                node = _node(self.kern, x, q_s, self._j, J)
+                for c in range(len(q0)):
+                    if c != self._j:
+                        node = self._move(node, c, q0[c])
+                return node
             except (AssemblyError, SingularPositionError):
                 pass
-        x, ok, _ = self.newton(qd, x_start, max_iter=60)
-        if ok:
-            return x
-        sol = least_squares(self.residual, x_start, jac=lambda xx, qd: self.jac(xx),
-                            args=(qd,), method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15,
-                            x_scale=self.scale / self.model.length_scale, max_nfev=2000)
-        x, ok, _ = self.newton(qd, sol.x)
+        x, ok, _, J = self._newton(q0, x_start, max_iter=60)
         if not ok:
-            raise self._error(qd, x)
-        return x
+            def system(xx):
+                return self.kern.system(xx, q0)
+
+            sol = least_squares(lambda xx: system(xx)[0], x_start, jac=lambda xx: system(xx)[1],
+                                method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                                x_scale=self.kern.col_scale / self.model.length_scale,
+                                max_nfev=2000)
+            x, ok, _, J = self._newton(q0, sol.x)
+            if not ok:
+                raise self._error(q0, x)
+        return _node(self.kern, x, q0, self._j, J)
 
     def _error(self, qd, x, t=None):
         res = joint_residuals(self.model, x, self.lay)
@@ -194,152 +174,48 @@ class _Positions:
                              f"open (residual, m or rad): {parts}", t=t, q=qd,
                              residuals=open_)
 
-    def step(self, qd_from, x_from, qd_to, J_from=None, depth=0):
-        """Solve at qd_to continuing from a solved pose, halving the step on failure.
-
-        Returns the pose and the Jacobian there."""
-        L = self.model.length_scale
-        if J_from is None:
-            J_from = self.jac(x_from)
-        dx = self.analogs(J_from) @ (qd_to - qd_from)
-        # near a singular position the analogs blow up: then start from x_from itself
-        pred = x_from + dx if np.max(np.abs(dx * self.scale)) <= 0.5 * L else x_from
-        x, ok, J = self.newton(qd_to, pred)
-        if ok:
-            # a link turning by more than ~1 rad in one step means the solve jumped
-            jump = np.max(np.abs((x - x_from) * self.scale)) > L
-            same = self.det_sign(J) == self.det_sign(J_from)
-            if (same and not jump) or depth > 10:
-                if not same or jump:
-                    self.branch_changes.append(np.array(qd_to, dtype=float))
-                return x, J
-        if depth > 14:
-            raise self._error(qd_to, x)
-        mid = 0.5 * (qd_from + qd_to)
-        xm, Jm = self.step(qd_from, x_from, mid, J_from, depth + 1)
-        return self.step(mid, xm, qd_to, Jm, depth + 1)
-
     def solve(self, qd, x_start, x_guess=None):
-        """Poses for all rows of qd (n, n_d), by continuation from x_start.
-
-        Sequential continuation on about 100 anchor positions, then one batched
-        Newton solve for all the others from the anchors' first-order predictions
-        (with a branch check, falling back to continuation where it fails)."""
-        n = qd.shape[0]
-        self._open_book(qd)
+        """Poses (n, n_x) at the driven coordinates qd (n, n_d): one batched Newton solve
+        from the guesses x_guess when it converges everywhere, else by continuation from
+        x_start (or the first guess)."""
+        n, kern = qd.shape[0], self.kern
+        var = np.flatnonzero(np.ptp(qd, axis=0) > 0) if n > 1 else []
+        self._j = int(var[0]) if len(var) == 1 else 0
+        self.book, self.charted, self._system = None, None, None
+        if len(var) == 1 and kern.square and not isinstance(self.lay, ModeRows):
+            self.book = ChartBook(PathProblem(self.model, self.lay, self.didx, qd[0], self._j))
         if x_guess is not None:
-            x, ok, _ = self.newton(qd, x_guess)
+            x, ok, F, J = self._newton(qd, x_guess)
             if np.all(ok):
-                return self._charts_after(qd, x)
-        x = np.empty((n, self.model.n_x))
-        x[0] = self.first(qd[0], x_start if x_guess is None else x_guess[0])
-        if n == 1:
-            return self._charts_after(qd, x)
-        stride = max(1, n // 100)
-        anchors = sorted({*range(0, n, stride), n - 1})
-        J0 = self.jac(x[0])
-        Ja = np.empty((len(anchors),) + J0.shape)
-        Ja[0] = J0
-        for i, (a0, a1) in enumerate(zip(anchors[:-1], anchors[1:], strict=True)):
-            x[a1], Ja[i + 1] = self.advance(qd[a0], x[a0], qd[a1], Ja[i])
-        rest = np.setdiff1d(np.arange(n), anchors)
-        if rest.size:
-            base = np.searchsorted(anchors, rest, side="right") - 1
-            a = np.asarray(anchors)[base]
-            with np.errstate(all="ignore"):
-                B = self.analogs(Ja[base])
-            pred = x[a] + (B @ (qd[rest] - qd[a])[..., None])[..., 0]
-            sign = self.det_sign(Ja[base])
-            near = np.zeros(rest.size, dtype=bool)
-            if self.book is not None:  # near a bifurcation: the chart predicts
-                for i, k in enumerate(rest):
-                    ch = self.book.window_chart(qd[k, self._j])
-                    if ch is not None:
-                        near[i] = True
-                        pred[i] = ch.evaluate(qd[k, self._j])[0]
-                        sign[i] = ch.side_sign(qd[k, self._j])
-            with np.errstate(all="ignore"):
-                xr, ok, Jr = self.newton(qd[rest], np.where(np.isfinite(pred), pred, x[a]))
-                ok &= (self.det_sign(Jr) == sign) | near
-            x[rest] = xr
-            for k in rest[~ok]:
-                x[k] = self.advance(qd[k - 1], x[k - 1], qd[k])[0]
-        return self._charts_after(qd, x)
-
-    # ------------------------------------------------------------------ bifurcations
-    def _open_book(self, qd):
-        """A chart book when one driven coordinate varies and the others are held, for
-        a square system of joint rows (not the rows of a variable-structure mode)."""
-        self.book, self.charted = None, None
-        var = np.flatnonzero(np.ptp(qd, axis=0) > 0) if qd.shape[0] > 1 else []
-        if isinstance(self.lay, ModeRows) or len(var) != 1 or \
-                self.lay.n_rows + len(self.didx) != self.model.n_x:
-            return
-        self._j = int(var[0])
-        self.book = ChartBook(PathProblem(self.model, self.lay, self.didx, qd[0], self._j))
-
-    def advance(self, qd_from, x_from, qd_to, J_from=None):
-        """:meth:`step` that goes through bifurcation positions on the branch: poses in
-        a chart's zone come from the chart, steps near or across a chart start from it."""
-        book, j = self.book, self._j
-        if book is None:
-            return self.step(qd_from, x_from, qd_to, J_from)
-        s0, s1 = float(qd_from[j]), float(qd_to[j])
-        if book.zone_chart(s0) is None:
-            book.watch(s0, x_from)
-        ch = book.zone_chart(s1)
-        if ch is not None:
-            x = ch.evaluate(s1)[0]
-            return x, self.jac(x)
-        ch = book.window_chart(s1) or book.crossed(s0, s1) or book.window_chart(s0)
-        if ch is None:
-            return self.step(qd_from, x_from, qd_to, J_from)
-        se = float(np.clip(s1, ch.centre - ch.window, ch.centre + ch.window))
-        qe = np.array(qd_to, dtype=float)
-        qe[j] = se
-        xe = ch.evaluate(se)[0]
-        if se == s1:
-            x, ok, J = self.newton(qd_to, xe)
-            if ok:
-                return x, J
-        return self.step(qe, xe, qd_to)
-
-    def _charts_after(self, qd, x):
-        """Watch the solved poses for bifurcations (when they came from guesses), and
-        take the poses in the charts' zones from the charts."""
-        if self.book is None:
+                self._system = (F, J, kern.factor(J))
+                if self.book is not None:  # watch the poses for bifurcations
+                    for k in range(n):
+                        if self.book.zone_chart(qd[k, self._j]) is None:
+                            self.book.watch(float(qd[k, self._j]), x[k])
+                return x
+            x_start = x_guess[0]
+        node = self._start(qd[0], np.asarray(x_start, dtype=float))
+        if len(var) <= 1:
+            x, stop, self._system = _path(kern, node, self._j, qd[:, self._j], book=self.book,
+                                          **self._steps(self._j))
+            if stop is not None:
+                raise self._error(stop.q_try, stop.node.x)
             return x
-        j = self._j
-        if not self.book.charts:
-            for k in range(qd.shape[0]):
-                if self.book.zone_chart(qd[k, j]) is None:
-                    self.book.watch(float(qd[k, j]), x[k])
-        mask, xc, xs, xss = self.book.apply(qd[:, j])
-        if mask.any():
-            x = x.copy()
-            x[mask] = xc
-            self.charted = (mask, xs, xss)
+        x = np.empty((n, self.model.n_x))
+        for k in range(n):
+            for c in var:
+                node = self._move(node, c, qd[k, c])
+            x[k] = node.x
         return x
 
-    def motion(self, x, qd_dot, qd_ddot):
-        """Velocities and accelerations of the poses for driven rates (batched)."""
-        J, n_r = self.jac(x), self.lay.n_rows
-        rhs = np.zeros(J.shape[:-1])
-        rhs[..., n_r:] = qd_dot
-        with np.errstate(all="ignore"):  # singular at a bifurcation: charted below
-            xdot = _lin_solve(J, rhs[..., None])[..., 0]
-            gam = -rows_numpy.quad(self.rows, x, xdot)
-            gam[..., n_r:] += qd_ddot
-            xddot = _lin_solve(J, gam[..., None])[..., 0]
-        if self.charted is not None and x.ndim == 2:
-            mask, xs, xss = self.charted
-            held = np.delete(qd_dot[mask], self._j, axis=1)
-            if not np.any(held) and not np.any(np.delete(qd_ddot[mask], self._j, axis=1)):
-                w, a = qd_dot[mask, self._j, None], qd_ddot[mask, self._j, None]
-                xdot, xddot = xdot.copy(), xddot.copy()
-                xdot[mask] = xs * w
-                xddot[mask] = xs * a + xss * w * w
-        return xdot, xddot
+    def motion(self, x, qd, qd_dot, qd_ddot):
+        """Poses, velocities and accelerations for the driven coordinates and their rates
+        at the poses x of :meth:`solve` (batched), from the charts in bifurcation zones
+        (:attr:`charted`)."""
+        x, _, xdot, xddot, self.charted = _motion(self.kern, x, qd, qd_dot, qd_ddot,
+                                                  self.book, self._j, self._system,
+                                                  correct=False)
+        return x, xdot, xddot
 
 
 def _independent_subset(model, lay, x0, first: list[int], candidates=None) -> list[int]:

@@ -127,7 +127,7 @@ class Kernel:
     def apply(self, J, fac, rhs):
         """y with J y = rhs, J (N, n_eq, n_x) and rhs (N, n_eq, k) -> (N, n_x, k), or one
         position (J 2-D, rhs 1-D or 2-D), with the factors of :meth:`factor`."""
-        if fac is None or fac[0] is None:
+        if fac is None or fac[0] is None or not np.size(rhs):
             return _dense_solve(J, rhs)
         y = np.array(rhs, dtype=float)
         shape = y.shape
