@@ -42,10 +42,10 @@ class ModeRows:
     forward dynamics, :attr:`mechdyn.dynamics.modes.ModeSystem.rowset`.
 
     It stands in for a layout everywhere kinetostatics uses one (``rowset``,
-    ``n_rows``, ``rows`` of the joints and weld locks, ``row_joint``,
-    ``lock_active``, ``mode``); ``extra`` are the switchable rows, ``elements``
-    the row indices of every switchable element but the weld locks (which report
-    as joints), ``row_is_angle`` whether each switchable row is in rad.
+    ``n_rows``, ``rows`` of the joints and weld locks, ``row_joint``, ``mode``);
+    ``extra`` are the switchable rows, ``elements`` the row indices of every
+    switchable element but the weld locks (which report as joints), ``row_is_angle``
+    whether each switchable row is in rad.
     """
 
     def __init__(self, model: Model, extra, mode):
@@ -55,7 +55,6 @@ class ModeRows:
         self.n_base = base.n_rows
         self.rowset = concat(model.n_bodies, model.joint_rows, *[r.rows for r in self.extra])
         self.n_rows = len(self.rowset)
-        self.lock_active = np.array([n in self.mode for n in model.lock.names], dtype=bool)
         self.rows = dict(base.rows)
         self.elements: dict[str, list[int]] = {}
         welds = set(model.lock.names)

@@ -437,13 +437,13 @@ def analyze(mech_or_model, q, qdot, qddot=None, x_guess=None, *, mode=None) -> K
         if x_guess is None:
             x_guess = assemble(model, layout=lay)
     tol = _position_tol(model)
-    x, ok, _, J = _newton(kern, np.asarray(x_guess, float), q, tol)
+    x, ok, F, J = _newton(kern, np.asarray(x_guess, float), q, tol)
     if not ok:
         x = assemble(model, q, x_guess=x_guess, layout=lay)
-        J = kern.system(x, q)[1]
-    fac = kern.factor(J)
-    B = kern.apply(J, fac, kern.rhs_unit(1)[0])
-    xdot = B @ qdot
-    xddot = B @ qddot + kern.apply(J, fac, kern.gamma(x, xdot))
+        F, J = kern.system(x, q)
+    system = (F[None], J[None], kern.factor(J[None]))
+    x, B, xdot, xddot, _ = _motion(kern, x[None], q[None], qdot[None], qddot[None], None, 0,
+                                   system, correct=False)
     return KinematicPoint(q=_ro(q.copy()), qdot=_ro(qdot.copy()), qddot=_ro(qddot.copy()),
-                          x=_ro(x), xdot=_ro(xdot), xddot=_ro(xddot), B=_ro(B), model=model)
+                          x=_ro(x[0]), xdot=_ro(xdot[0]), xddot=_ro(xddot[0]), B=_ro(B[0]),
+                          model=model)
