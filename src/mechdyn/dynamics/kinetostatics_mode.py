@@ -16,7 +16,7 @@ from ..errors import ModelError, Status, did_you_mean
 from ..kinematics.constraints import coordinates, coordinates_gamma, coordinates_jacobian
 from ..results.kinetostatics_record import Kinetostatics
 from .forces import force_model
-from .prescribed_motion import _independent_subset, _Positions
+from .prescribed_motion import _independent_subset, _prescribed
 from .reactions import _inverse
 
 __all__ = ["_kinetostatics", "MESSAGES"]
@@ -193,9 +193,8 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
         raise ValueError("no positions to analyse")
 
     # ---------------------------------------------------------- kinematics
-    pos = _Positions(model, lay, didx)
-    x = pos.solve(qd, np.asarray(x_start, dtype=float), x_guess)
-    x, xdot, xddot = pos.motion(x, qd, qd_dot, qd_ddot)
+    x, xdot, xddot, charted, pos_stats = _prescribed(
+        model, lay, didx, qd, qd_dot, qd_ddot, np.asarray(x_start, dtype=float), x_guess)
     G = coordinates_jacobian(model, x)
     q = coordinates(model, x)
     qdot = np.einsum("nqx,nx->nq", G, xdot)
@@ -206,7 +205,7 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
     core = _inverse(model, lay, didx, tt, x, xdot, xddot, q, qdot,
                     skip=didx if model_drives == "replace" else (),
                     reacting=tuple(reacting_loads), point=np.asarray(point, dtype=float),
-                    charted=pos.charted)
+                    charted=charted)
     tau, status = core.pop("tau"), core.pop("status")
     warn.extend(core.pop("warnings"))
     notes = []
@@ -218,10 +217,7 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                            "(driving = the whole torque the drive must deliver)")
     over_values = q[:, model.coordinate_index(over_names[0])]
     stats = core.pop("stats")
-    stats.update(positions=n,
-                 position_solves=pos.counter["solves"] + pos.counter.get("coarse_steps", 0),
-                 bifurcations=pos.book.report() if pos.book is not None else [],
-                 seconds=time.perf_counter() - t_start)
+    stats.update(positions=n, **pos_stats, seconds=time.perf_counter() - t_start)
     message = MESSAGES[status]
     if status == Status.SINGULAR_POSITION and not stats.get("singular_positions"):
         message = ("completed through bifurcation position(s): the mechanism stays on its "

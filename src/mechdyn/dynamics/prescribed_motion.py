@@ -83,138 +83,125 @@ def mode_jacobian(model: Model, x, lay, *, friction: bool = False) -> np.ndarray
     return J
 
 
-class _Positions:
-    """Poses, velocities and accelerations with the driven coordinates ``didx`` prescribed,
-    on the kinematics continuation: the kernel of the rows of the layout then the driven
-    coordinates' rows (:class:`~mechdyn.kinematics.continuation.Kernel`) and the sweep's
-    continuation (:func:`~mechdyn.kinematics.sweep._path`) along the one varying driven
-    coordinate, through bifurcation positions with a chart book; coordinate by coordinate
-    (:func:`~mechdyn.kinematics.continuation._march`) when several vary."""
+def _steps(kern: Kernel, c: int, tol: float, counter: dict) -> dict:
+    """The march's step limits for the kernel's coordinate c (those of the sweep)."""
+    model = kern.model
+    L = 1.0 if model.coord_is_angle[kern.idx[c]] else model.length_scale
+    return {"max_step": (DEFAULT_MAX_STEP if L == 1.0 else 0.05 * L),
+            "min_step": DEFAULT_MIN_STEP * L, "tol": tol, "counter": counter}
 
-    def __init__(self, model: Model, lay, didx):
-        self.model, self.lay, self.didx = model, lay, np.asarray(didx, dtype=int)
-        self.kern = (Kernel(model, lay, self.didx) if isinstance(lay, ModeRows)
-                     else _kernel(model, lay, self.didx))
-        self.tol = 1e-12 * max(model.length_scale, 1e-3)
-        #: step counts of the continuation (``coarse_steps`` ...) and batched solves
-        self.counter: dict = {"solves": 0}
-        #: branch charts of the bifurcation positions passed (one varying coordinate)
-        self.book: ChartBook | None = None
-        #: samples in a chart's zone (mask (n,), x', x'' along the varying coordinate)
-        self.charted = None
-        self._j, self._system = 0, None
 
-    def _newton(self, qd, x, max_iter=30):
-        self.counter["solves"] += 1
-        return _newton(self.kern, np.asarray(x, dtype=float), qd, self.tol, max_iter)
+def _move(kern: Kernel, node, c: int, target: float, tol: float, counter: dict):
+    """March node's coordinate c to target (no chart book); raises where it stalls."""
+    if node.q[c] == target:
+        return node
+    nodes, stop = _march(kern, _node(kern, node.x, node.q, c), c, [target],
+                         **_steps(kern, c, tol, counter))
+    if stop is not None:
+        raise _error(kern, stop.q_try, stop.node.x)
+    return nodes[-1]
 
-    def _steps(self, c: int) -> dict:
-        """The march's step limits for driven coordinate c (those of the sweep)."""
-        L = 1.0 if self.model.coord_is_angle[self.didx[c]] else self.model.length_scale
-        return {"max_step": (DEFAULT_MAX_STEP if L == 1.0 else 0.05 * L),
-                "min_step": DEFAULT_MIN_STEP * L, "tol": self.tol, "counter": self.counter}
 
-    def _move(self, node, c: int, target: float):
-        """March node's coordinate c to target (no chart book); raises where it stalls."""
-        if node.q[c] == target:
+def _start(kern: Kernel, q0, x_start, j: int, tol: float, counter: dict):
+    """The node at the held coordinates of q0 (coordinate j as at x_start), by
+    continuation from the pose x_start when it is assembled, else by Newton's method
+    (least squares first when that fails) at q0."""
+    q_s = coordinates(kern.model, x_start)[kern.idx]
+    x, ok, _, J = _newton(kern, x_start, q_s, tol, max_iter=60)
+    if ok:
+        try:
+            node = _node(kern, x, q_s, j, J)
+            for c in range(len(q0)):
+                if c != j:
+                    node = _move(kern, node, c, q0[c], tol, counter)
             return node
-        nodes, stop = _march(self.kern, _node(self.kern, node.x, node.q, c), c, [target],
-                             **self._steps(c))
-        if stop is not None:
-            raise self._error(stop.q_try, stop.node.x)
-        return nodes[-1]
-
-    def _start(self, q0, x_start):
-        """The node at the held coordinates of q0 (the varying one as at x_start), by
-        continuation from the pose x_start when it is assembled, else by Newton's method
-        (least squares first when that fails) at q0."""
-        q_s = coordinates(self.model, x_start)[self.didx]
-        x, ok, _, J = self._newton(q_s, x_start, max_iter=60)
-        if ok:
-            try:
-                node = _node(self.kern, x, q_s, self._j, J)
-                for c in range(len(q0)):
-                    if c != self._j:
-                        node = self._move(node, c, q0[c])
-                return node
-            except (AssemblyError, SingularPositionError):
-                pass
-        x, ok, _, J = self._newton(q0, x_start, max_iter=60)
+        except (AssemblyError, SingularPositionError):
+            pass
+    x, ok, _, J = _newton(kern, x_start, q0, tol, max_iter=60)
+    if not ok:
+        sol = least_squares(lambda xx: kern.system(xx, q0)[0], x_start,
+                            jac=lambda xx: kern.system(xx, q0)[1], method="trf", xtol=1e-15,
+                            ftol=1e-15, gtol=1e-15, max_nfev=2000,
+                            x_scale=kern.col_scale / kern.model.length_scale)
+        x, ok, _, J = _newton(kern, sol.x, q0, tol, max_iter=30)
         if not ok:
-            def system(xx):
-                return self.kern.system(xx, q0)
+            raise _error(kern, q0, x)
+    return _node(kern, x, q0, j, J)
 
-            sol = least_squares(lambda xx: system(xx)[0], x_start, jac=lambda xx: system(xx)[1],
-                                method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15,
-                                x_scale=self.kern.col_scale / self.model.length_scale,
-                                max_nfev=2000)
-            x, ok, _, J = self._newton(q0, sol.x)
-            if not ok:
-                raise self._error(q0, x)
-        return _node(self.kern, x, q0, self._j, J)
 
-    def _error(self, qd, x, t=None):
-        res = joint_residuals(self.model, x, self.lay)
-        r = rows_numpy.values(self.lay.rowset, x)
-        res.update({el: float(np.linalg.norm(r[idx]))
-                    for el, idx in getattr(self.lay, "elements", {}).items()})
-        names = [self.model.coordinate_names[k] for k in self.didx]
-        if max(res.values(), default=0.0) < 1e-6 * self.model.length_scale:
-            return SingularPositionError(
-                "the position solve stalls near a dead, toggle or change point: the driven "
-                "coordinate(s) " + ", ".join(names) + " lose control of the mechanism there "
-                "(largest joint residual " + f"{max(res.values()):.3g}); analyse up to that "
-                "position or choose another driven coordinate", t=t, q=qd,
-                coordinates=names, joints=list(res))
-        open_ = {n: v for n, v in res.items() if v > 1e-9 * max(self.model.length_scale, 1e-3)}
-        qs = ", ".join(f"{n} = {v:.6g}" for n, v in zip(names, np.atleast_1d(qd), strict=True))
-        parts = ", ".join(f"{n!r}: {v:.3g}" for n, v in open_.items()) or "none"
-        return AssemblyError(f"the mechanism cannot be assembled at {qs}; joints that stay "
-                             f"open (residual, m or rad): {parts}", t=t, q=qd,
-                             residuals=open_)
+def _error(kern: Kernel, qd, x):
+    """SingularPositionError where the position solve stalls at an assembled pose x, else
+    AssemblyError naming the joints (and switchable elements) that stay open."""
+    model, lay = kern.model, kern.lay
+    res = joint_residuals(model, x, lay)
+    r = rows_numpy.values(lay.rowset, x)
+    res.update({el: float(np.linalg.norm(r[idx]))
+                for el, idx in getattr(lay, "elements", {}).items()})
+    names = [model.coordinate_names[k] for k in kern.idx]
+    if max(res.values(), default=0.0) < 1e-6 * model.length_scale:
+        return SingularPositionError(
+            "the position solve stalls near a dead, toggle or change point: the driven "
+            "coordinate(s) " + ", ".join(names) + " lose control of the mechanism there "
+            "(largest joint residual " + f"{max(res.values()):.3g}); analyse up to that "
+            "position or choose another driven coordinate", q=qd, coordinates=names,
+            joints=list(res))
+    open_ = {n: v for n, v in res.items() if v > 1e-9 * max(model.length_scale, 1e-3)}
+    qs = ", ".join(f"{n} = {v:.6g}" for n, v in zip(names, np.atleast_1d(qd), strict=True))
+    parts = ", ".join(f"{n!r}: {v:.3g}" for n, v in open_.items()) or "none"
+    return AssemblyError(f"the mechanism cannot be assembled at {qs}; joints that stay "
+                         f"open (residual, m or rad): {parts}", q=qd, residuals=open_)
 
-    def solve(self, qd, x_start, x_guess=None):
-        """Poses (n, n_x) at the driven coordinates qd (n, n_d): one batched Newton solve
-        from the guesses x_guess when it converges everywhere, else by continuation from
-        x_start (or the first guess)."""
-        n, kern = qd.shape[0], self.kern
-        var = np.flatnonzero(np.ptp(qd, axis=0) > 0) if n > 1 else []
-        self._j = int(var[0]) if len(var) == 1 else 0
-        self.book, self.charted, self._system = None, None, None
-        if len(var) == 1 and kern.square and not isinstance(self.lay, ModeRows):
-            self.book = ChartBook(PathProblem(self.model, self.lay, self.didx, qd[0], self._j))
-        if x_guess is not None:
-            x, ok, F, J = self._newton(qd, x_guess)
-            if np.all(ok):
-                self._system = (F, J, kern.factor(J))
-                if self.book is not None:  # watch the poses for bifurcations
-                    for k in range(n):
-                        if self.book.zone_chart(qd[k, self._j]) is None:
-                            self.book.watch(float(qd[k, self._j]), x[k])
-                return x
-            x_start = x_guess[0]
-        node = self._start(qd[0], np.asarray(x_start, dtype=float))
+
+def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=None):
+    """Poses, velocities and accelerations with the driven coordinates ``didx`` following
+    qd, qd_dot, qd_ddot (n, n_d), on the kinematics continuation: the kernel of the rows
+    of ``lay`` (a layout or :class:`ModeRows`) then the driven coordinates' rows, one
+    batched Newton solve from the guesses x_guess (n, n_x) when it converges everywhere,
+    else the sweep's continuation (:func:`~mechdyn.kinematics.sweep._path`) from the pose
+    x_start along the one varying driven coordinate, through bifurcation positions with
+    a chart book, or coordinate by coordinate when several vary.
+
+    Returns x, xdot, xddot (n, n_x), the samples in a chart's zone (mask (n,), x', x''
+    along the varying coordinate) or None, and the stats ``position_solves`` and
+    ``bifurcations``."""
+    didx = np.asarray(didx, dtype=int)
+    kern = Kernel(model, lay, didx) if isinstance(lay, ModeRows) else _kernel(model, lay, didx)
+    tol, counter, n = 1e-12 * max(model.length_scale, 1e-3), {"coarse_steps": 0}, len(qd)
+    var = np.flatnonzero(np.ptp(qd, axis=0) > 0) if n > 1 else []
+    j = int(var[0]) if len(var) == 1 else 0
+    book = None
+    if len(var) == 1 and kern.square and not isinstance(lay, ModeRows):
+        book = ChartBook(PathProblem(model, lay, didx, qd[0], j))
+    ok = guessed = False
+    if x_guess is not None:
+        x, ok, F, J = _newton(kern, x_guess, qd, tol, max_iter=30)
+    if np.all(ok):
+        guessed = True
+        system = (F, J, kern.factor(J))
+        for k in range(n if book is not None else 0):  # watch the poses for bifurcations
+            if book.zone_chart(qd[k, j]) is None:
+                book.watch(float(qd[k, j]), x[k])
+    else:
+        node = _start(kern, qd[0], np.asarray(x_start if x_guess is None else x_guess[0],
+                                              dtype=float), j, tol, counter)
         if len(var) <= 1:
-            x, stop, self._system = _path(kern, node, self._j, qd[:, self._j], book=self.book,
-                                          **self._steps(self._j))
+            x, stop, system = _path(kern, node, j, qd[:, j], book=book,
+                                    **_steps(kern, j, tol, counter))
             if stop is not None:
-                raise self._error(stop.q_try, stop.node.x)
-            return x
-        x = np.empty((n, self.model.n_x))
-        for k in range(n):
-            for c in var:
-                node = self._move(node, c, qd[k, c])
-            x[k] = node.x
-        return x
-
-    def motion(self, x, qd, qd_dot, qd_ddot):
-        """Poses, velocities and accelerations for the driven coordinates and their rates
-        at the poses x of :meth:`solve` (batched), from the charts in bifurcation zones
-        (:attr:`charted`)."""
-        x, _, xdot, xddot, self.charted = _motion(self.kern, x, qd, qd_dot, qd_ddot,
-                                                  self.book, self._j, self._system,
-                                                  correct=False)
-        return x, xdot, xddot
+                raise _error(kern, stop.q_try, stop.node.x)
+        else:
+            x, system = np.empty((n, model.n_x)), None
+            for k in range(n):
+                for c in var:
+                    node = _move(kern, node, c, qd[k, c], tol, counter)
+                x[k] = node.x
+    x, _, xdot, xddot, charted = _motion(kern, x, qd, qd_dot, qd_ddot, book, j, system,
+                                         correct=False)
+    # Newton solves: the continuation's steps and the batched solves
+    solves = counter["coarse_steps"] + (x_guess is not None) + (not guessed)
+    stats = {"position_solves": solves,
+             "bifurcations": book.report() if book is not None else []}
+    return x, xdot, xddot, charted, stats
 
 
 def _independent_subset(model, lay, x0, first: list[int], candidates=None) -> list[int]:

@@ -11,7 +11,7 @@ import warnings as _warnings
 import numpy as np
 
 from ..errors import Status
-from ..kinematics.assembly import SINGULAR_RCOND, _scale
+from ..kinematics.assembly import SINGULAR_RCOND, _dependent_rows, _scale
 from ..kinematics.constraints import _perp, coordinates_jacobian, extend
 from ..model import ConstraintLayout, Model
 from .forces import applied_forces, cross, rotate
@@ -45,10 +45,7 @@ def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
     if n_red == 0:
         return 0, [], []
     k = int(np.argmin(r))
-    u = np.linalg.svd(P[k])[0]
-    null = u[:, int(r[k]):]
-    weight = np.sum(null**2, axis=1)
-    rows = [i for i in range(lay.n_rows) if weight[i] > 1e-6]
+    rows = _dependent_rows(P[k], int(r[k]))
     joints = sorted({str(lay.row_joint[i]) for i in rows})
     n_base = getattr(lay, "n_base", lay.n_rows)
     labels = [lay.extra[i - n_base].label if i >= n_base else

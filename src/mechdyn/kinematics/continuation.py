@@ -58,8 +58,9 @@ class Kernel:
     """
 
     def __init__(self, model: Model, layout: ConstraintLayout, idx=None):
-        self.model = model
-        self.lay = layout
+        self.model, self.lay = model, layout
+        #: the coordinates q stands for
+        self.idx = np.arange(model.n_q) if idx is None else np.asarray(idx, dtype=int)
         nb = self.nb = model.n_bodies
         self.n_x = 3 * nb
         self.n_rows = layout.n_rows
