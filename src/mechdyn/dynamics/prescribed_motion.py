@@ -159,14 +159,15 @@ def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=N
     batched Newton solve from the guesses x_guess (n, n_x) when it converges everywhere,
     else the sweep's continuation (:func:`~mechdyn.kinematics.sweep._path`) from the pose
     x_start along the one varying driven coordinate, through bifurcation positions with
-    a chart book, or coordinate by coordinate when several vary.
+    a chart book, or through anchors reached coordinate by coordinate when several vary.
 
     Returns x, xdot, xddot (n, n_x), the samples in a chart's zone (mask (n,), x', x''
     along the varying coordinate) or None, and the stats ``position_solves`` and
     ``bifurcations``."""
     didx = np.asarray(didx, dtype=int)
     kern = Kernel(model, lay, didx) if isinstance(lay, ModeRows) else _kernel(model, lay, didx)
-    tol, counter, n = 1e-12 * max(model.length_scale, 1e-3), {"coarse_steps": 0}, len(qd)
+    tol, n = 1e-12 * max(model.length_scale, 1e-3), len(qd)
+    counter = {"coarse_steps": 0}
     var = np.flatnonzero(np.ptp(qd, axis=0) > 0) if n > 1 else []
     j = int(var[0]) if len(var) == 1 else 0
     book = None
@@ -189,12 +190,24 @@ def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=N
                                     **_steps(kern, j, tol, counter))
             if stop is not None:
                 raise _error(kern, stop.q_try, stop.node.x)
-        else:
-            x, system = np.empty((n, model.n_x)), None
-            for k in range(n):
+        else:  # about 100 anchors in sequence, then one batched solve from their analogs
+            anchors = np.unique(np.r_[np.arange(0, n, max(1, n // 100)), n - 1])
+            nodes = []
+            for k in anchors:
                 for c in var:
                     node = _move(kern, node, c, qd[k, c], tol, counter)
-                x[k] = node.x
+                nodes.append(node)
+            a = [nodes[i] for i in np.searchsorted(anchors, np.arange(n), "right") - 1]
+            pred = np.array([nd.x + nd.B @ (qk - nd.q) for nd, qk in zip(a, qd, strict=True)])
+            x, ok, F, J = _newton(kern, pred, qd, tol, max_iter=30)
+            fac = kern.factor(J)
+            system = (F, J, fac)
+            ok &= fac[2] == np.array([nd.sign for nd in a])  # on the anchor's branch
+            for k in np.flatnonzero(~ok):  # by continuation from the anchor
+                nd = a[k]
+                for c in var:
+                    nd = _move(kern, nd, c, qd[k, c], tol, counter)
+                x[k], system = nd.x, None
     x, _, xdot, xddot, charted = _motion(kern, x, qd, qd_dot, qd_ddot, book, j, system,
                                          correct=False)
     # Newton solves: the continuation's steps and the batched solves
