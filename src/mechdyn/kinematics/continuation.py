@@ -14,7 +14,8 @@ Jacobian [Phi_x; g_x] and gamma = -quad of the model's rows, evaluated and facto
 drivers of :mod:`mechdyn.kernels.rows_sweep`, one position or a whole batch per call
 (NumPy's per-call overhead and temporaries would dominate), or without numba by
 :mod:`mechdyn.kernels.rows_numpy` and dense solves.  The analyses that use them are in
-:mod:`mechdyn.kinematics.sweep`; the dead-centre refinement of
+:mod:`mechdyn.kinematics.sweep` and, with the driven coordinates prescribed,
+:mod:`mechdyn.dynamics.prescribed_motion`; the dead-centre refinement of
 :mod:`mechdyn.kinematics.records` reuses :func:`_newton` and :func:`_node`.
 """
 

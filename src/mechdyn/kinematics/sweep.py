@@ -38,7 +38,8 @@ constraint and coordinate rows (:mod:`mechdyn.model.rows`), the equations of
 (compiled when numba is installed) that also factors the Jacobians (sparse LU,
 which gives the branch sign too).
 
-This module holds the analyses :func:`sweep` and :func:`analyze`; the building
+This module holds the analyses :func:`sweep` and :func:`analyze` (steps 1-3 in
+:func:`_path`, step 4 in :func:`_motion`, which kinetostatics uses too); the building
 blocks of the continuation are in :mod:`mechdyn.kinematics.continuation`, the
 records :class:`KinematicSweep` and :class:`KinematicPoint` and their derived
 figures (:class:`SweepSummary`: dead centres, strokes, four-bar loops and
