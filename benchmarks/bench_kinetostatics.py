@@ -1,7 +1,7 @@
 """Kinetostatic cycle of the six-bar toggle press: vectorized over positions vs a loop.
 
-The vectorized analysis solves the positions by continuation on ~100 anchors and
-one batched Newton solve, then the velocities, accelerations, loads and the
+The vectorized analysis solves the positions by the sweep's continuation (anchors
+every 5 deg, then one batched Newton solve), then the velocities, accelerations, loads and the
 inverse-dynamics systems of all positions in single batched calls.  The loop
 does the same work position by position (continuation from the previous pose,
 one inverse solve per position), as a scalar implementation would.
@@ -17,9 +17,8 @@ import numpy as np
 
 from mechdyn import examples
 from mechdyn.dynamics.kinetostatics import kinetostatics
-from mechdyn.dynamics.prescribed_motion import _Positions
 from mechdyn.dynamics.reactions import _inverse
-from mechdyn.kinematics.constraints import coordinates
+from mechdyn.kinematics.sweep import analyze
 
 N_POSITIONS = 3600
 OMEGA = 40 * 2 * np.pi / 60  # rad/s, 40 strokes per minute
@@ -37,20 +36,14 @@ def per_position_loop(model, values):
     """The same analysis, one position at a time; returns the driving torques (n,)."""
     lay = model.layout()
     didx = np.array([model.coordinate_index("phi")])
-    pos = _Positions(model, lay, didx)
-    qd = values[:, None]
-    x = pos.first(qd[0], model.x0)
-    J = pos.jac(x)
+    x = model.x0
     tau = np.empty(values.size)
     for k in range(values.size):
-        if k:
-            x, J = pos.step(qd[k - 1], x, qd[k], J)
-        xs = x[None, :]
-        xdot, xddot = pos.motion(xs, np.array([[OMEGA]]), np.zeros((1, 1)))
-        q = coordinates(model, xs)
+        pt = analyze(model, [values[k]], [OMEGA], x_guess=x)  # from the previous pose
+        x, q = pt.x, pt.q[None, :]
         t = np.array([(values[k] - values[0]) / OMEGA])
-        tau[k] = _inverse(model, lay, didx, t, xs, xdot, xddot, q, q * 0 + OMEGA, skip=didx,
-                          reacting=(), point=np.zeros(2))["tau"][0, 0]
+        tau[k] = _inverse(model, lay, didx, t, x[None], pt.xdot[None], pt.xddot[None], q,
+                          q * 0 + OMEGA, skip=didx, reacting=(), point=np.zeros(2))["tau"][0, 0]
     return tau
 
 

@@ -16,7 +16,7 @@ from ..errors import ModelError, Status, did_you_mean
 from ..kinematics.constraints import coordinates, coordinates_gamma, coordinates_jacobian
 from ..results.kinetostatics_record import Kinetostatics
 from .forces import force_model
-from .prescribed_motion import _independent_subset, _Positions
+from .prescribed_motion import _independent_subset, _prescribed
 from .reactions import _inverse
 
 __all__ = ["_kinetostatics", "MESSAGES"]
@@ -47,17 +47,13 @@ def _on_times(fn: Callable, tt, n_d: int) -> np.ndarray:
 
 def _derivs(law: Callable, t: np.ndarray, n_d: int):
     """Values and two derivatives of a law of time (5-point central differences)."""
-    def ev(tt):
-        return _on_times(law, tt, n_d)
-
     first = law(float(t[0])) if t.size else None
     if isinstance(first, tuple) and len(first) == 3:
         return tuple(np.array([np.asarray(law(float(s))[i], dtype=float).reshape(n_d)
                                for s in t]) for i in range(3))
     span = float(np.ptp(t)) if t.size > 1 else 1.0
     h = 1e-3 * (span if span > 0 else 1.0)
-    y0 = ev(t)
-    yp1, ym1, yp2, ym2 = ev(t + h), ev(t - h), ev(t + 2 * h), ev(t - 2 * h)
+    y0, yp1, ym1, yp2, ym2 = (_on_times(law, t + d * h, n_d) for d in (0, 1, -1, 2, -2))
     yd = (8 * (yp1 - ym1) - (yp2 - ym2)) / (12 * h)
     ydd = (16 * (yp1 + ym1) - (yp2 + ym2) - 30 * y0) / (12 * h * h)
     return y0, yd, ydd
@@ -65,9 +61,6 @@ def _derivs(law: Callable, t: np.ndarray, n_d: int):
 
 def _integrate_speed(omega: Callable, t: np.ndarray, start: np.ndarray, n_d: int):
     """q(t) = start + integral of omega, by 5-point Gauss-Legendre per interval."""
-    def ev(tt):
-        return _on_times(omega, tt, n_d)
-
     xg, wg = np.polynomial.legendre.leggauss(5)
     q = np.empty((t.size, n_d))
     q[0] = start
@@ -75,10 +68,11 @@ def _integrate_speed(omega: Callable, t: np.ndarray, start: np.ndarray, n_d: int
         a, b = t[:-1], t[1:]
         mid, half = 0.5 * (a + b), 0.5 * (b - a)
         nodes = (mid[:, None] + half[:, None] * xg[None, :]).ravel()
-        w = ev(nodes).reshape(a.size, xg.size, n_d)
+        w = _on_times(omega, nodes, n_d).reshape(a.size, xg.size, n_d)
         inc = np.einsum("k,nkd->nd", wg, w) * half[:, None]
         q[1:] = start + np.cumsum(inc, axis=0)
-    return q, *_derivs(ev, t, n_d)[:2]
+    # (through _on_times: a tuple omega(t) is not a law's (q, qdot, qddot))
+    return q, *_derivs(lambda tt: _on_times(omega, tt, n_d), t, n_d)[:2]
 
 
 def _to_array(v, n_d: int, what: str) -> np.ndarray:
@@ -199,16 +193,8 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
         raise ValueError("no positions to analyse")
 
     # ---------------------------------------------------------- kinematics
-    pos = _Positions(model, lay, didx)
-    x = pos.solve(qd, np.asarray(x_start, dtype=float), x_guess)
-    xdot, xddot = pos.motion(x, qd_dot, qd_ddot)
-    if pos.branch_changes:
-        names = [model.coordinate_names[k] for k in didx]
-        at = ", ".join(f"{nm} = {v:.6g}" for nm, v in zip(names, pos.branch_changes[0],
-                                                          strict=True))
-        warn.append(f"the assembly branch changes near {at} ({len(pos.branch_changes)} "
-                    f"time(s)): the motion passes a singular (change or dead) position; "
-                    f"results beyond it belong to another assembly mode")
+    x, xdot, xddot, charted, pos_stats = _prescribed(
+        model, lay, didx, qd, qd_dot, qd_ddot, np.asarray(x_start, dtype=float), x_guess)
     G = coordinates_jacobian(model, x)
     q = coordinates(model, x)
     qdot = np.einsum("nqx,nx->nq", G, xdot)
@@ -219,7 +205,7 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
     core = _inverse(model, lay, didx, tt, x, xdot, xddot, q, qdot,
                     skip=didx if model_drives == "replace" else (),
                     reacting=tuple(reacting_loads), point=np.asarray(point, dtype=float),
-                    charted=pos.charted)
+                    charted=charted)
     tau, status = core.pop("tau"), core.pop("status")
     warn.extend(core.pop("warnings"))
     notes = []
@@ -231,9 +217,7 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                            "(driving = the whole torque the drive must deliver)")
     over_values = q[:, model.coordinate_index(over_names[0])]
     stats = core.pop("stats")
-    stats.update(positions=n, position_solves=pos.solves,
-                 bifurcations=pos.book.report() if pos.book is not None else [],
-                 seconds=time.perf_counter() - t_start)
+    stats.update(positions=n, **pos_stats, seconds=time.perf_counter() - t_start)
     message = MESSAGES[status]
     if status == Status.SINGULAR_POSITION and not stats.get("singular_positions"):
         message = ("completed through bifurcation position(s): the mechanism stays on its "

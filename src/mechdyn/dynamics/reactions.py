@@ -11,7 +11,7 @@ import warnings as _warnings
 import numpy as np
 
 from ..errors import Status
-from ..kinematics.assembly import SINGULAR_RCOND, _scale
+from ..kinematics.assembly import SINGULAR_RCOND, _dependent_rows, _scale
 from ..kinematics.constraints import _perp, coordinates_jacobian, extend
 from ..model import ConstraintLayout, Model
 from .forces import applied_forces, cross, rotate
@@ -45,10 +45,7 @@ def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
     if n_red == 0:
         return 0, [], []
     k = int(np.argmin(r))
-    u = np.linalg.svd(P[k])[0]
-    null = u[:, int(r[k]):]
-    weight = np.sum(null**2, axis=1)
-    rows = [i for i in range(lay.n_rows) if weight[i] > 1e-6]
+    rows = _dependent_rows(P[k], int(r[k]))
     joints = sorted({str(lay.row_joint[i]) for i in rows})
     n_base = getattr(lay, "n_base", lay.n_rows)
     labels = [lay.extra[i - n_base].label if i >= n_base else
@@ -273,17 +270,15 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     frame_loads: dict[str, np.ndarray] = {}
     for name in (n for n in model.joint_names if n in lay.rows):
         kind, i, j, _ = reaction_frame(model, name)
-        f, mP, Pt = joint_reaction(model, name, x, C[:, lay.rows[name], :].sum(axis=1))
+        gen = C[:, lay.rows[name], :].sum(axis=1)
+        f, mP, Pt = joint_reaction(model, name, x, gen)
         reactions[name], moments[name], jpoints[name], kinds[name] = f, mP, Pt, kind
         # prismatic: along and normal to the axis; else along the parent's x and y axes
         u = rotate(X[:, i, 2], model.pri.ui[model.pri.names.index(name)]
                    if kind == "prismatic" else (1.0, 0.0))
         jframe[name] = np.stack([np.sum(f * u, -1), np.sum(f * _perp(u), -1)], axis=-1)
         if i == nb or j == nb:
-            sgn = 1.0 if j == nb else -1.0  # what the frame receives
-            ff, mm = sgn * f, sgn * mP
-            frame_loads[name] = np.concatenate(
-                [ff, (mm + cross(Pt - point, ff))[:, None]], axis=-1)
+            frame_loads[name] = _net_on_ground(model, x, gen, point)
 
     # ------------------------------------------------ switchable elements (modes.py rows)
     el_forces: dict[str, np.ndarray] = {}

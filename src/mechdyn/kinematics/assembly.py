@@ -395,12 +395,7 @@ def rank_report(model: Model, x, layout=None) -> dict:
     rank_phi = _rank(P, tol_rel)
     redundant = []
     if rank_phi < lay.n_rows:
-        # rows that are linear combinations of the others: left null space of Phi_x
-        u, s, _ = np.linalg.svd(P)
-        smax = s[0] if s.size else 1.0
-        null = u[:, int(np.sum(s > tol_rel * smax)):]
-        weight = np.sum(null**2, axis=1)
-        redundant = sorted({lay.row_joint[r] for r in range(lay.n_rows) if weight[r] > 1e-6})
+        redundant = sorted({lay.row_joint[r] for r in _dependent_rows(P, rank_phi)})
     rank_full = _rank(np.concatenate([P, Gq]), tol_rel)
     dep = []
     if model.n_q and rank_full < rank_phi + model.n_q:
@@ -415,3 +410,10 @@ def _rank(A, tol_rel):
         return 0
     s = np.linalg.svd(A, compute_uv=False)
     return int(np.sum(s > tol_rel * s[0])) if s[0] > 0 else 0
+
+
+def _dependent_rows(P, rank: int) -> np.ndarray:
+    """The rows of P (of rank ``rank``) that are linear combinations of the others: those
+    that carry its left null space."""
+    null = np.linalg.svd(P)[0][:, rank:]
+    return np.flatnonzero(np.sum(null**2, axis=1) > 1e-6)

@@ -14,7 +14,8 @@ Jacobian [Phi_x; g_x] and gamma = -quad of the model's rows, evaluated and facto
 drivers of :mod:`mechdyn.kernels.rows_sweep`, one position or a whole batch per call
 (NumPy's per-call overhead and temporaries would dominate), or without numba by
 :mod:`mechdyn.kernels.rows_numpy` and dense solves.  The analyses that use them are in
-:mod:`mechdyn.kinematics.sweep`; the dead-centre refinement of
+:mod:`mechdyn.kinematics.sweep` and, with the driven coordinates prescribed,
+:mod:`mechdyn.dynamics.prescribed_motion`; the dead-centre refinement of
 :mod:`mechdyn.kinematics.records` reuses :func:`_newton` and :func:`_node`.
 """
 
@@ -58,8 +59,9 @@ class Kernel:
     """
 
     def __init__(self, model: Model, layout: ConstraintLayout, idx=None):
-        self.model = model
-        self.lay = layout
+        self.model, self.lay = model, layout
+        #: the coordinates q stands for
+        self.idx = np.arange(model.n_q) if idx is None else np.asarray(idx, dtype=int)
         nb = self.nb = model.n_bodies
         self.n_x = 3 * nb
         self.n_rows = layout.n_rows
@@ -127,7 +129,7 @@ class Kernel:
     def apply(self, J, fac, rhs):
         """y with J y = rhs, J (N, n_eq, n_x) and rhs (N, n_eq, k) -> (N, n_x, k), or one
         position (J 2-D, rhs 1-D or 2-D), with the factors of :meth:`factor`."""
-        if fac is None or fac[0] is None:
+        if fac is None or fac[0] is None or not np.size(rhs):
             return _dense_solve(J, rhs)
         y = np.array(rhs, dtype=float)
         shape = y.shape

@@ -12,6 +12,7 @@ every named point.  :func:`_travel` is the travel of a prismatic joint and its r
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
+from functools import partial
 
 import numpy as np
 from scipy.optimize import brentq
@@ -424,7 +425,7 @@ def _summarize(sw: KinematicSweep) -> SweepSummary:
             continue
         found = []
         for i in np.flatnonzero(np.sign(ds[:-1]) * np.sign(ds[1:]) < 0):
-            q_at, s_at = _refine_dead_centre(sw, jname, i)
+            q_at, s_at = _refine_root(sw, i, partial(_travel, m, jname))
             # a maximum where the travel rate goes from + to - along the sweep direction
             is_max = (ds[i] > 0) == (sw.values[i + 1] > sw.values[i])
             found.append((q_at, s_at, is_max))
@@ -462,9 +463,11 @@ def _summarize(sw: KinematicSweep) -> SweepSummary:
     return SweepSummary(sw.over, sw.over_is_angle, strokes, dcs, trans, ext)
 
 
-def _refine_dead_centre(sw: KinematicSweep, jname: str, i: int) -> tuple[float, float]:
-    """Root of the exact travel rate ds/dq between positions i and i+1 (Brent's method,
-    each rate at a position solved from the last); returns (q there, travel there)."""
+def _refine_root(sw: KinematicSweep, i: int, quantity) -> tuple[float, float]:
+    """Root of the exact rate of a quantity along the swept coordinate between positions
+    i and i+1 (Brent's method, each position solved from the last): ``quantity(x, x', x'')``
+    gives the value and its first derivative (a travel, a point coordinate); returns
+    (q there, value there)."""
     m, k = sw.model, sw.over_index
     kern = _kernel(m, m.layout(sw.stats.get("mode")))
     tol = _position_tol(m)
@@ -478,7 +481,7 @@ def _refine_dead_centre(sw: KinematicSweep, jname: str, i: int) -> tuple[float, 
             raise ArithmeticError(f"no position at {sw.over} = {q_over!r}")
         node = _node(kern, x, q, k, J=J)
         last["x"] = x
-        s, ds, _ = _travel(m, jname, x, node.B[:, k], node.H)
+        s, ds = quantity(x, node.B[:, k], node.H)[:2]
         last["s"] = float(s)
         return float(ds)
 
@@ -487,7 +490,7 @@ def _refine_dead_centre(sw: KinematicSweep, jname: str, i: int) -> tuple[float, 
         q = brentq(rate, min(a, b), max(a, b), xtol=1e-15, rtol=4 * np.finfo(float).eps)
         rate(q)
     except (ArithmeticError, ValueError):  # no solved root: interpolate the sampled rates
-        _, fa, _ = _travel(m, jname, sw.x[i], sw.B[i, :, k], np.zeros(m.n_x))
-        _, fb, _ = _travel(m, jname, sw.x[i + 1], sw.B[i + 1, :, k], np.zeros(m.n_x))
+        fa = quantity(sw.x[i], sw.B[i, :, k], np.zeros(m.n_x))[1]
+        fb = quantity(sw.x[i + 1], sw.B[i + 1, :, k], np.zeros(m.n_x))[1]
         q = a - fa * (b - a) / (fb - fa)
     return float(q), last["s"]

@@ -38,7 +38,8 @@ constraint and coordinate rows (:mod:`mechdyn.model.rows`), the equations of
 (compiled when numba is installed) that also factors the Jacobians (sparse LU,
 which gives the branch sign too).
 
-This module holds the analyses :func:`sweep` and :func:`analyze`; the building
+This module holds the analyses :func:`sweep` and :func:`analyze` (steps 1-3 in
+:func:`_path`, step 4 in :func:`_motion`, which kinetostatics uses too); the building
 blocks of the continuation are in :mod:`mechdyn.kinematics.continuation`, the
 records :class:`KinematicSweep` and :class:`KinematicPoint` and their derived
 figures (:class:`SweepSummary`: dead centres, strokes, four-bar loops and
@@ -234,19 +235,54 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
     qdot_c = _rates(model, k, speed)
 
     counter: dict = {}
+    X, stop, system = _path(kern, start, k, values, max_step=max_step, min_step=min_step,
+                            tol=tol, book=book, counter=counter)
+    N = len(X)
+    Q = _coords(q_init, k, values[:N])
+    qdot = np.broadcast_to(qdot_c, (N, model.n_q)).copy()
+    qddot = np.zeros((N, model.n_q))
+    X, B, xdot, xddot, _ = _motion(kern, X, Q, qdot, qddot, book, k, system)
+
+    status, message, events, error = "success", "", (), None
+    if stop is not None:
+        status = Status.SINGULAR_POSITION
+        error, event = _dead_report(model, lay, k, stop, N, n_req)
+        message = str(error)
+        events = (event,)
+    elapsed = time.perf_counter() - t_start
+    stats = {"n_points": int(N), "n_requested": int(n_req), "anchors": counter["anchors"],
+             "coarse_steps": int(counter.get("coarse_steps", 0)),
+             "rejected_steps": int(counter.get("rejected_steps", 0)),
+             "fallback_segments": counter["fallback"], "time_s": elapsed,
+             "time_coarse_s": counter["time_coarse"],
+             "positions_per_s": N / elapsed if elapsed > 0 else np.inf,
+             "bifurcations": book.report() if book is not None else [],
+             "mode": tuple(sorted(lay.mode))}
+    return KinematicSweep(
+        over=over, values=_ro(values[:N].copy()), q=_ro(Q), qdot=_ro(qdot), qddot=_ro(qddot),
+        x=_ro(X), xdot=_ro(xdot), xddot=_ro(xddot), B=_ro(B), status=status, message=message,
+        stats=stats, events=events, error=error, model=model)
+
+
+def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter):
+    """The continuation of the sweep from the node ``start`` through ``values`` of
+    coordinate k (the kernel's other coordinates held at ``start.q``): steps 1 to 3 of
+    the module docstring.  Returns the poses reached (n_ok, n_x), the :class:`_Stop` or
+    None and (F, J, factors) at the poses or None; ``counter`` gets the step counts,
+    ``anchors``, ``fallback`` and ``time_coarse``."""
+    model, n_req = kern.model, len(values)
     t_coarse = time.perf_counter()
     # ---- 1. coarse continuation through the anchors
     anchors = _anchor_indices(values, max_step)
     anodes, stop = _march(kern, start, k, values[anchors], max_step=max_step,
                           min_step=min_step, tol=tol, counter=counter, book=book)
     n_anch = len(anodes)
-
-    t_coarse = time.perf_counter() - t_coarse
+    counter.update(time_coarse=time.perf_counter() - t_coarse, anchors=len(anchors),
+                   fallback=0)
     # ---- 2. batched solve of every value between solved anchors
     n_ok = int(anchors[n_anch - 1]) + 1 if n_anch else 0
     X = np.empty((n_ok, model.n_x))
-    F = fac = None  # F, J and the factors at X, while they are current
-    fallback = 0
+    system = None  # F, J and the factors at X, while they are current
     if n_anch == 1:
         X[:] = anodes[0].x
     elif n_anch > 1:
@@ -261,14 +297,15 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
         with np.errstate(invalid="ignore", divide="ignore"):
             t = np.where(h != 0, (values[:n_ok, None] - qa[seg, None]) / h, 0.0)
         xp = _hermite5(t, h, xa[seg], da[seg], aa[seg], xa[seg + 1], da[seg + 1], aa[seg + 1])
-        X, ok_f, F, J = _newton(kern, xp, _coords(q_init, k, values[:n_ok]), tol, max_iter=5)
+        X, ok_f, F, J = _newton(kern, xp, _coords(start.q, k, values[:n_ok]), tol, max_iter=5)
         fac = kern.factor(J)
-        sgn = fac[2]
-        near = np.max(np.abs((X - xp) * kern.col_scale), axis=1) <= 1e-3 * L
-        ok_f &= (sgn == sg[seg]) & near
+        near = np.max(np.abs((X - xp) * kern.col_scale), axis=1) <= 1e-3 * model.length_scale
+        ok_f &= (fac[2] == sg[seg]) & near
+        system = (F, J, fac)
         bad_segments = np.unique(seg[~ok_f])
         for m_ in bad_segments:  # re-solve those segments point by point
-            fallback += 1
+            counter["fallback"] += 1
+            system = None
             i0, i1 = a_idx[m_], a_idx[m_ + 1]
             nodes, st = _march(kern, anodes[m_], k, values[i0 + 1:i1 + 1],
                                max_step=max_step, min_step=min_step, tol=tol, counter=counter,
@@ -281,8 +318,6 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
                 X = X[:n_ok]
                 anodes, n_anch = anodes[:m_ + 1], -1
                 break
-        if bad_segments.size:
-            F = None
 
     # ---- 3. past the last anchor: go on point by point up to the dead position
     if stop is not None and n_anch >= 0 and n_ok < n_req:
@@ -293,53 +328,54 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
                              book=book)
         if stop is None:  # cannot happen: the anchor itself was unreachable
             stop = _Stop(nodes[-1], nodes[-1].q, "the continuation could not reach "
-                         f"{over} = {values[nxt]:.9g}")
+                         f"{values[nxt]:.9g}")
         if nodes:
             X = np.concatenate([X, [nd.x for nd in nodes]])
-            n_ok += len(nodes)
-            F = None
+            system = None
+    return X, stop, system
 
-    # ---- 4. velocities and accelerations in one batch
-    N = n_ok
-    Q = _coords(q_init, k, values[:N])
-    qdot = np.broadcast_to(qdot_c, (N, model.n_q)).copy()
-    qddot = np.zeros((N, model.n_q))
-    if N:
-        if F is None:
-            F, J = kern.system(X, Q)
-            fac = kern.factor(J)
-        with np.errstate(all="ignore"):  # a Jacobian singular at a bifurcation: charted
-            rhs = np.concatenate([F[..., None], kern.rhs_unit(N)], axis=-1)
-            sol = kern.apply(J, fac, rhs)
-            X = X - sol[:, :, 0]  # a last Newton correction, at round-off level
-            B = sol[:, :, 1:]
-            xdot = np.einsum("nij,nj->ni", B, qdot)
-            xddot = kern.apply(J, fac, kern.gamma(X, xdot)[..., None])[..., 0]
-        if book is not None and book.charts:
-            X, B, xdot, xddot = _charted(book, k, Q, qdot, X, B, xdot, xddot)
-    else:
-        B = np.empty((0, model.n_x, model.n_q))
-        xdot = xddot = np.empty((0, model.n_x))
 
-    status, message, events, error = "success", "", (), None
-    if stop is not None:
-        status = Status.SINGULAR_POSITION
-        error, event = _dead_report(model, lay, k, stop, N, n_req)
-        message = str(error)
-        events = (event,)
-    elapsed = time.perf_counter() - t_start
-    stats = {"n_points": int(N), "n_requested": int(n_req), "anchors": int(len(anchors)),
-             "coarse_steps": int(counter.get("coarse_steps", 0)),
-             "rejected_steps": int(counter.get("rejected_steps", 0)),
-             "fallback_segments": int(fallback), "time_s": elapsed,
-             "time_coarse_s": t_coarse,
-             "positions_per_s": N / elapsed if elapsed > 0 else np.inf,
-             "bifurcations": book.report() if book is not None else [],
-             "mode": tuple(sorted(lay.mode))}
-    return KinematicSweep(
-        over=over, values=_ro(values[:N].copy()), q=_ro(Q), qdot=_ro(qdot), qddot=_ro(qddot),
-        x=_ro(X), xdot=_ro(xdot), xddot=_ro(xddot), B=_ro(B), status=status, message=message,
-        stats=stats, events=events, error=error, model=model)
+def _motion(kern, X, Q, qdot, qddot, book, k: int, system=None, correct=True):
+    """Step 4 of the module docstring: a last Newton correction of the poses X (N, n_x)
+    at the coordinates Q (with ``correct``), the analogs B and the velocities and
+    accelerations for the rates qdot, qddot (N, n_q), from the charts in the bifurcation
+    zones of ``book`` (swept coordinate k).  Returns X, B, xdot, xddot and the charted
+    samples (mask, x', x'') or None; ``system``: (F, J, factors) at X when they are current."""
+    N = len(X)
+    if not N:
+        empty = np.empty((0, kern.n_x))
+        return X, np.empty((0, kern.n_x, kern.n_q)), empty, empty, None
+    if system is None:
+        F, J = kern.system(X, Q)
+        system = (F, J, kern.factor(J))
+    F, J, fac = system
+    with np.errstate(all="ignore"):  # a Jacobian singular at a bifurcation: charted
+        rhs = kern.rhs_unit(N)
+        if correct:
+            rhs = np.concatenate([F[..., None], rhs], axis=-1)
+        B = kern.apply(J, fac, rhs)
+        if correct:
+            X = X - B[:, :, 0]  # a last Newton correction, at round-off level
+            B = B[:, :, 1:]
+        xdot = np.einsum("nij,nj->ni", B, qdot)
+        xddot = np.einsum("nij,nj->ni", B, qddot)
+        xddot += kern.apply(J, fac, kern.gamma(X, xdot)[..., None])[..., 0]
+    if book is None or not book.charts:
+        return X, B, xdot, xddot, None
+    mask, xc, xs, xss = book.apply(Q[:, k])
+    if not mask.any():
+        return X, B, xdot, xddot, None
+    # the limit from both sides, where the equations are ill-conditioned: the analogs of
+    # the other coordinates stay those of the direct solve, and so does the part of the
+    # acceleration due to their rates
+    X, B, xdot, xddot = X.copy(), B.copy(), xdot.copy(), xddot.copy()
+    X[mask] = xc
+    B[mask, :, k] = xs
+    xdot[mask] = np.einsum("nij,nj->ni", B[mask], qdot[mask])
+    if not np.any(np.delete(qdot[mask], k, axis=1)) and \
+            not np.any(np.delete(qddot[mask], k, axis=1)):
+        xddot[mask] = xss * qdot[mask, k, None] ** 2 + xs * qddot[mask, k, None]
+    return X, B, xdot, xddot, (mask, xs, xss)
 
 
 def _coords(q_init, k: int, values) -> np.ndarray:
@@ -347,23 +383,6 @@ def _coords(q_init, k: int, values) -> np.ndarray:
     Q = np.tile(q_init, (len(values), 1))
     Q[:, k] = values
     return Q
-
-
-def _charted(book: ChartBook, k: int, Q, qdot, X, B, xdot, xddot):
-    """Poses, analogs and motion of the samples in bifurcation zones, from the charts:
-    the limit from both sides, where the equations are ill-conditioned.  The analogs
-    of the other coordinates stay those of the direct solve, and so does the part of
-    the acceleration due to their rates."""
-    mask, xc, xs, xss = book.apply(Q[:, k])
-    if mask.any():
-        X, B, xdot, xddot = X.copy(), B.copy(), xdot.copy(), xddot.copy()
-        X[mask] = xc
-        B[mask, :, k] = xs
-        xdot[mask] = np.einsum("nij,nj->ni", B[mask], qdot[mask])
-        others = np.delete(qdot[mask], k, axis=1)
-        if not np.any(others):
-            xddot[mask] = xss * qdot[mask, k, None] ** 2
-    return X, B, xdot, xddot
 
 
 def _dead_report(model, lay, k, stop: _Stop, n_done, n_req):
@@ -419,13 +438,13 @@ def analyze(mech_or_model, q, qdot, qddot=None, x_guess=None, *, mode=None) -> K
         if x_guess is None:
             x_guess = assemble(model, layout=lay)
     tol = _position_tol(model)
-    x, ok, _, J = _newton(kern, np.asarray(x_guess, float), q, tol)
+    x, ok, F, J = _newton(kern, np.asarray(x_guess, float), q, tol)
     if not ok:
         x = assemble(model, q, x_guess=x_guess, layout=lay)
-        J = kern.system(x, q)[1]
-    fac = kern.factor(J)
-    B = kern.apply(J, fac, kern.rhs_unit(1)[0])
-    xdot = B @ qdot
-    xddot = B @ qddot + kern.apply(J, fac, kern.gamma(x, xdot))
+        F, J = kern.system(x, q)
+    system = (F[None], J[None], kern.factor(J[None]))
+    x, B, xdot, xddot, _ = _motion(kern, x[None], q[None], qdot[None], qddot[None], None, 0,
+                                   system, correct=False)
     return KinematicPoint(q=_ro(q.copy()), qdot=_ro(qdot.copy()), qddot=_ro(qddot.copy()),
-                          x=_ro(x), xdot=_ro(xdot), xddot=_ro(xddot), B=_ro(B), model=model)
+                          x=_ro(x[0]), xdot=_ro(xdot[0]), xddot=_ro(xddot[0]), B=_ro(B[0]),
+                          model=model)
