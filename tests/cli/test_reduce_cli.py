@@ -137,3 +137,13 @@ def test_the_default_flywheel_agrees_with_the_simulated_steady_cycle(capsys):
     assert code == 0 and v["delta without flywheel"] <= 0.02
     assert v["J_fly on the crank"] == 0.0 and "no flywheel is needed" in out
     assert "J_fly energy method" in out
+
+
+def test_a_textbook_flywheel_on_a_model_without_a_drive(capsys):
+    """No drive: a constant driving torque equal to the mean load torque keeps the mean
+    speed (the classic energy method), and the flywheel it gives meets the target."""
+    code = main(["flywheel", "toggle_press", "--delta", "5%", "--speed", "40rpm"])
+    out = capsys.readouterr().out
+    assert code == 0 and "the model has no drive" in out and "(refined method)" in out
+    delta = float(re.search(r"delta simulated\s+([-0-9.e+]+)", out)[1])
+    assert abs(delta / 0.05 - 1) < 0.02

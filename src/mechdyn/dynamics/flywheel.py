@@ -440,9 +440,29 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
     wm = float(omega_mean)
     if not wm > 0:
         raise ModelError(f"omega_mean must be > 0 rad/s, got {omega_mean!r}")
+    no_drive = None
+    if machine.drive is None and not dependent:
+        # no drive: the classic energy method's drive, a constant torque equal to the mean
+        # of the load torque, keeps the mean speed
+        from scipy.integrate import simpson
+
+        # Simpson's rule on the steady cycle's own grid (RK4 in phi of a torque of phi
+        # alone is Simpson's rule), so that the cycle balances in its quadrature too
+        ph_ = phi0 + np.linspace(0.0, machine.period, 2 * 720 + 1)
+        load = float(simpson([machine.torque(t, p, wm) for p in ph_], x=ph_)) / machine.period
+        machine = machine.with_driving_torque(-load)
+        no_drive = (f"the model has no drive: a constant driving torque of {-load:.6g} N m "
+                    f"(the mean of the load torque) keeps the mean speed (classic energy "
+                    f"method)")
     kw = {"omega_guess": wm} if dependent else {"omega_mean": wm}
+    stall = None
     if base is None:
-        base = steady_state(machine, phi0=phi0, **kw)
+        try:
+            base = steady_state(machine, phi0=phi0, **kw)
+        except LockupError as exc:  # without a flywheel the machine cannot keep this speed
+            if dependent:
+                raise
+            stall = str(exc)
     if gear_ratio is None:
         gear_ratio = getattr(machine.drive, "ratio", None)
     ph = phi0 + np.linspace(0.0, machine.period, int(points))
@@ -459,7 +479,7 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
     j_basic = dE * need - jm
     j_ref = dE_ref * need - jm
     j_fly = j_basic if method == "energy" else j_ref
-    msgs = []
+    msgs = [] if no_drive is None else [no_drive]
     if abs(imbalance) > 0.02 * max(1e-300, float(np.max(np.abs(M)))):
         msgs.append(f"the mean torque at omega_mean is {imbalance:.4g} N m (the cycle is not "
                     f"balanced at this speed); it was removed for the energy method")
@@ -468,7 +488,9 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
                     f"{j_fly:.4g} kg m^2): no flywheel is needed")
         j_fly = 0.0
     cycle = d_sim = None
-    met = base.delta <= delta  # the machine as it is meets the target
+    if stall is not None:
+        msgs.append(f"without a flywheel the machine cannot keep the mean speed ({stall})")
+    met = base is not None and base.delta <= delta  # the machine as it is meets the target
     if met:
         msgs = [m for m in msgs if "no flywheel is needed" not in m]
         msgs.append(f"the steady cycle without a flywheel has delta = {base.delta:.4g} <= "
@@ -507,7 +529,7 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
                     f"{100 * (d_sim / delta - 1):.1f} %: the energy method's assumptions "
                     f"(torque independent of the speed, small fluctuation) do not hold well; "
                     f"use method='simulation'")
-    d0 = base.delta
+    d0 = None if base is None else base.delta
     j_motor = None if gear_ratio is None else j_fly / float(gear_ratio) ** 2
     return FlywheelSizing(
         delta_target=float(delta), omega_mean=wm, delta_E_max=dE, delta_E_refined=dE_ref,

@@ -250,6 +250,13 @@ class ReducedMachine:
                 return True
         return False
 
+    def with_driving_torque(self, torque: float) -> ReducedMachine:
+        """A copy with a constant driving torque ``torque`` (N m) added on the link."""
+        new = copy.copy(self)
+        base = self._torque
+        new._torque = lambda t, p, w: base(t, p, w) + torque
+        return new
+
     def with_extra_inertia(self, added: float) -> ReducedMachine:
         """A copy with ``added`` kg m^2 more on the link (a flywheel)."""
         new = copy.copy(self)
