@@ -156,3 +156,19 @@ def test_kinetostatics_driving_torque_balances_gravity(speed):
     assert np.max(np.abs(M - 2 * G * np.cos(values))) < 1e-9
     assert res.stats["power_balance_rel"] < 1e-9
     assert "bifurcation" in res.message
+
+
+@pytest.mark.parametrize(("start_deg", "stop_deg", "step_deg"), [(90.0, 450.0, 1.0),
+                                                                 (170.0, 190.0, 0.01)])
+def test_a_sweep_never_leaves_the_parallelogram_branch_silently(start_deg, stop_deg, step_deg):
+    """The reproducers of the fuzzing campaign: a full turn in 1 deg steps used to leave the
+    parallelogram branch at 181 deg, and 0.01 deg steps near 180 deg at 180.7 deg with
+    status success. Continuity keeps the branch: the rocker turns with the crank."""
+    from mechdyn.kinematics.sweep import sweep
+
+    values = np.deg2rad(np.arange(start_deg, stop_deg + step_deg / 2, step_deg))
+    sw = sweep(parallelogram().compile(), values=values)
+    assert sw.status == "success" and len(sw) == values.size
+    th = sw.x[:, 2::3]
+    assert np.max(np.abs(np.angle(np.exp(1j * (th[:, 2] - th[:, 0]))))) < 1e-9
+    assert {b["kind"] for b in sw.stats["bifurcations"]} == {"bifurcation"}
