@@ -152,3 +152,19 @@ def test_a_dead_position_is_met_promptly():
     tr = simulate(rocker_driven(), 1.0, progress=False)
     assert tr.status == "singular-position" and 0.29 < tr.t[-1] < 0.32
     assert tr.stats["steps"] < 1000
+
+
+@pytest.mark.parametrize(("word", "renamed", "match"), [
+    ("t", r"\bphi\b", "coordinate 't': the name is reserved"),
+    ("phi_dot", r"\bphi\b", "coordinate 'phi_dot': a name ending in '_dot'"),
+    ("com", r"\bcrank\b", "body 'com': the name is reserved"),
+    ("t", r"\bcrank\b", "body 't': the name is reserved"),
+])
+def test_reserved_words_are_not_names(word, renamed, match):
+    import re
+
+    from mechdyn import examples
+
+    text = examples.path("slider_crank").read_text(encoding="utf-8")
+    with pytest.raises(ModelError, match=match):
+        loads(re.sub(renamed, word, text), name="x.toml")

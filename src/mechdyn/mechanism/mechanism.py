@@ -183,6 +183,8 @@ class Mechanism:
                     out.append(f"{where}: axis must be a non-zero direction (x, y), "
                                f"got {j.axis!r}")
 
+        out += reserved_names(self.bodies, self.coordinates,
+                              {b.name: list(b.points) for b in self.bodies.values()})
         joint_types = {n: type(j).__name__.lower() for n, j in self.joints.items()}
         for c in self.coordinates.values():
             for key, msg in coordinate_problems(c.kind, c.body, c.joint, self.bodies,
@@ -230,3 +232,37 @@ class Mechanism:
     def __repr__(self) -> str:
         return (f"Mechanism({self.name!r}: {len(self.bodies)} bodies, {len(self.joints)} joints, "
                 f"coordinates {list(self.coordinates)})")
+
+
+#: names the variable grammar gives a meaning (time; the centre of mass of a body)
+RESERVED = ("t", "com", GROUND)
+
+
+def reserved_names(bodies, coordinates, points) -> list[str]:
+    """Names that the variables of loads, switches and tables could not tell apart: a body
+    or coordinate named ``t``, ``com`` or ``ground``, a coordinate named like a rate
+    (``..._dot``) or a body, a point named ``com``, and characters of the grammar.
+
+    Examples
+    --------
+    >>> reserved_names(["t"], ["phi_dot"], {"t": ["com"]})[0]
+    "body 't': the name is reserved (t, com, ground); choose another"
+    """
+    out = []
+    for kind, names in (("body", bodies), ("coordinate", coordinates)):
+        for n in names:
+            if n in RESERVED:
+                out.append(f"{kind} {n!r}: the name is reserved ({', '.join(RESERVED)}); "
+                           f"choose another")
+            elif any(c in n for c in ".:()@, "):
+                out.append(f"{kind} {n!r}: the name may not contain . : ( ) @ , or spaces")
+    for n in coordinates:
+        if n.endswith("_dot"):
+            out.append(f"coordinate {n!r}: a name ending in '_dot' would read as the rate of "
+                       f"{n[:-4]!r}; choose another")
+        elif n in bodies:
+            out.append(f"coordinate {n!r}: a body has the same name; choose another")
+    for b, pts in points.items():
+        if "com" in pts:
+            out.append(f"body {b!r}: point 'com': the name is reserved for the centre of mass")
+    return out
