@@ -48,6 +48,7 @@ import re
 import unicodedata
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 from .errors import UnitError
@@ -197,39 +198,47 @@ def parse_quantity(value: Any, kind: str, *, where: str = "") -> float:
     if not math.isfinite(number):
         raise _problem(where, value, k, "not a finite value")
 
-    try:
-        q = ureg.Quantity(number, ureg.parse_units(m["unit"]) if m["unit"] else "")
-    except Exception as exc:  # noqa: BLE001 - pint's parser raises many kinds; report them all
-        why = str(exc).strip() or "malformed unit"
-        if isinstance(exc, pint.errors.UndefinedUnitError):
-            why = f"unknown unit ({why})"
-        raise _problem(where, value, k, f"cannot be read as a quantity: {why}") from None
     if not m["unit"]:  # a bare number in a string: SI
-        out = float(q.magnitude)
-    else:
-        shown = f"{q.units:~}" if q._units else m["unit"]  # units that cancel: the text
-        root = q.to_root_units()
-        rad_power = dict(root._units).get("radian", 0)
-        target = ureg.Unit(k.si) if k.si else ureg.dimensionless
-        if root.dimensionality != target.dimensionality:
-            dim = _dimension_text(root)
-            raise _problem(where, value, k, f"the unit {shown} is a {dim}")
-        if k.angle_power == 1 and rad_power != 1:
-            raise _problem(where, value, k,
-                           f"the unit {shown} has no angle unit (use rad, deg, turn or rpm; "
-                           "a frequency in Hz is not an angular velocity)")
-        if k.angle_power == 0 and rad_power != 0:
-            raise _problem(where, value, k, f"the unit {shown} carries an angle unit")
-        if kind == "frequency" and rad_power == 1:
-            out = float(root.magnitude) / (2.0 * math.pi)
-        elif kind == "frequency" and rad_power not in (0, 1):
-            raise _problem(where, value, k, f"the unit {shown} is not a frequency")
-        else:
-            out = float(q.to(target).magnitude) if k.si else float(q.to("").magnitude)
+        return number
+    factor, why = _unit_factor(m["unit"], kind)
+    if why:
+        raise _problem(where, value, k, why)
+    out = number * factor
     if not math.isfinite(out):
         raise _problem(where, value, k, "not a finite value")
     return out
 
+
+@lru_cache(maxsize=1024)
+def _unit_factor(unit: str, kind: str) -> tuple[float, str]:
+    """(SI factor, "") of a unit text for a kind, or (nan, why it does not fit): the
+    conversions are linear, so each unit is read by pint once."""
+    import pint
+
+    ureg, k = registry(), KINDS[kind]
+    try:
+        q = ureg.Quantity(1.0, ureg.parse_units(unit))
+    except Exception as exc:  # noqa: BLE001 - pint's parser raises many kinds; report them all
+        why = str(exc).strip() or "malformed unit"
+        if isinstance(exc, pint.errors.UndefinedUnitError):
+            why = f"unknown unit ({why})"
+        return math.nan, f"cannot be read as a quantity: {why}"
+    shown = f"{q.units:~}" if q._units else unit  # units that cancel: the text
+    root = q.to_root_units()
+    rad_power = dict(root._units).get("radian", 0)
+    target = ureg.Unit(k.si) if k.si else ureg.dimensionless
+    if root.dimensionality != target.dimensionality:
+        return math.nan, f"the unit {shown} is a {_dimension_text(root)}"
+    if k.angle_power == 1 and rad_power != 1:
+        return math.nan, (f"the unit {shown} has no angle unit (use rad, deg, turn or rpm; "
+                          "a frequency in Hz is not an angular velocity)")
+    if k.angle_power == 0 and rad_power != 0:
+        return math.nan, f"the unit {shown} carries an angle unit"
+    if kind == "frequency" and rad_power == 1:
+        return float(root.magnitude) / (2.0 * math.pi), ""
+    if kind == "frequency" and rad_power not in (0, 1):
+        return math.nan, f"the unit {shown} is not a frequency"
+    return (float(q.to(target).magnitude) if k.si else float(q.to("").magnitude)), ""
 
 def _dimension_text(q) -> str:
     """'length unit', 'mass unit', ... for a root-unit quantity, else its dimensionality."""
