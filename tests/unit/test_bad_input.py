@@ -170,16 +170,13 @@ def test_reserved_words_are_not_names(word, renamed, match):
         loads(re.sub(renamed, word, text), name="x.toml")
 
 
-def test_a_body_with_thousands_of_points_loads_in_seconds():
-    """Each unit is read by pint once (20 000 points took 15 s)."""
-    import time
-
+def test_a_body_with_thousands_of_points_loads():
+    """Each unit is read by pint once (20 000 points took 15 s; the time is measured in
+    benchmarks/, not here)."""
     from mechdyn import examples
 
     text = examples.path("slider_crank").read_text(encoding="utf-8")
     pts = "\n".join(f'P{k} = ["{k * 0.001:.3f} mm", "0 mm"]' for k in range(5000))
-    start = time.process_time()
     mech = loads(text.replace("[bodies.crank.points]", "[bodies.crank.points]\n" + pts, 1),
                  name="x.toml")
     assert len(mech.bodies["crank"].points) > 5000
-    assert time.process_time() - start < 10.0  # a budget, not a benchmark (about 1 s here)
