@@ -15,7 +15,7 @@ def test_andrews_to_csv(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "status: success" in text
     assert "evaluations" in text and "balance" in text
-    df = pd.read_csv(out)
+    df = pd.read_csv(out, comment="#")
     assert df["t_s"].iloc[-1] == pytest.approx(0.01)
     for col in ("beta_rad", "beta_deg", "beta_dot_rad_s", "beta_ddot_rad_s2", "theta_rod_rad",
                 "omega_rod_rad_s", "x_rod_m", "vx_rod_m_s", "T_J", "U_J", "W_nc_J",
@@ -30,7 +30,7 @@ def test_press_wilson_40_steps_with_drive_and_plot(tmp_path, capsys):
                  "--steps", "40", "--drive", "phi=34.5 N*m", "--points",
                  "-o", str(out), "--plot", str(png)])
     assert code == 0, capsys.readouterr()
-    df = pd.read_csv(out)
+    df = pd.read_csv(out, comment="#")
     assert len(df) == 41
     assert {"phi_deg", "psi_deg", "x_rocker_B_m", "vx_rocker_B_m_s", "ax_rocker_B_m_s2"} <= \
         set(df.columns)
@@ -47,7 +47,7 @@ def test_stopped_run_exits_1_and_keeps_data(tmp_path, capsys):
     assert code == 1
     cap = capsys.readouterr()
     assert "singular-position" in cap.out and "stopped early" in cap.err
-    df = pd.read_csv(out)
+    df = pd.read_csv(out, comment="#")
     assert 0.04 < df["t_s"].iloc[-1] < 0.06
 
 
@@ -104,7 +104,7 @@ def test_ctrl_c_writes_the_samples_so_far_and_exits_130(tmp_path, capsys, monkey
     captured = capsys.readouterr()
     assert code == 130
     assert "interrupted" in captured.out and "Traceback" not in captured.err
-    df = pd.read_csv(out)
+    df = pd.read_csv(out, comment="#")
     assert len(df) > 5 and 0.0 < df["t_s"].iloc[-1] < 1.0
 
 
@@ -152,7 +152,7 @@ def test_sigterm_writes_the_samples_so_far_atomically_and_exits_143(tmp_path, ca
     code = main(["simulate", "clutchless_press", "--t-end", "1 s", "--backend", "numpy",
                  "-o", str(out)])
     assert code == 143
-    df = pd.read_csv(out)
+    df = pd.read_csv(out, comment="#")
     assert len(df) > 5 and df["t_s"].iloc[-1] < 1.0
     assert not list(tmp_path.glob(".*part*"))  # no temporary file left
 
@@ -160,8 +160,34 @@ def test_sigterm_writes_the_samples_so_far_atomically_and_exits_143(tmp_path, ca
 def test_the_table_is_a_uniform_grid_by_default_and_steps_on_request(tmp_path, capsys):
     out = tmp_path / "fb.csv"
     assert main(["simulate", "four_bar", "--t-end", "0.1 s", "-o", str(out)]) == 0
-    t = pd.read_csv(out)["t_s"].to_numpy()
+    t = pd.read_csv(out, comment="#")["t_s"].to_numpy()
     assert t.size == 1001 and np.allclose(np.diff(t), 1e-4)
     assert main(["simulate", "four_bar", "--t-end", "0.1 s", "--every-step", "-o",
                  str(out)]) == 0
-    assert 2 < len(pd.read_csv(out)) < 200  # the integrator's own steps
+    assert 2 < len(pd.read_csv(out, comment="#")) < 200  # the integrator's own steps
+
+
+def test_sigint_to_a_running_command_keeps_the_samples_marked_interrupted(tmp_path):
+    """The acceptance run: ``mechdyn simulate press_cycle --t-end 2s -o out.csv`` stopped by
+    SIGINT after 4 s exits 130 without a traceback; out.csv holds the samples computed so
+    far and its header says the run was interrupted."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "out.csv"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", "import sys; from mechdyn.cli import main; sys.exit(main())",
+         "simulate", "press_cycle", "--t-end", "2s",
+         "--backend", "numpy", "--no-progress", "-o", str(out)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(4.0)
+    proc.send_signal(signal.SIGINT)
+    stdout, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 130, (stdout, stderr)
+    assert "Traceback" not in stderr
+    text = out.read_text()
+    assert "# status: interrupted" in text
+    df = pd.read_csv(out, comment="#")
+    assert len(df) > 2 and df["t_s"].iloc[-1] < 2.0

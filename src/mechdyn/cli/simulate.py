@@ -23,7 +23,7 @@ from ..dynamics.lagrange import FORMULATIONS
 from ..errors import ModelError, Status, did_you_mean
 from ..mechanism import Drive
 from ..results.plot_dynamics import plot_trajectory
-from ..results.table import deg_or_mm, written
+from ..results.table import deg_or_mm, write_csv, written
 from ..simulate import simulate
 from ..simulate_events import format_events
 from ..units import parse_quantity
@@ -126,8 +126,8 @@ def run(args) -> int:
             traj.coordinate_names, traj.q[-1], traj.coordinate_is_angle, strict=True))
         print(f"at t = {traj.t[-1]:.9g} s: {last}")
     if args.output:
-        with written(args.output) as tmp:  # never a half-written or stale table
-            traj.to_dataframe(points=args.points).to_csv(tmp, index=False)
+        # its header says the status (an interrupted run is marked so), atomically written
+        write_csv(traj, args.output, points=args.points)
         print(f"wrote {args.output} ({traj.t.size} rows)")
         if traj.events:
             ev_path = Path(args.output).with_name(Path(args.output).stem + "_events.csv")

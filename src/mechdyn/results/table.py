@@ -121,7 +121,7 @@ def _describe(record) -> list[str]:
     return lines
 
 
-def write_csv(record, path, *, float_format: str = "%.12g") -> Path:
+def write_csv(record, path, *, float_format: str = "%.12g", **options) -> Path:
     """Write a result record's table to CSV with a commented header of units.
 
     Parameters
@@ -133,13 +133,15 @@ def write_csv(record, path, *, float_format: str = "%.12g") -> Path:
         Output file; its folder is created if needed.
     float_format : str
         printf-style format of the numbers (default 12 significant digits).
+    **options
+        Passed to the record's ``to_dataframe`` (e.g. ``points=True`` for a trajectory).
 
     Returns
     -------
     Path
         The file written.
     """
-    df = record.to_dataframe()
+    df = record.to_dataframe(**options)
     lines = _describe(record)
     lines.append("units: " + ", ".join(f"{c} [{unit_of_column(c) or '-'}]" for c in df.columns))
     path = output_path(path)
