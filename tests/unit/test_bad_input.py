@@ -180,3 +180,26 @@ def test_a_body_with_thousands_of_points_loads():
     mech = loads(text.replace("[bodies.crank.points]", "[bodies.crank.points]\n" + pts, 1),
                  name="x.toml")
     assert len(mech.bodies["crank"].points) > 5000
+
+
+@pytest.mark.parametrize(("old", "new", "match"), [
+    ('variable = "joint:guide"\nupper', 'variable = "ghost"\nupper', "stops.*'ghost'"),
+    ('variable = "joint:guide"\nupper', 'variable = ""\nupper', r"stops.*variable"),
+    ('variable = "joint:guide"\nupper', 'variable = "x.y.z"\nupper', r"stops.*x\.y\.z"),
+    ('guard = [["p", ">", "-2.25 mm"]]', 'guard = [["ghost", ">", "-2.25 mm"]]',
+     r"guard: 'ghost': unknown variable"),
+    ('line_body = "slider"\nline_point = "ear"', 'line_body = "piston"\nline_point = [0, 0]',
+     "piston_on_ram.*same body"),
+    ('variable = "joint:C"', 'variable = "dist(rod.B, ground.O)"',
+     "allowed only in switch conditions"),
+    ('name = "lock_off"', 'name = "lock_on"', "'lock_on' is already the name"),
+])
+def test_references_of_the_switchable_elements_are_checked_at_load(old, new, match):
+    """Invalid references that load accepted and only simulate rejected (sweep and
+    kinetostatics ran on them) are named when the file is loaded."""
+    from mechdyn import examples
+
+    text = examples.path("press_cycle").read_text(encoding="utf-8")
+    assert old in text
+    with pytest.raises(ModelError, match=match):
+        loads(text.replace(old, new, 1), name="press.toml")
