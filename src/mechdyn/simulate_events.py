@@ -44,7 +44,7 @@ from .dynamics.modes import (
     SwitchedModel,
     switched_model,
 )
-from .dynamics.reactions import element_forces, frame_forces
+from .dynamics.reactions import element_forces, frame_forces, net_on_ground
 from .dynamics.switching import apply_switch, event_functions
 from .errors import (
     LockupError,
@@ -430,15 +430,18 @@ def _finish(model, rec, events, stats, wall0, status, message, sm) -> Trajectory
     x, xd, q, qd, qdd = (np.array([getattr(r[2], k) for r in rec], float).reshape(n, w)
                          for k, w in (("x", n_x), ("xdot", n_x), ("q", n_q), ("qdot", n_q),
                                       ("qddot", n_q)))
-    frame, res = np.zeros((n, 2)), np.zeros(n)
+    frame, res = np.zeros((n, 3)), np.zeros(n)
     forces: dict = {}
     starts = [k for k in range(n) if k == 0 or rec[k][1] is not rec[k - 1][1]] + [n]
     for a, b in zip(starts[:-1], starts[1:], strict=True):
         ms, sl = rec[a][1], slice(a, b)
         lam = np.array([r[2].lam for r in rec[a:b]], float).reshape(b - a, ms.n_rows)
-        # the frame also carries the load elements anchored on it (spring ends, reactions)
-        on_ground = sm.fm.loads(t[sl], x[sl], xd[sl], q[sl], qd[sl])[1]
-        frame[sl] = frame_forces(ms, x[sl], lam)["total"] + on_ground[:, :2]
+        # the frame also carries the load elements anchored on it (spring ends, torque
+        # reactions) and the stators of the drives between it and the bodies
+        _, on_ground, Qd = sm.fm.loads(t[sl], x[sl], xd[sl], q[sl], qd[sl])
+        drives = np.einsum("nqx,nq->nx", RN.jacobian(model.coordinate_rows, x[sl]), Qd)
+        frame[sl] = (frame_forces(ms, x[sl], lam, point=(0.0, 0.0))["total"] + on_ground
+                     + net_on_ground(model, x[sl], drives, np.zeros(2)))
         for el, v in element_forces(ms, x[sl], lam).items():
             forces.setdefault(el, np.zeros((n,) + np.shape(v)[1:]))[sl] = v
         if ms.n_rows:
@@ -453,7 +456,8 @@ def _finish(model, rec, events, stats, wall0, status, message, sm) -> Trajectory
     stats["variable_structure"] = SwitchedSamples(
         mode=[r[1].mode for r in rec], modes=modes,
         mode_index=np.array([modes.index(r[1].mode) for r in rec], int),
-        frame_force=frame, forces=forces, impact_losses=lost,
+        frame_force=frame[:, :2], frame_moment=frame[:, 2], forces=forces,
+        impact_losses=lost,
         penetration=stats["penetration"])
     energy = dict(kinetic=T, potential=U, work_nc=W, balance=T + U - W + lost, residual=res)
     return Trajectory(t, q, qd, qdd, x, xd, status=status, message=message,

@@ -167,6 +167,14 @@ def test_forward_run_and_kinetostatics_report_the_same_joint_reactions():
         moment = f[:, 2] if f.shape[1] == 3 else np.zeros(tr.t.size)
         np.testing.assert_allclose(moment, res.moments[j], rtol=0, atol=1e-8 * scale)
     assert "M_B_Nm" not in tr.to_dataframe() and "M_guide_Nm" in tr.to_dataframe()
+    # the loads on the frame (joint reactions, spring ends, stops, the motor's stator):
+    # force and moment about the ground origin, forward run against inverse dynamics
+    vs = tr.stats["variable_structure"]
+    fscale = np.max(np.abs(res.frame_force))
+    np.testing.assert_allclose(vs.frame_force, res.frame_force, rtol=0, atol=1e-9 * fscale)
+    np.testing.assert_allclose(vs.frame_moment, res.frame_moment, rtol=0,
+                               atol=1e-9 * np.max(np.abs(res.frame_moment)))
+    assert "M_frame_Nm" in tr.to_dataframe()
 
     discs = _discs(True)
     tr = _run(discs)

@@ -140,22 +140,26 @@ def element_forces(ms, x, lam) -> dict:
     return out
 
 
-def frame_forces(ms, x, lam) -> dict:
+def frame_forces(ms, x, lam, point=None) -> dict:
     """Forces (Fx, Fy), shape (..., 2), N, that the mechanism exerts on the frame through
     each element of a mode attached to the ground (joint, lock, stop or contact);
     key ``"total"`` sums them (batched over poses ``x`` (..., n_x) and multipliers
-    ``lam`` (..., n_rows))."""
-    nb = ms.model.n_bodies
+    ``lam`` (..., n_rows)).  With ``point`` (2,) m, each entry is (Fx, Fy, M), shape
+    (..., 3), with the moment M about that point, N m."""
+    model = ms.model
     R = ms.row_jacobian(x)
     lam = np.asarray(lam, float)
     out: dict = {}
-    total = np.zeros(lam.shape[:-1] + (2,))
+    total = np.zeros(lam.shape[:-1] + (2 if point is None else 3,))
     for el, idx in ms.element_rows.items():
         if el not in ms.grounded:
             continue
         gen = np.einsum("...rx,...r->...x", R[..., idx, :], lam[..., idx])
         # Newton's third law: the frame gets the opposite of the force on the bodies
-        f = -gen.reshape(gen.shape[:-1] + (nb, 3))[..., :2].sum(axis=-2)
+        if point is None:
+            f = -gen.reshape(gen.shape[:-1] + (model.n_bodies, 3))[..., :2].sum(axis=-2)
+        else:
+            f = net_on_ground(model, x, gen, np.asarray(point, float)).reshape(total.shape)
         out[el] = f
         total = total + f
     out["total"] = total
@@ -172,9 +176,25 @@ def touches_ground(rows) -> bool:
     return bool(np.any(pts | ang))
 
 
-def _net_on_ground(model: Model, x, D, point) -> np.ndarray:
-    """Minus the net force and moment about ``point`` of body forces D (n, n_x): for a
-    force element between the frame and the moving bodies, what the frame receives."""
+def net_on_ground(model: Model, x, D, point) -> np.ndarray:
+    """What the frame receives from force elements between it and the moving bodies:
+    minus the net force and moment about ``point`` (2,) m of their forces on the bodies.
+
+    Parameters
+    ----------
+    model : Model
+    x : ndarray, shape (n, n_x)
+        Poses.
+    D : ndarray, shape (n, n_x)
+        Forces (N) and moments about the body frame origins (N m) of the elements on
+        the bodies (elements acting between two moving bodies add nothing).
+    point : array_like, shape (2,)
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+        (Fx, Fy) N and the moment about ``point``, N m.
+    """
     Db = D.reshape(-1, model.n_bodies, 3)
     r = np.reshape(x, Db.shape)[..., :2] - point
     m = (Db[..., 2] + cross(r, Db[..., :2])).sum(axis=1)
@@ -278,7 +298,7 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
                    if kind == "prismatic" else (1.0, 0.0))
         jframe[name] = np.stack([np.sum(f * u, -1), np.sum(f * _perp(u), -1)], axis=-1)
         if i == nb or j == nb:
-            frame_loads[name] = _net_on_ground(model, x, gen, point)
+            frame_loads[name] = net_on_ground(model, x, gen, point)
 
     # ------------------------------------------------ switchable elements (modes.py rows)
     el_forces: dict[str, np.ndarray] = {}
@@ -291,11 +311,11 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
             el_forces[el] = -lam[:, idx[0]]
             Del = C[:, idx, :].sum(axis=1)
             p_el += np.einsum("nx,nx->n", Del, xdot)
-            frame_loads[el] = _net_on_ground(model, x, Del, point)
+            frame_loads[el] = net_on_ground(model, x, Del, point)
 
     # ------------------------------------------------ drives' stator and ground-attached loads
     D = np.einsum("nd,ndx->nx", tau, Gd) + np.einsum("nq,nqx->nx", Qd_loads, G)
-    frame_loads["drives"] = _net_on_ground(model, x, D, point)
+    frame_loads["drives"] = net_on_ground(model, x, D, point)
     frame_loads["loads"] = F_ground - np.concatenate(
         [np.zeros((n, 2)), cross(point, F_ground[:, :2])[:, None]], axis=-1)
     tot = sum(frame_loads.values())

@@ -32,6 +32,8 @@ class SwitchedSamples(Mapping):
         Index of each sample's mode in ``modes``.
     frame_force : ndarray, shape (n, 2)
         Force the frame receives (reactions and the ground ends of springs), N.
+    frame_moment : ndarray, shape (n,)
+        Moment the frame receives about the ground origin, N m.
     forces : dict
         Per joint, lock, stop and contact: its reaction per sample ((n, 2) or (n, 3):
         force on the child from the parent at the joint point, N, and moment, N m;
@@ -49,6 +51,7 @@ class SwitchedSamples(Mapping):
     forces: dict
     impact_losses: np.ndarray
     penetration: float = 0.0
+    frame_moment: np.ndarray | None = None
 
     def __getitem__(self, key):
         if key not in self.__dataclass_fields__:
@@ -260,6 +263,8 @@ def _switched_columns(vs: dict, modes: bool = True) -> dict:
     cols["Fx_frame_N"] = frame[:, 0]
     cols["Fy_frame_N"] = frame[:, 1]
     cols["F_frame_N"] = np.hypot(frame[:, 0], frame[:, 1])
+    if vs.get("frame_moment") is not None:
+        cols["M_frame_Nm"] = np.asarray(vs["frame_moment"], float)
     for name, f in vs.get("forces", {}).items():
         f = np.asarray(f, float)
         key = str(name).replace("@", "_")
