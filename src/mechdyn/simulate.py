@@ -35,7 +35,7 @@ __all__ = ["simulate", "initial_state"]  # initial_state: re-exported from .init
 
 #: the options of the segment loop that :func:`simulate` passes on (``**switching``)
 SWITCHING_OPTIONS = ("dt_out", "max_events", "small_velocity", "gap_tol", "zeno_time",
-                     "max_wall_time", "max_steps", "min_step")
+                     "max_wall_time", "max_steps", "min_step", "point")
 
 
 def _keywords_without_effect(integrator, rtol, atol, formulation, d) -> float:
@@ -129,7 +129,9 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
         ``"step-too-small"``, when an adaptive step falls below it, s; default
         1e-13 (t_end - t0)).  A run whose steps shrink below 1e-7 (t_end - t0) where the
         position Jacobian is nearly singular (sigma_min/sigma_max < 1e-5) stops at once
-        as a dead position approached.
+        as a dead position approached; ``point`` ((2,) m, default the ground origin):
+        the point the frame moment ``M_frame_Nm`` is taken about, as in
+        :func:`mechdyn.kinetostatics`.
 
     Returns
     -------

@@ -94,7 +94,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                     small_velocity: float | None = None, gap_tol: float | None = None,
                     zeno_time: float | None = None,
                     max_wall_time: float | None = None, max_steps: int | None = None,
-                    min_step: float | None = None,
+                    min_step: float | None = None, point=(0.0, 0.0),
                     progress: bool | None = None, dt: float | None = None,
                     steps: int | None = None, iterations: int | None = None,
                     tol: float | None = None, theta: float | None = None,
@@ -128,6 +128,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     if zeno_time is None:
         zeno_time = 1e-4 * (t_end - t0)
     span = t_end - t0
+    if np.shape(point) != (2,) or not np.all(np.isfinite(np.asarray(point, float))):
+        raise ModelError(f"point must be a finite (x, y) in m, got {point!r}")
     if min_step is None:
         min_step = 1e-13 * span
     if max_steps is None:
@@ -368,7 +370,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     stats["backend"] = "numba" if backends == {"numba"} else (
         "numpy" if backends <= {"numpy"} else "numba+numpy")
     bar.close()
-    return _finish(model, rec, events, stats, wall0, status, message, sm)
+    return _finish(model, rec, events, stats, wall0, status, message, sm, point)
 
 
 #: steps below this fraction of the run, where sigma_min/sigma_max of the position
@@ -420,7 +422,8 @@ def _penetration(sm: SwitchedModel, x) -> float:
 
 
 # ============================================================================ output
-def _finish(model, rec, events, stats, wall0, status, message, sm) -> Trajectory:
+def _finish(model, rec, events, stats, wall0, status, message, sm,
+            point=(0.0, 0.0)) -> Trajectory:
     """The Trajectory of a run from its samples: forces, frame loads and energies are
     evaluated here, batched over the samples of each mode segment."""
     n_q, n_x, n = model.n_q, model.n_x, len(rec)
@@ -431,6 +434,7 @@ def _finish(model, rec, events, stats, wall0, status, message, sm) -> Trajectory
                          for k, w in (("x", n_x), ("xdot", n_x), ("q", n_q), ("qdot", n_q),
                                       ("qddot", n_q)))
     frame, res = np.zeros((n, 3)), np.zeros(n)
+    point = np.asarray(point, float)
     forces: dict = {}
     starts = [k for k in range(n) if k == 0 or rec[k][1] is not rec[k - 1][1]] + [n]
     for a, b in zip(starts[:-1], starts[1:], strict=True):
@@ -439,9 +443,10 @@ def _finish(model, rec, events, stats, wall0, status, message, sm) -> Trajectory
         # the frame also carries the load elements anchored on it (spring ends, torque
         # reactions) and the stators of the drives between it and the bodies
         _, on_ground, Qd = sm.fm.loads(t[sl], x[sl], xd[sl], q[sl], qd[sl])
+        on_ground[:, 2] -= point[0] * on_ground[:, 1] - point[1] * on_ground[:, 0]  # about P
         drives = np.einsum("nqx,nq->nx", RN.jacobian(model.coordinate_rows, x[sl]), Qd)
-        frame[sl] = (frame_forces(ms, x[sl], lam, point=(0.0, 0.0))["total"] + on_ground
-                     + net_on_ground(model, x[sl], drives, np.zeros(2)))
+        frame[sl] = (frame_forces(ms, x[sl], lam, point=point)["total"] + on_ground
+                     + net_on_ground(model, x[sl], drives, point))
         for el, v in element_forces(ms, x[sl], lam).items():
             forces.setdefault(el, np.zeros((n,) + np.shape(v)[1:]))[sl] = v
         if ms.n_rows:

@@ -175,6 +175,11 @@ def test_forward_run_and_kinetostatics_report_the_same_joint_reactions():
     np.testing.assert_allclose(vs.frame_moment, res.frame_moment, rtol=0,
                                atol=1e-9 * np.max(np.abs(res.frame_moment)))
     assert "M_frame_Nm" in tr.to_dataframe()
+    P = (0.05, -0.12)  # about another point, as kinetostatics takes it
+    trp = md.simulate(mech, 0.2, rtol=1e-9, t_eval=np.linspace(0.0, 0.2, 101), point=P)
+    resp = md.kinetostatics(mech, trajectory=trp, point=P)
+    np.testing.assert_allclose(trp.stats["variable_structure"].frame_moment, resp.frame_moment,
+                               rtol=0, atol=1e-9 * np.max(np.abs(resp.frame_moment)))
 
     discs = _discs(True)
     tr = _run(discs)
