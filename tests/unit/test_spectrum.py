@@ -39,3 +39,13 @@ def test_spectrum_of_a_column_of_a_run():
     assert {"f_Hz", "amplitude"} <= set(sp.columns) and np.all(np.isfinite(sp["amplitude"]))
     with pytest.raises(KeyError, match="valid columns"):
         S.of_column(tr, "Fz_frame_N")
+
+
+def test_orders_of_a_cyclic_run_whatever_the_speed():
+    """A second-order load of a crank whose speed fluctuates by 30 %: its order spectrum
+    has the amplitude at order 2 and nothing at the other orders."""
+    t = np.linspace(0.0, 2.0, 3001)
+    phi = 2 * np.pi * 3.0 * t + 0.3 * np.sin(2 * np.pi * 3.0 * t)  # 6 turns, uneven
+    y = 0.5 + 4.0 * np.cos(2 * phi + 0.2)
+    o = S.order_spectrum(phi, y, orders=5)
+    np.testing.assert_allclose(o["amplitude"], [0.5, 0, 4.0, 0, 0, 0], atol=1e-6)

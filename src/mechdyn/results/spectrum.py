@@ -8,7 +8,9 @@ window by default: amplitudes true to a few 1e-3 between bins).  :func:`dominant
 the strongest components and refines each one by least squares on the original
 samples (frequency, amplitude and phase of a sum of sinusoids), which is exact for a
 stationary signal.  :func:`spectrogram` (scipy.signal) shows how the content changes
-through a start-up or a switching transient.
+through a start-up or a switching transient, and :func:`order_spectrum` gives the
+harmonics of a cyclic run against the crank angle (orders of the turn), whatever the
+speed fluctuation.
 
 Examples
 --------
@@ -24,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["spectrum", "dominant", "spectrogram", "of_column"]
+__all__ = ["spectrum", "dominant", "spectrogram", "order_spectrum", "of_column"]
 
 
 def _uniform(t, y, samples: int | None):
@@ -153,6 +155,51 @@ def spectrogram(t, y, *, segment: float | None = None, samples: int | None = Non
     f, tc, s = _spectrogram(u, fs=1.0 / dt, window="hann", nperseg=per, noverlap=per // 2,
                             scaling="spectrum", mode="magnitude", detrend="constant")
     return f, t0 + tc, 2.0 * s
+
+
+def order_spectrum(angle, y, *, period: float = 2.0 * np.pi, orders: int = 20):
+    """Harmonics of a signal of a cyclic run against its cycle angle: the amplitude of
+    each order (multiple of the turn), whatever the speed fluctuation.
+
+    Parameters
+    ----------
+    angle : array_like, shape (n,)
+        The cycle angle (a crank's), rad, monotonic (it is unwrapped).
+    y : array_like, shape (n,)
+        The signal, in its unit.
+    period : float
+        Angle of one cycle, rad.
+    orders : int
+        Orders returned (0 .. orders).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``order`` and ``amplitude`` (unit of ``y``; the mean at order 0), from the whole
+        cycles covered, resampled uniformly in angle.
+
+    Raises
+    ------
+    ValueError
+        The angle is not monotonic or covers less than one cycle.
+    """
+    import pandas as pd
+    from scipy.interpolate import CubicSpline
+
+    a, y = np.unwrap(np.asarray(angle, float)), np.asarray(y, float)
+    if a[-1] < a[0]:
+        a, y = -a[::-1], y[::-1]
+    keep = np.concatenate([[True], np.diff(a) > 0])
+    a, y = a[keep], y[keep]
+    cycles = int(np.floor((a[-1] - a[0]) / period + 1e-9))
+    if cycles < 1 or a.size < 8:
+        raise ValueError("an order spectrum needs a monotonic angle over at least one cycle")
+    per = max(64, 4 * (orders + 1))
+    grid = a[0] + np.arange(cycles * per) * (period / per)
+    c = np.fft.rfft(CubicSpline(a, y)(grid)) / grid.size
+    amp = 2.0 * np.abs(c[::cycles][:orders + 1])
+    amp[0] /= 2.0
+    return pd.DataFrame({"order": np.arange(amp.size), "amplitude": amp})
 
 
 def of_column(record, column: str, how=spectrum, **options):
