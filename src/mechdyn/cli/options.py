@@ -202,11 +202,12 @@ def sweep_values(model, args, *, start: float | None = None, only: bool = False)
 
 
 def simulate_from_args(model, args, samples: int):
-    """The forward-dynamics run of ``--simulate`` (needs ``--t-end``), ``samples`` samples."""
+    """The forward-dynamics run of ``--simulate`` (needs ``--t-end``), ``samples`` samples;
+    a progress bar once it takes more than 2 s."""
     if args.t_end is None:
         raise ModelError("--simulate needs --t-end, e.g. --t-end 0.05s")
     t_end = parse_quantity(args.t_end, "time", where="--t-end")
-    return simulate(model, t_end, integrator=args.integrator, rtol=args.rtol, progress=False,
+    return simulate(model, t_end, integrator=args.integrator, rtol=args.rtol, progress=None,
                     t_eval=np.linspace(0.0, t_end, samples))
 
 
