@@ -48,8 +48,8 @@ def register(sub) -> None:
     p.add_argument("--point", metavar="BODY.POINT", help="also give the reduced mass at a point")
     p.add_argument("--steps", type=int, default=361, metavar="N",
                    help="positions over one turn, ends included (default 361)")
-    p.add_argument("--start", metavar="ANGLE", default="0deg",
-                   help="first position (default 0deg)")
+    p.add_argument("--from", "--start", dest="start", metavar="ANGLE", default="0deg",
+                   help="first position (default 0deg; --start is the older name)")
     p.add_argument("--speed", metavar="RATE",
                    help="speed of the link at which drives and velocity-dependent loads are "
                         "evaluated (default 1 rad/s; give the working speed for motors)")
