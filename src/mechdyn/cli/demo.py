@@ -64,7 +64,7 @@ def run(args) -> int:
                     t_eval=np.linspace(0.0, 0.03, 301))
     written += [write_csv(traj, out / "andrews_trajectory.csv"),
                 plot_trajectory(traj, out / "andrews_trajectory.png")]
-    print(f"    status {traj.status}: {traj.message}")
+    print(f"    status {traj.status}" + (f": {traj.message}" if traj.message else ""))
     beta = traj.q[-1, 0]
     print(f"    beta(0.03 s) = {beta:.12f} rad (Test Set reference 15.81077119629904 rad)")
 
