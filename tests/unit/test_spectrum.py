@@ -49,3 +49,16 @@ def test_orders_of_a_cyclic_run_whatever_the_speed():
     y = 0.5 + 4.0 * np.cos(2 * phi + 0.2)
     o = S.order_spectrum(phi, y, orders=5)
     np.testing.assert_allclose(o["amplitude"], [0.5, 0, 4.0, 0, 0, 0], atol=1e-6)
+
+
+def test_psd_and_summary_of_a_sinusoid():
+    t = np.linspace(0.0, 20.0, 20001)
+    y = 3.0 * np.sin(2 * np.pi * 5.0 * t)
+    p = S.welch(t, y, segment=4.0)
+    assert p["f_Hz"].iloc[p["psd"].idxmax()] == pytest.approx(5.0, abs=0.25)
+    # Parseval: the PSD integrates to the mean square, A^2 / 2
+    assert np.trapezoid(p["psd"], p["f_Hz"]) == pytest.approx(4.5, rel=2e-2)
+    s = S.summary(t, y, n=1)
+    assert s["rms"] == pytest.approx(3.0 / np.sqrt(2.0), rel=1e-6)
+    assert abs(s["peak"]) == pytest.approx(3.0, rel=1e-6) and abs(s["mean"]) < 1e-6
+    assert s["dominant"]["f_Hz"].iloc[0] == pytest.approx(5.0, rel=1e-9)

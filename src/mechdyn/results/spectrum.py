@@ -26,7 +26,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["spectrum", "dominant", "spectrogram", "order_spectrum", "of_column"]
+__all__ = ["spectrum", "dominant", "spectrogram", "order_spectrum", "welch", "summary",
+           "of_column"]
 
 
 def _uniform(t, y, samples: int | None):
@@ -202,9 +203,53 @@ def order_spectrum(angle, y, *, period: float = 2.0 * np.pi, orders: int = 20):
     return pd.DataFrame({"order": np.arange(amp.size), "amplitude": amp})
 
 
+def welch(t, y, *, segment: float | None = None, samples: int | None = None):
+    """Power spectral density by Welch's method (:func:`scipy.signal.welch`, Hann window,
+    half-overlapping segments): for a noisy or long transient history.
+
+    Parameters
+    ----------
+    t, y : array_like, shape (n,)
+        As in :func:`spectrum`.
+    segment : float, optional
+        Length of each segment, s (default 1/8 of the run).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``f_Hz`` and ``psd`` (unit of ``y`` squared per Hz).
+    """
+    import pandas as pd
+    from scipy.signal import welch as _welch
+
+    dt, u = _uniform(t, y, samples)
+    per = max(8, int(round((segment or (u.size * dt) / 8) / dt)))
+    f, p = _welch(u, fs=1.0 / dt, window="hann", nperseg=min(per, u.size))
+    return pd.DataFrame({"f_Hz": f, "psd": p})
+
+
+def summary(t, y, n: int = 5) -> dict:
+    """Peak, RMS and the dominant components of a history, for a table.
+
+    Returns
+    -------
+    dict
+        ``peak`` (largest absolute value) and ``peak_t`` (its time, s), ``rms``, ``mean``
+        (time averages over the run, trapezoidal in t) and ``dominant`` (the DataFrame of
+        :func:`dominant`).
+    """
+    t, y = np.asarray(t, float), np.asarray(y, float)
+    k = int(np.argmax(np.abs(y)))
+    span = t[-1] - t[0]
+    return {"peak": float(y[k]), "peak_t": float(t[k]),
+            "rms": float(np.sqrt(np.trapezoid(y * y, t) / span)),
+            "mean": float(np.trapezoid(y, t) / span), "dominant": dominant(t, y, n)}
+
+
 def of_column(record, column: str, how=spectrum, **options):
-    """Apply :func:`spectrum`, :func:`dominant` or :func:`spectrogram` to a column of a
-    record's table (``record.to_dataframe()``, e.g. ``"Fy_frame_N"`` of a trajectory).
+    """Apply :func:`spectrum`, :func:`dominant`, :func:`spectrogram`, :func:`welch` or
+    :func:`summary` to a column of a record's table (``record.to_dataframe()``, e.g.
+    ``"Fy_frame_N"`` of a trajectory).
 
     Raises
     ------
