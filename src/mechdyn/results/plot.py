@@ -18,9 +18,11 @@ from .plot_dynamics import plot_trajectory
 from .plot_kinematics import plot_kinematic_sweep
 from .plot_kinetostatics import plot_kinetostatics
 from .plot_reduction import plot_motor, plot_reduction, plot_startup, plot_steady_cycle
+from .plot_spectrum import plot_spectrum
 
 __all__ = ["plot", "PLOTTERS", "plot_kinematic_sweep", "plot_trajectory", "plot_kinetostatics",
-           "plot_reduction", "plot_steady_cycle", "plot_startup", "plot_motor"]
+           "plot_reduction", "plot_steady_cycle", "plot_startup", "plot_motor",
+           "plot_spectrum"]
 
 
 #: record class name -> plotting function
