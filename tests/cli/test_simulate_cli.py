@@ -191,3 +191,16 @@ def test_sigint_to_a_running_command_keeps_the_samples_marked_interrupted(tmp_pa
     assert "# status: interrupted" in text
     df = pd.read_csv(out, comment="#")
     assert len(df) > 2 and df["t_s"].iloc[-1] < 2.0
+
+
+def test_the_spectrum_of_a_column(tmp_path, capsys):
+    out, png = tmp_path / "fb.csv", tmp_path / "fb.png"
+    assert main(["simulate", "four_bar", "--t-end", "1s", "--spectrum", "Fy_frame_N",
+                 "-o", str(out), "--plot", str(png)]) == 0
+    text = capsys.readouterr().out
+    assert "Fy_frame_N: peak" in text and "dominant components" in text
+    sp = pd.read_csv(tmp_path / "fb_spectrum.csv")
+    assert {"f_Hz", "amplitude"} <= set(sp.columns)
+    assert (tmp_path / "fb_spectrum.png").stat().st_size > 1000
+    assert main(["simulate", "four_bar", "--t-end", "0.1s", "--spectrum", "Fz_frame_N"]) == 2
+    assert "valid columns" in capsys.readouterr().err

@@ -22,7 +22,9 @@ import numpy as np
 from ..dynamics.lagrange import FORMULATIONS
 from ..errors import ModelError, Status, did_you_mean
 from ..mechanism import Drive
+from ..results import spectrum
 from ..results.plot_dynamics import plot_trajectory
+from ..results.plot_spectrum import plot_spectrum
 from ..results.table import deg_or_mm, write_csv, written
 from ..simulate import simulate
 from ..simulate_events import format_events
@@ -73,6 +75,10 @@ def register(sub) -> None:
     p.add_argument("--points", action="store_true",
                    help="add the positions, velocities, accelerations of every named point")
     add_files(p, plot="write a plot of q, q', q'' and the energies")
+    p.add_argument("--spectrum", metavar="COLUMN",
+                   help="frequency content of a column of the table, e.g. Fy_frame_N: print "
+                        "its peak, RMS and dominant components; with -o also write "
+                        "NAME_spectrum.csv, with --plot NAME_spectrum.png")
     p.add_argument("--backend", default="auto", choices=("auto", "numpy", "numba"),
                    help="right-hand side evaluation (default auto: compiled when possible)")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
@@ -137,6 +143,8 @@ def run(args) -> int:
     if args.plot:
         plot_trajectory(traj, args.plot)
         print(f"wrote {args.plot}")
+    if args.spectrum and traj.t.size >= 8:
+        _spectrum(traj, args)
     if not traj.success:
         print(f"mechdyn simulate: stopped early: {traj.status}: {traj.message}", file=sys.stderr)
         return 130 if traj.status == Status.INTERRUPTED else 1
@@ -157,3 +165,26 @@ def _events_table(traj):
                                                         strict=False)})
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def _spectrum(traj, args) -> None:
+    """Print and write the frequency content of the column ``--spectrum``."""
+    col = args.spectrum
+    try:
+        summ = spectrum.of_column(traj, col, spectrum.summary, n=5)
+    except KeyError as exc:
+        raise ModelError(f"--spectrum: {exc.args[0]}") from None
+    print(f"{col}: peak {summ['peak']:.6g} at t = {summ['peak_t']:.6g} s, RMS "
+          f"{summ['rms']:.6g}, mean {summ['mean']:.6g}; dominant components:")
+    for _, row in summ["dominant"].iterrows():
+        print(f"  {row['f_Hz']:10.6g} Hz  amplitude {row['amplitude']:.6g}")
+    for path, write in ((args.output, "csv"), (args.plot, "png")):
+        if not path:
+            continue
+        out = Path(path).with_name(f"{Path(path).stem}_spectrum.{write}")
+        if write == "csv":
+            with written(out) as tmp:
+                spectrum.of_column(traj, col).to_csv(tmp, index=False)
+        else:
+            plot_spectrum(traj, col, out)
+        print(f"wrote {out}")
