@@ -180,14 +180,14 @@ def parse_quantity(value: Any, kind: str, *, where: str = "") -> float:
         raise _problem(where, value[:40] + "...", k, f"longer than {MAX_TEXT} characters")
     if any(c in text for c in ",;()[]{}"):
         raise _problem(where, value, k, "one quantity expected (no commas or brackets)")
-    ureg = registry()
-    import pint
-
     m = _QUANTITY_RE.match(text)
     if m is None:
         why = ("expected one number followed by a unit (arithmetic, a second number and "
                "quotes are not read)")
         if re.fullmatch(r"[^\W\d_]+", text):
+            import pint
+
+            ureg = registry()
             try:
                 ureg.parse_units(text)
                 why = "a unit without a number"

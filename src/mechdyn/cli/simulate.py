@@ -170,10 +170,12 @@ def _events_table(traj):
 def _spectrum(traj, args) -> None:
     """Print and write the frequency content of the column ``--spectrum``."""
     col = args.spectrum
-    try:
-        summ = spectrum.of_column(traj, col, spectrum.summary, n=5)
-    except KeyError as exc:
-        raise ModelError(f"--spectrum: {exc.args[0]}") from None
+    df = traj.to_dataframe()
+    if col not in df:
+        raise ModelError(f"--spectrum: no column {col!r}; valid columns: "
+                         + ", ".join(df.columns))
+    t, y = df["t_s"].to_numpy(), df[col].to_numpy(dtype=float)
+    summ = spectrum.summary(t, y, n=5)
     print(f"{col}: peak {summ['peak']:.6g} at t = {summ['peak_t']:.6g} s, RMS "
           f"{summ['rms']:.6g}, mean {summ['mean']:.6g}; dominant components:")
     for _, row in summ["dominant"].iterrows():
@@ -184,7 +186,7 @@ def _spectrum(traj, args) -> None:
         out = Path(path).with_name(f"{Path(path).stem}_spectrum.{write}")
         if write == "csv":
             with written(out) as tmp:
-                spectrum.of_column(traj, col).to_csv(tmp, index=False)
+                spectrum.spectrum(t, y).to_csv(tmp, index=False)
         else:
             plot_spectrum(traj, col, out)
         print(f"wrote {out}")

@@ -22,6 +22,10 @@ from .reduced_machine import ReducedMachine, _frozen, _Motion, _Record
 
 __all__ = ["SteadyCycle", "steady_state", "FlywheelSizing", "size_flywheel", "FLYWHEEL_METHODS"]
 
+#: RK4 steps over one cycle of the steady-state shooting (and of the balance of a
+#: machine without a drive, in the same quadrature)
+CYCLE_STEPS = 720
+
 
 # ============================================================================ steady cycle
 @dataclass(frozen=True)
@@ -117,7 +121,8 @@ class _Cycle:
 
 def steady_state(machine: ReducedMachine, *, omega_guess: float | None = None,
                  omega_mean: float | None = None, phi0: float = 0.0, t0: float = 0.0,
-                 steps: int = 720, tol: float = 1e-10, max_iter: int = 60) -> SteadyCycle:
+                 steps: int = CYCLE_STEPS, tol: float = 1e-10,
+                 max_iter: int = 60) -> SteadyCycle:
     """The periodic steady motion: shooting on the speed at ``phi0``.
 
     One cycle is integrated in the position (``dE/dphi = M_red`` with the kinetic
@@ -448,7 +453,7 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
 
         # Simpson's rule on the steady cycle's own grid (RK4 in phi of a torque of phi
         # alone is Simpson's rule), so that the cycle balances in its quadrature too
-        ph_ = phi0 + np.linspace(0.0, machine.period, 2 * 720 + 1)
+        ph_ = phi0 + np.linspace(0.0, machine.period, 2 * CYCLE_STEPS + 1)
         load = float(simpson([machine.torque(t, p, wm) for p in ph_], x=ph_)) / machine.period
         machine = machine.with_driving_torque(-load)
         no_drive = (f"the model has no drive: a constant driving torque of {-load:.6g} N m "

@@ -369,9 +369,8 @@ class ModeSystem:
         except np.linalg.LinAlgError:
             sol = None
         if sol is None:
-            A = B.T @ M @ B
-            if A.size and np.linalg.cond(A) > 1e14:  # no inertia on some coordinate
-                solve_mass(self.coord_names, A, A[:, 0], None, None)
+            if self.n_i:  # a coordinate without inertia is named, not solved around
+                solve_mass(self.coord_names, B.T @ M @ B, np.zeros(self.n_i), None, None)
             sol = self._redundant_solve(Ks, rhs * rs)
         return sol[:self.n_i], sol[self.n_i:]
 

@@ -146,20 +146,18 @@ def frame_forces(ms, x, lam, point=None) -> dict:
     key ``"total"`` sums them (batched over poses ``x`` (..., n_x) and multipliers
     ``lam`` (..., n_rows)).  With ``point`` (2,) m, each entry is (Fx, Fy, M), shape
     (..., 3), with the moment M about that point, N m."""
-    model = ms.model
     R = ms.row_jacobian(x)
     lam = np.asarray(lam, float)
+    width = 2 if point is None else 3
+    p = np.zeros(2) if point is None else np.asarray(point, float)
     out: dict = {}
-    total = np.zeros(lam.shape[:-1] + (2 if point is None else 3,))
+    total = np.zeros(lam.shape[:-1] + (width,))
     for el, idx in ms.element_rows.items():
         if el not in ms.grounded:
             continue
         gen = np.einsum("...rx,...r->...x", R[..., idx, :], lam[..., idx])
         # Newton's third law: the frame gets the opposite of the force on the bodies
-        if point is None:
-            f = -gen.reshape(gen.shape[:-1] + (model.n_bodies, 3))[..., :2].sum(axis=-2)
-        else:
-            f = net_on_ground(model, x, gen, np.asarray(point, float)).reshape(total.shape)
+        f = net_on_ground(ms.model, x, gen, p)[..., :width].reshape(total.shape)
         out[el] = f
         total = total + f
     out["total"] = total

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from .figure import figure as _figure
 from .figure import save as _save
-from .spectrum import of_column, spectrogram, spectrum
+from .spectrum import spectrogram, spectrum
 from .table import unit_of_column
 
 __all__ = ["plot_spectrum"]
@@ -46,7 +46,7 @@ def plot_spectrum(record, column: str, path, *, f_max: float | None = None,
         raise KeyError(f"no column {column!r}; valid columns: {', '.join(df.columns)}")
     t, y = df["t_s"].to_numpy(), df[column].to_numpy(dtype=float)
     unit = unit_of_column(column) or "-"
-    sp = of_column(record, column, spectrum)
+    sp = spectrum(t, y)
     f, tc, amp = spectrogram(t, y, segment=segment)
     top = f_max if f_max is not None else float(sp["f_Hz"].iloc[-1])
     fig, ax = _figure(3, height=2.6, sharex=False)
