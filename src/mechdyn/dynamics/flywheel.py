@@ -69,54 +69,46 @@ class SteadyCycle(_Motion):
         return (self.omega_max - self.omega_min) / self.omega_avg
 
 
-class _Cycle:
-    """One cycle integrated in the position with classical RK4 on a fixed grid.
+def _cycle(machine: ReducedMachine, ph: np.ndarray, omega0: float, t0: float, calls: list):
+    """One cycle from speed ``omega0`` over the grid ``ph``: (omega_end, E, t, M on the grid).
 
-    State (E, t) with E = J omega^2 / 2: dE/dphi = M_red(t, phi, omega),
-    dt/dphi = 1/omega.  A fixed grid makes the cycle map omega0 -> omega_end a
-    smooth deterministic function (shooting finds its fixed point exactly) and
-    copes with loads that jump (punch windows); its error is O(h^4).
+    Classical RK4 in the position on the state (E, t) with E = J omega^2 / 2:
+    dE/dphi = M_red(t, phi, omega), dt/dphi = 1/omega.  A fixed grid makes the cycle
+    map omega0 -> omega_end a smooth deterministic function (shooting finds its fixed
+    point exactly) and copes with loads that jump (punch windows); its error is O(h^4).
+    ``calls[0]`` counts the machine's evaluations.
     """
+    if not (math.isfinite(omega0) and omega0 > 0):
+        raise IntegrationError(f"cycle start speed must be > 0 rad/s, got {omega0!r}")
+    h = machine.period / (ph.size - 1)
+    E, T, M = np.empty(ph.size), np.empty(ph.size), np.empty(ph.size)
+    e = 0.5 * machine.inertia(ph[0])[0] * omega0 * omega0
+    floor = 1e-10 * e
 
-    def __init__(self, machine: ReducedMachine, phi0: float, steps: int):
-        self.m = machine
-        self.steps = int(steps)
-        self.phi = float(phi0) + np.linspace(0.0, machine.period, self.steps + 1)
-        self.h = machine.period / self.steps
-        self.evaluations = 0
-
-    def _f(self, p, e, t, e_floor):
-        self.evaluations += 1
-        j = self.m.inertia(p)[0]
-        if e <= e_floor:
+    def f(p, e, t):
+        calls[0] += 1
+        j = machine.inertia(p)[0]
+        if e <= floor:
             raise LockupError(
                 f"the machine stalls during the cycle at phi = {math.degrees(p):.4g} deg "
                 f"(its speed drops to zero): the driving torque cannot carry the load through "
                 f"the cycle at this speed; use startup() or start faster", q=[p])
         w = math.sqrt(2.0 * e / j)
-        return self.m.torque(t, p, w), 1.0 / w
+        return machine.torque(t, p, w), 1.0 / w
 
-    def run(self, omega0: float, t0: float = 0.0):
-        """Integrate one cycle from speed ``omega0``: (omega_end, E, t, M on the grid)."""
-        if not (math.isfinite(omega0) and omega0 > 0):
-            raise IntegrationError(f"cycle start speed must be > 0 rad/s, got {omega0!r}")
-        h, ph, f = self.h, self.phi, self._f
-        E, T, M = np.empty(ph.size), np.empty(ph.size), np.empty(ph.size)
-        e = 0.5 * self.m.inertia(ph[0])[0] * omega0 * omega0
-        floor = 1e-10 * e
-        t = float(t0)
-        for k in range(self.steps):
-            p = ph[k]
-            m1, r1 = f(p, e, t, floor)
-            E[k], T[k], M[k] = e, t, m1
-            m2, r2 = f(p + 0.5 * h, e + 0.5 * h * m1, t + 0.5 * h * r1, floor)
-            m3, r3 = f(p + 0.5 * h, e + 0.5 * h * m2, t + 0.5 * h * r2, floor)
-            m4, r4 = f(ph[k + 1], e + h * m3, t + h * r3, floor)
-            e += h * (m1 + 2.0 * m2 + 2.0 * m3 + m4) / 6.0
-            t += h * (r1 + 2.0 * r2 + 2.0 * r3 + r4) / 6.0
-        E[-1], T[-1] = e, t
-        M[-1], _ = f(ph[-1], e, t, floor)
-        return math.sqrt(2.0 * e / self.m.inertia(ph[-1])[0]), E, T, M
+    t = float(t0)
+    for k in range(ph.size - 1):
+        p = ph[k]
+        m1, r1 = f(p, e, t)
+        E[k], T[k], M[k] = e, t, m1
+        m2, r2 = f(p + 0.5 * h, e + 0.5 * h * m1, t + 0.5 * h * r1)
+        m3, r3 = f(p + 0.5 * h, e + 0.5 * h * m2, t + 0.5 * h * r2)
+        m4, r4 = f(ph[k + 1], e + h * m3, t + h * r3)
+        e += h * (m1 + 2.0 * m2 + 2.0 * m3 + m4) / 6.0
+        t += h * (r1 + 2.0 * r2 + 2.0 * r3 + r4) / 6.0
+    E[-1], T[-1] = e, t
+    M[-1], _ = f(ph[-1], e, t)
+    return math.sqrt(2.0 * e / machine.inertia(ph[-1])[0]), E, T, M
 
 
 def steady_state(machine: ReducedMachine, *, omega_guess: float | None = None,
@@ -169,13 +161,14 @@ def steady_state(machine: ReducedMachine, *, omega_guess: float | None = None,
 
     if int(steps) < 8:
         raise ModelError(f"steps must be at least 8, got {steps!r}")
-    cyc = _Cycle(machine, phi0, steps)
+    ph = float(phi0) + np.linspace(0.0, machine.period, int(steps) + 1)
+    calls = [0]
     iters = 0
 
     def g(w0):
         nonlocal iters
         iters += 1
-        w1 = cyc.run(w0, t0)[0]
+        w1 = _cycle(machine, ph, w0, t0, calls)[0]
         return w1 - w0, w1
 
     if omega_mean is not None:
@@ -184,8 +177,8 @@ def steady_state(machine: ReducedMachine, *, omega_guess: float | None = None,
             raise ModelError(f"omega_mean must be > 0 rad/s, got {omega_mean!r}")
 
         def mean_err(w0):
-            E = cyc.run(w0, t0)[1]
-            om = np.sqrt(2.0 * np.maximum(E, 0.0) / machine.inertia_along(cyc.phi))
+            E = _cycle(machine, ph, w0, t0, calls)[1]
+            om = np.sqrt(2.0 * np.maximum(E, 0.0) / machine.inertia_along(ph))
             return 0.5 * (om.max() + om.min()) - target
 
         lo = hi = target
@@ -210,7 +203,7 @@ def steady_state(machine: ReducedMachine, *, omega_guess: float | None = None,
                 f"cycle its speed changes by {err:.6g} rad/s (the work of the driving torque "
                 f"does not balance the load); balance the mean torque or use a speed-dependent "
                 f"drive")
-        return _finish(machine, cyc, w0, t0, iters)
+        return _finish(machine, ph, calls, w0, t0, iters)
 
     w0 = omega_guess if omega_guess is not None else machine.nominal_speed
     if w0 is None:
@@ -222,7 +215,7 @@ def steady_state(machine: ReducedMachine, *, omega_guess: float | None = None,
     for _ in range(3):
         err, w1 = g(w0)
         if abs(err) <= tol * w0:
-            return _finish(machine, cyc, w0, t0, iters)
+            return _finish(machine, ph, calls, w0, t0, iters)
         w0 = w1
     # ... then the secant method on g(omega0) = omega_end - omega0
     wa = w0
@@ -231,7 +224,7 @@ def steady_state(machine: ReducedMachine, *, omega_guess: float | None = None,
     eb, _ = g(wb)
     for _ in range(max_iter):
         if abs(eb) <= tol * wb:
-            return _finish(machine, cyc, wb, t0, iters)
+            return _finish(machine, ph, calls, wb, t0, iters)
         if eb == ea:
             break
         wc = wb - eb * (wb - wa) / (eb - ea)
@@ -265,12 +258,11 @@ def _balance_speed(machine: ReducedMachine, t0: float, phi0: float) -> float:
                      "rad/s balances the mean torque over a cycle")
 
 
-def _finish(machine, cyc: _Cycle, w0, t0, iters) -> SteadyCycle:
+def _finish(machine, ph, calls, w0, t0, iters) -> SteadyCycle:
     from scipy.interpolate import CubicHermiteSpline
     from scipy.optimize import minimize_scalar
 
-    _, E, T, M = cyc.run(w0, t0)
-    ph = cyc.phi
+    _, E, T, M = _cycle(machine, ph, w0, t0, calls)
     J, dJ = np.array([machine.inertia(p) for p in ph]).T
     om = np.sqrt(2.0 * np.maximum(E, 0.0) / J)
     eps = (M - 0.5 * dJ * om**2) / J
@@ -283,7 +275,7 @@ def _finish(machine, cyc: _Cycle, w0, t0, iters) -> SteadyCycle:
     for k0, sign in ((int(np.argmax(om)), -1.0), (int(np.argmin(om)), 1.0)):
         best = (sign * om[k0], ph[k0])
         for k in (k0 - 1, k0):
-            if 0 <= k < cyc.steps:
+            if 0 <= k < ph.size - 1:
                 r = minimize_scalar(lambda p, s=sign: s * speed(p), bounds=(ph[k], ph[k + 1]),
                                     method="bounded", options={"xatol": 1e-12})
                 best = min(best, (float(r.fun), float(r.x)))
@@ -297,8 +289,8 @@ def _finish(machine, cyc: _Cycle, w0, t0, iters) -> SteadyCycle:
         omega_mean=float(wmean), omega_avg=float(machine.period / T_cyc),
         delta=float((wmax - wmin) / wmean), cycle_time=float(T_cyc), phi_at_max=float(pmax),
         phi_at_min=float(pmin), extra_inertia=machine.extra_inertia,
-        stats={"cycles_integrated": iters + 1, "evaluations": cyc.evaluations,
-               "omega0": float(w0), "steps": cyc.steps})
+        stats={"cycles_integrated": iters + 1, "evaluations": calls[0],
+               "omega0": float(w0), "steps": ph.size - 1})
 
 
 # ============================================================================ flywheel
@@ -488,30 +480,27 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
     if abs(imbalance) > 0.02 * max(1e-300, float(np.max(np.abs(M)))):
         msgs.append(f"the mean torque at omega_mean is {imbalance:.4g} N m (the cycle is not "
                     f"balanced at this speed); it was removed for the energy method")
-    if j_fly < 0:
+    met = base is not None and base.delta <= delta  # the machine as it is meets the target
+    if j_fly < 0 and not met:
         msgs.append(f"the machine's own inertia meets delta = {delta:g} (the estimate is "
                     f"{j_fly:.4g} kg m^2): no flywheel is needed")
-        j_fly = 0.0
+    j_fly = max(j_fly, 0.0)
     cycle = d_sim = None
     if stall is not None:
         msgs.append(f"without a flywheel the machine cannot keep the mean speed ({stall})")
-    met = base is not None and base.delta <= delta  # the machine as it is meets the target
-    if met:
-        msgs = [m for m in msgs if "no flywheel is needed" not in m]
-        msgs.append(f"the steady cycle without a flywheel has delta = {base.delta:.4g} <= "
-                    f"{delta:g}: no flywheel is needed (energy estimates: {j_basic:.4g}, "
-                    f"refined {j_ref:.4g} kg m^2)")
-        j_fly, cycle, d_sim = 0.0, base, base.delta
 
     def dsim(jf):
         c = steady_state(machine.with_extra_inertia(jf), phi0=phi0, **kw)
         return c.delta, c
 
     if met:
-        pass
+        msgs.append(f"the steady cycle without a flywheel has delta = {base.delta:.4g} <= "
+                    f"{delta:g}: no flywheel is needed (energy estimates: {j_basic:.4g}, "
+                    f"refined {j_ref:.4g} kg m^2)")
+        j_fly, cycle, d_sim = 0.0, base, base.delta
     elif method == "simulation":
         # 1/delta is nearly linear in the total inertia: secant on 1/delta - 1/target
-        ja = max(j_fly, 0.0)
+        ja = j_fly
         da, cycle = dsim(ja)
         jb, db = ja, da
         if abs(da / delta - 1.0) > rtol:

@@ -18,6 +18,7 @@ import copy
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -78,8 +79,11 @@ class _Motion(_Record):
         return pd.DataFrame(cols)
 
 
-def _extra_inertia(value) -> float:
-    """``value`` as an added inertia, kg m^2 (checked finite and >= 0)."""
+def _extra_inertia(value, model: Model | None = None) -> float:
+    """``value`` as an added inertia, kg m^2 (checked finite and >= 0); None: the inertia
+    of the model's drives (rotor and gear)."""
+    if value is None:
+        return float(drive_inertia(model)[0])
     j = float(value)
     if not math.isfinite(j) or j < 0:
         raise ModelError(f"extra_inertia must be >= 0 kg*m^2, got {value!r}")
@@ -146,16 +150,17 @@ class MemberLoad:
     ratio: float | Callable = 1.0
 
 
-def _ratio(r, phi):
-    return float(r(phi)) if callable(r) else float(r)
+def _value(f, *args) -> float:
+    """``f(*args)`` of a callable, else the constant ``f``, as a float."""
+    return float(f(*args)) if callable(f) else float(f)
 
 
 def _dratio(m: Member, phi, h=1e-6):
     if m.ratio_derivative is not None:
-        return _ratio(m.ratio_derivative, phi)
+        return _value(m.ratio_derivative, phi)
     if not callable(m.ratio):
         return 0.0
-    return (_ratio(m.ratio, phi + h) - _ratio(m.ratio, phi - h)) / (2 * h)
+    return (_value(m.ratio, phi + h) - _value(m.ratio, phi - h)) / (2 * h)
 
 
 class ReducedMachine:
@@ -277,13 +282,14 @@ class ReducedMachine:
         """
         model = as_model(model)  # a Mechanism is compiled (and validated) here
         ev = _ModelEvaluator(model, coordinate, mode=mode, x0=x0)
-        if extra_inertia is None:
-            extra_inertia = float(drive_inertia(model)[0])
-        drive = _single_drive(model, ev.coordinate)
+        motors = [d.torque for d in model.mechanism.drives
+                  if d.coordinate == ev.coordinate and hasattr(d.torque, "torque_at")]
+        drive = motors[0] if len(motors) == 1 else None  # for reports
         if period is None:
             period = TWO_PI if ev.is_angle else 1.0
-        return cls(ev.inertia, ev.torque, extra_inertia=extra_inertia, drive=drive,
-                   period=period, name=model.mechanism.name, coordinate=ev.coordinate)
+        return cls(ev.inertia, ev.torque, extra_inertia=_extra_inertia(extra_inertia, model),
+                   drive=drive, period=period, name=model.mechanism.name,
+                   coordinate=ev.coordinate)
 
     @classmethod
     def from_reduction(cls, red: Reduction, model: Model | None = None, *,
@@ -363,15 +369,12 @@ class ReducedMachine:
             raise ModelError(f"transmission: member names must be unique, got {names}")
 
         def inertia(p):
-            j = sum(m.inertia * _ratio(m.ratio, p) ** 2 for m in members)
-            dj = sum(2.0 * m.inertia * _ratio(m.ratio, p) * _dratio(m, p) for m in members)
+            j = sum(m.inertia * _value(m.ratio, p) ** 2 for m in members)
+            dj = sum(2.0 * m.inertia * _value(m.ratio, p) * _dratio(m, p) for m in members)
             return j, dj
 
         def torque(t, p, w):
-            tot = 0.0
-            for ld in loads:
-                v = ld.value(t, p, w) if callable(ld.value) else ld.value
-                tot += float(v) * _ratio(ld.ratio, p)
+            tot = sum(_value(ld.value, t, p, w) * _value(ld.ratio, p) for ld in loads)
             return tot + _drive_torque(drive, w)
 
         extra = float(drive.extra_inertia()) if hasattr(drive, "extra_inertia") else 0.0
@@ -387,27 +390,9 @@ class ReducedMachine:
         j = float(inertia)
 
         def tq(t, p, w):
-            v = torque(t, p, w) if callable(torque) else torque
-            return float(v) + _drive_torque(drive, w)
+            return _value(torque, t, p, w) + _drive_torque(drive, w)
 
         return cls(lambda p: (j, 0.0), tq, drive=drive, period=period, name=name)
-
-
-def _single_drive(model: Model, coordinate: str):
-    """The drive object on the coordinate (for reports), None if none or not a motor."""
-    objs = [d.torque for d in model.mechanism.drives if d.coordinate == coordinate]
-    objs = [o for o in objs if hasattr(o, "torque_at")]
-    return objs[0] if len(objs) == 1 else None
-
-
-class _SpeedDrives:
-    """The drives on one coordinate as one ``torque_at(omega)``: a sum of functions of omega."""
-
-    def __init__(self, parts):
-        self.parts = parts
-
-    def torque_at(self, omega):
-        return sum(float(p(omega)) for p in self.parts)
 
 
 def _speed_drive(model: Model, coordinate: str):
@@ -428,23 +413,18 @@ def _speed_drive(model: Model, coordinate: str):
             parts.append(lambda omega, v=float(tq): v)
     if len(drives) == 1 and hasattr(drives[0].torque, "torque_at"):
         return drives[0].torque
-    return _SpeedDrives(parts) if parts else None
+    # one torque_at(omega): the sum of the drives' functions of omega
+    return SimpleNamespace(torque_at=lambda w: sum(float(p(w)) for p in parts)) if parts else None
 
 
 def _nominal(drive) -> float | None:
     """A speed at which a drive runs near its rated point, rad/s (None if unknown)."""
-    if drive is None:
-        return None
     ratio = 1.0
-    d = drive
-    while hasattr(d, "ratio") and hasattr(d, "motor"):
-        ratio *= d.ratio
-        d = d.motor
-    for attr in ("rated_speed", "speed"):
-        v = getattr(d, attr, None)
+    while hasattr(drive, "ratio") and hasattr(drive, "motor"):  # through the gear stages
+        ratio *= drive.ratio
+        drive = drive.motor
+    for attr, share in (("rated_speed", 1.0), ("speed", 1.0), ("no_load_speed", 0.5)):
+        v = getattr(drive, attr, None)
         if v is not None:
-            return float(v) / ratio
-    v = getattr(d, "no_load_speed", None)
-    if v is not None:
-        return 0.5 * float(v) / ratio
+            return share * float(v) / ratio
     return None

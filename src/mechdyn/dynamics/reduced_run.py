@@ -48,16 +48,6 @@ class ReducedRun(_Motion):
     M_motor: np.ndarray | None = None
 
 
-def _history(machine: ReducedMachine, t, phi, omega, **kw) -> ReducedRun:
-    J, dJ = np.array([machine.inertia(p) for p in phi], dtype=float).reshape(-1, 2).T
-    M = np.array([machine.torque(*s) for s in zip(t, phi, omega, strict=True)], dtype=float)
-    md = np.array([machine.drive_torque(w) for w in omega], dtype=float)
-    mm = None if machine.drive is None else np.array([machine.motor_torque(w) for w in omega])
-    eps = (M - 0.5 * dJ * omega**2) / J
-    return ReducedRun(_frozen(t), _frozen(phi), _frozen(omega), _frozen(eps), _frozen(J),
-                      _frozen(M), _frozen(md), None if mm is None else _frozen(mm), **kw)
-
-
 def run_reduced(machine: ReducedMachine, t_end: float, *, phi0: float = 0.0,
                 omega0: float = 0.0, t0: float = 0.0, integrator: str = "dop853",
                 t_eval=None, events=None, **options) -> ReducedRun:
@@ -89,9 +79,15 @@ def run_reduced(machine: ReducedMachine, t_end: float, *, phi0: float = 0.0,
     """
     sol = solve(integrator, machine.rhs, t0, [phi0], [omega0], t_end, t_eval=t_eval,
                 events=events, **options)
-    return _history(machine, sol.t, sol.q[:, 0], sol.qdot[:, 0],
-                    status="success" if sol.status == "success" else sol.status,
-                    events=tuple(sol.events), stats=dict(sol.stats))
+    t, phi, omega = sol.t, sol.q[:, 0], sol.qdot[:, 0]
+    J, dJ = np.array([machine.inertia(p) for p in phi], dtype=float).reshape(-1, 2).T
+    M = np.array([machine.torque(*s) for s in zip(t, phi, omega, strict=True)], dtype=float)
+    md = np.array([machine.drive_torque(w) for w in omega], dtype=float)
+    mm = None if machine.drive is None else np.array([machine.motor_torque(w) for w in omega])
+    eps = (M - 0.5 * dJ * omega**2) / J
+    return ReducedRun(_frozen(t), _frozen(phi), _frozen(omega), _frozen(eps), _frozen(J),
+                      _frozen(M), _frozen(md), None if mm is None else _frozen(mm),
+                      status=sol.status, events=tuple(sol.events), stats=dict(sol.stats))
 
 
 def energy_speed(machine: ReducedMachine, phi, *, phi0: float = 0.0, omega0: float,

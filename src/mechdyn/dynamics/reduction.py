@@ -38,7 +38,6 @@ from ..errors import ModelError, Status, did_you_mean
 from ..mechanism.joint import Lock
 from ..model import Model, as_model
 from .flywheel import FlywheelSizing, SteadyCycle, size_flywheel, steady_state
-from .inertia import drive_inertia
 from .reduced_kinematics import _inertia, _ModelEvaluator, reduced_kinematics
 from .reduced_machine import (
     TWO_PI,
@@ -229,8 +228,7 @@ def reduce_model(model: Model, *, coordinate: str | None = None, link: str | Non
         phis = np.asarray(phi, dtype=float).reshape(-1)
         if phis.size < 1 or not np.all(np.isfinite(phis)):
             raise ModelError("phi must be a non-empty sequence of finite positions")
-    j_extra = float(drive_inertia(model)[0]) if extra_inertia is None else \
-        _extra_inertia(extra_inertia)
+    j_extra = _extra_inertia(extra_inertia, model)
     sw = ev.sweep(phis)
     xs, B = sw.x, sw.B[..., 0]
     J, dJ = _inertia(model, xs, B, sw.xddot)
