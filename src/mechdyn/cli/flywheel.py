@@ -18,7 +18,7 @@ Exit codes: 0 done; 1 the simulated delta misses the target by more than 5 %;
 
 from __future__ import annotations
 
-from ..dynamics.flywheel import size_flywheel
+from ..dynamics.flywheel import FLYWHEEL_METHODS, size_flywheel
 from ..dynamics.reduced_machine import ReducedMachine
 from ..dynamics.reduction import reduce_model
 from ..errors import ModelError
@@ -55,7 +55,7 @@ def register(sub) -> None:
     p.add_argument("--speed", metavar="RATE",
                    help="mean speed of the crank (needed for a constant driving torque; with a "
                         "motor the start of the steady-state search)")
-    p.add_argument("--method", choices=("energy", "refined", "simulation"),
+    p.add_argument("--method", choices=FLYWHEEL_METHODS,
                    help="energy method (basic or refined for a variable J_red) or iterate on "
                         "the simulated steady cycle (default: simulation with a motor, whose "
                         "slope smooths the speed; refined with a constant torque)")

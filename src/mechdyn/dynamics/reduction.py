@@ -311,12 +311,10 @@ def mode_mechanism(mechanism, *, engage: Sequence[str] = (), offsets: dict | Non
         off = offsets.pop(name, j.offset)
         joints[name] = dataclasses.replace(j, engaged=True,
                                            offset=None if off is None else tuple(map(float, off)))
-    for name in offsets:
-        probs.append(f"offsets: lock {name!r} is not in engage")
+    probs += [f"offsets: lock {name!r} is not in engage" for name in offsets]
+    probs += [did_you_mean(name, mechanism.coordinates, "coordinate") for name in drop
+              if name not in mechanism.coordinates]
     coords = {k: v for k, v in mechanism.coordinates.items() if k not in set(drop)}
-    for name in drop:
-        if name not in mechanism.coordinates:
-            probs.append(did_you_mean(name, mechanism.coordinates, "coordinate"))
     if probs:
         raise ModelError(probs)
     extras = dict(mechanism.extras)
