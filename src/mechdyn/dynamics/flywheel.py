@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import IntegrationError, LockupError, ModelError
-from .reduced_machine import ReducedMachine, _frozen, _Motion, _Record
+from .reduced_machine import ReducedMachine, _Motion, _Record
 
 __all__ = ["SteadyCycle", "steady_state", "FlywheelSizing", "size_flywheel", "FLYWHEEL_METHODS"]
 
@@ -284,9 +284,8 @@ def _finish(machine, ph, calls, w0, t0, iters) -> SteadyCycle:
     wmean = 0.5 * (wmax + wmin)
     T_cyc = T[-1] - t0
     return SteadyCycle(
-        phi=_frozen(ph), t=_frozen(T - t0), omega=_frozen(om), epsilon=_frozen(eps),
-        J=_frozen(J), M=_frozen(M), omega_max=float(wmax), omega_min=float(wmin),
-        omega_mean=float(wmean), omega_avg=float(machine.period / T_cyc),
+        phi=ph, t=T - t0, omega=om, epsilon=eps, J=J, M=M, omega_max=float(wmax),
+        omega_min=float(wmin), omega_mean=float(wmean), omega_avg=float(machine.period / T_cyc),
         delta=float((wmax - wmin) / wmean), cycle_time=float(T_cyc), phi_at_max=float(pmax),
         phi_at_min=float(pmin), extra_inertia=machine.extra_inertia,
         stats={"cycles_integrated": iters + 1, "evaluations": calls[0],

@@ -17,7 +17,7 @@ import bisect
 import copy
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from types import SimpleNamespace
 from typing import TYPE_CHECKING
 
@@ -38,20 +38,22 @@ __all__ = ["ReducedMachine", "Member", "MemberLoad"]
 TWO_PI = 2.0 * math.pi
 
 
-def _frozen(a) -> np.ndarray:
-    a = np.array(a, dtype=float, copy=True)
-    a.setflags(write=False)
-    return a
-
-
 @dataclass(frozen=True, kw_only=True)
 class _Record:
-    """The fields every record has: ``status``, ``message``, ``events``, ``stats``."""
+    """The fields every record has: ``status``, ``message``, ``events``, ``stats``; its
+    array fields are kept as read-only float copies."""
 
     status: str = "success"
     message: str = ""
     events: tuple = ()
     stats: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        for f in fields(self):
+            if isinstance(v := getattr(self, f.name), np.ndarray):
+                a = np.array(v, dtype=float, copy=True)
+                a.setflags(write=False)
+                object.__setattr__(self, f.name, a)
 
 
 @dataclass(frozen=True)

@@ -25,7 +25,7 @@ import numpy as np
 from ..errors import ModelError, Status
 from ..integrate import solve
 from .flywheel import SteadyCycle, steady_state
-from .reduced_machine import ReducedMachine, _frozen, _Motion, _Record
+from .reduced_machine import ReducedMachine, _Motion, _Record
 
 __all__ = ["ReducedRun", "run_reduced", "energy_speed", "StartupResult", "startup"]
 
@@ -85,9 +85,8 @@ def run_reduced(machine: ReducedMachine, t_end: float, *, phi0: float = 0.0,
     md = np.array([machine.drive_torque(w) for w in omega], dtype=float)
     mm = None if machine.drive is None else np.array([machine.motor_torque(w) for w in omega])
     eps = (M - 0.5 * dJ * omega**2) / J
-    return ReducedRun(_frozen(t), _frozen(phi), _frozen(omega), _frozen(eps), _frozen(J),
-                      _frozen(M), _frozen(md), None if mm is None else _frozen(mm),
-                      status=sol.status, events=tuple(sol.events), stats=dict(sol.stats))
+    return ReducedRun(t, phi, omega, eps, J, M, md, mm, status=sol.status,
+                      events=tuple(sol.events), stats=dict(sol.stats))
 
 
 def energy_speed(machine: ReducedMachine, phi, *, phi0: float = 0.0, omega0: float,

@@ -45,7 +45,6 @@ from .reduced_machine import (
     MemberLoad,
     ReducedMachine,
     _extra_inertia,
-    _frozen,
     _Record,
 )
 from .reduced_run import ReducedRun, StartupResult, energy_speed, run_reduced, startup
@@ -263,14 +262,11 @@ def reduce_model(model: Model, *, coordinate: str | None = None, link: str | Non
                    f"{np.degrees(phis[np.argmax(bad)]):.4g} deg): the reduced quantities are "
                    f"infinite there; choose a link that turns continuously")
     return Reduction(
-        coordinate=ev.coordinate, link=link, is_angle=ev.is_angle, phi=_frozen(phis),
-        link_angle=None if link_angle is None else _frozen(link_angle),
-        ratio=_frozen(ratio), J_red=_frozen(J_link), dJ_red_dphi=_frozen(dJ_link),
-        J_extra=_frozen(J_extra), M_red=_frozen(M_f + M_d), M_drive=_frozen(M_d),
-        M_forces=_frozen(M_f), omega=_frozen(np.full(n, float(omega))), t=float(t),
-        point=point, m_red=None if m_red is None else _frozen(m_red),
-        v_ratio=None if v_ratio is None else _frozen(v_ratio), status=status,
-        message=message, stats={"positions": n, "extra_inertia_coordinate": j_extra})
+        coordinate=ev.coordinate, link=link, is_angle=ev.is_angle, phi=phis,
+        link_angle=link_angle, ratio=ratio, J_red=J_link, dJ_red_dphi=dJ_link, J_extra=J_extra,
+        M_red=M_f + M_d, M_drive=M_d, M_forces=M_f, omega=np.full(n, float(omega)), t=float(t),
+        point=point, m_red=m_red, v_ratio=v_ratio, status=status, message=message,
+        stats={"positions": n, "extra_inertia_coordinate": j_extra})
 
 
 def mode_mechanism(mechanism, *, engage: Sequence[str] = (), offsets: dict | None = None,
