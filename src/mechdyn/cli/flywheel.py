@@ -78,8 +78,7 @@ def run(args) -> int:
     if args.exact:
         machine = ReducedMachine.from_model(model)
     else:
-        red = reduce_model(model, steps=args.steps, omega=speed or 1.0)
-        machine = red.machine(model)
+        machine = reduce_model(model, steps=args.steps, omega=speed or 1.0).machine(model)
     dependent = machine.speed_dependent()
     if not dependent and speed is None:
         raise ModelError("the driving torque does not depend on the speed, so the steady "

@@ -415,7 +415,7 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
     -------
     FlywheelSizing
     """
-    from scipy.integrate import cumulative_simpson
+    from scipy.integrate import cumulative_simpson, simpson
 
     if not (isinstance(delta, (int, float)) and 0 < delta < 2):
         raise ModelError(f"delta (coefficient of speed fluctuation) must lie in (0, 2), "
@@ -436,18 +436,16 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
     wm = float(omega_mean)
     if not wm > 0:
         raise ModelError(f"omega_mean must be > 0 rad/s, got {omega_mean!r}")
-    no_drive = None
+    msgs = []
     if machine.drive is None and not dependent:
         # no drive: the classic energy method's drive, a constant torque equal to the mean
-        # of the load torque, keeps the mean speed
-        from scipy.integrate import simpson
-
-        # Simpson's rule on the steady cycle's own grid (RK4 in phi of a torque of phi
-        # alone is Simpson's rule), so that the cycle balances in its quadrature too
+        # of the load torque, keeps the mean speed.  Simpson's rule on the steady cycle's
+        # own grid (RK4 in phi of a torque of phi alone is Simpson's rule), so that the
+        # cycle balances in its quadrature too
         ph_ = phi0 + np.linspace(0.0, machine.period, 2 * CYCLE_STEPS + 1)
         load = float(simpson([machine.torque(t, p, wm) for p in ph_], x=ph_)) / machine.period
         machine = machine.with_driving_torque(-load)
-        no_drive = (f"the model has no drive: a constant driving torque of {-load:.6g} N m "
+        msgs.append(f"the model has no drive: a constant driving torque of {-load:.6g} N m "
                     f"(the mean of the load torque) keeps the mean speed (classic energy "
                     f"method)")
     kw = {"omega_guess": wm} if dependent else {"omega_mean": wm}
@@ -475,7 +473,6 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
     j_basic = dE * need - jm
     j_ref = dE_ref * need - jm
     j_fly = j_basic if method == "energy" else j_ref
-    msgs = [] if no_drive is None else [no_drive]
     if abs(imbalance) > 0.02 * max(1e-300, float(np.max(np.abs(M)))):
         msgs.append(f"the mean torque at omega_mean is {imbalance:.4g} N m (the cycle is not "
                     f"balanced at this speed); it was removed for the energy method")

@@ -142,12 +142,8 @@ class Reduction(_Record):
 
         ang = self.is_angle or self.link is not None
         iu, tu, du = ("kgm2", "Nm", "kgm2") if ang else ("kg", "N", "kg")
-        cols: dict = {}
-        if self.is_angle:
-            cols["phi_deg"] = np.degrees(self.phi)
-            cols["phi_rad"] = self.phi
-        else:
-            cols["s_m"] = self.phi
+        cols = ({"phi_deg": np.degrees(self.phi), "phi_rad": self.phi} if self.is_angle
+                else {"s_m": self.phi})
         if self.link is not None:
             cols[f"theta_{self.link}_deg"] = np.degrees(self.link_angle)
             cols["ratio"] = self.ratio
