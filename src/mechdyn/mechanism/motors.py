@@ -76,11 +76,11 @@ def _raise(where: str, problems: list[str]):
         raise ModelError([f"{where}: {p}" for p in problems])
 
 
-def _floats(obj, *names):
-    """Store the fields ``names`` of a frozen dataclass as floats (None stays None)."""
-    for name in names:
-        if getattr(obj, name) is not None:
-            object.__setattr__(obj, name, float(getattr(obj, name)))
+def _set(obj, *floats, **values):
+    """Set fields of a frozen dataclass: ``values``, and ``floats`` as floats (None stays)."""
+    values.update((n, float(getattr(obj, n))) for n in floats if getattr(obj, n) is not None)
+    for name, value in values.items():
+        object.__setattr__(obj, name, value)
 
 
 class _DirectDrive:
@@ -272,27 +272,24 @@ class InductionMotor(_DirectDrive):
             p.append("characteristic 'extended' needs starting_ratio (M_start/M_n)")
         _raise(where, p)
 
-        w0 = float(self.synchronous_speed)
+        _set(self, "rated_power", "synchronous_speed", "rated_slip", "rated_speed",
+             "breakdown_ratio", "rotor_inertia", "starting_ratio")
+        w0 = self.synchronous_speed
         if self.rated_slip is None:
-            sn = (w0 - float(self.rated_speed)) / w0
-            object.__setattr__(self, "rated_slip", sn)
+            _set(self, rated_slip=(w0 - self.rated_speed) / w0)
         else:
-            sn = float(self.rated_slip)
-            object.__setattr__(self, "rated_speed", w0 * (1.0 - sn))
-        _floats(self, "rated_power", "synchronous_speed", "breakdown_ratio", "rotor_inertia",
-                "starting_ratio")
-        mn = self.rated_power / self.rated_speed
-        object.__setattr__(self, "rated_torque", mn)
-        object.__setattr__(self, "breakdown_torque", self.breakdown_ratio * mn)
+            _set(self, rated_speed=w0 * (1.0 - self.rated_slip))
         if self.characteristic == "kloss":
-            sk, a = kloss_critical_slip(sn, self.breakdown_ratio), 0.0
+            sk, a = kloss_critical_slip(self.rated_slip, self.breakdown_ratio), 0.0
         else:
             try:
-                sk, a = fit_extended_kloss(sn, self.breakdown_ratio, self.starting_ratio)
+                sk, a = fit_extended_kloss(self.rated_slip, self.breakdown_ratio,
+                                           self.starting_ratio)
             except ModelError as exc:
                 raise ModelError(f"{where}: {exc}") from None
-        object.__setattr__(self, "critical_slip", float(sk))
-        object.__setattr__(self, "a", float(a))
+        mn = self.rated_power / self.rated_speed
+        _set(self, rated_torque=mn, breakdown_torque=self.breakdown_ratio * mn,
+             critical_slip=float(sk), a=float(a))
 
     # ------------------------------------------------------------------ curve
     @property
@@ -455,8 +452,7 @@ class TabulatedMotor(_DirectDrive):
             p.append("omega and torque must be finite")
         _at_least(p, "rotor_inertia", self.rotor_inertia, 0, "kg*m^2", strict=False)
         _raise(f"tabulated motor {self.name!r}", p)
-        object.__setattr__(self, "omega", tuple(w))
-        object.__setattr__(self, "torque", tuple(m))
+        _set(self, omega=tuple(w), torque=tuple(m))
 
     def torque_at(self, omega):
         """Interpolated torque (N m) at shaft speed ``omega`` (rad/s)."""
@@ -514,7 +510,7 @@ class GearStage:
         for fld in ("input_inertia", "output_inertia"):
             _at_least(p, fld, getattr(self, fld), 0, "kg*m^2", strict=False)
         _raise(f"gear stage {self.name!r}", p)
-        _floats(self, "ratio", "efficiency", "input_inertia", "output_inertia")
+        _set(self, "ratio", "efficiency", "input_inertia", "output_inertia")
 
     def motor_speed(self, omega):
         """Motor shaft speed (rad/s) at driven speed ``omega`` (rad/s)."""
@@ -559,10 +555,7 @@ def extra_inertia_by_coordinate(mechanism) -> dict[str, float]:
     """
     out: dict[str, float] = {}
     for dr in mechanism.drives:
-        fn = getattr(dr.torque, "extra_inertia", None)
-        if fn is None:
-            continue
-        j = float(fn())
+        j = float(getattr(dr.torque, "extra_inertia", lambda: 0.0)())
         if j:
             out[dr.coordinate] = out.get(dr.coordinate, 0.0) + j
     return out

@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from ..errors import ModelError, did_you_mean
-from ..mechanism.catalogue import catalogue_entry
+from ..mechanism.catalogue import induction_motor
 from ..mechanism.drive import Drive
 from ..mechanism.motors import (
     ConstantSpeedDrive,
@@ -147,26 +147,19 @@ def drive_from_table(table: Mapping, where: str = "drives") -> Drive:
 
 
 def _induction_from_table(t, q, name, where) -> InductionMotor:
-    data: dict = {}
-    source = str(t.get("source", ""))
-    if "catalogue" in t:
-        entry = catalogue_entry(str(t["catalogue"]))
-        data = entry.motor_kwargs()
-        name = str(t.get("name", entry.designation))
-        source = source or entry.source_text()
-    data.update((k, v) for k, v in q.items() if k in DRIVE_TYPES["induction_motor"])
-    if "rated_speed" in t and "rated_slip" not in t:
-        data.pop("rated_slip", None)  # the file's rated speed replaces the catalogue slip
-    elif "rated_slip" in t and "rated_speed" not in t:
-        data.pop("rated_speed", None)
-    missing = [k for k in ("rated_power", "synchronous_speed", "breakdown_ratio") if k not in data]
-    if "rated_speed" not in data and "rated_slip" not in data:
-        missing.append("rated_speed (or rated_slip)")
-    if missing:
-        raise ModelError(f"{where}: missing {', '.join(missing)} (or name a motor with "
-                         f"catalogue = \"4A80B4U3\")")
+    data = {k: v for k, v in q.items() if k in DRIVE_TYPES["induction_motor"]}
     data["characteristic"] = str(t.get("characteristic", "kloss"))
+    data.update((k, str(t[k])) for k in ("name", "source") if t.get(k))
     try:
-        return InductionMotor(name, source=source, **data)
+        if "catalogue" in t:
+            return induction_motor(str(t["catalogue"]), **data)
+        missing = [k for k in ("rated_power", "synchronous_speed", "breakdown_ratio")
+                   if k not in data]
+        if "rated_speed" not in data and "rated_slip" not in data:
+            missing.append("rated_speed (or rated_slip)")
+        if missing:
+            raise ModelError(f"missing {', '.join(missing)} (or name a motor with "
+                             f"catalogue = \"4A80B4U3\")")
+        return InductionMotor(**{"name": name, **data})
     except ModelError as exc:
         raise ModelError([f"{where}: {p}" for p in exc.problems]) from None

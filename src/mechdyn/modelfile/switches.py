@@ -16,18 +16,13 @@ from ..mechanism.contact import Contact, Stop
 from ..mechanism.switch import CoordinateLock, Switch
 from ..model.variable import parse, quantity
 from .reader import _Reader
+from .schema import schema
 
 __all__ = ["parse_switches", "TABLES", "variable_kind"]
 
-#: the top-level tables this module reads, with their allowed keys
-TABLES = {
-    "coordinate_locks": ("name", "variable", "engaged", "value", "frees", "description"),
-    "stops": ("name", "variable", "lower", "upper", "restitution", "description"),
-    "contacts": ("name", "body", "point", "line_body", "line_point", "line_direction",
-                 "friction", "restitution", "compliance", "description"),
-    "switches": ("name", "action", "target", "variable", "value", "direction", "times",
-                 "guard", "once", "description"),
-}
+#: the top-level tables this module reads, with their allowed keys (from the schema)
+TABLES = {t: tuple(schema()["properties"][t]["items"]["properties"])
+          for t in ("coordinate_locks", "stops", "contacts", "switches")}
 _DIRECTIONS = {"rising": 1, "up": 1, "falling": -1, "down": -1, "both": 0, "either": 0,
                1: 1, -1: -1, 0: 0}
 
