@@ -103,19 +103,14 @@ KINDS: dict[str, Kind] = {
 }
 KINDS["ratio"] = KINDS["dimensionless"]
 
-_REGISTRY = None
-
-
+@lru_cache(maxsize=1)
 def registry():
     """The one shared pint ``UnitRegistry`` of mechdyn (built on first use: it is slow)."""
-    global _REGISTRY
-    if _REGISTRY is None:
-        import pint
+    import pint
 
-        ureg = pint.UnitRegistry()
-        ureg.define("rev = turn")
-        _REGISTRY = ureg
-    return _REGISTRY
+    ureg = pint.UnitRegistry()
+    ureg.define("rev = turn")
+    return ureg
 
 
 def _kind(kind: str) -> Kind:
