@@ -189,16 +189,11 @@ def parse_quantity(value: Any, kind: str, *, where: str = "") -> float:
             except pint.errors.UndefinedUnitError:
                 why = f"unknown unit ({text!r})"
         raise _problem(where, value, k, f"cannot be read as a quantity: {why}")
-    number = float(m["num"])
-    if not math.isfinite(number):
-        raise _problem(where, value, k, "not a finite value")
-
-    if not m["unit"]:  # a bare number in a string: SI
-        return number
-    factor, why = _unit_factor(m["unit"], kind)
+    # a bare number in a string is SI
+    factor, why = _unit_factor(m["unit"], kind) if m["unit"] else (1.0, "")
     if why:
         raise _problem(where, value, k, why)
-    out = number * factor
+    out = float(m["num"]) * factor
     if not math.isfinite(out):
         raise _problem(where, value, k, "not a finite value")
     return out
