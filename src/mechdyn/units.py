@@ -316,14 +316,7 @@ def format_quantity(value: float, kind: str, unit: str | None = None, *,
     k = _kind(kind)
     if unit is None or unit == k.si:
         return f"{value:.{digits}g} {k.si}".rstrip()
-    ureg = registry()
-    q = ureg.Quantity(float(value), k.si if k.si else "")
-    try:
-        if kind == "frequency" and dict(ureg.Unit(unit).dimensionality) == {"[time]": -1} and \
-                dict(ureg.get_root_units(unit)[1]._units).get("radian", 0) == 1:
-            out = ureg.Quantity(float(value) * 2 * math.pi, "rad/s").to(unit)
-        else:
-            out = q.to(unit)
-    except Exception as exc:  # noqa: BLE001 - turn pint's error into a clear one
-        raise UnitError(f"cannot show a {k.name} in {unit!r}: {exc}") from None
-    return f"{float(out.magnitude):.{digits}g} {unit}"
+    factor, why = _unit_factor(unit, kind)  # the unit -> SI factor parse_quantity uses
+    if why:
+        raise UnitError(f"cannot show a {k.name} in {unit!r}: {why}")
+    return f"{float(value) / factor:.{digits}g} {unit}"

@@ -5,25 +5,10 @@ Every class here is frozen data in SI units with one method the dynamics calls,
 float, arrays an array), and ``extra_inertia()`` (kg m^2), the moment of
 inertia the drive adds to the coordinate it drives (rotor, gears: reduced to
 the driven shaft).  A drive on a coordinate is ``Drive(name, coordinate,
-torque=<one of these>)`` (see :mod:`mechdyn.mechanism.drive`).
-
-Classes
--------
-InductionMotor
-    Squirrel-cage induction motor from catalogue data, by Kloss's formula
-    ``M = 2 M_k / (s/s_k + s_k/s)`` or by the extended Kloss formula with the
-    stator-resistance term ``a``,
-    ``M = 2 M_k (1 + a s_k) / (s/s_k + s_k/s + 2 a s_k)``, fitted so that it
-    passes through the rated, the breakdown and the starting torque.
-DCMotor
-    Separately excited DC motor: linear characteristic.
-ConstantSpeedDrive
-    An ideal drive holding a speed (kinematic driving, kinetostatics).
-TabulatedMotor
-    A characteristic M(omega) from a table.
-GearStage
-    A gear (or belt) stage of ratio ``i = omega_motor / omega_driven`` with
-    efficiency and inertias between a motor and the driven coordinate.
+torque=<one of these>)`` (see :mod:`mechdyn.mechanism.drive`): an
+:class:`InductionMotor` (Kloss's formula or its extended form), a :class:`DCMotor`, a
+:class:`ConstantSpeedDrive`, a :class:`TabulatedMotor`, or any of them behind a
+:class:`GearStage`.
 
 :func:`mechdyn.modelfile.drives.drive_from_table` builds a
 :class:`~mechdyn.mechanism.drive.Drive` with one of these from a model-file
@@ -176,6 +161,10 @@ def fit_extended_kloss(rated_slip: float, breakdown_ratio: float,
 @dataclass(frozen=True)
 class InductionMotor(_DirectDrive):
     """A squirrel-cage induction motor from catalogue data.
+
+    Kloss's formula ``M = 2 M_k / (s/s_k + s_k/s)``, or the extended formula with the
+    stator-resistance term ``a``, ``M = 2 M_k (1 + a s_k) / (s/s_k + s_k/s + 2 a s_k)``,
+    which also passes through the starting torque.
 
     Parameters
     ----------

@@ -1,9 +1,4 @@
-"""Reading the ``[bodies]``, ``[joints]`` and ``[coordinates]`` tables of a model file.
-
-:class:`_BodiesJoints` reads one body (with its points, its sketch frame and the
-inertia about a point), one joint (revolute, prismatic, lock) and one coordinate,
-each into its :mod:`mechdyn.mechanism` element, recording every problem.
-"""
+"""Reading the ``[bodies]``, ``[joints]`` and ``[coordinates]`` tables of a model file."""
 
 from __future__ import annotations
 

@@ -1,11 +1,5 @@
-"""The base that the model-file loader's table readers share.
-
-Holds the document being read, the problems found in it so far and the names
-read from it (bodies and their points, sketch frames, joint types, coordinate
-kinds), with the helpers that read one value (a quantity, a vector, a body or
-point name, a direction) and record its problem instead of raising it
-(:class:`_Failed` then says the problem is recorded).
-"""
+"""The base of the model-file loader's table readers: the document, its problems and names,
+and helpers that read one value and record its problem (then raise :class:`_Failed`)."""
 
 from __future__ import annotations
 
