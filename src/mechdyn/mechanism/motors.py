@@ -76,7 +76,6 @@ class _DirectDrive:
         return float(self.rotor_inertia)
 
 
-# ---------------------------------------------------------------------- induction motor
 def kloss_critical_slip(rated_slip: float, breakdown_ratio: float) -> float:
     """Critical slip of Kloss's formula through the rated point.
 
@@ -280,7 +279,6 @@ class InductionMotor(_DirectDrive):
         _set(self, rated_torque=mn, breakdown_torque=self.breakdown_ratio * mn,
              critical_slip=float(sk), a=float(a))
 
-    # ------------------------------------------------------------------ curve
     @property
     def starting_torque(self) -> float:
         """Torque of the model at standstill (s = 1), N m."""
@@ -306,7 +304,6 @@ class InductionMotor(_DirectDrive):
         return self.torque_at_slip(self.slip(omega))
 
 
-# ---------------------------------------------------------------------- DC motor
 @dataclass(frozen=True)
 class DCMotor(_DirectDrive):
     """A separately excited DC motor: ``M = M_stall (1 - omega / omega_0)``.
@@ -357,7 +354,6 @@ class DCMotor(_DirectDrive):
         return _out(self.stall_torque * (1.0 - np.asarray(omega, float) / self.no_load_speed))
 
 
-# ---------------------------------------------------------------------- ideal drive
 @dataclass(frozen=True)
 class ConstantSpeedDrive:
     """An ideal drive holding the coordinate at a constant speed.
@@ -403,7 +399,6 @@ class ConstantSpeedDrive:
         return 0.0
 
 
-# ---------------------------------------------------------------------- table
 @dataclass(frozen=True)
 class TabulatedMotor(_DirectDrive):
     """A mechanical characteristic M(omega) from a table, linearly interpolated.
@@ -457,7 +452,6 @@ class TabulatedMotor(_DirectDrive):
         return _out(out)
 
 
-# ---------------------------------------------------------------------- gear stage
 @dataclass(frozen=True)
 class GearStage:
     """A speed-reducing stage between a motor and the driven coordinate.

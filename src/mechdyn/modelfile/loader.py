@@ -134,7 +134,6 @@ def build(doc: dict, name: str = "<string>", *, default_title: str | None = None
 class _Builder(_BodiesJoints, _LoadsDrives):
     """Turns a document into mechanism elements, recording every problem."""
 
-    # ------------------------------------------------------------ passes
     def run(self, default_title: str | None) -> Mechanism:
         model = self.section("model")
         title = model.get("name") if isinstance(model.get("name"), str) else None

@@ -35,7 +35,6 @@ class _Reader:
         #: a problem was recorded in the element being read
         self.failed = False
 
-    # ------------------------------------------------------------ helpers
     def where(self, *path) -> str:
         return locate(self.fname, path, self.doc)
 
