@@ -217,8 +217,12 @@ def _unit_factor(unit: str, kind: str) -> tuple[float, str]:
     root = q.to_root_units()
     rad_power = dict(root._units).get("radian", 0)
     target = ureg.Unit(k.si) if k.si else ureg.dimensionless
-    if root.dimensionality != target.dimensionality:
-        return math.nan, f"the unit {shown} is a {_dimension_text(root)}"
+    dim = root.dimensionality
+    if dim != target.dimensionality:  # named after the kind of that dimension if there is one
+        what = next((f"{c.name.split(' (')[0]} unit" for c in KINDS.values()
+                     if c.si and c.angle_power != 1 and ureg.Unit(c.si).dimensionality == dim),
+                    f"unit of dimension {dim}")
+        return math.nan, f"the unit {shown} is a {what}"
     if k.angle_power == 1 and rad_power != 1:
         return math.nan, (f"the unit {shown} has no angle unit (use rad, deg, turn or rpm; "
                           "a frequency in Hz is not an angular velocity)")
@@ -230,13 +234,6 @@ def _unit_factor(unit: str, kind: str) -> tuple[float, str]:
         return math.nan, f"the unit {shown} is not a frequency"
     return (float(q.to(target).magnitude) if k.si else float(q.to("").magnitude)), ""
 
-def _dimension_text(q) -> str:
-    """'length unit', 'mass unit', ... for a root-unit quantity, else its dimensionality."""
-    ureg = registry()
-    for k in KINDS.values():
-        if k.si and k.angle_power != 1 and ureg.Unit(k.si).dimensionality == q.dimensionality:
-            return f"{k.name.split(' (')[0]} unit"
-    return f"unit of dimension {q.dimensionality}"
 
 
 _VECTOR_RE = re.compile(r"^\s*\((?P<body>[^()]*)\)\s*(?P<unit>.*?)\s*$")
