@@ -82,8 +82,7 @@ def loads(text: str, name: str = "<string>", *, default_title: str | None = None
     -------
     Mechanism
     """
-    doc = read_document(text, name)
-    return build(doc, name, default_title=default_title)
+    return build(read_document(text, name), name, default_title=default_title)
 
 
 #: tables and arrays nested deeper than this are refused (a model file needs about 4)
@@ -223,8 +222,7 @@ class _Builder(_BodiesJoints, _LoadsDrives):
                              + did_you_mean(cname, self.coord_kinds, "coordinate"))
                 continue
             try:
-                out[cname] = self.quantity(val, self.coord_value_kind(cname, rate),
-                                           section, cname)
+                out[cname] = self.quantity(val, self.coord_value_kind(cname, rate), section, cname)
             except _Failed:
                 pass
         return out

@@ -151,13 +151,8 @@ def schema_problems(doc: Any, fname: str) -> tuple[list[str], list[tuple]]:
     paths : list of tuple
         The path of each problem (to skip the broken elements when building).
     """
-    msgs: list[str] = []
-    paths: list[tuple] = []
-    errors = sorted(_validator().iter_errors(doc),
-                    key=lambda e: [str(p) for p in e.absolute_path])
-    for err in errors:
-        m = _message(err, fname, doc)
-        if m not in msgs:
-            msgs.append(m)
-            paths.append(tuple(err.absolute_path))
-    return msgs, paths
+    found: dict[str, tuple] = {}  # message -> path of its first error
+    for err in sorted(_validator().iter_errors(doc),
+                      key=lambda e: [str(p) for p in e.absolute_path]):
+        found.setdefault(_message(err, fname, doc), tuple(err.absolute_path))
+    return list(found), list(found.values())
