@@ -222,7 +222,8 @@ class _Builder(_BodiesJoints, _LoadsDrives):
                              + did_you_mean(cname, self.coord_kinds, "coordinate"))
                 continue
             try:
-                out[cname] = self.quantity(val, self.coord_value_kind(cname, rate), section, cname)
+                out[cname] = self.quantity(val, self.coord_value_kind(cname, rate),
+                                           section, cname)
             except _Failed:
                 pass
         return out
