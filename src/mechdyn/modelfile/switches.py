@@ -115,10 +115,6 @@ class _Switches(_Reader):
             self.failed = False
             yield (table, k), e
 
-    def kind_of(self, var, *path) -> str | None:
-        """The quantity kind of a variable string; None if it has a problem (recorded)."""
-        return self.soft(self.variable_kind, var, *path)
-
     def add(self, cls, path: tuple, *args, **kwargs):
         """File ``cls(*args, **kwargs)`` in ``mech.extras``; its own check is a problem."""
         try:
@@ -130,7 +126,7 @@ class _Switches(_Reader):
 
     def locks(self):
         for P, e in self.entries("coordinate_locks"):
-            kd = self.kind_of(e.get("variable"), *P, "variable")
+            kd = self.soft(self.variable_kind, e.get("variable"), *P, "variable")
             if kd is None:
                 continue
             value = self.opt(e, "value", kd, *P, default=None)
@@ -145,7 +141,7 @@ class _Switches(_Reader):
 
     def stops(self):
         for P, e in self.entries("stops"):
-            kd = self.kind_of(e.get("variable"), *P, "variable")
+            kd = self.soft(self.variable_kind, e.get("variable"), *P, "variable")
             if kd is None:
                 continue
             lower = self.opt(e, "lower", kd, *P, default=None)
@@ -182,7 +178,7 @@ class _Switches(_Reader):
                 self.problem(f"{self.where(*P, 'target')}: "
                              + did_you_mean(str(target), locks, "lock"))
                 self.failed = True
-            kd = self.kind_of(var, *P, "variable") if var is not None else None
+            kd = self.soft(self.variable_kind, var, *P, "variable") if var is not None else None
             value = self.opt(e, "value", kd, *P) if kd is not None else 0.0
             if dval not in _DIRECTIONS:
                 self.problem(f"{self.where(*P, 'direction')}: must be 'rising', "
@@ -198,7 +194,7 @@ class _Switches(_Reader):
                                  f"operator, value], got {g!r}")
                     self.failed = True
                     continue
-                kd = self.kind_of(g[0], *P, "guard")
+                kd = self.soft(self.variable_kind, g[0], *P, "guard")
                 gv = self.soft(self.quantity, g[2], kd, *P, "guard") if kd is not None else None
                 guards.append((g[0], g[1], 0.0 if gv is None else gv))
             sw = Switch(e["name"], e.get("action"), target, var, value,
