@@ -103,19 +103,14 @@ KINDS: dict[str, Kind] = {
 }
 KINDS["ratio"] = KINDS["dimensionless"]
 
-_REGISTRY = None
-
-
+@lru_cache(maxsize=1)
 def registry():
     """The one shared pint ``UnitRegistry`` of mechdyn (built on first use: it is slow)."""
-    global _REGISTRY
-    if _REGISTRY is None:
-        import pint
+    import pint
 
-        ureg = pint.UnitRegistry()
-        ureg.define("rev = turn")
-        _REGISTRY = ureg
-    return _REGISTRY
+    ureg = pint.UnitRegistry()
+    ureg.define("rev = turn")
+    return ureg
 
 
 def _kind(kind: str) -> Kind:
@@ -194,16 +189,11 @@ def parse_quantity(value: Any, kind: str, *, where: str = "") -> float:
             except pint.errors.UndefinedUnitError:
                 why = f"unknown unit ({text!r})"
         raise _problem(where, value, k, f"cannot be read as a quantity: {why}")
-    number = float(m["num"])
-    if not math.isfinite(number):
-        raise _problem(where, value, k, "not a finite value")
-
-    if not m["unit"]:  # a bare number in a string: SI
-        return number
-    factor, why = _unit_factor(m["unit"], kind)
+    # a bare number in a string is SI
+    factor, why = _unit_factor(m["unit"], kind) if m["unit"] else (1.0, "")
     if why:
         raise _problem(where, value, k, why)
-    out = number * factor
+    out = float(m["num"]) * factor
     if not math.isfinite(out):
         raise _problem(where, value, k, "not a finite value")
     return out
@@ -227,8 +217,12 @@ def _unit_factor(unit: str, kind: str) -> tuple[float, str]:
     root = q.to_root_units()
     rad_power = dict(root._units).get("radian", 0)
     target = ureg.Unit(k.si) if k.si else ureg.dimensionless
-    if root.dimensionality != target.dimensionality:
-        return math.nan, f"the unit {shown} is a {_dimension_text(root)}"
+    dim = root.dimensionality
+    if dim != target.dimensionality:  # named after the kind of that dimension if there is one
+        what = next((f"{c.name.split(' (')[0]} unit" for c in KINDS.values()
+                     if c.si and c.angle_power != 1 and ureg.Unit(c.si).dimensionality == dim),
+                    f"unit of dimension {dim}")
+        return math.nan, f"the unit {shown} is a {what}"
     if k.angle_power == 1 and rad_power != 1:
         return math.nan, (f"the unit {shown} has no angle unit (use rad, deg, turn or rpm; "
                           "a frequency in Hz is not an angular velocity)")
@@ -240,13 +234,6 @@ def _unit_factor(unit: str, kind: str) -> tuple[float, str]:
         return math.nan, f"the unit {shown} is not a frequency"
     return (float(q.to(target).magnitude) if k.si else float(q.to("").magnitude)), ""
 
-def _dimension_text(q) -> str:
-    """'length unit', 'mass unit', ... for a root-unit quantity, else its dimensionality."""
-    ureg = registry()
-    for k in KINDS.values():
-        if k.si and k.angle_power != 1 and ureg.Unit(k.si).dimensionality == q.dimensionality:
-            return f"{k.name.split(' (')[0]} unit"
-    return f"unit of dimension {q.dimensionality}"
 
 
 _VECTOR_RE = re.compile(r"^\s*\((?P<body>[^()]*)\)\s*(?P<unit>.*?)\s*$")
@@ -326,14 +313,7 @@ def format_quantity(value: float, kind: str, unit: str | None = None, *,
     k = _kind(kind)
     if unit is None or unit == k.si:
         return f"{value:.{digits}g} {k.si}".rstrip()
-    ureg = registry()
-    q = ureg.Quantity(float(value), k.si if k.si else "")
-    try:
-        if kind == "frequency" and dict(ureg.Unit(unit).dimensionality) == {"[time]": -1} and \
-                dict(ureg.get_root_units(unit)[1]._units).get("radian", 0) == 1:
-            out = ureg.Quantity(float(value) * 2 * math.pi, "rad/s").to(unit)
-        else:
-            out = q.to(unit)
-    except Exception as exc:  # noqa: BLE001 - turn pint's error into a clear one
-        raise UnitError(f"cannot show a {k.name} in {unit!r}: {exc}") from None
-    return f"{float(out.magnitude):.{digits}g} {unit}"
+    factor, why = _unit_factor(unit, kind)  # the unit -> SI factor parse_quantity uses
+    if why:
+        raise UnitError(f"cannot show a {k.name} in {unit!r}: {why}")
+    return f"{float(value) / factor:.{digits}g} {unit}"

@@ -93,7 +93,11 @@ REFERENCE_T003_RATES: dict[str, float] = {
     "Theta": -1424.379294994111,
 }
 
-_BODIES = ("crank", "rod", "triangle", "link4", "link5", "link6", "link7")
+#: the frame angle of each body (the table above) as its own Test Set angle plus, for a
+#: relative angle, the absolute angle it is measured from
+_FRAME_ANGLES = {"crank": ("beta",), "rod": ("Theta", "beta"), "triangle": ("gamma",),
+                 "link4": ("Phi", "delta"), "link5": ("delta",), "link6": ("Omega", "epsilon"),
+                 "link7": ("epsilon",)}
 
 
 def sketch_poses(angles: Mapping[str, float] | None = None) -> dict[str, tuple[float, ...]]:
@@ -105,19 +109,13 @@ def sketch_poses(angles: Mapping[str, float] | None = None) -> dict[str, tuple[f
     """
     p = PARAMS
     a = dict(Q0 if angles is None else angles)
-    be, th, ga, ph, de, om, ep = (a[n] for n in ANGLE_NAMES)
-    F = (p["rr"] * math.cos(be), p["rr"] * math.sin(be))
-    G = (p["xa"] + p["zt"] * math.cos(de), p["ya"] + p["zt"] * math.sin(de))
-    H = (p["xa"] + p["u"] * math.sin(ep), p["ya"] - p["u"] * math.cos(ep))
-    return {
-        "crank": (0.0, 0.0, be),
-        "rod": (F[0], F[1], be + th),
-        "triangle": (p["xb"], p["yb"], ga),
-        "link4": (G[0], G[1], ph + de),
-        "link5": (p["xa"], p["ya"], de),
-        "link6": (H[0], H[1], om + ep),
-        "link7": (p["xa"], p["ya"], ep),
-    }
+    be, de, ep = a["beta"], a["delta"], a["epsilon"]
+    A = (p["xa"], p["ya"])
+    origins = {"crank": (0.0, 0.0), "rod": (p["rr"] * math.cos(be), p["rr"] * math.sin(be)),
+               "triangle": (p["xb"], p["yb"]), "link5": A, "link7": A,
+               "link4": (p["xa"] + p["zt"] * math.cos(de), p["ya"] + p["zt"] * math.sin(de)),
+               "link6": (p["xa"] + p["u"] * math.sin(ep), p["ya"] - p["u"] * math.cos(ep))}
+    return {b: (*origins[b], sum(a[n] for n in names)) for b, names in _FRAME_ANGLES.items()}
 
 
 def build(*, loads: bool = True) -> Mechanism:
@@ -161,16 +159,10 @@ def test_set_angles(model, x) -> dict[str, np.ndarray | float]:
         the body angles, so they follow the body angles without wrapping.
     """
     x = np.asarray(x, dtype=float)
-    th = {b: x[..., 3 * model.body_index(b) + 2] for b in _BODIES}
-    out = {
-        "beta": th["crank"],
-        "Theta": th["rod"] - th["crank"],
-        "gamma": th["triangle"],
-        "Phi": th["link4"] - th["link5"],
-        "delta": th["link5"],
-        "Omega": th["link6"] - th["link7"],
-        "epsilon": th["link7"],
-    }
+    th = {b: x[..., 3 * model.body_index(b) + 2] for b in _FRAME_ANGLES}
+    absolute = {names[0]: th[b] for b, names in _FRAME_ANGLES.items() if len(names) == 1}
+    out = {own: th[b] - sum(absolute[n] for n in base)
+           for b, (own, *base) in _FRAME_ANGLES.items()}
     if x.ndim == 1:
         return {k: float(v) for k, v in out.items()}
     return out

@@ -62,11 +62,9 @@ def press_idle(mechanism=None, *, drive_torque=DRIVE_TORQUE,
     mechanism.add(Drive("motor", "phi", drive_torque))
     if support_stiffness:
         slider = mechanism.bodies["slider"]
-        x_c, y_c = slider.pose[0], slider.pose[1]
+        x_c, y_c, _ = slider.pose
         weight = slider.mass * abs(mechanism.gravity[0])
-        ground_points = dict(mechanism.ground.points)
-        ground_points["support"] = (x_c + 1.0, y_c)
-        mechanism.add_ground(ground_points)
+        mechanism.add_ground({**mechanism.ground.points, "support": (x_c + 1.0, y_c)})
         mechanism.add(Spring("ram_support", "ground", "support", "slider", (0.0, 0.0),
                              stiffness=float(support_stiffness),
                              free_length=1.0 - weight / float(support_stiffness)))

@@ -24,14 +24,15 @@ def unknown_point(ref, body: str, valid) -> str:
             + ", ".join(repr(p) for p in valid))
 
 
-def _vec2(value, what: str) -> tuple[float, float]:
+def _vec(value, what: str, form: str = "a pair of numbers (x, y)") -> tuple[float, ...]:
+    """``value`` as a tuple of floats with as many items as ``form`` names, or a ValueError."""
     try:
         arr = np.asarray(value, dtype=float).reshape(-1)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{what} must be a pair of numbers (x, y), got {value!r}") from exc
-    if arr.shape != (2,):
-        raise ValueError(f"{what} must be a pair of numbers (x, y), got {value!r}")
-    return float(arr[0]), float(arr[1])
+    except (TypeError, ValueError):
+        arr = None
+    if arr is None or arr.shape != (form.count(",") + 1,):
+        raise ValueError(f"{what} must be {form}, got {value!r}")
+    return tuple(float(v) for v in arr)
 
 
 @dataclass(frozen=True)
@@ -62,14 +63,12 @@ class Body:
     pose: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def __post_init__(self):
-        object.__setattr__(self, "com", _vec2(self.com, f"body {self.name!r}: com"))
-        pts = {str(k): _vec2(v, f"body {self.name!r}: point {k!r}")
+        object.__setattr__(self, "com", _vec(self.com, f"body {self.name!r}: com"))
+        pts = {str(k): _vec(v, f"body {self.name!r}: point {k!r}")
                for k, v in dict(self.points).items()}
         object.__setattr__(self, "points", MappingProxyType(pts))
-        pose = np.asarray(self.pose, dtype=float).reshape(-1)
-        if pose.shape != (3,):
-            raise ValueError(f"body {self.name!r}: pose must be (x, y, theta), got {self.pose!r}")
-        object.__setattr__(self, "pose", tuple(float(v) for v in pose))
+        object.__setattr__(self, "pose", _vec(self.pose, f"body {self.name!r}: pose",
+                                              "(x, y, theta)"))
         object.__setattr__(self, "mass", float(self.mass))
         object.__setattr__(self, "inertia", float(self.inertia))
 

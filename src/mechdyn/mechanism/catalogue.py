@@ -154,12 +154,11 @@ def induction_motor(designation: str, characteristic: str = "kloss", **overrides
         E.g. ``"4A80B4U3"``.
     characteristic : {"kloss", "extended"}
     **overrides
-        Any InductionMotor field (SI), e.g. ``rotor_inertia=0.0035``.
+        Any InductionMotor field (SI), e.g. ``rotor_inertia=0.0035``, ``name``, ``source``.
     """
     entry = catalogue_entry(designation)
-    kw = entry.motor_kwargs(warn="rotor_inertia" not in overrides)
-    kw.update(overrides)
+    kw = {"name": entry.designation, "source": entry.source_text(),
+          **entry.motor_kwargs(warn="rotor_inertia" not in overrides), **overrides}
     if "rated_speed" in overrides and "rated_slip" not in overrides:
-        kw.pop("rated_slip")
-    return InductionMotor(entry.designation, characteristic=characteristic,
-                          source=entry.source_text(), **kw)
+        kw.pop("rated_slip")  # the given rated speed replaces the catalogue slip
+    return InductionMotor(characteristic=characteristic, **kw)

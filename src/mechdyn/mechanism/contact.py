@@ -17,11 +17,13 @@ import numpy as np
 __all__ = ["Stop", "Contact"]
 
 
-def _check_fraction(value, what):
-    v = float(value)
-    if not (0.0 <= v <= 1.0):
-        raise ValueError(f"{what}: restitution must be in [0, 1], got {value!r}")
-    return v
+def _store_nonneg(el, what: str, fld: str, high: float | None = None):
+    """Store the field ``fld`` of ``el`` as a float in [0, ``high``]; ValueError otherwise."""
+    v = float(getattr(el, fld))
+    if not (np.isfinite(v) and v >= 0 and (high is None or v <= high)):
+        bound = ">= 0" if high is None else f"in [0, {high:g}]"
+        raise ValueError(f"{what}: {fld} must be {bound}, got {v!r}")
+    object.__setattr__(el, fld, v)
 
 
 @dataclass(frozen=True)
@@ -50,8 +52,7 @@ class Stop:
     extra_kind = "stops"
 
     def __post_init__(self):
-        object.__setattr__(self, "restitution",
-                           _check_fraction(self.restitution, f"stop {self.name!r}"))
+        _store_nonneg(self, f"stop {self.name!r}", "restitution", 1.0)
         for side in ("lower", "upper"):
             v = getattr(self, side)
             if v is not None:
@@ -119,10 +120,5 @@ class Contact:
             raise ValueError(f"contact {self.name!r}: line_direction must be a non-zero (x, y), "
                              f"got {self.line_direction!r}")
         object.__setattr__(self, "line_direction", tuple(d / np.hypot(*d)))
-        object.__setattr__(self, "restitution",
-                           _check_fraction(self.restitution, f"contact {self.name!r}"))
-        for fld in ("friction", "compliance"):
-            v = float(getattr(self, fld))
-            if not (np.isfinite(v) and v >= 0):
-                raise ValueError(f"contact {self.name!r}: {fld} must be >= 0, got {v!r}")
-            object.__setattr__(self, fld, v)
+        for fld, high in (("restitution", 1.0), ("friction", None), ("compliance", None)):
+            _store_nonneg(self, f"contact {self.name!r}", fld, high)

@@ -152,6 +152,15 @@ class Mechanism:
         """Every problem of the description that can be found without solving."""
         out: list[str] = []
         names = [GROUND, *self.bodies]
+
+        def point_problem(bname, ref, where_body, where_point):
+            """Record an unknown body ``bname`` or an unknown point ``ref`` of it."""
+            if bname not in names:
+                out.append(f"{where_body}: " + did_you_mean(bname, names, "body"))
+            elif isinstance(ref, str) and ref not in self.body(bname).point_names():
+                out.append(f"{where_point}: "
+                           + unknown_point(ref, bname, self.body(bname).point_names()))
+
         for b in self.bodies.values():
             if not np.isfinite(b.mass) or b.mass < 0:
                 out.append(f"body {b.name!r}: mass must be >= 0 kg, got {b.mass!r}")
@@ -169,12 +178,8 @@ class Mechanism:
         for j in self.joints.values():
             where = f"{type(j).__name__.lower()} joint {j.name!r}"
             for role in ("parent", "child"):
-                bname, ref = getattr(j, role), getattr(j, f"{role}_point", None)
-                if bname not in names:
-                    out.append(f"{where}: {role}: " + did_you_mean(bname, names, "body"))
-                elif isinstance(ref, str) and ref not in self.body(bname).point_names():
-                    out.append(f"{where}: {role}_point: "
-                               + unknown_point(ref, bname, self.body(bname).point_names()))
+                point_problem(getattr(j, role), getattr(j, f"{role}_point", None),
+                              f"{where}: {role}", f"{where}: {role}_point")
             if j.parent == j.child:
                 out.append(f"{where}: parent and child are the same body {j.parent!r}")
             if isinstance(j, Prismatic):
@@ -193,11 +198,7 @@ class Mechanism:
         for am in self.extras.get("assembly", []):
             for role, (bname, ref) in zip("PQR", am.points, strict=True):
                 where = f"assembly mode {am.name!r}: point {role}"
-                if bname not in names:
-                    out.append(f"{where}: " + did_you_mean(bname, names, "body"))
-                elif isinstance(ref, str) and ref not in self.body(bname).point_names():
-                    out.append(f"{where}: "
-                               + unknown_point(ref, bname, self.body(bname).point_names()))
+                point_problem(bname, ref, where, where)
         if not self.bodies:
             out.append("the mechanism has no moving bodies")
         if not self.coordinates:

@@ -5,25 +5,10 @@ Every class here is frozen data in SI units with one method the dynamics calls,
 float, arrays an array), and ``extra_inertia()`` (kg m^2), the moment of
 inertia the drive adds to the coordinate it drives (rotor, gears: reduced to
 the driven shaft).  A drive on a coordinate is ``Drive(name, coordinate,
-torque=<one of these>)`` (see :mod:`mechdyn.mechanism.drive`).
-
-Classes
--------
-InductionMotor
-    Squirrel-cage induction motor from catalogue data, by Kloss's formula
-    ``M = 2 M_k / (s/s_k + s_k/s)`` or by the extended Kloss formula with the
-    stator-resistance term ``a``,
-    ``M = 2 M_k (1 + a s_k) / (s/s_k + s_k/s + 2 a s_k)``, fitted so that it
-    passes through the rated, the breakdown and the starting torque.
-DCMotor
-    Separately excited DC motor: linear characteristic.
-ConstantSpeedDrive
-    An ideal drive holding a speed (kinematic driving, kinetostatics).
-TabulatedMotor
-    A characteristic M(omega) from a table.
-GearStage
-    A gear (or belt) stage of ratio ``i = omega_motor / omega_driven`` with
-    efficiency and inertias between a motor and the driven coordinate.
+torque=<one of these>)`` (see :mod:`mechdyn.mechanism.drive`): an
+:class:`InductionMotor` (Kloss's formula or its extended form), a :class:`DCMotor`, a
+:class:`ConstantSpeedDrive`, a :class:`TabulatedMotor`, or any of them behind a
+:class:`GearStage`.
 
 :func:`mechdyn.modelfile.drives.drive_from_table` builds a
 :class:`~mechdyn.mechanism.drive.Drive` with one of these from a model-file
@@ -76,11 +61,11 @@ def _raise(where: str, problems: list[str]):
         raise ModelError([f"{where}: {p}" for p in problems])
 
 
-def _floats(obj, *names):
-    """Store the fields ``names`` of a frozen dataclass as floats (None stays None)."""
-    for name in names:
-        if getattr(obj, name) is not None:
-            object.__setattr__(obj, name, float(getattr(obj, name)))
+def _set(obj, *floats, **values):
+    """Set fields of a frozen dataclass: ``values``, and ``floats`` as floats (None stays)."""
+    values.update((n, float(getattr(obj, n))) for n in floats if getattr(obj, n) is not None)
+    for name, value in values.items():
+        object.__setattr__(obj, name, value)
 
 
 class _DirectDrive:
@@ -91,7 +76,6 @@ class _DirectDrive:
         return float(self.rotor_inertia)
 
 
-# ---------------------------------------------------------------------- induction motor
 def kloss_critical_slip(rated_slip: float, breakdown_ratio: float) -> float:
     """Critical slip of Kloss's formula through the rated point.
 
@@ -176,6 +160,10 @@ def fit_extended_kloss(rated_slip: float, breakdown_ratio: float,
 @dataclass(frozen=True)
 class InductionMotor(_DirectDrive):
     """A squirrel-cage induction motor from catalogue data.
+
+    Kloss's formula ``M = 2 M_k / (s/s_k + s_k/s)``, or the extended formula with the
+    stator-resistance term ``a``, ``M = 2 M_k (1 + a s_k) / (s/s_k + s_k/s + 2 a s_k)``,
+    which also passes through the starting torque.
 
     Parameters
     ----------
@@ -272,29 +260,25 @@ class InductionMotor(_DirectDrive):
             p.append("characteristic 'extended' needs starting_ratio (M_start/M_n)")
         _raise(where, p)
 
-        w0 = float(self.synchronous_speed)
+        _set(self, "rated_power", "synchronous_speed", "rated_slip", "rated_speed",
+             "breakdown_ratio", "rotor_inertia", "starting_ratio")
+        w0 = self.synchronous_speed
         if self.rated_slip is None:
-            sn = (w0 - float(self.rated_speed)) / w0
-            object.__setattr__(self, "rated_slip", sn)
+            _set(self, rated_slip=(w0 - self.rated_speed) / w0)
         else:
-            sn = float(self.rated_slip)
-            object.__setattr__(self, "rated_speed", w0 * (1.0 - sn))
-        _floats(self, "rated_power", "synchronous_speed", "breakdown_ratio", "rotor_inertia",
-                "starting_ratio")
-        mn = self.rated_power / self.rated_speed
-        object.__setattr__(self, "rated_torque", mn)
-        object.__setattr__(self, "breakdown_torque", self.breakdown_ratio * mn)
+            _set(self, rated_speed=w0 * (1.0 - self.rated_slip))
         if self.characteristic == "kloss":
-            sk, a = kloss_critical_slip(sn, self.breakdown_ratio), 0.0
+            sk, a = kloss_critical_slip(self.rated_slip, self.breakdown_ratio), 0.0
         else:
             try:
-                sk, a = fit_extended_kloss(sn, self.breakdown_ratio, self.starting_ratio)
+                sk, a = fit_extended_kloss(self.rated_slip, self.breakdown_ratio,
+                                           self.starting_ratio)
             except ModelError as exc:
                 raise ModelError(f"{where}: {exc}") from None
-        object.__setattr__(self, "critical_slip", float(sk))
-        object.__setattr__(self, "a", float(a))
+        mn = self.rated_power / self.rated_speed
+        _set(self, rated_torque=mn, breakdown_torque=self.breakdown_ratio * mn,
+             critical_slip=float(sk), a=float(a))
 
-    # ------------------------------------------------------------------ curve
     @property
     def starting_torque(self) -> float:
         """Torque of the model at standstill (s = 1), N m."""
@@ -320,7 +304,6 @@ class InductionMotor(_DirectDrive):
         return self.torque_at_slip(self.slip(omega))
 
 
-# ---------------------------------------------------------------------- DC motor
 @dataclass(frozen=True)
 class DCMotor(_DirectDrive):
     """A separately excited DC motor: ``M = M_stall (1 - omega / omega_0)``.
@@ -371,7 +354,6 @@ class DCMotor(_DirectDrive):
         return _out(self.stall_torque * (1.0 - np.asarray(omega, float) / self.no_load_speed))
 
 
-# ---------------------------------------------------------------------- ideal drive
 @dataclass(frozen=True)
 class ConstantSpeedDrive:
     """An ideal drive holding the coordinate at a constant speed.
@@ -417,7 +399,6 @@ class ConstantSpeedDrive:
         return 0.0
 
 
-# ---------------------------------------------------------------------- table
 @dataclass(frozen=True)
 class TabulatedMotor(_DirectDrive):
     """A mechanical characteristic M(omega) from a table, linearly interpolated.
@@ -455,8 +436,7 @@ class TabulatedMotor(_DirectDrive):
             p.append("omega and torque must be finite")
         _at_least(p, "rotor_inertia", self.rotor_inertia, 0, "kg*m^2", strict=False)
         _raise(f"tabulated motor {self.name!r}", p)
-        object.__setattr__(self, "omega", tuple(w))
-        object.__setattr__(self, "torque", tuple(m))
+        _set(self, omega=tuple(w), torque=tuple(m))
 
     def torque_at(self, omega):
         """Interpolated torque (N m) at shaft speed ``omega`` (rad/s)."""
@@ -472,7 +452,6 @@ class TabulatedMotor(_DirectDrive):
         return _out(out)
 
 
-# ---------------------------------------------------------------------- gear stage
 @dataclass(frozen=True)
 class GearStage:
     """A speed-reducing stage between a motor and the driven coordinate.
@@ -514,7 +493,7 @@ class GearStage:
         for fld in ("input_inertia", "output_inertia"):
             _at_least(p, fld, getattr(self, fld), 0, "kg*m^2", strict=False)
         _raise(f"gear stage {self.name!r}", p)
-        _floats(self, "ratio", "efficiency", "input_inertia", "output_inertia")
+        _set(self, "ratio", "efficiency", "input_inertia", "output_inertia")
 
     def motor_speed(self, omega):
         """Motor shaft speed (rad/s) at driven speed ``omega`` (rad/s)."""
@@ -559,10 +538,7 @@ def extra_inertia_by_coordinate(mechanism) -> dict[str, float]:
     """
     out: dict[str, float] = {}
     for dr in mechanism.drives:
-        fn = getattr(dr.torque, "extra_inertia", None)
-        if fn is None:
-            continue
-        j = float(fn())
+        j = float(getattr(dr.torque, "extra_inertia", lambda: 0.0)())
         if j:
             out[dr.coordinate] = out.get(dr.coordinate, 0.0) + j
     return out

@@ -1,9 +1,4 @@
-"""Reading the ``[bodies]``, ``[joints]`` and ``[coordinates]`` tables of a model file.
-
-:class:`_BodiesJoints` reads one body (with its points, its sketch frame and the
-inertia about a point), one joint (revolute, prismatic, lock) and one coordinate,
-each into its :mod:`mechdyn.mechanism` element, recording every problem.
-"""
+"""Reading the ``[bodies]``, ``[joints]`` and ``[coordinates]`` tables of a model file."""
 
 from __future__ import annotations
 
@@ -20,7 +15,6 @@ _POSE_KINDS = ("length", "length", "angle")
 class _BodiesJoints(_Reader):
     """Reads the elements of the ``[bodies]``, ``[joints]`` and ``[coordinates]`` tables."""
 
-    # ------------------------------------------------------------ bodies
     def body(self, bname: str, spec: dict) -> Body:
         P = ("bodies", bname)
         mass = self.opt(spec, "mass", "mass", *P, nonneg=True)
@@ -78,7 +72,6 @@ class _BodiesJoints(_Reader):
         self.check()
         return Body(bname, mass=mass, inertia=inertia, com=com, points=points, pose=pose)
 
-    # ------------------------------------------------------------ joints
     def joint(self, jname: str, spec: dict):
         P = ("joints", jname)
         parent = self.soft(self.body_name, spec["parent"], *P, "parent")
@@ -115,7 +108,6 @@ class _BodiesJoints(_Reader):
         self.check()
         return Lock(jname, parent, child, bool(spec.get("engaged", True)), offset)
 
-    # ------------------------------------------------------------ coordinates
     def coordinate(self, cname: str, spec: dict) -> Coordinate:
         P = ("coordinates", cname)
         kind, body, joint = spec["kind"], spec.get("body"), spec.get("joint")

@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from ..errors import ModelError, did_you_mean
-from ..mechanism.catalogue import catalogue_entry
+from ..mechanism.catalogue import induction_motor
 from ..mechanism.drive import Drive
 from ..mechanism.motors import (
     ConstantSpeedDrive,
@@ -24,7 +24,7 @@ from ..mechanism.motors import (
     InductionMotor,
     TabulatedMotor,
 )
-from ..units import parse_quantity
+from ..units import parse_quantity, parse_vector
 
 __all__ = ["drive_from_table", "DRIVE_TYPES"]
 
@@ -86,30 +86,35 @@ def drive_from_table(table: Mapping, where: str = "drives") -> Drive:
         gear_ratio = 3.4
         efficiency = 0.95
     """
-    t = dict(table)
+    try:
+        return _drive(dict(table))
+    except ModelError as exc:  # UnitError stays a UnitError
+        raise type(exc)([f"{where}: {p}" for p in exc.problems]) from None
+
+
+def _drive(t: dict) -> Drive:
+    """:func:`drive_from_table` without the location in the messages."""
     kind = t.get("type")
     if kind not in DRIVE_TYPES:
-        raise ModelError(f"{where}: type: " + did_you_mean(str(kind), DRIVE_TYPES, "drive type"))
+        raise ModelError("type: " + did_you_mean(str(kind), DRIVE_TYPES, "drive type"))
     name = str(t.get("name", kind))
     problems = []
     if "coordinate" not in t:
-        problems.append(f"{where}: coordinate: missing (the driven generalized coordinate)")
+        problems.append("coordinate: missing (the driven generalized coordinate)")
     allowed = set(_COMMON_KEYS) | set(DRIVE_TYPES[kind]) | set(_GEAR_KEYS)
     for key in t:
         if key not in allowed:
-            problems.append(f"{where}: " + did_you_mean(key, sorted(allowed),
-                                                        f"key of a {kind!r} drive"))
+            problems.append(did_you_mean(key, sorted(allowed), f"key of a {kind!r} drive"))
     if problems:
         raise ModelError(problems)
 
-    q = {k: parse_quantity(v, _KINDS[k], where=f"{where}: {k}")
-         for k, v in t.items() if k in _KINDS}
+    q = {k: parse_quantity(v, _KINDS[k], where=k) for k, v in t.items() if k in _KINDS}
     source = str(t.get("source", ""))
     if kind == "induction_motor":
-        motor = _induction_from_table(t, q, name, where)
+        motor = _induction_from_table(t, q, name)
     elif kind == "dc_motor":
         if "no_load_speed" not in q:
-            raise ModelError(f"{where}: no_load_speed: missing (rad/s, e.g. \"3000 rpm\")")
+            raise ModelError("no_load_speed: missing (rad/s, e.g. \"3000 rpm\")")
         jr = q.get("rotor_inertia", 0.0)
         if "stall_torque" in q:
             motor = DCMotor(name, q["no_load_speed"], q["stall_torque"], jr, source)
@@ -117,56 +122,39 @@ def drive_from_table(table: Mapping, where: str = "drives") -> Drive:
             motor = DCMotor.from_rated(name, q["rated_power"], q["rated_speed"],
                                        q["no_load_speed"], jr, source)
         else:
-            raise ModelError(f"{where}: give stall_torque, or rated_power and rated_speed")
+            raise ModelError("give stall_torque, or rated_power and rated_speed")
     elif kind == "constant_speed":
         if "speed" not in q:
-            raise ModelError(f"{where}: speed: missing (e.g. \"43.5 rad/s\")")
+            raise ModelError("speed: missing (e.g. \"43.5 rad/s\")")
         motor = ConstantSpeedDrive(name, q["speed"], q.get("stiffness"))
     else:
         om, tq = t.get("omega"), t.get("torque")
         if not isinstance(om, list) or not isinstance(tq, list):
-            raise ModelError(f"{where}: omega and torque must be lists of quantities")
-        w = [parse_quantity(v, "angular_velocity", where=f"{where}: omega[{k}]")
-             for k, v in enumerate(om)]
-        m = [parse_quantity(v, "torque", where=f"{where}: torque[{k}]")
-             for k, v in enumerate(tq)]
-        motor = TabulatedMotor(name, tuple(w), tuple(m), q.get("rotor_inertia", 0.0),
-                               bool(t.get("extrapolate", True)), source)
+            raise ModelError("omega and torque must be lists of quantities")
+        motor = TabulatedMotor(name, parse_vector(om, "angular_velocity", "omega", size=len(om)),
+                               parse_vector(tq, "torque", "torque", size=len(tq)),
+                               q.get("rotor_inertia", 0.0), bool(t.get("extrapolate", True)),
+                               source)
     if not any(k in t for k in _GEAR_KEYS):
         return Drive(name, str(t["coordinate"]), motor)
     if "gear_ratio" not in t:
-        raise ModelError(f"{where}: gear_ratio: missing (the efficiency and gear "
-                         f"inertias need a gear ratio omega_motor/omega_driven)")
-    try:
-        gear = GearStage(motor, q["gear_ratio"], q.get("efficiency", 1.0),
-                         q.get("gear_input_inertia", 0.0), q.get("gear_output_inertia", 0.0),
-                         name=f"{name} gear")
-    except ModelError as exc:
-        raise ModelError([f"{where}: {p}" for p in exc.problems]) from None
-    return Drive(name, str(t["coordinate"]), gear)
+        raise ModelError("gear_ratio: missing (the efficiency and gear inertias need a gear "
+                         "ratio omega_motor/omega_driven)")
+    return Drive(name, str(t["coordinate"]), GearStage(
+        motor, q["gear_ratio"], q.get("efficiency", 1.0), q.get("gear_input_inertia", 0.0),
+        q.get("gear_output_inertia", 0.0), name=f"{name} gear"))
 
 
-def _induction_from_table(t, q, name, where) -> InductionMotor:
-    data: dict = {}
-    source = str(t.get("source", ""))
+def _induction_from_table(t, q, name) -> InductionMotor:
+    data = {k: v for k, v in q.items() if k in DRIVE_TYPES["induction_motor"]}
+    data["characteristic"] = str(t.get("characteristic", "kloss"))
+    data.update((k, str(t[k])) for k in ("name", "source") if t.get(k))
     if "catalogue" in t:
-        entry = catalogue_entry(str(t["catalogue"]))
-        data = entry.motor_kwargs()
-        name = str(t.get("name", entry.designation))
-        source = source or entry.source_text()
-    data.update((k, v) for k, v in q.items() if k in DRIVE_TYPES["induction_motor"])
-    if "rated_speed" in t and "rated_slip" not in t:
-        data.pop("rated_slip", None)  # the file's rated speed replaces the catalogue slip
-    elif "rated_slip" in t and "rated_speed" not in t:
-        data.pop("rated_speed", None)
+        return induction_motor(str(t["catalogue"]), **data)
     missing = [k for k in ("rated_power", "synchronous_speed", "breakdown_ratio") if k not in data]
     if "rated_speed" not in data and "rated_slip" not in data:
         missing.append("rated_speed (or rated_slip)")
     if missing:
-        raise ModelError(f"{where}: missing {', '.join(missing)} (or name a motor with "
+        raise ModelError(f"missing {', '.join(missing)} (or name a motor with "
                          f"catalogue = \"4A80B4U3\")")
-    data["characteristic"] = str(t.get("characteristic", "kloss"))
-    try:
-        return InductionMotor(name, source=source, **data)
-    except ModelError as exc:
-        raise ModelError([f"{where}: {p}" for p in exc.problems]) from None
+    return InductionMotor(**{"name": name, **data})

@@ -82,8 +82,7 @@ def loads(text: str, name: str = "<string>", *, default_title: str | None = None
     -------
     Mechanism
     """
-    doc = read_document(text, name)
-    return build(doc, name, default_title=default_title)
+    return build(read_document(text, name), name, default_title=default_title)
 
 
 #: tables and arrays nested deeper than this are refused (a model file needs about 4)
@@ -134,7 +133,6 @@ def build(doc: dict, name: str = "<string>", *, default_title: str | None = None
 class _Builder(_BodiesJoints, _LoadsDrives):
     """Turns a document into mechanism elements, recording every problem."""
 
-    # ------------------------------------------------------------ passes
     def run(self, default_title: str | None) -> Mechanism:
         model = self.section("model")
         title = model.get("name") if isinstance(model.get("name"), str) else None

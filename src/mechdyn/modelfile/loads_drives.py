@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..errors import ModelError, UnitError, did_you_mean
+from ..errors import did_you_mean
 from ..mechanism import GROUND
 from ..mechanism.drive import Drive, TorqueSpeedCurve
 from ..mechanism.load import Force, RotarySpring, Spring, Table, Torque, pulse
@@ -171,14 +171,7 @@ class _LoadsDrives(_Reader):
                          + did_you_mean(coord, self.coord_kinds, "coordinate"))
             raise _Failed
         if "type" in spec:  # a motor model (induction motor, DC motor, ...)
-            try:
-                return drive_from_table({"name": name, **spec}, where=self.where(*P))
-            except ModelError as exc:
-                for p in exc.problems:
-                    self.problem(p)
-                    if isinstance(exc, UnitError):
-                        self.unit_problems.add(p)
-                raise _Failed from None
+            return self.recorded(drive_from_table, {"name": name, **spec}, where=self.where(*P))
         travel = self.coord_kinds[coord] == "travel"
         tkind = "force" if travel else "torque"
         raw = spec["torque"]

@@ -1,11 +1,5 @@
-"""The base that the model-file loader's table readers share.
-
-Holds the document being read, the problems found in it so far and the names
-read from it (bodies and their points, sketch frames, joint types, coordinate
-kinds), with the helpers that read one value (a quantity, a vector, a body or
-point name, a direction) and record its problem instead of raising it
-(:class:`_Failed` then says the problem is recorded).
-"""
+"""The base of the model-file loader's table readers: the document, its problems and names,
+and helpers that read one value and record its problem (then raise :class:`_Failed`)."""
 
 from __future__ import annotations
 
@@ -41,7 +35,6 @@ class _Reader:
         #: a problem was recorded in the element being read
         self.failed = False
 
-    # ------------------------------------------------------------ helpers
     def where(self, *path) -> str:
         return locate(self.fname, path, self.doc)
 
@@ -96,17 +89,20 @@ class _Reader:
         if msg not in self.problems:
             self.problems.append(msg)
 
-    def _units(self, parse, *args, **kwargs):
-        """``parse(*args, **kwargs)`` of :mod:`mechdyn.units`, its UnitError recorded."""
+    def recorded(self, fn, *args, **kwargs):
+        """``fn(*args, **kwargs)``, its ModelError's problems recorded (a UnitError's as unit
+        problems)."""
         try:
-            return parse(*args, **kwargs)
-        except UnitError as exc:
-            self.problem(str(exc))
-            self.unit_problems.add(str(exc))
+            return fn(*args, **kwargs)
+        except ModelError as exc:
+            for p in exc.problems:
+                self.problem(p)
+                if isinstance(exc, UnitError):
+                    self.unit_problems.add(p)
             raise _Failed from None
 
     def quantity(self, value: Any, kind: str, *path, nonneg: bool = False) -> float:
-        out = self._units(parse_quantity, value, kind, where=self.where(*path))
+        out = self.recorded(parse_quantity, value, kind, where=self.where(*path))
         if nonneg and out < 0:
             self.problem(f"{self.where(*path)}: {value!r}: {path[-1]} must be >= 0 "
                          f"{KINDS[kind].si}")
@@ -114,7 +110,7 @@ class _Reader:
         return out
 
     def vector(self, value: Any, kind, *path, size: int | None = None) -> tuple[float, ...]:
-        return self._units(parse_vector, value, kind, self.where(*path), size=size)
+        return self.recorded(parse_vector, value, kind, self.where(*path), size=size)
 
     def points(self, raw: Any, *path, hint: str) -> dict[str, tuple[float, float]]:
         """The named points of the table ``raw`` at ``path`` (m); ``"com"`` is reserved."""

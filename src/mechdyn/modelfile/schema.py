@@ -91,36 +91,24 @@ def locate(fname: str, path: Sequence, doc: Any = None) -> str:
             depth = 2
         label = "[" + ".".join(str(p) for p in path[:depth]) + "]"
         rest = path[depth:]
-    key = ""
-    for p in rest:
-        if isinstance(p, int):
-            key += f"[{p}]"
-        else:
-            key += ("." if key else "") + str(p)
+    key = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in rest).removeprefix(".")
     return (f"{fname}: " if fname else "") + label + (f" {key}" if key else "")
-
-
-def _property_hint(sch: dict, key: str) -> str:
-    prop = sch.get("properties", {}).get(key)
-    if isinstance(prop, dict) and prop.get("description"):
-        return f" ({prop['description']})"
-    return ""
 
 
 def _message(err, fname: str, doc: Any) -> str:
     path = list(err.absolute_path)
     where = locate(fname, path, doc)
-    v = err.validator
-    inst = err.instance
+    v, inst = err.validator, err.instance
+    what = "table" if not path else "key"
     if v == "required":
         missing = [k for k in err.validator_value if not (isinstance(inst, dict) and k in inst)]
         key = missing[0] if missing else "?"
-        what = "table" if not path else "key"
-        return f"{where}: missing {what} {key!r}{_property_hint(err.schema, key)}"
+        prop = err.schema.get("properties", {}).get(key)
+        desc = prop.get("description") if isinstance(prop, dict) else None
+        return f"{where}: missing {what} {key!r}" + (f" ({desc})" if desc else "")
     if v == "additionalProperties":
         valid = list(err.schema.get("properties", {}))
         extra = [k for k in inst if k not in valid] if isinstance(inst, dict) else []
-        what = "table" if not path else "key"
         names = ", ".join(repr(k) for k in extra) or "?"
         close = [m for k in extra for m in difflib.get_close_matches(str(k), valid, n=1)]
         hint = f" (did you mean {', '.join(repr(c) for c in close)}?)" if close else ""
@@ -163,13 +151,8 @@ def schema_problems(doc: Any, fname: str) -> tuple[list[str], list[tuple]]:
     paths : list of tuple
         The path of each problem (to skip the broken elements when building).
     """
-    msgs: list[str] = []
-    paths: list[tuple] = []
-    errors = sorted(_validator().iter_errors(doc),
-                    key=lambda e: [str(p) for p in e.absolute_path])
-    for err in errors:
-        m = _message(err, fname, doc)
-        if m not in msgs:
-            msgs.append(m)
-            paths.append(tuple(err.absolute_path))
-    return msgs, paths
+    found: dict[str, tuple] = {}  # message -> path of its first error
+    for err in sorted(_validator().iter_errors(doc),
+                      key=lambda e: [str(p) for p in e.absolute_path]):
+        found.setdefault(_message(err, fname, doc), tuple(err.absolute_path))
+    return list(found), list(found.values())

@@ -16,18 +16,13 @@ from ..mechanism.contact import Contact, Stop
 from ..mechanism.switch import CoordinateLock, Switch
 from ..model.variable import parse, quantity
 from .reader import _Reader
+from .schema import schema
 
 __all__ = ["parse_switches", "TABLES", "variable_kind"]
 
-#: the top-level tables this module reads, with their allowed keys
-TABLES = {
-    "coordinate_locks": ("name", "variable", "engaged", "value", "frees", "description"),
-    "stops": ("name", "variable", "lower", "upper", "restitution", "description"),
-    "contacts": ("name", "body", "point", "line_body", "line_point", "line_direction",
-                 "friction", "restitution", "compliance", "description"),
-    "switches": ("name", "action", "target", "variable", "value", "direction", "times",
-                 "guard", "once", "description"),
-}
+#: the top-level tables this module reads, with their allowed keys (from the schema)
+TABLES = {t: tuple(schema()["properties"][t]["items"]["properties"])
+          for t in ("coordinate_locks", "stops", "contacts", "switches")}
 _DIRECTIONS = {"rising": 1, "up": 1, "falling": -1, "down": -1, "both": 0, "either": 0,
                1: 1, -1: -1, 0: 0}
 
@@ -120,10 +115,6 @@ class _Switches(_Reader):
             self.failed = False
             yield (table, k), e
 
-    def kind_of(self, var, *path) -> str | None:
-        """The quantity kind of a variable string; None if it has a problem (recorded)."""
-        return self.soft(self.variable_kind, var, *path)
-
     def add(self, cls, path: tuple, *args, **kwargs):
         """File ``cls(*args, **kwargs)`` in ``mech.extras``; its own check is a problem."""
         try:
@@ -135,7 +126,7 @@ class _Switches(_Reader):
 
     def locks(self):
         for P, e in self.entries("coordinate_locks"):
-            kd = self.kind_of(e.get("variable"), *P, "variable")
+            kd = self.soft(self.variable_kind, e.get("variable"), *P, "variable")
             if kd is None:
                 continue
             value = self.opt(e, "value", kd, *P, default=None)
@@ -150,7 +141,7 @@ class _Switches(_Reader):
 
     def stops(self):
         for P, e in self.entries("stops"):
-            kd = self.kind_of(e.get("variable"), *P, "variable")
+            kd = self.soft(self.variable_kind, e.get("variable"), *P, "variable")
             if kd is None:
                 continue
             lower = self.opt(e, "lower", kd, *P, default=None)
@@ -187,7 +178,7 @@ class _Switches(_Reader):
                 self.problem(f"{self.where(*P, 'target')}: "
                              + did_you_mean(str(target), locks, "lock"))
                 self.failed = True
-            kd = self.kind_of(var, *P, "variable") if var is not None else None
+            kd = self.soft(self.variable_kind, var, *P, "variable") if var is not None else None
             value = self.opt(e, "value", kd, *P) if kd is not None else 0.0
             if dval not in _DIRECTIONS:
                 self.problem(f"{self.where(*P, 'direction')}: must be 'rising', "
@@ -203,7 +194,7 @@ class _Switches(_Reader):
                                  f"operator, value], got {g!r}")
                     self.failed = True
                     continue
-                kd = self.kind_of(g[0], *P, "guard")
+                kd = self.soft(self.variable_kind, g[0], *P, "guard")
                 gv = self.soft(self.quantity, g[2], kd, *P, "guard") if kd is not None else None
                 guards.append((g[0], g[1], 0.0 if gv is None else gv))
             sw = Switch(e["name"], e.get("action"), target, var, value,
