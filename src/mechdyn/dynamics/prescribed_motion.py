@@ -18,7 +18,7 @@ from scipy.optimize import least_squares
 
 from ..errors import AssemblyError, ModelError, SingularPositionError
 from ..kernels import rows_numpy
-from ..kinematics.assembly import _rank, _scale, joint_residuals
+from ..kinematics.assembly import _scale, joint_residuals
 from ..kinematics.branch_chart import ChartBook, PathProblem
 from ..kinematics.constraints import _point_kinematics, coordinates, coordinates_jacobian
 from ..kinematics.continuation import Kernel, _kernel, _march, _newton, _node
@@ -26,12 +26,9 @@ from ..kinematics.records import _refine_root
 from ..kinematics.sweep import DEFAULT_MAX_STEP, DEFAULT_MIN_STEP, _motion, _path, sweep
 from ..model import Model, as_model
 from ..model.rows import concat
+from .mode_system import _independent_rows
 
 __all__ = ["dead_centres", "ModeRows"]
-
-#: relative singular value below which constraint equations count as dependent
-REDUNDANT_RCOND = 1e-9
-
 
 class ModeRows:
     """The constraint rows of a variable-structure mode for kinetostatics: the joint
@@ -55,32 +52,16 @@ class ModeRows:
         self.n_base = base.n_rows
         self.rowset = concat(model.n_bodies, model.joint_rows, *[r.rows for r in self.extra])
         self.n_rows = len(self.rowset)
-        self.rows = dict(base.rows)
-        self.elements: dict[str, list[int]] = {}
-        welds = set(model.lock.names)
         keys = [r.label if r.kind == "stick" else r.element for r in self.extra]
-        for k, (r, key) in enumerate(zip(self.extra, keys, strict=True)):
-            if r.element in welds:
-                self.rows[key] = np.append(self.rows.get(key, np.zeros(0, int)),
-                                           self.n_base + k)
-            else:
-                self.elements.setdefault(key, []).append(self.n_base + k)
         self.row_joint = np.array([*base.row_joint, *keys], dtype=object)
+        groups = {k: np.flatnonzero(self.row_joint == k) for k in dict.fromkeys(self.row_joint)}
+        joints = set(base.rows) | set(model.lock.names)
+        self.rows = {k: v for k, v in groups.items() if k in joints}
+        self.elements = {k: v for k, v in groups.items() if k not in joints}
         self.row_is_angle = self.rowset.is_angle[self.n_base:]
         slip = [(self.n_base + k, r.friction_rows) for k, r in enumerate(self.extra) if r.slip]
         self.slip_rows = np.array([k for k, _ in slip], int)
         self.friction = concat(model.n_bodies, *[f for _, f in slip])
-
-
-def mode_jacobian(model: Model, x, lay, *, friction: bool = False) -> np.ndarray:
-    """Jacobian of every row of ``lay`` (a layout or :class:`ModeRows`), (..., n_rows, n_x).
-    With ``friction``, the rows of slipping contacts carry their Coulomb friction
-    (R - mu s T_x, the force direction of the row, as in
-    :meth:`mechdyn.dynamics.modes.ModeSystem.evaluate_x`)."""
-    J = rows_numpy.jacobian(lay.rowset, x)
-    if friction and isinstance(lay, ModeRows) and lay.slip_rows.size:
-        J[..., lay.slip_rows, :] += rows_numpy.jacobian(lay.friction, x)
-    return J
 
 
 def _steps(kern: Kernel, c: int, tol: float, counter: dict) -> dict:
@@ -220,27 +201,19 @@ def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=N
 def _independent_subset(model, lay, x0, first: list[int], candidates=None) -> list[int]:
     """Extend ``first`` with coordinates that add rank, up to the DOF of the layout
     (``candidates``: the order in which the others are tried; default declared order)."""
-    sc = _scale(model)
-    P = mode_jacobian(model, x0, lay) * sc
-    G = coordinates_jacobian(model, x0) * sc
-    r_phi = _rank(P, REDUNDANT_RCOND)
-    dof = model.n_x - r_phi
-    chosen: list[int] = []
-
-    def adds_rank(k):
-        A = np.concatenate([P, G[chosen + [k]]])
-        return _rank(A, REDUNDANT_RCOND) == r_phi + len(chosen) + 1
-
+    order = first + [k for k in (range(model.n_q) if candidates is None else candidates)
+                     if k not in first]
+    A = np.concatenate([rows_numpy.jacobian(lay.rowset, x0),
+                        coordinates_jacobian(model, x0)[order]]) * _scale(model)
+    keep = _independent_rows(A)
+    dof = model.n_x - int(np.sum(keep < lay.n_rows))
+    chosen = [order[i - lay.n_rows] for i in keep if i >= lay.n_rows]
     for k in first:
-        if not adds_rank(k):
+        if k not in chosen:
             raise ModelError(
                 f"coordinate {model.coordinate_names[k]!r} cannot be driven in mode "
                 f"{sorted(lay.mode)}: it is fixed by the other driven coordinates and the "
                 f"constraints ({dof} degree(s) of freedom)")
-        chosen.append(k)
-    for k in (range(model.n_q) if candidates is None else candidates):
-        if len(chosen) < dof and k not in chosen and adds_rank(k):
-            chosen.append(k)
     if len(chosen) < dof:
         raise ModelError(f"the mechanism has {dof} degrees of freedom in mode "
                          f"{sorted(lay.mode)}, but only {len(chosen)} coordinates can be driven")

@@ -11,16 +11,18 @@ import warnings as _warnings
 import numpy as np
 
 from ..errors import Status
+from ..kernels import rows_numpy
 from ..kinematics.assembly import SINGULAR_RCOND, _dependent_rows, _scale
 from ..kinematics.constraints import _perp, coordinates_jacobian, extend
 from ..model import ConstraintLayout, Model
 from .forces import applied_forces, cross, rotate
 from .inertia import inertia_forces
-from .prescribed_motion import REDUNDANT_RCOND, ModeRows, mode_jacobian
 
 __all__ = ["KinetostaticsWarning", "joint_reaction", "reaction_frame", "element_forces",
            "frame_forces", "touches_ground"]
 
+#: relative singular value below which constraint equations count as dependent
+REDUNDANT_RCOND = 1e-9
 #: rcond of the scaled inverse-dynamics matrix below which a position is reported
 #: as close to singular (a warning; the solve is still exact)
 NEAR_SINGULAR_RCOND = 1e-6
@@ -38,7 +40,7 @@ def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
     x = np.asarray(x, dtype=float).reshape(-1, model.n_x)
     if x.shape[0] > 64:  # redundancy is structural: a sample of the positions suffices
         x = x[np.unique(np.linspace(0, x.shape[0] - 1, 64).astype(int))]
-    P = mode_jacobian(model, x, lay) * sc
+    P = rows_numpy.jacobian(lay.rowset, x) * sc
     s = np.linalg.svd(P, compute_uv=False)
     r = np.sum(s > REDUNDANT_RCOND * s[..., :1], axis=-1)
     n_red = int(lay.n_rows - r.min())
@@ -218,8 +220,9 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     F, F_ground, Qd_loads = applied_forces(model, t, x, xdot, q, qdot, skip_drives=skip,
                                            reacting_loads=reacting)
     Ix = inertia_forces(model, x, xdot, xddot)
-    # (n, rows, n_x); slipping contacts' rows carry their friction
-    P = mode_jacobian(model, x, lay, friction=True)
+    P = rows_numpy.jacobian(lay.rowset, x)  # (n, rows, n_x)
+    if len(getattr(lay, "slip_rows", ())):  # slipping contacts' rows: R - mu s T_x
+        P[:, lay.slip_rows, :] += rows_numpy.jacobian(lay.friction, x)
     G = coordinates_jacobian(model, x)  # (n, n_q, n_x)
     Gd = G[:, didx, :]
     A = np.concatenate([-P, Gd], axis=1).transpose(0, 2, 1)  # (n, n_x, rows + n_d)
@@ -301,15 +304,14 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     # ------------------------------------------------ switchable elements (modes.py rows)
     el_forces: dict[str, np.ndarray] = {}
     p_el = np.zeros(n)
-    if isinstance(lay, ModeRows):
-        for el, idx in lay.elements.items():
-            # the multiplier in the forward convention (M xddot = F + R^T lambda_m):
-            # the normal force of a stop or contact (>= 0), the torque/force of a
-            # coordinate lock on its measure, the tangential force of a sticking contact
-            el_forces[el] = -lam[:, idx[0]]
-            Del = C[:, idx, :].sum(axis=1)
-            p_el += np.einsum("nx,nx->n", Del, xdot)
-            frame_loads[el] = net_on_ground(model, x, Del, point)
+    for el, idx in getattr(lay, "elements", {}).items():
+        # the multiplier in the forward convention (M xddot = F + R^T lambda_m):
+        # the normal force of a stop or contact (>= 0), the torque/force of a
+        # coordinate lock on its measure, the tangential force of a sticking contact
+        el_forces[el] = -lam[:, idx[0]]
+        Del = C[:, idx, :].sum(axis=1)
+        p_el += np.einsum("nx,nx->n", Del, xdot)
+        frame_loads[el] = net_on_ground(model, x, Del, point)
 
     # ------------------------------------------------ drives' stator and ground-attached loads
     D = np.einsum("nd,ndx->nx", tau, Gd) + np.einsum("nq,nqx->nx", Qd_loads, G)
