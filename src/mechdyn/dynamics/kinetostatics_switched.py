@@ -85,7 +85,7 @@ def kinetostatics_switched(model: Model, trajectory, vs, *, over=None,
             lay, candidates = _mode_rows(model, sm, mode, X[a], first)
             res = _kinetostatics(model, trajectory=seg, point=point, model_drives=model_drives,
                                  reacting_loads=reacting_loads, lay=lay, candidates=candidates,
-                                 x_start=X[a])
+                                 x_guess=X[a])
             parts.append((a, b, mode, res, None))
         except (MechdynError, np.linalg.LinAlgError) as exc:
             parts.append((a, b, mode, None, exc))

@@ -41,8 +41,7 @@ class ModeRows:
     It stands in for a layout everywhere kinetostatics uses one (``rowset``,
     ``n_rows``, ``rows`` of the joints and weld locks, ``row_joint``, ``mode``);
     ``extra`` are the switchable rows, ``elements`` the row indices of every
-    switchable element but the weld locks (which report as joints), ``row_is_angle``
-    whether each switchable row is in rad.
+    switchable element but the weld locks (which report as joints).
     """
 
     def __init__(self, model: Model, extra, mode):
@@ -58,7 +57,6 @@ class ModeRows:
         joints = set(base.rows) | set(model.lock.names)
         self.rows = {k: v for k, v in groups.items() if k in joints}
         self.elements = {k: v for k, v in groups.items() if k not in joints}
-        self.row_is_angle = self.rowset.is_angle[self.n_base:]
         slip = [(self.n_base + k, r.friction_rows) for k, r in enumerate(self.extra) if r.slip]
         self.slip_rows = np.array([k for k, _ in slip], int)
         self.friction = concat(model.n_bodies, *[f for _, f in slip])
@@ -72,15 +70,17 @@ def _steps(kern: Kernel, c: int, tol: float, counter: dict) -> dict:
             "min_step": DEFAULT_MIN_STEP * L, "tol": tol, "counter": counter}
 
 
-def _move(kern: Kernel, node, c: int, target: float, tol: float, counter: dict):
-    """March node's coordinate c to target (no chart book); raises where it stalls."""
-    if node.q[c] == target:
-        return node
-    nodes, stop = _march(kern, _node(kern, node.x, node.q, c), c, [target],
-                         **_steps(kern, c, tol, counter))
-    if stop is not None:
-        raise _error(kern, stop.q_try, stop.node.x)
-    return nodes[-1]
+def _move(kern: Kernel, node, q, cs, tol: float, counter: dict):
+    """March node's coordinates cs, one after the other, to their values in q (no chart
+    book); raises where it stalls."""
+    for c in cs:
+        if node.q[c] != q[c]:
+            nodes, stop = _march(kern, _node(kern, node.x, node.q, c), c, [q[c]],
+                                 **_steps(kern, c, tol, counter))
+            if stop is not None:
+                raise _error(kern, stop.q_try, stop.node.x)
+            node = nodes[-1]
+    return node
 
 
 def _start(kern: Kernel, q0, x_start, j: int, tol: float, counter: dict):
@@ -91,11 +91,8 @@ def _start(kern: Kernel, q0, x_start, j: int, tol: float, counter: dict):
     x, ok, _, J = _newton(kern, x_start, q_s, tol, max_iter=60)
     if ok:
         try:
-            node = _node(kern, x, q_s, j, J)
-            for c in range(len(q0)):
-                if c != j:
-                    node = _move(kern, node, c, q0[c], tol, counter)
-            return node
+            return _move(kern, _node(kern, x, q_s, j, J), q0,
+                         [c for c in range(len(q0)) if c != j], tol, counter)
         except (AssemblyError, SingularPositionError):
             pass
     x, ok, _, J = _newton(kern, x_start, q0, tol, max_iter=60)
@@ -134,18 +131,12 @@ def _error(kern: Kernel, qd, x):
 
 
 def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=None):
-    """Poses, velocities and accelerations with the driven coordinates ``didx`` following
-    qd, qd_dot, qd_ddot (n, n_d), on the kinematics continuation: the kernel of the rows
-    of ``lay`` (a layout or :class:`ModeRows`) then the driven coordinates' rows, one
-    batched Newton solve from the guesses x_guess (n, n_x) when it converges everywhere,
-    else the sweep's continuation (:func:`~mechdyn.kinematics.sweep._path`) from the pose
-    x_start along the one varying driven coordinate, through bifurcation positions with
-    a chart book, or through anchors reached coordinate by coordinate when several vary.
-
-    Returns x, xdot, xddot (n, n_x), the samples in a chart's zone (mask (n,), x', x''
-    along the varying coordinate) or None, and the stats ``position_solves`` and
-    ``bifurcations``."""
-    didx = np.asarray(didx, dtype=int)
+    """Poses, velocities and accelerations (n, n_x) with the driven coordinates ``didx``
+    following qd, qd_dot, qd_ddot (n, n_d): one batched Newton solve from the guesses
+    x_guess when it converges everywhere, else the sweep's continuation from x_start
+    (through bifurcation positions with a chart book), or through anchors when several
+    driven coordinates vary.  Also returns the charted samples (mask (n,), x', x'') or
+    None and the stats ``position_solves`` and ``bifurcations``."""
     kern = Kernel(model, lay, didx) if isinstance(lay, ModeRows) else _kernel(model, lay, didx)
     tol, n = 1e-12 * max(model.length_scale, 1e-3), len(qd)
     counter = {"coarse_steps": 0}
@@ -175,8 +166,7 @@ def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=N
             anchors = np.unique(np.r_[np.arange(0, n, max(1, n // 100)), n - 1])
             nodes = []
             for k in anchors:
-                for c in var:
-                    node = _move(kern, node, c, qd[k, c], tol, counter)
+                node = _move(kern, node, qd[k], var, tol, counter)
                 nodes.append(node)
             a = [nodes[i] for i in np.searchsorted(anchors, np.arange(n), "right") - 1]
             pred = np.array([nd.x + nd.B @ (qk - nd.q) for nd, qk in zip(a, qd, strict=True)])
@@ -185,10 +175,7 @@ def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=N
             system = (F, J, fac)
             ok &= fac[2] == np.array([nd.sign for nd in a])  # on the anchor's branch
             for k in np.flatnonzero(~ok):  # by continuation from the anchor
-                nd = a[k]
-                for c in var:
-                    nd = _move(kern, nd, c, qd[k, c], tol, counter)
-                x[k], system = nd.x, None
+                x[k], system = _move(kern, a[k], qd[k], var, tol, counter).x, None
     x, _, xdot, xddot, charted = _motion(kern, x, qd, qd_dot, qd_ddot, book, j, system,
                                          correct=False)
     # Newton solves: the continuation's steps and the batched solves
