@@ -194,17 +194,17 @@ def _independent_subset(model, lay, x0, first: list[int], candidates=None) -> li
                         coordinates_jacobian(model, x0)[order]]) * _scale(model)
     keep = _independent_rows(A)
     dof = model.n_x - int(np.sum(keep < lay.n_rows))
-    chosen = [order[i - lay.n_rows] for i in keep if i >= lay.n_rows]
-    for k in first:
-        if k not in chosen:
+    picked = [i - lay.n_rows for i in keep if i >= lay.n_rows]  # positions in order
+    for i, k in enumerate(first):
+        if i not in picked:
             raise ModelError(
                 f"coordinate {model.coordinate_names[k]!r} cannot be driven in mode "
                 f"{sorted(lay.mode)}: it is fixed by the other driven coordinates and the "
                 f"constraints ({dof} degree(s) of freedom)")
-    if len(chosen) < dof:
+    if len(picked) < dof:
         raise ModelError(f"the mechanism has {dof} degrees of freedom in mode "
-                         f"{sorted(lay.mode)}, but only {len(chosen)} coordinates can be driven")
-    return chosen
+                         f"{sorted(lay.mode)}, but only {len(picked)} coordinates can be driven")
+    return [order[i] for i in picked]
 
 
 def dead_centres(mech_or_model, body: str, point, *, coordinate: str = "y",
