@@ -33,14 +33,11 @@ class KinetostaticsWarning(UserWarning):
 
 
 def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
-    """Number of dependent joint equations, the joints involved and row labels."""
-    if lay.n_rows == 0:
-        return 0, [], []
-    sc = _scale(model)
-    x = np.asarray(x, dtype=float).reshape(-1, model.n_x)
+    """Number of dependent joint equations at poses x (n, n_x), the joints involved and
+    row labels."""
     if x.shape[0] > 64:  # redundancy is structural: a sample of the positions suffices
         x = x[np.unique(np.linspace(0, x.shape[0] - 1, 64).astype(int))]
-    P = rows_numpy.jacobian(lay.rowset, x) * sc
+    P = rows_numpy.jacobian(lay.rowset, x) * _scale(model)
     s = np.linalg.svd(P, compute_uv=False)
     r = np.sum(s > REDUNDANT_RCOND * s[..., :1], axis=-1)
     n_red = int(lay.n_rows - r.min())
@@ -152,17 +149,14 @@ def frame_forces(ms, x, lam, point=None) -> dict:
     lam = np.asarray(lam, float)
     width = 2 if point is None else 3
     p = np.zeros(2) if point is None else np.asarray(point, float)
+    shape = lam.shape[:-1] + (width,)
     out: dict = {}
-    total = np.zeros(lam.shape[:-1] + (width,))
     for el, idx in ms.element_rows.items():
-        if el not in ms.grounded:
-            continue
-        gen = np.einsum("...rx,...r->...x", R[..., idx, :], lam[..., idx])
-        # Newton's third law: the frame gets the opposite of the force on the bodies
-        f = net_on_ground(ms.model, x, gen, p)[..., :width].reshape(total.shape)
-        out[el] = f
-        total = total + f
-    out["total"] = total
+        if el in ms.grounded:
+            gen = np.einsum("...rx,...r->...x", R[..., idx, :], lam[..., idx])
+            # Newton's third law: the frame gets the opposite of the force on the bodies
+            out[el] = net_on_ground(ms.model, x, gen, p)[..., :width].reshape(shape)
+    out["total"] = sum(out.values(), np.zeros(shape))
     return out
 
 
@@ -204,14 +198,10 @@ def net_on_ground(model: Model, x, D, point) -> np.ndarray:
 def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qdot, *,
              skip, reacting, point, charted=None) -> dict:
     """The batched inverse-dynamics solve and the reaction bookkeeping: the record fields
-    it gives (named as in :class:`~mechdyn.results.kinetostatics_record.Kinetostatics`),
-    ``tau`` (n, n_d), ``status``, ``warnings`` and ``stats``.
-
-    ``charted`` = (mask (n,), x' (m, n_x), x'' (m, n_x)): samples near a bifurcation
-    position, where the system is (nearly) singular but the branch goes on; with one
-    driven coordinate its torque there is the virtual work along the branch's tangent
-    x', tau = x'^T (I - F) (the reactions do no work along it), and these samples do
-    not count for the redundancy check."""
+    it gives (as named in ``Kinetostatics``), ``tau`` (n, n_d), ``status``, ``warnings``
+    and ``stats``.  ``charted`` = (mask (n,), x', x''): samples near a bifurcation, where
+    one driven coordinate's torque is the virtual work along the branch's tangent x',
+    tau = x'^T (I - F) (the reactions do no work along it)."""
     n = t.shape[0]
     nb = model.n_bodies
     L = model.length_scale
@@ -228,8 +218,7 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     A = np.concatenate([-P, Gd], axis=1).transpose(0, 2, 1)  # (n, n_x, rows + n_d)
     rhs = Ix - F
     # balance units: moment equations / L; moment-like unknowns scaled by L
-    rs = np.ones(model.n_x)
-    rs[2::3] = 1.0 / L
+    rs = 1.0 / _scale(model)
     cs = np.where(np.concatenate([lay.rowset.is_angle, model.coord_is_angle[didx]]), L, 1.0)
     As = A * rs[:, None] * cs[None, :]
     bs = rhs * rs
