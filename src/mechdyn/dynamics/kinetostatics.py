@@ -37,7 +37,6 @@ __all__ = ["Kinetostatics", "kinetostatics", "inertia_forces", "frame_mass_matri
            "applied_forces", "dead_centres", "KinetostaticsWarning"]
 
 
-# ================================================================ motion specs
 def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
                   speed=None, values=None, t=None, law: Callable | None = None,
                   start=None, trajectory=None, hold: Mapping[str, float] | None = None,

@@ -159,11 +159,10 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
             tt = ((qo[:, k0] - qo[0, k0]) / w[k0]) if w[k0] != 0 else np.zeros(qo.shape[0])
         didx = _independent_subset(model, lay, x_start, over_idx)
         extra = didx[n_o:]
-        hold = dict(hold or {})
-        for nm in hold:
-            model.coordinate_index(nm)  # an unknown name raises
         q0 = coordinates(model, x_start)
-        held = np.array([hold.get(names[k], q0[k]) for k in extra], float)
+        for nm, v in (hold or {}).items():
+            q0[model.coordinate_index(nm)] = v  # an unknown name raises
+        held = q0[extra]
         zero = np.zeros((tt.size, len(extra)))
         qd = np.concatenate([qo, held + zero], axis=1)
         qd_dot, qd_ddot = np.concatenate([qo_d, zero], axis=1), np.concatenate([qo_dd, zero], 1)

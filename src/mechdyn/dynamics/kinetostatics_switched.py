@@ -11,7 +11,6 @@ element is not part of a sample's mode.  The rules are stated in
 
 from __future__ import annotations
 
-import itertools
 import time
 from types import SimpleNamespace
 
@@ -77,8 +76,8 @@ def kinetostatics_switched(model: Model, trajectory, vs, *, over=None,
     mode_index = np.array([modes.index(m) for m in sample_modes], int)
 
     parts = []
-    ends = list(itertools.accumulate(len(list(g)) for _, g in itertools.groupby(sample_modes)))
-    for a, b in zip([0, *ends[:-1]], ends, strict=True):
+    cuts = [0, *(np.flatnonzero(np.diff(mode_index)) + 1).tolist(), n]
+    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
         mode = sample_modes[a]
         seg = SimpleNamespace(t=tt[a:b], q=Q[a:b], qdot=Qd[a:b], qddot=Qdd[a:b], x=X[a:b])
         try:

@@ -179,8 +179,7 @@ def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=N
     x, _, xdot, xddot, charted = _motion(kern, x, qd, qd_dot, qd_ddot, book, j, system,
                                          correct=False)
     # Newton solves: the continuation's steps and the batched solves
-    solves = counter["coarse_steps"] + (x_guess is not None) + (not guessed)
-    stats = {"position_solves": solves,
+    stats = {"position_solves": counter["coarse_steps"] + (x_guess is not None) + (not guessed),
              "bifurcations": book.report() if book is not None else []}
     return x, xdot, xddot, charted, stats
 

@@ -203,7 +203,6 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     one driven coordinate's torque is the virtual work along the branch's tangent x',
     tau = x'^T (I - F) (the reactions do no work along it)."""
     n = t.shape[0]
-    nb = model.n_bodies
     L = model.length_scale
     n_d = len(didx)
     warn: list[str] = []
@@ -287,7 +286,7 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
         u = rotate(X[:, i, 2], model.pri.ui[model.pri.names.index(name)]
                    if kind == "prismatic" else (1.0, 0.0))
         jframe[name] = np.stack([np.sum(f * u, -1), np.sum(f * _perp(u), -1)], axis=-1)
-        if i == nb or j == nb:
+        if model.n_bodies in (i, j):  # attached to the ground
             frame_loads[name] = net_on_ground(model, x, gen, point)
 
     # ------------------------------------------------ switchable elements (modes.py rows)
@@ -313,8 +312,7 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     p_in = (np.einsum("nd,nd->n", tau, qdot[:, didx]) + np.einsum("nx,nx->n", F, xdot)
             + p_el)
     p_kin = np.einsum("nx,nx->n", Ix, xdot)
-    p_scale = max(float(np.max(np.abs(p_kin))), float(np.max(np.abs(p_in))),
-                  float(np.max(np.abs(F * xdot))), 1e-300)
+    p_scale = max(np.abs(p_kin).max(), np.abs(p_in).max(), np.abs(F * xdot).max(), 1e-300)
     stats = {"power_balance_rel": float(np.max(np.abs(p_in - p_kin)) / p_scale),
              "rcond_min": float(np.min(rcond)), "redundant_equations": n_red,
              "singular_positions": int(singular.sum()),
