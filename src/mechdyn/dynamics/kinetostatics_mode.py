@@ -113,11 +113,11 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
         x_start, x_guess = x_guess, None
 
     # ---------------------------------------------------------- the motion
-    over = [] if over is None else [over] if isinstance(over, str) else list(over)
+    over = [over] if isinstance(over, str) else list(over or [])
     over_idx = [model.coordinate_index(c) for c in over]
+    didx = _independent_subset(model, lay, x_start, over_idx, candidates)
     if trajectory is not None:
         tt = np.asarray(trajectory.t, dtype=float).reshape(-1)
-        didx = _independent_subset(model, lay, x_start, over_idx, candidates)
         qd, qd_dot, qd_ddot = (np.asarray(getattr(trajectory, a), dtype=float)
                                .reshape(tt.size, model.n_q)[:, didx]
                                for a in ("q", "qdot", "qddot"))
@@ -125,9 +125,8 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
         if x_guess is None and np.shape(tx) == (tt.size, model.n_x):
             x_guess = np.asarray(tx, dtype=float)
     else:
-        if not over_idx:
-            over_idx = _independent_subset(model, lay, x_start, [])[:1]
-        n_o = len(over_idx)
+        n_o = len(over_idx) if over_idx else 1  # default: the first independent coordinate
+        over_idx = didx[:n_o]
         if law is not None and (speed is not None or values is not None):
             raise ValueError("give law= or speed=/values=, not both")
         if law is not None or callable(speed):
@@ -157,7 +156,6 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
             qo_d, qo_dd = np.broadcast_to(w, qo.shape).copy(), np.zeros_like(qo)
             k0 = int(np.argmax(np.abs(w)))
             tt = ((qo[:, k0] - qo[0, k0]) / w[k0]) if w[k0] != 0 else np.zeros(qo.shape[0])
-        didx = _independent_subset(model, lay, x_start, over_idx)
         extra = didx[n_o:]
         q0 = coordinates(model, x_start)
         for nm, v in (hold or {}).items():
