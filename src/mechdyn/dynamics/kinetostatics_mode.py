@@ -88,12 +88,9 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                    start=None, trajectory=None, hold=None, mode=None, point=(0.0, 0.0),
                    model_drives="replace", reacting_loads=(), x_guess=None, lay=None,
                    candidates=None) -> Kinetostatics:
-    """The analysis in one mode (see :func:`kinetostatics`).
-
-    For the segments of a switched trajectory: ``lay`` (a layout or
-    :class:`~mechdyn.dynamics.prescribed_motion.ModeRows`, the rows of the segment's
-    mode with the targets its locks held), ``candidates`` (order in which
-    coordinates are chosen as driven) and ``x_guess`` a pose of the segment."""
+    """The analysis in one mode (see :func:`kinetostatics`); a switched trajectory's
+    segment gives its rows ``lay`` (a layout or ModeRows), the order in which coordinates
+    are chosen as driven (``candidates``) and its first pose as ``x_guess``."""
     t_start = time.perf_counter()
     names = model.coordinate_names
     if mode is None and isinstance(getattr(trajectory, "mode", None), frozenset):

@@ -126,10 +126,9 @@ def element_forces(ms, x, lam) -> dict:
     model = ms.model
     R = ms.row_jacobian(x)
     lam = np.asarray(lam, float)
-    joints = model.mechanism.joints
     out: dict = {}
     for el, idx in ms.element_rows.items():
-        if el not in joints:
+        if el not in model.mechanism.joints:
             out[el] = lam[..., idx[0]] if lam.ndim > 1 else float(lam[idx[0]])
             continue
         gen = np.einsum("...rx,...r->...x", R[..., idx, :], lam[..., idx])
@@ -233,11 +232,9 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
         z = np.linalg.solve(As, bs[..., None])[..., 0]
     else:
         z = (np.linalg.pinv(As, rcond=1e-10) @ bs[..., None])[..., 0]
-    resid = np.einsum("nij,nj->ni", As, z) - bs
-    scale_f = np.maximum(np.max(np.abs(bs), axis=-1), 1e-300)
-    bad = np.max(np.abs(resid), axis=-1) > 1e-6 * np.maximum(
-        scale_f, np.max(np.abs(As), axis=(1, 2)) * np.max(np.abs(z), axis=-1))
-    singular |= bad
+    resid = np.abs(np.einsum("nij,nj->ni", As, z) - bs).max(axis=-1)
+    singular |= resid > 1e-6 * np.maximum(np.maximum(np.abs(bs).max(axis=-1), 1e-300),
+                                          np.abs(As).max(axis=(1, 2)) * np.abs(z).max(axis=-1))
     z = z * cs
     lam = z[:, :lay.n_rows]
     tau = z[:, lay.n_rows:]
