@@ -137,8 +137,7 @@ def kinetostatics_switched(model: Model, trajectory, vs, *, over=None,
         warn.extend(w for w in (f"mode {fmt_mode(mode)}: {w}" for w in r.warnings) if w not in warn)
         notes.extend(nt for nt in r.message.split("; ")[1:] if nt not in notes)
         info.update(driven=r.driven, status=r.status,
-                    power_balance_rel=r.stats["power_balance_rel"],
-                    rcond_min=r.stats["rcond_min"])
+                    **{k: r.stats[k] for k in ("power_balance_rel", "rcond_min")})
 
     statuses = {Status.PARTIAL if r is None else r.status for *_, r, _ in parts}
     status = next((s for s in (Status.PARTIAL, Status.SINGULAR_POSITION, Status.REDUNDANT)

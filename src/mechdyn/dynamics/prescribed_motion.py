@@ -32,16 +32,13 @@ __all__ = ["dead_centres", "ModeRows"]
 
 class ModeRows:
     """The constraint rows of a variable-structure mode for kinetostatics: the joint
-    rows of the model, then the switchable rows of the mode (weld and coordinate
-    locks, closed stops, closed contacts and sticking contacts), the
-    :class:`~mechdyn.dynamics.modes.Row` objects of
-    :meth:`~mechdyn.dynamics.modes.SwitchedModel.rows` -- the rows of the
-    forward dynamics, :attr:`mechdyn.dynamics.modes.ModeSystem.rowset`.
+    rows of the model, then ``extra``, the switchable rows of the mode
+    (:meth:`~mechdyn.dynamics.modes.SwitchedModel.rows`, as in the forward dynamics).
 
     It stands in for a layout everywhere kinetostatics uses one (``rowset``,
     ``n_rows``, ``rows`` of the joints and weld locks, ``row_joint``, ``mode``);
-    ``extra`` are the switchable rows, ``elements`` the row indices of every
-    switchable element but the weld locks (which report as joints).
+    ``elements`` are the row indices of every switchable element but the weld locks
+    (which report as joints).
     """
 
     def __init__(self, model: Model, extra, mode):
