@@ -187,13 +187,6 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                     charted=charted)
     tau, status = core.pop("tau"), core.pop("status")
     warn.extend(core.pop("warnings"))
-    notes = []
-    if model_drives == "replace":
-        replaced = [dr.name for dr, k in force_model(model).drives if k in didx]
-        if replaced:
-            notes.append("drive(s) " + ", ".join(repr(r) for r in replaced)
-                         + " on driven coordinates are replaced by the prescribed motion "
-                           "(driving = the whole torque the drive must deliver)")
     stats = core.pop("stats")
     stats.update(positions=n, **pos_stats, seconds=time.perf_counter() - t_start)
     message = MESSAGES[status]
@@ -201,6 +194,11 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
         message = ("completed through bifurcation position(s): the mechanism stays on its "
                    "branch, the driving torques are the limits along it; the reactions are "
                    "unbounded there")
+    replaced = [dr.name for dr, k in force_model(model).drives if k in didx]
+    if model_drives == "replace" and replaced:
+        message += ("; drive(s) " + ", ".join(repr(r) for r in replaced)
+                    + " on driven coordinates are replaced by the prescribed motion "
+                      "(driving = the whole torque the drive must deliver)")
     over_k = int(didx[0]) if didx.size else 0  # the first driven coordinate is over[0]
     return Kinetostatics(
         over=names[over_k], t=tt, values=q[:, over_k], q=q, qdot=qdot, qddot=qddot, x=x,
@@ -209,6 +207,6 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
         driving={names[k]: tau[:, i] for i, k in enumerate(didx)},
         power={names[k]: tau[:, i] * qdot[:, k] for i, k in enumerate(didx)},
         frame_point=np.asarray(point, dtype=float).copy(), mode=lay.mode, status=status,
-        message="; ".join([message, *notes]), warnings=tuple(warn), stats=stats, model=model,
+        message=message, warnings=tuple(warn), stats=stats, model=model,
         **core, element_units={el: "N m" if lay.rowset.is_angle[idx[0]] else "N"
                                for el, idx in getattr(lay, "elements", {}).items()})
