@@ -24,8 +24,6 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 
-import numpy as np
-
 from ..model import as_model
 from ..results.kinetostatics_record import Kinetostatics
 from .forces import applied_forces
@@ -39,7 +37,6 @@ __all__ = ["Kinetostatics", "kinetostatics", "inertia_forces", "frame_mass_matri
            "applied_forces", "dead_centres", "KinetostaticsWarning"]
 
 
-# ================================================================ motion specs
 def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
                   speed=None, values=None, t=None, law: Callable | None = None,
                   start=None, trajectory=None, hold: Mapping[str, float] | None = None,
@@ -125,7 +122,7 @@ def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
         raise ValueError(f"model_drives must be 'replace' or 'load', got {model_drives!r}")
     if trajectory is not None and any(v is not None for v in (speed, values, t, law)):
         raise ValueError("give either trajectory= or speed/values/t/law, not both")
-    vs = _variable_structure(trajectory)
+    vs = getattr(trajectory, "switching", None)
     if vs is not None:
         if mode is not None:
             raise ValueError("mode= cannot be given with a variable-structure trajectory: "
@@ -137,15 +134,3 @@ def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
                           start=start, trajectory=trajectory, hold=hold, mode=mode,
                           point=point, model_drives=model_drives,
                           reacting_loads=reacting_loads, x_guess=x_guess)
-
-
-def _variable_structure(trajectory):
-    """The per-sample modes of a switched run (``trajectory.switching``), else None."""
-    vs = getattr(trajectory, "switching", None) if trajectory is not None else None
-    if vs is None:
-        return None
-    if len(vs.mode) != np.size(trajectory.t):
-        raise ValueError("the trajectory's variable_structure record does not match its "
-                         f"samples ({len(vs.mode)} modes for {np.size(trajectory.t)} "
-                         f"samples)")
-    return vs

@@ -87,17 +87,13 @@ def _to_array(v, n_d: int, what: str) -> np.ndarray:
 def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=None,
                    start=None, trajectory=None, hold=None, mode=None, point=(0.0, 0.0),
                    model_drives="replace", reacting_loads=(), x_guess=None, lay=None,
-                   candidates=None, x_start=None) -> Kinetostatics:
-    """The analysis in one mode (see :func:`kinetostatics`).
-
-    For the segments of a switched trajectory: ``lay`` (a layout or
-    :class:`~mechdyn.dynamics.prescribed_motion.ModeRows`, the rows of the segment's
-    mode with the targets its locks held), ``candidates`` (order in which
-    coordinates are chosen as driven) and ``x_start`` (a pose of the segment)."""
+                   candidates=None) -> Kinetostatics:
+    """The analysis in one mode (see :func:`kinetostatics`); a switched trajectory's
+    segment gives its rows ``lay`` (a layout or ModeRows), the order in which coordinates
+    are chosen as driven (``candidates``) and its first pose as ``x_guess``."""
     t_start = time.perf_counter()
-    fm = force_model(model)
-    if mode is None and trajectory is not None and isinstance(
-            getattr(trajectory, "mode", None), frozenset):
+    names = model.coordinate_names
+    if mode is None and isinstance(getattr(trajectory, "mode", None), frozenset):
         mode = trajectory.mode
     if lay is None:
         lay = model.layout(mode)
@@ -105,51 +101,39 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
     for nm in reacting_loads:
         if nm not in load_names:
             raise ModelError(did_you_mean(nm, [n for n in load_names if n], "load"))
-    warn: list[str] = []
-    for ld in model.mechanism.loads:
-        if hasattr(ld, "generalized"):
-            warn.append(f"load {getattr(ld, 'name', '?')!r} ({type(ld).__name__}) is an "
-                        f"extension load that kinetostatics does not evaluate; it is left out")
-    if x_start is None:
-        x_start = model.x_sketch if getattr(model, "x0", None) is None else model.x0
-    if x_guess is not None:
-        xg = np.asarray(x_guess, dtype=float)
-        if xg.ndim == 1:
-            x_start, x_guess = xg, None
-        else:
-            x_guess = xg
+    warn = [f"load {getattr(ld, 'name', '?')!r} ({type(ld).__name__}) is an extension load "
+            f"that kinetostatics does not evaluate; it is left out"
+            for ld in model.mechanism.loads if hasattr(ld, "generalized")]
+    x_start = model.x_sketch if getattr(model, "x0", None) is None else model.x0
+    x_guess = None if x_guess is None else np.asarray(x_guess, dtype=float)
+    if x_guess is not None and x_guess.ndim == 1:
+        x_start, x_guess = x_guess, None
 
     # ---------------------------------------------------------- the motion
-    over_names = [] if over is None else [over] if isinstance(over, str) else list(over)
-    over_idx = [model.coordinate_index(c) for c in over_names]
-
+    over = [over] if isinstance(over, str) else list(over or [])
+    over_idx = [model.coordinate_index(c) for c in over]
+    didx = _independent_subset(model, lay, x_start, over_idx, candidates)
     if trajectory is not None:
         tt = np.asarray(trajectory.t, dtype=float).reshape(-1)
-        didx = _independent_subset(model, lay, x_start, over_idx, candidates)
         qd, qd_dot, qd_ddot = (np.asarray(getattr(trajectory, a), dtype=float)
                                .reshape(tt.size, model.n_q)[:, didx]
                                for a in ("q", "qdot", "qddot"))
         tx = getattr(trajectory, "x", None)
-        if x_guess is None and tx is not None and np.shape(tx) == (tt.size, model.n_x):
+        if x_guess is None and np.shape(tx) == (tt.size, model.n_x):
             x_guess = np.asarray(tx, dtype=float)
-        if not over_names:
-            over_names = [model.coordinate_names[didx[0] if len(didx) else 0]]
     else:
-        if not over_idx:
-            over_idx = _independent_subset(model, lay, x_start, [])[:1]
-            over_names = [model.coordinate_names[over_idx[0]]]
-        n_o = len(over_idx)
-        if law is not None:
+        n_o = len(over_idx) if over_idx else 1  # default: the first independent coordinate
+        over_idx = didx[:n_o]
+        if law is not None and (speed is not None or values is not None):
+            raise ValueError("give law= or speed=/values=, not both")
+        if law is not None or callable(speed):
             if t is None:
-                raise ValueError("law= needs the times t=")
-            if speed is not None or values is not None:
-                raise ValueError("give law= or speed=/values=, not both")
+                raise ValueError(("law=" if law is not None else "a speed law omega(t)")
+                                 + " needs the times t=")
             tt = np.asarray(t, dtype=float).reshape(-1)
+        if law is not None:
             qo, qo_d, qo_dd = _derivs(law, tt, n_o)
         elif callable(speed):
-            if t is None:
-                raise ValueError("a speed law omega(t) needs the times t=")
-            tt = np.asarray(t, dtype=float).reshape(-1)
             if start is None:
                 start = coordinates(model, x_start)[over_idx]
             qo, qo_d, qo_dd = _integrate_speed(speed, tt, _to_array(start, n_o, "start"), n_o)
@@ -157,34 +141,29 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
             if speed is None:
                 raise ValueError("give the motion: speed= (a constant, 0 for statics, or a "
                                  "callable omega(t) with t=), law= with t=, or trajectory=")
+            if t is not None:
+                raise ValueError("t= is used with law= or a callable speed, not with a "
+                                 "constant speed (time follows from values and speed)")
             w = _to_array(speed, n_o, "speed")
             if values is None:
                 if not all(model.coord_is_angle[k] for k in over_idx):
                     raise ValueError("values= is needed for a travel coordinate")
-                sgn = np.where(w < 0, -1.0, 1.0)
-                values = np.linspace(0.0, 2 * np.pi, 361)[:, None] * sgn
+                values = np.linspace(0.0, 2 * np.pi, 361)[:, None] * np.where(w < 0, -1.0, 1.0)
             qo = np.asarray(values, dtype=float).reshape(-1, n_o)
-            qo_d = np.broadcast_to(w, qo.shape).copy()
-            qo_dd = np.zeros_like(qo)
+            qo_d, qo_dd = np.broadcast_to(w, qo.shape).copy(), np.zeros_like(qo)
             k0 = int(np.argmax(np.abs(w)))
             tt = ((qo[:, k0] - qo[0, k0]) / w[k0]) if w[k0] != 0 else np.zeros(qo.shape[0])
-            if t is not None:
-                raise ValueError("t= is used with law= or a callable speed, not with a "
-                                 "constant speed (time follows from values and speed)")
-        didx = _independent_subset(model, lay, x_start, over_idx)
         extra = didx[n_o:]
-        hold = dict(hold or {})
-        for nm in hold:
-            model.coordinate_index(nm)  # an unknown name raises
         q0 = coordinates(model, x_start)
-        held = np.array([hold.get(model.coordinate_names[k], q0[k]) for k in extra], float)
+        for nm, v in (hold or {}).items():
+            q0[model.coordinate_index(nm)] = v  # an unknown name raises
+        held = q0[extra]
         zero = np.zeros((tt.size, len(extra)))
         qd = np.concatenate([qo, held + zero], axis=1)
         qd_dot, qd_ddot = np.concatenate([qo_d, zero], axis=1), np.concatenate([qo_dd, zero], 1)
         if extra:
             warn.append("coordinate(s) " + ", ".join(
-                f"{model.coordinate_names[k]!r} = {h:.6g}" for k, h in zip(extra, held,
-                                                                           strict=True))
+                f"{names[k]!r} = {h:.6g}" for k, h in zip(extra, held, strict=True))
                 + " are held fixed (not driven by the given motion); their driving entries "
                   "are holding torques/forces")
     didx = np.asarray(didx, dtype=int)
@@ -208,14 +187,6 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                     charted=charted)
     tau, status = core.pop("tau"), core.pop("status")
     warn.extend(core.pop("warnings"))
-    notes = []
-    if model_drives == "replace":
-        replaced = [dr.name for dr, k in fm.drives if k in set(didx.tolist())]
-        if replaced:
-            notes.append("drive(s) " + ", ".join(repr(r) for r in replaced)
-                         + " on driven coordinates are replaced by the prescribed motion "
-                           "(driving = the whole torque the drive must deliver)")
-    over_values = q[:, model.coordinate_index(over_names[0])]
     stats = core.pop("stats")
     stats.update(positions=n, **pos_stats, seconds=time.perf_counter() - t_start)
     message = MESSAGES[status]
@@ -223,16 +194,19 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
         message = ("completed through bifurcation position(s): the mechanism stays on its "
                    "branch, the driving torques are the limits along it; the reactions are "
                    "unbounded there")
-    message = "; ".join([message, *notes])
-    names = model.coordinate_names
+    replaced = [dr.name for dr, k in force_model(model).drives if k in didx]
+    if model_drives == "replace" and replaced:
+        message += ("; drive(s) " + ", ".join(repr(r) for r in replaced)
+                    + " on driven coordinates are replaced by the prescribed motion "
+                      "(driving = the whole torque the drive must deliver)")
+    over_k = int(didx[0]) if didx.size else 0  # the first driven coordinate is over[0]
     return Kinetostatics(
-        over=over_names[0], t=tt, values=over_values, q=q, qdot=qdot, qddot=qddot, x=x,
+        over=names[over_k], t=tt, values=q[:, over_k], q=q, qdot=qdot, qddot=qddot, x=x,
         xdot=xdot, xddot=xddot, coordinate_names=tuple(names),
         driven=tuple(names[k] for k in didx),
         driving={names[k]: tau[:, i] for i, k in enumerate(didx)},
         power={names[k]: tau[:, i] * qdot[:, k] for i, k in enumerate(didx)},
         frame_point=np.asarray(point, dtype=float).copy(), mode=lay.mode, status=status,
-        message=message, warnings=tuple(warn), stats=stats, model=model, **core,
-        element_units={el: ("N m" if bool(lay.row_is_angle[idx[0] - lay.n_base]) else "N")
-                       for el, idx in getattr(lay, "elements", {}).items()})
-
+        message=message, warnings=tuple(warn), stats=stats, model=model,
+        **core, element_units={el: "N m" if lay.rowset.is_angle[idx[0]] else "N"
+                               for el, idx in getattr(lay, "elements", {}).items()})

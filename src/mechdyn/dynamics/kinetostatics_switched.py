@@ -11,7 +11,6 @@ element is not part of a sample's mode.  The rules are stated in
 
 from __future__ import annotations
 
-import itertools
 import time
 from types import SimpleNamespace
 
@@ -29,29 +28,23 @@ from .prescribed_motion import ModeRows
 __all__ = ["kinetostatics_switched"]
 
 
-def _mode_rows(model: Model, sm: SwitchedModel, mode: frozenset, x0):
-    """(layout or ModeRows, frees) of a mode whose first pose is ``x0``: the rows of the
-    forward dynamics (:meth:`SwitchedModel.rows`), the locks holding what they held."""
+def _mode_rows(model: Model, sm: SwitchedModel, mode: frozenset, x0, first):
+    """(layout or ModeRows, candidates) of a mode whose first pose is ``x0``: the rows of
+    the forward dynamics (:meth:`SwitchedModel.rows`), the locks holding what they held,
+    and the order in which coordinates are tried as driven (``first``, the others, and
+    last those the mode's locks free)."""
     targets: dict = {}
-    for n in mode_locks(mode):
+    sticks = [f"{c}:stick" for c, s in mode_friction(mode).items() if s == "stick"]
+    for n in [*mode_locks(mode), *sticks]:
         sm.capture_target(n, x0, targets)
-    for c, s in mode_friction(mode).items():
-        if s == "stick":
-            sm.capture_target(f"{c}:stick", x0, targets)
     extra = sm.rows(mode, targets)
     lay = ModeRows(model, extra, mode) if extra else model.layout(frozenset())
-    frees = [f for n in mode_locks(mode) for f in sm.lock_frees(n)]
-    return lay, frees
+    late = {model.coordinate_index(f) for n in mode_locks(mode) for f in sm.lock_frees(n)
+            if f in model.coordinate_names}
+    return lay, sorted(dict.fromkeys([*first, *range(model.n_q)]), key=late.__contains__)
 
 
-def _candidates(model: Model, over_k, drive_coords, frees) -> list[int]:
-    order = ([] if over_k is None else [over_k]) + list(drive_coords) + list(range(model.n_q))
-    late = {model.coordinate_index(f) for f in frees if f in model.coordinate_names}
-    order = list(dict.fromkeys(order))
-    return [k for k in order if k not in late] + [k for k in order if k in late]
-
-
-def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
+def kinetostatics_switched(model: Model, trajectory, vs, *, over=None,
                            point=(0.0, 0.0), model_drives="replace",
                            reacting_loads=()) -> Kinetostatics:
     """Kinetostatics of a switched trajectory (called by
@@ -62,38 +55,36 @@ def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
     n = tt.size
     if n == 0:
         raise ValueError("no positions to analyse")
+    if len(vs.mode) != n:
+        raise ValueError("the trajectory's variable_structure record does not match its "
+                         f"samples ({len(vs.mode)} modes for {n} samples)")
     Q, Qd, Qdd = (np.asarray(getattr(trajectory, a), dtype=float).reshape(n, model.n_q)
                   for a in ("q", "qdot", "qddot"))
     X = getattr(trajectory, "x", None)
-    if X is None or np.shape(X) != (n, model.n_x):
+    if np.shape(X) != (n, model.n_x):
         raise ValueError("a switched trajectory needs its body poses x (n, n_x) to be "
                          "analysed mode by mode")
     X = np.asarray(X, dtype=float)
-    if isinstance(over, str):
-        over_k = model.coordinate_index(over)
-    elif over is None:
-        over_k = None
-    else:
+    if over is not None and not isinstance(over, str):
         raise ValueError("over= names one coordinate for a switched trajectory (the driven "
                          "coordinates are the independent ones of each mode)")
+    over_k = None if over is None else model.coordinate_index(over)
     sm = switched_model(model)
-    fm = force_model(model)
-    drive_coords = [k for _, k in fm.drives]
-    sample_modes = tuple(frozenset(m) for m in vs["mode"])
+    first = ([] if over_k is None else [over_k]) + [k for _, k in force_model(model).drives]
+    sample_modes = tuple(frozenset(m) for m in vs.mode)
     modes = tuple(dict.fromkeys(sample_modes))
     mode_index = np.array([modes.index(m) for m in sample_modes], int)
 
     parts = []
-    ends = list(itertools.accumulate(len(list(g)) for _, g in itertools.groupby(sample_modes)))
-    for a, b in zip([0, *ends[:-1]], ends, strict=True):
+    cuts = [0, *(np.flatnonzero(np.diff(mode_index)) + 1).tolist(), n]
+    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
         mode = sample_modes[a]
         seg = SimpleNamespace(t=tt[a:b], q=Q[a:b], qdot=Qd[a:b], qddot=Qdd[a:b], x=X[a:b])
         try:
-            lay, frees = _mode_rows(model, sm, mode, X[a])
+            lay, candidates = _mode_rows(model, sm, mode, X[a], first)
             res = _kinetostatics(model, trajectory=seg, point=point, model_drives=model_drives,
-                                 reacting_loads=reacting_loads, lay=lay,
-                                 candidates=_candidates(model, over_k, drive_coords, frees),
-                                 x_start=X[a])
+                                 reacting_loads=reacting_loads, lay=lay, candidates=candidates,
+                                 x_guess=X[a])
             parts.append((a, b, mode, res, None))
         except (MechdynError, np.linalg.LinAlgError) as exc:
             parts.append((a, b, mode, None, exc))
@@ -122,10 +113,12 @@ def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
     multipliers = nan(max([r.multipliers.shape[1] for r in done], default=0))
     driven = [c for c in names if any(c in r.driven for r in done)]
     joints = [j for j in model.joint_names if any(j in r.reactions for r in done)]
-    elements = list(dict.fromkeys(e for r in done for e in r.element_forces))
-    kinds = {j: r.joint_kinds[j] for r in done for j in r.reactions}
-    units = {e: r.element_units.get(e, "N") for r in done for e in r.element_forces}
-    redundant = sorted({j for r in done for j in r.redundant_joints})
+    loads = dict.fromkeys(k for r in done for k in r.frame_loads)
+    elements = dict.fromkeys(e for r in done for e in r.element_forces)
+    series = {attr: merged(attr, keys, *tail) for attr, keys, *tail in (
+        ("reactions", joints, 2), ("moments", joints), ("joint_frame", joints, 2),
+        ("joint_points", joints, 2), ("driving", driven), ("power", driven),
+        ("frame_loads", loads, 3), ("element_forces", elements))}
     warn: list[str] = []
     notes: list[str] = []
     seg_stats = []
@@ -144,35 +137,26 @@ def kinetostatics_switched(model: Model, trajectory, vs: dict, *, over=None,
         warn.extend(w for w in (f"mode {fmt_mode(mode)}: {w}" for w in r.warnings) if w not in warn)
         notes.extend(nt for nt in r.message.split("; ")[1:] if nt not in notes)
         info.update(driven=r.driven, status=r.status,
-                    power_balance_rel=r.stats["power_balance_rel"],
-                    rcond_min=r.stats["rcond_min"])
+                    **{k: r.stats[k] for k in ("power_balance_rel", "rcond_min")})
 
     statuses = {Status.PARTIAL if r is None else r.status for *_, r, _ in parts}
     status = next((s for s in (Status.PARTIAL, Status.SINGULAR_POSITION, Status.REDUNDANT)
                    if s in statuses), Status.SUCCESS)
     head = (f"{MESSAGES[status]} for a switched trajectory: {len(parts)} segment(s) in "
             f"{len(modes)} mode(s)")
-    stats = dict(positions=n, segments=seg_stats,
-                 seconds=time.perf_counter() - t_start,
-                 position_solves=int(sum(r.stats["position_solves"] for r in done)),
-                 power_balance_rel=max([r.stats["power_balance_rel"] for r in done],
-                                       default=float("nan")),
-                 rcond_min=min([r.stats["rcond_min"] for r in done], default=float("nan")),
-                 redundant_equations=max([r.stats["redundant_equations"] for r in done],
-                                         default=0),
-                 singular_positions=int(sum(r.stats["singular_positions"] for r in done)))
-    q = arrays["q"]
+    stats = dict(positions=n, segments=seg_stats, seconds=time.perf_counter() - t_start)
+    for key, agg, empty in (("position_solves", sum, 0), ("power_balance_rel", max, np.nan),
+                            ("rcond_min", min, np.nan), ("redundant_equations", max, 0),
+                            ("singular_positions", sum, 0)):
+        stats[key] = agg([r.stats[key] for r in done] or [empty])
     return Kinetostatics(
-        over=names[over_k], t=tt, values=q[:, over_k].copy(), **arrays, multipliers=multipliers,
-        coordinate_names=tuple(names), driven=tuple(driven),
-        reactions=merged("reactions", joints, 2), moments=merged("moments", joints),
-        joint_frame=merged("joint_frame", joints, 2),
-        joint_points=merged("joint_points", joints, 2), driving=merged("driving", driven),
-        power=merged("power", driven), frame_point=np.asarray(point, dtype=float).copy(),
-        frame_loads=merged("frame_loads", dict.fromkeys(k for r in done for k in r.frame_loads),
-                           3),
-        joint_kinds=kinds, mode=frozenset().union(*sample_modes),
-        redundant_joints=tuple(redundant), status=status, message="; ".join([head, *notes]),
-        warnings=tuple(warn), stats=stats, model=model,
-        element_forces=merged("element_forces", elements), element_units=units,
+        over=names[over_k], t=tt, values=arrays["q"][:, over_k].copy(), **arrays, **series,
+        multipliers=multipliers, coordinate_names=tuple(names), driven=tuple(driven),
+        frame_point=np.asarray(point, dtype=float).copy(),
+        joint_kinds={j: r.joint_kinds[j] for r in done for j in r.reactions},
+        mode=frozenset().union(*sample_modes),
+        redundant_joints=tuple(sorted({j for r in done for j in r.redundant_joints})),
+        status=status, message="; ".join([head, *notes]), warnings=tuple(warn), stats=stats,
+        model=model, element_units={e: r.element_units.get(e, "N") for r in done
+                                    for e in r.element_forces},
         sample_modes=sample_modes, mode_index=mode_index, modes=modes)

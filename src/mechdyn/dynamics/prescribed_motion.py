@@ -18,7 +18,7 @@ from scipy.optimize import least_squares
 
 from ..errors import AssemblyError, ModelError, SingularPositionError
 from ..kernels import rows_numpy
-from ..kinematics.assembly import _rank, _scale, joint_residuals
+from ..kinematics.assembly import _scale, joint_residuals
 from ..kinematics.branch_chart import ChartBook, PathProblem
 from ..kinematics.constraints import _point_kinematics, coordinates, coordinates_jacobian
 from ..kinematics.continuation import Kernel, _kernel, _march, _newton, _node
@@ -26,26 +26,19 @@ from ..kinematics.records import _refine_root
 from ..kinematics.sweep import DEFAULT_MAX_STEP, DEFAULT_MIN_STEP, _motion, _path, sweep
 from ..model import Model, as_model
 from ..model.rows import concat
+from .mode_system import _independent_rows
 
 __all__ = ["dead_centres", "ModeRows"]
 
-#: relative singular value below which constraint equations count as dependent
-REDUNDANT_RCOND = 1e-9
-
-
 class ModeRows:
     """The constraint rows of a variable-structure mode for kinetostatics: the joint
-    rows of the model, then the switchable rows of the mode (weld and coordinate
-    locks, closed stops, closed contacts and sticking contacts), the
-    :class:`~mechdyn.dynamics.modes.Row` objects of
-    :meth:`~mechdyn.dynamics.modes.SwitchedModel.rows` -- the rows of the
-    forward dynamics, :attr:`mechdyn.dynamics.modes.ModeSystem.rowset`.
+    rows of the model, then ``extra``, the switchable rows of the mode
+    (:meth:`~mechdyn.dynamics.modes.SwitchedModel.rows`, as in the forward dynamics).
 
     It stands in for a layout everywhere kinetostatics uses one (``rowset``,
     ``n_rows``, ``rows`` of the joints and weld locks, ``row_joint``, ``mode``);
-    ``extra`` are the switchable rows, ``elements`` the row indices of every
-    switchable element but the weld locks (which report as joints), ``row_is_angle``
-    whether each switchable row is in rad.
+    ``elements`` are the row indices of every switchable element but the weld locks
+    (which report as joints).
     """
 
     def __init__(self, model: Model, extra, mode):
@@ -55,32 +48,15 @@ class ModeRows:
         self.n_base = base.n_rows
         self.rowset = concat(model.n_bodies, model.joint_rows, *[r.rows for r in self.extra])
         self.n_rows = len(self.rowset)
-        self.rows = dict(base.rows)
-        self.elements: dict[str, list[int]] = {}
-        welds = set(model.lock.names)
         keys = [r.label if r.kind == "stick" else r.element for r in self.extra]
-        for k, (r, key) in enumerate(zip(self.extra, keys, strict=True)):
-            if r.element in welds:
-                self.rows[key] = np.append(self.rows.get(key, np.zeros(0, int)),
-                                           self.n_base + k)
-            else:
-                self.elements.setdefault(key, []).append(self.n_base + k)
         self.row_joint = np.array([*base.row_joint, *keys], dtype=object)
-        self.row_is_angle = self.rowset.is_angle[self.n_base:]
+        groups = {k: np.flatnonzero(self.row_joint == k) for k in dict.fromkeys(self.row_joint)}
+        joints = set(base.rows) | set(model.lock.names)
+        self.rows = {k: v for k, v in groups.items() if k in joints}
+        self.elements = {k: v for k, v in groups.items() if k not in joints}
         slip = [(self.n_base + k, r.friction_rows) for k, r in enumerate(self.extra) if r.slip]
         self.slip_rows = np.array([k for k, _ in slip], int)
         self.friction = concat(model.n_bodies, *[f for _, f in slip])
-
-
-def mode_jacobian(model: Model, x, lay, *, friction: bool = False) -> np.ndarray:
-    """Jacobian of every row of ``lay`` (a layout or :class:`ModeRows`), (..., n_rows, n_x).
-    With ``friction``, the rows of slipping contacts carry their Coulomb friction
-    (R - mu s T_x, the force direction of the row, as in
-    :meth:`mechdyn.dynamics.modes.ModeSystem.evaluate_x`)."""
-    J = rows_numpy.jacobian(lay.rowset, x)
-    if friction and isinstance(lay, ModeRows) and lay.slip_rows.size:
-        J[..., lay.slip_rows, :] += rows_numpy.jacobian(lay.friction, x)
-    return J
 
 
 def _steps(kern: Kernel, c: int, tol: float, counter: dict) -> dict:
@@ -91,15 +67,17 @@ def _steps(kern: Kernel, c: int, tol: float, counter: dict) -> dict:
             "min_step": DEFAULT_MIN_STEP * L, "tol": tol, "counter": counter}
 
 
-def _move(kern: Kernel, node, c: int, target: float, tol: float, counter: dict):
-    """March node's coordinate c to target (no chart book); raises where it stalls."""
-    if node.q[c] == target:
-        return node
-    nodes, stop = _march(kern, _node(kern, node.x, node.q, c), c, [target],
-                         **_steps(kern, c, tol, counter))
-    if stop is not None:
-        raise _error(kern, stop.q_try, stop.node.x)
-    return nodes[-1]
+def _move(kern: Kernel, node, q, cs, tol: float, counter: dict):
+    """March node's coordinates cs, one after the other, to their values in q (no chart
+    book); raises where it stalls."""
+    for c in cs:
+        if node.q[c] != q[c]:
+            nodes, stop = _march(kern, _node(kern, node.x, node.q, c), c, [q[c]],
+                                 **_steps(kern, c, tol, counter))
+            if stop is not None:
+                raise _error(kern, stop.q_try, stop.node.x)
+            node = nodes[-1]
+    return node
 
 
 def _start(kern: Kernel, q0, x_start, j: int, tol: float, counter: dict):
@@ -110,11 +88,8 @@ def _start(kern: Kernel, q0, x_start, j: int, tol: float, counter: dict):
     x, ok, _, J = _newton(kern, x_start, q_s, tol, max_iter=60)
     if ok:
         try:
-            node = _node(kern, x, q_s, j, J)
-            for c in range(len(q0)):
-                if c != j:
-                    node = _move(kern, node, c, q0[c], tol, counter)
-            return node
+            return _move(kern, _node(kern, x, q_s, j, J), q0,
+                         [c for c in range(len(q0)) if c != j], tol, counter)
         except (AssemblyError, SingularPositionError):
             pass
     x, ok, _, J = _newton(kern, x_start, q0, tol, max_iter=60)
@@ -153,18 +128,12 @@ def _error(kern: Kernel, qd, x):
 
 
 def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=None):
-    """Poses, velocities and accelerations with the driven coordinates ``didx`` following
-    qd, qd_dot, qd_ddot (n, n_d), on the kinematics continuation: the kernel of the rows
-    of ``lay`` (a layout or :class:`ModeRows`) then the driven coordinates' rows, one
-    batched Newton solve from the guesses x_guess (n, n_x) when it converges everywhere,
-    else the sweep's continuation (:func:`~mechdyn.kinematics.sweep._path`) from the pose
-    x_start along the one varying driven coordinate, through bifurcation positions with
-    a chart book, or through anchors reached coordinate by coordinate when several vary.
-
-    Returns x, xdot, xddot (n, n_x), the samples in a chart's zone (mask (n,), x', x''
-    along the varying coordinate) or None, and the stats ``position_solves`` and
-    ``bifurcations``."""
-    didx = np.asarray(didx, dtype=int)
+    """Poses, velocities and accelerations (n, n_x) with the driven coordinates ``didx``
+    following qd, qd_dot, qd_ddot (n, n_d): one batched Newton solve from the guesses
+    x_guess when it converges everywhere, else the sweep's continuation from x_start
+    (through bifurcation positions with a chart book), or through anchors when several
+    driven coordinates vary.  Also returns the charted samples (mask (n,), x', x'') or
+    None and the stats ``position_solves`` and ``bifurcations``."""
     kern = Kernel(model, lay, didx) if isinstance(lay, ModeRows) else _kernel(model, lay, didx)
     tol, n = 1e-12 * max(model.length_scale, 1e-3), len(qd)
     counter = {"coarse_steps": 0}
@@ -194,8 +163,7 @@ def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=N
             anchors = np.unique(np.r_[np.arange(0, n, max(1, n // 100)), n - 1])
             nodes = []
             for k in anchors:
-                for c in var:
-                    node = _move(kern, node, c, qd[k, c], tol, counter)
+                node = _move(kern, node, qd[k], var, tol, counter)
                 nodes.append(node)
             a = [nodes[i] for i in np.searchsorted(anchors, np.arange(n), "right") - 1]
             pred = np.array([nd.x + nd.B @ (qk - nd.q) for nd, qk in zip(a, qd, strict=True)])
@@ -204,15 +172,11 @@ def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=N
             system = (F, J, fac)
             ok &= fac[2] == np.array([nd.sign for nd in a])  # on the anchor's branch
             for k in np.flatnonzero(~ok):  # by continuation from the anchor
-                nd = a[k]
-                for c in var:
-                    nd = _move(kern, nd, c, qd[k, c], tol, counter)
-                x[k], system = nd.x, None
+                x[k], system = _move(kern, a[k], qd[k], var, tol, counter).x, None
     x, _, xdot, xddot, charted = _motion(kern, x, qd, qd_dot, qd_ddot, book, j, system,
                                          correct=False)
     # Newton solves: the continuation's steps and the batched solves
-    solves = counter["coarse_steps"] + (x_guess is not None) + (not guessed)
-    stats = {"position_solves": solves,
+    stats = {"position_solves": counter["coarse_steps"] + (x_guess is not None) + (not guessed),
              "bifurcations": book.report() if book is not None else []}
     return x, xdot, xddot, charted, stats
 
@@ -220,31 +184,23 @@ def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=N
 def _independent_subset(model, lay, x0, first: list[int], candidates=None) -> list[int]:
     """Extend ``first`` with coordinates that add rank, up to the DOF of the layout
     (``candidates``: the order in which the others are tried; default declared order)."""
-    sc = _scale(model)
-    P = mode_jacobian(model, x0, lay) * sc
-    G = coordinates_jacobian(model, x0) * sc
-    r_phi = _rank(P, REDUNDANT_RCOND)
-    dof = model.n_x - r_phi
-    chosen: list[int] = []
-
-    def adds_rank(k):
-        A = np.concatenate([P, G[chosen + [k]]])
-        return _rank(A, REDUNDANT_RCOND) == r_phi + len(chosen) + 1
-
-    for k in first:
-        if not adds_rank(k):
+    order = first + [k for k in (range(model.n_q) if candidates is None else candidates)
+                     if k not in first]
+    A = np.concatenate([rows_numpy.jacobian(lay.rowset, x0),
+                        coordinates_jacobian(model, x0)[order]]) * _scale(model)
+    keep = _independent_rows(A)
+    dof = model.n_x - int(np.sum(keep < lay.n_rows))
+    picked = [i - lay.n_rows for i in keep if i >= lay.n_rows]  # positions in order
+    for i, k in enumerate(first):
+        if i not in picked:
             raise ModelError(
                 f"coordinate {model.coordinate_names[k]!r} cannot be driven in mode "
                 f"{sorted(lay.mode)}: it is fixed by the other driven coordinates and the "
                 f"constraints ({dof} degree(s) of freedom)")
-        chosen.append(k)
-    for k in (range(model.n_q) if candidates is None else candidates):
-        if len(chosen) < dof and k not in chosen and adds_rank(k):
-            chosen.append(k)
-    if len(chosen) < dof:
+    if len(picked) < dof:
         raise ModelError(f"the mechanism has {dof} degrees of freedom in mode "
-                         f"{sorted(lay.mode)}, but only {len(chosen)} coordinates can be driven")
-    return chosen
+                         f"{sorted(lay.mode)}, but only {len(picked)} coordinates can be driven")
+    return [order[i] for i in picked]
 
 
 def dead_centres(mech_or_model, body: str, point, *, coordinate: str = "y",

@@ -11,16 +11,18 @@ import warnings as _warnings
 import numpy as np
 
 from ..errors import Status
+from ..kernels import rows_numpy
 from ..kinematics.assembly import SINGULAR_RCOND, _dependent_rows, _scale
 from ..kinematics.constraints import _perp, coordinates_jacobian, extend
 from ..model import ConstraintLayout, Model
 from .forces import applied_forces, cross, rotate
 from .inertia import inertia_forces
-from .prescribed_motion import REDUNDANT_RCOND, ModeRows, mode_jacobian
 
 __all__ = ["KinetostaticsWarning", "joint_reaction", "reaction_frame", "element_forces",
            "frame_forces", "touches_ground"]
 
+#: relative singular value below which constraint equations count as dependent
+REDUNDANT_RCOND = 1e-9
 #: rcond of the scaled inverse-dynamics matrix below which a position is reported
 #: as close to singular (a warning; the solve is still exact)
 NEAR_SINGULAR_RCOND = 1e-6
@@ -31,14 +33,11 @@ class KinetostaticsWarning(UserWarning):
 
 
 def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
-    """Number of dependent joint equations, the joints involved and row labels."""
-    if lay.n_rows == 0:
-        return 0, [], []
-    sc = _scale(model)
-    x = np.asarray(x, dtype=float).reshape(-1, model.n_x)
+    """Number of dependent joint equations at poses x (n, n_x), the joints involved and
+    row labels."""
     if x.shape[0] > 64:  # redundancy is structural: a sample of the positions suffices
         x = x[np.unique(np.linspace(0, x.shape[0] - 1, 64).astype(int))]
-    P = mode_jacobian(model, x, lay) * sc
+    P = rows_numpy.jacobian(lay.rowset, x) * _scale(model)
     s = np.linalg.svd(P, compute_uv=False)
     r = np.sum(s > REDUNDANT_RCOND * s[..., :1], axis=-1)
     n_red = int(lay.n_rows - r.min())
@@ -127,10 +126,9 @@ def element_forces(ms, x, lam) -> dict:
     model = ms.model
     R = ms.row_jacobian(x)
     lam = np.asarray(lam, float)
-    joints = model.mechanism.joints
     out: dict = {}
     for el, idx in ms.element_rows.items():
-        if el not in joints:
+        if el not in model.mechanism.joints:
             out[el] = lam[..., idx[0]] if lam.ndim > 1 else float(lam[idx[0]])
             continue
         gen = np.einsum("...rx,...r->...x", R[..., idx, :], lam[..., idx])
@@ -150,17 +148,14 @@ def frame_forces(ms, x, lam, point=None) -> dict:
     lam = np.asarray(lam, float)
     width = 2 if point is None else 3
     p = np.zeros(2) if point is None else np.asarray(point, float)
+    shape = lam.shape[:-1] + (width,)
     out: dict = {}
-    total = np.zeros(lam.shape[:-1] + (width,))
     for el, idx in ms.element_rows.items():
-        if el not in ms.grounded:
-            continue
-        gen = np.einsum("...rx,...r->...x", R[..., idx, :], lam[..., idx])
-        # Newton's third law: the frame gets the opposite of the force on the bodies
-        f = net_on_ground(ms.model, x, gen, p)[..., :width].reshape(total.shape)
-        out[el] = f
-        total = total + f
-    out["total"] = total
+        if el in ms.grounded:
+            gen = np.einsum("...rx,...r->...x", R[..., idx, :], lam[..., idx])
+            # Newton's third law: the frame gets the opposite of the force on the bodies
+            out[el] = net_on_ground(ms.model, x, gen, p)[..., :width].reshape(shape)
+    out["total"] = sum(out.values(), np.zeros(shape))
     return out
 
 
@@ -202,31 +197,26 @@ def net_on_ground(model: Model, x, D, point) -> np.ndarray:
 def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qdot, *,
              skip, reacting, point, charted=None) -> dict:
     """The batched inverse-dynamics solve and the reaction bookkeeping: the record fields
-    it gives (named as in :class:`~mechdyn.results.kinetostatics_record.Kinetostatics`),
-    ``tau`` (n, n_d), ``status``, ``warnings`` and ``stats``.
-
-    ``charted`` = (mask (n,), x' (m, n_x), x'' (m, n_x)): samples near a bifurcation
-    position, where the system is (nearly) singular but the branch goes on; with one
-    driven coordinate its torque there is the virtual work along the branch's tangent
-    x', tau = x'^T (I - F) (the reactions do no work along it), and these samples do
-    not count for the redundancy check."""
+    it gives (as named in ``Kinetostatics``), ``tau`` (n, n_d), ``status``, ``warnings``
+    and ``stats``.  ``charted`` = (mask (n,), x', x''): samples near a bifurcation, where
+    one driven coordinate's torque is the virtual work along the branch's tangent x',
+    tau = x'^T (I - F) (the reactions do no work along it)."""
     n = t.shape[0]
-    nb = model.n_bodies
     L = model.length_scale
     n_d = len(didx)
     warn: list[str] = []
     F, F_ground, Qd_loads = applied_forces(model, t, x, xdot, q, qdot, skip_drives=skip,
                                            reacting_loads=reacting)
     Ix = inertia_forces(model, x, xdot, xddot)
-    # (n, rows, n_x); slipping contacts' rows carry their friction
-    P = mode_jacobian(model, x, lay, friction=True)
+    P = rows_numpy.jacobian(lay.rowset, x)  # (n, rows, n_x)
+    if len(getattr(lay, "slip_rows", ())):  # slipping contacts' rows: R - mu s T_x
+        P[:, lay.slip_rows, :] += rows_numpy.jacobian(lay.friction, x)
     G = coordinates_jacobian(model, x)  # (n, n_q, n_x)
     Gd = G[:, didx, :]
     A = np.concatenate([-P, Gd], axis=1).transpose(0, 2, 1)  # (n, n_x, rows + n_d)
     rhs = Ix - F
     # balance units: moment equations / L; moment-like unknowns scaled by L
-    rs = np.ones(model.n_x)
-    rs[2::3] = 1.0 / L
+    rs = 1.0 / _scale(model)
     cs = np.where(np.concatenate([lay.rowset.is_angle, model.coord_is_angle[didx]]), L, 1.0)
     As = A * rs[:, None] * cs[None, :]
     bs = rhs * rs
@@ -242,11 +232,9 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
         z = np.linalg.solve(As, bs[..., None])[..., 0]
     else:
         z = (np.linalg.pinv(As, rcond=1e-10) @ bs[..., None])[..., 0]
-    resid = np.einsum("nij,nj->ni", As, z) - bs
-    scale_f = np.maximum(np.max(np.abs(bs), axis=-1), 1e-300)
-    bad = np.max(np.abs(resid), axis=-1) > 1e-6 * np.maximum(
-        scale_f, np.max(np.abs(As), axis=(1, 2)) * np.max(np.abs(z), axis=-1))
-    singular |= bad
+    resid = np.abs(np.einsum("nij,nj->ni", As, z) - bs).max(axis=-1)
+    singular |= resid > 1e-6 * np.maximum(np.maximum(np.abs(bs).max(axis=-1), 1e-300),
+                                          np.abs(As).max(axis=(1, 2)) * np.abs(z).max(axis=-1))
     z = z * cs
     lam = z[:, :lay.n_rows]
     tau = z[:, lay.n_rows:]
@@ -295,21 +283,20 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
         u = rotate(X[:, i, 2], model.pri.ui[model.pri.names.index(name)]
                    if kind == "prismatic" else (1.0, 0.0))
         jframe[name] = np.stack([np.sum(f * u, -1), np.sum(f * _perp(u), -1)], axis=-1)
-        if i == nb or j == nb:
+        if model.n_bodies in (i, j):  # attached to the ground
             frame_loads[name] = net_on_ground(model, x, gen, point)
 
     # ------------------------------------------------ switchable elements (modes.py rows)
     el_forces: dict[str, np.ndarray] = {}
     p_el = np.zeros(n)
-    if isinstance(lay, ModeRows):
-        for el, idx in lay.elements.items():
-            # the multiplier in the forward convention (M xddot = F + R^T lambda_m):
-            # the normal force of a stop or contact (>= 0), the torque/force of a
-            # coordinate lock on its measure, the tangential force of a sticking contact
-            el_forces[el] = -lam[:, idx[0]]
-            Del = C[:, idx, :].sum(axis=1)
-            p_el += np.einsum("nx,nx->n", Del, xdot)
-            frame_loads[el] = net_on_ground(model, x, Del, point)
+    for el, idx in getattr(lay, "elements", {}).items():
+        # the multiplier in the forward convention (M xddot = F + R^T lambda_m):
+        # the normal force of a stop or contact (>= 0), the torque/force of a
+        # coordinate lock on its measure, the tangential force of a sticking contact
+        el_forces[el] = -lam[:, idx[0]]
+        Del = C[:, idx, :].sum(axis=1)
+        p_el += np.einsum("nx,nx->n", Del, xdot)
+        frame_loads[el] = net_on_ground(model, x, Del, point)
 
     # ------------------------------------------------ drives' stator and ground-attached loads
     D = np.einsum("nd,ndx->nx", tau, Gd) + np.einsum("nq,nqx->nx", Qd_loads, G)
@@ -322,8 +309,7 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     p_in = (np.einsum("nd,nd->n", tau, qdot[:, didx]) + np.einsum("nx,nx->n", F, xdot)
             + p_el)
     p_kin = np.einsum("nx,nx->n", Ix, xdot)
-    p_scale = max(float(np.max(np.abs(p_kin))), float(np.max(np.abs(p_in))),
-                  float(np.max(np.abs(F * xdot))), 1e-300)
+    p_scale = max(np.abs(p_kin).max(), np.abs(p_in).max(), np.abs(F * xdot).max(), 1e-300)
     stats = {"power_balance_rel": float(np.max(np.abs(p_in - p_kin)) / p_scale),
              "rcond_min": float(np.min(rcond)), "redundant_equations": n_red,
              "singular_positions": int(singular.sum()),
