@@ -103,8 +103,8 @@ def test_load_histories_must_match():
         distribute(f, [1.0, 2.0], [1.0], [0.0, 0.0])
     with pytest.raises(ModelError, match="non-finite"):
         distribute(f, [np.nan], [1.0], [0.0])
-    with pytest.raises(ModelError, match="times must increase"):
-        mounted_response(f, [0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0])
+    with pytest.raises(ModelError, match="times must not decrease"):
+        mounted_response(f, [0.0, -1.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0])
     with pytest.raises(ModelError, match="start must be 'static' or 'rest'"):
         mounted_response(f, [0.0], [0.0], [0.0], [0.0], start="moving")
 

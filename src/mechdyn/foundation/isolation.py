@@ -235,7 +235,8 @@ def mounted_response(foundation: Foundation, t, Fx, Fy, M, point=(0.0, 0.0),
     foundation : Foundation
         With ``mass`` and ``inertia``.
     t : array_like, shape (n,)
-        Increasing times, s.
+        Times, s, not decreasing (a repeated time, as at a switching instant, is a jump
+        of the load).
     Fx, Fy, M : array_like, shape (n,)
         The load the machine exerts on its frame: N, N, N m about ``point``.
     point : (float, float)
@@ -250,8 +251,8 @@ def mounted_response(foundation: Foundation, t, Fx, Fy, M, point=(0.0, 0.0),
     Raises
     ------
     ModelError
-        ``mass`` or ``inertia`` missing, arrays of different lengths, times not
-        increasing, an unknown ``start``.
+        ``mass`` or ``inertia`` missing, arrays of different lengths, times that
+        decrease, an unknown ``start``.
 
     Examples
     --------
@@ -271,8 +272,8 @@ def mounted_response(foundation: Foundation, t, Fx, Fy, M, point=(0.0, 0.0),
     loads = [np.atleast_1d(np.asarray(v, float)) for v in (Fx, Fy, M)]
     if any(a.shape != t.shape for a in loads) or t.ndim != 1:
         raise ModelError("mounted_response: t, Fx, Fy and M must be 1-D of the same length")
-    if t.size > 1 and not np.all(np.diff(t) > 0):
-        raise ModelError("mounted_response: the times must increase")
+    if t.size > 1 and not np.all(np.diff(t) >= 0):
+        raise ModelError("mounted_response: the times must not decrease")
     com = foundation.com
     f = _shift(np.column_stack(loads), point, com)
     Mm = foundation.mass_matrix()

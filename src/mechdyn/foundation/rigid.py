@@ -96,21 +96,20 @@ class SupportLoads:
 
     def to_dataframe(self):
         """A pandas DataFrame, one row per sample: ``t_s``, the applied load
-        (``Fx_base_N``, ``Fy_base_N``, ``M_base_Nm``), and per support: bolts
-        ``V_<name>_N`` (shear), ``N_<name>_N`` (tension), ``clamp_<name>_N``;
-        isolators ``Fx_<name>_N``, ``Fy_<name>_N``."""
+        (``Fx_base_N``, ``Fy_base_N``, ``M_base_Nm``), and per support the forces it
+        passes to the floor, ``Fx_<name>_N`` (bolts: the shear ``V_<name>_N``) and
+        ``Fy_<name>_N`` (bolts: the axial share, uplift > 0), for bolts also the tension
+        ``N_<name>_N`` and the clamp force ``clamp_<name>_N``."""
         import pandas as pd
 
         cols = {"t_s": self.t, "Fx_base_N": self.applied[:, 0],
                 "Fy_base_N": self.applied[:, 1], "M_base_Nm": self.applied[:, 2]}
         for name in self.names:
+            cols[f"{'V' if name in self.tension else 'Fx'}_{name}_N"] = self.fx[name]
+            cols[f"Fy_{name}_N"] = self.fy[name]
             if name in self.tension:
-                cols[f"V_{name}_N"] = self.fx[name]
                 cols[f"N_{name}_N"] = self.tension[name]
                 cols[f"clamp_{name}_N"] = self.clamp[name]
-            else:
-                cols[f"Fx_{name}_N"] = self.fx[name]
-                cols[f"Fy_{name}_N"] = self.fy[name]
         return pd.DataFrame(cols)
 
     def summary(self) -> str:
