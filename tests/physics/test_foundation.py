@@ -78,6 +78,16 @@ def test_bolt_with_a_load_factor_is_in_equilibrium_and_opens_later():
     assert s.clamp["left"][-1] == pytest.approx(0.0, abs=1e-6)
 
 
+def test_the_weight_of_the_base_presses_on_the_bolts():
+    f = Foundation(_two_bolts().supports, mass=1000.0, inertia=80.0, com=(0.1, 0.5))
+    s = distribute(f, [0.0], [0.0], [0.0], gravity=(0.0, -9.81))
+    W = 1000.0 * 9.81
+    # the weight at x = 0.1 on bolts at -/+0.4: levers 0.5 and 0.3 of 0.8
+    assert s.fy["left"][0] == pytest.approx(-W * 0.3 / 0.8, rel=1e-12)
+    assert s.fy["right"][0] == pytest.approx(-W * 0.5 / 0.8, rel=1e-12)
+    assert s.clamp["right"][0] == pytest.approx(P + W * 0.5 / 0.8, rel=1e-12)
+
+
 def test_support_forces_add_up_to_the_load():
     rng = np.random.default_rng(7)
     f = Foundation([AnchorBolt("b1", -0.7, 0.05, 3e8, 1e8, preload=1e4),

@@ -101,6 +101,9 @@ def test_load_histories_must_match():
     f = Foundation([_bolt(), _bolt("b2", 0.4)], mass=500.0, inertia=80.0)
     with pytest.raises(ModelError, match="same length"):
         distribute(f, [1.0, 2.0], [1.0], [0.0, 0.0])
+    with pytest.raises(ModelError, match="weight of the base needs the foundation's mass"):
+        distribute(Foundation([_bolt(), _bolt("b2", 0.4)]), [0.0], [0.0], [0.0],
+                   gravity=(0.0, -9.81))
     with pytest.raises(ModelError, match="non-finite"):
         distribute(f, [np.nan], [1.0], [0.0])
     with pytest.raises(ModelError, match="times must not decrease"):

@@ -84,6 +84,9 @@ def register(sub) -> None:
                    help="their moment of inertia about their centre of mass, e.g. 80kg*m^2")
     p.add_argument("--com", default="0m,0m", metavar="X,Y",
                    help="their centre of mass (default 0m,0m)")
+    p.add_argument("--weight", action="store_true",
+                   help="add the weight of frame and base (--mass, the model's gravity) to "
+                        "the loads of the rigid base")
     p.add_argument("--rpm", metavar="SPEED",
                    help="running speed for the excitation orders, e.g. 300rpm (default: the "
                         "mean speed of the first angle coordinate over the run)")
@@ -169,7 +172,9 @@ def run(args) -> int:
         raise ModelError(f"--samples must be >= 2, got {args.samples}")
     mech, model = open_model(args)
     traj = simulate_from_args(model, args, args.samples)
-    loads = support_loads(foundation, traj)
+    if args.weight and foundation.mass is None:
+        raise ModelError("--weight needs --mass (and --inertia)")
+    loads = support_loads(foundation, traj, gravity=model.gravity if args.weight else None)
     print(f"{mech.name}: loads on {len(foundation.supports)} supports over t = "
           f"{loads.t[0]:.6g} .. {loads.t[-1]:.6g} s (rigid base)")
     print(loads.summary())
@@ -186,7 +191,7 @@ def run(args) -> int:
                   + ", ".join(f"{k * rpm / 60:.4g}" for k in orders) + " Hz")
             for w in warnings:
                 print(f"  warning: {w}")
-        a = loads.applied
+        a = loads.applied  # with --weight, a constant: a static deflection and floor force
         mounted = mounted_response(foundation, loads.t, a[:, 0], a[:, 1], a[:, 2],
                                    point=loads.point)
         print(f"  force to the floor: peak {np.max(np.hypot(a[:, 0], a[:, 1])) / 1e3:.4g} kN "

@@ -151,7 +151,8 @@ def bolt_forces(bolt: AnchorBolt, share) -> tuple[np.ndarray, np.ndarray]:
     return np.where(open_, s, P + phi * s), np.where(open_, 0.0, clamp)
 
 
-def distribute(foundation: Foundation, Fx, Fy, M, point=(0.0, 0.0), t=None) -> SupportLoads:
+def distribute(foundation: Foundation, Fx, Fy, M, point=(0.0, 0.0), t=None,
+               gravity=None) -> SupportLoads:
     """Share a load history on the rigid base among the supports, by stiffness.
 
     Parameters
@@ -165,17 +166,22 @@ def distribute(foundation: Foundation, Fx, Fy, M, point=(0.0, 0.0), t=None) -> S
         The point of ``M``, m.
     t : array_like, shape (n,), optional
         Times, s (default 0, 1, 2, ...).
+    gravity : (float, float), optional
+        Add the weight of the frame and base, ``foundation.mass`` times this (m/s^2, e.g.
+        ``(0, -9.81)``), at ``foundation.com`` (default: not added).
 
     Returns
     -------
     SupportLoads
         Force per support passed to the floor (see the module's sign convention); their
-        sum is (Fx, Fy) and their moment about ``point`` is M, to round-off.
+        sum is the load (Fx, Fy) and their moment about ``point`` is M (weight included),
+        to round-off.
 
     Raises
     ------
     ModelError
-        Arrays of different lengths or non-finite values.
+        Arrays of different lengths or non-finite values; ``gravity`` without
+        ``foundation.mass``.
 
     Examples
     --------
@@ -202,6 +208,8 @@ def distribute(foundation: Foundation, Fx, Fy, M, point=(0.0, 0.0), t=None) -> S
         raise ModelError("distribute: the load history has non-finite values (a run that "
                          "stopped early? drop its NaN rows)")
     point = np.asarray(point, float)
+    if gravity is not None:
+        load = load + _weight(foundation, gravity, point)
     u = np.linalg.solve(foundation.stiffness_matrix(point), load.T).T  # (n, 3)
     T = support_matrix(foundation.supports, point)
     f = np.einsum("sk,ski,ni->nsk", foundation.stiffnesses(), T, u)  # (n, s, 2)
@@ -215,11 +223,24 @@ def distribute(foundation: Foundation, Fx, Fy, M, point=(0.0, 0.0), t=None) -> S
                         clamp=clamp, applied=load, point=point)
 
 
+def _weight(foundation: Foundation, gravity, point) -> np.ndarray:
+    """(Fx, Fy, M about ``point``) of the weight of the frame and base, shape (3,)."""
+    if foundation.mass is None:
+        raise ModelError("distribute: the weight of the base needs the foundation's mass")
+    g = np.asarray(gravity, float)
+    if g.shape != (2,) or not np.all(np.isfinite(g)):
+        raise ModelError(f"distribute: gravity must be a finite (gx, gy) in m/s^2, got "
+                         f"{gravity!r}")
+    W = foundation.mass * g
+    arm = np.asarray(foundation.com) - point
+    return np.array([W[0], W[1], arm[0] * W[1] - arm[1] * W[0]])
+
+
 def _same_length(*arrays) -> bool:
     return len({np.atleast_1d(np.asarray(a, float)).shape for a in arrays}) == 1
 
 
-def support_loads(foundation: Foundation, source, point=None) -> SupportLoads:
+def support_loads(foundation: Foundation, source, point=None, gravity=None) -> SupportLoads:
     """The loads of every support over a run: :func:`distribute` of its frame loads.
 
     Parameters
@@ -231,6 +252,9 @@ def support_loads(foundation: Foundation, source, point=None) -> SupportLoads:
     point : (float, float), optional
         The point of ``M_frame_Nm``, m (default: the record's ``frame_point``, else the
         ground origin; give the ``point`` of ``simulate(..., point=...)`` if one was used).
+    gravity : (float, float), optional
+        Add the weight of the frame and base (see :func:`distribute`), e.g. the model's
+        ``gravity``.
 
     Returns
     -------
@@ -251,4 +275,4 @@ def support_loads(foundation: Foundation, source, point=None) -> SupportLoads:
     ('R', 0.5)
     """
     h = frame_loads(source, point)
-    return distribute(foundation, h.Fx, h.Fy, h.M, point=h.point, t=h.t)
+    return distribute(foundation, h.Fx, h.Fy, h.M, point=h.point, t=h.t, gravity=gravity)
