@@ -3,19 +3,13 @@ bolts or isolators (rigid frame), and the frame on elastic mounts (natural frequ
 transmissibility, the response to a frame-load history).  See ``docs/foundation.md``."""
 
 from .frame_loads import FrameLoads, frame_loads
-from .isolation import (
-    ExcitationWarning,
-    Modes,
-    MountedResponse,
-    excitation_warnings,
-    mounted_response,
-    natural_frequencies,
-    transmissibility,
-)
+from .isolation import transmissibility
+from .modes import ExcitationWarning, Modes, excitation_warnings, natural_frequencies
+from .response import MountedResponse, mounted_response
 from .rigid import SupportLoads, bolt_forces, distribute, support_loads
-from .supports import AnchorBolt, Foundation, Isolator, support_matrix
+from .supports import AnchorBolt, Foundation, Isolator, shift_moment, support_matrix
 
-__all__ = ["AnchorBolt", "Isolator", "Foundation", "support_matrix", "SupportLoads",
-           "distribute", "bolt_forces", "support_loads", "FrameLoads", "frame_loads",
-           "Modes", "natural_frequencies", "transmissibility", "MountedResponse",
-           "mounted_response", "ExcitationWarning", "excitation_warnings"]
+__all__ = ["AnchorBolt", "Isolator", "Foundation", "support_matrix", "shift_moment",
+           "SupportLoads", "distribute", "bolt_forces", "support_loads", "FrameLoads",
+           "frame_loads", "Modes", "natural_frequencies", "transmissibility",
+           "MountedResponse", "mounted_response", "ExcitationWarning", "excitation_warnings"]

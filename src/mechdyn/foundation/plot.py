@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..results.figure import figure, save
-from .isolation import MountedResponse
+from .response import MountedResponse
 from .rigid import SupportLoads
 
 __all__ = ["plot_support_loads"]

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..errors import ModelError
 from .frame_loads import frame_loads
-from .supports import AnchorBolt, Foundation, support_matrix
+from .supports import AnchorBolt, Foundation, shift_moment, support_matrix
 
 __all__ = ["SupportLoads", "distribute", "bolt_forces", "support_loads"]
 
@@ -231,9 +231,7 @@ def _weight(foundation: Foundation, gravity, point) -> np.ndarray:
     if g.shape != (2,) or not np.all(np.isfinite(g)):
         raise ModelError(f"distribute: gravity must be a finite (gx, gy) in m/s^2, got "
                          f"{gravity!r}")
-    W = foundation.mass * g
-    arm = np.asarray(foundation.com) - point
-    return np.array([W[0], W[1], arm[0] * W[1] - arm[1] * W[0]])
+    return shift_moment([*(foundation.mass * g), 0.0], foundation.com, point)
 
 
 def _same_length(*arrays) -> bool:

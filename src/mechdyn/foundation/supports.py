@@ -24,22 +24,37 @@ import numpy as np
 
 from ..errors import ModelError
 
-__all__ = ["AnchorBolt", "Isolator", "Foundation", "support_matrix"]
+__all__ = ["AnchorBolt", "Isolator", "Foundation", "support_matrix", "shift_moment"]
 
 
-def _check(owner: str, **values: float) -> list[str]:
-    """Problems of the fields ``values`` of ``owner``: each must be finite and positive."""
-    problems = []
-    for key, value in values.items():
-        if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
-            problems.append(f"{owner}: {key} must be a finite positive number, got {value!r}")
-    return problems
+def _problems(owner: str, strict: bool, unit: str, **values) -> list[str]:
+    """The fields of ``owner`` among ``values`` that are not finite numbers > 0 (``strict``)
+    or >= 0 (``unit`` names what is expected, e.g. "force >= 0 N")."""
+    return [f"{owner}: {key} must be a finite {unit}, got {value!r}"
+            for key, value in values.items()
+            if not (isinstance(value, int | float) and not isinstance(value, bool)
+                    and math.isfinite(value) and (value > 0 if strict else value >= 0))]
 
 
-def _finite(owner: str, **values: float) -> list[str]:
+def _finite(owner: str, **values) -> list[str]:
     return [f"{owner}: {key} must be a finite number, got {value!r}"
             for key, value in values.items()
             if not (isinstance(value, int | float) and math.isfinite(value))]
+
+
+def shift_moment(F, point, to) -> np.ndarray:
+    """Loads (..., 3) = (Fx, Fy, M about ``point``) with the moment taken about ``to``
+    (real, or complex amplitudes).
+
+    Examples
+    --------
+    >>> shift_moment([0.0, 10.0, 0.0], (1.0, 0.0), (0.0, 0.0)).tolist()
+    [0.0, 10.0, 10.0]
+    """
+    out = np.array(F, dtype=np.result_type(np.asarray(F), float))  # complex stays complex
+    d = np.asarray(point, float) - np.asarray(to, float)
+    out[..., 2] += d[0] * out[..., 1] - d[1] * out[..., 0]
+    return out
 
 
 @dataclass(frozen=True)
@@ -85,12 +100,10 @@ class AnchorBolt:
 
     def __post_init__(self):
         who = f"anchor bolt {self.name!r}"
-        problems = _finite(who, x=self.x, y=self.y) + _check(
-            who, k_axial=self.k_axial, k_shear=self.k_shear)
-        if not (isinstance(self.preload, int | float) and math.isfinite(self.preload)
-                and self.preload >= 0):
-            problems.append(f"{who}: preload must be a finite force >= 0 N, got "
-                            f"{self.preload!r}")
+        problems = (_finite(who, x=self.x, y=self.y)
+                    + _problems(who, True, "positive number", k_axial=self.k_axial,
+                                k_shear=self.k_shear)
+                    + _problems(who, False, "force >= 0 N", preload=self.preload))
         if self.load_factor is not None and not 0.0 <= self.load_factor <= 1.0:
             problems.append(f"{who}: load_factor must be in [0, 1], got {self.load_factor!r}")
         if problems:
@@ -143,12 +156,9 @@ class Isolator:
 
     def __post_init__(self):
         who = f"isolator {self.name!r}"
-        problems = _finite(who, x=self.x, y=self.y) + _check(who, kx=self.kx, ky=self.ky)
-        for key in ("cx", "cy"):
-            value = getattr(self, key)
-            if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
-                problems.append(f"{who}: {key} must be a finite damping >= 0 N*s/m, got "
-                                f"{value!r}")
+        problems = (_finite(who, x=self.x, y=self.y)
+                    + _problems(who, True, "positive number", kx=self.kx, ky=self.ky)
+                    + _problems(who, False, "damping >= 0 N*s/m", cx=self.cx, cy=self.cy))
         if problems:
             raise ModelError(problems)
 
@@ -236,12 +246,9 @@ class Foundation:
             if name in seen:
                 problems.append(f"foundation: support name {name!r} is used twice")
             seen.add(name)
-        for key in ("mass", "inertia"):
-            value = getattr(self, key)
-            if value is not None and not (isinstance(value, int | float)
-                                          and math.isfinite(value) and value > 0):
-                problems.append(f"foundation: {key} must be a finite positive number, got "
-                                f"{value!r}")
+        problems += _problems("foundation", True, "positive number", **{
+            key: getattr(self, key) for key in ("mass", "inertia")
+            if getattr(self, key) is not None})
         if len(self.com) != 2 or not all(math.isfinite(v) for v in self.com):
             problems.append(f"foundation: com must be a finite (x, y) in m, got {self.com!r}")
         if problems:
