@@ -210,3 +210,21 @@ def test_a_real_run_through_support_loads():
     df = tr.to_dataframe()
     np.testing.assert_allclose(h.Fy, df["Fy_frame_N"])
     assert np.ptp(h.Fy) > 0  # the run does load its frame
+
+
+def test_a_kinetostatics_record_brings_its_own_point():
+    point = (0.2, 0.1)
+    model = md.examples.load("slider_crank").compile()
+    tr = md.simulate(model, 0.02, t_eval=np.linspace(0, 0.02, 21), progress=False)
+    ks = md.kinetostatics(model, trajectory=tr, point=point)
+    f = _two_bolts()
+    s = support_loads(f, ks)  # the moment about ks.frame_point, taken from the record
+    np.testing.assert_allclose(s.point, point)
+    moment = sum((sp.x - point[0]) * s.fy[sp.name] - (sp.y - point[1]) * s.fx[sp.name]
+                 for sp in f.supports)
+    np.testing.assert_allclose(moment, ks.frame_moment, rtol=0,
+                               atol=1e-12 * np.max(np.abs(ks.frame_force)))
+    # the same loads as from the run's own frame columns about the origin
+    about_origin = support_loads(f, tr)
+    for name in f.names:
+        np.testing.assert_allclose(s.fy[name], about_origin.fy[name], rtol=1e-9, atol=1e-6)
