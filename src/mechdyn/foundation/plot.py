@@ -34,8 +34,8 @@ def plot_support_loads(loads: SupportLoads, path, mounted: MountedResponse | Non
     -------
     Path
     """
-    n = 4 if mounted is None else 5
-    fig, ax = figure(n, height=2.2)
+    bolts = bool(loads.tension)
+    fig, ax = figure(3 + bolts + (mounted is not None), height=2.2)
     t = loads.t
     a = loads.applied
     ax[0].plot(t, a[:, 0] * _KN, label="Fx")
@@ -51,22 +51,22 @@ def plot_support_loads(loads: SupportLoads, path, mounted: MountedResponse | Non
         ax[2].plot(t, loads.fx[name] * _KN, label=name)
         if bolt:
             ax[3].plot(t, loads.clamp[name] * _KN, label=name)
-    ax[1].set_ylabel("bolt tension /\nvertical force (kN)")
-    ax[2].set_ylabel("shear / horizontal\nforce (kN)")
-    ax[3].set_ylabel("clamp force (kN)")
-    ax[3].axhline(0.0, color="k", lw=0.8)
-    opening = loads.first_opening
-    if opening is not None:
-        ax[3].axvline(opening[1], color="r", ls="--", lw=1.0,
-                      label=f"{opening[0]} opens, {opening[1]:.4g} s")
+    ax[1].set_ylabel("bolt tension /\nvertical force (kN)" if bolts else "vertical force (kN)")
+    ax[2].set_ylabel("shear / horizontal\nforce (kN)" if bolts else "horizontal force (kN)")
+    if bolts:
+        ax[3].set_ylabel("clamp force (kN)")
+        ax[3].axhline(0.0, color="k", lw=0.8)
+        opening = loads.first_opening
+        if opening is not None:
+            ax[3].axvline(opening[1], color="r", ls="--", lw=1.0,
+                          label=f"{opening[0]} opens, {opening[1]:.4g} s")
     if mounted is not None:
-        ax[4].plot(t, np.hypot(a[:, 0], a[:, 1]) * _KN, label="rigid frame")
-        ax[4].plot(mounted.t, np.hypot(mounted.floor[:, 0], mounted.floor[:, 1]) * _KN,
-                   label="on the mounts")
-        ax[4].set_ylabel("|force to floor| (kN)")
-    for k in range(1, n):
-        if ax[k].lines:
-            ax[k].legend(loc="upper right", fontsize="small")
+        ax[-1].plot(t, np.hypot(a[:, 0], a[:, 1]) * _KN, label="rigid frame")
+        ax[-1].plot(mounted.t, np.hypot(mounted.floor[:, 0], mounted.floor[:, 1]) * _KN,
+                    label="on the mounts")
+        ax[-1].set_ylabel("|force to floor| (kN)")
+    for panel in ax[1:]:
+        panel.legend(loc="upper right", fontsize="small")
     ax[-1].set_xlabel("t (s)")
     fig.suptitle("loads on the supports")
     return save(fig, Path(path), dpi)

@@ -268,7 +268,7 @@ class Foundation:
             return
         ux, uy, th = v[:, 0] / scale
         if abs(th) > 1e-9 * max(abs(ux), abs(uy)):
-            free = f"rotation about ({-uy / th:.6g}, {ux / th:.6g}) m"
+            free = f"rotation about ({-uy / th + 0.0:.6g}, {ux / th + 0.0:.6g}) m"
         else:
             free = f"translation along ({ux / math.hypot(ux, uy):.3g}, " \
                    f"{uy / math.hypot(ux, uy):.3g})"
