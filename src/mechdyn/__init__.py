@@ -28,6 +28,15 @@ from .errors import (
                                  Status,
                                  UnitError,
 )
+from .foundation import (
+                                 AnchorBolt,
+                                 Foundation,
+                                 Isolator,
+                                 mounted_response,
+                                 natural_frequencies,
+                                 support_loads,
+                                 transmissibility,
+)
 from .kinematics.sweep import KinematicPoint, KinematicSweep, SweepSummary, analyze, sweep
 from .mechanism import (
                                  Body,
@@ -70,6 +79,9 @@ __all__ = [
     "kinetostatics", "Kinetostatics", "Status",
     "reduce_model", "Reduction", "run_reduced", "steady_state", "SteadyCycle", "size_flywheel",
     "FlywheelSizing", "startup",
+    # supports: the loads a machine sends into its building
+    "Foundation", "AnchorBolt", "Isolator", "support_loads", "transmissibility",
+    "natural_frequencies", "mounted_response",
     # errors
     "MechdynError", "ModelError", "UnitError", "AssemblyError", "SingularPositionError",
     "BranchJumpError", "LockupError", "IntegrationError",
