@@ -171,18 +171,25 @@ def test_without_a_spring_the_ram_falls_into_a_singular_position(mech):
     assert abs(run.t[-1] - 0.05682) < 2e-5
     phi, psi = np.rad2deg(run.q[-1])
     assert abs(phi - 54.98) < 0.01 and abs(psi + 67.50) < 0.01
+    assert abs(run.qdot[-1, 0] - 7.13) < 0.01
+    x_c = run.to_dataframe()["x_slider_m"].iloc[-1]
+    assert abs(x_c + 2.87e-3) < 1e-5
     a, b, _, _ = points(*run.q[-1])
     assert abs(b[0] - a[0]) < 1e-5           # the rod A-B normal to the ram axis
 
 
-def _table():
-    """Rows of the results table of docs/paper-press.md: (variant, run) -> numbers."""
-    rows = {}
+def _rows(n_cells):
+    """Rows of n_cells cells of the tables of docs/paper-press.md whose third cell is a
+    number (the results table has 6 cells, the one-change-at-a-time table 7)."""
     for line in PAGE.read_text(encoding="utf-8").splitlines():
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if len(cells) == 6 and re.fullmatch(r"-?\d+\.\d+", cells[2]):
-            rows[cells[0].strip("`"), cells[1]] = [float(c) for c in cells[2:]]
-    return rows
+        if len(cells) == n_cells and re.fullmatch(r"-?\d+\.\d+", cells[3]):
+            yield cells
+
+
+def _table():
+    """The results table: (variant, run) -> phi, psi (deg), omega1, omega3 (rad/s)."""
+    return {(c[0].strip("`"), c[1]): [float(v) for v in c[2:]] for c in _rows(6)}
 
 
 RUNS = {"Wilson, N = 40": dict(integrator="wilson", steps=N),
@@ -198,4 +205,43 @@ def test_the_numbers_of_the_page_are_the_code_s():
         for label, options in RUNS.items():
             run = mechdyn.simulate(mech, T_END, progress=False, **options)
             got = [*np.rad2deg(run.q[-1]), *run.qdot[-1]]
-            np.testing.assert_allclose(got, rows[name, label], rtol=0, atol=6e-4)
+            np.testing.assert_allclose(got, rows[name, label], rtol=0, atol=6e-5)
+
+
+def _variant(masses, drive, ram):
+    """clutchless_press with the lumped or mid-length bodies, the motor of the lumped
+    file or 34.5 N m, the ram free or on the 1e7 N/m spring of clutchless_press_paper."""
+    from mechdyn.examples.paper_case import press_idle
+    lumped = mechdyn.examples.load("clutchless_press_lumped")
+    mech = mechdyn.examples.load("clutchless_press")
+    if masses == "lumped":
+        mech.bodies.update(lumped.bodies)
+    press_idle(mech, support_stiffness=1e7 if ram == "spring" else None)
+    if drive == "motor":
+        mech.drives[:] = lumped.drives
+    return mech
+
+
+def test_one_change_at_a_time():
+    rows = list(_rows(7))
+    assert len(rows) == 8
+    for masses, drive, ram, *numbers, end in rows:
+        run = mechdyn.simulate(_variant(masses, drive, ram), T_END, integrator="dop853",
+                               rtol=1e-10, progress=False)
+        got = [*np.rad2deg(run.q[-1]), run.qdot[-1, 0]]
+        np.testing.assert_allclose(got, [float(v) for v in numbers], rtol=0, atol=6e-3)
+        if end == "0.05 s":
+            assert run.success, run.message
+        else:
+            assert run.status == "singular-position"
+            assert abs(run.t[-1] - float(end.split()[2])) < 6e-5
+
+
+def test_the_prose_numbers(converged):
+    assert abs(crank_torque(OMEGA0) / RATIO - 10.21) < 0.005
+    assert abs(crank_torque(np.linspace(0, OMEGA0, 4351)).max() - 75.8) < 0.05
+    assert abs(crank_torque(43.0) - crank_torque(44.0) - 11.4) < 0.05
+    df = converged.to_dataframe()
+    assert abs(df["x_slider_m"].iloc[-1] - 6.6e-3) < 5e-5
+    assert abs(df["phi_dot_rad_s"].max() - 47.0) < 0.05
+    assert abs(2 * math.pi * math.sqrt(M4 / 1e7) - 0.020) < 5e-4
