@@ -10,7 +10,8 @@ from mechdyn.errors import ModelError
 from mechdyn.kinematics import solve_position
 from mechdyn.kinematics.constraints import point_position
 
-NAMES = ["andrews_squeezer", "bolt_buffer", "clutchless_press", "clutchless_press_paper",
+NAMES = ["andrews_squeezer", "bolt_buffer", "clutchless_press", "clutchless_press_lumped",
+         "clutchless_press_paper",
          "four_bar", "press_cycle", "slider_crank", "toggle_press"]
 
 
@@ -23,7 +24,8 @@ def test_every_example_is_listed_with_a_description():
 def test_unknown_example_lists_the_names():
     with pytest.raises(ModelError, match="unknown example 'fourbar'; valid example names: "
                                          "'andrews_squeezer', 'bolt_buffer', 'clutchless_press', "
-                                         "'clutchless_press_paper', 'four_bar'"):
+                                         "'clutchless_press_lumped', 'clutchless_press_paper', "
+                                         "'four_bar'"):
         examples.path("fourbar")
     assert examples.path("four_bar.toml") == examples.path("four_bar")
 
