@@ -252,7 +252,7 @@ class ModeEquations:
             if win is not None:
                 s = win.centre + np.sign(s - win.centre) * win.window
         if win is not None:
-            self._reset(win.evaluate(s)[0])
+            self.reset(win.evaluate(s)[0])
         return None
 
     def _watch(self, s: float) -> BranchChart | None:
@@ -266,7 +266,8 @@ class ModeEquations:
         ch = self.book.watch(s, x)
         return ch if ch is not None and ch.in_zone(s) else None
 
-    def _reset(self, x) -> None:
+    def reset(self, x) -> None:
+        """Restart the Newton continuation from the pose ``x`` (n_x,)."""
         self.ms.ws.reset(x)
         if self.kernel is not None:
             self.kernel.reset(x)
@@ -274,7 +275,7 @@ class ModeEquations:
     def _chart_eval(self, ch: BranchChart, t, qi, qdi) -> ModeEval:
         qd = np.asarray(qdi, float).reshape(-1)
         x, xs, xss = ch.evaluate(float(np.asarray(qi, float).reshape(-1)[0]))
-        self._reset(x)
+        self.reset(x)
         return self.ms.evaluate_x(t, x, xs * qd[0], xs[:, None], b=xss * qd[0] ** 2)
 
     def _chart_rhs(self, ch, t, qi, qdi):
