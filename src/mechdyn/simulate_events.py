@@ -35,7 +35,7 @@ import time
 
 import numpy as np
 
-from .dynamics.contact import touching
+from .dynamics.contact import gaps, touching
 from .dynamics.dead_position import diagnose, status_of, turning_point
 from .dynamics.lagrange import kinetic_energy
 from .dynamics.mode_equations import ModeEquations
@@ -65,7 +65,6 @@ from .integrate.segment import (
     user_event_records,
 )
 from .kernels import rows_numpy as RN
-from .kinematics.constraints import extend
 from .model import Model
 from .model.workspace import Workspace
 from .progress import Progress
@@ -196,23 +195,20 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         x = ms.solve_position(q_init[ms.coords], x, t=t)
         # rates: given for the independent coordinates of the mode with every
         # touching stop and contact closed (the rest are dependent there)
-        touch0 = touching(sm, ms, x, gap_tol=gap_tol)
+        touch0 = touching(sm, x, gap_tol=gap_tol)
         ms_t = ModeSystem(sm, locks | frozenset(touch0), targets, x, workspace=ws) \
             if touch0 else ms
         B, _ = ms_t.velocity_analogs(x)
         xd = B @ qd_init[ms_t.coords]
-        X = extend(model, x)
-        for n, (st, meas) in sm.stops.items():
-            v = meas.value(X)
-            tol = gap_tol if not meas.is_angle else gap_tol / L
-            if (st.lower is not None and v < st.lower - tol) or (
-                    st.upper is not None and v > st.upper + tol):
-                raise ModelError(f"stop {n!r}: the initial state violates its limits "
-                                 f"({meas.label} = {v:.9g}, lower {st.lower}, upper {st.upper})")
-        for n, (_ct, gap, _) in sm.contacts.items():
-            if gap.value(X) < -gap_tol:
-                raise ModelError(f"contact {n!r}: the initial state penetrates by "
-                                 f"{-gap.value(X):.3g} m")
+        for tok, (g, is_angle) in gaps(sm, x).items():
+            n, side = tok.split("@")
+            if g >= -(gap_tol / L if is_angle else gap_tol):
+                continue
+            if side == "contact":
+                raise ModelError(f"contact {n!r}: the initial state penetrates by {-g:.3g} m")
+            st, meas = sm.stops[n]
+            raise ModelError(f"stop {n!r}: the initial state violates its limits ({meas.label} "
+                             f"= {meas.value(x):.9g}, lower {st.lower}, upper {st.upper})")
         if sm.has_switching:  # the mode the state is in: touching stops and contacts
             ms, x, xd, _ = apply_switch(sm, t, ms, x, xd, targets, events, fired=[],
                                         small_velocity=small_velocity, gap_tol=gap_tol,
@@ -407,18 +403,7 @@ def _budget(step, ev, ms, stats, span, min_step, max_steps, fixed_step) -> None:
 
 def _penetration(sm: SwitchedModel, x) -> float:
     """Largest penetration of a stop (lengths only) or contact over poses x (n, n_x), m."""
-    worst = 0.0
-    for _n, (st, meas) in sm.stops.items():
-        if meas.is_angle:
-            continue
-        v = RN.values(meas.rows, x)[..., 0]
-        if st.lower is not None:
-            worst = max(worst, float(np.max(st.lower - v)))
-        if st.upper is not None:
-            worst = max(worst, float(np.max(v - st.upper)))
-    for _n, (_ct, gap, _) in sm.contacts.items():
-        worst = max(worst, float(np.max(-RN.values(gap.rows, x)[..., 0])))
-    return worst
+    return max([0.0] + [float(np.max(-g)) for g, angle in gaps(sm, x).values() if not angle])
 
 
 # ============================================================================ output

@@ -178,19 +178,23 @@ def row_terms(ms: ModeSystem, rows: list[Row], x, xdot, B, b):
     return g @ B, gw @ B, g @ b + quad
 
 
-def touching(sm: SwitchedModel, ms: ModeSystem, x, *, gap_tol: float) -> list[str]:
-    """Unilateral tokens whose gap is within ``gap_tol`` (m, or rad for angle stops)."""
-    out = []
+def gaps(sm: SwitchedModel, x) -> dict:
+    """``{token: (gap, is_angle)}`` of every stop side and contact at poses x (..., n_x):
+    m, or rad for angle stops, negative where it penetrates."""
+    out = {}
     for n, (st, meas) in sm.stops.items():
-        v = meas.value(x)
-        if st.lower is not None and v - st.lower <= gap_tol:
-            out.append(f"{n}@lower")
-        if st.upper is not None and st.upper - v <= gap_tol:
-            out.append(f"{n}@upper")
+        v = rows_numpy.values(meas.rows, x)[..., 0]
+        for side in st.sides():
+            out[f"{n}@{side}"] = (v - st.lower if side == "lower" else st.upper - v,
+                                  meas.is_angle)
     for n, (_ct, gap, _) in sm.contacts.items():
-        if gap.value(x) <= gap_tol:
-            out.append(f"{n}@contact")
+        out[f"{n}@contact"] = (rows_numpy.values(gap.rows, x)[..., 0], False)
     return out
+
+
+def touching(sm: SwitchedModel, x, *, gap_tol: float) -> list[str]:
+    """Unilateral tokens whose gap is within ``gap_tol`` (m, or rad for angle stops)."""
+    return [tok for tok, (g, _) in gaps(sm, x).items() if g <= gap_tol]
 
 
 def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates,

@@ -19,7 +19,6 @@ import numpy as np
 from ..errors import AssemblyError
 from ..integrate.events import EventRecord
 from ..integrate.segment import EventFunction
-from ..kinematics.constraints import extend
 from .contact import resolve_mode, touching
 from .impact import impact
 from .modes import (
@@ -34,12 +33,11 @@ from .modes import (
 __all__ = ["event_functions", "guard_holds", "apply_switch"]
 
 
-def _value(model, meas, t, x, xd):
+def _value(meas, t, x, xd):
     """A switch's or guard's variable at a state: the time, a pose measure or a rate."""
     if isinstance(meas, TimeMeasure):
         return t
-    X = extend(model, x)
-    return meas.value(X, extend(model, xd)) if meas.needs_velocity else meas.value(X)
+    return meas.value(x, xd)
 
 
 def _row(ms: ModeSystem, element: str, kind: str) -> int:
@@ -51,8 +49,6 @@ def _row(ms: ModeSystem, element: str, kind: str) -> int:
 def event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_scale, gap_tol,
                      L) -> list[EventFunction]:
     out: list[EventFunction] = []
-    nb = sm.nb
-    model = sm.model
     locks = mode_locks(ms.mode)
     for sw, meas, _guards in sm.switches:
         if sw.name in fired_once:
@@ -71,7 +67,7 @@ def event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_scal
         for d in ((1, -1) if sw.direction == 0 else (sw.direction,)):
             # rising (d > 0) fires when value - v crosses zero upwards: watched as v - value
             def fn(tt, ev, m=meas, v=sw.value, d=d):
-                return d * (v - _value(model, m, tt, ev.x, ev.xdot))
+                return d * (v - _value(m, tt, ev.x, ev.xdot))
             out.append(EventFunction("switch", sw.name, fn, np.inf, (sw, d),
                                      arm=1e-11 * (abs(sw.value) + scale)))
     closed = set(mode_unilateral(ms.mode))
@@ -86,12 +82,12 @@ def event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_scal
             tol = gap_tol / L if meas.is_angle else gap_tol
             out.append(EventFunction("gap", tok,
                                 lambda tt, ev, m=meas, lim=lim, s=sgn:
-                                s * (m.value(extend(model, ev.x)) - lim), tol, arm=1e-3 * tol))
+                                s * (m.value(ev.x) - lim), tol, arm=1e-3 * tol))
     for n, (_ct, gap, _) in sm.contacts.items():
         if f"{n}@contact" in closed:
             continue
         out.append(EventFunction("gap", f"{n}@contact",
-                            lambda tt, ev, m=gap: m.value(extend(model, ev.x)),
+                            lambda tt, ev, m=gap: m.value(ev.x),
                             gap_tol, arm=1e-3 * gap_tol))
     # closed ones: forces
     fr = mode_friction(ms.mode)
@@ -112,7 +108,7 @@ def event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_scal
             sg = 1.0 if s == "slip+" else -1.0
             slip = sm.contacts[c][2]
             out.append(EventFunction("slip", c, lambda tt, ev, m=slip, sg=sg:
-                                sg * m.rate(extend(model, ev.x), extend(model, ev.xdot), nb),
+                                sg * m.rate(ev.x, ev.xdot),
                                 np.inf, arm=1e-12 * L))
     return out
 
@@ -121,7 +117,7 @@ _OPS = {"<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge
 
 
 def guard_holds(sm, guards, t, x, xd) -> bool:
-    return all(_OPS[op](_value(sm.model, meas, t, x, xd), val) for meas, op, val in guards)
+    return all(_OPS[op](_value(meas, t, x, xd), val) for meas, op, val in guards)
 
 
 def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *, fired,
@@ -167,7 +163,7 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
     frees = [f for n, _ in engage for f in sm.lock_frees(n)]
     locks = frozenset(locks)
     # touching unilateral constraints (closed ones have zero gap by construction)
-    touch = set(touching(sm, ms, x, gap_tol=gap_tol)) | set(mode_unilateral(mode_before))
+    touch = set(touching(sm, x, gap_tol=gap_tol)) | set(mode_unilateral(mode_before))
     lost = 0.0
     imp = None
     xd_plus = xd
@@ -248,6 +244,5 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
 
 def _rates(sm, tokens, targets, x, xd) -> list:
     """(label, gap rate) of the unilateral rows of stop and contact tokens (< 0 closing)."""
-    X, V = extend(sm.model, x), extend(sm.model, xd)
-    return [(r.label, r.sign * r.measure.rate(X, V, sm.nb))
+    return [(r.label, r.sign * r.measure.rate(x, xd))
             for r in sm.rows(frozenset(tokens), targets) if r.unilateral]
