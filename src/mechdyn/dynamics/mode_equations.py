@@ -158,9 +158,8 @@ class ModeEquations:
                 k = self.kernel.evaluation(t, qi, qdi)
                 if k is not None:
                     lam = np.zeros(ms.n_rows)
-                    lam[ms.independent_rows] = k["lam"]
-                    return ModeEval(k["x"], k["xdot"], k["xddot"], k["q"], k["qdot"],
-                                    k["qddot"], lam, k["F"])
+                    lam[ms.independent_rows] = k[6]
+                    return ModeEval(*k[:6], lam, k[7])
             return ms.evaluate(t, qi, qdi, x_guess=self.kernel.x.copy())
         return ms.evaluate(t, qi, qdi)
 
