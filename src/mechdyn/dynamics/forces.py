@@ -276,8 +276,9 @@ class ForceModel:
         nb = m.n_bodies
         X = extend(m, x)
         F = np.zeros(batch + (nb + 1, 3))
-        if self._weights is not None:
-            _add_weights(self._weights, m, F[..., :nb, :], x)
+        if self._weights is not None:  # at the centres of mass
+            F[..., :nb, :2] += self._weights
+            F[..., :nb, 2] += cross(com_arms(m, x), self._weights)
         V = None if conservative else extend(m, xdot)
         for (name, i, si, j, sj, k, L0, c, pre) in self.springs:
             ai, aj, d, L = _spring_geometry(X, i, si, j, sj)
@@ -382,13 +383,6 @@ class ForceModel:
     def conservative(self, x) -> np.ndarray:
         """Forces of gravity and spring stiffness/preload alone, (..., n_x)."""
         return self.loads(None, x, None, None, None, conservative=True)[0]
-
-
-def _add_weights(w, model: Model, Fb, x):
-    """Add the weights w (n_bodies, 2) at the centres of mass to the body forces
-    Fb (..., n_bodies, 3), in place."""
-    Fb[..., :2] += w
-    Fb[..., 2] += cross(com_arms(model, x), w)
 
 
 def applied_forces(model: Model, t, x, xdot, q, qdot, *, skip_drives: Sequence[int] = (),

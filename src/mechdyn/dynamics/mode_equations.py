@@ -42,6 +42,7 @@ from ..kinematics.assembly import SINGULAR_RCOND, solve_position
 from ..kinematics.branch_chart import BranchChart, ChartBook, PathProblem
 from ..kinematics.constraints import extend
 from .compiled import compile_mode_kernel
+from .dead_position import _dependent, _where
 from .forces import com_arms
 from .mode_system import solve_mass
 from .modes import ModeEval
@@ -306,14 +307,10 @@ class ModeEquations:
         rep = self.ms.singularity(x)
         if rep["rcond"] >= SINGULAR_RCOND:
             return
-        model = self.ms.model
-        names = ", ".join(f"{n} = {v:.9g}" for n, v in zip(model.coordinate_names, q,
-                                                               strict=True))
         raise SingularPositionError(
             f"singular position in mode {sorted(self.ms.mode) or '(none)'} at t = {t:.9g} s, "
-            f"{names}: sigma_min/sigma_max of the position Jacobian {rep['rcond']:.2e}; the "
-            f"coordinate(s) {', '.join(rep['coordinates']) or '-'} lose control, joints "
-            f"{', '.join(rep['joints']) or '-'} become dependent", t=t, q=q)
+            f"{_where(self.ms, q)}: sigma_min/sigma_max of the position Jacobian "
+            f"{rep['rcond']:.2e}; the {_dependent(rep)}", t=t, q=q)
 
     # ------------------------------------------------------------------ analogs
     def analogs_terms(self, t: float, q, qdot, x=None) -> dict:
