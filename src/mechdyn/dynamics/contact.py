@@ -280,13 +280,9 @@ def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates
         Kinv = np.linalg.pinv(K) if K.size else np.zeros((0, 0))
         base_sol = Kinv @ np.concatenate([f, -de]) if K.size else np.zeros(0)
         resp = Kinv[:, :n] @ Wu.T if K.size else np.zeros((0, len(uni)))
-        H = Cu @ resp[:n]
-        r = Cu @ base_sol[:n] + du
-        comp = np.array([r_.compliance for r_ in uni], float)
-        H = H + np.diag(comp)
-        sol = solve_lcp(H, r)
-        lam = sol.z
-        acc = sol.w
+        H = Cu @ resp[:n] + np.diag(np.array([r_.compliance for r_ in uni], float))
+        sol = solve_lcp(H, Cu @ base_sol[:n] + du)
+        lam, acc = sol.z, sol.w
         mu_e = base_sol[n:] + resp[n:] @ lam if ne else np.zeros(0)
         changed = False
         # drop rows without force (they separate or just touch)
@@ -319,13 +315,8 @@ def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates
                 forced_open -= set(reopen)
                 active = sorted(set(active) | set(reopen))
                 continue
-            mode = locks | frozenset(active) | frozenset(
-                f"{c}:{s}" for c, s in fric.items() if f"{c}@contact" in active)
-            for c in [a[:-8] for a in active if a.endswith("@contact")]:
-                if fric.get(c) == "stick":
-                    targets[f"{c}:stick"] = sm.contacts[c][2].value(x)
-            forces = {u.label: float(l_) for u, l_ in zip(uni, lam, strict=True)
-                      if u.label in active}
-            return mode, forces
+            targets.update(stick_targets)  # the stick positions chosen
+            return locks | toks, {u.label: float(l_) for u, l_ in zip(uni, lam, strict=True)
+                                  if u.label in active}
     raise ContactError("the contact and friction states do not settle (stick/slip cycling)",
                        t=t)
