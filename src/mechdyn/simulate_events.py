@@ -124,31 +124,26 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         small_velocity = 1e-6 * L
     if gap_tol is None:
         gap_tol = 1e-9 * L
-    if zeno_time is None:
-        zeno_time = 1e-4 * (t_end - t0)
     span = t_end - t0
+    if zeno_time is None:
+        zeno_time = 1e-4 * span
     if np.shape(point) != (2,) or not np.all(np.isfinite(np.asarray(point, float))):
         raise ModelError(f"point must be a finite (x, y) in m, got {point!r}")
     if min_step is None:
         min_step = 1e-13 * span
+    fixed_step = str(getattr(method, "name", method)).lower() in ("wilson", "rk4")
     if max_steps is None:
-        grid = (span / dt if dt else steps or 0) if str(method).lower() in ("wilson", "rk4") \
-            else 0
-        max_steps = max(200_000, 2 * int(grid))
+        max_steps = max(200_000, 2 * int((span / dt if dt else steps or 0) if fixed_step else 0))
     last_impact: dict = {}
     every_step = t_eval is None and dt_out is None  # as a fixed-structure run
     if every_step:
         t_eval = np.zeros(0)
     elif t_eval is None:
-        h_out = dt_out
-        n = int(math.floor((t_end - t0) / h_out + 1e-9))
-        t_eval = t0 + h_out * np.arange(n + 1)
+        t_eval = t0 + dt_out * np.arange(int(math.floor(span / dt_out + 1e-9)) + 1)
         if t_eval[-1] < t_end - 1e-12 * max(1.0, abs(t_end)):
             t_eval = np.append(t_eval, t_end)
     t_eval = np.asarray(t_eval, float)
-    weight = float(np.sum(model.mass) * max(np.hypot(*model.gravity), 1.0))
-    force_scale = max(weight, 1.0)
-    fixed_step = str(getattr(method, "name", method)).lower() in ("wilson", "rk4")
+    force_scale = max(float(np.sum(model.mass) * max(np.hypot(*model.gravity), 1.0)), 1.0)
     segment_integrator, method_name = segment_integrators(
         method, t0, t_end, rtol=rtol, atol=atol, dt=dt, steps=steps, iterations=iterations,
         tol=tol, theta=theta, first_step=first_step, max_step=max_step)

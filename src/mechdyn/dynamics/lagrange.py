@@ -223,9 +223,7 @@ class EquationsOfMotion(ModeEquations):
         """All terms of the equations at one state (NumPy path, for inspection)."""
         q, qdot = np.asarray(q, float), np.asarray(qdot, float)
         if self.formulation == "analogs":
-            tm = self.analogs_terms(t, q, qdot)
-            return Terms(t, q, qdot, tm["qddot"], tm["x"], tm["xdot"], tm["B"], tm["A"],
-                         tm["c"], tm["Q"], tm["Q_drive"], tm["power_nc"])
+            return Terms(t, q, qdot, **self.analogs_terms(t, q, qdot))
         ev = self.evaluate(t, q, qdot)
         tm = self.ms.terms(t, ev.x, ev.xdot)
         B, M = tm["B"], tm["M"]
