@@ -34,6 +34,8 @@ singular pose, so a minimum-norm solve there gives a wrong acceleration.
 
 from __future__ import annotations
 
+from functools import cached_property
+
 import numpy as np
 
 from ..errors import ModelError, SingularPositionError
@@ -182,31 +184,27 @@ class ModeEquations:
 
     def rhs(self, t: float, qi, qdi):
         """(q_I'' (n_i,), array([P_nc])) at (t, q_I, q_I')."""
-        if self.book is not None:
-            ch = self._zone(qi)
-            if ch is not None:
-                return self._chart_rhs(ch, t, qi, qdi)
-        out = self.kernel.rhs(t, qi, qdi) if self.kernel is not None else None
-        if out is None:
-            out = self.numpy_rhs(t, qi, qdi)
-        if self.book is not None:
-            ch = self._watch(float(qi[0]))
-            if ch is not None:
-                return self._chart_rhs(ch, t, qi, qdi)
-        return out
+        n = self.ms.n_i
+        out = self._first_order(t, np.concatenate([qi, qdi, [0.0]]))
+        return out[n:2 * n], out[2 * n:]
 
     def first_order_function(self):
         """``fun(t, y) -> y'`` for y = (q_I, q_I', w) on the compiled kernel (the branch
         charts inside bifurcation zones), or None without the compiled kernel."""
-        if self.kernel is None:
-            return None
+        return None if self.kernel is None else self._first_order
+
+    @cached_property
+    def _first_order(self):
+        """y' = (q_I', q_I'', P_nc) on the compiled kernel, else (and where the kernel
+        fails) on the NumPy path; from a branch chart inside a bifurcation zone."""
         n = self.ms.n_i
 
-        def on_failure(t, y):
+        def numpy_path(t, y):
             qdd, p = self.numpy_rhs(t, y[:n], y[n:2 * n])
             return np.concatenate([y[n:2 * n], qdd, p])
 
-        base = self.kernel.first_order_function(on_failure)
+        base = numpy_path if self.kernel is None else self.kernel.first_order_function(
+            numpy_path)
         book = self.book
         if book is None:
             return base
@@ -278,13 +276,9 @@ class ModeEquations:
         self.reset(x)
         return self.ms.evaluate_x(t, x, xs * qd[0], xs[:, None], b=xss * qd[0] ** 2)
 
-    def _chart_rhs(self, ch, t, qi, qdi):
-        ev = self._chart_eval(ch, t, qi, qdi)
-        return ev.qddot[self.ms.coords], np.array([self._power(ev)])
-
     def _chart_first_order(self, ch, t, y):
-        qdd, p = self._chart_rhs(ch, t, y[:1], y[1:2])
-        return np.concatenate([y[1:2], qdd, p])
+        ev = self._chart_eval(ch, t, y[:1], y[1:2])
+        return np.concatenate([y[1:2], ev.qddot[self.ms.coords], [self._power(ev)]])
 
     # ------------------------------------------------------------------ checks
     def check_position(self, t: float, x, q) -> None:
