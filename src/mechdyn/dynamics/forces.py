@@ -219,7 +219,6 @@ class ForceModel:
     """The loads and drives of a model, resolved to indices (build with :func:`force_model`)."""
 
     model: Model
-    gravity_F: np.ndarray  # (n_x,) forces of gravity at theta = 0 (moments added per pose)
     springs: list
     rotary: list
     forces: list
@@ -498,6 +497,6 @@ def force_model(model: Model) -> ForceModel:
         drives.append((dr, model.coordinate_index(dr.coordinate)))
     if probs:
         raise ModelError(probs)
-    fm = ForceModel(model, np.zeros(model.n_x), springs, rotary, forces, torques, drives)
+    fm = ForceModel(model, springs, rotary, forces, torques, drives)
     model.memo["force_model"] = fm
     return fm
