@@ -147,14 +147,11 @@ def diagnose(exc, good):
 
 def status_of(exc):
     """(status, message) of an error that ended a run (:class:`~mechdyn.errors.Status`)."""
-    if isinstance(exc, SingularPositionError):
-        return Status.SINGULAR_POSITION, str(exc)
-    if isinstance(exc, AssemblyError):
-        return Status.ASSEMBLY_FAILED, str(exc)
-    if isinstance(exc, ContactError):
-        return Status.NO_CONTACT_SOLUTION, str(exc)
-    if isinstance(exc, LockupError):
-        return Status.LOCKUP, str(exc)
+    for cls, status in ((SingularPositionError, Status.SINGULAR_POSITION),
+                        (AssemblyError, Status.ASSEMBLY_FAILED),
+                        (ContactError, Status.NO_CONTACT_SOLUTION), (LockupError, Status.LOCKUP)):
+        if isinstance(exc, cls):
+            return status, str(exc)
     if isinstance(exc, IntegrationError) and "mass matrix" in str(exc):
         return Status.SINGULAR_MASS_MATRIX, str(exc)
     if isinstance(exc, ArithmeticError):

@@ -156,15 +156,18 @@ class ModeEquations:
             ev = ms.evaluate(t, qi, qdi)
             ev.qddot = self.analogs_terms(t, qi, qdi, ev.x)["qddot"]
             return ev
-        if self.kernel is not None:
-            if self._full:
-                k = self.kernel.evaluation(t, qi, qdi)
-                if k is not None:
-                    lam = np.zeros(ms.n_rows)
-                    lam[ms.independent_rows] = k[6]
-                    return ModeEval(*k[:6], lam, k[7])
-            return ms.evaluate(t, qi, qdi, x_guess=self.kernel.x.copy())
-        return ms.evaluate(t, qi, qdi)
+        if self.kernel is not None and self._full:
+            k = self.kernel.evaluation(t, qi, qdi)
+            if k is not None:
+                lam = np.zeros(ms.n_rows)
+                lam[ms.independent_rows] = k[6]
+                return ModeEval(*k[:6], lam, k[7])
+        return self._numpy_evaluate(t, qi, qdi)
+
+    def _numpy_evaluate(self, t: float, qi, qdi) -> ModeEval:
+        """The NumPy evaluation, its Newton solve started from the kernel's last pose."""
+        k = self.kernel
+        return self.ms.evaluate(t, qi, qdi, x_guess=None if k is None else k.x.copy())
 
     def _power(self, ev) -> float:
         """Power of the non-conservative forces at an evaluation, W."""
@@ -178,8 +181,7 @@ class ModeEquations:
         if self.formulation == "analogs":
             tm = self.analogs_terms(t, qi, qdi)
             return tm["qddot"], np.array([tm["power_nc"]])
-        ev = self.ms.evaluate(t, qi, qdi, x_guess=None if self.kernel is None
-                              else self.kernel.x.copy())
+        ev = self._numpy_evaluate(t, qi, qdi)
         return ev.qddot[self.ms.coords], np.array([self._power(ev)])
 
     def rhs(self, t: float, qi, qdi):
