@@ -437,25 +437,24 @@ def force_model(model: Model) -> ForceModel:
             probs.append(f"{where}: " + did_you_mean(name, [*model.body_names, "ground"], "body"))
             return None
 
-    def point(b, p, where):
+    def anchor(b, p, where):
+        """(body index, point in the body frame), or None with the problem noted."""
+        i = body(b, where)
         try:
-            return model.point_local(b, p)
+            return None if i is None else (i, model.point_local(b, p))
         except ModelError as exc:
             probs.append(f"{where}: {exc}")
-            return None
 
     for ld in mech.loads:
         where = f"{type(ld).__name__.lower()} {getattr(ld, 'name', '?')!r}"
         if isinstance(ld, Spring):
-            i, j = body(ld.body1, where), body(ld.body2, where)
-            si = point(ld.body1, ld.point1, where) if i is not None else None
-            sj = point(ld.body2, ld.point2, where) if j is not None else None
+            a1, a2 = anchor(ld.body1, ld.point1, where), anchor(ld.body2, ld.point2, where)
             for fld in ("stiffness", "free_length", "damping"):
                 if getattr(ld, fld) < 0:
                     probs.append(f"{where}: {fld} must be >= 0, got {getattr(ld, fld)!r}")
-            if None not in (i, j) and si is not None and sj is not None:
-                springs.append((ld.name, i, si, j, sj, float(ld.stiffness),
-                                float(ld.free_length), float(ld.damping), float(ld.preload)))
+            if a1 and a2:
+                springs.append((ld.name, *a1, *a2, float(ld.stiffness), float(ld.free_length),
+                                float(ld.damping), float(ld.preload)))
         elif isinstance(ld, RotarySpring):
             if ld.joint not in mech.joints or model.joint_kind(ld.joint) != "revolute":
                 probs.append(f"{where}: joint: " + did_you_mean(ld.joint, model.rev.names,
@@ -466,10 +465,9 @@ def force_model(model: Model) -> ForceModel:
                            float(ld.stiffness), float(ld.free_angle), float(ld.damping),
                            float(ld.preload)))
         elif isinstance(ld, Force):
-            b = body(ld.body, where)
-            s = point(ld.body, ld.point, where) if b is not None else None
-            if b is not None and s is not None:
-                forces.append((ld, b, s))
+            a = anchor(ld.body, ld.point, where)
+            if a:
+                forces.append((ld, *a))
         elif isinstance(ld, Torque):
             b = body(ld.body, where)
             r = body(ld.reaction_body, where) if ld.reaction_body is not None else None
