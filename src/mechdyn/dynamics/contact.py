@@ -178,18 +178,21 @@ def row_terms(ms: ModeSystem, rows: list[Row], x, xdot, B, b):
     return g @ B, gw @ B, g @ b + quad
 
 
+def gap_measures(sm: SwitchedModel):
+    """``(token, measure, sign, limit)`` of every stop side and contact, its gap being
+    sign (measure - limit)."""
+    for n, (st, meas) in sm.stops.items():
+        for side in st.sides():
+            yield f"{n}@{side}", meas, (1.0 if side == "lower" else -1.0), getattr(st, side)
+    for n, (_ct, gap, _) in sm.contacts.items():
+        yield f"{n}@contact", gap, 1.0, 0.0
+
+
 def gaps(sm: SwitchedModel, x) -> dict:
     """``{token: (gap, is_angle)}`` of every stop side and contact at poses x (..., n_x):
     m, or rad for angle stops, negative where it penetrates."""
-    out = {}
-    for n, (st, meas) in sm.stops.items():
-        v = rows_numpy.values(meas.rows, x)[..., 0]
-        for side in st.sides():
-            out[f"{n}@{side}"] = (v - st.lower if side == "lower" else st.upper - v,
-                                  meas.is_angle)
-    for n, (_ct, gap, _) in sm.contacts.items():
-        out[f"{n}@contact"] = (rows_numpy.values(gap.rows, x)[..., 0], False)
-    return out
+    return {tok: (sign * (rows_numpy.values(m.rows, x)[..., 0] - lim), m.is_angle)
+            for tok, m, sign, lim in gap_measures(sm)}
 
 
 def touching(sm: SwitchedModel, x, *, gap_tol: float) -> list[str]:

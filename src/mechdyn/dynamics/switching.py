@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import AssemblyError
 from ..integrate.events import EventRecord
 from ..integrate.segment import EventFunction
-from .contact import resolve_mode, touching
+from .contact import gap_measures, resolve_mode, touching
 from .impact import impact
 from .modes import (
     ModeSystem,
@@ -72,23 +72,11 @@ def event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_scal
                                      arm=1e-11 * (abs(sw.value) + scale)))
     closed = set(mode_unilateral(ms.mode))
     # open stops and contacts: gaps
-    for n, (st, meas) in sm.stops.items():
-        for side in st.sides():
-            tok = f"{n}@{side}"
-            if tok in closed:
-                continue
-            lim = getattr(st, side)
-            sgn = 1.0 if side == "lower" else -1.0
+    for tok, meas, sgn, lim in gap_measures(sm):
+        if tok not in closed:
             tol = gap_tol / L if meas.is_angle else gap_tol
-            out.append(EventFunction("gap", tok,
-                                lambda tt, ev, m=meas, lim=lim, s=sgn:
-                                s * (m.value(ev.x) - lim), tol, arm=1e-3 * tol))
-    for n, (_ct, gap, _) in sm.contacts.items():
-        if f"{n}@contact" in closed:
-            continue
-        out.append(EventFunction("gap", f"{n}@contact",
-                            lambda tt, ev, m=gap: m.value(ev.x),
-                            gap_tol, arm=1e-3 * gap_tol))
+            out.append(EventFunction("gap", tok, lambda tt, ev, m=meas, lim=lim, s=sgn:
+                                     s * (m.value(ev.x) - lim), tol, arm=1e-3 * tol))
     # closed ones: forces
     fr = mode_friction(ms.mode)
     for k, r in enumerate(ms.rows):
