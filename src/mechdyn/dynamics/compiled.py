@@ -64,6 +64,7 @@ class CompiledKernel:
 
     def __init__(self, ip, fp, ri, rf, dims, n_x, compile_time):
         self.ip, self.fp, self.ri, self.rf, self.dims = ip, fp, ri, rf, dims
+        self._arrays = (ip, fp, ri, rf, dims)
         self.n_x, self.n_i = n_x, int(dims[D_NI])
         self.ws = np.zeros(work_size(n_x, self.n_i))
         self.compile_time = compile_time
@@ -98,21 +99,23 @@ class CompiledKernel:
         self.ws[:self.n_x] = x
         self.ws[-N_FLAGS + W_VALID] = 0.0
 
-    def rhs(self, t, q, qdot):
-        """(q_I'', array([P_nc])) or None on failure (see ``status``)."""
-        n = self.n_i
-        y = np.empty(2 * n + 1)
-        y[:n] = q
-        y[n:2 * n] = qdot
+    def _run(self, fn, t, *args):
+        """``fn(t, *args, <packed arrays>, status)``; False where the kernel failed (see
+        ``status``)."""
         try:
-            out = first_order(float(t), y, self.ip, self.fp, self.ri, self.rf, self.dims,
-                              self.ws, self._st)
+            self._out = fn(float(t), *args, self._st)
         except ZeroDivisionError:  # e.g. a spring whose ends meet: the NumPy path names it
             self._st[0] = 3
         self.status = int(self._st[0])
-        if self.status:
+        return not self.status
+
+    def rhs(self, t, q, qdot):
+        """(q_I'', array([P_nc])) or None on failure (see ``status``)."""
+        n = self.n_i
+        y = np.concatenate([q, qdot, [0.0]])
+        if not self._run(first_order, t, y, *self._arrays, self.ws):
             return None
-        return out[n:2 * n], out[2 * n:]
+        return self._out[n:2 * n], self._out[2 * n:]
 
     def evaluation(self, t, q, qdot):
         """Everything at one state, or None on failure (see ``status``): ``(x, xdot,
@@ -121,14 +124,8 @@ class CompiledKernel:
         (M x'' + h - F = Phi_x^T lambda) and the applied forces with the drives (n_x,)."""
         nx, nq, nc = self.n_x, int(self.dims[D_NQ]), int(self.dims[D_NC])
         ext = np.empty(nx + 3 * nq + nc + nx)
-        try:
-            full(float(t), np.asarray(q, np.float64), np.asarray(qdot, np.float64), self.ip,
-                 self.fp, self.ri, self.rf, self.dims, self.ws, np.empty(2 * self.n_i + 1),
-                 ext, self._st)
-        except ZeroDivisionError:
-            self._st[0] = 3
-        self.status = int(self._st[0])
-        if self.status:
+        if not self._run(full, t, np.asarray(q, np.float64), np.asarray(qdot, np.float64),
+                         *self._arrays, self.ws, np.empty(2 * self.n_i + 1), ext):
             return None
         return (self.x.copy(), self.xdot.copy(), *np.split(ext, np.cumsum([nx, nq, nq, nq, nc])))
 
