@@ -170,10 +170,13 @@ class ModeEquations:
         return self.ms.evaluate(t, qi, qdi, x_guess=None if k is None else k.x.copy())
 
     def _power(self, ev) -> float:
-        """Power of the non-conservative forces at an evaluation, W."""
+        """Power of the non-conservative forces at an evaluation (all applied forces but
+        gravity and spring stiffness, and the sliding friction of slipping contacts), W."""
         Fc = ev.F_conservative
         p = float((ev.F - (self.sm.fm.conservative(ev.x) if Fc is None else Fc)) @ ev.xdot)
-        return p + friction_power(self.ms, ev)
+        ms = self.ms
+        return p + float(sum(-r.mu * r.slip * ev.lam[ms.n_base + k] * r.tangent.rate(ev.x, ev.xdot)
+                             for k, r in enumerate(ms.rows) if r.slip))
 
     def numpy_rhs(self, t: float, qi, qdi):
         """(q_I'', array([P_nc])) on the NumPy path; raises the diagnosed error of a
@@ -360,12 +363,3 @@ class ModeEquations:
         p = fm.nonconservative_power(None, x, xdot, None, qdot, applied=(F, Qd))
         return dict(x=x, xdot=xdot, B=B, A=A, c=c, Q=Q, Q_drive=Qd, qddot=qdd, power_nc=p)
 
-
-def friction_power(ms, ev) -> float:
-    """Power of the sliding friction of the mode's slipping contacts, W (<= 0)."""
-    slips = [(k, r) for k, r in enumerate(ms.rows) if r.slip]
-    if not slips:
-        return 0.0
-    X, V = extend(ms.model, ev.x), extend(ms.model, ev.xdot)
-    return float(sum(-r.mu * r.slip * ev.lam[ms.n_base + k] * r.tangent.rate(X, V)
-                     for k, r in slips))
