@@ -39,11 +39,7 @@ from .dynamics.contact import gaps, touching
 from .dynamics.dead_position import diagnose, status_of, turning_point
 from .dynamics.lagrange import kinetic_energy
 from .dynamics.mode_equations import ModeEquations
-from .dynamics.modes import (
-    ModeSystem,
-    SwitchedModel,
-    switched_model,
-)
+from .dynamics.modes import ModeSystem, switched_model
 from .dynamics.reactions import element_forces, frame_forces, net_on_ground
 from .dynamics.switching import apply_switch, event_functions
 from .errors import (
@@ -396,11 +392,6 @@ def _budget(step, ev, ms, stats, span, min_step, max_steps, fixed_step) -> None:
                                   f"({max_steps} steps; raise max_steps to go on)")
 
 
-def _penetration(sm: SwitchedModel, x) -> float:
-    """Largest penetration of a stop (lengths only) or contact over poses x (n, n_x), m."""
-    return max([0.0] + [float(np.max(-g)) for g, angle in gaps(sm, x).values() if not angle])
-
-
 # ============================================================================ output
 def _finish(model, rec, events, stats, wall0, status, message, sm,
             point=(0.0, 0.0)) -> Trajectory:
@@ -436,7 +427,9 @@ def _finish(model, rec, events, stats, wall0, status, message, sm,
     T = kinetic_energy(model, x, xd) + 0.5 * (qd**2) @ sm.drive_inertia
     U = sm.fm.potential_energy(x)
     stats = dict(stats)
-    stats["penetration"] = _penetration(sm, x) if n else 0.0
+    # the largest penetration of a stop (lengths only) or contact, m
+    pen = [float(np.max(-g)) for g, angle in gaps(sm, x).values() if not angle] if n else []
+    stats["penetration"] = max([0.0, *pen])
     stats["wall_time_s"] = time.perf_counter() - wall0
     stats["variable_structure"] = SwitchedSamples(
         mode=[r[1].mode for r in rec], modes=modes,
