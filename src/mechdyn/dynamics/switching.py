@@ -77,27 +77,22 @@ def event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_scal
             tol = gap_tol / L if meas.is_angle else gap_tol
             out.append(EventFunction("gap", tok, lambda tt, ev, m=meas, lim=lim, s=sgn:
                                      s * (m.value(ev.x) - lim), tol, arm=1e-3 * tol))
-    # closed ones: forces
-    fr = mode_friction(ms.mode)
+    # closed ones: forces; the friction cone of sticking contacts, the slip of slipping ones
     for k, r in enumerate(ms.rows):
-        idx = ms.n_base + k
         if r.unilateral:
-            tok = r.label
-            out.append(EventFunction("force", tok, lambda tt, ev, i=idx: ev.lam[i],
-                                1e-7 * force_scale, arm=1e-10 * force_scale))
-    for c, s in fr.items():
-        ct = sm.contacts[c][0]
+            out.append(EventFunction("force", r.label, lambda tt, ev, i=ms.n_base + k: ev.lam[i],
+                                     1e-7 * force_scale, arm=1e-10 * force_scale))
+    for c, s in mode_friction(ms.mode).items():
+        ct, _, slip = sm.contacts[c]
         if s == "stick":
             kn, kt = _row(ms, c, "contact"), _row(ms, c, "stick")
             out.append(EventFunction("cone", c, lambda tt, ev, kn=kn, kt=kt, mu=ct.friction:
-                                mu * ev.lam[kn] - abs(ev.lam[kt]), 1e-7 * force_scale,
-                                arm=1e-10 * force_scale))
+                                     mu * ev.lam[kn] - abs(ev.lam[kt]), 1e-7 * force_scale,
+                                     arm=1e-10 * force_scale))
         else:
             sg = 1.0 if s == "slip+" else -1.0
-            slip = sm.contacts[c][2]
             out.append(EventFunction("slip", c, lambda tt, ev, m=slip, sg=sg:
-                                sg * m.rate(ev.x, ev.xdot),
-                                np.inf, arm=1e-12 * L))
+                                     sg * m.rate(ev.x, ev.xdot), np.inf, arm=1e-12 * L))
     return out
 
 
