@@ -159,15 +159,15 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
         xd_plus = imp.xdot_plus
         lost = imp.energy_lost
     # candidates: touching and not separating
-    vtol = max(small_velocity * 1e-3, 1e-9 * float(np.max(np.abs(xd_plus), initial=0.0)))
-    cand = [tok for tok, v in _rates(sm, touch, targets, x, xd_plus) if v <= vtol]
-    vscale = max(float(np.max(np.abs(xd_plus), initial=0.0)), small_velocity)
-    mode_after, forces = resolve_mode(
-        sm, t, x, xd_plus, locks, targets, cand, slip_velocity_tol=1e-9 * vscale + 1e-12,
+    vmax = float(np.max(np.abs(xd_plus), initial=0.0))
+    cand = [tok for tok, v in _rates(sm, touch, targets, x, xd_plus)
+            if v <= max(small_velocity * 1e-3, 1e-9 * vmax)]
+    mode_after, _ = resolve_mode(
+        sm, t, x, xd_plus, locks, targets, cand,
+        slip_velocity_tol=1e-9 * max(vmax, small_velocity) + 1e-12,
         force_tol=1e-10 * force_scale, forced_open=forced_open, forced_slip=forced_slip,
         forced_stick=forced_stick)
-    prefer = ms.coord_names
-    ms_new = ModeSystem(sm, mode_after, targets, x, prefer=prefer, avoid=frees,
+    ms_new = ModeSystem(sm, mode_after, targets, x, prefer=ms.coord_names, avoid=frees,
                         workspace=ms.ws)
     # an engaging lock must hold the pose it engages at (no position jump)
     tol_pos = 1e-8 * sm.model.length_scale
@@ -184,10 +184,9 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
     qi = ms_new.coordinates(x)[ms_new.coords]
     x_new = ms_new.solve_position(qi, x, t=t)
     B, _ = ms_new.velocity_analogs(x_new)
-    G = ms_new._coord_jac(x_new)[ms_new.coords]
-    xd_new = B @ (G @ xd_plus)
-    q_a = ms_new.coordinates(x_new)
-    qd_a = ms_new._coord_jac(x_new) @ xd_new
+    G = ms_new._coord_jac(x_new)
+    xd_new = B @ (G[ms_new.coords] @ xd_plus)
+    q_a, qd_a = ms_new.coordinates(x_new), G @ xd_new
     if initial and mode_after == mode_before and not engage:
         return ms_new, x_new, xd_new, lost
 
