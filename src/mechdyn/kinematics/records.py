@@ -394,14 +394,9 @@ def four_bar_loops(model: Model, over: str | None = None) -> list[FourBarLoop]:
                     if key in seen:
                         continue
                     seen.add(key)
-                    forward = FourBarLoop(a, c, d, (j0, j1, j2, j3))
-                    backward = FourBarLoop(d, c, a, (j3, j2, j1, j0))
-                    if d in driven and a not in driven:
-                        loops.append(backward)
-                    elif a in driven or order[a] <= order[d]:
-                        loops.append(forward)
-                    else:
-                        loops.append(backward)
+                    forward = a in driven or (d not in driven and order[a] <= order[d])
+                    loops.append(FourBarLoop(a, c, d, (j0, j1, j2, j3)) if forward
+                                 else FourBarLoop(d, c, a, (j3, j2, j1, j0)))
     return loops
 
 
@@ -414,15 +409,13 @@ def _joint_point(model: Model, name: str, x) -> np.ndarray:
 
 
 def _summarize(sw: KinematicSweep) -> SweepSummary:
-    m = sw.model
-    k = sw.over_index
-    strokes, dcs = {}, []
-    n = len(sw)
+    m, k, n = sw.model, sw.over_index, len(sw)
+    strokes, dcs, trans, ext = {}, [], [], []
+    if n == 0:
+        return SweepSummary(sw.over, sw.over_is_angle, strokes, dcs, trans, ext)
     for jname in m.pri.names:
         # travel and its analog (per unit of the swept coordinate)
         s, ds, _ = _travel(m, jname, sw.x, sw.B[..., k], np.zeros_like(sw.x))
-        if n == 0:
-            continue
         found = []
         for i in np.flatnonzero(np.sign(ds[:-1]) * np.sign(ds[1:]) < 0):
             q_at, s_at = _refine_root(sw, i, partial(_travel, m, jname))
@@ -438,23 +431,15 @@ def _summarize(sw: KinematicSweep) -> SweepSummary:
         strokes[jname] = float(np.max(allvals) - np.min(allvals))
         for q_at, s_at, is_max in sorted(found):
             dcs.append(DeadCentre(jname, "TDC" if is_max else "BDC", q_at, s_at))
-    trans = []
     for lp in four_bar_loops(m, sw.over):
-        if n == 0:
-            continue
-        B_ = _joint_point(m, lp.joints[1], sw.x)
-        C_ = _joint_point(m, lp.joints[2], sw.x)
-        D_ = _joint_point(m, lp.joints[3], sw.x)
+        B_, C_, D_ = (_joint_point(m, j, sw.x) for j in lp.joints[1:])
         u, v = B_ - C_, D_ - C_
         mu = np.arctan2(np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]),
                         u[:, 0] * v[:, 0] + u[:, 1] * v[:, 1])
         i0, i1 = int(np.argmin(mu)), int(np.argmax(mu))
         trans.append(TransmissionAngle(lp, float(mu[i0]), float(sw.values[i0]),
                                        float(mu[i1]), float(sw.values[i1])))
-    ext = []
     for b, p in m.named_points():
-        if n == 0:
-            continue
         _, v, a = sw.point(b, p)
         vn, an = np.hypot(v[:, 0], v[:, 1]), np.hypot(a[:, 0], a[:, 1])
         iv, ia = int(np.argmax(vn)), int(np.argmax(an))

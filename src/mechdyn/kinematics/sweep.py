@@ -97,11 +97,7 @@ def initial_coordinates(model: Model, x0=None) -> np.ndarray:
     the model-file loader stores them, or a sequence of n_q values); the others
     measured on the pose ``x0`` (default the assembled sketch ``model.x0``).
     """
-    if x0 is None:
-        x0 = getattr(model, "x0", None)
-        if x0 is None:
-            x0 = assemble(model)
-    q0 = coordinates(model, np.asarray(x0, float))
+    q0 = coordinates(model, np.asarray(_start_pose(model) if x0 is None else x0, float))
     init = (model.mechanism.extras or {}).get("initial", {})
     given = init.get("q") if isinstance(init, Mapping) else None
     if given is None:
@@ -117,6 +113,21 @@ def initial_coordinates(model: Model, x0=None) -> np.ndarray:
                              f"({', '.join(model.coordinate_names)}), got {given!r}")
         q = arr
     return q
+
+
+def _start_pose(model: Model, lay=None, fresh: bool = False) -> np.ndarray:
+    """The assembled sketch ``model.x0``, assembled anew (in ``lay``'s mode) if ``fresh``."""
+    x0 = getattr(model, "x0", None)
+    return assemble(model, layout=lay) if x0 is None or fresh else x0
+
+
+def _solve_at(kern, x_guess, q, tol):
+    """Pose at q by Newton from ``x_guess`` (else assembled from it), with F and J there."""
+    x, ok, F, J = _newton(kern, np.asarray(x_guess, float), q, tol)
+    if not ok:
+        x = assemble(kern.model, q, x_guess=x_guess, layout=kern.lay)
+        F, J = kern.system(x, q)
+    return x, F, J
 
 
 def _rates(model: Model, k: int, speed) -> np.ndarray:
@@ -207,17 +218,12 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
 
     # ---- start pose and coordinates
     if x_start is None:
-        x0 = getattr(model, "x0", None)
-        if x0 is None or (mode is not None and lay.mode != model.initial_mode):
-            x0 = assemble(model, layout=lay)
+        x0 = _start_pose(model, lay, fresh=lay.mode != model.initial_mode)
         q_init = initial_coordinates(model, x0)
     else:
         x0 = np.asarray(x_start, float).reshape(model.n_x)
         q_init = coordinates(model, x0)
-    x_init, ok, _, J0 = _newton(kern, x0, q_init, tol)
-    if not ok:
-        x_init = assemble(model, q_init, x_guess=x0, layout=lay)
-        J0 = None
+    x_init, _, J0 = _solve_at(kern, x0, q_init, tol)
     start = _node(kern, x_init, q_init, k, J=J0)
     # bifurcation positions on the way are gone through on the branch (branch charts)
     book = None
@@ -433,15 +439,8 @@ def analyze(mech_or_model, q, qdot, qddot=None, x_guess=None, *, mode=None) -> K
     qdot = np.asarray(qdot, float).reshape(model.n_q)
     qddot = np.zeros(model.n_q) if qddot is None else np.asarray(qddot, float).reshape(
         model.n_q)
-    if x_guess is None:
-        x_guess = getattr(model, "x0", None)
-        if x_guess is None:
-            x_guess = assemble(model, layout=lay)
-    tol = _position_tol(model)
-    x, ok, F, J = _newton(kern, np.asarray(x_guess, float), q, tol)
-    if not ok:
-        x = assemble(model, q, x_guess=x_guess, layout=lay)
-        F, J = kern.system(x, q)
+    x, F, J = _solve_at(kern, _start_pose(model, lay) if x_guess is None else x_guess, q,
+                        _position_tol(model))
     system = (F[None], J[None], kern.factor(J[None]))
     x, B, xdot, xddot, _ = _motion(kern, x[None], q[None], qdot[None], qddot[None], None, 0,
                                    system, correct=False)
