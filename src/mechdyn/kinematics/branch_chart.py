@@ -42,8 +42,7 @@ from numpy.polynomial import chebyshev as cheb
 
 from ..model import ConstraintLayout, Model
 from .assembly import _scale
-from .continuation import _hermite5, _kernel, _march, _newton, _node
-from .continuation import _Node as _SweepNode
+from .continuation import _hermite5, _kernel, _march, _newton, _Node, _node
 
 __all__ = ["PathProblem", "BranchChart", "ChartBook", "bridge", "ZONE", "WINDOW", "REACH"]
 
@@ -61,18 +60,6 @@ NEAR_MISS_RCOND = 1e-3
 _STEP = 0.1
 #: the chart is rejected if it misses a direct solve at a check point by more (scaled)
 _CHART_TOL = 1e-7
-
-
-@dataclass
-class _Node:
-    """A solved pose of the path: coordinate s, pose x, x' = dx/ds, x'' and the sign of
-    det of the scaled Jacobian."""
-
-    s: float
-    x: np.ndarray
-    xs: np.ndarray
-    xss: np.ndarray
-    sign: float
 
 
 class PathProblem:
@@ -139,11 +126,8 @@ class PathProblem:
         return self.kernel.system(np.asarray(x, dtype=float), self.q_fixed)[1]
 
     def node(self, s, x, J=None) -> _Node:
-        """Analogs x', x'' and the branch sign at a solved pose."""
-        return self._node(_node(self.kernel, np.asarray(x, dtype=float), self._q(s), self.k, J))
-
-    def _node(self, nd) -> _Node:
-        return _Node(float(nd.q[self.k]), nd.x, nd.B[:, self.k], nd.H, float(nd.sign))
+        """The solved pose x at s with x' = dx/ds (``xs``), x'' (``xss``) and the branch sign."""
+        return _node(self.kernel, np.asarray(x, dtype=float), self._q(s), self.k, J)
 
     def solve(self, s, x_guess) -> _Node | None:
         """The node at s by Newton from ``x_guess`` (None if it does not converge)."""
@@ -181,12 +165,9 @@ class PathProblem:
         """Continuation from ``node`` to s_to (the sweep's march, without charts); returns
         (node reached, ok).  A change of the branch sign is refused, so the march stops
         in front of a singular position."""
-        B = np.zeros((node.x.size, self.idx.size))
-        B[:, self.k] = node.xs
-        start = _SweepNode(self._q(node.s), node.x, B, node.xss, node.sign)
-        out, stop = _march(self.kernel, start, self.k, [s_to], max_step=_STEP * self.unit,
+        out, stop = _march(self.kernel, node, self.k, [s_to], max_step=_STEP * self.unit,
                            min_step=1e-9 * self.unit, tol=self.tol, counter={})
-        return self._node(stop.node if stop is not None else out[-1]), stop is None
+        return (stop.node if stop is not None else out[-1]), stop is None
 
 
 @dataclass

@@ -1,12 +1,10 @@
 """Records of the kinematic analyses: :class:`KinematicSweep` and :class:`KinematicPoint`.
 
-Read-only arrays of positions, velocities, accelerations and velocity analogs,
-with point and body accessors and :meth:`KinematicSweep.to_dataframe`, and the
-derived figures of :meth:`KinematicSweep.summary` (:func:`_summarize`,
-:class:`SweepSummary`): the stroke and the dead centres (TDC/BDC, refined on the
-exact travel rate) of every slider, the range of the transmission angle of every
-four-bar loop (:func:`four_bar_loops`) and the largest speed and acceleration of
-every named point.  :func:`_travel` is the travel of a prismatic joint and its rates.
+Read-only arrays of positions, velocities, accelerations and velocity analogs, and the
+derived figures of :meth:`KinematicSweep.summary` (:class:`SweepSummary`): stroke and
+dead centres (TDC/BDC, refined on the exact travel rate) of every slider, range of the
+transmission angle of every four-bar loop and the largest speed and acceleration of
+every named point.
 """
 
 from __future__ import annotations

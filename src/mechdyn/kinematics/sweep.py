@@ -38,13 +38,9 @@ constraint and coordinate rows (:mod:`mechdyn.model.rows`), the equations of
 (compiled when numba is installed) that also factors the Jacobians (sparse LU,
 which gives the branch sign too).
 
-This module holds the analyses :func:`sweep` and :func:`analyze` (steps 1-3 in
-:func:`_path`, step 4 in :func:`_motion`, which kinetostatics uses too); the building
-blocks of the continuation are in :mod:`mechdyn.kinematics.continuation`, the
-records :class:`KinematicSweep` and :class:`KinematicPoint` and their derived
-figures (:class:`SweepSummary`: dead centres, strokes, four-bar loops and
-transmission angles, extremes) in :mod:`mechdyn.kinematics.records`; all their
-public names are importable from here.
+Steps 1-2 are :func:`_path`, step 3 :func:`_motion` (kinetostatics uses both); the
+building blocks are in :mod:`mechdyn.kinematics.continuation`, the records (public
+names importable from here) in :mod:`mechdyn.kinematics.records`.
 """
 
 from __future__ import annotations
@@ -249,11 +245,9 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
     qddot = np.zeros((N, model.n_q))
     X, B, xdot, xddot, _ = _motion(kern, X, Q, qdot, qddot, book, k, system)
 
-    status, message, events, error = "success", "", (), None
+    error, events = None, ()
     if stop is not None:
-        status = Status.SINGULAR_POSITION
         error, event = _dead_report(model, lay, k, stop, N, n_req)
-        message = str(error)
         events = (event,)
     elapsed = time.perf_counter() - t_start
     stats = {"n_points": int(N), "n_requested": int(n_req), "anchors": counter["anchors"],
@@ -266,13 +260,14 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
              "mode": tuple(sorted(lay.mode))}
     return KinematicSweep(
         over=over, values=_ro(values[:N].copy()), q=_ro(Q), qdot=_ro(qdot), qddot=_ro(qddot),
-        x=_ro(X), xdot=_ro(xdot), xddot=_ro(xddot), B=_ro(B), status=status, message=message,
-        stats=stats, events=events, error=error, model=model)
+        x=_ro(X), xdot=_ro(xdot), xddot=_ro(xddot), B=_ro(B), stats=stats, events=events,
+        status="success" if error is None else Status.SINGULAR_POSITION,
+        message="" if error is None else str(error), error=error, model=model)
 
 
 def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter):
     """The continuation of the sweep from the node ``start`` through ``values`` of
-    coordinate k (the kernel's other coordinates held at ``start.q``): steps 1 to 3 of
+    coordinate k (the kernel's other coordinates held at ``start.q``): steps 1 and 2 of
     the module docstring.  Returns the poses reached (n_ok, n_x), the :class:`_Stop` or
     None and (F, J, factors) at the poses or None; ``counter`` gets the step counts,
     ``anchors``, ``fallback`` and ``time_coarse``."""
@@ -342,7 +337,7 @@ def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter
 
 
 def _motion(kern, X, Q, qdot, qddot, book, k: int, system=None, correct=True):
-    """Step 4 of the module docstring: a last Newton correction of the poses X (N, n_x)
+    """Step 3 of the module docstring: a last Newton correction of the poses X (N, n_x)
     at the coordinates Q (with ``correct``), the analogs B and the velocities and
     accelerations for the rates qdot, qddot (N, n_q), from the charts in the bifurcation
     zones of ``book`` (swept coordinate k).  Returns X, B, xdot, xddot and the charted

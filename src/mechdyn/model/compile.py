@@ -128,7 +128,19 @@ class Model:
         scale = max([p for p in pts if np.isfinite(p)] + [0.0])
         self.length_scale = scale if scale > 0 else 1.0
 
-        self._lower_rows()
+        # every joint and coordinate lowered to constraint rows (mechdyn.model.rows)
+        rv, pr, lk = self.rev, self.pri, self.lock
+        self.joint_rows = R.concat(
+            nb,
+            *[R.revolute(n, rv.i[k], rv.si[k], rv.j[k], rv.sj[k], nb=nb)
+              for k, n in enumerate(rv.names)],
+            *[R.prismatic(n, pr.i[k], pr.si[k], pr.ui[k], pr.j[k], pr.sj[k], pr.angle[k], nb=nb)
+              for k, n in enumerate(pr.names)])
+        self.weld_rows = {n: R.weld(n, lk.i[k], lk.c[k], lk.j[k], lk.angle[k], nb=nb)
+                          for k, n in enumerate(lk.names)}
+        self.coordinate_rows = R.concat(nb, *[
+            R.angle(c.name, self._bindex[c.body], c.offset, nb=nb) if c.kind == "angle"
+            else self.joint_variable(c.name, c.joint, c.offset) for c in coords])
 
         #: the engaged locks at the start (frozenset of lock names)
         self.initial_mode = frozenset(n for n, e in zip(self.lock.names, self.lock.engaged,
@@ -148,23 +160,6 @@ class Model:
         #: sweep kernels ...): constants of the model computed on first use, never
         #: the state of a run
         self.memo: dict = {}
-
-    def _lower_rows(self) -> None:
-        """Lower every joint and coordinate to constraint rows (:mod:`mechdyn.model.rows`)."""
-        nb = self.n_bodies
-        rv, pr, lk = self.rev, self.pri, self.lock
-        self.joint_rows = R.concat(
-            nb,
-            *[R.revolute(n, rv.i[k], rv.si[k], rv.j[k], rv.sj[k], nb=nb)
-              for k, n in enumerate(rv.names)],
-            *[R.prismatic(n, pr.i[k], pr.si[k], pr.ui[k], pr.j[k], pr.sj[k], pr.angle[k], nb=nb)
-              for k, n in enumerate(pr.names)])
-        self.weld_rows = {n: R.weld(n, lk.i[k], lk.c[k], lk.j[k], lk.angle[k], nb=nb)
-                          for k, n in enumerate(lk.names)}
-        coords = [R.angle(c.name, self._bindex[c.body], c.offset, nb=nb) if c.kind == "angle"
-                  else self.joint_variable(c.name, c.joint, c.offset)
-                  for c in self.mechanism.coordinates.values()]
-        self.coordinate_rows = R.concat(nb, *coords)
 
     def joint_variable(self, label: str, joint: str, offset: float = 0.0) -> R.Rows:
         """The row of the relative angle theta_child - theta_parent of a revolute joint (rad)
@@ -282,8 +277,7 @@ class ConstraintLayout:
         self.lock_active = np.array([n in mode for n in model.lock.names], dtype=bool)
         #: the constraint rows of the mode (joints, then engaged locks), as data
         self.rowset = R.concat(model.n_bodies, model.joint_rows,
-                               *[model.weld_rows[n] for n, a in
-                                 zip(model.lock.names, self.lock_active, strict=True) if a])
+                               *[model.weld_rows[n] for n in model.lock.names if n in mode])
         self.n_rows = len(self.rowset)
         self.row_joint = np.array(self.rowset.elements, dtype=object)
         self.rows = {n: np.flatnonzero(self.row_joint == n)

@@ -87,15 +87,10 @@ class Rows:
 
     def __post_init__(self):
         n = len(np.atleast_1d(self.c))
-        for name in ("b1", "b2", "d", "a", "bb"):
-            object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=np.int64)
-                               .reshape(n))
-        for name in ("s1", "s2", "u"):
-            object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=float)
-                               .reshape(n, 2))
-        for name in ("ka", "kb", "c"):
-            object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=float)
-                               .reshape(n))
+        for name in ARRAYS[:-1]:
+            shape = (n, 2) if name in ("s1", "s2", "u") else (n,)
+            dtype = np.int64 if name in ("b1", "b2", "d", "a", "bb") else float
+            object.__setattr__(self, name, np.asarray(getattr(self, name), dtype).reshape(shape))
         if self.is_angle is None:
             object.__setattr__(self, "is_angle", ~np.any(self.u != 0.0, axis=1))
         else:
