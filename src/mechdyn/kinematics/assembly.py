@@ -300,8 +300,7 @@ def _mirror_guess(model: Model, x, pts) -> np.ndarray:
         mirrored = P + 2 * np.outer(rel @ d, d) - rel
         # rigid fit (rotation only): angle from the centred cross-covariance
         lc, mc = local - local.mean(0), mirrored - mirrored.mean(0)
-        th = np.arctan2(np.sum(lc[:, 0] * mc[:, 1] - lc[:, 1] * mc[:, 0]),
-                        np.sum(lc[:, 0] * mc[:, 0] + lc[:, 1] * mc[:, 1]))
+        th = np.angle(np.vdot(lc @ [1, 1j], mc @ [1, 1j]))
         origin = mirrored.mean(0) - _turn(th, local.mean(0))
         # keep the angle on the branch of the sketch angle (no 2 pi jumps)
         th = xg[3 * k + 2] + np.angle(np.exp(1j * (th - xg[3 * k + 2])))

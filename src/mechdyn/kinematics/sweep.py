@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping
+from functools import partial
 
 import numpy as np
 
@@ -128,17 +129,11 @@ def _solve_at(kern, x_guess, q, tol):
 
 def _rates(model: Model, k: int, speed) -> np.ndarray:
     qdot = np.zeros(model.n_q)
-    if speed is None:
-        qdot[k] = 1.0
-    elif isinstance(speed, Mapping):
-        qdot[k] = 1.0
-        for name, v in speed.items():
-            if name not in model.coordinate_names:
-                raise ModelError("speed: " + did_you_mean(name, model.coordinate_names,
-                                                          "coordinate"))
-            qdot[model.coordinate_index(name)] = float(v)
-    else:
-        qdot[k] = float(speed)
+    qdot[k] = 1.0 if speed is None or isinstance(speed, Mapping) else float(speed)
+    for name, v in (speed.items() if isinstance(speed, Mapping) else ()):
+        if name not in model.coordinate_names:
+            raise ModelError("speed: " + did_you_mean(name, model.coordinate_names, "coordinate"))
+        qdot[model.coordinate_index(name)] = float(v)
     if not np.all(np.isfinite(qdot)):
         raise ModelError(f"speed must be finite, got {speed!r}")
     return qdot
@@ -275,8 +270,9 @@ def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter
     t_coarse = time.perf_counter()
     # ---- 1. coarse continuation through the anchors
     anchors = _anchor_indices(values, max_step)
-    anodes, stop = _march(kern, start, k, values[anchors], max_step=max_step,
-                          min_step=min_step, tol=tol, counter=counter, book=book)
+    march = partial(_march, kern, k=k, max_step=max_step, min_step=min_step, tol=tol,
+                    counter=counter, book=book)
+    anodes, stop = march(start, targets=values[anchors])
     n_anch = len(anodes)
     counter.update(time_coarse=time.perf_counter() - t_coarse, anchors=len(anchors),
                    fallback=0)
@@ -308,9 +304,7 @@ def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter
             counter["fallback"] += 1
             system = None
             i0, i1 = a_idx[m_], a_idx[m_ + 1]
-            nodes, st = _march(kern, anodes[m_], k, values[i0 + 1:i1 + 1],
-                               max_step=max_step, min_step=min_step, tol=tol, counter=counter,
-                               book=book)
+            nodes, st = march(anodes[m_], targets=values[i0 + 1:i1 + 1])
             for r, nd in enumerate(nodes):
                 X[i0 + 1 + r] = nd.x
             if st is not None:  # only if a singular position lies between two anchors
@@ -324,9 +318,7 @@ def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter
     if stop is not None and n_anch >= 0 and n_ok < n_req:
         last = anodes[-1] if n_anch else start
         nxt = anchors[n_anch] if n_anch < len(anchors) else n_req - 1
-        nodes, stop = _march(kern, last, k, values[n_ok:nxt + 1], max_step=max_step,
-                             min_step=min_step, tol=tol, counter=counter, prev=None,
-                             book=book)
+        nodes, stop = march(last, targets=values[n_ok:nxt + 1])
         if stop is None:  # cannot happen: the anchor itself was unreachable
             stop = _Stop(nodes[-1], nodes[-1].q, "the continuation could not reach "
                          f"{values[nxt]:.9g}")

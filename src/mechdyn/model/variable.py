@@ -308,15 +308,15 @@ def parse_variable(model, spec: str, *, allow_time: bool = False, allow_rate: bo
         lists the valid forms or names.
     """
     var = parse(spec, model.coordinate_names)
-    for kind, ok, what in (("time", allow_time, "variable 't' (time)"),
-                           ("distance", allow_distance, f"distance variable {var.text!r}")):
-        if var.kind == kind and not ok:
+    for bad, what in ((var.kind == "time" and not allow_time, "variable 't' (time)"),
+                      (var.kind == "distance" and not allow_distance,
+                       f"distance variable {var.text!r}"),
+                      (var.rate and not allow_rate, f"rate variable {var.text!r}")):
+        if bad:
             raise ModelError(f"{what} is allowed only in switch conditions")
-    if var.rate and not allow_rate:
-        raise ModelError(f"rate variable {var.text!r} is allowed only in switch conditions")
-    rows = lower(model, var)
     if var.kind == "time":
         return TimeMeasure()
+    rows = lower(model, var)
     if var.kind == "distance":
         return DistanceMeasure(rows, var.text)
     base = Measure(rows.renamed(var.text))
