@@ -336,8 +336,7 @@ def bridge(path: PathProblem, start: _Node, s_star: float, *, zone: float = ZONE
     if nb is None:
         return None
     sc = path.scale
-    step = np.max(np.abs((nb.x - b.x) * sc))
-    if np.max(np.abs((nb.x - xp) * sc)) > 0.1 * step:
+    if np.max(np.abs((nb.x - xp) * sc)) > 0.1 * np.max(np.abs((nb.x - b.x) * sc)):
         return None
     xs_p = b.xs + b.xss * (sb - b.s)
     if np.max(np.abs((nb.xs - xs_p) * sc)) > 0.25 * max(np.max(np.abs(nb.xs * sc)),
@@ -353,9 +352,8 @@ def bridge(path: PathProblem, start: _Node, s_star: float, *, zone: float = ZONE
     rc = min(path.rcond(b.x), path.rcond(nb.x))
     if not flip:
         # no crossing: keep the chart only if the branches nearly touch in between
-        xs_mid = 0.5 * (b.s + nb.s)
-        mid = path.solve(xs_mid, _hermite5(0.5, nb.s - b.s, b.x, b.xs, b.xss, nb.x, nb.xs,
-                                           nb.xss))
+        mid = path.solve(0.5 * (b.s + nb.s), _hermite5(0.5, nb.s - b.s, b.x, b.xs, b.xss,
+                                                       nb.x, nb.xs, nb.xss))
         if mid is None:
             return None
         rc = min(rc, path.rcond(mid.x))
@@ -448,11 +446,8 @@ class ChartBook:
 
         ``force_at`` skips the estimate: a singular position is known to lie there."""
         unit = self.path.unit
-        if force_at is None:
-            if not self.due(s):
-                return None
-            if self.window_chart(s) is not None or self._skipped(s):
-                return None
+        if force_at is None and (not self.due(s) or self._blocked(s)):
+            return None
         try:
             off = force_at - s if force_at is not None else self.path.singular_offset(x)
         except np.linalg.LinAlgError:
@@ -466,7 +461,7 @@ class ChartBook:
             if not dist <= r:
                 return None
         s_star = s + off
-        if self.window_chart(s_star) is not None or self._skipped(s_star):
+        if self._blocked(s_star):
             return None
         try:
             with np.errstate(all="ignore"):
@@ -481,8 +476,9 @@ class ChartBook:
         self.charts.append(chart)
         return chart
 
-    def _skipped(self, s) -> bool:
-        return any(lo <= s <= hi for lo, hi, _ in self.skipped)
+    def _blocked(self, s) -> bool:
+        """Whether s lies in the window of a chart or of a place where none was built."""
+        return self.window_chart(s) is not None or any(lo <= s <= hi for lo, hi, _ in self.skipped)
 
     def apply(self, s):
         """Chart values for the samples s (m,) that lie in a zone.

@@ -97,19 +97,15 @@ def initial_coordinates(model: Model, x0=None) -> np.ndarray:
     q0 = coordinates(model, np.asarray(_start_pose(model) if x0 is None else x0, float))
     init = (model.mechanism.extras or {}).get("initial", {})
     given = init.get("q") if isinstance(init, Mapping) else None
-    if given is None:
-        return q0
-    q = q0.copy()
-    if isinstance(given, Mapping):
-        for name, v in given.items():
-            q[model.coordinate_index(name)] = float(v)
-    else:
-        arr = np.asarray(given, float).reshape(-1)
-        if arr.shape != (model.n_q,):
+    if given is not None and not isinstance(given, Mapping):
+        q = np.asarray(given, float).reshape(-1)
+        if q.shape != (model.n_q,):
             raise ModelError(f"initial q must list {model.n_q} value(s) "
                              f"({', '.join(model.coordinate_names)}), got {given!r}")
-        q = arr
-    return q
+        return q
+    for name, v in (given or {}).items():
+        q0[model.coordinate_index(name)] = float(v)
+    return q0
 
 
 def _start_pose(model: Model, lay=None, fresh: bool = False) -> np.ndarray:
@@ -217,9 +213,8 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
     x_init, _, J0 = _solve_at(kern, x0, q_init, tol)
     start = _node(kern, x_init, q_init, k, J=J0)
     # bifurcation positions on the way are gone through on the branch (branch charts)
-    book = None
-    if lay.n_rows + model.n_q == model.n_x:
-        book = ChartBook(PathProblem(model, lay, np.arange(model.n_q), q_init, k))
+    book = ChartBook(PathProblem(model, lay, np.arange(model.n_q), q_init, k)) \
+        if kern.square else None
 
     if values is None:
         if not is_angle:
@@ -285,10 +280,8 @@ def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter
     elif n_anch > 1:
         a_idx = anchors[:n_anch]
         seg = np.clip(np.searchsorted(a_idx, np.arange(n_ok), side="right") - 1, 0, n_anch - 2)
-        xa = np.array([nd.x for nd in anodes])
-        da = np.array([nd.B[:, k] for nd in anodes])
-        aa = np.array([nd.H for nd in anodes])
-        sg = np.array([nd.sign for nd in anodes])
+        xa, da, aa, sg = (np.array([getattr(nd, f) for nd in anodes])
+                          for f in ("x", "xs", "xss", "sign"))
         qa = values[a_idx]
         h = (qa[seg + 1] - qa[seg])[:, None]
         with np.errstate(invalid="ignore", divide="ignore"):
