@@ -104,10 +104,7 @@ def travel_rows(model: Model, joint: str) -> R.Rows:
     if model.joint_kind(joint) != "prismatic":
         raise ModelError(f"joint {joint!r} is not a prismatic joint; prismatic joints: "
                          + (", ".join(repr(v) for v in model.pri.names) or "(none)"))
-    pr = model.pri
-    k = pr.names.index(joint)
-    return R.line(joint, pr.j[k], pr.sj[k], pr.i[k], pr.si[k], pr.ui[k], normal=False,
-                  nb=model.n_bodies)
+    return model.joint_variable(joint, joint)
 
 
 # ---------------------------------------------------------------- points

@@ -199,10 +199,8 @@ class KinematicSweep:
             return "" if m.coord_is_angle[c] else "_m"
 
         for b in m.body_names:
-            th, om, al = self.angular(b)
-            cols[f"theta_{b}_rad"] = th
-            cols[f"omega_{b}_rad_s"] = om
-            cols[f"alpha_{b}_rad_s2"] = al
+            cols.update(zip((f"theta_{b}_rad", f"omega_{b}_rad_s", f"alpha_{b}_rad_s2"),
+                            self.angular(b), strict=True))
             k = 3 * m.body_index(b) + 2
             for c, name in enumerate(names):
                 cols[f"dtheta_{b}_d{name}_rad{per(c)}"] = self.B[:, k, c]
@@ -210,9 +208,8 @@ class KinematicSweep:
             r, v, a = self.point(b, p)
             dr = self.point_analogs(b, p)
             tag = f"{b}_{p}"
-            cols[f"x_{tag}_m"], cols[f"y_{tag}_m"] = r[:, 0], r[:, 1]
-            cols[f"vx_{tag}_m_s"], cols[f"vy_{tag}_m_s"] = v[:, 0], v[:, 1]
-            cols[f"ax_{tag}_m_s2"], cols[f"ay_{tag}_m_s2"] = a[:, 0], a[:, 1]
+            for pre, arr, unit in (("", r, "m"), ("v", v, "m_s"), ("a", a, "m_s2")):
+                cols[f"{pre}x_{tag}_{unit}"], cols[f"{pre}y_{tag}_{unit}"] = arr[:, 0], arr[:, 1]
             for c, name in enumerate(names):
                 cols[f"dx_{tag}_d{name}_m{per(c)}"] = dr[:, 0, c]
                 cols[f"dy_{tag}_d{name}_m{per(c)}"] = dr[:, 1, c]

@@ -88,8 +88,7 @@ class Model:
         self.body_names = tuple(b.name for b in bodies)
         self.n_bodies = nb = len(bodies)
         self.n_x = 3 * nb
-        self._bindex = {n: k for k, n in enumerate(self.body_names)}
-        self._bindex[GROUND] = nb
+        self._bindex = {**{n: k for k, n in enumerate(self.body_names)}, GROUND: nb}
         self._bodies = {**mechanism.all_bodies}
 
         self.mass = np.array([b.mass for b in bodies], dtype=float)
@@ -143,8 +142,7 @@ class Model:
             else self.joint_variable(c.name, c.joint, c.offset) for c in coords])
 
         #: the engaged locks at the start (frozenset of lock names)
-        self.initial_mode = frozenset(n for n, e in zip(self.lock.names, self.lock.engaged,
-                                                        strict=True) if e)
+        self.initial_mode = frozenset(j.name for j in locks if j.engaged)
         #: declared assembly modes: (AssemblyMode, ((body index, local point) for P, Q, R))
         self.assembly_modes = [
             (am, tuple((self._bindex[b], np.asarray(self._point(b, ref), dtype=float))

@@ -262,18 +262,13 @@ class DistanceMeasure(Measure):
     """Distance between two body points, m (switch conditions only); ``rows`` are the
     ground x and y of their separation."""
 
-    def __init__(self, rows: Rows, label: str):
-        self.rows, self.label, self.is_angle = rows, label, False
-
     def value(self, X, V=None) -> float:
         return float(np.hypot(*rows_numpy.values(self.rows, _pose(X, self.rows.nb))))
 
     def rate(self, X, V, nb: int | None = None) -> float:
-        n = self.rows.nb
-        x = _pose(X, n)
-        d = rows_numpy.values(self.rows, x)
+        d, J, _ = rows_numpy.evaluate(self.rows, _pose(X, self.rows.nb))
         r = float(np.hypot(*d))
-        return float(d @ (rows_numpy.jacobian(self.rows, x) @ _pose(V, n))) / r if r else 0.0
+        return float(d @ (J @ _pose(V, self.rows.nb))) / r if r else 0.0
 
 
 class TimeMeasure:
