@@ -160,10 +160,8 @@ def solve_position(model: Model, q, x_guess, *, layout: ConstraintLayout | None 
     x, done = newton(lay.position_rows, x_guess, np.concatenate([zeros, q], axis=-1), tol=tol,
                      max_iter=max_iter)
     if not np.all(done):
-        batch = done.shape
-        bad = np.unravel_index(np.argmax(~done), batch) if batch else ()
-        xb, qb = x[bad], q[bad] if q.ndim > 1 else q
-        raise _assembly_error(model, qb, xb, lay, t)
+        bad = np.unravel_index(np.argmax(~done), done.shape)
+        raise _assembly_error(model, q[bad] if q.ndim > 1 else q, x[bad], lay, t)
     if check_singular:
         _check_singular(model, x, q, lay, t)
     return x

@@ -346,11 +346,9 @@ def _motion(kern, X, Q, qdot, qddot, book, k: int, system=None, correct=True):
         xdot = np.einsum("nij,nj->ni", B, qdot)
         xddot = np.einsum("nij,nj->ni", B, qddot)
         xddot += kern.apply(J, fac, kern.gamma(X, xdot)[..., None])[..., 0]
-    if book is None or not book.charts:
+    if book is None or not (charted := book.apply(Q[:, k]))[0].any():
         return X, B, xdot, xddot, None
-    mask, xc, xs, xss = book.apply(Q[:, k])
-    if not mask.any():
-        return X, B, xdot, xddot, None
+    mask, xc, xs, xss = charted
     # the limit from both sides, where the equations are ill-conditioned: the analogs of
     # the other coordinates stay those of the direct solve, and so does the part of the
     # acceleration due to their rates
@@ -415,15 +413,13 @@ def analyze(mech_or_model, q, qdot, qddot=None, x_guess=None, *, mode=None) -> K
     model = as_model(mech_or_model)
     lay = model.layout(mode)
     kern = _kernel(model, lay)
-    q = np.asarray(q, float).reshape(model.n_q)
-    qdot = np.asarray(qdot, float).reshape(model.n_q)
-    qddot = np.zeros(model.n_q) if qddot is None else np.asarray(qddot, float).reshape(
-        model.n_q)
+    q, qdot, qddot = (np.array(v, float).reshape(model.n_q)
+                      for v in (q, qdot, np.zeros(model.n_q) if qddot is None else qddot))
     x, F, J = _solve_at(kern, _start_pose(model, lay) if x_guess is None else x_guess, q,
                         _position_tol(model))
     system = (F[None], J[None], kern.factor(J[None]))
     x, B, xdot, xddot, _ = _motion(kern, x[None], q[None], qdot[None], qddot[None], None, 0,
                                    system, correct=False)
-    return KinematicPoint(q=_ro(q.copy()), qdot=_ro(qdot.copy()), qddot=_ro(qddot.copy()),
+    return KinematicPoint(q=_ro(q), qdot=_ro(qdot), qddot=_ro(qddot),
                           x=_ro(x[0]), xdot=_ro(xdot[0]), xddot=_ro(xddot[0]), B=_ro(B[0]),
                           model=model)
