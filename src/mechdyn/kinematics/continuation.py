@@ -235,10 +235,8 @@ def _march(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, t
         while node.q[k] != target:
             remaining = target - node.q[k]
             qn = node.q.copy()
-            if abs(remaining) <= h_try * (1 + 1e-6):
-                qn[k] = target
-            else:
-                qn[k] = node.q[k] + np.sign(remaining) * h_try
+            qn[k] = target if abs(remaining) <= h_try * (1 + 1e-6) else \
+                node.q[k] + np.sign(remaining) * h_try
             h = qn[k] - node.q[k]
             counter["coarse_steps"] = counter.get("coarse_steps", 0) + 1
             zone = book.zone_chart(qn[k]) if book is not None else None
@@ -246,13 +244,10 @@ def _march(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, t
                 prev, node = node, _chart_node(kern, zone, qn, k)
                 h_try = min(2 * h_try, max_step)
                 continue
-            win = None
-            if book is not None:
-                win = book.window_chart(qn[k]) or book.window_chart(node.q[k])
+            win = (book.window_chart(qn[k]) or book.window_chart(node.q[k])) if book else None
             xp = win.evaluate(qn[k])[0] if win is not None else _predict(prev, node, k, h)
             x, ok, _, J = _newton(kern, xp, qn, tol)
-            accepted = False
-            reason = "Newton's method does not converge"
+            reason = "Newton's method does not converge"  # None: the step is accepted
             if ok:
                 nn = _node(kern, x, qn, k, J=J)
                 step = np.max(np.abs((nn.x - node.x) * kern.col_scale))
@@ -263,8 +258,8 @@ def _march(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, t
                 elif corr > 0.25 * step + 1e-9 * L:
                     reason = "the corrector moves far from the predictor"
                 else:
-                    accepted = True
-            if not accepted:
+                    reason = None
+            if reason is not None:
                 counter["rejected_steps"] = counter.get("rejected_steps", 0) + 1
                 h_try = abs(h) / 2
                 prev = None  # fall back to the Taylor predictor near trouble

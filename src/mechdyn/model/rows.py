@@ -192,21 +192,14 @@ def revolute(name: str, i: int, si, j: int, sj, *, nb: int) -> Rows:
 
 def prismatic(name: str, i: int, si, ui, j: int, sj, held_angle: float, *, nb: int) -> Rows:
     """The normal row n_i . (p_j - p_i) (m) and the angle row theta_j - theta_i - angle."""
-    ux, uy = np.asarray(ui, float) / np.hypot(*ui)
-    return _rows(nb, [
-        _one(nb, b1=j, s1=sj, b2=i, s2=si, d=i, u=(-uy, ux), label=f"{name}.normal",
-             element=name),
-        _one(nb, a=j, ka=1.0, bb=i, kb=-1.0, c=-held_angle, label=f"{name}.angle",
-             element=name, is_angle=True)])
+    return concat(nb, line(f"{name}.normal", j, sj, i, si, ui, normal=True, nb=nb, element=name),
+                  relative_angle(f"{name}.angle", i, j, -held_angle, nb=nb, element=name))
 
 
 def weld(name: str, i: int, c, j: int, held_angle: float, *, nb: int) -> Rows:
     """Three rows: ground x and y of r_j - (r_i + A_i c) (m), then theta_j - theta_i - angle."""
-    return _rows(nb, [
-        *[_one(nb, b1=j, b2=i, s2=c, u=e, label=f"{name}.{k}", element=name)
-          for e, k in ((EX, "x"), (EY, "y"))],
-        _one(nb, a=j, ka=1.0, bb=i, kb=-1.0, c=-held_angle, label=f"{name}.angle",
-             element=name, is_angle=True)])
+    return concat(nb, revolute(name, j, (0.0, 0.0), i, c, nb=nb),
+                  relative_angle(f"{name}.angle", i, j, -held_angle, nb=nb, element=name))
 
 
 def angle(label: str, b: int, offset: float = 0.0, *, nb: int, element: str = "") -> Rows:
