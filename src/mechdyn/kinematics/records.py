@@ -87,9 +87,8 @@ class KinematicSweep:
     B : ndarray, shape (n, n_x, n_q)
         Velocity analogs dx/dq (m/rad, rad/rad, m/m or rad/m).
     status : Status
-        ``"success"`` or ``"singular-position"``
-        ``"singular-position"``: the sweep stopped at a dead or toggle position; the
-        positions before it are kept and ``message`` says where.
+        ``"success"``, or ``"singular-position"``: the sweep stopped at a dead or toggle
+        position; the positions before it are kept and ``message`` says where.
     message : str
     stats : dict
         Counts and timings (``n_points``, ``n_requested``, ``coarse_steps``,
@@ -413,10 +412,9 @@ def _summarize(sw: KinematicSweep) -> SweepSummary:
         s, ds, _ = _travel(m, jname, sw.x, sw.B[..., k], np.zeros_like(sw.x))
         found = []
         for i in np.flatnonzero(np.sign(ds[:-1]) * np.sign(ds[1:]) < 0):
-            q_at, s_at = _refine_root(sw, i, partial(_travel, m, jname))
             # a maximum where the travel rate goes from + to - along the sweep direction
             is_max = (ds[i] > 0) == (sw.values[i + 1] > sw.values[i])
-            found.append((q_at, s_at, is_max))
+            found.append((*_refine_root(sw, i, partial(_travel, m, jname)), is_max))
         for i in np.flatnonzero(ds == 0.0):  # exactly on a sample: keep it if an extremum
             j0, j1 = max(i - 1, 0), min(i + 1, n - 1)
             hi, lo = s[i] >= max(s[j0], s[j1]), s[i] <= min(s[j0], s[j1])
@@ -424,8 +422,8 @@ def _summarize(sw: KinematicSweep) -> SweepSummary:
                 found.append((float(sw.values[i]), float(s[i]), bool(hi)))
         allvals = np.concatenate([s, [f[1] for f in found]])
         strokes[jname] = float(np.max(allvals) - np.min(allvals))
-        for q_at, s_at, is_max in sorted(found):
-            dcs.append(DeadCentre(jname, "TDC" if is_max else "BDC", q_at, s_at))
+        dcs.extend(DeadCentre(jname, "TDC" if is_max else "BDC", q_at, s_at)
+                   for q_at, s_at, is_max in sorted(found))
     for lp in four_bar_loops(m, sw.over):
         B_, C_, D_ = (_joint_point(m, j, sw.x) for j in lp.joints[1:])
         u, v = B_ - C_, D_ - C_
