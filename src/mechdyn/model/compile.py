@@ -105,12 +105,11 @@ class Model:
             *self._ends(pris), self._points(pris, "parent"),
             np.array([np.asarray(j.axis, float) / np.hypot(*j.axis) for j in pris]).reshape(-1, 2),
             self._points(pris, "child"),
-            np.array([self._sketch_angle(j) if j.angle is None else j.angle for j in pris],
-                     dtype=float))
-        offsets = [self._sketch_offset(j) if j.offset is None else j.offset for j in locks]
-        self.lock = LockRows(*self._ends(locks),
-                             np.array([o[:2] for o in offsets], dtype=float).reshape(-1, 2),
-                             np.array([o[2] for o in offsets], dtype=float),
+            np.array([self._bodies[j.child].pose[2] - self._bodies[j.parent].pose[2]
+                      if j.angle is None else j.angle for j in pris], dtype=float))
+        off = np.array([self._sketch_offset(j) if j.offset is None else j.offset[:3]
+                        for j in locks], dtype=float).reshape(-1, 3)
+        self.lock = LockRows(*self._ends(locks), off[:, :2], off[:, 2],
                              np.array([j.engaged for j in locks], dtype=bool))
         self.joint_names = tuple(mechanism.joints)
         self._jkind = {n: type(j).__name__.lower() for n, j in mechanism.joints.items()}
@@ -207,9 +206,6 @@ class Model:
         if isinstance(ref, str):
             return self._bodies[body].point(ref)
         return (float(ref[0]), float(ref[1]))
-
-    def _sketch_angle(self, j) -> float:
-        return self._bodies[j.child].pose[2] - self._bodies[j.parent].pose[2]
 
     def _sketch_offset(self, j):
         pi = np.asarray(self._bodies[j.parent].pose)

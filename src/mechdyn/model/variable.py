@@ -198,10 +198,9 @@ def lower(model, var: Variable) -> Rows | None:
     if var.kind == "angle":
         return R.angle(var.text, model.body_index(var.name), nb=nb)
     if var.kind == "point":
-        b, s = _body_point(model, var.points[0])
-        return R.point(var.text, b, s, var.comp, nb=nb)
-    (b1, s1), (b2, s2) = (_body_point(model, p) for p in var.points)
+        return R.point(var.text, *_body_point(model, var.points[0]), var.comp, nb=nb)
     # the separation of two points: the two rows of a pin joint between them
+    (b1, s1), (b2, s2) = (_body_point(model, p) for p in var.points)
     return R.revolute(var.text, b1, s1, b2, s2, nb=nb)
 
 
