@@ -226,10 +226,7 @@ class BranchChart:
         s = np.asarray(s, dtype=float)
         u = (s - self.centre) / self.window
         out = cheb.chebvander(u, self.coef.shape[0] - 1) @ self.coef
-        if s.ndim == 0:
-            out = out.reshape(-1)
-        n = out.shape[-1] // 3
-        return out[..., :n], out[..., n:2 * n], out[..., 2 * n:]
+        return tuple(np.split(out.reshape(-1) if s.ndim == 0 else out, 3, axis=-1))
 
     def summary(self) -> dict:
         """The chart as a plain dict (for run statistics)."""
@@ -490,8 +487,7 @@ class ChartBook:
         """
         s = np.asarray(s, dtype=float).reshape(-1)
         mask = np.zeros(s.size, dtype=bool)
-        n_x = self.path.model.n_x
-        x, xs, xss = (np.empty((s.size, n_x)) for _ in range(3))
+        x, xs, xss = (np.empty((s.size, self.path.model.n_x)) for _ in range(3))
         for ch in self.charts:
             m = (np.abs(s - ch.centre) < ch.zone) & ~mask
             if m.any():

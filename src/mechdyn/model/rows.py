@@ -140,13 +140,11 @@ class Rows:
         """Flat indices into an (n, n_x + 1) array of the nine Jacobian terms of every row
         (columns of b1 x, y, theta; b2 x, y, theta; d theta; a theta; bb theta), the
         ground's columns sent to the last (dump) column."""
-        n, nb = len(self), self.nb
-        n_x = 3 * nb
-        cols = []
-        for b, k in ((self.b1, 0), (self.b1, 1), (self.b1, 2), (self.b2, 0), (self.b2, 1),
-                     (self.b2, 2), (self.d, 2), (self.a, 2), (self.bb, 2)):
-            cols.append(np.where(b >= nb, n_x, 3 * b + k))
-        return np.concatenate([np.arange(n) * (n_x + 1) + c for c in cols])
+        n_x = self.n_x
+        terms = ((self.b1, 0), (self.b1, 1), (self.b1, 2), (self.b2, 0), (self.b2, 1),
+                 (self.b2, 2), (self.d, 2), (self.a, 2), (self.bb, 2))
+        return np.concatenate([np.arange(len(self)) * (n_x + 1)
+                               + np.where(b >= self.nb, n_x, 3 * b + k) for b, k in terms])
 
     def packed(self) -> tuple[np.ndarray, np.ndarray]:
         """(ints (n, 5): b1 b2 d a bb; floats (n, 9): s1 s2 u ka kb c) for the compiled
