@@ -106,9 +106,8 @@ class PathProblem:
                              f"({layout.n_rows} joint rows + {self.idx.size} coordinates "
                              f"for {model.n_x} pose components)")
         self.scale = _scale(model)
-        angle = bool(model.coord_is_angle[self.idx[self.k]])
         #: unit of the path coordinate for the zone sizes: 1 rad, or the length scale
-        self.unit = 1.0 if angle else float(model.length_scale)
+        self.unit = 1.0 if model.coord_is_angle[self.idx[self.k]] else float(model.length_scale)
         self.tol = 1e-14 * max(model.length_scale, 1e-3)
         #: the equations [Phi; g_idx - q] (the compiled kernel of the sweep)
         self.kernel = _kernel(model, layout, self.idx)
@@ -303,10 +302,8 @@ def bridge(path: PathProblem, start: _Node, s_star: float, *, zone: float = ZONE
     r1, R = zone * path.unit, window * path.unit
     ts = r1 + (R - r1) * (1.0 - np.cos(np.array([0.0, 0.25, 0.5]) * np.pi))  # r1 .. R
     dsgn = 1.0 if s_star >= start.s else -1.0
-    node = start
-    near: list[_Node] = []
     for _ in range(4):  # place the approach side, re-centring on the way
-        near, n = [], node
+        near, n = [], start
         for t in ts[::-1]:
             n, ok = path.march(n, s_star - dsgn * t)
             if not ok:  # the singular position is closer than estimated
@@ -315,14 +312,11 @@ def bridge(path: PathProblem, start: _Node, s_star: float, *, zone: float = ZONE
         if len(near) < ts.size:
             s_star = n.s + dsgn * 1e-3 * path.unit
             continue
-        off = path.singular_offset(near[-1].x, near[-1].xs)
-        new = near[-1].s + off
+        new = near[-1].s + path.singular_offset(near[-1].x, near[-1].xs)
         if not np.isfinite(new) or abs(new - s_star) <= 0.2 * r1:
             break
         s_star = new
     else:
-        return None
-    if len(near) < ts.size:
         return None
     # ---- across: extrapolate the approach side, correct, check the continuation
     a, b = near[-2], near[-1]
