@@ -320,9 +320,7 @@ class SweepSummary:
             extra = f" = {wrapped:.4f} deg mod 360" if abs(wrapped - deg) > 1e-9 else ""
             return f"{self.over} = {deg:.4f} deg{extra}"
 
-        out = []
-        for j, s in self.strokes.items():
-            out.append(f"stroke of slider {j!r}: {s * 1e3:.6g} mm")
+        out = [f"stroke of slider {j!r}: {s * 1e3:.6g} mm" for j, s in self.strokes.items()]
         for d in self.dead_centres:
             out.append(f"dead centre {d.label} of {d.joint!r} at {at(d.at)} "
                        f"(travel {d.travel * 1e3:.6g} mm)")

@@ -124,10 +124,8 @@ def parse(spec: str, coordinates: Collection[str]) -> Variable:
     for head, kind in (("joint:", "joint"), ("angle:", "angle")):
         if s.startswith(head) and s[len(head):].strip():
             return Variable(s, kind, s[len(head):].strip())
-    m = _DIST.match(s)
-    if m:
-        return Variable(s, "distance", points=(_point_ref(m.group(1), s),
-                                               _point_ref(m.group(2), s)))
+    if m := _DIST.match(s):
+        return Variable(s, "distance", points=tuple(_point_ref(g, s) for g in m.groups()))
     parts = s.split(".")
     if len(parts) == 3 and parts[2] in ("x", "y") and parts[0] and parts[1]:
         return Variable(s, "point", points=((parts[0], parts[1]),), comp="xy".index(parts[2]))
