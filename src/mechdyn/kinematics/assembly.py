@@ -359,14 +359,9 @@ def _least_squares(model, x, q, lay, weight: float = 1.0, **options) -> np.ndarr
     """The pose nearest to [Phi; weight (g - q)] = 0 from x, by SciPy's least_squares."""
     w = np.ones(lay.n_rows + model.n_q)
     w[lay.n_rows:] = weight
-
-    def fun(xx):
-        return system(model, xx, q, lay)[0] * w
-
-    def jac(xx):
-        return system(model, xx, q, lay)[1] * w[:, None]
-
-    return least_squares(fun, x, jac=jac, xtol=1e-15, ftol=1e-15, gtol=1e-15, **options).x
+    return least_squares(lambda xx: system(model, xx, q, lay)[0] * w, x,
+                         jac=lambda xx: system(model, xx, q, lay)[1] * w[:, None],
+                         xtol=1e-15, ftol=1e-15, gtol=1e-15, **options).x
 
 
 def rank_report(model: Model, x, layout=None) -> dict:

@@ -111,8 +111,6 @@ class PathProblem:
         self.tol = 1e-14 * max(model.length_scale, 1e-3)
         #: the equations [Phi; g_idx - q] (the compiled kernel of the sweep)
         self.kernel = _kernel(model, layout, self.idx)
-        self._e = np.zeros(model.n_x)
-        self._e[layout.n_rows + self.k] = 1.0
 
     # ------------------------------------------------------------------ equations
     def _q(self, s) -> np.ndarray:
@@ -146,7 +144,7 @@ class PathProblem:
         no guide: away from the crossing the vanishing one need not be the smallest."""
         J = self.jacobian(x)
         if xs is None:
-            xs = np.linalg.solve(J, self._e)
+            xs = np.linalg.solve(J, np.eye(len(J))[self.layout.n_rows + self.k])
         h = 1e-5 * self.unit
         d0 = np.linalg.det(J * self.scale)
         d1 = (np.linalg.det(self.jacobian(x + h * xs) * self.scale) - d0) / h
