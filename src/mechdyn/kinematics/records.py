@@ -32,10 +32,6 @@ def _ro(a):
     return a
 
 
-def _unit_of(model: Model, c: int) -> str:
-    return "rad" if model.coord_is_angle[c] else "m"
-
-
 @dataclass(frozen=True)
 class KinematicPoint:
     """Kinematics of one position (see :func:`~mechdyn.kinematics.sweep.analyze`).
@@ -184,25 +180,21 @@ class KinematicSweep:
         m = self.model
         cols: dict[str, np.ndarray] = {}
         names = m.coordinate_names
-        for c, name in enumerate(names):
-            u = _unit_of(m, c)
+        units = ["rad" if a else "m" for a in m.coord_is_angle]
+        per = ["" if a else "_m" for a in m.coord_is_angle]  # analogs: per m is written
+        for c, (name, u) in enumerate(zip(names, units, strict=True)):
             cols[f"{name}_{u}"] = self.q[:, c]
             if name == self.over and u == "rad":
                 cols[f"{name}_deg"] = np.rad2deg(self.q[:, c])
-        for c, name in enumerate(names):
-            u = _unit_of(m, c)
+        for c, (name, u) in enumerate(zip(names, units, strict=True)):
             cols[f"{name}_dot_{u}_s"] = self.qdot[:, c]
             cols[f"{name}_ddot_{u}_s2"] = self.qddot[:, c]
-
-        def per(c):  # analog unit suffix: per rad is implied, per m is written
-            return "" if m.coord_is_angle[c] else "_m"
-
         for b in m.body_names:
             cols.update(zip((f"theta_{b}_rad", f"omega_{b}_rad_s", f"alpha_{b}_rad_s2"),
                             self.angular(b), strict=True))
             k = 3 * m.body_index(b) + 2
             for c, name in enumerate(names):
-                cols[f"dtheta_{b}_d{name}_rad{per(c)}"] = self.B[:, k, c]
+                cols[f"dtheta_{b}_d{name}_rad{per[c]}"] = self.B[:, k, c]
         for b, p in m.named_points():
             r, v, a = self.point(b, p)
             dr = self.point_analogs(b, p)
@@ -210,8 +202,8 @@ class KinematicSweep:
             for pre, arr, unit in (("", r, "m"), ("v", v, "m_s"), ("a", a, "m_s2")):
                 cols[f"{pre}x_{tag}_{unit}"], cols[f"{pre}y_{tag}_{unit}"] = arr[:, 0], arr[:, 1]
             for c, name in enumerate(names):
-                cols[f"dx_{tag}_d{name}_m{per(c)}"] = dr[:, 0, c]
-                cols[f"dy_{tag}_d{name}_m{per(c)}"] = dr[:, 1, c]
+                cols[f"dx_{tag}_d{name}_m{per[c]}"] = dr[:, 0, c]
+                cols[f"dy_{tag}_d{name}_m{per[c]}"] = dr[:, 1, c]
         return pd.DataFrame(cols)
 
     # ------------------------------------------------------------------ summary
