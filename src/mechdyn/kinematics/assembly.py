@@ -30,9 +30,7 @@ DEAD_RCOND = 1e-4
 
 def _scale(model: Model) -> np.ndarray:
     """Column scaling: lengths as they are, rotations times the length scale."""
-    s = np.ones(model.n_x)
-    s[2::3] = model.length_scale
-    return s
+    return np.tile([1.0, 1.0, model.length_scale], model.n_bodies)
 
 
 def _position_tol(model: Model) -> float:

@@ -410,8 +410,7 @@ def _summarize(sw: KinematicSweep) -> SweepSummary:
             hi, lo = s[i] >= max(s[j0], s[j1]), s[i] <= min(s[j0], s[j1])
             if hi != lo:
                 found.append((float(sw.values[i]), float(s[i]), bool(hi)))
-        allvals = np.concatenate([s, [f[1] for f in found]])
-        strokes[jname] = float(np.max(allvals) - np.min(allvals))
+        strokes[jname] = float(np.ptp(np.concatenate([s, [f[1] for f in found]])))
         dcs.extend(DeadCentre(jname, "TDC" if is_max else "BDC", q_at, s_at)
                    for q_at, s_at, is_max in sorted(found))
     for lp in four_bar_loops(m, sw.over):
