@@ -163,8 +163,6 @@ def _one(nb, *, label: str, element: str = "", is_angle: bool = False, **row) ->
 
 
 def _rows(nb: int, recs: list[dict]) -> Rows:
-    if not recs:
-        return Rows(nb, **{k: np.zeros(0, bool if k == "is_angle" else float) for k in ARRAYS})
     return Rows(nb, **{k: [r[k] for r in recs] for k in ARRAYS},
                 labels=tuple(r["label"] for r in recs), elements=tuple(r["element"] for r in recs))
 
