@@ -237,12 +237,10 @@ def _fit(nodes, centre: float, window: float) -> np.ndarray:
     N = 3 * len(nodes)
     u = np.array([(nd.s - centre) / window for nd in nodes])
     V0 = cheb.chebvander(u, N - 1)
-    eye = np.eye(N)
-    D1 = np.array([np.pad(cheb.chebder(eye[j]), (0, 1)) for j in range(N)])
-    D2 = np.array([np.pad(cheb.chebder(eye[j], 2), (0, 2)) for j in range(N)])
+    # the derivatives of T_0 .. T_(N-1) as Chebyshev series (one row each)
+    D1, D2 = (np.pad(cheb.chebder(np.eye(N), m, axis=1), ((0, 0), (0, m))) for m in (1, 2))
     V = np.concatenate([V0, V0 @ D1.T / window, V0 @ D2.T / window**2])
-    Y = np.concatenate([[nd.x for nd in nodes], [nd.xs for nd in nodes],
-                        [nd.xss for nd in nodes]])
+    Y = np.concatenate([[getattr(nd, f) for nd in nodes] for f in ("x", "xs", "xss")])
     c = np.linalg.solve(V, Y)
     return np.concatenate([c, D1.T @ c / window, D2.T @ c / window**2], axis=1)
 
