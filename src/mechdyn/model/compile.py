@@ -253,14 +253,11 @@ class Model:
     def layout(self, mode=None) -> ConstraintLayout:
         """Row layout of the constraint equations in a mode (cached)."""
         mode = self.initial_mode if mode is None else frozenset(mode)
-        lay = self._layouts.get(mode)
-        if lay is None:
-            unknown = set(mode) - set(self.lock.names)
-            if unknown:
+        if mode not in self._layouts:
+            if unknown := set(mode) - set(self.lock.names):
                 raise ModelError(did_you_mean(sorted(unknown)[0], self.lock.names, "lock"))
-            lay = ConstraintLayout(self, mode)
-            self._layouts[mode] = lay
-        return lay
+            self._layouts[mode] = ConstraintLayout(self, mode)
+        return self._layouts[mode]
 
 
 class ConstraintLayout:
