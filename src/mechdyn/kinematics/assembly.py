@@ -369,9 +369,7 @@ def rank_report(model: Model, x, layout=None) -> dict:
     P, Gq = J[:lay.n_rows], J[lay.n_rows:]
     tol_rel = 1e-9
     rank_phi = _rank(P, tol_rel)
-    redundant = []
-    if rank_phi < lay.n_rows:
-        redundant = sorted({lay.row_joint[r] for r in _dependent_rows(P, rank_phi)})
+    redundant = sorted({lay.row_joint[r] for r in _dependent_rows(P, rank_phi)})
     rank_full = _rank(J, tol_rel)
     dep = []
     if model.n_q and rank_full < rank_phi + model.n_q:
