@@ -9,6 +9,7 @@ import numpy as np
 
 from ..errors import ModelError, did_you_mean
 from ..model import Model
+from .table import coordinate_columns, force_columns, mode_columns
 
 __all__ = ["Kinetostatics"]
 
@@ -199,24 +200,16 @@ class Kinetostatics:
 
         cols: dict[str, np.ndarray] = {"t_s": self.t}
         if self.switched:
-            cols["mode"] = np.array([" ".join(sorted(m)) or "-" for m in self.sample_modes],
-                                    dtype=object)
-            cols["mode_index"] = np.asarray(self.mode_index)
-        for k, c in enumerate(self.coordinate_names):
-            ang = self._is_angle(k)
-            u = "rad" if ang else "m"
-            qk = self.q[:, k]
-            cols[f"{c}_deg" if ang else f"{c}_m"] = np.rad2deg(qk) if ang else qk
-            cols[f"{c}_dot_{u}_s"] = self.qdot[:, k]
-            cols[f"{c}_ddot_{u}_s2"] = self.qddot[:, k]
+            cols.update(mode_columns(self.sample_modes, self.mode_index))
+        is_angle = [self._is_angle(k) for k in range(len(self.coordinate_names))]
+        cols.update(coordinate_columns(self.coordinate_names, is_angle, self.q, self.qdot,
+                                       self.qddot, radians=False))
         for c in self.driven:
             sym, unit = self._drive_unit(c)
             cols[f"{sym}_drive_{c}_{unit}"] = self.driving[c]
             cols[f"P_drive_{c}_W"] = self.power[c]
         for j, R in self.reactions.items():
-            cols[f"Fx_{j}_N"] = R[:, 0]
-            cols[f"Fy_{j}_N"] = R[:, 1]
-            cols[f"F_{j}_N"] = np.hypot(R[:, 0], R[:, 1])
+            cols.update(force_columns(j, R, magnitude=True))
             cols[f"angle_F_{j}_deg"] = np.rad2deg(np.arctan2(R[:, 1], R[:, 0]))
             kind = self.joint_kinds[j]
             if kind == "prismatic":
@@ -229,12 +222,8 @@ class Kinetostatics:
             cols[f"{sym}_{el.replace('@', '_')}_{unit}"] = f
         for j, L in self.frame_loads.items():
             if j in self.reactions:
-                cols[f"Fx_frame_{j}_N"] = L[:, 0]
-                cols[f"Fy_frame_{j}_N"] = L[:, 1]
-                cols[f"M_frame_{j}_Nm"] = L[:, 2]
-        cols["Fx_frame_N"] = self.frame_force[:, 0]
-        cols["Fy_frame_N"] = self.frame_force[:, 1]
-        cols["F_frame_N"] = np.hypot(self.frame_force[:, 0], self.frame_force[:, 1])
+                cols.update(force_columns(f"frame_{j}", L))
+        cols.update(force_columns("frame", self.frame_force, magnitude=True))
         cols["M_frame_Nm"] = self.frame_moment
         return pd.DataFrame(cols)
 

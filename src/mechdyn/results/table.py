@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["write_csv", "read_csv", "unit_of_column", "UNIT_SUFFIXES", "output_path", "written",
-           "deg_or_mm", "rate_text"]
+           "deg_or_mm", "rate_text", "coordinate_columns", "force_columns", "mode_columns"]
 
 #: column-name suffix -> unit, longest suffixes first when matching
 UNIT_SUFFIXES: dict[str, str] = {
@@ -103,6 +103,43 @@ def deg_or_mm(values, is_angle: bool) -> tuple[np.ndarray, str]:
 def rate_text(rate: float, is_angle: bool) -> str:
     """A constant rate as text: ``"157.08 rad/s (1500 rpm)"`` or ``"0.5 m/s"``."""
     return f"{rate:.6g} rad/s ({rate * 30 / np.pi:.6g} rpm)" if is_angle else f"{rate:.6g} m/s"
+
+
+def coordinate_columns(names, is_angle, q, qdot, qddot, *, radians: bool = True,
+                       degrees: bool = True) -> dict:
+    """Table columns of coordinates (n, n_q) and their rates: ``<c>_rad`` (with ``radians``)
+    and ``<c>_deg`` (with ``degrees``) for an angle, ``<c>_m`` for a travel, then
+    ``<c>_dot_rad_s`` and ``<c>_ddot_rad_s2`` (``_m_s``, ``_m_s2``)."""
+    cols = {}
+    for k, c in enumerate(names):
+        u = "rad" if is_angle[k] else "m"
+        if radians or u == "m":
+            cols[f"{c}_{u}"] = q[:, k]
+        if degrees and u == "rad":
+            cols[f"{c}_deg"] = np.rad2deg(q[:, k])
+        cols[f"{c}_dot_{u}_s"] = qdot[:, k]
+        cols[f"{c}_ddot_{u}_s2"] = qddot[:, k]
+    return cols
+
+
+def force_columns(key: str, f, *, magnitude: bool = False) -> dict:
+    """Table columns of a force: ``F_<key>_N`` of shape (n,); ``Fx_<key>_N``, ``Fy_<key>_N``
+    (and ``F_<key>_N`` with ``magnitude``) of (n, 2); and ``M_<key>_Nm`` of a third column."""
+    f = np.asarray(f, float)
+    if f.ndim == 1:
+        return {f"F_{key}_N": f}
+    cols = {f"Fx_{key}_N": f[:, 0], f"Fy_{key}_N": f[:, 1]}
+    if magnitude:
+        cols[f"F_{key}_N"] = np.hypot(f[:, 0], f[:, 1])
+    if f.shape[1] > 2:
+        cols[f"M_{key}_Nm"] = f[:, 2]
+    return cols
+
+
+def mode_columns(modes, mode_index) -> dict:
+    """The ``mode`` (engaged elements, ``-`` for none) and ``mode_index`` of every sample."""
+    return {"mode": np.array([" ".join(sorted(m)) or "-" for m in modes], dtype=object),
+            "mode_index": np.asarray(mode_index)}
 
 
 def _describe(record) -> list[str]:

@@ -10,6 +10,7 @@ import numpy as np
 from ..errors import ModelError, did_you_mean
 from ..kinematics.analogs import accelerations
 from ..kinematics.constraints import point_acceleration, point_position, point_velocity
+from .table import coordinate_columns, force_columns, mode_columns
 
 __all__ = ["Trajectory", "SwitchedSamples"]
 
@@ -200,15 +201,9 @@ class Trajectory:
         """
         import pandas as pd
 
-        cols: dict[str, np.ndarray] = {"t_s": self.t}
-        for k, name in enumerate(self.coordinate_names):
-            ang = self.coordinate_is_angle[k] if self.coordinate_is_angle else True
-            u, ud, udd = ("rad", "rad_s", "rad_s2") if ang else ("m", "m_s", "m_s2")
-            cols[f"{name}_{u}"] = self.q[:, k]
-            if ang and degrees:
-                cols[f"{name}_deg"] = np.rad2deg(self.q[:, k])
-            cols[f"{name}_dot_{ud}"] = self.qdot[:, k]
-            cols[f"{name}_ddot_{udd}"] = self.qddot[:, k]
+        is_angle = self.coordinate_is_angle or (True,) * len(self.coordinate_names)
+        cols = {"t_s": self.t, **coordinate_columns(self.coordinate_names, is_angle, self.q,
+                                                    self.qdot, self.qddot, degrees=degrees)}
         body_columns = (("x", "m"), ("y", "m"), ("theta", "rad"),
                         ("vx", "m_s"), ("vy", "m_s"), ("omega", "rad_s"))
         for b, name in enumerate(self.body_names if bodies else ()):
@@ -254,25 +249,11 @@ def _switched_columns(vs: dict, modes: bool = True) -> dict:
     """Columns of the forces of a run: the mode of each sample (with ``modes``: the model
     has switchable elements), the force on the frame and the force of every joint, lock, stop and
     contact (see ``docs/variable-structure.md``)."""
-    cols: dict[str, np.ndarray] = {}
-    if modes:  # a model without switchable elements has one mode: no mode column
-        cols["mode"] = np.array([" ".join(sorted(m)) or "-" for m in vs["mode"]],
-                                dtype=object)
-        cols["mode_index"] = np.asarray(vs["mode_index"])
-    frame = np.asarray(vs["frame_force"], float)
-    cols["Fx_frame_N"] = frame[:, 0]
-    cols["Fy_frame_N"] = frame[:, 1]
-    cols["F_frame_N"] = np.hypot(frame[:, 0], frame[:, 1])
+    # a model without switchable elements has one mode: no mode column
+    cols = mode_columns(vs["mode"], vs["mode_index"]) if modes else {}
+    cols.update(force_columns("frame", vs["frame_force"], magnitude=True))
     if vs.get("frame_moment") is not None:
         cols["M_frame_Nm"] = np.asarray(vs["frame_moment"], float)
     for name, f in vs.get("forces", {}).items():
-        f = np.asarray(f, float)
-        key = str(name).replace("@", "_")
-        if f.ndim == 1:
-            cols[f"F_{key}_N"] = f
-        else:
-            cols[f"Fx_{key}_N"] = f[:, 0]
-            cols[f"Fy_{key}_N"] = f[:, 1]
-            if f.shape[1] > 2:
-                cols[f"M_{key}_Nm"] = f[:, 2]
+        cols.update(force_columns(str(name).replace("@", "_"), f))
     return cols
