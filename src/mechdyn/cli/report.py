@@ -22,7 +22,6 @@ the writing in :mod:`mechdyn.results.report`, which only reads records.
 
 from __future__ import annotations
 
-import sys
 import warnings
 from pathlib import Path
 
@@ -77,9 +76,7 @@ def run(args) -> int:
     problems = [] if sw.ok else [sw.message]
     if ks is not None and ks.status == Status.SINGULAR_POSITION:
         problems.append(ks.message)
-    for msg in problems:
-        print(f"mechdyn report: warning: {msg}", file=sys.stderr)
-    return 1 if problems else 0
+    return finish(args, not problems, "; ".join(problems))
 
 
 def report_records(mech_or_model, *, speed: float | None = None, over: str | None = None,

@@ -30,10 +30,11 @@ from .._version import __version__
 from ..errors import Status
 from ..kinematics.sweep import initial_coordinates
 from .animate import animate, snapshot
+from .events import events_table
 from .plot import plot_kinematic_sweep
 from .plot_dynamics import plot_trajectory
 from .plot_kinetostatics import plot_kinetostatics
-from .table import output_path, rate_text, written
+from .table import deg_or_mm, output_path, rate_text, written
 
 __all__ = ["write_report", "report_trajectory", "model_tables"]
 
@@ -290,10 +291,10 @@ def _harmonics(ks, harmonics: int) -> list[str]:
         h = ks.harmonics(harmonics)
     except ValueError as exc:
         return [f'<p class="note">No harmonics: {_esc(exc)}</p>']
-    h = h[["order", "f_Hz", "Fx_frame_N", "Fy_frame_N", "M_frame_Nm"]].copy()
-    for c in ("Fx_frame_N", "Fy_frame_N", "M_frame_Nm"):
-        a = h[c].to_numpy()
-        h[c] = np.where(np.abs(a) < 1e-9 * max(np.max(np.abs(a)), 1e-300), 0.0, a)
+    cols = ["Fx_frame_N", "Fy_frame_N", "M_frame_Nm"]
+    h = h[["order", "f_Hz", *cols]].copy()
+    a = h[cols].abs()
+    h[cols] = h[cols].mask(a < 1e-9 * np.maximum(a.max(), 1e-300), 0.0)
     return ["<h3>Harmonics of the shaking force and moment</h3>",
             '<p class="note">Amplitudes per order of the crank turn (order 0: the mean).</p>',
             _table(None, h)]
@@ -415,13 +416,11 @@ def report_trajectory(traj, path, *, title: str | None = None, animation: bool =
         rows = []
         for k, c in enumerate(traj.coordinate_names):
             ang = traj.coordinate_is_angle[k] if traj.coordinate_is_angle else True
-            f, u, ur = (np.rad2deg(1.0), "deg", "rpm") if ang else (1e3, "mm", "m/s")
-            fr = 30 / np.pi if ang else 1.0
-            qd = traj.qdot[:, k]
-            rows.append({"coordinate": c, f"start ({u})": traj.q[0, k] * f,
-                         f"end ({u})": traj.q[-1, k] * f, f"start rate ({ur})": qd[0] * fr,
-                         f"end rate ({ur})": qd[-1] * fr, f"min rate ({ur})": qd.min() * fr,
-                         f"max rate ({ur})": qd.max() * fr})
+            (q0, q1), u = deg_or_mm(traj.q[[0, -1], k], ang)
+            qd, ur = (traj.qdot[:, k] * 30 / np.pi, "rpm") if ang else (traj.qdot[:, k], "m/s")
+            rows.append({"coordinate": c, f"start ({u})": q0, f"end ({u})": q1,
+                         f"start rate ({ur})": qd[0], f"end rate ({ur})": qd[-1],
+                         f"min rate ({ur})": qd.min(), f"max rate ({ur})": qd.max()})
         parts.append(_table("Coordinates", rows, digits=9))
     if traj.energy and traj.t.size:
         e = traj.energy
@@ -433,12 +432,9 @@ def report_trajectory(traj, path, *, title: str | None = None, animation: bool =
         parts.append(f"<p>The balance drifts by at most {traj.energy_drift():.3e} J; the "
                      f"largest constraint residual is {np.max(e['residual']):.3e} "
                      "(m or rad).</p>")
-    parts += ["<h3>Events</h3>", "" if traj.events else "<p>No events.</p>", _table(None, [
-        {"t_s": getattr(ev, "t", np.nan), "kind": getattr(ev, "kind", type(ev).__name__),
-         "element": getattr(ev, "element", getattr(ev, "name", "")),
-         "mode after": " ".join(sorted(getattr(ev, "mode_after", ()) or ())),
-         "energy lost_J": getattr(ev, "energy_lost", 0.0)} for ev in traj.events[:max_events]],
-        digits=9)]
+    parts += ["<h3>Events</h3>", "" if traj.events else "<p>No events.</p>",
+              _table(None, events_table(traj.events[:max_events], traj.coordinate_names),
+                     digits=9)]
     if len(traj.events) > max_events:
         parts.append(f'<p class="note">{len(traj.events) - max_events} more events not listed.</p>')
     if model is not None and traj.t.size:
