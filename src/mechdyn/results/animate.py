@@ -34,9 +34,6 @@ __all__ = ["animate", "snapshot", "frame_geometry", "frame_indices", "check_anim
 #: largest number of frames drawn by default
 MAX_FRAMES = 200
 
-_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown",
-           "tab:pink", "tab:olive", "tab:cyan", "tab:gray")
-
 
 def _rot(theta: np.ndarray, s: np.ndarray) -> np.ndarray:
     """Rotate body-frame points ``s`` (k, 2) by angles ``theta`` (n,) -> (n, k, 2)."""
@@ -314,11 +311,10 @@ class _Scene:
         from matplotlib.figure import Figure
         from matplotlib.patches import Polygon
 
-        model, x = _record_parts(record)
+        model, _ = _record_parts(record)
         self.trace = _trace_spec(model, trace)
-        d = _drawing(model, x)
-        self.g = g = _geometry(model, x, d, None, self.trace)  # every frame, drawn by update()
-        (x0, x1), (y0, y1) = _limits(g)
+        self.g = g = frame_geometry(record, trace=self.trace)  # every frame, drawn by update()
+        (x0, x1), (y0, y1) = g["limits"]
         # the figure's shape follows the drawing's (room for title and labels added)
         height = float(np.clip((width - 1.0) * (y1 - y0) / (x1 - x0) + 1.2, 3.0, 7.5))
         self.fig = fig = Figure(figsize=(width, height), layout="constrained")
@@ -328,9 +324,9 @@ class _Scene:
                title=title if title is not None else getattr(model.mechanism, "name", "mechanism"))
         ax.set_aspect("equal", adjustable="box")
         ax.grid(True, alpha=0.25)
-        s = d.size
+        s = g["size"]
         # static: anchors (hatched triangles) and ground guides
-        for p in d.anchors.values():
+        for p in g["anchors"].values():
             tri = np.array([p, p + [-1.2 * s, -1.8 * s], p + [1.2 * s, -1.8 * s]])
             ax.add_patch(Polygon(tri, closed=True, facecolor="0.85", edgecolor="0.3",
                                  hatch="////", lw=1.0, zorder=1))
@@ -338,7 +334,7 @@ class _Scene:
                     lw=1.5, zorder=1)
         # the moving artists start empty: update() places them
         self.guides = {j: ax.plot([], [], color="0.35", lw=2.5, alpha=0.6,
-                                  solid_capstyle="butt", zorder=1)[0] for j in d.guides}
+                                  solid_capstyle="butt", zorder=1)[0] for j in g["guides"]}
         if self.trace is not None:
             gt = g["trace"]
             ax.plot(gt[:, 0], gt[:, 1], color="tab:red", lw=0.8, ls=":", alpha=0.6, zorder=2)
@@ -348,11 +344,11 @@ class _Scene:
             ax.legend(loc="upper right", fontsize="small")
         # moving bodies
         self.bodies = {}
-        for k, (b, (local, style)) in enumerate(d.bodies.items()):
-            c = _COLORS[k % len(_COLORS)]
+        for k, (b, style) in enumerate(g["styles"].items()):
+            c = f"C{k % 10}"  # the colour cycle
             if style in ("polygon", "block"):
-                art = Polygon(local, closed=True, facecolor=c, alpha=0.45, edgecolor=c, lw=2.0,
-                              zorder=3, label=b)
+                art = Polygon(g["bodies"][b][0], closed=True, facecolor=c, alpha=0.45,
+                              edgecolor=c, lw=2.0, zorder=3, label=b)
                 ax.add_patch(art)
             elif style == "bar":
                 (art,) = ax.plot([], [], color=c, lw=5.0, alpha=0.8, solid_capstyle="round",
