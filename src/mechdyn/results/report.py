@@ -228,15 +228,6 @@ def _at_text(over_is_angle: bool, v: float) -> str:
     return f"{np.rad2deg(v):.3f} deg" if over_is_angle else f"{_mm(v):.4f} mm"
 
 
-def _stroke_row(summ, ang: bool, joint: str, stroke: float) -> dict:
-    row = {"slider (joint)": joint, "stroke_mm": f"{_mm(stroke):.4f}"}
-    for d in summ.dead_centres:
-        if d.joint == joint:
-            row[f"{d.label} at"] = _at_text(ang, d.at)
-            row[f"{d.label} travel_mm"] = f"{_mm(d.travel):.4f}"
-    return row
-
-
 def _sweep_section(sw, *, animation: bool, trace) -> str:
     ang = sw.over_is_angle
     rate = float(sw.qdot[0, sw.over_index]) if len(sw) else 1.0
@@ -251,11 +242,17 @@ def _sweep_section(sw, *, animation: bool, trace) -> str:
     if not len(sw):
         return _join(parts)
     summ = sw.summary()
+    strokes = []
+    for joint, stroke in summ.strokes.items():
+        strokes.append({"slider (joint)": joint, "stroke_mm": f"{_mm(stroke):.4f}"})
+        for d in summ.dead_centres:
+            if d.joint == joint:
+                strokes[-1][f"{d.label} at"] = _at_text(ang, d.at)
+                strokes[-1][f"{d.label} travel_mm"] = f"{_mm(d.travel):.4f}"
     mu = [(t, np.rad2deg(t.min), np.rad2deg(t.max)) for t in summ.transmission]
     omegas = [(b, *sw.angular(b)[1:]) for b in sw.model.body_names]
     parts += [
-        _table("Strokes and dead centres",
-               [_stroke_row(summ, ang, j, s) for j, s in summ.strokes.items()]),
+        _table("Strokes and dead centres", strokes),
         _table("Transmission angles", [
             {"loop (coupler/rocker)": f"{t.loop.coupler}/{t.loop.rocker}",
              "joint": t.loop.joints[2], "mu_min_deg": f"{lo:.3f}",
@@ -277,14 +274,6 @@ def _sweep_section(sw, *, animation: bool, trace) -> str:
 
 
 # ------------------------------------------------------------------ kinetostatics
-def _drive_row(ks, ang: bool, c: str, d: dict) -> dict:
-    sym, unit = ks._drive_unit(c)
-    u = "Nm" if unit == "Nm" else "N"
-    return {"drive": c, f"peak |{sym}|_{u}": abs(d["peak_abs"]),
-            "at": _at_text(ang, d["peak_abs_at"]), f"max_{u}": d["max"], f"min_{u}": d["min"],
-            f"RMS_{u}": d["rms"], f"mean_{u}": d["mean"], "peak power_W": d["peak_power"]}
-
-
 def _harmonics(ks, harmonics: int) -> list[str]:
     """The shaking force and moment per order of the turn (round-off noise shown as 0)."""
     try:
@@ -317,9 +306,15 @@ def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
                "at": _at_text(ang, d["peak_at"]), "RMS force_N": d["rms"]}
               | ({"peak moment_Nm": d["peak_moment"]} if "peak_moment" in d else {})
               for j, d in p["joints"].items()]
-    fr = p["frame"]
+    fr, drives = p["frame"], []
+    for c, d in p["driving"].items():
+        sym, u = ks._drive_unit(c)
+        drives.append({"drive": c, f"peak |{sym}|_{u}": abs(d["peak_abs"]),
+                       "at": _at_text(ang, d["peak_abs_at"]), f"max_{u}": d["max"],
+                       f"min_{u}": d["min"], f"RMS_{u}": d["rms"], f"mean_{u}": d["mean"],
+                       "peak power_W": d["peak_power"]})
     parts += [
-        _table("Driving torque", [_drive_row(ks, ang, c, d) for c, d in p["driving"].items()]),
+        _table("Driving torque", drives),
         _table("Peak joint forces", joints),
         _table("Frame (shaking) loads", [
             {"quantity": "|F| frame (N)", "min": np.nan, "max": fr["force_peak"],
