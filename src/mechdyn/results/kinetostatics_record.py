@@ -288,12 +288,12 @@ class Kinetostatics:
         lines = [f"kinetostatics over {self.over}: {self.n} positions, "
                  f"{self.over} from {self.values[0] * f:.4g} to {self.values[-1] * f:.4g} "
                  f"{unit}; status {self.status}"]
-        sw = self.switched
 
-        def when(key, d):
-            return f" (t = {d[key]:.6g} s)" if sw else ""
+        def at(d, key, when=True):  # where an extreme is (and, switched, when)
+            t = f" (t = {d[key + '_t']:.6g} s)" if when and self.switched else ""
+            return f"{d[key + '_at'] * f:.4g} {unit}{t}"
 
-        if sw:
+        if self.switched:
             segs = self.stats.get("segments", [])
             lines.append(f"  switched trajectory: {len(segs)} segment(s) in {len(self.modes)} "
                          f"mode(s); the quantities of a joint, drive or element that is not "
@@ -304,29 +304,25 @@ class Kinetostatics:
                              f"{{{', '.join(sorted(sg['mode']))}}}: driven "
                              f"{', '.join(sg['driven']) or '-'}; {sg['status']}")
         for c, d in p["driving"].items():
-            sym, u = self._drive_unit(c)
-            u = "N m" if u == "Nm" else u
+            u = "N m" if self._drive_unit(c)[1] == "Nm" else "N"
             lines.append(
                 f"  drive {c}: peak {d['peak_abs']:.6g} {u} at {self.over} = "
-                f"{d['peak_abs_at'] * f:.4g} {unit}{when('peak_abs_t', d)}; max "
-                f"{d['max']:.6g} {u} at "
-                f"{d['max_at'] * f:.4g} {unit}; min {d['min']:.6g} {u} at "
-                f"{d['min_at'] * f:.4g} {unit}; RMS {d['rms']:.6g} {u}; mean "
+                f"{at(d, 'peak_abs')}; max {d['max']:.6g} {u} at {at(d, 'max', False)}; min "
+                f"{d['min']:.6g} {u} at {at(d, 'min', False)}; RMS {d['rms']:.6g} {u}; mean "
                 f"{d['mean']:.6g} {u}; peak power {d['peak_power']:.6g} W")
         for j, d in p["joints"].items():
             s = (f"  joint {j} ({self.joint_kinds[j]}): peak force {d['peak']:.6g} N at "
-                 f"{self.over} = {d['peak_at'] * f:.4g} {unit}{when('peak_t', d)}")
+                 f"{self.over} = {at(d, 'peak')}")
             if "peak_moment" in d:
-                s += (f"; peak moment {d['peak_moment']:.6g} N m at "
-                      f"{d['peak_moment_at'] * f:.4g} {unit}{when('peak_moment_t', d)}")
+                s += f"; peak moment {d['peak_moment']:.6g} N m at {at(d, 'peak_moment')}"
             lines.append(s)
         for el, d in p["elements"].items():
             lines.append(f"  element {el}: peak {d['peak']:.6g} {d['unit']} at {self.over} = "
-                         f"{d['peak_at'] * f:.4g} {unit}{when('peak_t', d)}")
+                         f"{at(d, 'peak')}")
         fr = p["frame"]
         lines.append(
             f"  frame: shaking force peak {fr['force_peak']:.6g} N at {self.over} = "
-            f"{fr['force_peak_at'] * f:.4g} {unit} (Fx {fr['Fx_min']:.6g}..{fr['Fx_max']:.6g} N,"
+            f"{at(fr, 'force_peak', False)} (Fx {fr['Fx_min']:.6g}..{fr['Fx_max']:.6g} N,"
             f" Fy {fr['Fy_min']:.6g}..{fr['Fy_max']:.6g} N); shaking moment about "
             f"({self.frame_point[0]:.4g}, {self.frame_point[1]:.4g}) m: "
             f"{fr['M_min']:.6g}..{fr['M_max']:.6g} N m")
