@@ -130,12 +130,9 @@ def _drawing(model, x: np.ndarray) -> MechanismDrawing:
         else:
             c = p[0] if p else np.asarray(model.com[model.body_index(b)], dtype=float)
             if b in guided:
-                u = guided[b]
-                n = np.array([-u[1], u[0]])
-                w, h = 1.6 * size, 0.9 * size
-                block = np.array([c + w * u + h * n, c - w * u + h * n,
-                                  c - w * u - h * n, c + w * u - h * n])
-                bodies[b] = (block, "block")
+                u = guided[b]  # the block's corners along the guide and across it
+                corners = np.array([[1.6, 0.9], [-1.6, 0.9], [-1.6, -0.9], [1.6, -0.9]]) * size
+                bodies[b] = (c + corners @ np.array([u, [-u[1], u[0]]]), "block")
             else:
                 bodies[b] = (c[None, :], "disc")
     # guide segments: the travel range of the child point over the motion, plus margins
@@ -158,12 +155,8 @@ def _world(model, x: np.ndarray, body: str, local: np.ndarray) -> np.ndarray:
 
 def _extent(model, x: np.ndarray, pts: dict) -> float:
     """Size of the region swept by all points over the motion, m."""
-    allp = []
-    for b, p in pts.items():
-        if p:
-            allp.append(_world(model, x, b, np.array(p)).reshape(-1, 2))
-        k = model.body_index(b)
-        allp.append(x[:, 3 * k:3 * k + 2])
+    allp = [_world(model, x, b, np.array([*p, np.zeros(2)])).reshape(-1, 2)
+            for b, p in pts.items()]  # the points and the body origins
     P = np.concatenate(allp) if allp else np.zeros((1, 2))
     span = float(np.max(np.ptp(P, axis=0)))
     return span if span > 0 else model.length_scale
