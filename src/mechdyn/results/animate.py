@@ -338,7 +338,7 @@ class _Scene:
         # moving bodies
         self.bodies = {}
         for k, (b, style) in enumerate(g["styles"].items()):
-            c = f"C{k % 10}"  # the colour cycle
+            c = f"C{k}"  # the colour cycle
             if style in ("polygon", "block"):
                 art = Polygon(g["bodies"][b][0], closed=True, facecolor=c, alpha=0.45,
                               edgecolor=c, lw=2.0, zorder=3, label=b)

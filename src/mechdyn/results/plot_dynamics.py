@@ -35,8 +35,6 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
     Path
         The file written.
     """
-    from matplotlib import rcParams
-
     names = list(coordinates) if coordinates is not None else list(traj.coordinate_names)
     idx = [traj.coordinate_names.index(n) for n in names]
     show_energy = bool(energy and traj.energy and traj.t.size)
@@ -49,22 +47,19 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
     fa = np.rad2deg(1.0) if degrees else 1.0
     # lengths (travels) in mm on a right-hand axis when angles share the panel
     twins = [ax.twinx() if (any(is_angle) and not all(is_angle)) else ax for ax in axes[:3]]
-    colours = rcParams["axes.prop_cycle"].by_key()["color"]
     panels = (("coordinate", "", "", traj.q), ("rate", "'", "/s", traj.qdot),
               ("acceleration", "''", "/s^2", traj.qddot))
     for n, (k, name, ang) in enumerate(zip(idx, names, is_angle, strict=True)):
         f, u = (fa, au) if ang else (1e3, "mm")
         for ax, (_, tick, per, data) in zip(axes[:3] if ang else twins, panels, strict=True):
-            ax.plot(t, data[:, k] * f, color=colours[n % len(colours)],
-                    label=f"{name}{tick} [{u}{per}]")
+            ax.plot(t, data[:, k] * f, color=f"C{n}", label=f"{name}{tick} [{u}{per}]")
     for ax, twin, (what, _, per, _) in zip(axes[:3], twins, panels, strict=True):
         if twin is ax:
             ax.set_ylabel(f"{what} [{au if any(is_angle) else 'mm'}{per}]")
         else:
             ax.set_ylabel(f"{what}: angles")
             twin.set_ylabel(f"{what}: travels")
-            lines = ax.get_lines() + twin.get_lines()
-            ax.legend(lines, [ln.get_label() for ln in lines], loc="best", fontsize="small")
+            ax.legend(handles=ax.lines + twin.lines, loc="best", fontsize="small")
     if show_energy:
         for key, style, label in (("kinetic", "-", "T"), ("potential", "-", "U"),
                                   ("work_nc", "-", "W_nc"), ("balance", "k--", "T + U - W_nc")):

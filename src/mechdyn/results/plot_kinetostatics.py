@@ -67,7 +67,5 @@ def plot_kinetostatics(record, path, *, joints: Sequence[str] | None = None,
     ax2 = ax.twinx()
     ax2.plot(xv, record.frame_moment, "--", color="tab:red", lw=1.0, label="M frame")
     ax2.set_ylabel("shaking moment (N m)", color="tab:red")
-    h1, l1 = ax.get_legend_handles_labels()
-    h2, l2 = ax2.get_legend_handles_labels()
-    ax.legend(h1 + h2, l1 + l2, loc="best", fontsize="small")
+    ax.legend(handles=ax.lines + ax2.lines, loc="best", fontsize="small")
     return _save(fig, path, dpi)
