@@ -210,14 +210,27 @@ class Trajectory:
             for i, (what, unit) in enumerate(body_columns):
                 cols[f"{what}_{name}_{unit}"] = (self.x if i < 3 else self.xdot)[:, 3 * b + i % 3]
         if points and self.model is not None and self.t.size:
-            cols.update(self._point_columns())
+            m, xdd = self.model, self.xddot()
+            for body, pt in m.named_points():
+                r = point_position(m, self.x, body, pt)
+                v = point_velocity(m, self.x, self.xdot, body, pt)
+                a = point_acceleration(m, self.x, self.xdot, xdd, body, pt)
+                for what, unit, val in (("", "m", r), ("v", "m_s", v), ("a", "m_s2", a)):
+                    cols[f"{what}x_{body}_{pt}_{unit}"] = val[:, 0]
+                    cols[f"{what}y_{body}_{pt}_{unit}"] = val[:, 1]
         if energy and self.energy:
             cols.update({col: self.energy[key] for col, key in (
                 ("T_J", "kinetic"), ("U_J", "potential"), ("W_nc_J", "work_nc"),
                 ("E_balance_J", "balance"), ("residual", "residual"))})
         vs = self.switching
-        if vs and self.t.size:
-            cols.update(_switched_columns(vs, getattr(self.model, "has_switching", True)))
+        if vs and self.t.size:  # the forces of a run (see docs/variable-structure.md)
+            if getattr(self.model, "has_switching", True):  # else one mode: no mode column
+                cols.update(mode_columns(vs["mode"], vs["mode_index"]))
+            cols.update(force_columns("frame", vs["frame_force"], magnitude=True))
+            if vs.get("frame_moment") is not None:
+                cols["M_frame_Nm"] = np.asarray(vs["frame_moment"], float)
+            for name, f in vs.get("forces", {}).items():
+                cols.update(force_columns(str(name).replace("@", "_"), f))
         return pd.DataFrame(cols)
 
     @property
@@ -230,30 +243,3 @@ class Trajectory:
         """Body frame accelerations xddot = B q'' + b, shape (n, n_x) (needs ``model``)."""
         return accelerations(self.model, self.x, self.xdot, self.qddot,
                              layout=self.model.layout(self.stats.get("mode")))
-
-    def _point_columns(self) -> dict:
-        m = self.model
-        xdd = self.xddot()
-        out = {}
-        for body, pt in m.named_points():
-            r = point_position(m, self.x, body, pt)
-            v = point_velocity(m, self.x, self.xdot, body, pt)
-            a = point_acceleration(m, self.x, self.xdot, xdd, body, pt)
-            for what, unit, val in (("", "m", r), ("v", "m_s", v), ("a", "m_s2", a)):
-                out[f"{what}x_{body}_{pt}_{unit}"] = val[:, 0]
-                out[f"{what}y_{body}_{pt}_{unit}"] = val[:, 1]
-        return out
-
-
-def _switched_columns(vs: dict, modes: bool = True) -> dict:
-    """Columns of the forces of a run: the mode of each sample (with ``modes``: the model
-    has switchable elements), the force on the frame and the force of every joint, lock, stop and
-    contact (see ``docs/variable-structure.md``)."""
-    # a model without switchable elements has one mode: no mode column
-    cols = mode_columns(vs["mode"], vs["mode_index"]) if modes else {}
-    cols.update(force_columns("frame", vs["frame_force"], magnitude=True))
-    if vs.get("frame_moment") is not None:
-        cols["M_frame_Nm"] = np.asarray(vs["frame_moment"], float)
-    for name, f in vs.get("forces", {}).items():
-        cols.update(force_columns(str(name).replace("@", "_"), f))
-    return cols
