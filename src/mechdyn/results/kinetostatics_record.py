@@ -233,8 +233,20 @@ class Kinetostatics:
         (trapezoidal rule), else by position count."""
         y = np.asarray(series, dtype=float)
         t = self.t
-        if not np.all(np.isfinite(y)):
-            return _rms_finite(y, t)
+        ok = np.isfinite(y)
+        if not ok.all():  # time-weighted over each run of finite samples if time advances
+            if not ok.any():
+                return float("nan")
+            if y.size > 1 and np.all(np.diff(t) >= 0) and t[-1] > t[0]:
+                num = den = 0.0
+                edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(int), [0]])))
+                for a, b in zip(edges[0::2], edges[1::2], strict=True):
+                    if t[b - 1] > t[a]:
+                        num += float(np.trapezoid(y[a:b] ** 2, t[a:b]))
+                        den += float(t[b - 1] - t[a])
+                if den > 0:
+                    return float(np.sqrt(num / den))
+            return float(np.sqrt(np.mean(y[ok] ** 2)))
         if y.size < 2:
             return float(np.sqrt(np.mean(y**2)))
         if np.all(np.diff(t) > 0):
@@ -406,21 +418,3 @@ def _at(y, k: int) -> float:
 def _nanext(y, fn) -> float:
     y = np.asarray(y, dtype=float)
     return float(fn(y)) if np.isfinite(y).any() else float("nan")
-
-
-def _rms_finite(y, t) -> float:
-    """RMS over the samples where y is finite: time-weighted over each run of finite
-    samples when time does not decrease, else the plain mean square."""
-    ok = np.isfinite(y)
-    if not ok.any():
-        return float("nan")
-    if y.size > 1 and np.all(np.diff(t) >= 0) and t[-1] > t[0]:
-        num = den = 0.0
-        edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(int), [0]])))
-        for a, b in zip(edges[0::2], edges[1::2], strict=True):
-            if t[b - 1] > t[a]:
-                num += float(np.trapezoid(y[a:b] ** 2, t[a:b]))
-                den += float(t[b - 1] - t[a])
-        if den > 0:
-            return float(np.sqrt(num / den))
-    return float(np.sqrt(np.mean(y[ok] ** 2)))
