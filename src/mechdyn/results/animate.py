@@ -42,22 +42,6 @@ def _rot(theta: np.ndarray, s: np.ndarray) -> np.ndarray:
                      sn * s[None, :, 0] + c * s[None, :, 1]], axis=-1)
 
 
-def _unique(points: list[np.ndarray], tol: float) -> list[np.ndarray]:
-    out: list[np.ndarray] = []
-    for p in points:
-        if all(np.hypot(*(p - q)) > tol for q in out):
-            out.append(p)
-    return out
-
-
-def _outline(points: list[np.ndarray]) -> np.ndarray:
-    """Order three or more body-frame points around their centroid (a simple polygon)."""
-    P = np.array(points)
-    c = P.mean(axis=0)
-    ang = np.arctan2(P[:, 1] - c[1], P[:, 0] - c[0])
-    return P[np.argsort(ang)]
-
-
 @dataclass(frozen=True)
 class MechanismDrawing:
     """What to draw of a model, in body-frame coordinates (built once per record).
@@ -122,9 +106,13 @@ def _drawing(model, x: np.ndarray) -> MechanismDrawing:
     size = 0.035 * _extent(model, x, pts)
     bodies = {}
     for b in model.body_names:
-        p = _unique(pts[b], tol)
-        if len(p) >= 3:
-            bodies[b] = (_outline(p), "polygon")
+        p: list[np.ndarray] = []
+        for a in pts[b]:  # the distinct points
+            if all(np.hypot(*(a - q)) > tol for q in p):
+                p.append(a)
+        if len(p) >= 3:  # ordered around their centroid: a simple polygon
+            d = np.array(p) - np.mean(p, axis=0)
+            bodies[b] = (np.array(p)[np.argsort(np.arctan2(d[:, 1], d[:, 0]))], "polygon")
         elif len(p) == 2:
             bodies[b] = (np.array(p), "bar")
         else:
@@ -257,7 +245,16 @@ def frame_geometry(record, index=None, *, trace=None) -> dict:
     model, x = _record_parts(record)
     drawing, spec = _drawing(model, x), _trace_spec(model, trace)
     g = _geometry(model, x, drawing, index, spec)
-    g["limits"] = _limits(g if index is None else _geometry(model, x, drawing, None, spec))
+    every = g if index is None else _geometry(model, x, drawing, None, spec)  # all frames
+    s = g["size"]
+    arrs = [a.reshape(-1, 2) for a in (*every["bodies"].values(), *every["guides"].values())]
+    for a in every["anchors"].values():  # the anchor triangles and their ground lines
+        arrs.append(np.asarray(a).reshape(1, 2) + [[-1.8 * s, -1.8 * s], [1.8 * s, 0.0]])
+    if "trace" in every:
+        arrs.append(every["trace"])
+    P = np.concatenate(arrs)
+    lo, hi = P.min(axis=0) - 1.5 * s, P.max(axis=0) + 1.5 * s
+    g["limits"] = ((float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1])))
     return g
 
 
@@ -278,22 +275,6 @@ def _geometry(model, x, drawing: MechanismDrawing, index, trace) -> dict:
         body, point = trace
         g["trace"] = _world(model, xs, body, model.point_local(body, point)[None, :])[:, 0]
     return g
-
-
-def _limits(g: dict) -> tuple[tuple[float, float], tuple[float, float]]:
-    """Axis limits around the geometry ``g`` of all frames (see :func:`frame_geometry`)."""
-    arrs = [a.reshape(-1, 2) for a in g["bodies"].values()]
-    arrs += [a.reshape(-1, 2) for a in g["guides"].values()]
-    s = g["size"]
-    for a in g["anchors"].values():  # the anchor triangles and their ground lines
-        arrs.append(np.asarray(a).reshape(1, 2) + [[-1.8 * s, -1.8 * s], [1.8 * s, 0.0]])
-    if "trace" in g:
-        arrs.append(g["trace"])
-    P = np.concatenate(arrs)
-    lo, hi = P.min(axis=0), P.max(axis=0)
-    pad = 1.5 * s
-    return ((float(lo[0] - pad), float(hi[0] + pad)),
-            (float(lo[1] - pad), float(hi[1] + pad)))
 
 
 class _Scene:

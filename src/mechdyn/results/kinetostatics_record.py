@@ -259,7 +259,9 @@ class Kinetostatics:
     def _peak(self, y, name: str = "peak", rank=None) -> dict:
         """``name``, ``name_at`` (position) and ``name_t`` (time) of the sample of y where
         ``rank`` (default y) is largest, NaN samples aside."""
-        k = _arg(y if rank is None else rank)
+        r = np.asarray(y if rank is None else rank, dtype=float)
+        ok = np.isfinite(r)
+        k = int(np.argmax(np.where(ok, r, -np.inf))) if ok.any() else -1
         return {name: _at(y, k), f"{name}_at": _at(self.values, k), f"{name}_t": _at(self.t, k)}
 
     def peaks(self) -> dict:
@@ -402,13 +404,6 @@ class Kinetostatics:
             cols[name] = amp
             cols[f"{name}_phase_deg"] = np.rad2deg(ph)
         return pd.DataFrame(cols)
-
-
-def _arg(y) -> int:
-    """Index of the largest finite value (-1 when there is none)."""
-    y = np.asarray(y, dtype=float)
-    ok = np.isfinite(y)
-    return int(np.argmax(np.where(ok, y, -np.inf))) if ok.any() else -1
 
 
 def _at(y, k: int) -> float:

@@ -274,21 +274,6 @@ def _sweep_section(sw, *, animation: bool, trace) -> str:
 
 
 # ------------------------------------------------------------------ kinetostatics
-def _harmonics(ks, harmonics: int) -> list[str]:
-    """The shaking force and moment per order of the turn (round-off noise shown as 0)."""
-    try:
-        h = ks.harmonics(harmonics)
-    except ValueError as exc:
-        return [f'<p class="note">No harmonics: {_esc(exc)}</p>']
-    cols = ["Fx_frame_N", "Fy_frame_N", "M_frame_Nm"]
-    h = h[["order", "f_Hz", *cols]].copy()
-    a = h[cols].abs()
-    h[cols] = h[cols].mask(a < 1e-9 * np.maximum(a.max(), 1e-300), 0.0)
-    return ["<h3>Harmonics of the shaking force and moment</h3>",
-            '<p class="note">Amplitudes per order of the crank turn (order 0: the mean).</p>',
-            _table(None, h)]
-
-
 def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
     ang = ks.over_is_angle
     parts = ["<h2>Kinetostatics</h2>"]
@@ -325,7 +310,18 @@ def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
                          "(N m)", "min": fr["M_min"], "max": fr["M_max"],
              "peak at": _at_text(ang, fr["moment_peak_at"])}])]
     if harmonics > 0 and ang:
-        parts += _harmonics(ks, harmonics)
+        try:
+            h = ks.harmonics(harmonics)
+        except ValueError as exc:
+            parts.append(f'<p class="note">No harmonics: {_esc(exc)}</p>')
+        else:  # the shaking force and moment per order of the turn, round-off noise as 0
+            cols = ["Fx_frame_N", "Fy_frame_N", "M_frame_Nm"]
+            h = h[["order", "f_Hz", *cols]].copy()
+            a = h[cols].abs()
+            h[cols] = h[cols].mask(a < 1e-9 * np.maximum(a.max(), 1e-300), 0.0)
+            parts += ["<h3>Harmonics of the shaking force and moment</h3>",
+                      '<p class="note">Amplitudes per order of the crank turn (order 0: the '
+                      'mean).</p>', _table(None, h)]
     parts += [f'<p class="note">Warning: {_esc(w)}</p>' for w in ks.warnings]
     parts += ["<h3>Plot</h3>", _img(lambda p: plot_kinetostatics(ks, p), "kinetostatics plot")]
     return _join(parts)

@@ -142,22 +142,6 @@ def mode_columns(modes, mode_index) -> dict:
             "mode_index": np.asarray(mode_index)}
 
 
-def _describe(record) -> list[str]:
-    kind = type(record).__name__
-    model = getattr(record, "model", None)
-    mech = getattr(model, "mechanism", None)
-    lines = [f"mechdyn {kind}" + (f" of {mech.name!r}" if mech is not None else "")]
-    for label, attr in (("swept coordinate", "over"), ("status", "status")):
-        if getattr(record, attr, None) is not None:
-            lines.append(f"{label}: {getattr(record, attr)}")
-    message = getattr(record, "message", "")
-    if message:
-        lines.append("message: " + " ".join(str(message).split()))
-    lines.append("column names end with their SI unit (see docs/notation.md); "
-                 "analogs are per rad (angle coordinates) or per m (travels)")
-    return lines
-
-
 def write_csv(record, path, *, float_format: str = "%.12g", **options) -> Path:
     """Write a result record's table to CSV with a commented header of units.
 
@@ -179,7 +163,17 @@ def write_csv(record, path, *, float_format: str = "%.12g", **options) -> Path:
         The file written.
     """
     df = record.to_dataframe(**options)
-    lines = _describe(record)
+    mech = getattr(getattr(record, "model", None), "mechanism", None)
+    lines = [f"mechdyn {type(record).__name__}"
+             + (f" of {mech.name!r}" if mech is not None else "")]
+    for label, attr in (("swept coordinate", "over"), ("status", "status")):
+        if getattr(record, attr, None) is not None:
+            lines.append(f"{label}: {getattr(record, attr)}")
+    message = getattr(record, "message", "")
+    if message:
+        lines.append("message: " + " ".join(str(message).split()))
+    lines.append("column names end with their SI unit (see docs/notation.md); "
+                 "analogs are per rad (angle coordinates) or per m (travels)")
     lines.append("units: " + ", ".join(f"{c} [{unit_of_column(c) or '-'}]" for c in df.columns))
     path = output_path(path)
     with written(path) as tmp, open(tmp, "w", encoding="utf-8", newline="") as fh:
