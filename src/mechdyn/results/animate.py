@@ -103,7 +103,11 @@ def _drawing(model, x: np.ndarray) -> MechanismDrawing:
                 guided[j.child] = _rot(-model.pri.angle[k:k + 1], u[None, :])[0, 0]
             guides[name] = (j.parent, pp, u, j.child)
 
-    size = 0.035 * _extent(model, x, pts)
+    # the symbols' size follows the region swept by all points and body origins
+    allp = [_world(model, x, b, np.array([*p, np.zeros(2)])).reshape(-1, 2)
+            for b, p in pts.items()]
+    span = float(np.max(np.ptp(np.concatenate(allp), axis=0))) if allp else 0.0
+    size = 0.035 * (span if span > 0 else model.length_scale)
     bodies = {}
     for b in model.body_names:
         p: list[np.ndarray] = []
@@ -139,15 +143,6 @@ def _world(model, x: np.ndarray, body: str, local: np.ndarray) -> np.ndarray:
     """Ground-frame positions (n, k, 2) of body-frame points ``local`` (k, 2) over ``x``."""
     pose = extend(model, x)[:, model.body_index(body)]
     return pose[:, None, :2] + _rot(pose[:, 2], local)
-
-
-def _extent(model, x: np.ndarray, pts: dict) -> float:
-    """Size of the region swept by all points over the motion, m."""
-    allp = [_world(model, x, b, np.array([*p, np.zeros(2)])).reshape(-1, 2)
-            for b, p in pts.items()]  # the points and the body origins
-    P = np.concatenate(allp) if allp else np.zeros((1, 2))
-    span = float(np.max(np.ptp(P, axis=0)))
-    return span if span > 0 else model.length_scale
 
 
 def _trace_spec(model, trace, what: str = "trace") -> tuple[str, object] | None:
@@ -425,6 +420,7 @@ def animate(record, path, *, fps: int = 25, frames: int | None = None, trace=Non
         A record without poses or model, or an unknown trace point.
     """
     from matplotlib import animation
+    from PIL import Image
 
     path = check_animation_path(path)
     if fps <= 0:
@@ -440,17 +436,8 @@ def animate(record, path, *, fps: int = 25, frames: int | None = None, trace=Non
                 scene.update(int(i), lab)
                 writer.grab_frame()
         return path
-    images = _paletted(list(scene.render(idx, labels, dpi)))
-    # as matplotlib's PillowWriter does, but with the background drawn once and one palette
-    images[0].save(path, save_all=True, append_images=images[1:],
-                   duration=max(1, round(1000 / fps)), loop=0)
-    return path
-
-
-def _paletted(images: list) -> list:
-    """Quantize RGB frames to one shared palette (taken from the first, middle and last)."""
-    from PIL import Image
-
+    images = list(scene.render(idx, labels, dpi))
+    # one shared palette, taken from the first, middle and last frames
     w, h = images[0].size
     probe_ids = sorted({0, len(images) // 2, len(images) - 1})
     probe = Image.new("RGB", (w, h * len(probe_ids)))
@@ -458,7 +445,12 @@ def _paletted(images: list) -> list:
         probe.paste(images[k], (0, j * h))
     palette = probe.quantize(colors=128, method=Image.Quantize.MEDIANCUT,
                              dither=Image.Dither.NONE)
-    return [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
+    images = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
+    # as matplotlib's PillowWriter does, but with the background drawn once and one palette
+    with written(path) as tmp:
+        images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],
+                       duration=max(1, round(1000 / fps)), loop=0)
+    return path
 
 
 def check_animation_path(path) -> Path:

@@ -71,7 +71,16 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
         ax.plot(t, frame[:, 0] * 1e-3, label="Fx frame [kN]")
         ax.plot(t, frame[:, 1] * 1e-3, label="Fy frame [kN]")
         ax.set_ylabel("force on the frame [kN]")
-        _shade_modes(axes, t, np.asarray(vs["mode_index"]), vs["modes"])
+        mode_index = np.asarray(vs["mode_index"])
+        if t.size >= 2 and len(vs["modes"]) >= 2:  # the time span of each mode, one tint a mode
+            from matplotlib import colormaps
+
+            cmap = colormaps["Pastel2"]
+            change = np.flatnonzero(np.diff(mode_index) != 0) + 1
+            for a, b in zip(np.r_[0, change], np.r_[change, t.size - 1], strict=True):
+                for ax_ in axes:
+                    ax_.axvspan(t[a], t[b], color=cmap(int(mode_index[a]) % cmap.N), alpha=0.35,
+                                lw=0)
     for ax in axes:
         if ax.get_legend() is None:
             ax.legend(loc="best", fontsize="small")
@@ -82,19 +91,3 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
         head += f" - stopped: {traj.status}"
     fig.suptitle(head)
     return _save(fig, path, dpi)
-
-
-def _shade_modes(axes, t, mode_index, modes) -> None:
-    """Shade the time spans of the modes of a variable-structure run (one tint per mode)."""
-    if t.size < 2 or len(modes) < 2:
-        return
-    from matplotlib import colormaps
-
-    cmap = colormaps["Pastel2"]
-    change = np.flatnonzero(np.diff(mode_index) != 0) + 1
-    starts = np.concatenate([[0], change])
-    ends = np.concatenate([change, [t.size - 1]])
-    for a, b in zip(starts, ends, strict=True):
-        colour = cmap(int(mode_index[a]) % cmap.N)
-        for ax in axes:
-            ax.axvspan(t[a], t[b], color=colour, alpha=0.35, lw=0)
