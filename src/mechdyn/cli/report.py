@@ -14,10 +14,7 @@ RMS driving torque, peak joint forces, shaking-force harmonics) with its plot;
 with ``--simulate``, the run summary, energy balance and events instead.
 
 Exit codes: 0 done; 1 an analysis stopped early (the report says where); 2 bad input.
-
-:func:`report_records` runs the analyses a report shows and :func:`report` writes
-them with :func:`mechdyn.results.report.write_report`: the composing lives here,
-the writing in :mod:`mechdyn.results.report`, which only reads records.
+The analyses are composed here and written by :mod:`mechdyn.results.report`.
 """
 
 from __future__ import annotations

@@ -26,6 +26,7 @@ import numpy as np
 from ..errors import MechdynError, ModelError
 from ..kernels import rows_numpy
 from ..kinematics.constraints import extend, travel_rows
+from .figure import figure, save
 from .table import deg_or_mm, output_path, written
 
 __all__ = ["animate", "snapshot", "frame_geometry", "frame_indices", "check_animation_path",
@@ -276,8 +277,6 @@ class _Scene:
     """The matplotlib artists of one figure, updated frame by frame."""
 
     def __init__(self, record, *, trace=None, title=None, width: float = 6.4):
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from matplotlib.figure import Figure
         from matplotlib.patches import Polygon
 
         model, _ = _record_parts(record)
@@ -286,13 +285,11 @@ class _Scene:
         (x0, x1), (y0, y1) = g["limits"]
         # the figure's shape follows the drawing's (room for title and labels added)
         height = float(np.clip((width - 1.0) * (y1 - y0) / (x1 - x0) + 1.2, 3.0, 7.5))
-        self.fig = fig = Figure(figsize=(width, height), layout="constrained")
-        FigureCanvasAgg(fig)
-        ax = self.ax = fig.add_subplot()
+        self.fig, (ax,) = figure(1, width, height)
+        self.ax = ax
         ax.set(xlim=(x0, x1), ylim=(y0, y1), xlabel="x (m)", ylabel="y (m)",
                title=title if title is not None else getattr(model.mechanism, "name", "mechanism"))
         ax.set_aspect("equal", adjustable="box")
-        ax.grid(True, alpha=0.25)
         s = g["size"]
         # static: anchors (hatched triangles) and ground guides
         for p in g["anchors"].values():
@@ -505,7 +502,4 @@ def snapshot(record, path, index: int = 0, *, trace=None, title: str | None = No
     if hasattr(path, "write"):
         scene.fig.savefig(path, dpi=dpi, format="png")
         return path
-    path = output_path(path)
-    with written(path) as tmp:
-        scene.fig.savefig(tmp, dpi=dpi)
-    return path
+    return save(scene.fig, path, dpi)
