@@ -330,21 +330,16 @@ class _Scene:
                             bbox={"boxstyle": "round", "fc": "white", "ec": "0.7",
                                   "alpha": 0.85}, zorder=7)
 
-    def artists(self) -> list:
-        """The artists that move from frame to frame."""
-        out = [a for a, _ in self.bodies.values()] + list(self.guides.values())
-        out += [self.revolutes, self.locks, self.text]
-        if self.trace is not None:
-            out += [self.trace_line, self.trace_dot]
-        return out
-
     def render(self, idx, labels, dpi: int):
         """Yield one RGB :class:`PIL.Image.Image` per sample of ``idx`` (blitting)."""
         from PIL import Image
 
         canvas = self.fig.canvas
         self.fig.set_dpi(dpi)
-        moving = self.artists()
+        moving = [a for a, _ in self.bodies.values()] + list(self.guides.values())
+        moving += [self.revolutes, self.locks, self.text]
+        if self.trace is not None:
+            moving += [self.trace_line, self.trace_dot]
         for a in moving:
             a.set_animated(True)
         canvas.draw()  # the background: axes, anchors, the faint trace

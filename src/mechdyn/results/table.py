@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["write_csv", "read_csv", "unit_of_column", "UNIT_SUFFIXES", "output_path", "written",
-           "deg_or_mm", "rate_text", "coordinate_columns", "force_columns", "mode_columns"]
+           "deg_or_mm", "rate_text"]
 
 #: column-name suffix -> unit, longest suffixes first when matching
 UNIT_SUFFIXES: dict[str, str] = {
