@@ -7,7 +7,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ModelError, did_you_mean
 from .figure import figure as _figure
 from .figure import save as _save
 from .table import deg_or_mm
@@ -38,9 +37,6 @@ def plot_kinetostatics(record, path, *, joints: Sequence[str] | None = None,
         The file written.
     """
     names = list(record.reactions) if joints is None else list(joints)
-    for j in names:
-        if j not in record.reactions:
-            raise ModelError(did_you_mean(j, record.reactions, "joint"))
     xv, xunit = deg_or_mm(record.values, record.over_is_angle)
     fig, axes = _figure(3, height=3.0)
     ax = axes[0]
