@@ -317,15 +317,6 @@ class Foundation:
         return np.diag([float(self.mass), float(self.mass), float(self.inertia)])
 
 
-    def transmissibility(self, omega, direction="y", point=None,
-                         resultant: bool = False) -> np.ndarray:
-        """Force to the floor per unit harmonic load on the base, at angular frequencies
-        ``omega`` (rad/s): :func:`mechdyn.foundation.isolation.transmissibility` of this
-        foundation (same parameters and result)."""
-        from .isolation import transmissibility  # isolation imports this module
-
-        return transmissibility(self, omega, direction, point, resultant)
-
 def _assemble(supports, k, reference) -> np.ndarray:
     T = support_matrix(supports, (0.0, 0.0) if reference is None else reference)
     return np.einsum("nki,nk,nkj->ij", T, k, T)
