@@ -43,27 +43,6 @@ def _values(model: Model, given, base: np.ndarray, what: str) -> np.ndarray:
 MAX_WALK = 2000
 
 
-def _continue_to(model: Model, q_from, x_from, q_to, layout) -> np.ndarray:
-    """Newton continuation from a solved pose to new coordinates (keeps the branch)."""
-    q_from = np.asarray(q_from, float)
-    dq = np.asarray(q_to, float) - q_from
-    size = np.where(model.coord_is_angle, np.abs(dq) / 0.05,
-                    np.abs(dq) / (0.05 * model.length_scale))
-    if float(np.max(size, initial=0.0)) > MAX_WALK:
-        k = int(np.argmax(size))
-        unit = "deg" if model.coord_is_angle[k] else "mm"
-        far = np.rad2deg(q_to[k]) if model.coord_is_angle[k] else 1e3 * q_to[k]
-        raise ModelError(f"initial {model.coordinate_names[k]} = {far:.6g} {unit} is too far "
-                         f"from the sketch to be reached by continuation (more than "
-                         f"{MAX_WALK} steps of 0.05 rad or 0.05 length scale); give it "
-                         "within a few turns of the sketch (angles modulo 360 deg)")
-    n = max(1, int(math.ceil(float(np.max(size, initial=0.0)))))
-    x = np.array(x_from, float)
-    for k in range(1, n + 1):
-        x = solve_position(model, q_from + dq * (k / n), x, layout=layout, check_singular=False)
-    return x
-
-
 def initial_state(model: Model, q0=None, qdot0=None, *, mode=None):
     """Initial (q, qdot, x): arguments, else ``mechanism.extras["initial"]``, else the sketch.
 
@@ -91,5 +70,21 @@ def initial_state(model: Model, q0=None, qdot0=None, *, mode=None):
     qd = _values(model, qdot0, qd, "qdot0")
     if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd))):
         raise ModelError(f"the initial state must be finite, got q = {q}, qdot = {qd}")
-    x = _continue_to(model, q_sk, x_sk, q, layout)
+    # Newton continuation from the sketch (keeps its branch), in steps of 0.05 rad or 0.05
+    # length scale
+    dq = q - q_sk
+    size = np.where(model.coord_is_angle, np.abs(dq) / 0.05,
+                    np.abs(dq) / (0.05 * model.length_scale))
+    if float(np.max(size, initial=0.0)) > MAX_WALK:
+        k = int(np.argmax(size))
+        unit = "deg" if model.coord_is_angle[k] else "mm"
+        far = np.rad2deg(q[k]) if model.coord_is_angle[k] else 1e3 * q[k]
+        raise ModelError(f"initial {model.coordinate_names[k]} = {far:.6g} {unit} is too far "
+                         f"from the sketch to be reached by continuation (more than "
+                         f"{MAX_WALK} steps of 0.05 rad or 0.05 length scale); give it "
+                         "within a few turns of the sketch (angles modulo 360 deg)")
+    n = max(1, int(math.ceil(float(np.max(size, initial=0.0)))))
+    x = np.array(x_sk, float)
+    for k in range(1, n + 1):
+        x = solve_position(model, q_sk + dq * (k / n), x, layout=layout, check_singular=False)
     return q, qd, x

@@ -38,23 +38,6 @@ SWITCHING_OPTIONS = ("dt_out", "max_events", "small_velocity", "gap_tol", "zeno_
                      "max_wall_time", "max_steps", "min_step", "point")
 
 
-def _keywords_without_effect(integrator, rtol, atol, formulation, d) -> float:
-    """Warn (IntegratorWarning, naming them) about keywords that would have no effect;
-    returns rtol with its default filled in."""
-    name = integrator.lower() if isinstance(integrator, str) else getattr(integrator, "name", "")
-    if name in ("wilson", "rk4"):
-        given = [k for k, v in (("rtol", rtol), ("atol", atol)) if v is not None]
-        if given:
-            warnings.warn(f"option(s) {', '.join(given)} have no effect with the fixed-step "
-                          f"integrator {name!r} (it takes steps or dt)", IntegratorWarning,
-                          stacklevel=3)
-    if d is not None and formulation == "exact":
-        warnings.warn("option d (the virtual displacement) has no effect with "
-                      "formulation='exact'; it belongs to formulation='analogs'",
-                      IntegratorWarning, stacklevel=3)
-    return DEFAULT_RTOL if rtol is None else rtol
-
-
 def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | None = None,
              dt: float | None = None, rtol: float | None = None, atol=None, q0=None, qdot0=None,
              t_eval=None, formulation: str = "exact", d=None, progress: bool | None = None,
@@ -168,7 +151,18 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
         raise IntegratorOptionError(f"simulate() got an unknown keyword {unknown[0]!r}; the "
                                     "options of the segment loop are "
                                     + ", ".join(SWITCHING_OPTIONS))
-    rtol = _keywords_without_effect(integrator, rtol, atol, formulation, d)
+    # keywords that would have no effect are named in a warning
+    name = integrator.lower() if isinstance(integrator, str) else getattr(integrator, "name", "")
+    given = [k for k, v in (("rtol", rtol), ("atol", atol)) if v is not None]
+    if name in ("wilson", "rk4") and given:
+        warnings.warn(f"option(s) {', '.join(given)} have no effect with the fixed-step "
+                      f"integrator {name!r} (it takes steps or dt)", IntegratorWarning,
+                      stacklevel=2)
+    if d is not None and formulation == "exact":
+        warnings.warn("option d (the virtual displacement) has no effect with "
+                      "formulation='exact'; it belongs to formulation='analogs'",
+                      IntegratorWarning, stacklevel=2)
+    rtol = DEFAULT_RTOL if rtol is None else rtol
     if formulation not in FORMULATIONS:
         raise IntegratorOptionError(f"unknown formulation {formulation!r}; valid formulations: "
                                     + ", ".join(FORMULATIONS))

@@ -35,15 +35,11 @@ import time
 
 import numpy as np
 
-from .dynamics.contact import touching
+from .dynamics.contact import gaps, touching
 from .dynamics.dead_position import diagnose, status_of, turning_point
 from .dynamics.lagrange import kinetic_energy
 from .dynamics.mode_equations import ModeEquations
-from .dynamics.modes import (
-    ModeSystem,
-    SwitchedModel,
-    switched_model,
-)
+from .dynamics.modes import ModeSystem, switched_model
 from .dynamics.reactions import element_forces, frame_forces, net_on_ground
 from .dynamics.switching import apply_switch, event_functions
 from .errors import (
@@ -65,7 +61,6 @@ from .integrate.segment import (
     user_event_records,
 )
 from .kernels import rows_numpy as RN
-from .kinematics.constraints import extend
 from .model import Model
 from .model.workspace import Workspace
 from .progress import Progress
@@ -125,31 +120,26 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         small_velocity = 1e-6 * L
     if gap_tol is None:
         gap_tol = 1e-9 * L
-    if zeno_time is None:
-        zeno_time = 1e-4 * (t_end - t0)
     span = t_end - t0
+    if zeno_time is None:
+        zeno_time = 1e-4 * span
     if np.shape(point) != (2,) or not np.all(np.isfinite(np.asarray(point, float))):
         raise ModelError(f"point must be a finite (x, y) in m, got {point!r}")
     if min_step is None:
         min_step = 1e-13 * span
+    fixed_step = str(getattr(method, "name", method)).lower() in ("wilson", "rk4")
     if max_steps is None:
-        grid = (span / dt if dt else steps or 0) if str(method).lower() in ("wilson", "rk4") \
-            else 0
-        max_steps = max(200_000, 2 * int(grid))
+        max_steps = max(200_000, 2 * int((span / dt if dt else steps or 0) if fixed_step else 0))
     last_impact: dict = {}
     every_step = t_eval is None and dt_out is None  # as a fixed-structure run
     if every_step:
         t_eval = np.zeros(0)
     elif t_eval is None:
-        h_out = dt_out
-        n = int(math.floor((t_end - t0) / h_out + 1e-9))
-        t_eval = t0 + h_out * np.arange(n + 1)
+        t_eval = t0 + dt_out * np.arange(int(math.floor(span / dt_out + 1e-9)) + 1)
         if t_eval[-1] < t_end - 1e-12 * max(1.0, abs(t_end)):
             t_eval = np.append(t_eval, t_end)
     t_eval = np.asarray(t_eval, float)
-    weight = float(np.sum(model.mass) * max(np.hypot(*model.gravity), 1.0))
-    force_scale = max(weight, 1.0)
-    fixed_step = str(getattr(method, "name", method)).lower() in ("wilson", "rk4")
+    force_scale = max(float(np.sum(model.mass) * max(np.hypot(*model.gravity), 1.0)), 1.0)
     segment_integrator, method_name = segment_integrators(
         method, t0, t_end, rtol=rtol, atol=atol, dt=dt, steps=steps, iterations=iterations,
         tol=tol, theta=theta, first_step=first_step, max_step=max_step)
@@ -196,23 +186,20 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         x = ms.solve_position(q_init[ms.coords], x, t=t)
         # rates: given for the independent coordinates of the mode with every
         # touching stop and contact closed (the rest are dependent there)
-        touch0 = touching(sm, ms, x, gap_tol=gap_tol)
+        touch0 = touching(sm, x, gap_tol=gap_tol)
         ms_t = ModeSystem(sm, locks | frozenset(touch0), targets, x, workspace=ws) \
             if touch0 else ms
         B, _ = ms_t.velocity_analogs(x)
         xd = B @ qd_init[ms_t.coords]
-        X = extend(model, x)
-        for n, (st, meas) in sm.stops.items():
-            v = meas.value(X)
-            tol = gap_tol if not meas.is_angle else gap_tol / L
-            if (st.lower is not None and v < st.lower - tol) or (
-                    st.upper is not None and v > st.upper + tol):
-                raise ModelError(f"stop {n!r}: the initial state violates its limits "
-                                 f"({meas.label} = {v:.9g}, lower {st.lower}, upper {st.upper})")
-        for n, (_ct, gap, _) in sm.contacts.items():
-            if gap.value(X) < -gap_tol:
-                raise ModelError(f"contact {n!r}: the initial state penetrates by "
-                                 f"{-gap.value(X):.3g} m")
+        for tok, (g, is_angle) in gaps(sm, x).items():
+            n, side = tok.split("@")
+            if g >= -(gap_tol / L if is_angle else gap_tol):
+                continue
+            if side == "contact":
+                raise ModelError(f"contact {n!r}: the initial state penetrates by {-g:.3g} m")
+            st, meas = sm.stops[n]
+            raise ModelError(f"stop {n!r}: the initial state violates its limits ({meas.label} "
+                             f"= {meas.value(x):.9g}, lower {st.lower}, upper {st.upper})")
         if sm.has_switching:  # the mode the state is in: touching stops and contacts
             ms, x, xd, _ = apply_switch(sm, t, ms, x, xd, targets, events, fired=[],
                                         small_velocity=small_velocity, gap_tol=gap_tol,
@@ -405,22 +392,6 @@ def _budget(step, ev, ms, stats, span, min_step, max_steps, fixed_step) -> None:
                                   f"({max_steps} steps; raise max_steps to go on)")
 
 
-def _penetration(sm: SwitchedModel, x) -> float:
-    """Largest penetration of a stop (lengths only) or contact over poses x (n, n_x), m."""
-    worst = 0.0
-    for _n, (st, meas) in sm.stops.items():
-        if meas.is_angle:
-            continue
-        v = RN.values(meas.rows, x)[..., 0]
-        if st.lower is not None:
-            worst = max(worst, float(np.max(st.lower - v)))
-        if st.upper is not None:
-            worst = max(worst, float(np.max(v - st.upper)))
-    for _n, (_ct, gap, _) in sm.contacts.items():
-        worst = max(worst, float(np.max(-RN.values(gap.rows, x)[..., 0])))
-    return worst
-
-
 # ============================================================================ output
 def _finish(model, rec, events, stats, wall0, status, message, sm,
             point=(0.0, 0.0)) -> Trajectory:
@@ -456,7 +427,9 @@ def _finish(model, rec, events, stats, wall0, status, message, sm,
     T = kinetic_energy(model, x, xd) + 0.5 * (qd**2) @ sm.drive_inertia
     U = sm.fm.potential_energy(x)
     stats = dict(stats)
-    stats["penetration"] = _penetration(sm, x) if n else 0.0
+    # the largest penetration of a stop (lengths only) or contact, m
+    pen = [float(np.max(-g)) for g, angle in gaps(sm, x).values() if not angle] if n else []
+    stats["penetration"] = max([0.0, *pen])
     stats["wall_time_s"] = time.perf_counter() - wall0
     stats["variable_structure"] = SwitchedSamples(
         mode=[r[1].mode for r in rec], modes=modes,

@@ -171,10 +171,12 @@ def test_sigint_to_a_running_command_keeps_the_samples_marked_interrupted(tmp_pa
     """The acceptance run: ``mechdyn simulate press_cycle --t-end 2s -o out.csv`` stopped by
     SIGINT after 4 s exits 130 without a traceback; out.csv holds the samples computed so
     far and its header says the run was interrupted."""
+    import os
     import signal
     import subprocess
     import sys
     import time
+    from pathlib import Path
 
     out = tmp_path / "out.csv"
     proc = subprocess.Popen(
@@ -182,7 +184,18 @@ def test_sigint_to_a_running_command_keeps_the_samples_marked_interrupted(tmp_pa
          "simulate", "press_cycle", "--t-end", "2s",
          "--backend", "numpy", "--no-progress", "-o", str(out)],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(4.0)
+    # wait for 4 s of the child's own CPU time (not wall time: on a loaded machine the
+    # child may still be importing after 4 s), at most 90 s of wall time
+    deadline = time.monotonic() + 90.0
+    while time.monotonic() < deadline and proc.poll() is None:
+        try:
+            fields = Path(f"/proc/{proc.pid}/stat").read_text().rsplit(")", 1)[1].split()
+            cpu = (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+        except (OSError, IndexError, ValueError):  # no /proc: fall back to wall time
+            cpu = 4.0 if time.monotonic() > deadline - 86.0 else 0.0
+        if cpu >= 4.0:
+            break
+        time.sleep(0.1)
     proc.send_signal(signal.SIGINT)
     stdout, stderr = proc.communicate(timeout=120)
     assert proc.returncode == 130, (stdout, stderr)

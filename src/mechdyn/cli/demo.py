@@ -15,9 +15,7 @@ import numpy as np
 from .. import examples
 from ..dynamics.kinetostatics import kinetostatics
 from ..kinematics.sweep import sweep
-from ..results.plot import plot_kinematic_sweep
-from ..results.plot_dynamics import plot_trajectory
-from ..results.plot_kinetostatics import plot_kinetostatics
+from ..results.plot import plot
 from ..results.table import write_csv
 from ..simulate import simulate
 
@@ -38,14 +36,16 @@ def run(args) -> int:
     out.mkdir(parents=True, exist_ok=True)
     written: list[Path] = []
 
+    def save(record, name: str) -> None:
+        written.extend([write_csv(record, out / f"{name}.csv"), plot(record, out / f"{name}.png")])
+
     print("1/3 toggle press: kinematics over one crank turn (3601 positions)")
     press = examples.load("toggle_press")
     t0 = time.perf_counter()
     sw = sweep(press, "phi", np.linspace(0.0, 2 * np.pi, 3601), speed=40 * np.pi / 30)
     dt = time.perf_counter() - t0
     sw.raise_for_status()
-    written += [write_csv(sw, out / "toggle_press_kinematics.csv"),
-                plot_kinematic_sweep(sw, out / "toggle_press_kinematics.png")]
+    save(sw, "toggle_press_kinematics")
     print(f"    {len(sw)} positions in {dt * 1e3:.0f} ms")
     for line in sw.summary().lines():
         print("    " + line)
@@ -53,8 +53,7 @@ def run(args) -> int:
     print("2/3 toggle press: driving torque and joint forces at 40 rpm, punch near BDC")
     ks = kinetostatics(press, over="phi", speed=40 * np.pi / 30,
                        values=np.linspace(0.0, 2 * np.pi, 721))
-    written += [write_csv(ks, out / "toggle_press_forces.csv"),
-                plot_kinetostatics(ks, out / "toggle_press_forces.png")]
+    save(ks, "toggle_press_forces")
     for line in ks.summary().splitlines():
         print("    " + line)
 
@@ -62,8 +61,7 @@ def run(args) -> int:
     andrews = examples.load("andrews_squeezer")
     traj = simulate(andrews, 0.03, integrator="dop853", rtol=1e-10, atol=1e-12,
                     t_eval=np.linspace(0.0, 0.03, 301))
-    written += [write_csv(traj, out / "andrews_trajectory.csv"),
-                plot_trajectory(traj, out / "andrews_trajectory.png")]
+    save(traj, "andrews_trajectory")
     print(f"    status {traj.status}" + (f": {traj.message}" if traj.message else ""))
     beta = traj.q[-1, 0]
     print(f"    beta(0.03 s) = {beta:.12f} rad (Test Set reference 15.81077119629904 rad)")

@@ -14,11 +14,10 @@ from __future__ import annotations
 import warnings
 
 from ..dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
-from ..errors import Status, UnitError
+from ..errors import Status
 from ..results.plot_kinetostatics import plot_kinetostatics
 from ..results.table import rate_text, written
-from ..units import parse_quantity
-from .options import add_files, add_model, add_range, finish, open_model, sweep_values
+from .options import add_files, add_model, add_range, finish, open_model, sweep_values, vector
 
 __all__ = ["register", "run"]
 
@@ -57,18 +56,12 @@ def register(sub) -> None:
                    help="print the shaking-force harmonics up to order K (default 6; 0: none)")
 
 
-def _point(text: str):
-    parts = [p.strip() for p in text.split(",")]
-    if len(parts) != 2:
-        raise UnitError(f"--point: {text!r}: expected two lengths X,Y, e.g. 0,0 or 100mm,-50mm")
-    return tuple(parse_quantity(p, "length", where="--point") for p in parts)
-
-
 def run(args) -> int:
     """Run ``mechdyn kinetostatics``; returns the exit code."""
     mech, model = open_model(args)
     over, values, speed = sweep_values(model, args, start=0.0)
-    point = _point(args.point)
+    point = vector(args.point, ("length", "length"), "--point",
+                   "two lengths X,Y, e.g. 0,0 or 100mm,-50mm")
     mode = None
     if args.mode is not None:
         mode = (frozenset() if args.mode.strip().lower() == "none"

@@ -11,7 +11,7 @@ import numpy as np
 
 from .. import examples
 from ..dynamics.reduction import mode_mechanism
-from ..errors import ModelError
+from ..errors import ModelError, UnitError
 from ..integrate.base import DEFAULT_RTOL
 from ..integrate.driver import INTEGRATORS
 from ..kinematics.sweep import initial_coordinates
@@ -21,7 +21,7 @@ from ..results.table import write_csv
 from ..simulate import simulate
 from ..units import parse_quantity, parse_vector
 
-__all__ = ["quantity", "add_model", "add_files", "add_range", "add_motion_arguments",
+__all__ = ["quantity", "vector", "add_model", "add_files", "add_range", "add_motion_arguments",
            "add_model_arguments", "add_run", "load_model", "open_model", "prepare_model",
            "sweep_values", "simulate_from_args", "write_files", "finish"]
 
@@ -43,6 +43,14 @@ def quantity(value, kind: str, flag: str) -> float:
               f"(= {out * factor:.6g} {other}); write the unit, e.g. {text}{other.split('^')[0]}",
               file=sys.stderr)
     return out
+
+
+def vector(text: str, kinds, flag: str, hint: str) -> tuple:
+    """Comma-separated quantities of ``kinds``, in SI; a wrong count names ``hint``."""
+    parts = [p.strip() for p in text.split(",")]
+    if len(parts) != len(kinds):
+        raise UnitError(f"{flag}: {text!r}: expected {hint}")
+    return parse_vector(parts, kinds, where=flag)
 
 
 def add_model(p) -> None:
@@ -138,12 +146,8 @@ def prepare_model(args):
         name, sep, pose = spec.partition("=")
         engage.append(name)
         if sep:
-            parts = pose.split(",")
-            if len(parts) != 3:
-                raise ModelError(f"--engage {spec!r}: give the pose as X,Y,THETA, e.g. "
-                                 f"{name}=0mm,0mm,0deg")
-            offsets[name] = parse_vector(parts, ("length", "length", "angle"),
-                                         where=f"--engage {name}")
+            offsets[name] = vector(pose, ("length", "length", "angle"), f"--engage {name}",
+                                   f"the pose as X,Y,THETA, e.g. {name}=0mm,0mm,0deg")
     if engage or args.drop:
         mech = mode_mechanism(mech, engage=engage, offsets=offsets, drop=args.drop)
     if args.motor is None and (args.gear_ratio is not None or args.efficiency is not None):

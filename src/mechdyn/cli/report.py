@@ -14,15 +14,11 @@ RMS driving torque, peak joint forces, shaking-force harmonics) with its plot;
 with ``--simulate``, the run summary, energy balance and events instead.
 
 Exit codes: 0 done; 1 an analysis stopped early (the report says where); 2 bad input.
-
-:func:`report_records` runs the analyses a report shows and :func:`report` writes
-them with :func:`mechdyn.results.report.write_report`: the composing lives here,
-the writing in :mod:`mechdyn.results.report`, which only reads records.
+The analyses are composed here and written by :mod:`mechdyn.results.report`.
 """
 
 from __future__ import annotations
 
-import sys
 import warnings
 from pathlib import Path
 
@@ -77,9 +73,7 @@ def run(args) -> int:
     problems = [] if sw.ok else [sw.message]
     if ks is not None and ks.status == Status.SINGULAR_POSITION:
         problems.append(ks.message)
-    for msg in problems:
-        print(f"mechdyn report: warning: {msg}", file=sys.stderr)
-    return 1 if problems else 0
+    return finish(args, not problems, "; ".join(problems))
 
 
 def report_records(mech_or_model, *, speed: float | None = None, over: str | None = None,

@@ -23,6 +23,7 @@ from ..dynamics.lagrange import FORMULATIONS
 from ..errors import ModelError, Status, did_you_mean
 from ..mechanism import Drive
 from ..results import spectrum
+from ..results.events import events_table
 from ..results.plot_dynamics import plot_trajectory
 from ..results.plot_spectrum import plot_spectrum
 from ..results.table import deg_or_mm, write_csv, written
@@ -136,9 +137,9 @@ def run(args) -> int:
         write_csv(traj, args.output, points=args.points)
         print(f"wrote {args.output} ({traj.t.size} rows)")
         if traj.events:
-            ev_path = Path(args.output).with_name(Path(args.output).stem + "_events.csv")
+            ev_path = _beside(args.output, "_events.csv")
             with written(ev_path) as tmp:
-                _events_table(traj).to_csv(tmp, index=False)
+                events_table(traj.events, traj.coordinate_names).to_csv(tmp, index=False)
             print(f"wrote {ev_path} ({len(traj.events)} events)")
     if args.plot:
         plot_trajectory(traj, args.plot)
@@ -151,42 +152,27 @@ def run(args) -> int:
     return 0
 
 
-def _events_table(traj):
-    """One row per event: time, kind, element, modes, coordinates after, energy lost."""
-    import pandas as pd
-
-    rows = []
-    for ev in traj.events:
-        row = {"t_s": ev.t, "kind": ev.kind, "element": ev.element,
-               "mode_before": " ".join(sorted(ev.mode_before)),
-               "mode_after": " ".join(sorted(ev.mode_after)), "energy_lost_J": ev.energy_lost}
-        if ev.q_after is not None:
-            row.update({f"{n}_after": v for n, v in zip(traj.coordinate_names, ev.q_after,
-                                                        strict=False)})
-        rows.append(row)
-    return pd.DataFrame(rows)
+def _beside(path, tail: str) -> Path:
+    """The file ``NAME<tail>`` beside ``path`` (``NAME.csv``)."""
+    return Path(path).with_name(Path(path).stem + tail)
 
 
 def _spectrum(traj, args) -> None:
     """Print and write the frequency content of the column ``--spectrum``."""
     col = args.spectrum
-    df = traj.to_dataframe()
-    if col not in df:
-        raise ModelError(f"--spectrum: no column {col!r}; valid columns: "
-                         + ", ".join(df.columns))
-    t, y = df["t_s"].to_numpy(), df[col].to_numpy(dtype=float)
+    try:
+        t, y = spectrum.history(traj, col)
+    except KeyError as exc:
+        raise ModelError(f"--spectrum: {exc.args[0]}") from None
     summ = spectrum.summary(t, y, n=5)
     print(f"{col}: peak {summ['peak']:.6g} at t = {summ['peak_t']:.6g} s, RMS "
           f"{summ['rms']:.6g}, mean {summ['mean']:.6g}; dominant components:")
     for _, row in summ["dominant"].iterrows():
         print(f"  {row['f_Hz']:10.6g} Hz  amplitude {row['amplitude']:.6g}")
-    for path, write in ((args.output, "csv"), (args.plot, "png")):
-        if not path:
-            continue
-        out = Path(path).with_name(f"{Path(path).stem}_spectrum.{write}")
-        if write == "csv":
-            with written(out) as tmp:
-                spectrum.spectrum(t, y).to_csv(tmp, index=False)
-        else:
-            plot_spectrum(traj, col, out)
+    if args.output:
+        out = _beside(args.output, "_spectrum.csv")
+        with written(out) as tmp:
+            spectrum.spectrum(t, y).to_csv(tmp, index=False)
         print(f"wrote {out}")
+    if args.plot:
+        print(f"wrote {plot_spectrum(traj, col, _beside(args.plot, '_spectrum.png'))}")

@@ -64,6 +64,7 @@ class CompiledKernel:
 
     def __init__(self, ip, fp, ri, rf, dims, n_x, compile_time):
         self.ip, self.fp, self.ri, self.rf, self.dims = ip, fp, ri, rf, dims
+        self._arrays = (ip, fp, ri, rf, dims)
         self.n_x, self.n_i = n_x, int(dims[D_NI])
         self.ws = np.zeros(work_size(n_x, self.n_i))
         self.compile_time = compile_time
@@ -98,51 +99,35 @@ class CompiledKernel:
         self.ws[:self.n_x] = x
         self.ws[-N_FLAGS + W_VALID] = 0.0
 
-    def rhs(self, t, q, qdot):
-        """(q_I'', array([P_nc])) or None on failure (see ``status``)."""
-        n = self.n_i
-        y = np.empty(2 * n + 1)
-        y[:n] = q
-        y[n:2 * n] = qdot
+    def _run(self, fn, t, *args):
+        """``fn(t, *args, <packed arrays>, status)``; False where the kernel failed (see
+        ``status``)."""
         try:
-            out = first_order(float(t), y, self.ip, self.fp, self.ri, self.rf, self.dims,
-                              self.ws, self._st)
+            self._out = fn(float(t), *args, self._st)
         except ZeroDivisionError:  # e.g. a spring whose ends meet: the NumPy path names it
             self._st[0] = 3
         self.status = int(self._st[0])
-        if self.status:
+        return not self.status
+
+    def rhs(self, t, q, qdot):
+        """(q_I'', array([P_nc])) or None on failure (see ``status``)."""
+        n = self.n_i
+        y = np.concatenate([q, qdot, [0.0]])
+        if not self._run(first_order, t, y, *self._arrays, self.ws):
             return None
-        return out[n:2 * n], out[2 * n:]
+        return self._out[n:2 * n], self._out[2 * n:]
 
     def evaluation(self, t, q, qdot):
-        """Everything at one state, or None on failure (see ``status``).
-
-        Returns
-        -------
-        dict with ``x``, ``xdot``, ``xddot`` (n_x,), ``q``, ``qdot``, ``qddot`` (n_q,,
-        every declared coordinate), ``qddot_i`` (n_i,), ``lam`` (n_c,) multipliers of the
-        constraint rows (M x'' + h - F = Phi_x^T lambda), ``F`` (n_x,) applied forces
-        with the drives, ``power_nc`` (W).
-        """
-        n, nx, nq = self.n_i, self.n_x, int(self.dims[D_NQ])
-        nc = int(self.dims[D_NC])
-        out = np.empty(2 * n + 1)
+        """Everything at one state, or None on failure (see ``status``): ``(x, xdot,
+        xddot, q, qdot, qddot, lam, F)``, x and its rates (n_x,), every declared
+        coordinate (n_q,), the multipliers (n_c,) of the constraint rows
+        (M x'' + h - F = Phi_x^T lambda) and the applied forces with the drives (n_x,)."""
+        nx, nq, nc = self.n_x, int(self.dims[D_NQ]), int(self.dims[D_NC])
         ext = np.empty(nx + 3 * nq + nc + nx)
-        try:
-            full(float(t), np.asarray(q, np.float64), np.asarray(qdot, np.float64), self.ip,
-                 self.fp, self.ri, self.rf, self.dims, self.ws, out, ext, self._st)
-        except ZeroDivisionError:
-            self._st[0] = 3
-        self.status = int(self._st[0])
-        if self.status:
+        if not self._run(full, t, np.asarray(q, np.float64), np.asarray(qdot, np.float64),
+                         *self._arrays, self.ws, np.empty(2 * self.n_i + 1), ext):
             return None
-        o = nx
-        return dict(x=self.x.copy(), xdot=self.xdot.copy(), xddot=ext[:nx].copy(),
-                    q=ext[o:o + nq].copy(), qdot=ext[o + nq:o + 2 * nq].copy(),
-                    qddot=ext[o + 2 * nq:o + 3 * nq].copy(),
-                    lam=ext[o + 3 * nq:o + 3 * nq + nc].copy(),
-                    F=ext[o + 3 * nq + nc:].copy(), qddot_i=out[n:2 * n].copy(),
-                    power_nc=float(out[2 * n]))
+        return (self.x.copy(), self.xdot.copy(), *np.split(ext, np.cumsum([nx, nq, nq, nq, nc])))
 
     def snapshot(self) -> np.ndarray:
         """A copy of the workspace (last pose, analogs, flags), for :meth:`restore`."""
@@ -184,41 +169,30 @@ class CompiledKernel:
 _COMPILED = {"done": False, "time": 0.0}
 
 
-def _pendulum_arrays():
-    """The packed arrays of a small pendulum (a bar pinned to the ground, its angle as
-    coordinate, gravity): the kernels are generic over their arrays, so compiling them
-    on this model compiles them for every model -- and never evaluates a user's model
-    at a position its run does not visit (a spring whose ends meet at the sketch ...)."""
-    mech = Mechanism("warm-up pendulum", gravity=(0.0, -9.81))
-    mech.add_body("bar", mass=1.0, inertia=0.1, com=(0.5, 0.0), pose=(0.0, 0.0, 0.0))
-    mech.add_revolute("O", "ground", "bar")
-    mech.add_coordinate("theta", kind="angle", body="bar")
-    model = Model(mech)
-    ip, fp = LoadPacker(model, force_model(model)).pack()
-    ri, rf = concat(model.n_bodies, model.joint_rows, model.coordinate_rows,
-                    model.coordinate_rows).packed()
-    dims = np.array([len(model.joint_rows), 1, 1, 0], dtype=np.int64)
-    x0 = np.array(model.x_sketch, dtype=float)
-    return ip, fp, ri, rf, dims, model.n_x, x0
-
-
 def _warm_up() -> float:
     """Compile (or load from the disk cache) the kernels, once per process, on a small
-    pendulum; a compilation that takes longer than a few seconds is announced on stderr
-    (it happens on the first run of a fresh installation only)."""
+    pendulum (a bar pinned to the ground, its angle as coordinate, gravity): the kernels
+    are generic over their arrays, so compiling them on this model compiles them for
+    every model -- and never evaluates a user's model at a position its run does not
+    visit (a spring whose ends meet at the sketch ...).  A compilation that takes longer
+    than a few seconds is announced on stderr (the first run of a fresh installation)."""
     if _COMPILED["done"]:
         return 0.0
     t0 = time.perf_counter()
     with compiling("numba kernels of the dynamics"):
-        ip, fp, ri, rf, dims, n_x, x0 = _pendulum_arrays()
-        ni, nq, nc = int(dims[D_NI]), int(dims[D_NQ]), int(dims[D_NC])
-        ws = np.zeros(work_size(n_x, ni))
-        ws[:n_x] = x0
-        q, qd = np.array([0.3]), np.array([1.0])
-        st = np.zeros(1, dtype=np.int64)
-        first_order(0.0, np.concatenate([q, qd, [0.0]]), ip, fp, ri, rf, dims, ws, st)
-        full(0.0, q, qd, ip, fp, ri, rf, dims, ws, np.empty(2 * ni + 1),
-              np.empty(2 * n_x + 3 * nq + nc), st)
+        mech = Mechanism("warm-up pendulum", gravity=(0.0, -9.81))
+        mech.add_body("bar", mass=1.0, inertia=0.1, com=(0.5, 0.0), pose=(0.0, 0.0, 0.0))
+        mech.add_revolute("O", "ground", "bar")
+        mech.add_coordinate("theta", kind="angle", body="bar")
+        model = Model(mech)
+        ri, rf = concat(model.n_bodies, model.joint_rows, model.coordinate_rows,
+                        model.coordinate_rows).packed()
+        dims = np.array([len(model.joint_rows), 1, 1, 0], dtype=np.int64)
+        kernel = CompiledKernel(*LoadPacker(model, force_model(model)).pack(), ri, rf, dims,
+                                model.n_x, 0.0)
+        kernel.reset(model.x_sketch)
+        kernel.rhs(0.0, [0.3], [1.0])
+        kernel.evaluation(0.0, [0.3], [1.0])
     _COMPILED["done"] = True
     _COMPILED["time"] = time.perf_counter() - t0
     return _COMPILED["time"]

@@ -178,19 +178,26 @@ def row_terms(ms: ModeSystem, rows: list[Row], x, xdot, B, b):
     return g @ B, gw @ B, g @ b + quad
 
 
-def touching(sm: SwitchedModel, ms: ModeSystem, x, *, gap_tol: float) -> list[str]:
-    """Unilateral tokens whose gap is within ``gap_tol`` (m, or rad for angle stops)."""
-    out = []
+def gap_measures(sm: SwitchedModel):
+    """``(token, measure, sign, limit)`` of every stop side and contact, its gap being
+    sign (measure - limit)."""
     for n, (st, meas) in sm.stops.items():
-        v = meas.value(x)
-        if st.lower is not None and v - st.lower <= gap_tol:
-            out.append(f"{n}@lower")
-        if st.upper is not None and st.upper - v <= gap_tol:
-            out.append(f"{n}@upper")
+        for side in st.sides():
+            yield f"{n}@{side}", meas, (1.0 if side == "lower" else -1.0), getattr(st, side)
     for n, (_ct, gap, _) in sm.contacts.items():
-        if gap.value(x) <= gap_tol:
-            out.append(f"{n}@contact")
-    return out
+        yield f"{n}@contact", gap, 1.0, 0.0
+
+
+def gaps(sm: SwitchedModel, x) -> dict:
+    """``{token: (gap, is_angle)}`` of every stop side and contact at poses x (..., n_x):
+    m, or rad for angle stops, negative where it penetrates."""
+    return {tok: (sign * (rows_numpy.values(m.rows, x)[..., 0] - lim), m.is_angle)
+            for tok, m, sign, lim in gap_measures(sm)}
+
+
+def touching(sm: SwitchedModel, x, *, gap_tol: float) -> list[str]:
+    """Unilateral tokens whose gap is within ``gap_tol`` (m, or rad for angle stops)."""
+    return [tok for tok, (g, _) in gaps(sm, x).items() if g <= gap_tol]
 
 
 def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates,
@@ -276,13 +283,9 @@ def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates
         Kinv = np.linalg.pinv(K) if K.size else np.zeros((0, 0))
         base_sol = Kinv @ np.concatenate([f, -de]) if K.size else np.zeros(0)
         resp = Kinv[:, :n] @ Wu.T if K.size else np.zeros((0, len(uni)))
-        H = Cu @ resp[:n]
-        r = Cu @ base_sol[:n] + du
-        comp = np.array([r_.compliance for r_ in uni], float)
-        H = H + np.diag(comp)
-        sol = solve_lcp(H, r)
-        lam = sol.z
-        acc = sol.w
+        H = Cu @ resp[:n] + np.diag(np.array([r_.compliance for r_ in uni], float))
+        sol = solve_lcp(H, Cu @ base_sol[:n] + du)
+        lam, acc = sol.z, sol.w
         mu_e = base_sol[n:] + resp[n:] @ lam if ne else np.zeros(0)
         changed = False
         # drop rows without force (they separate or just touch)
@@ -315,13 +318,8 @@ def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates
                 forced_open -= set(reopen)
                 active = sorted(set(active) | set(reopen))
                 continue
-            mode = locks | frozenset(active) | frozenset(
-                f"{c}:{s}" for c, s in fric.items() if f"{c}@contact" in active)
-            for c in [a[:-8] for a in active if a.endswith("@contact")]:
-                if fric.get(c) == "stick":
-                    targets[f"{c}:stick"] = sm.contacts[c][2].value(x)
-            forces = {u.label: float(l_) for u, l_ in zip(uni, lam, strict=True)
-                      if u.label in active}
-            return mode, forces
+            targets.update(stick_targets)  # the stick positions chosen
+            return locks | toks, {u.label: float(l_) for u, l_ in zip(uni, lam, strict=True)
+                                  if u.label in active}
     raise ContactError("the contact and friction states do not settle (stick/slip cycling)",
                        t=t)

@@ -73,38 +73,34 @@ def turning_point(eqs, step, qd_old, x_good) -> str | None:
     kern, ws = eqs.kernel, eqs.ms.ws
     saved = kern.snapshot() if kern is not None else None
     kept = (ws.x, ws.B, ws.qi)
+    ms = eqs.ms
     try:
-        return _dead_turn(eqs, step, turns, x_good)
+        for k in turns:
+            try:
+                tk = brentq(lambda s, k=k: step.dense(s)[1][k], step.t_old, step.t,
+                            xtol=1e-14, rtol=4 * np.finfo(float).eps)
+            except ValueError:
+                continue
+            qk = step.dense(tk)[0]
+            if eqs.chart_at(qk) is not None:
+                continue  # a bifurcation: the branch goes on through it
+            try:
+                xk = ms.solve_position(qk, x_good)
+            except AssemblyError:
+                xk = None
+            rep = ms.singularity(x_good if xk is None else xk)
+            if xk is None or (rep["rcond"] < TURN_RCOND
+                              and ms.coord_names[k] in rep["coordinates"]):
+                q = ms.coordinates(x_good if xk is None else xk)
+                return (f"dead position reached near t = {tk:.9g} s at {_where(ms, q)}: "
+                        f"{ms.coord_names[k]} turns back where the position Jacobian is "
+                        f"singular (sigma_min/sigma_max {rep['rcond']:.2e}); "
+                        f"{_dependent(rep)}; going on would need the other assembly branch")
+        return None
     finally:
         ws.x, ws.B, ws.qi = kept
         if saved is not None:
             kern.restore(saved)
-
-
-def _dead_turn(eqs, step, turns, x_good) -> str | None:
-    ms = eqs.ms
-    for k in turns:
-        try:
-            tk = brentq(lambda s, k=k: step.dense(s)[1][k], step.t_old, step.t, xtol=1e-14,
-                        rtol=4 * np.finfo(float).eps)
-        except ValueError:
-            continue
-        qk = step.dense(tk)[0]
-        if eqs.chart_at(qk) is not None:
-            continue  # a bifurcation: the branch goes on through it
-        try:
-            xk = ms.solve_position(qk, x_good)
-        except AssemblyError:
-            xk = None
-        rep = ms.singularity(x_good if xk is None else xk)
-        if xk is None or (rep["rcond"] < TURN_RCOND
-                          and ms.coord_names[k] in rep["coordinates"]):
-            q = ms.coordinates(x_good if xk is None else xk)
-            return (f"dead position reached near t = {tk:.9g} s at {_where(ms, q)}: "
-                    f"{ms.coord_names[k]} turns back where the position Jacobian is singular "
-                    f"(sigma_min/sigma_max {rep['rcond']:.2e}); {_dependent(rep)}; going on "
-                    f"would need the other assembly branch")
-    return None
 
 
 def diagnose(exc, good):
@@ -151,14 +147,11 @@ def diagnose(exc, good):
 
 def status_of(exc):
     """(status, message) of an error that ended a run (:class:`~mechdyn.errors.Status`)."""
-    if isinstance(exc, SingularPositionError):
-        return Status.SINGULAR_POSITION, str(exc)
-    if isinstance(exc, AssemblyError):
-        return Status.ASSEMBLY_FAILED, str(exc)
-    if isinstance(exc, ContactError):
-        return Status.NO_CONTACT_SOLUTION, str(exc)
-    if isinstance(exc, LockupError):
-        return Status.LOCKUP, str(exc)
+    for cls, status in ((SingularPositionError, Status.SINGULAR_POSITION),
+                        (AssemblyError, Status.ASSEMBLY_FAILED),
+                        (ContactError, Status.NO_CONTACT_SOLUTION), (LockupError, Status.LOCKUP)):
+        if isinstance(exc, cls):
+            return status, str(exc)
     if isinstance(exc, IntegrationError) and "mass matrix" in str(exc):
         return Status.SINGULAR_MASS_MATRIX, str(exc)
     if isinstance(exc, ArithmeticError):

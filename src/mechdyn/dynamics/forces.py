@@ -219,7 +219,6 @@ class ForceModel:
     """The loads and drives of a model, resolved to indices (build with :func:`force_model`)."""
 
     model: Model
-    gravity_F: np.ndarray  # (n_x,) forces of gravity at theta = 0 (moments added per pose)
     springs: list
     rotary: list
     forces: list
@@ -276,8 +275,9 @@ class ForceModel:
         nb = m.n_bodies
         X = extend(m, x)
         F = np.zeros(batch + (nb + 1, 3))
-        if self._weights is not None:
-            _add_weights(self._weights, m, F[..., :nb, :], x)
+        if self._weights is not None:  # at the centres of mass
+            F[..., :nb, :2] += self._weights
+            F[..., :nb, 2] += cross(com_arms(m, x), self._weights)
         V = None if conservative else extend(m, xdot)
         for (name, i, si, j, sj, k, L0, c, pre) in self.springs:
             ai, aj, d, L = _spring_geometry(X, i, si, j, sj)
@@ -384,13 +384,6 @@ class ForceModel:
         return self.loads(None, x, None, None, None, conservative=True)[0]
 
 
-def _add_weights(w, model: Model, Fb, x):
-    """Add the weights w (n_bodies, 2) at the centres of mass to the body forces
-    Fb (..., n_bodies, 3), in place."""
-    Fb[..., :2] += w
-    Fb[..., 2] += cross(com_arms(model, x), w)
-
-
 def applied_forces(model: Model, t, x, xdot, q, qdot, *, skip_drives: Sequence[int] = (),
                    reacting_loads: Sequence[str] = ()):
     """Applied forces for a batch of positions, drives included on the body poses.
@@ -444,25 +437,24 @@ def force_model(model: Model) -> ForceModel:
             probs.append(f"{where}: " + did_you_mean(name, [*model.body_names, "ground"], "body"))
             return None
 
-    def point(b, p, where):
+    def anchor(b, p, where):
+        """(body index, point in the body frame), or None with the problem noted."""
+        i = body(b, where)
         try:
-            return model.point_local(b, p)
+            return None if i is None else (i, model.point_local(b, p))
         except ModelError as exc:
             probs.append(f"{where}: {exc}")
-            return None
 
     for ld in mech.loads:
         where = f"{type(ld).__name__.lower()} {getattr(ld, 'name', '?')!r}"
         if isinstance(ld, Spring):
-            i, j = body(ld.body1, where), body(ld.body2, where)
-            si = point(ld.body1, ld.point1, where) if i is not None else None
-            sj = point(ld.body2, ld.point2, where) if j is not None else None
+            a1, a2 = anchor(ld.body1, ld.point1, where), anchor(ld.body2, ld.point2, where)
             for fld in ("stiffness", "free_length", "damping"):
                 if getattr(ld, fld) < 0:
                     probs.append(f"{where}: {fld} must be >= 0, got {getattr(ld, fld)!r}")
-            if None not in (i, j) and si is not None and sj is not None:
-                springs.append((ld.name, i, si, j, sj, float(ld.stiffness),
-                                float(ld.free_length), float(ld.damping), float(ld.preload)))
+            if a1 and a2:
+                springs.append((ld.name, *a1, *a2, float(ld.stiffness), float(ld.free_length),
+                                float(ld.damping), float(ld.preload)))
         elif isinstance(ld, RotarySpring):
             if ld.joint not in mech.joints or model.joint_kind(ld.joint) != "revolute":
                 probs.append(f"{where}: joint: " + did_you_mean(ld.joint, model.rev.names,
@@ -473,10 +465,9 @@ def force_model(model: Model) -> ForceModel:
                            float(ld.stiffness), float(ld.free_angle), float(ld.damping),
                            float(ld.preload)))
         elif isinstance(ld, Force):
-            b = body(ld.body, where)
-            s = point(ld.body, ld.point, where) if b is not None else None
-            if b is not None and s is not None:
-                forces.append((ld, b, s))
+            a = anchor(ld.body, ld.point, where)
+            if a:
+                forces.append((ld, *a))
         elif isinstance(ld, Torque):
             b = body(ld.body, where)
             r = body(ld.reaction_body, where) if ld.reaction_body is not None else None
@@ -504,6 +495,6 @@ def force_model(model: Model) -> ForceModel:
         drives.append((dr, model.coordinate_index(dr.coordinate)))
     if probs:
         raise ModelError(probs)
-    fm = ForceModel(model, np.zeros(model.n_x), springs, rotary, forces, torques, drives)
+    fm = ForceModel(model, springs, rotary, forces, torques, drives)
     model.memo["force_model"] = fm
     return fm

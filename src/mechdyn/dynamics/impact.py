@@ -116,9 +116,8 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     rows_b = sm.rows(new_locks, targets) if new_locks else []
     uni_tokens = sorted(set(unilateral))
     rows_u = [r for r in sm.rows(frozenset(uni_tokens), targets) if r.unilateral]
-    zero_b = np.zeros_like(B[:, 0]) if B.shape[1] else np.zeros(model.n_x)
-    Cb, _, _ = row_terms(base, rows_b, x, xdot_minus, B, zero_b)
-    Cu, _, _ = row_terms(base, rows_u, x, xdot_minus, B, zero_b)
+    Cb, _, _ = row_terms(base, rows_b, x, xdot_minus, B, np.zeros(model.n_x))
+    Cu, _, _ = row_terms(base, rows_u, x, xdot_minus, B, np.zeros(model.n_x))
     Z = constrained_inverse(A, Cb)
     p_minus = A @ qd_minus
     v_minus = Cu @ qd_minus
@@ -142,17 +141,15 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     xdot_plus = B @ qd_plus
     T0 = 0.5 * float(xdot_minus @ M @ xdot_minus)
     T1 = 0.5 * float(xdot_plus @ M @ xdot_plus)
-    res = ImpactResult(xdot_plus, T0, T1, T0 - T1)
     # impulses of every row of the mode after the impact
     after = ModeSystem(sm, frozenset(locks_after) | frozenset(uni_tokens), targets, x)
     R = after.row_jacobian(x)
     dp = M @ (xdot_plus - xdot_minus)
     Lam = np.linalg.lstsq(R.T, dp, rcond=None)[0] if R.size else np.zeros(0)
-    labels = after.row_labels()
-    res.impulses = dict(zip(labels, (float(v) for v in Lam), strict=True))
-    res.element_impulses = element_forces(after, x, Lam)
-    for r, vm, vp in zip(rows_b + rows_u, np.concatenate([Cb @ qd_minus, v_minus]),
-                         np.concatenate([Cb @ qd_plus, Cu @ qd_plus]), strict=True):
-        res.velocity_before[r.label] = float(vm)
-        res.velocity_after[r.label] = float(vp)
-    return res
+    labels = [r.label for r in rows_b + rows_u]
+    C = np.concatenate([Cb, Cu])  # the rates of the new rows
+    return ImpactResult(xdot_plus, T0, T1, T0 - T1,
+                        dict(zip(after.row_labels(), map(float, Lam), strict=True)),
+                        element_forces(after, x, Lam),
+                        dict(zip(labels, map(float, C @ qd_minus), strict=True)),
+                        dict(zip(labels, map(float, C @ qd_plus), strict=True)))

@@ -105,7 +105,7 @@ def potential_energy(model: Model, x) -> np.ndarray:
     return force_model(model).potential_energy(x)
 
 
-class EquationsOfMotion:
+class EquationsOfMotion(ModeEquations):
     """A(q) q'' + c(q, q') = Q(t, q, q') of a model in one mode, evaluated on demand.
 
     Parameters
@@ -128,7 +128,7 @@ class EquationsOfMotion:
     Attributes
     ----------
     equations : ModeEquations
-        The equations of the mode, as the integrators see them.
+        The equations of the mode, as the integrators see them (the view itself).
     backend, backend_note : str
         ``"numba"`` or ``"numpy"``; why the compiled path is not used.
 
@@ -164,10 +164,7 @@ class EquationsOfMotion:
 
     def __init__(self, model: Model, formulation: str = "exact", *, d=None, mode=None,
                  x0=None, backend: str = "auto"):
-        if formulation not in FORMULATIONS:
-            raise ModelError(f"unknown formulation {formulation!r}; valid formulations: "
-                             + ", ".join(repr(f) for f in FORMULATIONS))
-        self.model, self.formulation = model, formulation
+        self.model = model
         self.layout = model.layout(mode)
         if x0 is None:
             x0 = getattr(model, "x0", None)
@@ -182,36 +179,22 @@ class EquationsOfMotion:
         if ms.n_i != model.n_q:
             raise ModelError(f"in mode {sorted(locks)} the coordinates "
                              f"{', '.join(model.coordinate_names)} are not all independent")
-        self.equations = ModeEquations(sm, ms, backend, formulation, d)
+        super().__init__(sm, ms, backend, formulation, d)
         self.extra_inertia = sm.drive_inertia
 
     @property
-    def backend(self) -> str:
-        return self.equations.backend
+    def equations(self) -> ModeEquations:
+        return self
 
     @property
     def backend_note(self) -> str:
-        return self.equations.note
-
-    @property
-    def kernel(self):
-        """The compiled kernel, or None."""
-        return self.equations.kernel
-
-    @property
-    def book(self):
-        """The branch charts (None where charts do not apply)."""
-        return self.equations.book
+        return self.note
 
     @property
     def x(self) -> np.ndarray:
         """The last solved pose."""
         k = self.kernel
-        return k.x.copy() if k is not None else self.equations.ms.ws.x.copy()
-
-    def reset(self, x) -> None:
-        """Restart the Newton continuation from the pose ``x`` (n_x,)."""
-        self.equations._reset(x)
+        return k.x.copy() if k is not None else self.ms.ws.x.copy()
 
     def positions(self, q, t: float | None = None, *, check_singular: bool = False):
         """Body poses x (n_x,) at coordinates ``q``, by Newton from the last solution.
@@ -221,14 +204,14 @@ class EquationsOfMotion:
         AssemblyError, SingularPositionError
             (the latter only with ``check_singular``).
         """
-        ev = self.equations.evaluate(t or 0.0, np.asarray(q, float), np.zeros(self.model.n_q))
+        ev = self.evaluate(t or 0.0, np.asarray(q, float), np.zeros(self.model.n_q))
         if check_singular:
-            self.equations.check_position(t or 0.0, ev.x, ev.q)
+            self.check_position(t or 0.0, ev.x, ev.q)
         return ev.x.copy()
 
     def rhs(self, t: float, q, qdot):
         """q'' and the non-conservative power at (t, q, q'): ``(qddot (n_q,), p (1,))``."""
-        return self.equations.rhs(t, np.asarray(q, float), np.asarray(qdot, float))
+        return super().rhs(t, np.asarray(q, float), np.asarray(qdot, float))
 
     def qddot(self, t: float, q, qdot) -> np.ndarray:
         """Generalized accelerations q'' (n_q,) at (t, q, q')."""
@@ -236,24 +219,17 @@ class EquationsOfMotion:
 
     __call__ = qddot
 
-    def first_order_function(self):
-        """``fun(t, y) -> y'`` for y = (q, q', w) on the compiled kernel, or None."""
-        return self.equations.first_order_function()
-
     def terms(self, t: float, q, qdot) -> Terms:
         """All terms of the equations at one state (NumPy path, for inspection)."""
         q, qdot = np.asarray(q, float), np.asarray(qdot, float)
-        eqs = self.equations
         if self.formulation == "analogs":
-            tm = eqs.analogs_terms(t, q, qdot)
-            return Terms(t, q, qdot, tm["qddot"], tm["x"], tm["xdot"], tm["B"], tm["A"],
-                         tm["c"], tm["Q"], tm["Q_drive"], tm["power_nc"])
-        ev = eqs.evaluate(t, q, qdot)
-        tm = eqs.ms.terms(t, ev.x, ev.xdot)
+            return Terms(t, q, qdot, **self.analogs_terms(t, q, qdot))
+        ev = self.evaluate(t, q, qdot)
+        tm = self.ms.terms(t, ev.x, ev.xdot)
         B, M = tm["B"], tm["M"]
-        Qd = eqs.sm.fm.applied(t, ev.x, ev.xdot, q, qdot)[1]
+        Qd = self.sm.fm.applied(t, ev.x, ev.xdot, q, qdot)[1]
         return Terms(t, q, qdot, ev.qddot, ev.x, ev.xdot, B, tm["A"],
-                     B.T @ (M @ tm["b"] + tm["h"]), B.T @ tm["F"], Qd, eqs._power(ev))
+                     B.T @ (M @ tm["b"] + tm["h"]), B.T @ tm["F"], Qd, self._power(ev))
 
     def energy(self, t: float, q, qdot) -> dict:
         """Kinetic and potential energy (J) and the non-conservative power (W) at one state."""
@@ -261,14 +237,6 @@ class EquationsOfMotion:
         T = 0.5 * float(qdot @ tm.A @ qdot)
         return {"kinetic": T, "potential": float(potential_energy(self.model, tm.x)),
                 "power_nc": tm.power_nc}
-
-    def chart_at(self, q):
-        """The branch chart whose zone holds q, else None."""
-        return self.equations.chart_at(q)
-
-    def report(self) -> list[dict]:
-        """The bifurcation positions met."""
-        return self.equations.report()
 
 
 #: the equations go through bifurcation positions on the branch (kept as a name)

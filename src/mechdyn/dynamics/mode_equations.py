@@ -34,6 +34,8 @@ singular pose, so a minimum-norm solve there gives a wrong acceleration.
 
 from __future__ import annotations
 
+from functools import cached_property
+
 import numpy as np
 
 from ..errors import ModelError, SingularPositionError
@@ -42,6 +44,7 @@ from ..kinematics.assembly import SINGULAR_RCOND, solve_position
 from ..kinematics.branch_chart import BranchChart, ChartBook, PathProblem
 from ..kinematics.constraints import extend
 from .compiled import compile_mode_kernel
+from .dead_position import _dependent, _where
 from .forces import com_arms
 from .mode_system import solve_mass
 from .modes import ModeEval
@@ -153,22 +156,27 @@ class ModeEquations:
             ev = ms.evaluate(t, qi, qdi)
             ev.qddot = self.analogs_terms(t, qi, qdi, ev.x)["qddot"]
             return ev
-        if self.kernel is not None:
-            if self._full:
-                k = self.kernel.evaluation(t, qi, qdi)
-                if k is not None:
-                    lam = np.zeros(ms.n_rows)
-                    lam[ms.independent_rows] = k["lam"]
-                    return ModeEval(k["x"], k["xdot"], k["xddot"], k["q"], k["qdot"],
-                                    k["qddot"], lam, k["F"])
-            return ms.evaluate(t, qi, qdi, x_guess=self.kernel.x.copy())
-        return ms.evaluate(t, qi, qdi)
+        if self.kernel is not None and self._full:
+            k = self.kernel.evaluation(t, qi, qdi)
+            if k is not None:
+                lam = np.zeros(ms.n_rows)
+                lam[ms.independent_rows] = k[6]
+                return ModeEval(*k[:6], lam, k[7])
+        return self._numpy_evaluate(t, qi, qdi)
+
+    def _numpy_evaluate(self, t: float, qi, qdi) -> ModeEval:
+        """The NumPy evaluation, its Newton solve started from the kernel's last pose."""
+        k = self.kernel
+        return self.ms.evaluate(t, qi, qdi, x_guess=None if k is None else k.x.copy())
 
     def _power(self, ev) -> float:
-        """Power of the non-conservative forces at an evaluation, W."""
+        """Power of the non-conservative forces at an evaluation (all applied forces but
+        gravity and spring stiffness, and the sliding friction of slipping contacts), W."""
         Fc = ev.F_conservative
         p = float((ev.F - (self.sm.fm.conservative(ev.x) if Fc is None else Fc)) @ ev.xdot)
-        return p + friction_power(self.ms, ev)
+        ms = self.ms
+        return p + float(sum(-r.mu * r.slip * ev.lam[ms.n_base + k] * r.tangent.rate(ev.x, ev.xdot)
+                             for k, r in enumerate(ms.rows) if r.slip))
 
     def numpy_rhs(self, t: float, qi, qdi):
         """(q_I'', array([P_nc])) on the NumPy path; raises the diagnosed error of a
@@ -176,37 +184,32 @@ class ModeEquations:
         if self.formulation == "analogs":
             tm = self.analogs_terms(t, qi, qdi)
             return tm["qddot"], np.array([tm["power_nc"]])
-        ev = self.ms.evaluate(t, qi, qdi, x_guess=None if self.kernel is None
-                              else self.kernel.x.copy())
+        ev = self._numpy_evaluate(t, qi, qdi)
         return ev.qddot[self.ms.coords], np.array([self._power(ev)])
 
     def rhs(self, t: float, qi, qdi):
         """(q_I'' (n_i,), array([P_nc])) at (t, q_I, q_I')."""
-        if self.book is not None:
-            ch = self._zone(qi)
-            if ch is not None:
-                return self._chart_rhs(ch, t, qi, qdi)
-        out = self.kernel.rhs(t, qi, qdi) if self.kernel is not None else None
-        if out is None:
-            out = self.numpy_rhs(t, qi, qdi)
-        if self.book is not None:
-            ch = self._watch(float(qi[0]))
-            if ch is not None:
-                return self._chart_rhs(ch, t, qi, qdi)
-        return out
+        n = self.ms.n_i
+        out = self._first_order(t, np.concatenate([qi, qdi, [0.0]]))
+        return out[n:2 * n], out[2 * n:]
 
     def first_order_function(self):
         """``fun(t, y) -> y'`` for y = (q_I, q_I', w) on the compiled kernel (the branch
         charts inside bifurcation zones), or None without the compiled kernel."""
-        if self.kernel is None:
-            return None
+        return None if self.kernel is None else self._first_order
+
+    @cached_property
+    def _first_order(self):
+        """y' = (q_I', q_I'', P_nc) on the compiled kernel, else (and where the kernel
+        fails) on the NumPy path; from a branch chart inside a bifurcation zone."""
         n = self.ms.n_i
 
-        def on_failure(t, y):
+        def numpy_path(t, y):
             qdd, p = self.numpy_rhs(t, y[:n], y[n:2 * n])
             return np.concatenate([y[n:2 * n], qdd, p])
 
-        base = self.kernel.first_order_function(on_failure)
+        base = numpy_path if self.kernel is None else self.kernel.first_order_function(
+            numpy_path)
         book = self.book
         if book is None:
             return base
@@ -252,7 +255,7 @@ class ModeEquations:
             if win is not None:
                 s = win.centre + np.sign(s - win.centre) * win.window
         if win is not None:
-            self._reset(win.evaluate(s)[0])
+            self.reset(win.evaluate(s)[0])
         return None
 
     def _watch(self, s: float) -> BranchChart | None:
@@ -266,7 +269,8 @@ class ModeEquations:
         ch = self.book.watch(s, x)
         return ch if ch is not None and ch.in_zone(s) else None
 
-    def _reset(self, x) -> None:
+    def reset(self, x) -> None:
+        """Restart the Newton continuation from the pose ``x`` (n_x,)."""
         self.ms.ws.reset(x)
         if self.kernel is not None:
             self.kernel.reset(x)
@@ -274,16 +278,12 @@ class ModeEquations:
     def _chart_eval(self, ch: BranchChart, t, qi, qdi) -> ModeEval:
         qd = np.asarray(qdi, float).reshape(-1)
         x, xs, xss = ch.evaluate(float(np.asarray(qi, float).reshape(-1)[0]))
-        self._reset(x)
+        self.reset(x)
         return self.ms.evaluate_x(t, x, xs * qd[0], xs[:, None], b=xss * qd[0] ** 2)
 
-    def _chart_rhs(self, ch, t, qi, qdi):
-        ev = self._chart_eval(ch, t, qi, qdi)
-        return ev.qddot[self.ms.coords], np.array([self._power(ev)])
-
     def _chart_first_order(self, ch, t, y):
-        qdd, p = self._chart_rhs(ch, t, y[:1], y[1:2])
-        return np.concatenate([y[1:2], qdd, p])
+        ev = self._chart_eval(ch, t, y[:1], y[1:2])
+        return np.concatenate([y[1:2], ev.qddot[self.ms.coords], [self._power(ev)]])
 
     # ------------------------------------------------------------------ checks
     def check_position(self, t: float, x, q) -> None:
@@ -306,14 +306,10 @@ class ModeEquations:
         rep = self.ms.singularity(x)
         if rep["rcond"] >= SINGULAR_RCOND:
             return
-        model = self.ms.model
-        names = ", ".join(f"{n} = {v:.9g}" for n, v in zip(model.coordinate_names, q,
-                                                               strict=True))
         raise SingularPositionError(
             f"singular position in mode {sorted(self.ms.mode) or '(none)'} at t = {t:.9g} s, "
-            f"{names}: sigma_min/sigma_max of the position Jacobian {rep['rcond']:.2e}; the "
-            f"coordinate(s) {', '.join(rep['coordinates']) or '-'} lose control, joints "
-            f"{', '.join(rep['joints']) or '-'} become dependent", t=t, q=q)
+            f"{_where(self.ms, q)}: sigma_min/sigma_max of the position Jacobian "
+            f"{rep['rcond']:.2e}; the {_dependent(rep)}", t=t, q=q)
 
     # ------------------------------------------------------------------ analogs
     def analogs_terms(self, t: float, q, qdot, x=None) -> dict:
@@ -367,12 +363,3 @@ class ModeEquations:
         p = fm.nonconservative_power(None, x, xdot, None, qdot, applied=(F, Qd))
         return dict(x=x, xdot=xdot, B=B, A=A, c=c, Q=Q, Q_drive=Qd, qddot=qdd, power_nc=p)
 
-
-def friction_power(ms, ev) -> float:
-    """Power of the sliding friction of the mode's slipping contacts, W (<= 0)."""
-    slips = [(k, r) for k, r in enumerate(ms.rows) if r.slip]
-    if not slips:
-        return 0.0
-    X, V = extend(ms.model, ev.x), extend(ms.model, ev.xdot)
-    return float(sum(-r.mu * r.slip * ev.lam[ms.n_base + k] * r.tangent.rate(X, V)
-                     for k, r in slips))

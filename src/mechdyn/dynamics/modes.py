@@ -140,12 +140,18 @@ class SwitchedModel:
             self.welds[n] = dict(i=int(lk.i[k]), j=int(lk.j[k]), c=lk.c[k].copy(),
                                  angle=float(lk.angle[k]), engaged=bool(lk.engaged[k]),
                                  declared=model.mechanism.joints[n].offset is not None)
+
+        def measure(where, var, into=probs, **cond):
+            """The Measure of a variable, or None with the problem noted."""
+            try:
+                return parse_variable(model, var, **cond)
+            except ModelError as exc:
+                into.append(f"{where}: {exc}")
+
         self.coord_locks = {}
         for cl in ex.get("coordinate_locks", []):
-            try:
-                meas = parse_variable(model, cl.variable)
-            except ModelError as exc:
-                probs.append(f"coordinate lock {cl.name!r}: variable: {exc}")
+            meas = measure(f"coordinate lock {cl.name!r}: variable", cl.variable)
+            if meas is None:
                 continue
             for f in cl.frees:
                 if f not in model.coordinate_names:
@@ -154,10 +160,9 @@ class SwitchedModel:
             self.coord_locks[cl.name] = (cl, meas)
         self.stops = {}
         for st in ex.get("stops", []):
-            try:
-                self.stops[st.name] = (st, parse_variable(model, st.variable))
-            except ModelError as exc:
-                probs.append(f"stop {st.name!r}: variable: {exc}")
+            meas = measure(f"stop {st.name!r}: variable", st.variable)
+            if meas is not None:
+                self.stops[st.name] = (st, meas)
         self.contacts = {}
         for ct in ex.get("contacts", []):
             try:
@@ -190,18 +195,11 @@ class SwitchedModel:
             if sw.target not in lock_names:
                 p.append(f"switch {sw.name!r}: target: "
                          + did_you_mean(sw.target, lock_names, "lock"))
-            meas, guards = None, []
             cond = dict(allow_time=True, allow_rate=True, allow_distance=True)
-            if sw.variable is not None:
-                try:
-                    meas = parse_variable(model, sw.variable, **cond)
-                except ModelError as exc:
-                    p.append(f"switch {sw.name!r}: variable: {exc}")
-            for var, op, val in sw.guard:
-                try:
-                    guards.append((parse_variable(model, var, **cond), op, val))
-                except ModelError as exc:
-                    p.append(f"switch {sw.name!r}: guard: {exc}")
+            meas = None if sw.variable is None else measure(f"switch {sw.name!r}: variable",
+                                                             sw.variable, p, **cond)
+            guards = [(measure(f"switch {sw.name!r}: guard", var, p, **cond), op, val)
+                      for var, op, val in sw.guard]
             probs.extend(p)
             self.switches.append((sw, meas, guards))
         if probs:

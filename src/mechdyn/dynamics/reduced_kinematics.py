@@ -56,7 +56,7 @@ def reduced_kinematics(model: Model, x, layout=None) -> dict:
     lay = layout or model.layout()
     x = np.asarray(x, dtype=float)
     Jf = full_jacobian(model, x, lay)
-    B = velocity_analogs(model, x, lay)[..., 0]
+    B = velocity_analogs(model, x, lay, J=Jf)[..., 0]
     b = acceleration_bias(model, x, B, lay, J=Jf)
     arm = com_arms(model, x)
     V = B.reshape(B.shape[:-1] + (-1, 3))

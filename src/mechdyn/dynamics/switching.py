@@ -12,13 +12,14 @@ and an :class:`~mechdyn.integrate.events.EventRecord` per thing that happened.
 
 from __future__ import annotations
 
+import operator
+
 import numpy as np
 
 from ..errors import AssemblyError
 from ..integrate.events import EventRecord
 from ..integrate.segment import EventFunction
-from ..kinematics.constraints import extend
-from .contact import resolve_mode, touching
+from .contact import gap_measures, resolve_mode, touching
 from .impact import impact
 from .modes import (
     ModeSystem,
@@ -32,21 +33,23 @@ from .modes import (
 __all__ = ["event_functions", "guard_holds", "apply_switch"]
 
 
+def _value(meas, t, x, xd):
+    """A switch's or guard's variable at a state: the time, a pose measure or a rate."""
+    if isinstance(meas, TimeMeasure):
+        return t
+    return meas.value(x, xd)
+
+
+def _row(ms: ModeSystem, element: str, kind: str) -> int:
+    """Index into the mode's rowset of the row of ``kind`` of a contact."""
+    return next(ms.n_base + k for k, r in enumerate(ms.rows)
+                if r.element == element and r.kind == kind)
+
+
 def event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_scale, gap_tol,
                      L) -> list[EventFunction]:
     out: list[EventFunction] = []
-    nb = sm.nb
-    model = sm.model
     locks = mode_locks(ms.mode)
-
-    def value_of(meas, tt, ev):
-        if isinstance(meas, TimeMeasure):
-            return tt
-        X = extend(model, ev.x)
-        if meas.needs_velocity:
-            return meas.value(X, extend(model, ev.xdot))
-        return meas.value(X)
-
     for sw, meas, _guards in sm.switches:
         if sw.name in fired_once:
             continue
@@ -55,85 +58,49 @@ def event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_scal
         if sw.action == "release" and sw.target not in locks:
             continue
         if sw.is_scheduled:
-            nxt = [tc for tc in sw.times if tc > t or (tc == t and (sw.name, tc) not in
-                                                       fired_once)]
-            nxt = [tc for tc in nxt if (sw.name, tc) not in fired_once]
+            nxt = [tc for tc in sw.times if tc >= t and (sw.name, tc) not in fired_once]
             if nxt:
-                tc = nxt[0]
-                out.append(EventFunction("time", sw.name, lambda tt, ev, tc=tc: tc - tt, 0.0,
-                                    (sw, tc)))
+                out.append(EventFunction("time", sw.name, lambda tt, ev, tc=nxt[0]: tc - tt,
+                                         0.0, (sw, nxt[0])))
             continue
-        hard = np.inf
+        scale = 1.0 if isinstance(meas, TimeMeasure) or meas.is_angle else L
         for d in ((1, -1) if sw.direction == 0 else (sw.direction,)):
-            if d > 0:
-                def fn(tt, ev, m=meas, v=sw.value):
-                    return (v - value_of(m, tt, ev))
-            else:
-                def fn(tt, ev, m=meas, v=sw.value):
-                    return (value_of(m, tt, ev) - v)
-            scale = 1.0 if isinstance(meas, TimeMeasure) or meas.is_angle else L
-            out.append(EventFunction("switch", sw.name, fn, hard, (sw, d),
-                                arm=1e-11 * (abs(sw.value) + scale)))
+            # rising (d > 0) fires when value - v crosses zero upwards: watched as v - value
+            def fn(tt, ev, m=meas, v=sw.value, d=d):
+                return d * (v - _value(m, tt, ev.x, ev.xdot))
+            out.append(EventFunction("switch", sw.name, fn, np.inf, (sw, d),
+                                     arm=1e-11 * (abs(sw.value) + scale)))
     closed = set(mode_unilateral(ms.mode))
     # open stops and contacts: gaps
-    for n, (st, meas) in sm.stops.items():
-        for side in st.sides():
-            tok = f"{n}@{side}"
-            if tok in closed:
-                continue
-            lim = getattr(st, side)
-            sgn = 1.0 if side == "lower" else -1.0
+    for tok, meas, sgn, lim in gap_measures(sm):
+        if tok not in closed:
             tol = gap_tol / L if meas.is_angle else gap_tol
-            out.append(EventFunction("gap", tok,
-                                lambda tt, ev, m=meas, lim=lim, s=sgn:
-                                s * (m.value(extend(model, ev.x)) - lim), tol, arm=1e-3 * tol))
-    for n, (_ct, gap, _) in sm.contacts.items():
-        if f"{n}@contact" in closed:
-            continue
-        out.append(EventFunction("gap", f"{n}@contact",
-                            lambda tt, ev, m=gap: m.value(extend(model, ev.x)),
-                            gap_tol, arm=1e-3 * gap_tol))
-    # closed ones: forces
-    fr = mode_friction(ms.mode)
+            out.append(EventFunction("gap", tok, lambda tt, ev, m=meas, lim=lim, s=sgn:
+                                     s * (m.value(ev.x) - lim), tol, arm=1e-3 * tol))
+    # closed ones: forces; the friction cone of sticking contacts, the slip of slipping ones
     for k, r in enumerate(ms.rows):
-        idx = ms.n_base + k
         if r.unilateral:
-            tok = r.label
-            out.append(EventFunction("force", tok, lambda tt, ev, i=idx: ev.lam[i],
-                                1e-7 * force_scale, arm=1e-10 * force_scale))
-    for c, s in fr.items():
-        ct = sm.contacts[c][0]
-        kn = [ms.n_base + k for k, r in enumerate(ms.rows) if r.element == c
-              and r.kind == "contact"][0]
+            out.append(EventFunction("force", r.label, lambda tt, ev, i=ms.n_base + k: ev.lam[i],
+                                     1e-7 * force_scale, arm=1e-10 * force_scale))
+    for c, s in mode_friction(ms.mode).items():
+        ct, _, slip = sm.contacts[c]
         if s == "stick":
-            kt = [ms.n_base + k for k, r in enumerate(ms.rows) if r.element == c
-                  and r.kind == "stick"][0]
+            kn, kt = _row(ms, c, "contact"), _row(ms, c, "stick")
             out.append(EventFunction("cone", c, lambda tt, ev, kn=kn, kt=kt, mu=ct.friction:
-                                mu * ev.lam[kn] - abs(ev.lam[kt]), 1e-7 * force_scale,
-                                arm=1e-10 * force_scale))
+                                     mu * ev.lam[kn] - abs(ev.lam[kt]), 1e-7 * force_scale,
+                                     arm=1e-10 * force_scale))
         else:
             sg = 1.0 if s == "slip+" else -1.0
-            slip = sm.contacts[c][2]
             out.append(EventFunction("slip", c, lambda tt, ev, m=slip, sg=sg:
-                                sg * m.rate(extend(model, ev.x), extend(model, ev.xdot), nb),
-                                np.inf, arm=1e-12 * L))
+                                     sg * m.rate(ev.x, ev.xdot), np.inf, arm=1e-12 * L))
     return out
 
 
+_OPS = {"<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge}
+
+
 def guard_holds(sm, guards, t, x, xd) -> bool:
-    model = sm.model
-    X, V = extend(model, x), extend(model, xd)
-    for meas, op, val in guards:
-        if isinstance(meas, TimeMeasure):
-            v = t
-        elif meas.needs_velocity:
-            v = meas.value(X, V)
-        else:
-            v = meas.value(X)
-        ok = {"<": v < val, "<=": v <= val, ">": v > val, ">=": v >= val}[op]
-        if not ok:
-            return False
-    return True
+    return all(_OPS[op](_value(meas, t, x, xd), val) for meas, op, val in guards)
 
 
 def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *, fired,
@@ -165,10 +132,8 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
         elif e.kind == "force":
             forced_open.add(e.key)
         elif e.kind == "cone":
-            kt = [ms.n_base + k for k, r in enumerate(ms.rows) if r.element == e.key
-                  and r.kind == "stick"][0]
             ev = ms.evaluate_x(t, x, xd)
-            forced_slip[e.key] = -1 if ev.lam[kt] > 0 else 1
+            forced_slip[e.key] = -1 if ev.lam[_row(ms, e.key, "stick")] > 0 else 1
         elif e.kind == "slip":
             forced_stick.add(e.key)
     for n, _ in release:
@@ -181,41 +146,28 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
     frees = [f for n, _ in engage for f in sm.lock_frees(n)]
     locks = frozenset(locks)
     # touching unilateral constraints (closed ones have zero gap by construction)
-    touch = set(touching(sm, ms, x, gap_tol=gap_tol)) | set(mode_unilateral(mode_before))
+    touch = set(touching(sm, x, gap_tol=gap_tol)) | set(mode_unilateral(mode_before))
     lost = 0.0
     imp = None
     xd_plus = xd
-    need_impact = bool(set(locks) - set(locks_before))
-    if not need_impact and touch:
-        # any touching constraint approaching?
-        for r in [r for r in sm.rows(frozenset(touch), targets) if r.unilateral]:
-            X, V = extend(sm.model, x), extend(sm.model, xd)
-            v = r.sign * r.measure.rate(X, V, sm.nb)
-            if v < 0.0:
-                need_impact = True
-                break
-    if need_impact:
+    # an engaging lock, or a touching constraint approaching
+    if set(locks) - set(locks_before) or any(v < 0.0 for _, v in _rates(sm, touch, targets,
+                                                                          x, xd)):
         imp = impact(sm, x, xd, locks_before, locks, targets, touch,
                      restitution={k: 0.0 for k in plastic},
                      small_velocity=small_velocity, t=t)
         xd_plus = imp.xdot_plus
         lost = imp.energy_lost
     # candidates: touching and not separating
-    X, V = extend(sm.model, x), extend(sm.model, xd_plus)
-    cand = []
-    vtol = max(small_velocity * 1e-3, 1e-9 * float(np.max(np.abs(xd_plus), initial=0.0)))
-    for r in [r for r in sm.rows(frozenset(touch), targets) if r.unilateral]:
-        tok = r.label
-        v = r.sign * r.measure.rate(X, V, sm.nb)
-        if v <= vtol:
-            cand.append(tok)
-    vscale = max(float(np.max(np.abs(xd_plus), initial=0.0)), small_velocity)
-    mode_after, forces = resolve_mode(
-        sm, t, x, xd_plus, locks, targets, cand, slip_velocity_tol=1e-9 * vscale + 1e-12,
+    vmax = float(np.max(np.abs(xd_plus), initial=0.0))
+    cand = [tok for tok, v in _rates(sm, touch, targets, x, xd_plus)
+            if v <= max(small_velocity * 1e-3, 1e-9 * vmax)]
+    mode_after, _ = resolve_mode(
+        sm, t, x, xd_plus, locks, targets, cand,
+        slip_velocity_tol=1e-9 * max(vmax, small_velocity) + 1e-12,
         force_tol=1e-10 * force_scale, forced_open=forced_open, forced_slip=forced_slip,
         forced_stick=forced_stick)
-    prefer = ms.coord_names
-    ms_new = ModeSystem(sm, mode_after, targets, x, prefer=prefer, avoid=frees,
+    ms_new = ModeSystem(sm, mode_after, targets, x, prefer=ms.coord_names, avoid=frees,
                         workspace=ms.ws)
     # an engaging lock must hold the pose it engages at (no position jump)
     tol_pos = 1e-8 * sm.model.length_scale
@@ -232,10 +184,9 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
     qi = ms_new.coordinates(x)[ms_new.coords]
     x_new = ms_new.solve_position(qi, x, t=t)
     B, _ = ms_new.velocity_analogs(x_new)
-    G = ms_new._coord_jac(x_new)[ms_new.coords]
-    xd_new = B @ (G @ xd_plus)
-    q_a = ms_new.coordinates(x_new)
-    qd_a = ms_new._coord_jac(x_new) @ xd_new
+    G = ms_new._coord_jac(x_new)
+    xd_new = B @ (G[ms_new.coords] @ xd_plus)
+    q_a, qd_a = ms_new.coordinates(x_new), G @ xd_new
     if initial and mode_after == mode_before and not engage:
         return ms_new, x_new, xd_new, lost
 
@@ -271,3 +222,9 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
         if mode_after != mode_before:
             add("switch", ",".join(sorted(set(mode_after) ^ set(mode_before))))
     return ms_new, x_new, xd_new, lost
+
+
+def _rates(sm, tokens, targets, x, xd) -> list:
+    """(label, gap rate) of the unilateral rows of stop and contact tokens (< 0 closing)."""
+    return [(r.label, r.sign * r.measure.rate(x, xd))
+            for r in sm.rows(frozenset(tokens), targets) if r.unilateral]

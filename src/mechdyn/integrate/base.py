@@ -109,6 +109,14 @@ class Step:
     dense: Callable = field(repr=False)
 
 
+#: the quintic Hermite basis (value, slope and curvature at both ends) and the cubic one
+#: (value and slope at both ends), as coefficients of 1, u, ..., u^5
+_QUINTIC = np.array([[1, 0, 0, -10, 15, -6], [0, 1, 0, -6, 8, -3],
+                     [0, 0, 0.5, -1.5, 1.5, -0.5], [0, 0, 0, 10, -15, 6],
+                     [0, 0, 0, -4, 7, -3], [0, 0, 0, 0.5, -1, 0.5]])
+_CUBIC = np.array([[1, 0, -3, 2], [0, 1, -2, 1], [0, 0, 3, -2], [0, 0, -1, 1]])
+
+
 def hermite_dense(t0, q0, v0, a0, w0, p0, t1, q1, v1, a1, w1, p1):
     """Quintic Hermite interpolant of q (from q, q', q'' at both ends) and cubic of w.
 
@@ -116,37 +124,18 @@ def hermite_dense(t0, q0, v0, a0, w0, p0, t1, q1, v1, a1, w1, p1):
     error O(h^6) in q, O(h^5) in qdot.
     """
     h = t1 - t0
-    q0, v0, a0, q1, v1, a1 = (np.asarray(v, float) for v in (q0, v0, a0, q1, v1, a1))
-    w0, p0, w1, p1 = (np.asarray(v, float) for v in (w0, p0, w1, p1))
+    q0, v0, a0, q1, v1, a1, w0, p0, w1, p1 = (np.asarray(v, float) for v in (
+        q0, v0, a0, q1, v1, a1, w0, p0, w1, p1))
+    Y = np.array([q0, h * v0, h * h * a0, q1, h * v1, h * h * a1])  # in the unit step u
+    W = np.array([w0, h * p0, w1, h * p1])
 
     def dense(s):
         if h == 0:
             return q1.copy(), v1.copy(), w1.copy()
         u = (s - t0) / h
-        u2, u3 = u * u, u * u * u
-        u4, u5 = u3 * u, u3 * u2
-        h00 = 1 - 10 * u3 + 15 * u4 - 6 * u5
-        h10 = u - 6 * u3 + 8 * u4 - 3 * u5
-        h20 = 0.5 * (u2 - 3 * u3 + 3 * u4 - u5)
-        h01 = 10 * u3 - 15 * u4 + 6 * u5
-        h11 = -4 * u3 + 7 * u4 - 3 * u5
-        h21 = 0.5 * (u3 - 2 * u4 + u5)
-        d00 = (-30 * u2 + 60 * u3 - 30 * u4) / h
-        d10 = 1 - 18 * u2 + 32 * u3 - 15 * u4
-        d20 = 0.5 * h * (2 * u - 9 * u2 + 12 * u3 - 5 * u4)
-        d01 = -d00
-        d11 = -12 * u2 + 28 * u3 - 15 * u4
-        d21 = 0.5 * h * (3 * u2 - 8 * u3 + 5 * u4)
-        q = h00 * q0 + h * h10 * v0 + h * h * h20 * a0 + h01 * q1 + h * h11 * v1 \
-            + h * h * h21 * a1
-        v = d00 * q0 + d10 * v0 + d20 * a0 + d01 * q1 + d11 * v1 + d21 * a1
-        # cubic Hermite for the quadrature states
-        c00 = 1 - 3 * u2 + 2 * u3
-        c10 = u - 2 * u2 + u3
-        c01 = 3 * u2 - 2 * u3
-        c11 = -u2 + u3
-        w = c00 * w0 + h * c10 * p0 + c01 * w1 + h * c11 * p1
-        return q, v, w
+        powers = u ** np.arange(6)
+        slopes = np.arange(6) * np.concatenate([[0.0], powers[:5]])  # d/du of the powers
+        return _QUINTIC @ powers @ Y, _QUINTIC @ slopes @ Y / h, _CUBIC @ powers[:4] @ W
 
     return dense
 

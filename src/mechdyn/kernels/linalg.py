@@ -52,24 +52,43 @@ def lu_factor(a, piv, n):
 
 
 @njit
-def lu_solve(a, piv, b, n):
-    """Solve with the factors of ``lu_factor`` (b overwritten)."""
-    for k in range(n):
+def _forward(L, b, n, unit):
+    """Solve L y = b for lower-triangular L (unit diagonal if ``unit``), b overwritten."""
+    for r in range(n):
+        s = b[r]
+        for c in range(r):
+            s -= L[r, c] * b[c]
+        b[r] = s if unit else s / L[r, r]
+
+
+@njit
+def _backward(U, b, n, unit):
+    """Solve U y = b for upper-triangular U (unit diagonal if ``unit``), b overwritten."""
+    for r in range(n - 1, -1, -1):
+        s = b[r]
+        for c in range(r + 1, n):
+            s -= U[r, c] * b[c]
+        b[r] = s if unit else s / U[r, r]
+
+
+@njit
+def _swap(b, piv, n, reverse):
+    """Apply the row swaps of ``lu_factor`` to b (undo them with ``reverse``)."""
+    for j in range(n):
+        k = n - 1 - j if reverse else j
         p = piv[k]
         if p != k:
             tmp = b[k]
             b[k] = b[p]
             b[p] = tmp
-    for r in range(1, n):
-        s = b[r]
-        for c in range(r):
-            s -= a[r, c] * b[c]
-        b[r] = s
-    for r in range(n - 1, -1, -1):
-        s = b[r]
-        for c in range(r + 1, n):
-            s -= a[r, c] * b[c]
-        b[r] = s / a[r, r]
+
+
+@njit
+def lu_solve(a, piv, b, n):
+    """Solve with the factors of ``lu_factor`` (b overwritten)."""
+    _swap(b, piv, n, False)
+    _forward(a, b, n, True)
+    _backward(a, b, n, False)
 
 
 @njit
@@ -93,16 +112,8 @@ def cholesky_solve(A, rhs, n):
             for k in range(j):
                 s2 -= A[i, k] * A[j, k]
             A[i, j] = s2 / d
-    for i in range(n):
-        s = rhs[i]
-        for k in range(i):
-            s -= A[i, k] * rhs[k]
-        rhs[i] = s / A[i, i]
-    for i in range(n - 1, -1, -1):
-        s = rhs[i]
-        for k in range(i + 1, n):
-            s -= A[k, i] * rhs[k]
-        rhs[i] = s / A[i, i]
+    _forward(A, rhs, n, False)
+    _backward(A.T, rhs, n, False)
     return True
 
 
@@ -110,19 +121,6 @@ def cholesky_solve(A, rhs, n):
 def lu_solve_transposed(a, piv, b, n):
     """Solve A^T z = b with the factors of ``lu_factor`` of A (b overwritten by z)."""
     # P A = L U, so A^T = U^T L^T P: solve U^T y = b, L^T u = y, then z = P^T u
-    for r in range(n):
-        s = b[r]
-        for c in range(r):
-            s -= a[c, r] * b[c]
-        b[r] = s / a[r, r]
-    for r in range(n - 1, -1, -1):
-        s = b[r]
-        for c in range(r + 1, n):
-            s -= a[c, r] * b[c]
-        b[r] = s
-    for k in range(n - 1, -1, -1):
-        p = piv[k]
-        if p != k:
-            tmp = b[k]
-            b[k] = b[p]
-            b[p] = tmp
+    _forward(a.T, b, n, False)
+    _backward(a.T, b, n, True)
+    _swap(b, piv, n, True)

@@ -92,11 +92,10 @@ def finite_difference_analogs(model: Model, q, x, *, d=None,
     -------
     ndarray, shape (n_x, n_q)
     """
-    lay = layout or model.layout()
     q = np.asarray(q, float)
     d = default_displacement(model) if d is None else np.broadcast_to(
         np.asarray(d, float), (model.n_q,))
     E = np.eye(model.n_q) * d
     qs = np.concatenate([q + E, q - E])  # (2 n_q, n_q): both partial systems at once
-    xs = solve_position(model, qs, x, layout=lay, check_singular=False)
+    xs = solve_position(model, qs, x, layout=layout, check_singular=False)
     return ((xs[: model.n_q] - xs[model.n_q:]) / (2 * d[:, None])).T

@@ -16,7 +16,7 @@ from ..errors import AssemblyError, SingularPositionError
 from ..kernels import rows_numpy
 from ..model import ConstraintLayout, Model
 from ..model.rows import Rows
-from .constraints import coordinates, coordinates_jacobian, extend, jacobian, residual, system
+from .constraints import _turn, coordinates, extend, full_jacobian, residual, system
 
 __all__ = ["newton", "solve_position", "assemble", "joint_residuals", "singularity", "rank_report",
            "branch_sign", "turn_signs", "SINGULAR_RCOND", "DEAD_RCOND"]
@@ -30,9 +30,7 @@ DEAD_RCOND = 1e-4
 
 def _scale(model: Model) -> np.ndarray:
     """Column scaling: lengths as they are, rotations times the length scale."""
-    s = np.ones(model.n_x)
-    s[2::3] = model.length_scale
-    return s
+    return np.tile([1.0, 1.0, model.length_scale], model.n_bodies)
 
 
 def _position_tol(model: Model) -> float:
@@ -160,10 +158,8 @@ def solve_position(model: Model, q, x_guess, *, layout: ConstraintLayout | None 
     x, done = newton(lay.position_rows, x_guess, np.concatenate([zeros, q], axis=-1), tol=tol,
                      max_iter=max_iter)
     if not np.all(done):
-        batch = done.shape
-        bad = np.unravel_index(np.argmax(~done), batch) if batch else ()
-        xb, qb = x[bad], q[bad] if q.ndim > 1 else q
-        raise _assembly_error(model, qb, xb, lay, t)
+        bad = np.unravel_index(np.argmax(~done), done.shape)
+        raise _assembly_error(model, q[bad] if q.ndim > 1 else q, x[bad], lay, t)
     if check_singular:
         _check_singular(model, x, q, lay, t)
     return x
@@ -213,11 +209,8 @@ def singularity(model: Model, x, layout: ConstraintLayout | None = None) -> dict
     and ``joints`` (joints whose equations become dependent).
     """
     lay = layout or model.layout()
-    _, J = system(model, x, np.zeros(model.n_q), lay)
-    Js = J * _scale(model)
-    u, s, _ = np.linalg.svd(Js)
-    y = u[:, -1]
-    share = y**2
+    u, s, _ = np.linalg.svd(full_jacobian(model, x, lay) * _scale(model))
+    share = u[:, -1] ** 2
     coords = [model.coordinate_names[c] for c in range(model.n_q)
               if share[lay.n_rows + c] > 1e-3]
     joints = sorted({lay.row_joint[r] for r in range(lay.n_rows) if share[r] > 1e-3})
@@ -226,41 +219,34 @@ def singularity(model: Model, x, layout: ConstraintLayout | None = None) -> dict
 
 
 def _check_singular(model, x, q, lay, t):
-    if model.n_x == 0:
+    if model.n_x == 0 or lay.n_rows + model.n_q != model.n_x:
         return
-    _, J = system(model, x, q, lay)
-    Js = J * _scale(model)
-    if Js.shape[-1] != Js.shape[-2]:
-        return
-    s = np.linalg.svd(Js, compute_uv=False)
+    s = np.linalg.svd(full_jacobian(model, x, lay) * _scale(model), compute_uv=False)
     rc = s[..., -1] / s[..., 0]
     if np.any(rc < SINGULAR_RCOND):
-        k = np.unravel_index(np.argmin(rc), rc.shape) if rc.ndim else ()
-        xb = x[k]
-        qb = q[k] if q.ndim > 1 else q
-        rep = singularity(model, xb, lay)
+        k = np.unravel_index(np.argmin(rc), rc.shape)
+        rep = singularity(model, x[k], lay)
         raise SingularPositionError(
             f"dead or toggle position: the constraint Jacobian is singular "
             f"(sigma_min/sigma_max = {rep['rcond']:.2e}); coordinate(s) "
             f"{', '.join(rep['coordinates']) or '-'} lose control, joints "
             f"{', '.join(rep['joints']) or '-'} become dependent",
-            t=t, q=qb, sigma_min=rep["sigma_min"], coordinates=rep["coordinates"],
-            joints=rep["joints"])
+            t=t, q=q[k] if q.ndim > 1 else q, sigma_min=rep["sigma_min"],
+            coordinates=rep["coordinates"], joints=rep["joints"])
 
 
 def branch_sign(model: Model, x, layout: ConstraintLayout | None = None) -> np.ndarray:
     """Sign of det [Phi_x; g_x] (batched): it changes only through a singular position,
     so a change between two solves means the assembly branch was left."""
-    lay = layout or model.layout()
-    _, J = system(model, x, np.zeros(np.shape(x)[:-1] + (model.n_q,)), lay)
+    J = full_jacobian(model, x, layout)
     if J.shape[-1] != J.shape[-2]:
         return np.ones(np.shape(x)[:-1])
     return np.sign(np.linalg.det(J * _scale(model)))
 
 
 def _world(X, b, s):
-    c, sn = np.cos(X[..., b, 2]), np.sin(X[..., b, 2])
-    return X[..., b, :2] + np.stack([c * s[0] - sn * s[1], sn * s[0] + c * s[1]], axis=-1)
+    """Ground-frame position of the point(s) s (..., 2) of body b, poses X (..., nb + 1, 3)."""
+    return X[..., b, :2] + _turn(X[..., b, 2], s)
 
 
 def turn_signs(model: Model, x) -> dict:
@@ -282,11 +268,12 @@ def turn_signs(model: Model, x) -> dict:
 
 
 def _wrong_modes(model: Model, x) -> list:
+    """(mode, its points P, Q, R) of the declared assembly modes x is not in."""
     signs = turn_signs(model, x)
-    return [am for am, _ in model.assembly_modes if signs[am.name] != am.sign]
+    return [(am, pts) for am, pts in model.assembly_modes if signs[am.name] != am.sign]
 
 
-def _mirror_guess(model: Model, x, am, pts) -> np.ndarray:
+def _mirror_guess(model: Model, x, pts) -> np.ndarray:
     """Sketch with the bodies that meet at Q mirrored across the line P-R
     (each body refitted as a rigid body to its mirrored points)."""
     X = extend(model, x)
@@ -302,18 +289,15 @@ def _mirror_guess(model: Model, x, am, pts) -> np.ndarray:
     for k, name in enumerate(model.body_names):
         body = model.mechanism.bodies[name]
         local = np.array([body.point(p) for p in body.point_names()] + [(0.0, 0.0)])
-        world = np.array([_world(X, k, s) for s in local])
+        world = _world(X, k, local)
         if not np.any(np.hypot(*(world - Q).T) < tol) or k in (bp, br):
             continue
         rel = world - P
         mirrored = P + 2 * np.outer(rel @ d, d) - rel
         # rigid fit (rotation only): angle from the centred cross-covariance
         lc, mc = local - local.mean(0), mirrored - mirrored.mean(0)
-        th = np.arctan2(np.sum(lc[:, 0] * mc[:, 1] - lc[:, 1] * mc[:, 0]),
-                        np.sum(lc[:, 0] * mc[:, 0] + lc[:, 1] * mc[:, 1]))
-        c, s = np.cos(th), np.sin(th)
-        origin = mirrored.mean(0) - np.array([c * local.mean(0)[0] - s * local.mean(0)[1],
-                                              s * local.mean(0)[0] + c * local.mean(0)[1]])
+        th = np.angle(np.vdot(lc @ [1, 1j], mc @ [1, 1j]))
+        origin = mirrored.mean(0) - _turn(th, local.mean(0))
         # keep the angle on the branch of the sketch angle (no 2 pi jumps)
         th = xg[3 * k + 2] + np.angle(np.exp(1j * (th - xg[3 * k + 2])))
         xg[3 * k:3 * k + 3] = (origin[0], origin[1], th)
@@ -340,13 +324,11 @@ def assemble(model: Model, q=None, *, x_guess=None, layout=None, t=None) -> np.n
         wrong = _wrong_modes(model, x)
         if not wrong:
             return x
-        am = wrong[0]
-        pts = dict((a.name, p) for a, p in model.assembly_modes)[am.name]
-        x = _assemble_near(model, q, x_guess=_mirror_guess(model, x, am, pts), layout=layout,
-                           t=t)
+        x = _assemble_near(model, q, x_guess=_mirror_guess(model, x, wrong[0][1]),
+                           layout=layout, t=t)
     wrong = _wrong_modes(model, x)
     if wrong:
-        names = ", ".join(f"{am.name!r} (declared {am.turn!r})" for am in wrong)
+        names = ", ".join(f"{am.name!r} (declared {am.turn!r})" for am, _ in wrong)
         raise AssemblyError(
             f"the declared assembly mode(s) {names} could not be reached from the sketch; "
             "draw the sketch in the declared mode or check the points P, Q, R", t=t, q=q)
@@ -375,28 +357,20 @@ def _least_squares(model, x, q, lay, weight: float = 1.0, **options) -> np.ndarr
     """The pose nearest to [Phi; weight (g - q)] = 0 from x, by SciPy's least_squares."""
     w = np.ones(lay.n_rows + model.n_q)
     w[lay.n_rows:] = weight
-
-    def fun(xx):
-        return system(model, xx, q, lay)[0] * w
-
-    def jac(xx):
-        return system(model, xx, q, lay)[1] * w[:, None]
-
-    return least_squares(fun, x, jac=jac, xtol=1e-15, ftol=1e-15, gtol=1e-15, **options).x
+    return least_squares(lambda xx: system(model, xx, q, lay)[0] * w, x,
+                         jac=lambda xx: system(model, xx, q, lay)[1] * w[:, None],
+                         xtol=1e-15, ftol=1e-15, gtol=1e-15, **options).x
 
 
 def rank_report(model: Model, x, layout=None) -> dict:
     """Ranks at a pose: constraint rank, redundant joints, dependent coordinates."""
     lay = layout or model.layout()
-    sc = _scale(model)
-    P = jacobian(model, x, lay) * sc
-    Gq = coordinates_jacobian(model, x) * sc
+    J = full_jacobian(model, x, lay) * _scale(model)
+    P, Gq = J[:lay.n_rows], J[lay.n_rows:]
     tol_rel = 1e-9
     rank_phi = _rank(P, tol_rel)
-    redundant = []
-    if rank_phi < lay.n_rows:
-        redundant = sorted({lay.row_joint[r] for r in _dependent_rows(P, rank_phi)})
-    rank_full = _rank(np.concatenate([P, Gq]), tol_rel)
+    redundant = sorted({lay.row_joint[r] for r in _dependent_rows(P, rank_phi)})
+    rank_full = _rank(J, tol_rel)
     dep = []
     if model.n_q and rank_full < rank_phi + model.n_q:
         # coordinate c depends on the others if dropping its row keeps the rank
@@ -406,10 +380,8 @@ def rank_report(model: Model, x, layout=None) -> dict:
 
 
 def _rank(A, tol_rel):
-    if A.size == 0:
-        return 0
-    s = np.linalg.svd(A, compute_uv=False)
-    return int(np.sum(s > tol_rel * s[0])) if s[0] > 0 else 0
+    """Number of singular values of A above ``tol_rel`` times the largest."""
+    return int(np.linalg.matrix_rank(A, rtol=tol_rel))
 
 
 def _dependent_rows(P, rank: int) -> np.ndarray:

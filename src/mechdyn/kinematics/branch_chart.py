@@ -42,8 +42,7 @@ from numpy.polynomial import chebyshev as cheb
 
 from ..model import ConstraintLayout, Model
 from .assembly import _scale
-from .continuation import _hermite5, _kernel, _march, _newton, _node
-from .continuation import _Node as _SweepNode
+from .continuation import _hermite5, _kernel, _march, _newton, _Node, _node
 
 __all__ = ["PathProblem", "BranchChart", "ChartBook", "bridge", "ZONE", "WINDOW", "REACH"]
 
@@ -61,18 +60,6 @@ NEAR_MISS_RCOND = 1e-3
 _STEP = 0.1
 #: the chart is rejected if it misses a direct solve at a check point by more (scaled)
 _CHART_TOL = 1e-7
-
-
-@dataclass
-class _Node:
-    """A solved pose of the path: coordinate s, pose x, x' = dx/ds, x'' and the sign of
-    det of the scaled Jacobian."""
-
-    s: float
-    x: np.ndarray
-    xs: np.ndarray
-    xss: np.ndarray
-    sign: float
 
 
 class PathProblem:
@@ -119,14 +106,11 @@ class PathProblem:
                              f"({layout.n_rows} joint rows + {self.idx.size} coordinates "
                              f"for {model.n_x} pose components)")
         self.scale = _scale(model)
-        angle = bool(model.coord_is_angle[self.idx[self.k]])
         #: unit of the path coordinate for the zone sizes: 1 rad, or the length scale
-        self.unit = 1.0 if angle else float(model.length_scale)
+        self.unit = 1.0 if model.coord_is_angle[self.idx[self.k]] else float(model.length_scale)
         self.tol = 1e-14 * max(model.length_scale, 1e-3)
         #: the equations [Phi; g_idx - q] (the compiled kernel of the sweep)
         self.kernel = _kernel(model, layout, self.idx)
-        self._e = np.zeros(model.n_x)
-        self._e[layout.n_rows + self.k] = 1.0
 
     # ------------------------------------------------------------------ equations
     def _q(self, s) -> np.ndarray:
@@ -139,11 +123,8 @@ class PathProblem:
         return self.kernel.system(np.asarray(x, dtype=float), self.q_fixed)[1]
 
     def node(self, s, x, J=None) -> _Node:
-        """Analogs x', x'' and the branch sign at a solved pose."""
-        return self._node(_node(self.kernel, np.asarray(x, dtype=float), self._q(s), self.k, J))
-
-    def _node(self, nd) -> _Node:
-        return _Node(float(nd.q[self.k]), nd.x, nd.B[:, self.k], nd.H, float(nd.sign))
+        """The solved pose x at s with x' = dx/ds (``xs``), x'' (``xss``) and the branch sign."""
+        return _node(self.kernel, np.asarray(x, dtype=float), self._q(s), self.k, J)
 
     def solve(self, s, x_guess) -> _Node | None:
         """The node at s by Newton from ``x_guess`` (None if it does not converge)."""
@@ -163,7 +144,7 @@ class PathProblem:
         no guide: away from the crossing the vanishing one need not be the smallest."""
         J = self.jacobian(x)
         if xs is None:
-            xs = np.linalg.solve(J, self._e)
+            xs = np.linalg.solve(J, np.eye(len(J))[self.layout.n_rows + self.k])
         h = 1e-5 * self.unit
         d0 = np.linalg.det(J * self.scale)
         d1 = (np.linalg.det(self.jacobian(x + h * xs) * self.scale) - d0) / h
@@ -181,12 +162,9 @@ class PathProblem:
         """Continuation from ``node`` to s_to (the sweep's march, without charts); returns
         (node reached, ok).  A change of the branch sign is refused, so the march stops
         in front of a singular position."""
-        B = np.zeros((node.x.size, self.idx.size))
-        B[:, self.k] = node.xs
-        start = _SweepNode(self._q(node.s), node.x, B, node.xss, node.sign)
-        out, stop = _march(self.kernel, start, self.k, [s_to], max_step=_STEP * self.unit,
+        out, stop = _march(self.kernel, node, self.k, [s_to], max_step=_STEP * self.unit,
                            min_step=1e-9 * self.unit, tol=self.tol, counter={})
-        return self._node(stop.node if stop is not None else out[-1]), stop is None
+        return (stop.node if stop is not None else out[-1]), stop is None
 
 
 @dataclass
@@ -245,10 +223,7 @@ class BranchChart:
         s = np.asarray(s, dtype=float)
         u = (s - self.centre) / self.window
         out = cheb.chebvander(u, self.coef.shape[0] - 1) @ self.coef
-        if s.ndim == 0:
-            out = out.reshape(-1)
-        n = out.shape[-1] // 3
-        return out[..., :n], out[..., n:2 * n], out[..., 2 * n:]
+        return tuple(np.split(out.reshape(-1) if s.ndim == 0 else out, 3, axis=-1))
 
     def summary(self) -> dict:
         """The chart as a plain dict (for run statistics)."""
@@ -262,12 +237,10 @@ def _fit(nodes, centre: float, window: float) -> np.ndarray:
     N = 3 * len(nodes)
     u = np.array([(nd.s - centre) / window for nd in nodes])
     V0 = cheb.chebvander(u, N - 1)
-    eye = np.eye(N)
-    D1 = np.array([np.pad(cheb.chebder(eye[j]), (0, 1)) for j in range(N)])
-    D2 = np.array([np.pad(cheb.chebder(eye[j], 2), (0, 2)) for j in range(N)])
+    # the derivatives of T_0 .. T_(N-1) as Chebyshev series (one row each)
+    D1, D2 = (np.pad(cheb.chebder(np.eye(N), m, axis=1), ((0, 0), (0, m))) for m in (1, 2))
     V = np.concatenate([V0, V0 @ D1.T / window, V0 @ D2.T / window**2])
-    Y = np.concatenate([[nd.x for nd in nodes], [nd.xs for nd in nodes],
-                        [nd.xss for nd in nodes]])
+    Y = np.concatenate([[getattr(nd, f) for nd in nodes] for f in ("x", "xs", "xss")])
     c = np.linalg.solve(V, Y)
     return np.concatenate([c, D1.T @ c / window, D2.T @ c / window**2], axis=1)
 
@@ -325,10 +298,8 @@ def bridge(path: PathProblem, start: _Node, s_star: float, *, zone: float = ZONE
     r1, R = zone * path.unit, window * path.unit
     ts = r1 + (R - r1) * (1.0 - np.cos(np.array([0.0, 0.25, 0.5]) * np.pi))  # r1 .. R
     dsgn = 1.0 if s_star >= start.s else -1.0
-    node = start
-    near: list[_Node] = []
     for _ in range(4):  # place the approach side, re-centring on the way
-        near, n = [], node
+        near, n = [], start
         for t in ts[::-1]:
             n, ok = path.march(n, s_star - dsgn * t)
             if not ok:  # the singular position is closer than estimated
@@ -337,14 +308,11 @@ def bridge(path: PathProblem, start: _Node, s_star: float, *, zone: float = ZONE
         if len(near) < ts.size:
             s_star = n.s + dsgn * 1e-3 * path.unit
             continue
-        off = path.singular_offset(near[-1].x, near[-1].xs)
-        new = near[-1].s + off
+        new = near[-1].s + path.singular_offset(near[-1].x, near[-1].xs)
         if not np.isfinite(new) or abs(new - s_star) <= 0.2 * r1:
             break
         s_star = new
     else:
-        return None
-    if len(near) < ts.size:
         return None
     # ---- across: extrapolate the approach side, correct, check the continuation
     a, b = near[-2], near[-1]
@@ -355,8 +323,7 @@ def bridge(path: PathProblem, start: _Node, s_star: float, *, zone: float = ZONE
     if nb is None:
         return None
     sc = path.scale
-    step = np.max(np.abs((nb.x - b.x) * sc))
-    if np.max(np.abs((nb.x - xp) * sc)) > 0.1 * step:
+    if np.max(np.abs((nb.x - xp) * sc)) > 0.1 * np.max(np.abs((nb.x - b.x) * sc)):
         return None
     xs_p = b.xs + b.xss * (sb - b.s)
     if np.max(np.abs((nb.xs - xs_p) * sc)) > 0.25 * max(np.max(np.abs(nb.xs * sc)),
@@ -372,9 +339,8 @@ def bridge(path: PathProblem, start: _Node, s_star: float, *, zone: float = ZONE
     rc = min(path.rcond(b.x), path.rcond(nb.x))
     if not flip:
         # no crossing: keep the chart only if the branches nearly touch in between
-        xs_mid = 0.5 * (b.s + nb.s)
-        mid = path.solve(xs_mid, _hermite5(0.5, nb.s - b.s, b.x, b.xs, b.xss, nb.x, nb.xs,
-                                           nb.xss))
+        mid = path.solve(0.5 * (b.s + nb.s), _hermite5(0.5, nb.s - b.s, b.x, b.xs, b.xss,
+                                                       nb.x, nb.xs, nb.xss))
         if mid is None:
             return None
         rc = min(rc, path.rcond(mid.x))
@@ -467,11 +433,8 @@ class ChartBook:
 
         ``force_at`` skips the estimate: a singular position is known to lie there."""
         unit = self.path.unit
-        if force_at is None:
-            if not self.due(s):
-                return None
-            if self.window_chart(s) is not None or self._skipped(s):
-                return None
+        if force_at is None and (not self.due(s) or self._blocked(s)):
+            return None
         try:
             off = force_at - s if force_at is not None else self.path.singular_offset(x)
         except np.linalg.LinAlgError:
@@ -485,7 +448,7 @@ class ChartBook:
             if not dist <= r:
                 return None
         s_star = s + off
-        if self.window_chart(s_star) is not None or self._skipped(s_star):
+        if self._blocked(s_star):
             return None
         try:
             with np.errstate(all="ignore"):
@@ -500,8 +463,9 @@ class ChartBook:
         self.charts.append(chart)
         return chart
 
-    def _skipped(self, s) -> bool:
-        return any(lo <= s <= hi for lo, hi, _ in self.skipped)
+    def _blocked(self, s) -> bool:
+        """Whether s lies in the window of a chart or of a place where none was built."""
+        return self.window_chart(s) is not None or any(lo <= s <= hi for lo, hi, _ in self.skipped)
 
     def apply(self, s):
         """Chart values for the samples s (m,) that lie in a zone.
@@ -513,8 +477,7 @@ class ChartBook:
         """
         s = np.asarray(s, dtype=float).reshape(-1)
         mask = np.zeros(s.size, dtype=bool)
-        n_x = self.path.model.n_x
-        x, xs, xss = (np.empty((s.size, n_x)) for _ in range(3))
+        x, xs, xss = (np.empty((s.size, self.path.model.n_x)) for _ in range(3))
         for ch in self.charts:
             m = (np.abs(s - ch.centre) < ch.zone) & ~mask
             if m.any():

@@ -29,10 +29,10 @@ def extend(model: Model, x: np.ndarray) -> np.ndarray:
     return np.concatenate([X, pad], axis=-2)
 
 
-def _rot(th, s):
-    """A(theta) s for th (...,n) and s (n,2) -> (..., n, 2)."""
+def _turn(th, s):
+    """A(theta) s: vectors s (..., 2) turned by the angles th (...), shape (..., 2)."""
     c, sn = np.cos(th), np.sin(th)
-    return np.stack([c * s[:, 0] - sn * s[:, 1], sn * s[:, 0] + c * s[:, 1]], axis=-1)
+    return np.stack([c * s[..., 0] - sn * s[..., 1], sn * s[..., 0] + c * s[..., 1]], axis=-1)
 
 
 def _perp(v):
@@ -104,36 +104,34 @@ def travel_rows(model: Model, joint: str) -> R.Rows:
     if model.joint_kind(joint) != "prismatic":
         raise ModelError(f"joint {joint!r} is not a prismatic joint; prismatic joints: "
                          + (", ".join(repr(v) for v in model.pri.names) or "(none)"))
-    pr = model.pri
-    k = pr.names.index(joint)
-    return R.line(joint, pr.j[k], pr.sj[k], pr.i[k], pr.si[k], pr.ui[k], normal=False,
-                  nb=model.n_bodies)
+    return model.joint_variable(joint, joint)
 
 
 # ---------------------------------------------------------------- points
+def _arm(model: Model, x, body: str, point):
+    """Body index k, poses with the ground X and the arm A(theta_k) s of a body point."""
+    k = model.body_index(body)
+    X = extend(model, x)
+    return k, X, _turn(X[..., k, 2], model.point_local(body, point))
+
+
 def point_position(model: Model, x, body: str, point) -> np.ndarray:
     """Position of a body point in the ground frame, shape (..., 2), m."""
-    k = model.body_index(body)
-    s = model.point_local(body, point)
-    X = extend(model, x)
-    return X[..., k, :2] + _rot(X[..., k, 2][..., None], s[None, :])[..., 0, :]
+    k, X, a = _arm(model, x, body, point)
+    return X[..., k, :2] + a
 
 
 def point_velocity(model: Model, x, xdot, body: str, point) -> np.ndarray:
     """Velocity of a body point, shape (..., 2), m/s."""
-    k = model.body_index(body)
-    s = model.point_local(body, point)
-    X, V = extend(model, x), extend(model, xdot)
-    a = _rot(X[..., k, 2][..., None], s[None, :])[..., 0, :]
+    k, _, a = _arm(model, x, body, point)
+    V = extend(model, xdot)
     return V[..., k, :2] + V[..., k, 2][..., None] * _perp(a)
 
 
 def point_acceleration(model: Model, x, xdot, xddot, body: str, point) -> np.ndarray:
     """Acceleration of a body point, shape (..., 2), m/s^2."""
-    k = model.body_index(body)
-    s = model.point_local(body, point)
-    X, V, W = extend(model, x), extend(model, xdot), extend(model, xddot)
-    a = _rot(X[..., k, 2][..., None], s[None, :])[..., 0, :]
+    k, _, a = _arm(model, x, body, point)
+    V, W = extend(model, xdot), extend(model, xddot)
     return W[..., k, :2] + W[..., k, 2][..., None] * _perp(a) - (V[..., k, 2] ** 2)[..., None] * a
 
 

@@ -1,22 +1,14 @@
 """Numerical continuation along one coordinate: the building blocks of the sweep.
 
-The position Newton of :mod:`mechdyn.kinematics.assembly` on the compiled kernel's
-equations, for a batch or one position (:func:`_newton`), the solved positions of
-the continuation (:class:`_Node`: pose, velocity analogs, second derivative along
-the swept coordinate and branch sign), their quintic Hermite predictor
-(:func:`_hermite5`, :func:`_predict`), the sequential step-halving march
-(:func:`_march`, through bifurcation positions with the branch charts of
-:mod:`mechdyn.kinematics.branch_chart`: :func:`_chart_node`), the choice of the
-anchors it visits (:func:`_anchor_indices`) and the per-model cache of the
-evaluation kernel (:class:`Kernel`, :func:`_kernel`): the residual [Phi; g - q], the
-Jacobian [Phi_x; g_x] and gamma = -quad of the model's rows, evaluated and factored
-(sparse LU with partial pivoting, which gives the branch sign too) by the compiled
-drivers of :mod:`mechdyn.kernels.rows_sweep`, one position or a whole batch per call
-(NumPy's per-call overhead and temporaries would dominate), or without numba by
-:mod:`mechdyn.kernels.rows_numpy` and dense solves.  The analyses that use them are in
-:mod:`mechdyn.kinematics.sweep` and, with the driven coordinates prescribed,
-:mod:`mechdyn.dynamics.prescribed_motion`; the dead-centre refinement of
-:mod:`mechdyn.kinematics.records` reuses :func:`_newton` and :func:`_node`.
+The evaluation kernel (:class:`Kernel`: [Phi; g - q], [Phi_x; g_x] and gamma of the
+model's rows, evaluated and factored by the compiled drivers of
+:mod:`mechdyn.kernels.rows_sweep` one position or a whole batch per call, since NumPy's
+per-call overhead and temporaries would dominate; sparse LU with partial pivoting
+gives the branch sign too), its Newton solve, the solved positions (:class:`_Node`),
+their quintic Hermite predictor and the step-halving march through bifurcation
+positions (:mod:`mechdyn.kinematics.branch_chart`).  Used by
+:mod:`mechdyn.kinematics.sweep`, :mod:`mechdyn.kinematics.records` and
+:mod:`mechdyn.dynamics.prescribed_motion`.
 """
 
 from __future__ import annotations
@@ -147,13 +139,18 @@ class Kernel:
 
 @dataclass
 class _Node:
-    """One solved position of the continuation: pose, analogs, second derivative, sign."""
+    """One solved position of the continuation: pose, analogs, second derivative, sign;
+    ``s``, ``xs``, ``xss``: q_k, dx/dq_k and d2x/dq_k^2 of the swept coordinate k."""
 
     q: np.ndarray  # (n_q,)
     x: np.ndarray  # (n_x,)
     B: np.ndarray  # (n_x, n_q)
     H: np.ndarray  # (n_x,) d2x/dq_k^2 of the swept coordinate
     sign: float
+    k: int = 0
+    s = property(lambda self: float(self.q[self.k]))
+    xs = property(lambda self: self.B[:, self.k])
+    xss = property(lambda self: self.H)
 
 
 def _newton(kern: Kernel, x, q, tol, max_iter=_MAX_NEWTON):
@@ -181,7 +178,7 @@ def _node(kern: Kernel, x, q, k: int, J=None) -> _Node:
     fac = kern.factor(J)
     B = kern.apply(J, fac, kern.rhs_unit(1)[0])
     H = kern.apply(J, fac, kern.gamma(x, B[:, k]))
-    return _Node(q.copy(), x.copy(), B, H, fac[2])
+    return _Node(q.copy(), x.copy(), B, H, fac[2], k)
 
 
 @dataclass
@@ -191,10 +188,6 @@ class _Stop:
     node: _Node  # last solved position
     q_try: np.ndarray  # the coordinates it could not reach
     reason: str
-
-
-def _scaled_norm(kern, dx):
-    return float(np.max(np.abs(dx * kern.col_scale)))
 
 
 def _predict(prev: _Node | None, node: _Node, k: int, h: float) -> np.ndarray:
@@ -217,7 +210,7 @@ def _chart_node(kern: Kernel, chart, q, k: int) -> _Node:
         J = kern.system(x, q)[1]
         B = kern.apply(J, kern.factor(J), kern.rhs_unit(1)[0])  # a new array
     B[:, k] = xs
-    return _Node(np.array(q, dtype=float), x, B, xss, chart.side_sign(q[k]))
+    return _Node(np.array(q, dtype=float), x, B, xss, chart.side_sign(q[k]), k)
 
 
 def _march(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, tol,
@@ -242,10 +235,8 @@ def _march(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, t
         while node.q[k] != target:
             remaining = target - node.q[k]
             qn = node.q.copy()
-            if abs(remaining) <= h_try * (1 + 1e-6):
-                qn[k] = target
-            else:
-                qn[k] = node.q[k] + np.sign(remaining) * h_try
+            qn[k] = target if abs(remaining) <= h_try * (1 + 1e-6) else \
+                node.q[k] + np.sign(remaining) * h_try
             h = qn[k] - node.q[k]
             counter["coarse_steps"] = counter.get("coarse_steps", 0) + 1
             zone = book.zone_chart(qn[k]) if book is not None else None
@@ -253,25 +244,22 @@ def _march(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, t
                 prev, node = node, _chart_node(kern, zone, qn, k)
                 h_try = min(2 * h_try, max_step)
                 continue
-            win = None
-            if book is not None:
-                win = book.window_chart(qn[k]) or book.window_chart(node.q[k])
+            win = (book.window_chart(qn[k]) or book.window_chart(node.q[k])) if book else None
             xp = win.evaluate(qn[k])[0] if win is not None else _predict(prev, node, k, h)
             x, ok, _, J = _newton(kern, xp, qn, tol)
-            accepted = False
-            reason = "Newton's method does not converge"
+            reason = "Newton's method does not converge"  # None: the step is accepted
             if ok:
                 nn = _node(kern, x, qn, k, J=J)
-                step = _scaled_norm(kern, nn.x - node.x)
-                corr = _scaled_norm(kern, nn.x - xp)
+                step = np.max(np.abs((nn.x - node.x) * kern.col_scale))
+                corr = np.max(np.abs((nn.x - xp) * kern.col_scale))
                 expected = win.side_sign(qn[k]) if win is not None else node.sign
                 if nn.sign != expected:
                     reason = "the sign of det [Phi_x; g_x] changes (the branch would be left)"
                 elif corr > 0.25 * step + 1e-9 * L:
                     reason = "the corrector moves far from the predictor"
                 else:
-                    accepted = True
-            if not accepted:
+                    reason = None
+            if reason is not None:
                 counter["rejected_steps"] = counter.get("rejected_steps", 0) + 1
                 h_try = abs(h) / 2
                 prev = None  # fall back to the Taylor predictor near trouble
@@ -316,7 +304,6 @@ def _hermite5(t, h, x0, d0, a0, x1, d1, a1):
     h5 = 10 * t3 - 15 * t4 + 6 * t5
     return (h0 * x0 + h1 * h * d0 + h2 * h * h * a0 + h3 * h * h * a1 + h4 * h * d1
             + h5 * x1)
-
 
 
 def _anchor_indices(values, max_step) -> np.ndarray:

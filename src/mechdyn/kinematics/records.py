@@ -1,12 +1,10 @@
 """Records of the kinematic analyses: :class:`KinematicSweep` and :class:`KinematicPoint`.
 
-Read-only arrays of positions, velocities, accelerations and velocity analogs,
-with point and body accessors and :meth:`KinematicSweep.to_dataframe`, and the
-derived figures of :meth:`KinematicSweep.summary` (:func:`_summarize`,
-:class:`SweepSummary`): the stroke and the dead centres (TDC/BDC, refined on the
-exact travel rate) of every slider, the range of the transmission angle of every
-four-bar loop (:func:`four_bar_loops`) and the largest speed and acceleration of
-every named point.  :func:`_travel` is the travel of a prismatic joint and its rates.
+Read-only arrays of positions, velocities, accelerations and velocity analogs, and the
+derived figures of :meth:`KinematicSweep.summary` (:class:`SweepSummary`): stroke and
+dead centres (TDC/BDC, refined on the exact travel rate) of every slider, range of the
+transmission angle of every four-bar loop and the largest speed and acceleration of
+every named point.
 """
 
 from __future__ import annotations
@@ -32,10 +30,6 @@ def _ro(a):
     a = np.asarray(a)
     a.flags.writeable = False
     return a
-
-
-def _unit_of(model: Model, c: int) -> str:
-    return "rad" if model.coord_is_angle[c] else "m"
 
 
 @dataclass(frozen=True)
@@ -89,9 +83,8 @@ class KinematicSweep:
     B : ndarray, shape (n, n_x, n_q)
         Velocity analogs dx/dq (m/rad, rad/rad, m/m or rad/m).
     status : Status
-        ``"success"`` or ``"singular-position"``
-        ``"singular-position"``: the sweep stopped at a dead or toggle position; the
-        positions before it are kept and ``message`` says where.
+        ``"success"``, or ``"singular-position"``: the sweep stopped at a dead or toggle
+        position; the positions before it are kept and ``message`` says where.
     message : str
     stats : dict
         Counts and timings (``n_points``, ``n_requested``, ``coarse_steps``,
@@ -187,37 +180,30 @@ class KinematicSweep:
         m = self.model
         cols: dict[str, np.ndarray] = {}
         names = m.coordinate_names
-        for c, name in enumerate(names):
-            u = _unit_of(m, c)
+        units = ["rad" if a else "m" for a in m.coord_is_angle]
+        per = ["" if a else "_m" for a in m.coord_is_angle]  # analogs: per m is written
+        for c, (name, u) in enumerate(zip(names, units, strict=True)):
             cols[f"{name}_{u}"] = self.q[:, c]
             if name == self.over and u == "rad":
                 cols[f"{name}_deg"] = np.rad2deg(self.q[:, c])
-        for c, name in enumerate(names):
-            u = _unit_of(m, c)
+        for c, (name, u) in enumerate(zip(names, units, strict=True)):
             cols[f"{name}_dot_{u}_s"] = self.qdot[:, c]
             cols[f"{name}_ddot_{u}_s2"] = self.qddot[:, c]
-
-        def per(c):  # analog unit suffix: per rad is implied, per m is written
-            return "" if m.coord_is_angle[c] else "_m"
-
         for b in m.body_names:
-            th, om, al = self.angular(b)
-            cols[f"theta_{b}_rad"] = th
-            cols[f"omega_{b}_rad_s"] = om
-            cols[f"alpha_{b}_rad_s2"] = al
+            cols.update(zip((f"theta_{b}_rad", f"omega_{b}_rad_s", f"alpha_{b}_rad_s2"),
+                            self.angular(b), strict=True))
             k = 3 * m.body_index(b) + 2
             for c, name in enumerate(names):
-                cols[f"dtheta_{b}_d{name}_rad{per(c)}"] = self.B[:, k, c]
+                cols[f"dtheta_{b}_d{name}_rad{per[c]}"] = self.B[:, k, c]
         for b, p in m.named_points():
             r, v, a = self.point(b, p)
             dr = self.point_analogs(b, p)
             tag = f"{b}_{p}"
-            cols[f"x_{tag}_m"], cols[f"y_{tag}_m"] = r[:, 0], r[:, 1]
-            cols[f"vx_{tag}_m_s"], cols[f"vy_{tag}_m_s"] = v[:, 0], v[:, 1]
-            cols[f"ax_{tag}_m_s2"], cols[f"ay_{tag}_m_s2"] = a[:, 0], a[:, 1]
+            for pre, arr, unit in (("", r, "m"), ("v", v, "m_s"), ("a", a, "m_s2")):
+                cols[f"{pre}x_{tag}_{unit}"], cols[f"{pre}y_{tag}_{unit}"] = arr[:, 0], arr[:, 1]
             for c, name in enumerate(names):
-                cols[f"dx_{tag}_d{name}_m{per(c)}"] = dr[:, 0, c]
-                cols[f"dy_{tag}_d{name}_m{per(c)}"] = dr[:, 1, c]
+                cols[f"dx_{tag}_d{name}_m{per[c]}"] = dr[:, 0, c]
+                cols[f"dy_{tag}_d{name}_m{per[c]}"] = dr[:, 1, c]
         return pd.DataFrame(cols)
 
     # ------------------------------------------------------------------ summary
@@ -326,9 +312,7 @@ class SweepSummary:
             extra = f" = {wrapped:.4f} deg mod 360" if abs(wrapped - deg) > 1e-9 else ""
             return f"{self.over} = {deg:.4f} deg{extra}"
 
-        out = []
-        for j, s in self.strokes.items():
-            out.append(f"stroke of slider {j!r}: {s * 1e3:.6g} mm")
+        out = [f"stroke of slider {j!r}: {s * 1e3:.6g} mm" for j, s in self.strokes.items()]
         for d in self.dead_centres:
             out.append(f"dead centre {d.label} of {d.joint!r} at {at(d.at)} "
                        f"(travel {d.travel * 1e3:.6g} mm)")
@@ -394,14 +378,9 @@ def four_bar_loops(model: Model, over: str | None = None) -> list[FourBarLoop]:
                     if key in seen:
                         continue
                     seen.add(key)
-                    forward = FourBarLoop(a, c, d, (j0, j1, j2, j3))
-                    backward = FourBarLoop(d, c, a, (j3, j2, j1, j0))
-                    if d in driven and a not in driven:
-                        loops.append(backward)
-                    elif a in driven or order[a] <= order[d]:
-                        loops.append(forward)
-                    else:
-                        loops.append(backward)
+                    forward = a in driven or (d not in driven and order[a] <= order[d])
+                    loops.append(FourBarLoop(a, c, d, (j0, j1, j2, j3)) if forward
+                                 else FourBarLoop(d, c, a, (j3, j2, j1, j0)))
     return loops
 
 
@@ -414,47 +393,35 @@ def _joint_point(model: Model, name: str, x) -> np.ndarray:
 
 
 def _summarize(sw: KinematicSweep) -> SweepSummary:
-    m = sw.model
-    k = sw.over_index
-    strokes, dcs = {}, []
-    n = len(sw)
+    m, k, n = sw.model, sw.over_index, len(sw)
+    strokes, dcs, trans, ext = {}, [], [], []
+    if n == 0:
+        return SweepSummary(sw.over, sw.over_is_angle, strokes, dcs, trans, ext)
     for jname in m.pri.names:
         # travel and its analog (per unit of the swept coordinate)
         s, ds, _ = _travel(m, jname, sw.x, sw.B[..., k], np.zeros_like(sw.x))
-        if n == 0:
-            continue
         found = []
         for i in np.flatnonzero(np.sign(ds[:-1]) * np.sign(ds[1:]) < 0):
-            q_at, s_at = _refine_root(sw, i, partial(_travel, m, jname))
             # a maximum where the travel rate goes from + to - along the sweep direction
             is_max = (ds[i] > 0) == (sw.values[i + 1] > sw.values[i])
-            found.append((q_at, s_at, is_max))
+            found.append((*_refine_root(sw, i, partial(_travel, m, jname)), is_max))
         for i in np.flatnonzero(ds == 0.0):  # exactly on a sample: keep it if an extremum
             j0, j1 = max(i - 1, 0), min(i + 1, n - 1)
             hi, lo = s[i] >= max(s[j0], s[j1]), s[i] <= min(s[j0], s[j1])
             if hi != lo:
                 found.append((float(sw.values[i]), float(s[i]), bool(hi)))
-        allvals = np.concatenate([s, [f[1] for f in found]])
-        strokes[jname] = float(np.max(allvals) - np.min(allvals))
-        for q_at, s_at, is_max in sorted(found):
-            dcs.append(DeadCentre(jname, "TDC" if is_max else "BDC", q_at, s_at))
-    trans = []
+        strokes[jname] = float(np.ptp(np.concatenate([s, [f[1] for f in found]])))
+        dcs.extend(DeadCentre(jname, "TDC" if is_max else "BDC", q_at, s_at)
+                   for q_at, s_at, is_max in sorted(found))
     for lp in four_bar_loops(m, sw.over):
-        if n == 0:
-            continue
-        B_ = _joint_point(m, lp.joints[1], sw.x)
-        C_ = _joint_point(m, lp.joints[2], sw.x)
-        D_ = _joint_point(m, lp.joints[3], sw.x)
+        B_, C_, D_ = (_joint_point(m, j, sw.x) for j in lp.joints[1:])
         u, v = B_ - C_, D_ - C_
         mu = np.arctan2(np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]),
                         u[:, 0] * v[:, 0] + u[:, 1] * v[:, 1])
         i0, i1 = int(np.argmin(mu)), int(np.argmax(mu))
         trans.append(TransmissionAngle(lp, float(mu[i0]), float(sw.values[i0]),
                                        float(mu[i1]), float(sw.values[i1])))
-    ext = []
     for b, p in m.named_points():
-        if n == 0:
-            continue
         _, v, a = sw.point(b, p)
         vn, an = np.hypot(v[:, 0], v[:, 1]), np.hypot(a[:, 0], a[:, 1])
         iv, ia = int(np.argmax(vn)), int(np.argmax(an))

@@ -38,19 +38,16 @@ constraint and coordinate rows (:mod:`mechdyn.model.rows`), the equations of
 (compiled when numba is installed) that also factors the Jacobians (sparse LU,
 which gives the branch sign too).
 
-This module holds the analyses :func:`sweep` and :func:`analyze` (steps 1-3 in
-:func:`_path`, step 4 in :func:`_motion`, which kinetostatics uses too); the building
-blocks of the continuation are in :mod:`mechdyn.kinematics.continuation`, the
-records :class:`KinematicSweep` and :class:`KinematicPoint` and their derived
-figures (:class:`SweepSummary`: dead centres, strokes, four-bar loops and
-transmission angles, extremes) in :mod:`mechdyn.kinematics.records`; all their
-public names are importable from here.
+Steps 1-2 are :func:`_path`, step 3 :func:`_motion` (kinetostatics uses both); the
+building blocks are in :mod:`mechdyn.kinematics.continuation`, the records (public
+names importable from here) in :mod:`mechdyn.kinematics.records`.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Mapping
+from functools import partial
 
 import numpy as np
 
@@ -97,41 +94,42 @@ def initial_coordinates(model: Model, x0=None) -> np.ndarray:
     the model-file loader stores them, or a sequence of n_q values); the others
     measured on the pose ``x0`` (default the assembled sketch ``model.x0``).
     """
-    if x0 is None:
-        x0 = getattr(model, "x0", None)
-        if x0 is None:
-            x0 = assemble(model)
-    q0 = coordinates(model, np.asarray(x0, float))
+    q0 = coordinates(model, np.asarray(_start_pose(model) if x0 is None else x0, float))
     init = (model.mechanism.extras or {}).get("initial", {})
     given = init.get("q") if isinstance(init, Mapping) else None
-    if given is None:
-        return q0
-    q = q0.copy()
-    if isinstance(given, Mapping):
-        for name, v in given.items():
-            q[model.coordinate_index(name)] = float(v)
-    else:
-        arr = np.asarray(given, float).reshape(-1)
-        if arr.shape != (model.n_q,):
+    if given is not None and not isinstance(given, Mapping):
+        q = np.asarray(given, float).reshape(-1)
+        if q.shape != (model.n_q,):
             raise ModelError(f"initial q must list {model.n_q} value(s) "
                              f"({', '.join(model.coordinate_names)}), got {given!r}")
-        q = arr
-    return q
+        return q
+    for name, v in (given or {}).items():
+        q0[model.coordinate_index(name)] = float(v)
+    return q0
+
+
+def _start_pose(model: Model, lay=None, fresh: bool = False) -> np.ndarray:
+    """The assembled sketch ``model.x0``, assembled anew (in ``lay``'s mode) if ``fresh``."""
+    x0 = getattr(model, "x0", None)
+    return assemble(model, layout=lay) if x0 is None or fresh else x0
+
+
+def _solve_at(kern, x_guess, q, tol):
+    """Pose at q by Newton from ``x_guess`` (else assembled from it), with F and J there."""
+    x, ok, F, J = _newton(kern, np.asarray(x_guess, float), q, tol)
+    if not ok:
+        x = assemble(kern.model, q, x_guess=x_guess, layout=kern.lay)
+        F, J = kern.system(x, q)
+    return x, F, J
 
 
 def _rates(model: Model, k: int, speed) -> np.ndarray:
     qdot = np.zeros(model.n_q)
-    if speed is None:
-        qdot[k] = 1.0
-    elif isinstance(speed, Mapping):
-        qdot[k] = 1.0
-        for name, v in speed.items():
-            if name not in model.coordinate_names:
-                raise ModelError("speed: " + did_you_mean(name, model.coordinate_names,
-                                                          "coordinate"))
-            qdot[model.coordinate_index(name)] = float(v)
-    else:
-        qdot[k] = float(speed)
+    qdot[k] = 1.0 if speed is None or isinstance(speed, Mapping) else float(speed)
+    for name, v in (speed.items() if isinstance(speed, Mapping) else ()):
+        if name not in model.coordinate_names:
+            raise ModelError("speed: " + did_you_mean(name, model.coordinate_names, "coordinate"))
+        qdot[model.coordinate_index(name)] = float(v)
     if not np.all(np.isfinite(qdot)):
         raise ModelError(f"speed must be finite, got {speed!r}")
     return qdot
@@ -207,22 +205,16 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
 
     # ---- start pose and coordinates
     if x_start is None:
-        x0 = getattr(model, "x0", None)
-        if x0 is None or (mode is not None and lay.mode != model.initial_mode):
-            x0 = assemble(model, layout=lay)
+        x0 = _start_pose(model, lay, fresh=lay.mode != model.initial_mode)
         q_init = initial_coordinates(model, x0)
     else:
         x0 = np.asarray(x_start, float).reshape(model.n_x)
         q_init = coordinates(model, x0)
-    x_init, ok, _, J0 = _newton(kern, x0, q_init, tol)
-    if not ok:
-        x_init = assemble(model, q_init, x_guess=x0, layout=lay)
-        J0 = None
+    x_init, _, J0 = _solve_at(kern, x0, q_init, tol)
     start = _node(kern, x_init, q_init, k, J=J0)
     # bifurcation positions on the way are gone through on the branch (branch charts)
-    book = None
-    if lay.n_rows + model.n_q == model.n_x:
-        book = ChartBook(PathProblem(model, lay, np.arange(model.n_q), q_init, k))
+    book = ChartBook(PathProblem(model, lay, np.arange(model.n_q), q_init, k)) \
+        if kern.square else None
 
     if values is None:
         if not is_angle:
@@ -243,11 +235,9 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
     qddot = np.zeros((N, model.n_q))
     X, B, xdot, xddot, _ = _motion(kern, X, Q, qdot, qddot, book, k, system)
 
-    status, message, events, error = "success", "", (), None
+    error, events = None, ()
     if stop is not None:
-        status = Status.SINGULAR_POSITION
         error, event = _dead_report(model, lay, k, stop, N, n_req)
-        message = str(error)
         events = (event,)
     elapsed = time.perf_counter() - t_start
     stats = {"n_points": int(N), "n_requested": int(n_req), "anchors": counter["anchors"],
@@ -260,13 +250,14 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
              "mode": tuple(sorted(lay.mode))}
     return KinematicSweep(
         over=over, values=_ro(values[:N].copy()), q=_ro(Q), qdot=_ro(qdot), qddot=_ro(qddot),
-        x=_ro(X), xdot=_ro(xdot), xddot=_ro(xddot), B=_ro(B), status=status, message=message,
-        stats=stats, events=events, error=error, model=model)
+        x=_ro(X), xdot=_ro(xdot), xddot=_ro(xddot), B=_ro(B), stats=stats, events=events,
+        status="success" if error is None else Status.SINGULAR_POSITION,
+        message="" if error is None else str(error), error=error, model=model)
 
 
 def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter):
     """The continuation of the sweep from the node ``start`` through ``values`` of
-    coordinate k (the kernel's other coordinates held at ``start.q``): steps 1 to 3 of
+    coordinate k (the kernel's other coordinates held at ``start.q``): steps 1 and 2 of
     the module docstring.  Returns the poses reached (n_ok, n_x), the :class:`_Stop` or
     None and (F, J, factors) at the poses or None; ``counter`` gets the step counts,
     ``anchors``, ``fallback`` and ``time_coarse``."""
@@ -274,8 +265,9 @@ def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter
     t_coarse = time.perf_counter()
     # ---- 1. coarse continuation through the anchors
     anchors = _anchor_indices(values, max_step)
-    anodes, stop = _march(kern, start, k, values[anchors], max_step=max_step,
-                          min_step=min_step, tol=tol, counter=counter, book=book)
+    march = partial(_march, kern, k=k, max_step=max_step, min_step=min_step, tol=tol,
+                    counter=counter, book=book)
+    anodes, stop = march(start, targets=values[anchors])
     n_anch = len(anodes)
     counter.update(time_coarse=time.perf_counter() - t_coarse, anchors=len(anchors),
                    fallback=0)
@@ -288,10 +280,8 @@ def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter
     elif n_anch > 1:
         a_idx = anchors[:n_anch]
         seg = np.clip(np.searchsorted(a_idx, np.arange(n_ok), side="right") - 1, 0, n_anch - 2)
-        xa = np.array([nd.x for nd in anodes])
-        da = np.array([nd.B[:, k] for nd in anodes])
-        aa = np.array([nd.H for nd in anodes])
-        sg = np.array([nd.sign for nd in anodes])
+        xa, da, aa, sg = (np.array([getattr(nd, f) for nd in anodes])
+                          for f in ("x", "xs", "xss", "sign"))
         qa = values[a_idx]
         h = (qa[seg + 1] - qa[seg])[:, None]
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -307,9 +297,7 @@ def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter
             counter["fallback"] += 1
             system = None
             i0, i1 = a_idx[m_], a_idx[m_ + 1]
-            nodes, st = _march(kern, anodes[m_], k, values[i0 + 1:i1 + 1],
-                               max_step=max_step, min_step=min_step, tol=tol, counter=counter,
-                               book=book)
+            nodes, st = march(anodes[m_], targets=values[i0 + 1:i1 + 1])
             for r, nd in enumerate(nodes):
                 X[i0 + 1 + r] = nd.x
             if st is not None:  # only if a singular position lies between two anchors
@@ -323,9 +311,7 @@ def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter
     if stop is not None and n_anch >= 0 and n_ok < n_req:
         last = anodes[-1] if n_anch else start
         nxt = anchors[n_anch] if n_anch < len(anchors) else n_req - 1
-        nodes, stop = _march(kern, last, k, values[n_ok:nxt + 1], max_step=max_step,
-                             min_step=min_step, tol=tol, counter=counter, prev=None,
-                             book=book)
+        nodes, stop = march(last, targets=values[n_ok:nxt + 1])
         if stop is None:  # cannot happen: the anchor itself was unreachable
             stop = _Stop(nodes[-1], nodes[-1].q, "the continuation could not reach "
                          f"{values[nxt]:.9g}")
@@ -336,7 +322,7 @@ def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter
 
 
 def _motion(kern, X, Q, qdot, qddot, book, k: int, system=None, correct=True):
-    """Step 4 of the module docstring: a last Newton correction of the poses X (N, n_x)
+    """Step 3 of the module docstring: a last Newton correction of the poses X (N, n_x)
     at the coordinates Q (with ``correct``), the analogs B and the velocities and
     accelerations for the rates qdot, qddot (N, n_q), from the charts in the bifurcation
     zones of ``book`` (swept coordinate k).  Returns X, B, xdot, xddot and the charted
@@ -360,11 +346,9 @@ def _motion(kern, X, Q, qdot, qddot, book, k: int, system=None, correct=True):
         xdot = np.einsum("nij,nj->ni", B, qdot)
         xddot = np.einsum("nij,nj->ni", B, qddot)
         xddot += kern.apply(J, fac, kern.gamma(X, xdot)[..., None])[..., 0]
-    if book is None or not book.charts:
+    if book is None or not (charted := book.apply(Q[:, k]))[0].any():
         return X, B, xdot, xddot, None
-    mask, xc, xs, xss = book.apply(Q[:, k])
-    if not mask.any():
-        return X, B, xdot, xddot, None
+    mask, xc, xs, xss = charted
     # the limit from both sides, where the equations are ill-conditioned: the analogs of
     # the other coordinates stay those of the direct solve, and so does the part of the
     # acceleration due to their rates
@@ -429,22 +413,13 @@ def analyze(mech_or_model, q, qdot, qddot=None, x_guess=None, *, mode=None) -> K
     model = as_model(mech_or_model)
     lay = model.layout(mode)
     kern = _kernel(model, lay)
-    q = np.asarray(q, float).reshape(model.n_q)
-    qdot = np.asarray(qdot, float).reshape(model.n_q)
-    qddot = np.zeros(model.n_q) if qddot is None else np.asarray(qddot, float).reshape(
-        model.n_q)
-    if x_guess is None:
-        x_guess = getattr(model, "x0", None)
-        if x_guess is None:
-            x_guess = assemble(model, layout=lay)
-    tol = _position_tol(model)
-    x, ok, F, J = _newton(kern, np.asarray(x_guess, float), q, tol)
-    if not ok:
-        x = assemble(model, q, x_guess=x_guess, layout=lay)
-        F, J = kern.system(x, q)
+    q, qdot, qddot = (np.array(v, float).reshape(model.n_q)
+                      for v in (q, qdot, np.zeros(model.n_q) if qddot is None else qddot))
+    x, F, J = _solve_at(kern, _start_pose(model, lay) if x_guess is None else x_guess, q,
+                        _position_tol(model))
     system = (F[None], J[None], kern.factor(J[None]))
     x, B, xdot, xddot, _ = _motion(kern, x[None], q[None], qdot[None], qddot[None], None, 0,
                                    system, correct=False)
-    return KinematicPoint(q=_ro(q.copy()), qdot=_ro(qdot.copy()), qddot=_ro(qddot.copy()),
+    return KinematicPoint(q=_ro(q), qdot=_ro(qdot), qddot=_ro(qddot),
                           x=_ro(x[0]), xdot=_ro(xdot[0]), xddot=_ro(xddot[0]), B=_ro(B[0]),
                           model=model)

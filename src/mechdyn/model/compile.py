@@ -88,8 +88,7 @@ class Model:
         self.body_names = tuple(b.name for b in bodies)
         self.n_bodies = nb = len(bodies)
         self.n_x = 3 * nb
-        self._bindex = {n: k for k, n in enumerate(self.body_names)}
-        self._bindex[GROUND] = nb
+        self._bindex = {**{n: k for k, n in enumerate(self.body_names)}, GROUND: nb}
         self._bodies = {**mechanism.all_bodies}
 
         self.mass = np.array([b.mass for b in bodies], dtype=float)
@@ -106,12 +105,11 @@ class Model:
             *self._ends(pris), self._points(pris, "parent"),
             np.array([np.asarray(j.axis, float) / np.hypot(*j.axis) for j in pris]).reshape(-1, 2),
             self._points(pris, "child"),
-            np.array([self._sketch_angle(j) if j.angle is None else j.angle for j in pris],
-                     dtype=float))
-        offsets = [self._sketch_offset(j) if j.offset is None else j.offset for j in locks]
-        self.lock = LockRows(*self._ends(locks),
-                             np.array([o[:2] for o in offsets], dtype=float).reshape(-1, 2),
-                             np.array([o[2] for o in offsets], dtype=float),
+            np.array([self._bodies[j.child].pose[2] - self._bodies[j.parent].pose[2]
+                      if j.angle is None else j.angle for j in pris], dtype=float))
+        off = np.array([self._sketch_offset(j) if j.offset is None else j.offset[:3]
+                        for j in locks], dtype=float).reshape(-1, 3)
+        self.lock = LockRows(*self._ends(locks), off[:, :2], off[:, 2],
                              np.array([j.engaged for j in locks], dtype=bool))
         self.joint_names = tuple(mechanism.joints)
         self._jkind = {n: type(j).__name__.lower() for n, j in mechanism.joints.items()}
@@ -128,11 +126,22 @@ class Model:
         scale = max([p for p in pts if np.isfinite(p)] + [0.0])
         self.length_scale = scale if scale > 0 else 1.0
 
-        self._lower_rows()
+        # every joint and coordinate lowered to constraint rows (mechdyn.model.rows)
+        rv, pr, lk = self.rev, self.pri, self.lock
+        self.joint_rows = R.concat(
+            nb,
+            *[R.revolute(n, rv.i[k], rv.si[k], rv.j[k], rv.sj[k], nb=nb)
+              for k, n in enumerate(rv.names)],
+            *[R.prismatic(n, pr.i[k], pr.si[k], pr.ui[k], pr.j[k], pr.sj[k], pr.angle[k], nb=nb)
+              for k, n in enumerate(pr.names)])
+        self.weld_rows = {n: R.weld(n, lk.i[k], lk.c[k], lk.j[k], lk.angle[k], nb=nb)
+                          for k, n in enumerate(lk.names)}
+        self.coordinate_rows = R.concat(nb, *[
+            R.angle(c.name, self._bindex[c.body], c.offset, nb=nb) if c.kind == "angle"
+            else self.joint_variable(c.name, c.joint, c.offset) for c in coords])
 
         #: the engaged locks at the start (frozenset of lock names)
-        self.initial_mode = frozenset(n for n, e in zip(self.lock.names, self.lock.engaged,
-                                                        strict=True) if e)
+        self.initial_mode = frozenset(j.name for j in locks if j.engaged)
         #: declared assembly modes: (AssemblyMode, ((body index, local point) for P, Q, R))
         self.assembly_modes = [
             (am, tuple((self._bindex[b], np.asarray(self._point(b, ref), dtype=float))
@@ -148,23 +157,6 @@ class Model:
         #: sweep kernels ...): constants of the model computed on first use, never
         #: the state of a run
         self.memo: dict = {}
-
-    def _lower_rows(self) -> None:
-        """Lower every joint and coordinate to constraint rows (:mod:`mechdyn.model.rows`)."""
-        nb = self.n_bodies
-        rv, pr, lk = self.rev, self.pri, self.lock
-        self.joint_rows = R.concat(
-            nb,
-            *[R.revolute(n, rv.i[k], rv.si[k], rv.j[k], rv.sj[k], nb=nb)
-              for k, n in enumerate(rv.names)],
-            *[R.prismatic(n, pr.i[k], pr.si[k], pr.ui[k], pr.j[k], pr.sj[k], pr.angle[k], nb=nb)
-              for k, n in enumerate(pr.names)])
-        self.weld_rows = {n: R.weld(n, lk.i[k], lk.c[k], lk.j[k], lk.angle[k], nb=nb)
-                          for k, n in enumerate(lk.names)}
-        coords = [R.angle(c.name, self._bindex[c.body], c.offset, nb=nb) if c.kind == "angle"
-                  else self.joint_variable(c.name, c.joint, c.offset)
-                  for c in self.mechanism.coordinates.values()]
-        self.coordinate_rows = R.concat(nb, *coords)
 
     def joint_variable(self, label: str, joint: str, offset: float = 0.0) -> R.Rows:
         """The row of the relative angle theta_child - theta_parent of a revolute joint (rad)
@@ -215,9 +207,6 @@ class Model:
             return self._bodies[body].point(ref)
         return (float(ref[0]), float(ref[1]))
 
-    def _sketch_angle(self, j) -> float:
-        return self._bodies[j.child].pose[2] - self._bodies[j.parent].pose[2]
-
     def _sketch_offset(self, j):
         pi = np.asarray(self._bodies[j.parent].pose)
         pj = np.asarray(self._bodies[j.child].pose)
@@ -264,14 +253,11 @@ class Model:
     def layout(self, mode=None) -> ConstraintLayout:
         """Row layout of the constraint equations in a mode (cached)."""
         mode = self.initial_mode if mode is None else frozenset(mode)
-        lay = self._layouts.get(mode)
-        if lay is None:
-            unknown = set(mode) - set(self.lock.names)
-            if unknown:
+        if mode not in self._layouts:
+            if unknown := set(mode) - set(self.lock.names):
                 raise ModelError(did_you_mean(sorted(unknown)[0], self.lock.names, "lock"))
-            lay = ConstraintLayout(self, mode)
-            self._layouts[mode] = lay
-        return lay
+            self._layouts[mode] = ConstraintLayout(self, mode)
+        return self._layouts[mode]
 
 
 class ConstraintLayout:
@@ -282,8 +268,7 @@ class ConstraintLayout:
         self.lock_active = np.array([n in mode for n in model.lock.names], dtype=bool)
         #: the constraint rows of the mode (joints, then engaged locks), as data
         self.rowset = R.concat(model.n_bodies, model.joint_rows,
-                               *[model.weld_rows[n] for n, a in
-                                 zip(model.lock.names, self.lock_active, strict=True) if a])
+                               *[model.weld_rows[n] for n in model.lock.names if n in mode])
         self.n_rows = len(self.rowset)
         self.row_joint = np.array(self.rowset.elements, dtype=object)
         self.rows = {n: np.flatnonzero(self.row_joint == n)

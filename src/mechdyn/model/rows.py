@@ -87,15 +87,10 @@ class Rows:
 
     def __post_init__(self):
         n = len(np.atleast_1d(self.c))
-        for name in ("b1", "b2", "d", "a", "bb"):
-            object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=np.int64)
-                               .reshape(n))
-        for name in ("s1", "s2", "u"):
-            object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=float)
-                               .reshape(n, 2))
-        for name in ("ka", "kb", "c"):
-            object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=float)
-                               .reshape(n))
+        for name in ARRAYS[:-1]:
+            shape = (n, 2) if name in ("s1", "s2", "u") else (n,)
+            dtype = np.int64 if name in ("b1", "b2", "d", "a", "bb") else float
+            object.__setattr__(self, name, np.asarray(getattr(self, name), dtype).reshape(shape))
         if self.is_angle is None:
             object.__setattr__(self, "is_angle", ~np.any(self.u != 0.0, axis=1))
         else:
@@ -145,13 +140,11 @@ class Rows:
         """Flat indices into an (n, n_x + 1) array of the nine Jacobian terms of every row
         (columns of b1 x, y, theta; b2 x, y, theta; d theta; a theta; bb theta), the
         ground's columns sent to the last (dump) column."""
-        n, nb = len(self), self.nb
-        n_x = 3 * nb
-        cols = []
-        for b, k in ((self.b1, 0), (self.b1, 1), (self.b1, 2), (self.b2, 0), (self.b2, 1),
-                     (self.b2, 2), (self.d, 2), (self.a, 2), (self.bb, 2)):
-            cols.append(np.where(b >= nb, n_x, 3 * b + k))
-        return np.concatenate([np.arange(n) * (n_x + 1) + c for c in cols])
+        n_x = self.n_x
+        terms = ((self.b1, 0), (self.b1, 1), (self.b1, 2), (self.b2, 0), (self.b2, 1),
+                 (self.b2, 2), (self.d, 2), (self.a, 2), (self.bb, 2))
+        return np.concatenate([np.arange(len(self)) * (n_x + 1)
+                               + np.where(b >= self.nb, n_x, 3 * b + k) for b, k in terms])
 
     def packed(self) -> tuple[np.ndarray, np.ndarray]:
         """(ints (n, 5): b1 b2 d a bb; floats (n, 9): s1 s2 u ka kb c) for the compiled
@@ -170,8 +163,6 @@ def _one(nb, *, label: str, element: str = "", is_angle: bool = False, **row) ->
 
 
 def _rows(nb: int, recs: list[dict]) -> Rows:
-    if not recs:
-        return Rows(nb, **{k: np.zeros(0, bool if k == "is_angle" else float) for k in ARRAYS})
     return Rows(nb, **{k: [r[k] for r in recs] for k in ARRAYS},
                 labels=tuple(r["label"] for r in recs), elements=tuple(r["element"] for r in recs))
 
@@ -197,21 +188,14 @@ def revolute(name: str, i: int, si, j: int, sj, *, nb: int) -> Rows:
 
 def prismatic(name: str, i: int, si, ui, j: int, sj, held_angle: float, *, nb: int) -> Rows:
     """The normal row n_i . (p_j - p_i) (m) and the angle row theta_j - theta_i - angle."""
-    ux, uy = np.asarray(ui, float) / np.hypot(*ui)
-    return _rows(nb, [
-        _one(nb, b1=j, s1=sj, b2=i, s2=si, d=i, u=(-uy, ux), label=f"{name}.normal",
-             element=name),
-        _one(nb, a=j, ka=1.0, bb=i, kb=-1.0, c=-held_angle, label=f"{name}.angle",
-             element=name, is_angle=True)])
+    return concat(nb, line(f"{name}.normal", j, sj, i, si, ui, normal=True, nb=nb, element=name),
+                  relative_angle(f"{name}.angle", i, j, -held_angle, nb=nb, element=name))
 
 
 def weld(name: str, i: int, c, j: int, held_angle: float, *, nb: int) -> Rows:
     """Three rows: ground x and y of r_j - (r_i + A_i c) (m), then theta_j - theta_i - angle."""
-    return _rows(nb, [
-        *[_one(nb, b1=j, b2=i, s2=c, u=e, label=f"{name}.{k}", element=name)
-          for e, k in ((EX, "x"), (EY, "y"))],
-        _one(nb, a=j, ka=1.0, bb=i, kb=-1.0, c=-held_angle, label=f"{name}.angle",
-             element=name, is_angle=True)])
+    return concat(nb, revolute(name, j, (0.0, 0.0), i, c, nb=nb),
+                  relative_angle(f"{name}.angle", i, j, -held_angle, nb=nb, element=name))
 
 
 def angle(label: str, b: int, offset: float = 0.0, *, nb: int, element: str = "") -> Rows:

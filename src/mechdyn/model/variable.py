@@ -124,10 +124,8 @@ def parse(spec: str, coordinates: Collection[str]) -> Variable:
     for head, kind in (("joint:", "joint"), ("angle:", "angle")):
         if s.startswith(head) and s[len(head):].strip():
             return Variable(s, kind, s[len(head):].strip())
-    m = _DIST.match(s)
-    if m:
-        return Variable(s, "distance", points=(_point_ref(m.group(1), s),
-                                               _point_ref(m.group(2), s)))
+    if m := _DIST.match(s):
+        return Variable(s, "distance", points=tuple(_point_ref(g, s) for g in m.groups()))
     parts = s.split(".")
     if len(parts) == 3 and parts[2] in ("x", "y") and parts[0] and parts[1]:
         return Variable(s, "point", points=((parts[0], parts[1]),), comp="xy".index(parts[2]))
@@ -198,10 +196,9 @@ def lower(model, var: Variable) -> Rows | None:
     if var.kind == "angle":
         return R.angle(var.text, model.body_index(var.name), nb=nb)
     if var.kind == "point":
-        b, s = _body_point(model, var.points[0])
-        return R.point(var.text, b, s, var.comp, nb=nb)
-    (b1, s1), (b2, s2) = (_body_point(model, p) for p in var.points)
+        return R.point(var.text, *_body_point(model, var.points[0]), var.comp, nb=nb)
     # the separation of two points: the two rows of a pin joint between them
+    (b1, s1), (b2, s2) = (_body_point(model, p) for p in var.points)
     return R.revolute(var.text, b1, s1, b2, s2, nb=nb)
 
 
@@ -262,18 +259,13 @@ class DistanceMeasure(Measure):
     """Distance between two body points, m (switch conditions only); ``rows`` are the
     ground x and y of their separation."""
 
-    def __init__(self, rows: Rows, label: str):
-        self.rows, self.label, self.is_angle = rows, label, False
-
     def value(self, X, V=None) -> float:
         return float(np.hypot(*rows_numpy.values(self.rows, _pose(X, self.rows.nb))))
 
     def rate(self, X, V, nb: int | None = None) -> float:
-        n = self.rows.nb
-        x = _pose(X, n)
-        d = rows_numpy.values(self.rows, x)
+        d, J, _ = rows_numpy.evaluate(self.rows, _pose(X, self.rows.nb))
         r = float(np.hypot(*d))
-        return float(d @ (rows_numpy.jacobian(self.rows, x) @ _pose(V, n))) / r if r else 0.0
+        return float(d @ (J @ _pose(V, self.rows.nb))) / r if r else 0.0
 
 
 class TimeMeasure:
@@ -308,15 +300,15 @@ def parse_variable(model, spec: str, *, allow_time: bool = False, allow_rate: bo
         lists the valid forms or names.
     """
     var = parse(spec, model.coordinate_names)
-    for kind, ok, what in (("time", allow_time, "variable 't' (time)"),
-                           ("distance", allow_distance, f"distance variable {var.text!r}")):
-        if var.kind == kind and not ok:
+    for bad, what in ((var.kind == "time" and not allow_time, "variable 't' (time)"),
+                      (var.kind == "distance" and not allow_distance,
+                       f"distance variable {var.text!r}"),
+                      (var.rate and not allow_rate, f"rate variable {var.text!r}")):
+        if bad:
             raise ModelError(f"{what} is allowed only in switch conditions")
-    if var.rate and not allow_rate:
-        raise ModelError(f"rate variable {var.text!r} is allowed only in switch conditions")
-    rows = lower(model, var)
     if var.kind == "time":
         return TimeMeasure()
+    rows = lower(model, var)
     if var.kind == "distance":
         return DistanceMeasure(rows, var.text)
     base = Measure(rows.renamed(var.text))

@@ -26,6 +26,7 @@ import numpy as np
 from ..errors import MechdynError, ModelError
 from ..kernels import rows_numpy
 from ..kinematics.constraints import extend, travel_rows
+from .figure import figure, save
 from .table import deg_or_mm, output_path, written
 
 __all__ = ["animate", "snapshot", "frame_geometry", "frame_indices", "check_animation_path",
@@ -34,31 +35,12 @@ __all__ = ["animate", "snapshot", "frame_geometry", "frame_indices", "check_anim
 #: largest number of frames drawn by default
 MAX_FRAMES = 200
 
-_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown",
-           "tab:pink", "tab:olive", "tab:cyan", "tab:gray")
-
 
 def _rot(theta: np.ndarray, s: np.ndarray) -> np.ndarray:
     """Rotate body-frame points ``s`` (k, 2) by angles ``theta`` (n,) -> (n, k, 2)."""
     c, sn = np.cos(theta)[:, None], np.sin(theta)[:, None]
     return np.stack([c * s[None, :, 0] - sn * s[None, :, 1],
                      sn * s[None, :, 0] + c * s[None, :, 1]], axis=-1)
-
-
-def _unique(points: list[np.ndarray], tol: float) -> list[np.ndarray]:
-    out: list[np.ndarray] = []
-    for p in points:
-        if all(np.hypot(*(p - q)) > tol for q in out):
-            out.append(p)
-    return out
-
-
-def _outline(points: list[np.ndarray]) -> np.ndarray:
-    """Order three or more body-frame points around their centroid (a simple polygon)."""
-    P = np.array(points)
-    c = P.mean(axis=0)
-    ang = np.arctan2(P[:, 1] - c[1], P[:, 0] - c[0])
-    return P[np.argsort(ang)]
 
 
 @dataclass(frozen=True)
@@ -122,23 +104,28 @@ def _drawing(model, x: np.ndarray) -> MechanismDrawing:
                 guided[j.child] = _rot(-model.pri.angle[k:k + 1], u[None, :])[0, 0]
             guides[name] = (j.parent, pp, u, j.child)
 
-    size = 0.035 * _extent(model, x, pts)
+    # the symbols' size follows the region swept by all points and body origins
+    allp = [_world(model, x, b, np.array([*p, np.zeros(2)])).reshape(-1, 2)
+            for b, p in pts.items()]
+    span = float(np.max(np.ptp(np.concatenate(allp), axis=0))) if allp else 0.0
+    size = 0.035 * (span if span > 0 else model.length_scale)
     bodies = {}
     for b in model.body_names:
-        p = _unique(pts[b], tol)
-        if len(p) >= 3:
-            bodies[b] = (_outline(p), "polygon")
+        p: list[np.ndarray] = []
+        for a in pts[b]:  # the distinct points
+            if all(np.hypot(*(a - q)) > tol for q in p):
+                p.append(a)
+        if len(p) >= 3:  # ordered around their centroid: a simple polygon
+            d = np.array(p) - np.mean(p, axis=0)
+            bodies[b] = (np.array(p)[np.argsort(np.arctan2(d[:, 1], d[:, 0]))], "polygon")
         elif len(p) == 2:
             bodies[b] = (np.array(p), "bar")
         else:
             c = p[0] if p else np.asarray(model.com[model.body_index(b)], dtype=float)
             if b in guided:
-                u = guided[b]
-                n = np.array([-u[1], u[0]])
-                w, h = 1.6 * size, 0.9 * size
-                block = np.array([c + w * u + h * n, c - w * u + h * n,
-                                  c - w * u - h * n, c + w * u - h * n])
-                bodies[b] = (block, "block")
+                u = guided[b]  # the block's corners along the guide and across it
+                corners = np.array([[1.6, 0.9], [-1.6, 0.9], [-1.6, -0.9], [1.6, -0.9]]) * size
+                bodies[b] = (c + corners @ np.array([u, [-u[1], u[0]]]), "block")
             else:
                 bodies[b] = (c[None, :], "disc")
     # guide segments: the travel range of the child point over the motion, plus margins
@@ -157,19 +144,6 @@ def _world(model, x: np.ndarray, body: str, local: np.ndarray) -> np.ndarray:
     """Ground-frame positions (n, k, 2) of body-frame points ``local`` (k, 2) over ``x``."""
     pose = extend(model, x)[:, model.body_index(body)]
     return pose[:, None, :2] + _rot(pose[:, 2], local)
-
-
-def _extent(model, x: np.ndarray, pts: dict) -> float:
-    """Size of the region swept by all points over the motion, m."""
-    allp = []
-    for b, p in pts.items():
-        if p:
-            allp.append(_world(model, x, b, np.array(p)).reshape(-1, 2))
-        k = model.body_index(b)
-        allp.append(x[:, 3 * k:3 * k + 2])
-    P = np.concatenate(allp) if allp else np.zeros((1, 2))
-    span = float(np.max(np.ptp(P, axis=0)))
-    return span if span > 0 else model.length_scale
 
 
 def _trace_spec(model, trace, what: str = "trace") -> tuple[str, object] | None:
@@ -267,7 +241,16 @@ def frame_geometry(record, index=None, *, trace=None) -> dict:
     model, x = _record_parts(record)
     drawing, spec = _drawing(model, x), _trace_spec(model, trace)
     g = _geometry(model, x, drawing, index, spec)
-    g["limits"] = _limits(g if index is None else _geometry(model, x, drawing, None, spec))
+    every = g if index is None else _geometry(model, x, drawing, None, spec)  # all frames
+    s = g["size"]
+    arrs = [a.reshape(-1, 2) for a in (*every["bodies"].values(), *every["guides"].values())]
+    for a in every["anchors"].values():  # the anchor triangles and their ground lines
+        arrs.append(np.asarray(a).reshape(1, 2) + [[-1.8 * s, -1.8 * s], [1.8 * s, 0.0]])
+    if "trace" in every:
+        arrs.append(every["trace"])
+    P = np.concatenate(arrs)
+    lo, hi = P.min(axis=0) - 1.5 * s, P.max(axis=0) + 1.5 * s
+    g["limits"] = ((float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1])))
     return g
 
 
@@ -290,47 +273,26 @@ def _geometry(model, x, drawing: MechanismDrawing, index, trace) -> dict:
     return g
 
 
-def _limits(g: dict) -> tuple[tuple[float, float], tuple[float, float]]:
-    """Axis limits around the geometry ``g`` of all frames (see :func:`frame_geometry`)."""
-    arrs = [a.reshape(-1, 2) for a in g["bodies"].values()]
-    arrs += [a.reshape(-1, 2) for a in g["guides"].values()]
-    s = g["size"]
-    for a in g["anchors"].values():  # the anchor triangles and their ground lines
-        arrs.append(np.asarray(a).reshape(1, 2) + [[-1.8 * s, -1.8 * s], [1.8 * s, 0.0]])
-    if "trace" in g:
-        arrs.append(g["trace"])
-    P = np.concatenate(arrs)
-    lo, hi = P.min(axis=0), P.max(axis=0)
-    pad = 1.5 * s
-    return ((float(lo[0] - pad), float(hi[0] + pad)),
-            (float(lo[1] - pad), float(hi[1] + pad)))
-
-
 class _Scene:
     """The matplotlib artists of one figure, updated frame by frame."""
 
     def __init__(self, record, *, trace=None, title=None, width: float = 6.4):
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from matplotlib.figure import Figure
         from matplotlib.patches import Polygon
 
-        model, x = _record_parts(record)
+        model, _ = _record_parts(record)
         self.trace = _trace_spec(model, trace)
-        d = _drawing(model, x)
-        self.g = g = _geometry(model, x, d, None, self.trace)  # every frame, drawn by update()
-        (x0, x1), (y0, y1) = _limits(g)
+        self.g = g = frame_geometry(record, trace=self.trace)  # every frame, drawn by update()
+        (x0, x1), (y0, y1) = g["limits"]
         # the figure's shape follows the drawing's (room for title and labels added)
         height = float(np.clip((width - 1.0) * (y1 - y0) / (x1 - x0) + 1.2, 3.0, 7.5))
-        self.fig = fig = Figure(figsize=(width, height), layout="constrained")
-        FigureCanvasAgg(fig)
-        ax = self.ax = fig.add_subplot()
+        self.fig, (ax,) = figure(1, width, height)
+        self.ax = ax
         ax.set(xlim=(x0, x1), ylim=(y0, y1), xlabel="x (m)", ylabel="y (m)",
                title=title if title is not None else getattr(model.mechanism, "name", "mechanism"))
         ax.set_aspect("equal", adjustable="box")
-        ax.grid(True, alpha=0.25)
-        s = d.size
+        s = g["size"]
         # static: anchors (hatched triangles) and ground guides
-        for p in d.anchors.values():
+        for p in g["anchors"].values():
             tri = np.array([p, p + [-1.2 * s, -1.8 * s], p + [1.2 * s, -1.8 * s]])
             ax.add_patch(Polygon(tri, closed=True, facecolor="0.85", edgecolor="0.3",
                                  hatch="////", lw=1.0, zorder=1))
@@ -338,7 +300,7 @@ class _Scene:
                     lw=1.5, zorder=1)
         # the moving artists start empty: update() places them
         self.guides = {j: ax.plot([], [], color="0.35", lw=2.5, alpha=0.6,
-                                  solid_capstyle="butt", zorder=1)[0] for j in d.guides}
+                                  solid_capstyle="butt", zorder=1)[0] for j in g["guides"]}
         if self.trace is not None:
             gt = g["trace"]
             ax.plot(gt[:, 0], gt[:, 1], color="tab:red", lw=0.8, ls=":", alpha=0.6, zorder=2)
@@ -348,11 +310,11 @@ class _Scene:
             ax.legend(loc="upper right", fontsize="small")
         # moving bodies
         self.bodies = {}
-        for k, (b, (local, style)) in enumerate(d.bodies.items()):
-            c = _COLORS[k % len(_COLORS)]
+        for k, (b, style) in enumerate(g["styles"].items()):
+            c = f"C{k}"  # the colour cycle
             if style in ("polygon", "block"):
-                art = Polygon(local, closed=True, facecolor=c, alpha=0.45, edgecolor=c, lw=2.0,
-                              zorder=3, label=b)
+                art = Polygon(g["bodies"][b][0], closed=True, facecolor=c, alpha=0.45,
+                              edgecolor=c, lw=2.0, zorder=3, label=b)
                 ax.add_patch(art)
             elif style == "bar":
                 (art,) = ax.plot([], [], color=c, lw=5.0, alpha=0.8, solid_capstyle="round",
@@ -368,21 +330,16 @@ class _Scene:
                             bbox={"boxstyle": "round", "fc": "white", "ec": "0.7",
                                   "alpha": 0.85}, zorder=7)
 
-    def artists(self) -> list:
-        """The artists that move from frame to frame."""
-        out = [a for a, _ in self.bodies.values()] + list(self.guides.values())
-        out += [self.revolutes, self.locks, self.text]
-        if self.trace is not None:
-            out += [self.trace_line, self.trace_dot]
-        return out
-
     def render(self, idx, labels, dpi: int):
         """Yield one RGB :class:`PIL.Image.Image` per sample of ``idx`` (blitting)."""
         from PIL import Image
 
         canvas = self.fig.canvas
         self.fig.set_dpi(dpi)
-        moving = self.artists()
+        moving = [a for a, _ in self.bodies.values()] + list(self.guides.values())
+        moving += [self.revolutes, self.locks, self.text]
+        if self.trace is not None:
+            moving += [self.trace_line, self.trace_dot]
         for a in moving:
             a.set_animated(True)
         canvas.draw()  # the background: axes, anchors, the faint trace
@@ -455,6 +412,7 @@ def animate(record, path, *, fps: int = 25, frames: int | None = None, trace=Non
         A record without poses or model, or an unknown trace point.
     """
     from matplotlib import animation
+    from PIL import Image
 
     path = check_animation_path(path)
     if fps <= 0:
@@ -470,17 +428,8 @@ def animate(record, path, *, fps: int = 25, frames: int | None = None, trace=Non
                 scene.update(int(i), lab)
                 writer.grab_frame()
         return path
-    images = _paletted(list(scene.render(idx, labels, dpi)))
-    # as matplotlib's PillowWriter does, but with the background drawn once and one palette
-    images[0].save(path, save_all=True, append_images=images[1:],
-                   duration=max(1, round(1000 / fps)), loop=0)
-    return path
-
-
-def _paletted(images: list) -> list:
-    """Quantize RGB frames to one shared palette (taken from the first, middle and last)."""
-    from PIL import Image
-
+    images = list(scene.render(idx, labels, dpi))
+    # one shared palette, taken from the first, middle and last frames
     w, h = images[0].size
     probe_ids = sorted({0, len(images) // 2, len(images) - 1})
     probe = Image.new("RGB", (w, h * len(probe_ids)))
@@ -488,7 +437,12 @@ def _paletted(images: list) -> list:
         probe.paste(images[k], (0, j * h))
     palette = probe.quantize(colors=128, method=Image.Quantize.MEDIANCUT,
                              dither=Image.Dither.NONE)
-    return [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
+    images = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
+    # as matplotlib's PillowWriter does, but with the background drawn once and one palette
+    with written(path) as tmp:
+        images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],
+                       duration=max(1, round(1000 / fps)), loop=0)
+    return path
 
 
 def check_animation_path(path) -> Path:
@@ -543,7 +497,4 @@ def snapshot(record, path, index: int = 0, *, trace=None, title: str | None = No
     if hasattr(path, "write"):
         scene.fig.savefig(path, dpi=dpi, format="png")
         return path
-    path = output_path(path)
-    with written(path) as tmp:
-        scene.fig.savefig(tmp, dpi=dpi)
-    return path
+    return save(scene.fig, path, dpi)

@@ -1,8 +1,8 @@
-"""Text listings of a run's events (for ``mechdyn simulate``)."""
+"""Listings of a run's events: a text table and a DataFrame (``mechdyn simulate``, reports)."""
 
 from __future__ import annotations
 
-__all__ = ["format_events"]
+__all__ = ["format_events", "events_table"]
 
 
 def format_events(events, coordinate_names=None, *, limit: int | None = None) -> str:
@@ -35,3 +35,20 @@ def format_events(events, coordinate_names=None, *, limit: int | None = None) ->
                                       zip(coordinate_names, e.q_after, strict=False))
         lines.append(line)
     return "\n".join(lines)
+
+
+def events_table(events, coordinate_names=()):
+    """One row per event: ``t_s``, ``kind``, ``element``, ``mode_before``, ``mode_after``,
+    ``energy_lost_J`` and the coordinates after it (``<c>_after``): a pandas DataFrame."""
+    import pandas as pd
+
+    rows = []
+    for ev in events:
+        row = {"t_s": ev.t, "kind": ev.kind, "element": ev.element,
+               "mode_before": " ".join(sorted(ev.mode_before)),
+               "mode_after": " ".join(sorted(ev.mode_after)), "energy_lost_J": ev.energy_lost}
+        if ev.q_after is not None:
+            row.update({f"{n}_after": v for n, v in zip(coordinate_names, ev.q_after,
+                                                        strict=False)})
+        rows.append(row)
+    return pd.DataFrame(rows)

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..errors import ModelError, did_you_mean
 from ..model import Model
+from .table import coordinate_columns, force_columns, mode_columns
 
 __all__ = ["Kinetostatics"]
 
@@ -199,24 +200,16 @@ class Kinetostatics:
 
         cols: dict[str, np.ndarray] = {"t_s": self.t}
         if self.switched:
-            cols["mode"] = np.array([" ".join(sorted(m)) or "-" for m in self.sample_modes],
-                                    dtype=object)
-            cols["mode_index"] = np.asarray(self.mode_index)
-        for k, c in enumerate(self.coordinate_names):
-            ang = self._is_angle(k)
-            u = "rad" if ang else "m"
-            qk = self.q[:, k]
-            cols[f"{c}_deg" if ang else f"{c}_m"] = np.rad2deg(qk) if ang else qk
-            cols[f"{c}_dot_{u}_s"] = self.qdot[:, k]
-            cols[f"{c}_ddot_{u}_s2"] = self.qddot[:, k]
+            cols.update(mode_columns(self.sample_modes, self.mode_index))
+        is_angle = [self._is_angle(k) for k in range(len(self.coordinate_names))]
+        cols.update(coordinate_columns(self.coordinate_names, is_angle, self.q, self.qdot,
+                                       self.qddot, radians=False))
         for c in self.driven:
             sym, unit = self._drive_unit(c)
             cols[f"{sym}_drive_{c}_{unit}"] = self.driving[c]
             cols[f"P_drive_{c}_W"] = self.power[c]
         for j, R in self.reactions.items():
-            cols[f"Fx_{j}_N"] = R[:, 0]
-            cols[f"Fy_{j}_N"] = R[:, 1]
-            cols[f"F_{j}_N"] = np.hypot(R[:, 0], R[:, 1])
+            cols.update(force_columns(j, R, magnitude=True))
             cols[f"angle_F_{j}_deg"] = np.rad2deg(np.arctan2(R[:, 1], R[:, 0]))
             kind = self.joint_kinds[j]
             if kind == "prismatic":
@@ -229,12 +222,8 @@ class Kinetostatics:
             cols[f"{sym}_{el.replace('@', '_')}_{unit}"] = f
         for j, L in self.frame_loads.items():
             if j in self.reactions:
-                cols[f"Fx_frame_{j}_N"] = L[:, 0]
-                cols[f"Fy_frame_{j}_N"] = L[:, 1]
-                cols[f"M_frame_{j}_Nm"] = L[:, 2]
-        cols["Fx_frame_N"] = self.frame_force[:, 0]
-        cols["Fy_frame_N"] = self.frame_force[:, 1]
-        cols["F_frame_N"] = np.hypot(self.frame_force[:, 0], self.frame_force[:, 1])
+                cols.update(force_columns(f"frame_{j}", L))
+        cols.update(force_columns("frame", self.frame_force, magnitude=True))
         cols["M_frame_Nm"] = self.frame_moment
         return pd.DataFrame(cols)
 
@@ -244,8 +233,20 @@ class Kinetostatics:
         (trapezoidal rule), else by position count."""
         y = np.asarray(series, dtype=float)
         t = self.t
-        if not np.all(np.isfinite(y)):
-            return _rms_finite(y, t)
+        ok = np.isfinite(y)
+        if not ok.all():  # time-weighted over each run of finite samples if time advances
+            if not ok.any():
+                return float("nan")
+            if y.size > 1 and np.all(np.diff(t) >= 0) and t[-1] > t[0]:
+                num = den = 0.0
+                edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(int), [0]])))
+                for a, b in zip(edges[0::2], edges[1::2], strict=True):
+                    if t[b - 1] > t[a]:
+                        num += float(np.trapezoid(y[a:b] ** 2, t[a:b]))
+                        den += float(t[b - 1] - t[a])
+                if den > 0:
+                    return float(np.sqrt(num / den))
+            return float(np.sqrt(np.mean(y[ok] ** 2)))
         if y.size < 2:
             return float(np.sqrt(np.mean(y**2)))
         if np.all(np.diff(t) > 0):
@@ -258,7 +259,9 @@ class Kinetostatics:
     def _peak(self, y, name: str = "peak", rank=None) -> dict:
         """``name``, ``name_at`` (position) and ``name_t`` (time) of the sample of y where
         ``rank`` (default y) is largest, NaN samples aside."""
-        k = _arg(y if rank is None else rank)
+        r = np.asarray(y if rank is None else rank, dtype=float)
+        ok = np.isfinite(r)
+        k = int(np.argmax(np.where(ok, r, -np.inf))) if ok.any() else -1
         return {name: _at(y, k), f"{name}_at": _at(self.values, k), f"{name}_t": _at(self.t, k)}
 
     def peaks(self) -> dict:
@@ -299,12 +302,12 @@ class Kinetostatics:
         lines = [f"kinetostatics over {self.over}: {self.n} positions, "
                  f"{self.over} from {self.values[0] * f:.4g} to {self.values[-1] * f:.4g} "
                  f"{unit}; status {self.status}"]
-        sw = self.switched
 
-        def when(key, d):
-            return f" (t = {d[key]:.6g} s)" if sw else ""
+        def at(d, key, when=True):  # where an extreme is (and, switched, when)
+            t = f" (t = {d[key + '_t']:.6g} s)" if when and self.switched else ""
+            return f"{d[key + '_at'] * f:.4g} {unit}{t}"
 
-        if sw:
+        if self.switched:
             segs = self.stats.get("segments", [])
             lines.append(f"  switched trajectory: {len(segs)} segment(s) in {len(self.modes)} "
                          f"mode(s); the quantities of a joint, drive or element that is not "
@@ -315,29 +318,25 @@ class Kinetostatics:
                              f"{{{', '.join(sorted(sg['mode']))}}}: driven "
                              f"{', '.join(sg['driven']) or '-'}; {sg['status']}")
         for c, d in p["driving"].items():
-            sym, u = self._drive_unit(c)
-            u = "N m" if u == "Nm" else u
+            u = "N m" if self._drive_unit(c)[1] == "Nm" else "N"
             lines.append(
                 f"  drive {c}: peak {d['peak_abs']:.6g} {u} at {self.over} = "
-                f"{d['peak_abs_at'] * f:.4g} {unit}{when('peak_abs_t', d)}; max "
-                f"{d['max']:.6g} {u} at "
-                f"{d['max_at'] * f:.4g} {unit}; min {d['min']:.6g} {u} at "
-                f"{d['min_at'] * f:.4g} {unit}; RMS {d['rms']:.6g} {u}; mean "
+                f"{at(d, 'peak_abs')}; max {d['max']:.6g} {u} at {at(d, 'max', False)}; min "
+                f"{d['min']:.6g} {u} at {at(d, 'min', False)}; RMS {d['rms']:.6g} {u}; mean "
                 f"{d['mean']:.6g} {u}; peak power {d['peak_power']:.6g} W")
         for j, d in p["joints"].items():
             s = (f"  joint {j} ({self.joint_kinds[j]}): peak force {d['peak']:.6g} N at "
-                 f"{self.over} = {d['peak_at'] * f:.4g} {unit}{when('peak_t', d)}")
+                 f"{self.over} = {at(d, 'peak')}")
             if "peak_moment" in d:
-                s += (f"; peak moment {d['peak_moment']:.6g} N m at "
-                      f"{d['peak_moment_at'] * f:.4g} {unit}{when('peak_moment_t', d)}")
+                s += f"; peak moment {d['peak_moment']:.6g} N m at {at(d, 'peak_moment')}"
             lines.append(s)
         for el, d in p["elements"].items():
             lines.append(f"  element {el}: peak {d['peak']:.6g} {d['unit']} at {self.over} = "
-                         f"{d['peak_at'] * f:.4g} {unit}{when('peak_t', d)}")
+                         f"{at(d, 'peak')}")
         fr = p["frame"]
         lines.append(
             f"  frame: shaking force peak {fr['force_peak']:.6g} N at {self.over} = "
-            f"{fr['force_peak_at'] * f:.4g} {unit} (Fx {fr['Fx_min']:.6g}..{fr['Fx_max']:.6g} N,"
+            f"{at(fr, 'force_peak', False)} (Fx {fr['Fx_min']:.6g}..{fr['Fx_max']:.6g} N,"
             f" Fy {fr['Fy_min']:.6g}..{fr['Fy_max']:.6g} N); shaking moment about "
             f"({self.frame_point[0]:.4g}, {self.frame_point[1]:.4g}) m: "
             f"{fr['M_min']:.6g}..{fr['M_max']:.6g} N m")
@@ -407,13 +406,6 @@ class Kinetostatics:
         return pd.DataFrame(cols)
 
 
-def _arg(y) -> int:
-    """Index of the largest finite value (-1 when there is none)."""
-    y = np.asarray(y, dtype=float)
-    ok = np.isfinite(y)
-    return int(np.argmax(np.where(ok, y, -np.inf))) if ok.any() else -1
-
-
 def _at(y, k: int) -> float:
     return float(np.asarray(y)[k]) if k >= 0 else float("nan")
 
@@ -421,21 +413,3 @@ def _at(y, k: int) -> float:
 def _nanext(y, fn) -> float:
     y = np.asarray(y, dtype=float)
     return float(fn(y)) if np.isfinite(y).any() else float("nan")
-
-
-def _rms_finite(y, t) -> float:
-    """RMS over the samples where y is finite: time-weighted over each run of finite
-    samples when time does not decrease, else the plain mean square."""
-    ok = np.isfinite(y)
-    if not ok.any():
-        return float("nan")
-    if y.size > 1 and np.all(np.diff(t) >= 0) and t[-1] > t[0]:
-        num = den = 0.0
-        edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(int), [0]])))
-        for a, b in zip(edges[0::2], edges[1::2], strict=True):
-            if t[b - 1] > t[a]:
-                num += float(np.trapezoid(y[a:b] ** 2, t[a:b]))
-                den += float(t[b - 1] - t[a])
-        if den > 0:
-            return float(np.sqrt(num / den))
-    return float(np.sqrt(np.mean(y[ok] ** 2)))

@@ -35,8 +35,6 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
     Path
         The file written.
     """
-    from matplotlib import rcParams
-
     names = list(coordinates) if coordinates is not None else list(traj.coordinate_names)
     idx = [traj.coordinate_names.index(n) for n in names]
     show_energy = bool(energy and traj.energy and traj.t.size)
@@ -49,22 +47,19 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
     fa = np.rad2deg(1.0) if degrees else 1.0
     # lengths (travels) in mm on a right-hand axis when angles share the panel
     twins = [ax.twinx() if (any(is_angle) and not all(is_angle)) else ax for ax in axes[:3]]
-    colours = rcParams["axes.prop_cycle"].by_key()["color"]
     panels = (("coordinate", "", "", traj.q), ("rate", "'", "/s", traj.qdot),
               ("acceleration", "''", "/s^2", traj.qddot))
     for n, (k, name, ang) in enumerate(zip(idx, names, is_angle, strict=True)):
         f, u = (fa, au) if ang else (1e3, "mm")
         for ax, (_, tick, per, data) in zip(axes[:3] if ang else twins, panels, strict=True):
-            ax.plot(t, data[:, k] * f, color=colours[n % len(colours)],
-                    label=f"{name}{tick} [{u}{per}]")
+            ax.plot(t, data[:, k] * f, color=f"C{n}", label=f"{name}{tick} [{u}{per}]")
     for ax, twin, (what, _, per, _) in zip(axes[:3], twins, panels, strict=True):
         if twin is ax:
             ax.set_ylabel(f"{what} [{au if any(is_angle) else 'mm'}{per}]")
         else:
             ax.set_ylabel(f"{what}: angles")
             twin.set_ylabel(f"{what}: travels")
-            lines = ax.get_lines() + twin.get_lines()
-            ax.legend(lines, [ln.get_label() for ln in lines], loc="best", fontsize="small")
+            ax.legend(handles=ax.lines + twin.lines, loc="best", fontsize="small")
     if show_energy:
         for key, style, label in (("kinetic", "-", "T"), ("potential", "-", "U"),
                                   ("work_nc", "-", "W_nc"), ("balance", "k--", "T + U - W_nc")):
@@ -76,7 +71,16 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
         ax.plot(t, frame[:, 0] * 1e-3, label="Fx frame [kN]")
         ax.plot(t, frame[:, 1] * 1e-3, label="Fy frame [kN]")
         ax.set_ylabel("force on the frame [kN]")
-        _shade_modes(axes, t, np.asarray(vs["mode_index"]), vs["modes"])
+        mode_index = np.asarray(vs["mode_index"])
+        if t.size >= 2 and len(vs["modes"]) >= 2:  # the time span of each mode, one tint a mode
+            from matplotlib import colormaps
+
+            cmap = colormaps["Pastel2"]
+            change = np.flatnonzero(np.diff(mode_index) != 0) + 1
+            for a, b in zip(np.r_[0, change], np.r_[change, t.size - 1], strict=True):
+                for ax_ in axes:
+                    ax_.axvspan(t[a], t[b], color=cmap(int(mode_index[a]) % cmap.N), alpha=0.35,
+                                lw=0)
     for ax in axes:
         if ax.get_legend() is None:
             ax.legend(loc="best", fontsize="small")
@@ -87,19 +91,3 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
         head += f" - stopped: {traj.status}"
     fig.suptitle(head)
     return _save(fig, path, dpi)
-
-
-def _shade_modes(axes, t, mode_index, modes) -> None:
-    """Shade the time spans of the modes of a variable-structure run (one tint per mode)."""
-    if t.size < 2 or len(modes) < 2:
-        return
-    from matplotlib import colormaps
-
-    cmap = colormaps["Pastel2"]
-    change = np.flatnonzero(np.diff(mode_index) != 0) + 1
-    starts = np.concatenate([[0], change])
-    ends = np.concatenate([change, [t.size - 1]])
-    for a, b in zip(starts, ends, strict=True):
-        colour = cmap(int(mode_index[a]) % cmap.N)
-        for ax in axes:
-            ax.axvspan(t[a], t[b], color=colour, alpha=0.35, lw=0)

@@ -16,19 +16,6 @@ __all__ = ["plot_kinematic_sweep"]
 
 
 # ---------------------------------------------------------------- kinematic sweep
-def _default_points(model) -> list[tuple[str, object, str]]:
-    """The sliders' guided points, else the named points of the last body."""
-    mech = model.mechanism
-    sliders = [(jn, mech.joints[jn]) for jn in model.pri.names]
-    out = [(j.child, j.child_point, f"{j.child} on {jn!r}") for jn, j in sliders
-           if j.child != "ground"]
-    if out:
-        return out
-    body = model.body_names[-1]
-    names = [p for p in mech.bodies[body].points] or ["com"]
-    return [(body, p, _label(body, p)) for p in names]
-
-
 def _label(body, name) -> str:
     return f"{body}.{name}" if isinstance(name, str) else f"{body}({name[0]:.4g}, {name[1]:.4g})"
 
@@ -53,8 +40,14 @@ def plot_kinematic_sweep(sweep, path, points: Iterable | None = None, *,
     Path
     """
     model = sweep.model
-    pts = _default_points(model) if points is None else [
-        (b, n, _label(b, n)) for b, n in (_trace_spec(model, p, "point") for p in points)]
+    if points is None:  # the sliders' guided points, else the named points of the last body
+        mech, body = model.mechanism, model.body_names[-1]
+        sliders = [(jn, mech.joints[jn]) for jn in model.pri.names]
+        pts = [(j.child, j.child_point, f"{j.child} on {jn!r}") for jn, j in sliders
+               if j.child != "ground"] or [
+            (body, p, _label(body, p)) for p in list(mech.bodies[body].points) or ["com"]]
+    else:
+        pts = [(b, n, _label(b, n)) for b, n in (_trace_spec(model, p, "point") for p in points)]
     angle = sweep.over_is_angle
     xs, xunit = deg_or_mm(sweep.values, angle)
     fig, axes = _figure(3)

@@ -7,7 +7,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ModelError, did_you_mean
 from .figure import figure as _figure
 from .figure import save as _save
 from .table import deg_or_mm
@@ -38,9 +37,6 @@ def plot_kinetostatics(record, path, *, joints: Sequence[str] | None = None,
         The file written.
     """
     names = list(record.reactions) if joints is None else list(joints)
-    for j in names:
-        if j not in record.reactions:
-            raise ModelError(did_you_mean(j, record.reactions, "joint"))
     xv, xunit = deg_or_mm(record.values, record.over_is_angle)
     fig, axes = _figure(3, height=3.0)
     ax = axes[0]
@@ -67,7 +63,5 @@ def plot_kinetostatics(record, path, *, joints: Sequence[str] | None = None,
     ax2 = ax.twinx()
     ax2.plot(xv, record.frame_moment, "--", color="tab:red", lw=1.0, label="M frame")
     ax2.set_ylabel("shaking moment (N m)", color="tab:red")
-    h1, l1 = ax.get_legend_handles_labels()
-    h2, l2 = ax2.get_legend_handles_labels()
-    ax.legend(h1 + h2, l1 + l2, loc="best", fontsize="small")
+    ax.legend(handles=ax.lines + ax2.lines, loc="best", fontsize="small")
     return _save(fig, path, dpi)

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from .figure import figure as _figure
 from .figure import save as _save
-from .spectrum import spectrogram, spectrum
+from .spectrum import history, spectrogram, spectrum
 from .table import unit_of_column
 
 __all__ = ["plot_spectrum"]
@@ -41,10 +41,7 @@ def plot_spectrum(record, column: str, path, *, f_max: float | None = None,
     KeyError
         An unknown column (the valid ones are listed).
     """
-    df = record.to_dataframe()
-    if column not in df:
-        raise KeyError(f"no column {column!r}; valid columns: {', '.join(df.columns)}")
-    t, y = df["t_s"].to_numpy(), df[column].to_numpy(dtype=float)
+    t, y = history(record, column)
     unit = unit_of_column(column) or "-"
     sp = spectrum(t, y)
     f, tc, amp = spectrogram(t, y, segment=segment)

@@ -30,10 +30,11 @@ from .._version import __version__
 from ..errors import Status
 from ..kinematics.sweep import initial_coordinates
 from .animate import animate, snapshot
+from .events import events_table
 from .plot import plot_kinematic_sweep
 from .plot_dynamics import plot_trajectory
 from .plot_kinetostatics import plot_kinetostatics
-from .table import output_path, rate_text, written
+from .table import deg_or_mm, output_path, rate_text, written
 
 __all__ = ["write_report", "report_trajectory", "model_tables"]
 
@@ -227,15 +228,6 @@ def _at_text(over_is_angle: bool, v: float) -> str:
     return f"{np.rad2deg(v):.3f} deg" if over_is_angle else f"{_mm(v):.4f} mm"
 
 
-def _stroke_row(summ, ang: bool, joint: str, stroke: float) -> dict:
-    row = {"slider (joint)": joint, "stroke_mm": f"{_mm(stroke):.4f}"}
-    for d in summ.dead_centres:
-        if d.joint == joint:
-            row[f"{d.label} at"] = _at_text(ang, d.at)
-            row[f"{d.label} travel_mm"] = f"{_mm(d.travel):.4f}"
-    return row
-
-
 def _sweep_section(sw, *, animation: bool, trace) -> str:
     ang = sw.over_is_angle
     rate = float(sw.qdot[0, sw.over_index]) if len(sw) else 1.0
@@ -250,11 +242,17 @@ def _sweep_section(sw, *, animation: bool, trace) -> str:
     if not len(sw):
         return _join(parts)
     summ = sw.summary()
+    strokes = []
+    for joint, stroke in summ.strokes.items():
+        strokes.append({"slider (joint)": joint, "stroke_mm": f"{_mm(stroke):.4f}"})
+        for d in summ.dead_centres:
+            if d.joint == joint:
+                strokes[-1][f"{d.label} at"] = _at_text(ang, d.at)
+                strokes[-1][f"{d.label} travel_mm"] = f"{_mm(d.travel):.4f}"
     mu = [(t, np.rad2deg(t.min), np.rad2deg(t.max)) for t in summ.transmission]
     omegas = [(b, *sw.angular(b)[1:]) for b in sw.model.body_names]
     parts += [
-        _table("Strokes and dead centres",
-               [_stroke_row(summ, ang, j, s) for j, s in summ.strokes.items()]),
+        _table("Strokes and dead centres", strokes),
         _table("Transmission angles", [
             {"loop (coupler/rocker)": f"{t.loop.coupler}/{t.loop.rocker}",
              "joint": t.loop.joints[2], "mu_min_deg": f"{lo:.3f}",
@@ -276,29 +274,6 @@ def _sweep_section(sw, *, animation: bool, trace) -> str:
 
 
 # ------------------------------------------------------------------ kinetostatics
-def _drive_row(ks, ang: bool, c: str, d: dict) -> dict:
-    sym, unit = ks._drive_unit(c)
-    u = "Nm" if unit == "Nm" else "N"
-    return {"drive": c, f"peak |{sym}|_{u}": abs(d["peak_abs"]),
-            "at": _at_text(ang, d["peak_abs_at"]), f"max_{u}": d["max"], f"min_{u}": d["min"],
-            f"RMS_{u}": d["rms"], f"mean_{u}": d["mean"], "peak power_W": d["peak_power"]}
-
-
-def _harmonics(ks, harmonics: int) -> list[str]:
-    """The shaking force and moment per order of the turn (round-off noise shown as 0)."""
-    try:
-        h = ks.harmonics(harmonics)
-    except ValueError as exc:
-        return [f'<p class="note">No harmonics: {_esc(exc)}</p>']
-    h = h[["order", "f_Hz", "Fx_frame_N", "Fy_frame_N", "M_frame_Nm"]].copy()
-    for c in ("Fx_frame_N", "Fy_frame_N", "M_frame_Nm"):
-        a = h[c].to_numpy()
-        h[c] = np.where(np.abs(a) < 1e-9 * max(np.max(np.abs(a)), 1e-300), 0.0, a)
-    return ["<h3>Harmonics of the shaking force and moment</h3>",
-            '<p class="note">Amplitudes per order of the crank turn (order 0: the mean).</p>',
-            _table(None, h)]
-
-
 def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
     ang = ks.over_is_angle
     parts = ["<h2>Kinetostatics</h2>"]
@@ -316,9 +291,15 @@ def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
                "at": _at_text(ang, d["peak_at"]), "RMS force_N": d["rms"]}
               | ({"peak moment_Nm": d["peak_moment"]} if "peak_moment" in d else {})
               for j, d in p["joints"].items()]
-    fr = p["frame"]
+    fr, drives = p["frame"], []
+    for c, d in p["driving"].items():
+        sym, u = ks._drive_unit(c)
+        drives.append({"drive": c, f"peak |{sym}|_{u}": abs(d["peak_abs"]),
+                       "at": _at_text(ang, d["peak_abs_at"]), f"max_{u}": d["max"],
+                       f"min_{u}": d["min"], f"RMS_{u}": d["rms"], f"mean_{u}": d["mean"],
+                       "peak power_W": d["peak_power"]})
     parts += [
-        _table("Driving torque", [_drive_row(ks, ang, c, d) for c, d in p["driving"].items()]),
+        _table("Driving torque", drives),
         _table("Peak joint forces", joints),
         _table("Frame (shaking) loads", [
             {"quantity": "|F| frame (N)", "min": np.nan, "max": fr["force_peak"],
@@ -329,7 +310,18 @@ def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
                          "(N m)", "min": fr["M_min"], "max": fr["M_max"],
              "peak at": _at_text(ang, fr["moment_peak_at"])}])]
     if harmonics > 0 and ang:
-        parts += _harmonics(ks, harmonics)
+        try:
+            h = ks.harmonics(harmonics)
+        except ValueError as exc:
+            parts.append(f'<p class="note">No harmonics: {_esc(exc)}</p>')
+        else:  # the shaking force and moment per order of the turn, round-off noise as 0
+            cols = ["Fx_frame_N", "Fy_frame_N", "M_frame_Nm"]
+            h = h[["order", "f_Hz", *cols]].copy()
+            a = h[cols].abs()
+            h[cols] = h[cols].mask(a < 1e-9 * np.maximum(a.max(), 1e-300), 0.0)
+            parts += ["<h3>Harmonics of the shaking force and moment</h3>",
+                      '<p class="note">Amplitudes per order of the crank turn (order 0: the '
+                      'mean).</p>', _table(None, h)]
     parts += [f'<p class="note">Warning: {_esc(w)}</p>' for w in ks.warnings]
     parts += ["<h3>Plot</h3>", _img(lambda p: plot_kinetostatics(ks, p), "kinetostatics plot")]
     return _join(parts)
@@ -415,13 +407,11 @@ def report_trajectory(traj, path, *, title: str | None = None, animation: bool =
         rows = []
         for k, c in enumerate(traj.coordinate_names):
             ang = traj.coordinate_is_angle[k] if traj.coordinate_is_angle else True
-            f, u, ur = (np.rad2deg(1.0), "deg", "rpm") if ang else (1e3, "mm", "m/s")
-            fr = 30 / np.pi if ang else 1.0
-            qd = traj.qdot[:, k]
-            rows.append({"coordinate": c, f"start ({u})": traj.q[0, k] * f,
-                         f"end ({u})": traj.q[-1, k] * f, f"start rate ({ur})": qd[0] * fr,
-                         f"end rate ({ur})": qd[-1] * fr, f"min rate ({ur})": qd.min() * fr,
-                         f"max rate ({ur})": qd.max() * fr})
+            (q0, q1), u = deg_or_mm(traj.q[[0, -1], k], ang)
+            qd, ur = (traj.qdot[:, k] * 30 / np.pi, "rpm") if ang else (traj.qdot[:, k], "m/s")
+            rows.append({"coordinate": c, f"start ({u})": q0, f"end ({u})": q1,
+                         f"start rate ({ur})": qd[0], f"end rate ({ur})": qd[-1],
+                         f"min rate ({ur})": qd.min(), f"max rate ({ur})": qd.max()})
         parts.append(_table("Coordinates", rows, digits=9))
     if traj.energy and traj.t.size:
         e = traj.energy
@@ -433,12 +423,9 @@ def report_trajectory(traj, path, *, title: str | None = None, animation: bool =
         parts.append(f"<p>The balance drifts by at most {traj.energy_drift():.3e} J; the "
                      f"largest constraint residual is {np.max(e['residual']):.3e} "
                      "(m or rad).</p>")
-    parts += ["<h3>Events</h3>", "" if traj.events else "<p>No events.</p>", _table(None, [
-        {"t_s": getattr(ev, "t", np.nan), "kind": getattr(ev, "kind", type(ev).__name__),
-         "element": getattr(ev, "element", getattr(ev, "name", "")),
-         "mode after": " ".join(sorted(getattr(ev, "mode_after", ()) or ())),
-         "energy lost_J": getattr(ev, "energy_lost", 0.0)} for ev in traj.events[:max_events]],
-        digits=9)]
+    parts += ["<h3>Events</h3>", "" if traj.events else "<p>No events.</p>",
+              _table(None, events_table(traj.events[:max_events], traj.coordinate_names),
+                     digits=9)]
     if len(traj.events) > max_events:
         parts.append(f'<p class="note">{len(traj.events) - max_events} more events not listed.</p>')
     if model is not None and traj.t.size:

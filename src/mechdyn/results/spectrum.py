@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["spectrum", "dominant", "spectrogram", "order_spectrum", "welch", "summary",
-           "of_column"]
+           "history", "of_column"]
 
 
 def _uniform(t, y, samples: int | None):
@@ -42,6 +42,12 @@ def _uniform(t, y, samples: int | None):
     n = int(samples or 2 ** int(np.ceil(np.log2(max(t.size, 256)))))
     grid = np.linspace(t[0], t[-1], n)
     return grid[1] - grid[0], CubicSpline(t, y)(grid)
+
+
+def _segments(t, y, segment: float | None, samples: int | None):
+    """(dt, y on a uniform grid, points per segment of ``segment`` s: 1/8 of the run)."""
+    dt, u = _uniform(t, y, samples)
+    return dt, u, max(8, int(round((segment or (u.size * dt) / 8) / dt)))
 
 
 def spectrum(t, y, *, window: str = "flattop", samples: int | None = None):
@@ -150,9 +156,8 @@ def spectrogram(t, y, *, segment: float | None = None, samples: int | None = Non
     """
     from scipy.signal import spectrogram as _spectrogram
 
-    dt, u = _uniform(t, y, samples)
+    dt, u, per = _segments(t, y, segment, samples)
     t0 = float(np.asarray(t, float)[0])
-    per = max(8, int(round((segment or (u.size * dt) / 8) / dt)))
     f, tc, s = _spectrogram(u, fs=1.0 / dt, window="hann", nperseg=per, noverlap=per // 2,
                             scaling="spectrum", mode="magnitude", detrend="constant")
     return f, t0 + tc, 2.0 * s
@@ -222,8 +227,7 @@ def welch(t, y, *, segment: float | None = None, samples: int | None = None):
     import pandas as pd
     from scipy.signal import welch as _welch
 
-    dt, u = _uniform(t, y, samples)
-    per = max(8, int(round((segment or (u.size * dt) / 8) / dt)))
+    dt, u, per = _segments(t, y, segment, samples)
     f, p = _welch(u, fs=1.0 / dt, window="hann", nperseg=min(per, u.size))
     return pd.DataFrame({"f_Hz": f, "psd": p})
 
@@ -246,10 +250,9 @@ def summary(t, y, n: int = 5) -> dict:
             "mean": float(np.trapezoid(y, t) / span), "dominant": dominant(t, y, n)}
 
 
-def of_column(record, column: str, how=spectrum, **options):
-    """Apply :func:`spectrum`, :func:`dominant`, :func:`spectrogram`, :func:`welch` or
-    :func:`summary` to a column of a record's table (``record.to_dataframe()``, e.g.
-    ``"Fy_frame_N"`` of a trajectory).
+def history(record, column: str):
+    """The times, s, and the values of a column of a record's table
+    (``record.to_dataframe()``, e.g. ``"Fy_frame_N"`` of a trajectory): (t, y).
 
     Raises
     ------
@@ -259,4 +262,16 @@ def of_column(record, column: str, how=spectrum, **options):
     df = record.to_dataframe()
     if column not in df:
         raise KeyError(f"no column {column!r}; valid columns: {', '.join(df.columns)}")
-    return how(df["t_s"].to_numpy(), df[column].to_numpy(dtype=float), **options)
+    return df["t_s"].to_numpy(), df[column].to_numpy(dtype=float)
+
+
+def of_column(record, column: str, how=spectrum, **options):
+    """Apply :func:`spectrum`, :func:`dominant`, :func:`spectrogram`, :func:`welch` or
+    :func:`summary` to a column of a record's table (see :func:`history`).
+
+    Raises
+    ------
+    KeyError
+        An unknown column (the message lists the valid ones).
+    """
+    return how(*history(record, column), **options)

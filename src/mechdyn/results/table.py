@@ -105,20 +105,41 @@ def rate_text(rate: float, is_angle: bool) -> str:
     return f"{rate:.6g} rad/s ({rate * 30 / np.pi:.6g} rpm)" if is_angle else f"{rate:.6g} m/s"
 
 
-def _describe(record) -> list[str]:
-    kind = type(record).__name__
-    model = getattr(record, "model", None)
-    mech = getattr(model, "mechanism", None)
-    lines = [f"mechdyn {kind}" + (f" of {mech.name!r}" if mech is not None else "")]
-    for label, attr in (("swept coordinate", "over"), ("status", "status")):
-        if getattr(record, attr, None) is not None:
-            lines.append(f"{label}: {getattr(record, attr)}")
-    message = getattr(record, "message", "")
-    if message:
-        lines.append("message: " + " ".join(str(message).split()))
-    lines.append("column names end with their SI unit (see docs/notation.md); "
-                 "analogs are per rad (angle coordinates) or per m (travels)")
-    return lines
+def coordinate_columns(names, is_angle, q, qdot, qddot, *, radians: bool = True,
+                       degrees: bool = True) -> dict:
+    """Table columns of coordinates (n, n_q) and their rates: ``<c>_rad`` (with ``radians``)
+    and ``<c>_deg`` (with ``degrees``) for an angle, ``<c>_m`` for a travel, then
+    ``<c>_dot_rad_s`` and ``<c>_ddot_rad_s2`` (``_m_s``, ``_m_s2``)."""
+    cols = {}
+    for k, c in enumerate(names):
+        u = "rad" if is_angle[k] else "m"
+        if radians or u == "m":
+            cols[f"{c}_{u}"] = q[:, k]
+        if degrees and u == "rad":
+            cols[f"{c}_deg"] = np.rad2deg(q[:, k])
+        cols[f"{c}_dot_{u}_s"] = qdot[:, k]
+        cols[f"{c}_ddot_{u}_s2"] = qddot[:, k]
+    return cols
+
+
+def force_columns(key: str, f, *, magnitude: bool = False) -> dict:
+    """Table columns of a force: ``F_<key>_N`` of shape (n,); ``Fx_<key>_N``, ``Fy_<key>_N``
+    (and ``F_<key>_N`` with ``magnitude``) of (n, 2); and ``M_<key>_Nm`` of a third column."""
+    f = np.asarray(f, float)
+    if f.ndim == 1:
+        return {f"F_{key}_N": f}
+    cols = {f"Fx_{key}_N": f[:, 0], f"Fy_{key}_N": f[:, 1]}
+    if magnitude:
+        cols[f"F_{key}_N"] = np.hypot(f[:, 0], f[:, 1])
+    if f.shape[1] > 2:
+        cols[f"M_{key}_Nm"] = f[:, 2]
+    return cols
+
+
+def mode_columns(modes, mode_index) -> dict:
+    """The ``mode`` (engaged elements, ``-`` for none) and ``mode_index`` of every sample."""
+    return {"mode": np.array([" ".join(sorted(m)) or "-" for m in modes], dtype=object),
+            "mode_index": np.asarray(mode_index)}
 
 
 def write_csv(record, path, *, float_format: str = "%.12g", **options) -> Path:
@@ -142,7 +163,17 @@ def write_csv(record, path, *, float_format: str = "%.12g", **options) -> Path:
         The file written.
     """
     df = record.to_dataframe(**options)
-    lines = _describe(record)
+    mech = getattr(getattr(record, "model", None), "mechanism", None)
+    lines = [f"mechdyn {type(record).__name__}"
+             + (f" of {mech.name!r}" if mech is not None else "")]
+    for label, attr in (("swept coordinate", "over"), ("status", "status")):
+        if getattr(record, attr, None) is not None:
+            lines.append(f"{label}: {getattr(record, attr)}")
+    message = getattr(record, "message", "")
+    if message:
+        lines.append("message: " + " ".join(str(message).split()))
+    lines.append("column names end with their SI unit (see docs/notation.md); "
+                 "analogs are per rad (angle coordinates) or per m (travels)")
     lines.append("units: " + ", ".join(f"{c} [{unit_of_column(c) or '-'}]" for c in df.columns))
     path = output_path(path)
     with written(path) as tmp, open(tmp, "w", encoding="utf-8", newline="") as fh:

@@ -10,6 +10,7 @@ import numpy as np
 from ..errors import ModelError, did_you_mean
 from ..kinematics.analogs import accelerations
 from ..kinematics.constraints import point_acceleration, point_position, point_velocity
+from .table import coordinate_columns, force_columns, mode_columns
 
 __all__ = ["Trajectory", "SwitchedSamples"]
 
@@ -200,29 +201,36 @@ class Trajectory:
         """
         import pandas as pd
 
-        cols: dict[str, np.ndarray] = {"t_s": self.t}
-        for k, name in enumerate(self.coordinate_names):
-            ang = self.coordinate_is_angle[k] if self.coordinate_is_angle else True
-            u, ud, udd = ("rad", "rad_s", "rad_s2") if ang else ("m", "m_s", "m_s2")
-            cols[f"{name}_{u}"] = self.q[:, k]
-            if ang and degrees:
-                cols[f"{name}_deg"] = np.rad2deg(self.q[:, k])
-            cols[f"{name}_dot_{ud}"] = self.qdot[:, k]
-            cols[f"{name}_ddot_{udd}"] = self.qddot[:, k]
+        is_angle = self.coordinate_is_angle or (True,) * len(self.coordinate_names)
+        cols = {"t_s": self.t, **coordinate_columns(self.coordinate_names, is_angle, self.q,
+                                                    self.qdot, self.qddot, degrees=degrees)}
         body_columns = (("x", "m"), ("y", "m"), ("theta", "rad"),
                         ("vx", "m_s"), ("vy", "m_s"), ("omega", "rad_s"))
         for b, name in enumerate(self.body_names if bodies else ()):
             for i, (what, unit) in enumerate(body_columns):
                 cols[f"{what}_{name}_{unit}"] = (self.x if i < 3 else self.xdot)[:, 3 * b + i % 3]
         if points and self.model is not None and self.t.size:
-            cols.update(self._point_columns())
+            m, xdd = self.model, self.xddot()
+            for body, pt in m.named_points():
+                r = point_position(m, self.x, body, pt)
+                v = point_velocity(m, self.x, self.xdot, body, pt)
+                a = point_acceleration(m, self.x, self.xdot, xdd, body, pt)
+                for what, unit, val in (("", "m", r), ("v", "m_s", v), ("a", "m_s2", a)):
+                    cols[f"{what}x_{body}_{pt}_{unit}"] = val[:, 0]
+                    cols[f"{what}y_{body}_{pt}_{unit}"] = val[:, 1]
         if energy and self.energy:
             cols.update({col: self.energy[key] for col, key in (
                 ("T_J", "kinetic"), ("U_J", "potential"), ("W_nc_J", "work_nc"),
                 ("E_balance_J", "balance"), ("residual", "residual"))})
         vs = self.switching
-        if vs and self.t.size:
-            cols.update(_switched_columns(vs, getattr(self.model, "has_switching", True)))
+        if vs and self.t.size:  # the forces of a run (see docs/variable-structure.md)
+            if getattr(self.model, "has_switching", True):  # else one mode: no mode column
+                cols.update(mode_columns(vs["mode"], vs["mode_index"]))
+            cols.update(force_columns("frame", vs["frame_force"], magnitude=True))
+            if vs.get("frame_moment") is not None:
+                cols["M_frame_Nm"] = np.asarray(vs["frame_moment"], float)
+            for name, f in vs.get("forces", {}).items():
+                cols.update(force_columns(str(name).replace("@", "_"), f))
         return pd.DataFrame(cols)
 
     @property
@@ -235,44 +243,3 @@ class Trajectory:
         """Body frame accelerations xddot = B q'' + b, shape (n, n_x) (needs ``model``)."""
         return accelerations(self.model, self.x, self.xdot, self.qddot,
                              layout=self.model.layout(self.stats.get("mode")))
-
-    def _point_columns(self) -> dict:
-        m = self.model
-        xdd = self.xddot()
-        out = {}
-        for body, pt in m.named_points():
-            r = point_position(m, self.x, body, pt)
-            v = point_velocity(m, self.x, self.xdot, body, pt)
-            a = point_acceleration(m, self.x, self.xdot, xdd, body, pt)
-            for what, unit, val in (("", "m", r), ("v", "m_s", v), ("a", "m_s2", a)):
-                out[f"{what}x_{body}_{pt}_{unit}"] = val[:, 0]
-                out[f"{what}y_{body}_{pt}_{unit}"] = val[:, 1]
-        return out
-
-
-def _switched_columns(vs: dict, modes: bool = True) -> dict:
-    """Columns of the forces of a run: the mode of each sample (with ``modes``: the model
-    has switchable elements), the force on the frame and the force of every joint, lock, stop and
-    contact (see ``docs/variable-structure.md``)."""
-    cols: dict[str, np.ndarray] = {}
-    if modes:  # a model without switchable elements has one mode: no mode column
-        cols["mode"] = np.array([" ".join(sorted(m)) or "-" for m in vs["mode"]],
-                                dtype=object)
-        cols["mode_index"] = np.asarray(vs["mode_index"])
-    frame = np.asarray(vs["frame_force"], float)
-    cols["Fx_frame_N"] = frame[:, 0]
-    cols["Fy_frame_N"] = frame[:, 1]
-    cols["F_frame_N"] = np.hypot(frame[:, 0], frame[:, 1])
-    if vs.get("frame_moment") is not None:
-        cols["M_frame_Nm"] = np.asarray(vs["frame_moment"], float)
-    for name, f in vs.get("forces", {}).items():
-        f = np.asarray(f, float)
-        key = str(name).replace("@", "_")
-        if f.ndim == 1:
-            cols[f"F_{key}_N"] = f
-        else:
-            cols[f"Fx_{key}_N"] = f[:, 0]
-            cols[f"Fy_{key}_N"] = f[:, 1]
-            if f.shape[1] > 2:
-                cols[f"M_{key}_Nm"] = f[:, 2]
-    return cols
