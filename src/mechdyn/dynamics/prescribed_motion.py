@@ -25,38 +25,9 @@ from ..kinematics.continuation import Kernel, _kernel, _march, _newton, _node
 from ..kinematics.records import _refine_root
 from ..kinematics.sweep import DEFAULT_MAX_STEP, DEFAULT_MIN_STEP, _motion, _path, sweep
 from ..model import Model, as_model
-from ..model.rows import concat
 from .mode_system import _independent_rows
 
-__all__ = ["dead_centres", "ModeRows"]
-
-class ModeRows:
-    """The constraint rows of a variable-structure mode for kinetostatics: the joint
-    rows of the model, then ``extra``, the switchable rows of the mode
-    (:meth:`~mechdyn.dynamics.modes.SwitchedModel.rows`, as in the forward dynamics).
-
-    It stands in for a layout everywhere kinetostatics uses one (``rowset``,
-    ``n_rows``, ``rows`` of the joints and weld locks, ``row_joint``, ``mode``);
-    ``elements`` are the row indices of every switchable element but the weld locks
-    (which report as joints).
-    """
-
-    def __init__(self, model: Model, extra, mode):
-        base = model.layout(frozenset())
-        self.extra = list(extra)
-        self.mode = frozenset(mode)
-        self.n_base = base.n_rows
-        self.rowset = concat(model.n_bodies, model.joint_rows, *[r.rows for r in self.extra])
-        self.n_rows = len(self.rowset)
-        keys = [r.label if r.kind == "stick" else r.element for r in self.extra]
-        self.row_joint = np.array([*base.row_joint, *keys], dtype=object)
-        groups = {k: np.flatnonzero(self.row_joint == k) for k in dict.fromkeys(self.row_joint)}
-        joints = set(base.rows) | set(model.lock.names)
-        self.rows = {k: v for k, v in groups.items() if k in joints}
-        self.elements = {k: v for k, v in groups.items() if k not in joints}
-        slip = [(self.n_base + k, r.friction_rows) for k, r in enumerate(self.extra) if r.slip]
-        self.slip_rows = np.array([k for k, _ in slip], int)
-        self.friction = concat(model.n_bodies, *[f for _, f in slip])
+__all__ = ["dead_centres"]
 
 
 def _steps(kern: Kernel, c: int, tol: float, counter: dict) -> dict:
@@ -110,8 +81,7 @@ def _error(kern: Kernel, qd, x):
     model, lay = kern.model, kern.lay
     res = joint_residuals(model, x, lay)
     r = rows_numpy.values(lay.rowset, x)
-    res.update({el: float(np.linalg.norm(r[idx]))
-                for el, idx in getattr(lay, "elements", {}).items()})
+    res.update({el: float(np.linalg.norm(r[idx])) for el, idx in lay.elements.items()})
     names = [model.coordinate_names[k] for k in kern.idx]
     if max(res.values(), default=0.0) < 1e-6 * model.length_scale:
         return SingularPositionError(
@@ -134,13 +104,13 @@ def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=N
     (through bifurcation positions with a chart book), or through anchors when several
     driven coordinates vary.  Also returns the charted samples (mask (n,), x', x'') or
     None and the stats ``position_solves`` and ``bifurcations``."""
-    kern = Kernel(model, lay, didx) if isinstance(lay, ModeRows) else _kernel(model, lay, didx)
+    kern = Kernel(model, lay, didx) if lay.extra else _kernel(model, lay, didx)
     tol, n = 1e-12 * max(model.length_scale, 1e-3), len(qd)
     counter = {"coarse_steps": 0}
     var = np.flatnonzero(np.ptp(qd, axis=0) > 0) if n > 1 else []
     j = int(var[0]) if len(var) == 1 else 0
     book = None
-    if len(var) == 1 and kern.square and not isinstance(lay, ModeRows):
+    if len(var) == 1 and kern.square and not lay.extra:
         book = ChartBook(PathProblem(model, lay, didx, qd[0], j))
     ok = guessed = False
     if x_guess is not None:

@@ -209,23 +209,39 @@ def singularity(model: Model, x, layout: ConstraintLayout | None = None) -> dict
     and ``joints`` (joints whose equations become dependent).
     """
     lay = layout or model.layout()
-    u, s, _ = np.linalg.svd(full_jacobian(model, x, lay) * _scale(model))
+    Js = _scaled(model, full_jacobian(model, x, lay), lay.position_rows.is_angle)
+    return _singular_report(Js, lay.row_joint, model.coordinate_names)
+
+
+def _scaled(model: Model, J, is_angle) -> np.ndarray:
+    """J (..., n_r, n_x) made dimensionless: rows in m divided by the length scale L (rows
+    in rad as they are), the x and y columns times L."""
+    L = model.length_scale
+    return J * np.where(is_angle, 1.0, 1.0 / L)[:, None] * np.tile([L, L, 1.0], model.n_bodies)
+
+
+def _singular_report(Js, rows, coords) -> dict:
+    """The report of :func:`singularity` from a scaled Jacobian ``Js`` whose rows are the
+    constraint rows (their elements ``rows``), then the coordinates ``coords``."""
+    if not Js.size:
+        return {"rcond": 1.0, "sigma_min": np.nan, "coordinates": [], "joints": []}
+    u, s, _ = np.linalg.svd(Js)
     share = u[:, -1] ** 2
-    coords = [model.coordinate_names[c] for c in range(model.n_q)
-              if share[lay.n_rows + c] > 1e-3]
-    joints = sorted({lay.row_joint[r] for r in range(lay.n_rows) if share[r] > 1e-3})
+    n_r = len(rows)
     return {"rcond": float(s[-1] / s[0]) if s[0] > 0 else 0.0, "sigma_min": float(s[-1]),
-            "coordinates": coords, "joints": joints}
+            "coordinates": [c for c, w in zip(coords, share[n_r:], strict=True) if w > 1e-3],
+            "joints": sorted({r for r, w in zip(rows, share[:n_r], strict=True) if w > 1e-3})}
 
 
 def _check_singular(model, x, q, lay, t):
     if model.n_x == 0 or lay.n_rows + model.n_q != model.n_x:
         return
-    s = np.linalg.svd(full_jacobian(model, x, lay) * _scale(model), compute_uv=False)
+    Js = _scaled(model, full_jacobian(model, x, lay), lay.position_rows.is_angle)
+    s = np.linalg.svd(Js, compute_uv=False)
     rc = s[..., -1] / s[..., 0]
     if np.any(rc < SINGULAR_RCOND):
         k = np.unravel_index(np.argmin(rc), rc.shape)
-        rep = singularity(model, x[k], lay)
+        rep = _singular_report(Js[k], lay.row_joint, model.coordinate_names)
         raise SingularPositionError(
             f"dead or toggle position: the constraint Jacobian is singular "
             f"(sigma_min/sigma_max = {rep['rcond']:.2e}); coordinate(s) "
