@@ -14,7 +14,6 @@ the exact right-hand side gamma.  The dead centres are refined on a sweep of the
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from ..errors import AssemblyError, ModelError, SingularPositionError
 from ..kernels import rows_numpy
@@ -23,7 +22,14 @@ from ..kinematics.branch_chart import ChartBook, PathProblem
 from ..kinematics.constraints import _point_kinematics, coordinates, coordinates_jacobian
 from ..kinematics.continuation import Kernel, _kernel, _march, _newton, _node
 from ..kinematics.records import _refine_root
-from ..kinematics.sweep import DEFAULT_MAX_STEP, DEFAULT_MIN_STEP, _motion, _path, sweep
+from ..kinematics.sweep import (
+    DEFAULT_MAX_STEP,
+    DEFAULT_MIN_STEP,
+    _motion,
+    _path,
+    _solve_at,
+    sweep,
+)
 from ..model import Model, as_model
 from .mode_system import _independent_rows
 
@@ -63,15 +69,7 @@ def _start(kern: Kernel, q0, x_start, j: int, tol: float, counter: dict):
                          [c for c in range(len(q0)) if c != j], tol, counter)
         except (AssemblyError, SingularPositionError):
             pass
-    x, ok, _, J = _newton(kern, x_start, q0, tol, max_iter=60)
-    if not ok:
-        sol = least_squares(lambda xx: kern.system(xx, q0)[0], x_start,
-                            jac=lambda xx: kern.system(xx, q0)[1], method="trf", xtol=1e-15,
-                            ftol=1e-15, gtol=1e-15, max_nfev=2000,
-                            x_scale=kern.col_scale / kern.model.length_scale)
-        x, ok, _, J = _newton(kern, sol.x, q0, tol, max_iter=30)
-        if not ok:
-            raise _error(kern, q0, x)
+    x, _, J = _solve_at(kern, x_start, q0, tol, max_iter=60, error=lambda x: _error(kern, q0, x))
     return _node(kern, x, q0, j, J)
 
 

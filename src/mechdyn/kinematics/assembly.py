@@ -182,7 +182,8 @@ def _assembly_error(model, q, x_start, lay, t):
     q = np.asarray(q, float)
     x = x_start if np.all(np.isfinite(x_start)) else model.x_sketch
     try:  # the coordinates are honoured much more strongly than the joints
-        x = _least_squares(model, x, q, lay, weight=1e3, method="lm")
+        w = np.r_[np.ones(lay.n_rows), np.full(model.n_q, 1e3)]
+        x = _least_squares(lambda xx: system(model, xx, q, lay), x, w, method="lm")
     except Exception:  # noqa: BLE001 - keep the Newton iterate for the report
         pass
     res = joint_residuals(model, x, lay)
@@ -364,17 +365,15 @@ def _assemble_near(model: Model, q, *, x_guess=None, layout=None, t=None) -> np.
         return solve_position(model, q, x, layout=lay, t=t, check_singular=False, max_iter=8)
     except AssemblyError:
         pass
-    x = _least_squares(model, x, q, lay, method="trf", max_nfev=2000,
+    x = _least_squares(lambda xx: system(model, xx, q, lay), x, method="trf", max_nfev=2000,
                        x_scale=_scale(model) / model.length_scale)
     return solve_position(model, q, x, layout=lay, t=t, check_singular=False)
 
 
-def _least_squares(model, x, q, lay, weight: float = 1.0, **options) -> np.ndarray:
-    """The pose nearest to [Phi; weight (g - q)] = 0 from x, by SciPy's least_squares."""
-    w = np.ones(lay.n_rows + model.n_q)
-    w[lay.n_rows:] = weight
-    return least_squares(lambda xx: system(model, xx, q, lay)[0] * w, x,
-                         jac=lambda xx: system(model, xx, q, lay)[1] * w[:, None],
+def _least_squares(fun, x, w=1.0, **options) -> np.ndarray:
+    """The pose nearest to w F = 0 from x, ``fun(x) -> (F, J)``, by SciPy's least_squares."""
+    w = np.asarray(w, dtype=float)
+    return least_squares(lambda xx: fun(xx)[0] * w, x, jac=lambda xx: fun(xx)[1] * w[..., None],
                          xtol=1e-15, ftol=1e-15, gtol=1e-15, **options).x
 
 
