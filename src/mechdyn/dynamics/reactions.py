@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import Status
 from ..kernels import rows_numpy
-from ..kinematics.assembly import SINGULAR_RCOND, _dependent_rows, _scale
+from ..kinematics.assembly import SINGULAR_RCOND, _redundant_rows, _scale
 from ..kinematics.constraints import _perp, coordinates_jacobian, extend
 from ..model import ConstraintLayout, Model
 from .forces import applied_forces, cross, rotate
@@ -37,14 +37,11 @@ def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
     row labels."""
     if x.shape[0] > 64:  # redundancy is structural: a sample of the positions suffices
         x = x[np.unique(np.linspace(0, x.shape[0] - 1, 64).astype(int))]
-    P = rows_numpy.jacobian(lay.rowset, x) * _scale(model)
-    s = np.linalg.svd(P, compute_uv=False)
-    r = np.sum(s > REDUNDANT_RCOND * s[..., :1], axis=-1)
-    n_red = int(lay.n_rows - r.min())
+    rank, rows = _redundant_rows(rows_numpy.jacobian(lay.rowset, x) * _scale(model),
+                                 REDUNDANT_RCOND)
+    n_red = lay.n_rows - rank
     if n_red == 0:
         return 0, [], []
-    k = int(np.argmin(r))
-    rows = _dependent_rows(P[k], int(r[k]))
     joints = sorted({str(lay.row_joint[i]) for i in rows})
     labels = [lay.rowset.labels[i] if i >= lay.n_base else
               "{} ({})".format(*lay.rowset.labels[i].rsplit(".", 1)) for i in rows]

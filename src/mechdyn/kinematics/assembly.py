@@ -382,25 +382,27 @@ def rank_report(model: Model, x, layout=None) -> dict:
     lay = layout or model.layout()
     J = full_jacobian(model, x, lay) * _scale(model)
     P, Gq = J[:lay.n_rows], J[lay.n_rows:]
-    tol_rel = 1e-9
-    rank_phi = _rank(P, tol_rel)
-    redundant = sorted({lay.row_joint[r] for r in _dependent_rows(P, rank_phi)})
-    rank_full = _rank(J, tol_rel)
+    rank_phi, redundant = _redundant_rows(P)
+    rank_full = _rank(J)
     dep = []
     if model.n_q and rank_full < rank_phi + model.n_q:
         # coordinate c depends on the others if dropping its row keeps the rank
         dep = [model.coordinate_names[c] for c in range(model.n_q)
-               if _rank(np.concatenate([P, np.delete(Gq, c, axis=0)]), tol_rel) == rank_full]
-    return {"rank_phi": rank_phi, "redundant_joints": redundant, "dependent_coordinates": dep}
+               if _rank(np.concatenate([P, np.delete(Gq, c, axis=0)])) == rank_full]
+    return {"rank_phi": rank_phi, "redundant_joints": sorted({lay.row_joint[r] for r in redundant}),
+            "dependent_coordinates": dep}
 
 
-def _rank(A, tol_rel):
-    """Number of singular values of A above ``tol_rel`` times the largest."""
-    return int(np.linalg.matrix_rank(A, rtol=tol_rel))
+def _rank(A, rtol=1e-9):
+    """Number of singular values of A above ``rtol`` times the largest (batched)."""
+    return np.linalg.matrix_rank(A, rtol=rtol)
 
 
-def _dependent_rows(P, rank: int) -> np.ndarray:
-    """The rows of P (of rank ``rank``) that are linear combinations of the others: those
-    that carry its left null space."""
-    null = np.linalg.svd(P)[0][:, rank:]
-    return np.flatnonzero(np.sum(null**2, axis=1) > 1e-6)
+def _redundant_rows(P, rtol=1e-9):
+    """(rank, dependent rows) of a scaled constraint Jacobian P (n_rows, n_x), or of the one
+    of least rank of a batch (..., n_rows, n_x): the dependent rows are linear combinations
+    of the others (they carry the left null space)."""
+    r = _rank(P, rtol)
+    k = np.unravel_index(np.argmin(r), np.shape(r))
+    null = np.linalg.svd(P[k])[0][:, r[k]:]
+    return int(r[k]), np.flatnonzero(np.sum(null**2, axis=1) > 1e-6)

@@ -268,26 +268,12 @@ class ConstraintLayout:
     model : Model
     mode : frozenset of str
     extra : list of Row, optional
-        The switchable rows of a variable-structure mode
-        (:meth:`~mechdyn.dynamics.modes.SwitchedModel.rows`, weld locks included); given,
-        they follow the joint rows instead of the welds of the model's engaged locks.
-
-    Attributes
-    ----------
-    rowset : Rows
-        The constraint rows of the mode (joints, then engaged locks or ``extra``).
-    n_base : int
-        The rows before ``extra`` (all of them without it).
-    element_rows : dict of str to ndarray of int
-        The rows of each element (joint, lock, stop, contact), indices into ``rowset``.
-    row_joint : ndarray of object
-        The key of each row: its element, but the label of a sticking contact's row.
-    rows, elements : dict of str to ndarray of int
-        The rows per key of the joints and weld locks, and of the other elements.
-    slip_rows, friction
-        The rows of sliding contacts and their friction terms (:attr:`Row.friction_rows`).
-    position_rows : Rows
-        The rows of the position problem [Phi(x); g(x)] = [0; q].
+        The switchable rows of a variable-structure mode (weld locks included,
+        :meth:`~mechdyn.dynamics.modes.SwitchedModel.rows`): they follow the joint rows
+        instead of the welds of the engaged locks.  ``rows`` then has the joints and weld
+        locks, ``elements`` the others (a sticking contact's row on its own, by its label;
+        ``element_rows`` groups every row by element), ``slip_rows`` and ``friction`` the
+        rows of sliding contacts and their friction terms.
     """
 
     def __init__(self, model: Model, mode: frozenset, extra=None):
@@ -308,6 +294,7 @@ class ConstraintLayout:
         slip = [(self.n_base + k, r.friction_rows) for k, r in enumerate(self.extra) if r.slip]
         self.slip_rows = np.array([k for k, _ in slip], int)
         self.friction = R.concat(nb, *[f for _, f in slip])
+        #: the rows of the position problem [Phi(x); g(x)] = [0; q]
         self.position_rows = R.concat(nb, self.rowset, model.coordinate_rows)
 
 
