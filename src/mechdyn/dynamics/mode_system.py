@@ -38,7 +38,7 @@ import scipy.linalg
 
 from ..errors import AssemblyError, IntegrationError, LockupError
 from ..kernels import rows_numpy as RN
-from ..kinematics.assembly import _scaled, _singular_report, newton
+from ..kinematics.assembly import _position_tol, _scale, _scaled, _singular_report, newton
 from ..model import ConstraintLayout
 from ..model.state import Mode
 from ..model.workspace import Workspace
@@ -150,7 +150,7 @@ class ModeSystem:
         self._sel = np.concatenate([self.independent_rows, self.n_rows + self.coords])
         self._eye_i = np.zeros((model.n_x, self.n_i))
         self._eye_i[len(self.independent_rows):, :] = np.eye(self.n_i)
-        self._rs = np.tile([1.0, 1.0, 1.0 / model.length_scale], model.n_bodies)
+        self._rs = 1.0 / _scale(model)
         self.ws = Workspace() if workspace is None else workspace
         self.ws.reset(self.x_ref)
 
@@ -225,7 +225,7 @@ class ModeSystem:
         qi = np.asarray(qi, float)
         x = self.ws.predict(qi) if x_guess is None else np.array(x_guess, float)
         n_r = len(self.independent_rows)
-        tol = 1e-13 * max(self.model.length_scale, 1e-3)
+        tol = _position_tol(self.model)
         x, done = newton(self._all, x, np.concatenate([np.zeros(n_r), qi]), sel=self._sel,
                          tol=tol)
         if not done:
