@@ -111,6 +111,8 @@ class ModeSystem:
     ----------
     rows : list of Row
         The switchable rows of the mode.
+    layout : ConstraintLayout
+        Their bookkeeping with the joint rows (:class:`~mechdyn.model.ConstraintLayout`).
     rowset : Rows
         Every row of the mode: the joint rows (``n_base`` of them), then ``rows``.
     independent_rows : ndarray of int

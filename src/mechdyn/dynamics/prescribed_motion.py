@@ -59,8 +59,8 @@ def _move(kern: Kernel, node, q, cs, tol: float, counter: dict):
 
 def _start(kern: Kernel, q0, x_start, j: int, tol: float, counter: dict):
     """The node at the held coordinates of q0 (coordinate j as at x_start), by
-    continuation from the pose x_start when it is assembled, else by Newton's method
-    (least squares first when that fails) at q0."""
+    continuation from the pose x_start when it is assembled, else at q0 by the sweep's
+    Newton-else-fit (:func:`~mechdyn.kinematics.sweep._solve_at`)."""
     q_s = coordinates(kern.model, x_start)[kern.idx]
     x, ok, _, J = _newton(kern, x_start, q_s, tol, max_iter=60)
     if ok:
@@ -69,7 +69,7 @@ def _start(kern: Kernel, q0, x_start, j: int, tol: float, counter: dict):
                          [c for c in range(len(q0)) if c != j], tol, counter)
         except (AssemblyError, SingularPositionError):
             pass
-    x, _, J = _solve_at(kern, x_start, q0, tol, max_iter=60, error=lambda x: _error(kern, q0, x))
+    x, _, J = _solve_at(kern, x_start, q0, tol, max_iter=60, error=lambda xx: _error(kern, q0, xx))
     return _node(kern, x, q0, j, J)
 
 
