@@ -65,3 +65,20 @@ def test_polar_plot_of_an_unknown_joint_fails_before_the_analysis(tmp_path, caps
     rc = main(["kinetostatics", "slider_crank", "--speed", "10rad/s", "--plot-polar", "A"])
     assert rc == 2
     assert "--plot-polar needs --plot" in capsys.readouterr().err
+
+
+def test_animate_without_labels(tmp_path, monkeypatch):
+    import mechdyn.cli.animate as cli_animate
+
+    seen = {}
+    real = cli_animate.animate
+
+    def spy(record, path, **kwargs):
+        seen.update(kwargs)
+        return real(record, path, **kwargs)
+
+    monkeypatch.setattr(cli_animate, "animate", spy)
+    rc = main(["animate", "slider_crank", "--steps", "5", "--no-labels",
+               "-o", str(tmp_path / "a.gif")])
+    assert rc == 0 and seen["labels"] is False
+    assert (tmp_path / "a.gif").stat().st_size > 1000
