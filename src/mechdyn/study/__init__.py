@@ -1,0 +1,1 @@
+"""Design studies: many variants of one model file, analysed and tabulated."""
