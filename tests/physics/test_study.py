@@ -1,0 +1,95 @@
+"""Design studies against the plain loop over mechdyn.kinetostatics, failing variants,
+and the same study on a Dask cluster."""
+
+import numpy as np
+import pytest
+
+from mechdyn.kinematics.sweep import sweep
+from mechdyn.study.analyses import KinematicSummary, KinetostaticExtremes
+from mechdyn.study.designs import design, parse_range
+from mechdyn.study.execute import run_study
+from mechdyn.study.parameters import BaseModel
+
+RANGES = ("bodies.crank.points.A.x=40mm..60mm", "bodies.rod.points.B.x=140mm..200mm")
+ANALYSIS = KinetostaticExtremes("1000 rpm", steps=120)
+
+
+@pytest.fixture(scope="module")
+def base():
+    return BaseModel("slider_crank")
+
+
+@pytest.fixture(scope="module")
+def variants(base):
+    return design([parse_range(base, r) for r in RANGES], 12, "lhs", seed=1)
+
+
+@pytest.fixture(scope="module")
+def study(base, variants):
+    return run_study(base, variants, ANALYSIS, workers=1, batch_size=3, progress=False)
+
+
+def plain_loop(base, variants, analysis):
+    """One cold kinetostatics call per variant: the reference."""
+    params = variants.attrs["parameters"]
+    out = []
+    for row in variants.to_numpy():
+        model = base.build(dict(zip(params, row, strict=True))).compile()
+        over, values = analysis.values(model)
+        from mechdyn import kinetostatics
+
+        rec = kinetostatics(model, over=over, speed=analysis.speed, values=values)
+        out.append(KinetostaticExtremes.figures(rec).figures)
+    return out
+
+
+def test_study_equals_the_plain_loop_over_kinetostatics(base, variants, study):
+    assert (study["status"] == "success").all()
+    assert study["variant"].tolist() == list(range(len(variants)))
+    np.testing.assert_allclose(study["bodies.crank.points.A.x_m"],
+                               variants["bodies.crank.points.A.x"], rtol=1e-15)
+    reference = plain_loop(base, variants.iloc[:5], ANALYSIS)
+    for k, ref in enumerate(reference):
+        for col, value in ref.items():
+            assert study.loc[k, col] == pytest.approx(value, rel=1e-9, abs=1e-9), col
+
+
+def test_non_assemblable_variants_are_rows_that_name_the_open_loop(base):
+    rods = [0.16, 0.01, 0.045, 0.18]  # 10 mm: no sketch; 45 mm < 50 mm crank: no full turn
+    df = run_study(base, {"bodies.rod.points.B.x": rods}, ANALYSIS, workers=1,
+                   progress=False)
+    assert df["status"].tolist()[0] == "success" and df["status"].tolist()[3] == "success"
+    assert df.loc[1, "status"] == "assembly-failed"
+    assert "loop through joints" in df.loc[1, "message"]
+    assert "does not close" in df.loc[1, "message"]
+    assert df.loc[2, "status"] in ("assembly-failed", "singular-position")
+    assert np.isnan(df.loc[1, "M_drive_phi_peak_Nm"])
+
+
+def test_kinematic_summary_gives_the_stroke_of_the_slider(base):
+    df = run_study(base, {"bodies.crank.points.A.x": [0.04, 0.05]}, KinematicSummary(steps=73),
+                   workers=1, progress=False)
+    assert df["stroke_cylinder_m"].tolist() == pytest.approx([0.08, 0.10], rel=1e-6)
+    model = base.build({base.parameter("bodies.crank.points.A.x"): 0.05}).compile()
+    assert sweep(model, "phi", np.linspace(0, 2 * np.pi, 73, endpoint=False)).status == "success"
+
+
+def test_local_processes_give_the_same_table(base, variants, study):
+    cols = [c for c in study if c != "seconds"]
+    df = run_study(base, variants, ANALYSIS, workers=2, batch_size=3, progress=False)
+    assert df[cols].equals(study[cols])  # the same batches: the same warm starts
+    other = run_study(base, variants, ANALYSIS, workers=2, batch_size=5, progress=False)
+    figures = [c for c in cols if c.endswith(("_N", "_Nm", "_W"))]
+    np.testing.assert_allclose(other[figures], study[figures], rtol=1e-9)
+
+
+@pytest.mark.slow  # a LocalCluster of two processes takes 10-20 s to start on 2 cores
+def test_the_same_study_on_a_dask_cluster_is_identical(base, variants, study):
+    distributed = pytest.importorskip("distributed",
+                                      reason="dask.distributed is not installed")
+    with distributed.LocalCluster(processes=True, n_workers=2, threads_per_worker=1,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        df = run_study(base, variants, ANALYSIS, client=client, batch_size=3, progress=False)
+    cols = [c for c in study if c != "seconds"]
+    assert df[cols].equals(study[cols])
