@@ -93,3 +93,33 @@ def test_the_same_study_on_a_dask_cluster_is_identical(base, variants, study):
         df = run_study(base, variants, ANALYSIS, client=client, batch_size=3, progress=False)
     cols = [c for c in study if c != "seconds"]
     assert df[cols].equals(study[cols])
+
+
+def test_optimum_with_a_fixed_stroke_is_found_from_three_starts_and_on_a_grid(base):
+    from mechdyn.study.analyses import Combined
+    from mechdyn.study.optimise import Constraint, optimise
+
+    steps = 72
+    ranges = [parse_range(base, "bodies.crank.points.A.x=40mm..60mm"),
+              parse_range(base, "bodies.rod.com.x=-60mm..60mm")]
+    analysis = Combined((KinetostaticExtremes("1000 rpm", steps=steps),
+                         KinematicSummary(steps=steps)))
+    stroke = Constraint("stroke_cylinder_m", 0.1, 0.1)
+    optima = [optimise(base, ranges, analysis, "M_drive_phi_peak_Nm", constraints=[stroke],
+                       start=s, maxiter=200)
+              for s in [(0.042, 0.05), (0.058, -0.05), (0.05, 0.0)]]
+    for o in optima:
+        assert o.values["bodies.crank.points.A.x"] == pytest.approx(0.05, abs=1e-6)
+        assert o.values["bodies.rod.com.x"] == pytest.approx(
+            optima[0].values["bodies.rod.com.x"], abs=1e-5)
+        assert o.objective == pytest.approx(optima[0].objective, rel=1e-5)
+        assert o.table["feasible"].any() and len(o.table) == o.evaluations
+    # a fine grid at the fixed stroke (crank radius 50 mm), 1 mm steps of the rod's centre
+    grid = np.arange(-0.060, 0.0605, 0.001)
+    df = run_study(base, {"bodies.crank.points.A.x": np.full(grid.size, 0.05),
+                          "bodies.rod.com.x": grid},
+                   KinetostaticExtremes("1000 rpm", steps=steps), workers=1, progress=False)
+    k = int(df["M_drive_phi_peak_Nm"].idxmin())
+    assert abs(grid[k] - optima[0].values["bodies.rod.com.x"]) <= 0.001
+    assert optima[0].objective <= df["M_drive_phi_peak_Nm"].min() + 1e-9
+    assert optima[0].objective == pytest.approx(df["M_drive_phi_peak_Nm"].min(), rel=0.02)

@@ -18,7 +18,7 @@ from ..errors import ModelError, Status
 from ..units import parse_quantity
 
 __all__ = ["Outcome", "KinetostaticExtremes", "KinematicSummary", "FlywheelSize",
-           "SimulationMetrics", "ANALYSES"]
+           "SimulationMetrics", "Combined", "ANALYSES"]
 
 _DEG = 180.0 / np.pi
 
@@ -271,6 +271,34 @@ class SimulationMetrics:
         out = {k: float(v) for k, v in dict(self.metrics(traj)).items()}
         ok = traj.status in ("success", "event")
         return Outcome(out, str(traj.status), "" if ok else traj.message)
+
+
+@dataclass(frozen=True)
+class Combined:
+    """Several analyses of each variant, their figures in one row (e.g. the stroke of
+    :class:`KinematicSummary` beside the torques of :class:`KinetostaticExtremes`).
+
+    The status is the first that is not a success; the warm state is the first
+    analysis'.
+
+    Examples
+    --------
+    >>> Combined((KinetostaticExtremes("100 rpm"), KinematicSummary())).name
+    'kinetostatics+kinematics'
+    """
+
+    parts: tuple
+
+    @property
+    def name(self) -> str:
+        return "+".join(p.name for p in self.parts)
+
+    def __call__(self, model, warm=None) -> Outcome:
+        outs = [p(model, warm if k == 0 else None) for k, p in enumerate(self.parts)]
+        figures = {k: v for oc in outs for k, v in oc.figures.items()}
+        bad = [oc for oc in outs if oc.status not in (Status.SUCCESS, Status.REDUNDANT)]
+        head = bad[0] if bad else outs[0]
+        return Outcome(figures, head.status, head.message, outs[0].warm)
 
 
 #: the analyses by their CLI name

@@ -13,7 +13,7 @@ import numpy as np
 from ..errors import AssemblyError, MechdynError, SingularPositionError, Status
 from .parameters import BaseModel, Parameter, to_shown
 
-__all__ = ["Task", "evaluate_batch", "order_variants", "failure"]
+__all__ = ["Task", "evaluate_batch", "evaluate_variant", "order_variants", "failure"]
 
 
 @dataclass(frozen=True)
@@ -75,24 +75,31 @@ def evaluate_batch(task: Task, batch: list[tuple[int, tuple[float, ...]]],
     """
     rows = []
     for vid, values in batch:
-        t0 = time.perf_counter()
-        row: dict = {"variant": int(vid)}
-        for p, v in zip(task.parameters, values, strict=True):
-            row[p.column] = to_shown(v, p.kind)
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")  # the record's status and message say it
-                model = task.base.build(dict(zip(task.parameters, values, strict=True)))
-                outcome = task.analysis(model.compile(), warm)
-            row.update(outcome.figures)
-            row["status"], row["message"] = outcome.status, outcome.message
-            if outcome.warm is not None:
-                warm = outcome.warm
-        except Exception as exc:  # noqa: BLE001 - a failed variant is a row, not the end
-            row["status"], row["message"] = failure(exc)
-        row["seconds"] = time.perf_counter() - t0
+        row, warm = evaluate_variant(task, vid, values, warm)
         rows.append(row)
     return rows
+
+
+def evaluate_variant(task: Task, vid: int, values: tuple[float, ...], warm=None):
+    """(row, warm) of one variant (see :func:`evaluate_batch`); ``warm`` is passed on
+    unchanged when the variant fails."""
+    t0 = time.perf_counter()
+    row: dict = {"variant": int(vid)}
+    for p, v in zip(task.parameters, values, strict=True):
+        row[p.column] = to_shown(v, p.kind)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the record's status and message say it
+            model = task.base.build(dict(zip(task.parameters, values, strict=True)))
+            outcome = task.analysis(model.compile(), warm)
+        row.update(outcome.figures)
+        row["status"], row["message"] = outcome.status, outcome.message
+        if outcome.warm is not None:
+            warm = outcome.warm
+    except Exception as exc:  # noqa: BLE001 - a failed variant is a row, not the end
+        row["status"], row["message"] = failure(exc)
+    row["seconds"] = time.perf_counter() - t0
+    return row, warm
 
 
 def order_variants(values: np.ndarray) -> np.ndarray:
