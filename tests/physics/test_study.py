@@ -88,7 +88,7 @@ def test_the_same_study_on_a_dask_cluster_is_identical(base, variants, study):
     distributed = pytest.importorskip("distributed",
                                       reason="dask.distributed is not installed")
     with distributed.LocalCluster(processes=True, n_workers=2, threads_per_worker=1,
-                                  dashboard_address=None) as cluster, \
+                                  dashboard_address=":0") as cluster, \
             distributed.Client(cluster) as client:
         df = run_study(base, variants, ANALYSIS, client=client, batch_size=3, progress=False)
     cols = [c for c in study if c != "seconds"]

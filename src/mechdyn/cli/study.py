@@ -123,7 +123,7 @@ def _client(address: str, workers: int | None):
                          "'mechdyn[study]'") from None
     if address == "local":
         cluster = LocalCluster(processes=True, n_workers=workers or os.cpu_count() or 1,
-                               threads_per_worker=1, dashboard_address=None)
+                               threads_per_worker=1, dashboard_address=":0")
         return Client(cluster), cluster
     return Client(address), None
 
@@ -174,6 +174,7 @@ def run(args) -> int:
     client = cluster = None
     if args.scheduler:
         client, cluster = _client(args.scheduler, args.workers)
+    t0 = time.perf_counter()  # the study, not the start of its cluster
     try:
         df = run_study(base, variants, analysis, output=args.output, client=client,
                        workers=args.workers, batch_size=args.batch, resume=args.resume)
