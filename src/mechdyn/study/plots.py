@@ -145,19 +145,25 @@ def plot_pareto(df, x: str, y: str, path: str | Path | None = None, *,
     Parameters
     ----------
     df : pandas.DataFrame
-    x, y : str
-        The two objective columns.
+        A study table.
+    x : str
+        The first objective column (horizontal axis).
+    y : str
+        The second objective column (vertical axis).
     path : str or Path, optional
         Write the plot there; otherwise return the figure.
+    title : str, optional
+    dpi : int
 
     Returns
     -------
     Path or matplotlib.figure.Figure
+        The path written, or the figure when no path is given.
 
     Raises
     ------
     ModelError
-        An unknown column.
+        An unknown column (the table's columns are listed).
 
     Examples
     --------
