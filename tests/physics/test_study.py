@@ -120,3 +120,34 @@ def test_optimum_with_a_fixed_stroke_is_found_from_three_starts_and_on_a_grid(ba
     assert abs(grid[k] - optima[0].values["bodies.rod.com.x"]) <= 0.001
     assert optima[0].objective <= df["M_drive_phi_peak_Nm"].min() + 1e-9
     assert optima[0].objective == pytest.approx(df["M_drive_phi_peak_Nm"].min(), rel=0.02)
+
+
+@pytest.mark.slow  # a LocalCluster of two processes, one of them killed mid-study
+def test_a_worker_killed_mid_study_loses_no_variant(base, variants, study, tmp_path):
+    distributed = pytest.importorskip("distributed",
+                                      reason="dask.distributed is not installed")
+    marker = tmp_path / "killed"
+
+    class KillsItsWorkerOnce:
+        """The study's analysis; the first worker to reach variant 7 dies there."""
+
+        name = "kinetostatics"
+
+        def __call__(self, model, warm=None):
+            import os
+
+            if abs(model.mechanism.bodies["crank"].points["A"][0] - kill_at) < 1e-15 \
+                    and not marker.exists():
+                marker.touch()
+                os._exit(1)
+            return ANALYSIS(model, warm)
+
+    kill_at = float(variants.iloc[7, 0])
+    with distributed.LocalCluster(processes=True, n_workers=2, threads_per_worker=1,
+                                  dashboard_address=":0") as cluster, \
+            distributed.Client(cluster) as client:
+        df = run_study(base, variants, KillsItsWorkerOnce(), client=client, batch_size=3,
+                       progress=False)
+    assert marker.exists()
+    cols = [c for c in study if c != "seconds"]
+    assert df[cols].equals(study[cols])
