@@ -130,9 +130,11 @@ def _client(address: str, workers: int | None):
 
 def _summary(df, args, ranges, seconds: float) -> None:
     n = len(df)
+    now = df.attrs.get("analysed", n)
     counts = df["status"].value_counts().to_dict() if n else {}
-    print(f"{args.model}: {n} variants in {seconds:.1f} s "
-          f"({1e3 * seconds / max(n, 1):.1f} ms per variant of wall time); "
+    resumed = f", {n - now} resumed" if now != n else ""
+    print(f"{args.model}: {n} variants ({now} analysed in {seconds:.1f} s, "
+          f"{1e3 * seconds / max(now, 1):.1f} ms each of wall time{resumed}); "
           + ", ".join(f"{v} {k}" for k, v in counts.items()))
     params = [r.parameter.column for r in ranges]
     figures = [c for c in df if c not in ("variant", "status", "message", "seconds",

@@ -3,8 +3,10 @@
 
 from __future__ import annotations
 
+import functools
 import math
 import os
+import signal
 import sys
 import uuid
 from pathlib import Path
@@ -64,23 +66,22 @@ def _bar(total: int, initial: int, progress):
                 delay=0.0 if progress else 2.0)
 
 
+def _quiet_worker() -> None:
+    """A worker process ignores Ctrl-C: the study's process stops them all."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def _local(task, batches, workers: int):
     """Results of the batches as they finish, in this process (workers <= 1) or in a
-    pool of worker processes."""
+    pool of worker processes (terminated when the study is interrupted)."""
     if workers <= 1:
         for b in batches:
             yield evaluate_batch(task, b)
         return
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    import multiprocessing
 
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        futures = [pool.submit(evaluate_batch, task, b) for b in batches]
-        try:
-            for f in as_completed(futures):
-                yield f.result()
-        finally:
-            for f in futures:
-                f.cancel()
+    with multiprocessing.Pool(workers, initializer=_quiet_worker) as pool:  # exit: terminate
+        yield from pool.imap_unordered(functools.partial(evaluate_batch, task), batches)
 
 
 def _dask(task, batches, client, retries: int):
@@ -88,9 +89,10 @@ def _dask(task, batches, client, retries: int):
     a batch lost with its worker is run again, up to ``retries`` times)."""
     from distributed import as_completed
 
-    shared = client.scatter(task, broadcast=True)
+    # the task (a few kB: the model document, the parameters, the analysis) goes with
+    # every batch: scattered data lost with a worker could not be recomputed
     tag = uuid.uuid4().hex[:12]
-    futures = [client.submit(evaluate_batch, shared, b, key=f"mechdyn-study-{tag}-{k}",
+    futures = [client.submit(evaluate_batch, task, b, key=f"mechdyn-study-{tag}-{k}",
                              retries=retries, pure=False) for k, b in enumerate(batches)]
     try:
         for f in as_completed(futures):
@@ -120,7 +122,8 @@ def run_study(model, variants, analysis, *, output: str | Path | None = None,
     client : distributed.Client, optional
         Run the batches on this Dask cluster instead of local processes.
     workers : int, optional
-        Local worker processes (default ``os.cpu_count()``; 1: in this process).
+        Local worker processes (default ``os.cpu_count()``; 1: in this process); with
+        ``client``, sets the batch size only (default the cluster's workers).
     batch_size : int, optional
         Variants per batch (task); default about four batches per worker, at most 50.
     resume : bool
@@ -139,7 +142,8 @@ def run_study(model, variants, analysis, *, output: str | Path | None = None,
     pandas.DataFrame
         One row per variant, sorted by ``variant`` (the design's row index): the
         parameters (columns with units, angles in deg), the figures, ``status``,
-        ``message``, ``seconds``.
+        ``message``, ``seconds``; ``attrs["analysed"]``: the variants analysed in this
+        call (the others were resumed).
 
     Raises
     ------
@@ -174,7 +178,10 @@ def run_study(model, variants, analysis, *, output: str | Path | None = None,
     todo = np.array([k for k, i in enumerate(ids) if int(i) not in done], int)
     if order and len(todo) > 1:
         todo = todo[order_variants(values[todo])]
-    workers = (os.cpu_count() or 1) if workers is None else int(workers)
+    if workers is None:
+        workers = len(client.scheduler_info()["workers"]) if client is not None else \
+            (os.cpu_count() or 1)
+    workers = max(1, int(workers))
     if batch_size is None:
         batch_size = max(1, min(50, math.ceil(len(todo) / max(1, 4 * workers))))
     batches = batches_of(ids[todo], values[todo], int(batch_size))
@@ -202,4 +209,5 @@ def run_study(model, variants, analysis, *, output: str | Path | None = None,
             table = order_columns(table.sort_values("variant").reset_index(drop=True))
     table.attrs["model"] = base.spec
     table.attrs["analysis"] = getattr(analysis, "name", type(analysis).__name__)
+    table.attrs["analysed"] = len(rows)  # in this call (the others were resumed)
     return table
