@@ -29,7 +29,7 @@ def test_a_kinetostatic_study_writes_the_table_and_prints_a_summary(tmp_path, ca
     code = run(["study", "slider_crank", *VARY, "--samples", "6", "--design", "lhs",
                 "--seed", "1", "--analysis", "kinetostatics", "--speed", "1000rpm",
                 "--steps", "36", "-o", str(out), "--workers", "1",
-                "--plot", str(tmp_path / "s.png")])
+                "--plot", str(tmp_path / "s.png"), "--report", str(tmp_path / "s.html")])
     assert code == 0
     df = read_table(out)
     assert len(df) == 6 and (df["status"] == "success").all()
@@ -39,6 +39,7 @@ def test_a_kinetostatic_study_writes_the_table_and_prints_a_summary(tmp_path, ca
     assert "6 variants" in text and "6 success" in text
     assert "smallest M_drive_phi_peak [N m]" in text and "bodies.crank.points.A.x [mm]" in text
     assert (tmp_path / "s.png").is_file()
+    assert "Design study: 6 variants" in (tmp_path / "s.html").read_text(encoding="utf-8")
     # resumed with more samples of the same seed: a Latin hypercube of another size is
     # another design, and is refused
     with pytest.raises(ModelError, match="another study"):

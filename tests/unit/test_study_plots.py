@@ -34,3 +34,14 @@ def test_plots_are_written_with_engineering_units(tmp_path):
 def test_an_unknown_column_is_named():
     with pytest.raises(ModelError, match="F_frame_peak_N"):
         plot_scatter(TABLE, "bodies.crank.points.A.x_m", "F_frame_peak")
+
+
+def test_the_report_section_lists_ranges_best_and_failed_variants():
+    from mechdyn.study.report import study_section
+
+    table = TABLE.assign(variant=range(5), message=[""] * 4 + ["the loop does not close"])
+    text = study_section(table, ["bodies.crank.points.A.x_m"],
+                         pareto=("M_drive_phi_peak_Nm", "F_frame_peak_N"))
+    assert "Design study: 5 variants" in text and "4 success, 1 assembly-failed" in text
+    assert "bodies.crank.points.A.x [mm]" in text and "Smallest M_drive_phi_peak [N m]" in text
+    assert text.count("<img") == 2 and "the loop does not close" in text

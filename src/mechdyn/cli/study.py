@@ -38,6 +38,7 @@ from ..study.execute import run_study
 from ..study.optimise import optimise, parse_constraint
 from ..study.parameters import BaseModel
 from ..study.plots import axis_label, plot_scatter
+from ..study.report import write_study_report
 from ..units import parse_quantity
 from .options import add_model, quantity
 
@@ -82,6 +83,8 @@ def register(sub) -> None:
     p.add_argument("--figure", metavar="COLUMN",
                    help="the figure summarised and plotted (default the first)")
     p.add_argument("--plot", metavar="PNG", help="plot the first parameter against --figure")
+    p.add_argument("--report", metavar="HTML",
+                   help="write an HTML page: ranges, best and failed variants, plots")
     o = p.add_argument_group("optimisation")
     o.add_argument("--minimise", metavar="COLUMN", help="minimise this figure instead")
     o.add_argument("--constraint", action="append", default=[], metavar="COLUMN>=VALUE",
@@ -155,6 +158,10 @@ def _summary(df, args, ranges, seconds: float) -> None:
           f"{where}")
     if args.plot:
         print(f"  plot: {plot_scatter(df, params[0], fig, args.plot)}")
+    if getattr(args, "report", None):
+        page = write_study_report(df, args.report, params, figure=fig,
+                                  title=f"{args.model}: design study")
+        print(f"  report: {page}")
 
 
 def run(args) -> int:
