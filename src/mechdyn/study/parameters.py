@@ -19,7 +19,8 @@ from ..errors import ModelError, UnitError, did_you_mean
 from ..modelfile.loader import build, read_document
 from ..units import KINDS, parse_quantity
 
-__all__ = ["BaseModel", "Parameter", "column_name", "unit_suffix", "KIND_ORDER"]
+__all__ = ["BaseModel", "Parameter", "column_name", "unit_suffix", "shown_unit", "to_shown",
+           "KIND_ORDER"]
 
 #: vector components by name
 _COMPONENTS = {"x": 0, "y": 1, "theta": 2}
@@ -43,7 +44,13 @@ def unit_suffix(unit: str) -> str:
 
 
 def shown_unit(kind: str) -> str:
-    """The unit a table shows a quantity of ``kind`` in (deg, rpm, else SI)."""
+    """The unit a table shows a quantity of ``kind`` in (deg, rpm, else SI).
+
+    Examples
+    --------
+    >>> shown_unit("angle"), shown_unit("inertia")
+    ('deg', 'kg*m^2')
+    """
     return _SHOWN.get(kind, KINDS[kind].si)
 
 
@@ -64,7 +71,13 @@ def column_name(name: str, kind: str) -> str:
 
 
 def to_shown(value: float, kind: str) -> float:
-    """An SI value in the unit :func:`shown_unit` gives (deg for angles, rpm for speeds)."""
+    """An SI value in the unit :func:`shown_unit` gives (deg for angles, rpm for speeds).
+
+    Examples
+    --------
+    >>> to_shown(3.141592653589793, "angle"), to_shown(0.05, "length")
+    (180.0, 0.05)
+    """
     factor = {"angle": 180.0 / 3.141592653589793, "angular_velocity": 30.0 / 3.141592653589793}
     return float(value) * factor.get(kind, 1.0)
 
@@ -90,7 +103,13 @@ class Parameter:
         return column_name(self.path, self.kind)
 
     def text(self, value: float) -> str:
-        """The SI value as model-file text with its unit, e.g. ``"0.045 m"``."""
+        """The SI value as model-file text with its unit.
+
+        Examples
+        --------
+        >>> Parameter("bodies.rod.mass", "mass").text(1.5)
+        '1.5 kg'
+        """
         unit = KINDS[self.kind].si
         return f"{float(value)!r} {unit}".rstrip()
 
