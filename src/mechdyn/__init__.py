@@ -9,6 +9,8 @@ pint are loaded only by the functions that need them.
 from __future__ import annotations
 
 import importlib
+import sys
+import types
 
 from ._version import __version__ as __version__
 
@@ -92,3 +94,17 @@ def __getattr__(name: str):
 def __dir__() -> list[str]:
     """The module's names, the public ones not yet imported included."""
     return sorted(set(globals()) | set(__all__))
+
+
+class _Package(types.ModuleType):
+    """This package's module type: importing a submodule that shares its name with a
+    public name of another kind (``mechdyn.simulate``, the module of the function) leaves
+    the public name as it is, as the eager imports of the past did."""
+
+    def __setattr__(self, name: str, value) -> None:
+        if isinstance(value, types.ModuleType) and _WHERE.get(name) is not None:
+            return  # the import system binding the submodule: the public name stays
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package

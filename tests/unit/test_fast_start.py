@@ -64,6 +64,13 @@ def test_all_and_dir_are_complete_and_unknown_names_fail():
     assert mechdyn.units is importlib.import_module("mechdyn.units")
 
 
+def test_a_submodule_imported_first_does_not_hide_the_public_name():
+    assert _python("import mechdyn.simulate, mechdyn; print(mechdyn.simulate.__module__)") \
+        == "mechdyn.simulate"
+    assert mechdyn.simulate is sys.modules["mechdyn.simulate"].simulate
+    assert mechdyn.examples is sys.modules["mechdyn.examples"]
+
+
 def test_help_lists_every_subcommand_with_its_help_line(capsys):
     with pytest.raises(SystemExit) as exc:
         cli.main(["--help"])
