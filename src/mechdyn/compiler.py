@@ -15,6 +15,10 @@
 so that an analysis never discovers a bad name.  The module sits above the analyses
 it borrows from; :meth:`Mechanism.compile <mechdyn.mechanism.Mechanism.compile>` and
 :func:`mechdyn.model.as_model` hand a mechanism to it.
+
+:func:`warmup` compiles the Numba kernels ahead of time (``mechdyn warmup``): they are
+compiled once per machine into the user's cache folder
+(:func:`mechdyn.kernels.cache_dir`), otherwise on their first use.
 """
 
 from __future__ import annotations
@@ -27,7 +31,7 @@ from .errors import MechdynError, ModelError
 from .kinematics.assembly import assemble, rank_report
 from .model import Model
 
-__all__ = ["compile_mechanism", "check_rank", "check_loads"]
+__all__ = ["compile_mechanism", "check_rank", "check_loads", "warmup"]
 
 _GRUEBLER = "degrees of freedom"
 
@@ -136,3 +140,48 @@ def check_loads(model: Model) -> Model:
     if probs:
         raise ModelError(probs)
     return model
+
+
+def warmup() -> dict[str, float]:
+    """Compile every Numba kernel now (or load it from the disk cache), so that the first
+    analysis does not wait for it.
+
+    The kernels are generic over their arrays: compiling them on a small pendulum of
+    their own compiles them for every model.  They are kept in
+    :func:`mechdyn.kernels.cache_dir`, once per machine; a later call, or a later
+    process, only loads them.
+
+    Returns
+    -------
+    dict of str to float
+        Wall time (s) of each group of kernels -- ``"dynamics"`` (the equations of
+        motion of :func:`mechdyn.simulate`) and ``"kinematic sweep"`` (the position
+        problem of :func:`mechdyn.sweep`) -- and ``"total"``.  Empty when Numba is not
+        installed (the analyses then run on NumPy, nothing to compile).
+
+    Examples
+    --------
+    >>> times = warmup()
+    >>> sorted(times) in ([], ["dynamics", "kinematic sweep", "total"])
+    True
+    """
+    import time
+
+    from .dynamics.compiled import _warm_up, numba_available
+    from .kinematics.continuation import Kernel
+    from .mechanism import Mechanism
+
+    if not numba_available():
+        return {}
+    t0 = time.perf_counter()
+    _warm_up()
+    t1 = time.perf_counter()
+    mech = Mechanism("warm-up pendulum")
+    mech.add_body("bar", mass=1.0, inertia=0.1, com=(0.5, 0.0))
+    mech.add_revolute("O", "ground", "bar")
+    mech.add_coordinate("theta", kind="angle", body="bar")
+    model = compile_mechanism(mech)
+    kernel = Kernel(model, model.layout())  # compiles the sweep's drivers on construction
+    kernel.gamma(model.x0, np.zeros(model.n_x))
+    t2 = time.perf_counter()
+    return {"dynamics": t1 - t0, "kinematic sweep": t2 - t1, "total": t2 - t0}

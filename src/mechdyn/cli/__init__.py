@@ -2,7 +2,10 @@
 
 Each subcommand lives in its own module of this package exposing
 ``register(subparsers)``, which adds its parser, and ``run(args) -> int``; the
-options several subcommands share are in :mod:`mechdyn.cli.options`.
+options several subcommands share are in :mod:`mechdyn.cli.options`.  Only the module
+of the subcommand that runs is imported (``mechdyn --help`` lists the others from
+:data:`SUBCOMMANDS`, without importing NumPy's heavier neighbours), so that the command
+line starts fast.
 """
 
 from __future__ import annotations
@@ -16,26 +19,67 @@ import sys
 from pathlib import Path
 
 from .._version import __version__
-from ..errors import MechdynError, ModelError
 
-__all__ = ["main", "SUBCOMMAND_MODULES", "check_outputs", "PLOT_SUFFIXES"]
+__all__ = ["main", "SUBCOMMANDS", "SUBCOMMAND_MODULES", "check_outputs", "PLOT_SUFFIXES"]
+
+#: the subcommands, in the order of ``mechdyn --help``, each with the help line its module
+#: registers (a test keeps the two the same)
+SUBCOMMANDS = {
+    "demo": "run a bundled example end to end (CSV + PNG)",
+    "examples": "list the bundled example models",
+    "check": "validate a model file (every problem at once)",
+    "kinematics": "sweep one coordinate: positions, velocities, accelerations, dead centres",
+    "simulate": "forward dynamics: integrate the equations of motion over time",
+    "kinetostatics": "driving torque, every joint reaction, frame and foundation loads",
+    "reduce": "reduced moment of inertia and reduced torque of a 1-DOF mechanism",
+    "flywheel": "steady cycle, coefficient of speed fluctuation and flywheel sizing",
+    "foundation": "loads on anchor bolts and isolators; natural frequencies of the mounted base",
+    "study": "design study: many variants of a model, one table row each",
+    "animate": "animated GIF of the motion (a sweep of one coordinate, or a simulation)",
+    "report": "self-contained HTML report: model, kinematics, kinetostatics (or a simulation)",
+    "warmup": "compile the numba kernels now (once per machine) and report the time",
+}
 
 #: modules of this package that define subcommands, in the order of ``mechdyn --help``
-SUBCOMMAND_MODULES = ("demo", "examples", "check", "kinematics", "simulate", "kinetostatics",
-                      "reduce", "flywheel", "foundation", "study", "animate", "report")
+SUBCOMMAND_MODULES = tuple(SUBCOMMANDS)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser with every subcommand."""
+def build_parser(load=SUBCOMMAND_MODULES) -> argparse.ArgumentParser:
+    """The argument parser with every subcommand.
+
+    Parameters
+    ----------
+    load : iterable of str
+        The subcommands whose modules are imported and registered in full (default
+        all); the others are listed with their help line only.
+
+    Examples
+    --------
+    >>> parser = build_parser(load=())
+    >>> "simulate" in parser.format_help()
+    True
+    """
     parser = argparse.ArgumentParser(
         prog="mechdyn", description="Kinematics, dynamics and kinetostatics of planar mechanisms.")
     parser.add_argument("--version", action="version", version=f"mechdyn {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for name in SUBCOMMAND_MODULES:
+    load = set(load)
+    for name, help_line in SUBCOMMANDS.items():
+        if name not in load:
+            sub.add_parser(name, help=help_line, add_help=False)
+            continue
         module = importlib.import_module(f"{__name__}.{name}")
         module.register(sub)
         sub.choices[name].set_defaults(func=module.run)
     return parser
+
+
+def _command(argv: list[str]) -> str | None:
+    """The subcommand named in ``argv`` (its first word that is not an option), if any."""
+    for arg in argv:
+        if not arg.startswith("-"):
+            return arg if arg in SUBCOMMANDS else None
+    return None
 
 
 def negative_values(argv: list[str]) -> list[str]:
@@ -70,6 +114,8 @@ def check_outputs(args) -> None:
     ModelError
         Naming the option, the path and what is wrong.
     """
+    from ..errors import ModelError  # here, not at the top: ``--help`` needs no NumPy
+
     for attr, flag in (("output", "-o"), ("plot", "--plot"), ("snapshot", "--snapshot")):
         value = getattr(args, attr, None)
         if value is None:
@@ -93,11 +139,15 @@ def check_outputs(args) -> None:
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code (0 ok, 1 analysis stopped, 2 bad input,
     130 interrupted by Ctrl-C, 143 by SIGTERM; an interrupted run writes its data)."""
-    parser = build_parser()
-    args = parser.parse_args(negative_values(sys.argv[1:] if argv is None else argv))
+    argv = negative_values(sys.argv[1:] if argv is None else list(argv))
+    command = _command(argv)
+    parser = build_parser(load=() if command is None else (command,))
+    args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()
         return 0
+    from ..errors import MechdynError
+
     terminated = []
 
     def on_term(signum, frame):  # SIGTERM ends a run as Ctrl-C does: the data is kept

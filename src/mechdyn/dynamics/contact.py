@@ -32,7 +32,6 @@ import itertools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import nnls
 
 from ..errors import MechdynError
 from ..kernels import rows_numpy
@@ -117,6 +116,7 @@ def solve_lcp(H, r, *, tol: float = 1e-9) -> LCPResult:
         # 1/2 z^T H z + r^T z = 1/2 |S^1/2 V^T z + S^-1/2 V^T r|^2 + const
         Lt = np.sqrt(s)[:, None] * V.T
         y = (V.T @ r) / np.sqrt(s)
+        from scipy.optimize import nnls
         z, _ = nnls(Lt, -y, maxiter=50 * m)
         w, res = _lcp_residual(H, r, z)
         if res <= tol:

@@ -13,7 +13,6 @@ which bisects for the edge of the assembly region).
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..errors import (
     AssemblyError,
@@ -73,6 +72,7 @@ def turning_point(eqs, step, qd_old, x_good) -> str | None:
     kern, ws = eqs.kernel, eqs.ms.ws
     saved = kern.snapshot() if kern is not None else None
     kept = (ws.x, ws.B, ws.qi)
+    from scipy.optimize import brentq
     ms = eqs.ms
     try:
         for k in turns:

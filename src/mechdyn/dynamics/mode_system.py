@@ -34,7 +34,6 @@ from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.linalg
 
 from ..errors import AssemblyError, IntegrationError, LockupError
 from ..kernels import rows_numpy as RN
@@ -172,6 +171,7 @@ class ModeSystem:
                 w[k] = 1e-6
             elif prefer and n not in prefer:
                 w[k] = 0.5
+        import scipy.linalg
         piv = scipy.linalg.qr((GN * w[:, None]).T, pivoting=True)[2]
         chosen = np.sort(piv[:self.dof])
         sv = np.linalg.svd(GN[chosen], compute_uv=False)
@@ -392,6 +392,7 @@ def solve_mass(names, A, rhs, t, q) -> np.ndarray:
     IntegrationError
     """
     try:
+        import scipy.linalg
         return scipy.linalg.cho_solve(scipy.linalg.cho_factor(A), rhs)
     except np.linalg.LinAlgError:
         ev, vec = np.linalg.eigh(0.5 * (A + A.T))

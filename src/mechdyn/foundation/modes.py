@@ -13,7 +13,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import eigh
 
 from ..errors import ModelError
 from .supports import Foundation
@@ -78,6 +77,7 @@ def natural_frequencies(foundation: Foundation) -> Modes:
     ('x (100 %)', 'y (100 %)', 'theta (100 %)')
     """
     Mm = foundation.mass_matrix()
+    from scipy.linalg import eigh
     w2, shapes = eigh(foundation.stiffness_matrix(foundation.com), Mm)
     omega = np.sqrt(np.clip(w2, 0.0, None))
     share = np.diag(Mm)[:, None] * shapes**2

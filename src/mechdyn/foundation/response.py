@@ -6,7 +6,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import expm
 
 from ..errors import ModelError
 from .supports import Foundation, shift_moment, support_matrix
@@ -144,5 +143,6 @@ def _hold(A, B, h):
     big[:n, :n] = A * h
     big[:n, n:n + m] = B * h
     big[n:n + m, n + m:] = np.eye(m)
+    from scipy.linalg import expm
     E = expm(big)
     return E[:n, :n], E[:n, n:n + m], E[:n, n + m:]

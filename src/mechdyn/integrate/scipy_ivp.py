@@ -14,7 +14,6 @@ from __future__ import annotations
 from collections.abc import Iterator
 
 import numpy as np
-import scipy.integrate as si
 
 from ..errors import IntegrationError
 from .base import DEFAULT_RTOL, Integrator, IntegratorOptionError, Step, check_positive
@@ -88,6 +87,7 @@ class ScipyIntegrator(Integrator):
                 f"{y0.size}")
         kw = {k: v for k, v in (("first_step", self.first_step), ("max_step", self.max_step))
               if v is not None}
+        import scipy.integrate as si
         solver = getattr(si, self.method)(fun, t0, y0, t_end, vectorized=False,
                                           rtol=self.rtol, atol=atol, **kw)
         fsal = self.method in _FSAL

@@ -21,7 +21,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..errors import Status
 from .events import EventRecord
@@ -109,6 +108,7 @@ def locate(cands, t_old: float, t_new: float, dense: Callable, evaluate: Callabl
     def gfun(s, e):
         return e.fn(s, evaluate(s, dense(s)))
 
+    from scipy.optimize import brentq
     roots = []
     for e in cands:
         a_val = gfun(t_old, e)

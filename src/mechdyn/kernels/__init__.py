@@ -1,2 +1,46 @@
 """Evaluators over data: the constraint rows (NumPy, batched; and the Numba twin), the
-packed loads and the small dense linear algebra of the compiled kernels."""
+packed loads and the small dense linear algebra of the compiled kernels.
+
+The Numba kernels are compiled once per machine and kept in the user's cache folder
+(:func:`cache_dir`, ``platformdirs.user_cache_dir("mechdyn")``, e.g.
+``~/.cache/mechdyn`` on Linux) rather than next to the installed sources, which may be
+read-only.  A ``NUMBA_CACHE_DIR`` the user has set is respected.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+__all__ = ["cache_dir"]
+
+
+def cache_dir() -> str:
+    """The folder the compiled kernels are cached in: ``NUMBA_CACHE_DIR`` when set (by
+    the user, or by this package on import), else the user's cache folder for mechdyn.
+
+    Examples
+    --------
+    >>> import os
+    >>> cache_dir() == os.environ["NUMBA_CACHE_DIR"]
+    True
+    """
+    chosen = os.environ.get("NUMBA_CACHE_DIR")
+    if chosen:
+        return chosen
+    from platformdirs import user_cache_dir
+
+    return user_cache_dir("mechdyn", appauthor=False)
+
+
+def _use_cache_dir() -> None:
+    """Point Numba's disk cache at :func:`cache_dir` before any kernel is decorated (Numba
+    reads the setting when a cached function is defined, and at its own import)."""
+    folder = cache_dir()
+    os.environ["NUMBA_CACHE_DIR"] = folder
+    numba_config = sys.modules.get("numba.core.config")  # numba imported before mechdyn
+    if numba_config is not None and not numba_config.CACHE_DIR:
+        numba_config.CACHE_DIR = folder
+
+
+_use_cache_dir()

@@ -16,6 +16,8 @@ from contextlib import contextmanager
 
 import numpy as np
 
+from . import cache_dir
+
 __all__ = ["rows_values", "rows_jacobian", "rows_quad", "body_pose", "njit", "NUMBA",
            "compiling", "ANNOUNCE_AFTER"]
 
@@ -34,8 +36,8 @@ except ImportError:  # pragma: no cover
 @contextmanager
 def compiling(what: str, after: float = ANNOUNCE_AFTER):
     """Announce on stderr a first compilation of ``what`` that takes longer than
-    ``after`` seconds, and how long it took (a later run loads the cached code and
-    says nothing).
+    ``after`` seconds, where it is cached (:func:`mechdyn.kernels.cache_dir`) and how
+    long it took (a later run, in any process, loads the cached code and says nothing).
 
     Examples
     --------
@@ -47,8 +49,8 @@ def compiling(what: str, after: float = ANNOUNCE_AFTER):
 
     def announce():
         said.append(True)
-        print(f"mechdyn: compiling the {what} (first run only, cached afterwards) ...",
-              file=sys.stderr, flush=True)
+        print(f"mechdyn: compiling the {what} (first use on this machine, cached in "
+              f"{cache_dir()}) ...", file=sys.stderr, flush=True)
 
     timer = threading.Timer(after, announce)
     timer.daemon = True

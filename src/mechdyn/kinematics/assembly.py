@@ -10,7 +10,6 @@ lose control and the joints whose equations become dependent.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from ..errors import AssemblyError, SingularPositionError
 from ..kernels import rows_numpy
@@ -373,6 +372,7 @@ def _assemble_near(model: Model, q, *, x_guess=None, layout=None, t=None) -> np.
 def _least_squares(fun, x, w=1.0, **options) -> np.ndarray:
     """The pose nearest to w F = 0 from x, ``fun(x) -> (F, J)``, by SciPy's least_squares."""
     w = np.asarray(w, dtype=float)
+    from scipy.optimize import least_squares
     return least_squares(lambda xx: fun(xx)[0] * w, x, jac=lambda xx: fun(xx)[1] * w[..., None],
                          xtol=1e-15, ftol=1e-15, gtol=1e-15, **options).x
 

@@ -13,7 +13,6 @@ from dataclasses import asdict, dataclass, field
 from functools import partial
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..kernels import rows_numpy
 from ..mechanism.joint import Revolute
@@ -452,6 +451,7 @@ def _refine_root(sw: KinematicSweep, i: int, quantity) -> tuple[float, float]:
         last["s"] = float(s)
         return float(ds)
 
+    from scipy.optimize import brentq
     a, b = float(sw.values[i]), float(sw.values[i + 1])
     try:
         q = brentq(rate, min(a, b), max(a, b), xtol=1e-15, rtol=4 * np.finfo(float).eps)
