@@ -109,7 +109,7 @@ def _balance(run):
 
 def test_between_events_the_frame_load_balances_the_momentum_of_the_mechanism(run):
     frame, moment, f_bal, m_bal = _balance(run)
-    # measured: 3e-16 of the largest force (89 kN), 8e-14 of the largest moment
+    # measured: 5e-16 of the largest force (89 kN), 2e-14 of the largest moment
     np.testing.assert_allclose(frame, f_bal, rtol=0, atol=1e-10 * np.abs(frame).max())
     np.testing.assert_allclose(moment, m_bal, rtol=0, atol=1e-10 * np.abs(moment).max())
 
@@ -132,7 +132,7 @@ def test_the_recorded_momentum_is_the_time_integral_of_the_loads(run):
         integral = cumulative_trapezoid(rate[a:b], tr.t[a:b], axis=0, initial=0.0)
         scale = np.trapezoid(np.abs(rate[a:b]), tr.t[a:b], axis=0).max()
         worst = max(worst, np.abs(P[a:b] - P[a] - integral).max() / scale)
-    assert worst < 3e-3  # measured 6.6e-4
+    assert worst < 3e-3  # measured 1.2e-3
 
 
 def test_at_impacts_the_momentum_jumps_by_minus_the_impulse_on_the_frame(run):
@@ -218,5 +218,5 @@ def test_the_spectrogram_marks_the_lock_engagements_and_releases(run):
                 near = np.abs(tc - t_ev) <= segment
                 around = (np.abs(tc - t_ev) > 2 * segment) & (np.abs(tc - t_ev) < 6 * segment)
                 assert np.isin(np.flatnonzero(near), peaks).any(), t_ev
-                # measured: 0.07-0.27 of the largest burst against <= 0.001 around
+                # measured: 180 to 1000 times the level around
                 assert broad[near].max() > 20.0 * np.median(broad[around])
