@@ -37,6 +37,7 @@ import numpy as np
 
 from .dynamics.contact import gaps, touching
 from .dynamics.dead_position import diagnose, status_of, turning_point
+from .dynamics.impact import frame_impulse_key
 from .dynamics.lagrange import kinetic_energy
 from .dynamics.mode_equations import ModeEquations
 from .dynamics.modes import ModeSystem, switched_model
@@ -423,6 +424,12 @@ def _finish(model, rec, events, stats, wall0, status, message, sm,
         if ms.n_rows:
             res[sl] = np.max(np.abs(ms.row_values(x[sl])), axis=-1)
     modes = list(dict.fromkeys(r[1].mode for r in rec))
+    key = frame_impulse_key(sm)
+    for ev in events:  # the frame's impulse of an impact: its angular part about the point
+        if key in ev.impulses:
+            f = np.array(ev.impulses[key], float)
+            f[2] -= point[0] * f[1] - point[1] * f[0]
+            ev.impulses[key] = f
     # the bodies, plus the rotors and gears of the drives reduced to their coordinates
     T = kinetic_energy(model, x, xd) + 0.5 * (qd**2) @ sm.drive_inertia
     U = sm.fm.potential_energy(x)

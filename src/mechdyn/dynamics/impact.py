@@ -22,7 +22,9 @@ The kinetic energy lost is T- - T+; for a plastic impact it equals
 1/2 (qdot- - qdot+)^T A (qdot- - qdot+).  The impulse of every joint, lock,
 stop and contact (including the pins that carry the impact through) comes from
 M (xdot+ - xdot-) = Phi_x^T Lambda over all rows of the new mode.  Friction is
-not active during the instant of an impact (frictionless impact law).
+not active during the instant of an impact (frictionless impact law).  The impulse that
+the frame receives (the opposite of the impulses of the rows that act between it and the
+moving bodies) is reported as well: minus the jump of the mechanism's momentum.
 """
 
 from __future__ import annotations
@@ -35,7 +37,32 @@ from .contact import constrained_inverse, row_terms, solve_lcp
 from .modes import ModeSystem, SwitchedModel, mass_matrix_x
 from .reactions import element_forces, frame_forces
 
-__all__ = ["ImpactResult", "impact", "element_forces", "frame_forces"]
+__all__ = ["ImpactResult", "impact", "element_forces", "frame_forces", "frame_impulse_key"]
+
+
+def frame_impulse_key(sm: SwitchedModel) -> str:
+    """The key of the frame's impulse in :attr:`ImpactResult.element_impulses` (and in
+    the ``impulses`` of an event): ``"frame"``, or ``"frame (total)"`` if a joint, lock,
+    stop or contact of the model is named ``"frame"``.
+
+    Parameters
+    ----------
+    sm : SwitchedModel
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> import mechdyn as md
+    >>> from mechdyn.dynamics.modes import switched_model
+    >>> frame_impulse_key(switched_model(md.examples.load("four_bar").compile()))
+    'frame'
+    """
+    names = set(sm.model.mechanism.joints) | set(sm.lock_names) | set(sm.stops) | set(
+        sm.contacts)
+    return "frame (total)" if "frame" in names else "frame"
 
 
 @dataclass
@@ -58,8 +85,15 @@ class ImpactResult:
         N m s for a prismatic joint or a weld (L about the child frame origin, the
         weld's point); for each coordinate lock, stop or contact, the impulse of
         its row (N s or N m s).
+        Under the key ``"frame"`` (``"frame (total)"`` if an element is named
+        ``"frame"``): :attr:`frame_impulse`.
     velocity_before, velocity_after : dict
         Rate of each new row (m/s or rad/s) before and after the impact.
+    frame_impulse : ndarray, shape (3,)
+        The impulse that the frame receives (:func:`~mechdyn.dynamics.reactions.
+        frame_forces` of the impulses): (Px, Py) N s and the angular impulse about the
+        ground origin, N m s.  By Newton's third law it is minus the jump of the
+        mechanism's linear and angular momentum.
     """
 
     xdot_plus: np.ndarray
@@ -70,6 +104,7 @@ class ImpactResult:
     element_impulses: dict = field(default_factory=dict)
     velocity_before: dict = field(default_factory=dict)
     velocity_after: dict = field(default_factory=dict)
+    frame_impulse: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
 
 def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets: dict,
@@ -148,8 +183,11 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     Lam = np.linalg.lstsq(R.T, dp, rcond=None)[0] if R.size else np.zeros(0)
     labels = [r.label for r in rows_b + rows_u]
     C = np.concatenate([Cb, Cu])  # the rates of the new rows
+    on_frame = frame_forces(after, x, Lam, point=np.zeros(2))["total"]
+    per_element = element_forces(after, x, Lam)
+    per_element[frame_impulse_key(sm)] = on_frame
     return ImpactResult(xdot_plus, T0, T1, T0 - T1,
                         dict(zip(after.row_labels(), map(float, Lam), strict=True)),
-                        element_forces(after, x, Lam),
+                        per_element,
                         dict(zip(labels, map(float, C @ qd_minus), strict=True)),
-                        dict(zip(labels, map(float, C @ qd_plus), strict=True)))
+                        dict(zip(labels, map(float, C @ qd_plus), strict=True)), on_frame)
