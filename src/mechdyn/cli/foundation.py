@@ -6,16 +6,19 @@ Example::
         --support "bolt1: x=-0.4m, y=0m, k_axial=2e8N/m, k_shear=1e8N/m, preload=20kN" \\
         --support "bolt2: x=0.4m, y=0m, k_axial=2e8N/m, k_shear=1e8N/m, preload=20kN" \\
         -o loads.csv --plot loads.png
-    mechdyn foundation press_cycle --t-end 1s --mass 500kg --inertia 80kg*m^2 \\
-        --isolator "left: x=-0.5m, y=-0.3m, kx=2e5N/m, ky=5e5N/m, cy=2000N*s/m" \\
-        --isolator "right: x=0.5m, y=-0.3m, kx=2e5N/m, ky=5e5N/m, cy=2000N*s/m"
+    mechdyn foundation press_cycle --t-end 1s    # the isolators of its [foundation]
+
+Without ``--support`` and ``--isolator`` the supports are those of the model file's
+``[foundation]`` table (docs/model-file.md), its mass, inertia and centre of mass too;
+supports given on the command line replace the file's, and ``--mass``, ``--inertia``
+and ``--com`` override its values.
 
 The run's frame loads (the load the machine exerts on its frame, moment about the
-ground origin) are shared among the supports of a rigid base by stiffness; with
-``--mass`` and ``--inertia`` the base is also taken as a body on elastic supports: its
-natural frequencies beside the excitation orders of the running speed, and its
-response to the frame loads (one way: the base's motion does not act back on the
-machine).
+ground origin) are shared among the supports of a rigid base by stiffness; with a mass
+and an inertia (the model's, or ``--mass`` and ``--inertia``) the base is also taken as
+a body on elastic supports: its natural frequencies beside the excitation orders of the
+running speed, and its response to the frame loads (one way: the base's motion does not
+act back on the machine).
 
 Exit codes: 0 done; 1 the run stopped early (the samples so far are analysed);
 2 bad input.
@@ -38,21 +41,16 @@ from ..foundation import (
     support_loads,
 )
 from ..foundation.plot import plot_support_loads
+from ..modelfile.foundation import support_fields
 from ..results.table import write_csv
 from ..units import parse_quantity, parse_vector
-from .options import add_files, add_model, add_run, finish, open_model, simulate_from_args
+from .options import add_files, add_model, add_run, finish, load_model, simulate_from_args
 
 __all__ = ["register", "run", "parse_support"]
 
-#: fields of a support text: kind of quantity, and whether it must be given
-_FIELDS = {
-    AnchorBolt: {"x": ("length", True), "y": ("length", True),
-                 "k_axial": ("stiffness", True), "k_shear": ("stiffness", True),
-                 "preload": ("force", False), "load_factor": ("ratio", False)},
-    Isolator: {"x": ("length", True), "y": ("length", True), "kx": ("stiffness", True),
-               "ky": ("stiffness", True), "cx": ("damping", False),
-               "cy": ("damping", False)},
-}
+#: fields of a support text: kind of quantity, and whether it must be given (the model
+#: file's [[foundation.bolts]] and [[foundation.isolators]] have the same)
+_FIELDS = {cls: support_fields(cls) for cls in (AnchorBolt, Isolator)}
 
 
 def register(sub) -> None:
@@ -61,14 +59,17 @@ def register(sub) -> None:
         "foundation",
         help="loads on anchor bolts and isolators; natural frequencies of the mounted base",
         description="Simulate the model, share the load its frame receives among the "
-                    "supports of a rigid base (bolt tension, shear and clamp force, the first "
+                    "supports (those of the model's [foundation] table, or --support and "
+                    "--isolator) of a rigid base (bolt tension, shear and clamp force, the first "
                     "bolt joint to open); with --mass and --inertia also the base on elastic "
                     "supports: natural frequencies, excitation orders near them, and the force "
                     "passed to the floor.",
         epilog='A support is "NAME: key=value, ...": bolts x, y, k_axial, k_shear '
                '[, preload, load_factor]; isolators x, y, kx, ky [, cx, cy]; values take '
-               "units (0.4m, 2e8N/m, 20kN, 2000N*s/m; a bare number is SI). Exit codes: 0 done,"
-               " 1 the run stopped early, 2 bad input.")
+               "units (0.4m, 2e8N/m, 20kN, 2000N*s/m; a bare number is SI). Supports given "
+               "here replace those of the model's [foundation] table; --mass, --inertia and "
+               "--com override its values. Exit codes: 0 done, 1 the run stopped early, 2 bad "
+               "input.")
     add_model(p)
     add_run(p, required=True)
     p.add_argument("--samples", type=int, default=2001, metavar="N",
@@ -82,8 +83,9 @@ def register(sub) -> None:
     p.add_argument("--mass", metavar="MASS", help="mass of frame and base, e.g. 500kg")
     p.add_argument("--inertia", metavar="J",
                    help="their moment of inertia about their centre of mass, e.g. 80kg*m^2")
-    p.add_argument("--com", default="0m,0m", metavar="X,Y",
-                   help="their centre of mass (default 0m,0m)")
+    p.add_argument("--com", metavar="X,Y",
+                   help="their centre of mass (default: the model's [foundation] com, else "
+                        "0m,0m)")
     p.add_argument("--weight", action="store_true",
                    help="add the weight of frame and base (--mass, the model's gravity) to "
                         "the loads of the rigid base")
@@ -132,21 +134,33 @@ def _example(cls) -> str:
             if cls is AnchorBolt else "m1: x=0.5m, y=0m, kx=2e5N/m, ky=5e5N/m, cy=2000N*s/m")
 
 
-def build_foundation(args) -> Foundation:
+def build_foundation(args, given: Foundation | None = None) -> Foundation:
     """The :class:`Foundation` of ``--support``, ``--isolator``, ``--mass``, ``--inertia``,
-    ``--com``."""
+    ``--com``; what they leave out is taken from ``given`` (the model's foundation)."""
     supports = ([parse_support(s, AnchorBolt, "--support") for s in args.support]
                 + [parse_support(s, Isolator, "--isolator") for s in args.isolator])
-    if not supports:
-        raise ModelError("give the supports with --support (anchor bolts) or --isolator, "
-                         "at least two at distinct points")
-    if (args.mass is None) != (args.inertia is None):
+    if not supports and given is None:
+        raise ModelError("no supports: the model has no [foundation] table; give the supports "
+                         "with --support (anchor bolts) or --isolator, at least two at distinct "
+                         "points, or add [[foundation.bolts]] or [[foundation.isolators]] to "
+                         "the model file (docs/model-file.md)")
+    mass = given.mass if given is not None else None
+    inertia = given.inertia if given is not None else None
+    com = given.com if given is not None else (0.0, 0.0)
+    if given is None and (args.mass is None) != (args.inertia is None):
         raise ModelError("--mass and --inertia go together (the elastic analysis needs both)")
-    mass = None if args.mass is None else parse_quantity(args.mass, "mass", where="--mass")
-    inertia = None if args.inertia is None else parse_quantity(args.inertia, "inertia",
-                                                                where="--inertia")
-    com = parse_vector(args.com.split(","), ("length", "length"), where="--com")
-    return Foundation(supports, mass=mass, inertia=inertia, com=tuple(com))
+    if args.mass is not None:
+        mass = parse_quantity(args.mass, "mass", where="--mass")
+    if args.inertia is not None:
+        inertia = parse_quantity(args.inertia, "inertia", where="--inertia")
+    if (mass is None) != (inertia is None):
+        raise ModelError(f"{'--mass' if inertia is None else '--inertia'}: the model's "
+                         f"[foundation] has no {'inertia' if inertia is None else 'mass'}; "
+                         "give --mass and --inertia together (the elastic analysis needs "
+                         "both)")
+    if args.com is not None:
+        com = tuple(parse_vector(args.com.split(","), ("length", "length"), where="--com"))
+    return Foundation(supports or given.supports, mass=mass, inertia=inertia, com=com)
 
 
 def _rpm(args, traj) -> float | None:
@@ -162,7 +176,8 @@ def _rpm(args, traj) -> float | None:
 
 def run(args) -> int:
     """Run ``mechdyn foundation``; returns the exit code."""
-    foundation = build_foundation(args)
+    mech = load_model(args.model)
+    foundation = build_foundation(args, mech.foundation)
     try:
         orders = tuple(int(k) for k in args.orders.split(","))
     except ValueError:
@@ -170,12 +185,14 @@ def run(args) -> int:
                          f"{args.orders!r}") from None
     if args.samples < 2:
         raise ModelError(f"--samples must be >= 2, got {args.samples}")
-    mech, model = open_model(args)
+    model = mech.compile()
     traj = simulate_from_args(model, args, args.samples)
     if args.weight and foundation.mass is None:
         raise ModelError("--weight needs --mass (and --inertia)")
     loads = support_loads(foundation, traj, gravity=model.gravity if args.weight else None)
-    print(f"{mech.name}: loads on {len(foundation.supports)} supports over t = "
+    source = "the model's [foundation]" if not (args.support or args.isolator) else \
+        "the command line"
+    print(f"{mech.name}: loads on {len(foundation.supports)} supports ({source}) over t = "
           f"{loads.t[0]:.6g} .. {loads.t[-1]:.6g} s (rigid base)")
     print(loads.summary())
     mounted = None
@@ -196,8 +213,8 @@ def run(args) -> int:
                                    point=loads.point)
         print(f"  force to the floor: peak {np.max(np.hypot(a[:, 0], a[:, 1])) / 1e3:.4g} kN "
               f"rigid, {np.max(np.hypot(*mounted.floor[:, :2].T)) / 1e3:.4g} kN on the "
-              f"mounts; base motion peak {np.max(np.abs(mounted.u[:, 1])) * 1e3:.4g} mm "
-              f"vertical, {np.max(np.abs(mounted.u[:, 0])) * 1e3:.4g} mm horizontal")
+              f"mounts; base motion peak {np.max(np.abs(mounted.u[:, 0])) * 1e3:.4g} mm "
+              f"in x, {np.max(np.abs(mounted.u[:, 1])) * 1e3:.4g} mm in y")
     if args.output:
         print(f"  table: {write_csv(loads, args.output)}")
         if mounted is not None:

@@ -89,7 +89,7 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                    model_drives="replace", reacting_loads=(), x_guess=None, lay=None,
                    candidates=None) -> Kinetostatics:
     """The analysis in one mode (see :func:`kinetostatics`); a switched trajectory's
-    segment gives its rows ``lay`` (a layout or ModeRows), the order in which coordinates
+    segment gives its rows ``lay`` (a layout with its extra rows), the order in which coordinates
     are chosen as driven (``candidates``) and its first pose as ``x_guess``."""
     t_start = time.perf_counter()
     names = model.coordinate_names
@@ -209,4 +209,4 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
         frame_point=np.asarray(point, dtype=float).copy(), mode=lay.mode, status=status,
         message=message, warnings=tuple(warn), stats=stats, model=model,
         **core, element_units={el: "N m" if lay.rowset.is_angle[idx[0]] else "N"
-                               for el, idx in getattr(lay, "elements", {}).items()})
+                               for el, idx in lay.elements.items()})

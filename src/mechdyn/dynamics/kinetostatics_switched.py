@@ -17,19 +17,18 @@ from types import SimpleNamespace
 import numpy as np
 
 from ..errors import MechdynError, Status
-from ..model import Model
+from ..model import ConstraintLayout, Model
 from ..results.kinetostatics_record import Kinetostatics
 from .forces import force_model
 from .kinetostatics_mode import MESSAGES, _kinetostatics
 from .mode_system import fmt_mode
 from .modes import SwitchedModel, mode_friction, mode_locks, switched_model
-from .prescribed_motion import ModeRows
 
 __all__ = ["kinetostatics_switched"]
 
 
 def _mode_rows(model: Model, sm: SwitchedModel, mode: frozenset, x0, first):
-    """(layout or ModeRows, candidates) of a mode whose first pose is ``x0``: the rows of
+    """(layout, candidates) of a mode whose first pose is ``x0``: the rows of
     the forward dynamics (:meth:`SwitchedModel.rows`), the locks holding what they held,
     and the order in which coordinates are tried as driven (``first``, the others, and
     last those the mode's locks free)."""
@@ -38,7 +37,7 @@ def _mode_rows(model: Model, sm: SwitchedModel, mode: frozenset, x0, first):
     for n in [*mode_locks(mode), *sticks]:
         sm.capture_target(n, x0, targets)
     extra = sm.rows(mode, targets)
-    lay = ModeRows(model, extra, mode) if extra else model.layout(frozenset())
+    lay = ConstraintLayout(model, mode, extra) if extra else model.layout(frozenset())
     late = {model.coordinate_index(f) for n in mode_locks(mode) for f in sm.lock_frees(n)
             if f in model.coordinate_names}
     return lay, sorted(dict.fromkeys([*first, *range(model.n_q)]), key=late.__contains__)

@@ -38,8 +38,8 @@ import scipy.linalg
 
 from ..errors import AssemblyError, IntegrationError, LockupError
 from ..kernels import rows_numpy as RN
-from ..kinematics.assembly import newton
-from ..model.rows import concat
+from ..kinematics.assembly import _position_tol, _scale, _scaled, _singular_report, newton
+from ..model import ConstraintLayout
 from ..model.state import Mode
 from ..model.workspace import Workspace
 from .inertia import mass_matrix_x
@@ -111,6 +111,8 @@ class ModeSystem:
     ----------
     rows : list of Row
         The switchable rows of the mode.
+    layout : ConstraintLayout
+        Their bookkeeping with the joint rows (:class:`~mechdyn.model.ConstraintLayout`).
     rowset : Rows
         Every row of the mode: the joint rows (``n_base`` of them), then ``rows``.
     independent_rows : ndarray of int
@@ -129,45 +131,38 @@ class ModeSystem:
         self.sm = sm
         model = sm.model
         self.model = model
-        nb = sm.nb
         self.mode = Mode(mode)
         self.targets = dict(targets)
         self.rows = sm.rows(self.mode, targets)
-        self.n_base = len(model.joint_rows)
-        self.rowset = concat(nb, model.joint_rows, *[r.rows for r in self.rows])
-        self.n_rows = len(self.rowset)
-        slip = [(self.n_base + k, r.friction_rows) for k, r in enumerate(self.rows) if r.slip]
-        self._slip_rows = np.array([k for k, _ in slip], int)
-        self._slip = concat(nb, *[f for _, f in slip]) if slip else None
-        L = model.length_scale
-        colscale = np.tile([L, L, 1.0], nb)
-        rowscale = np.where(self.rowset.is_angle, 1.0, 1.0 / L)
+        self.layout = lay = ConstraintLayout(model, self.mode, self.rows)
+        self.rowset, self.n_rows, self.n_base = lay.rowset, lay.n_rows, lay.n_base
+        #: the rows of each element (joint, lock, stop, contact), indices into rowset
+        self.element_rows = lay.element_rows
+        self._slip = lay.friction if len(lay.slip_rows) else None
         self.x_ref = np.array(x, float)
-        Rs = self.row_jacobian(self.x_ref) * rowscale[:, None] * colscale[None, :]
+        Rs = _scaled(model, self.row_jacobian(self.x_ref), self.rowset.is_angle)
         self.independent_rows = _independent_rows(Rs)
         self.dof = model.n_x - len(self.independent_rows)
-        self.coords = self._choose_coordinates(Rs[self.independent_rows], colscale, prefer,
-                                               avoid)
+        self.coords = self._choose_coordinates(Rs[self.independent_rows], prefer, avoid)
         self.coord_names = tuple(model.coordinate_names[k] for k in self.coords)
         self.n_i = len(self.coords)
         # every row and every coordinate, evaluated at once; the position problem
         # [independent rows; g_I - q_I] is the subset _sel of them
-        self._all = concat(nb, self.rowset, model.coordinate_rows)
+        self._all = lay.position_rows
         self._sel = np.concatenate([self.independent_rows, self.n_rows + self.coords])
         self._eye_i = np.zeros((model.n_x, self.n_i))
         self._eye_i[len(self.independent_rows):, :] = np.eye(self.n_i)
-        self._rs = np.tile([1.0, 1.0, 1.0 / L], nb)
+        self._rs = 1.0 / _scale(model)
         self.ws = Workspace() if workspace is None else workspace
         self.ws.reset(self.x_ref)
 
-    def _choose_coordinates(self, Ri, colscale, prefer, avoid) -> np.ndarray:
+    def _choose_coordinates(self, Ri, prefer, avoid) -> np.ndarray:
         """Pivots of G N (G the scaled coordinate Jacobian, N the null space of the
         scaled independent rows ``Ri``), weighted by ``prefer`` and ``avoid``."""
         model = self.model
         if self.dof == 0:
             return np.zeros(0, int)
-        cscale = np.where(model.coord_is_angle, 1.0, 1.0 / model.length_scale)
-        Gs = self._coord_jac(self.x_ref) * cscale[:, None] * colscale[None, :]
+        Gs = _scaled(model, self._coord_jac(self.x_ref), model.coord_is_angle)
         N = np.linalg.svd(Ri)[2][Ri.shape[0]:].T if Ri.shape[0] else np.eye(model.n_x)
         GN = Gs @ N  # (n_q, dof)
         names = model.coordinate_names
@@ -204,15 +199,6 @@ class ModeSystem:
         return list(self.rowset.elements)
 
     @cached_property
-    def element_rows(self) -> dict[str, np.ndarray]:
-        """The rows of each element (joint, lock, stop, contact), indices into
-        :attr:`rowset`."""
-        out: dict[str, list[int]] = {}
-        for k, el in enumerate(self.rowset.elements):
-            out.setdefault(el, []).append(k)
-        return {el: np.array(idx, int) for el, idx in out.items()}
-
-    @cached_property
     def grounded(self) -> frozenset:
         """The elements whose rows act between the frame and the moving bodies."""
         return frozenset(el for el, idx in self.element_rows.items()
@@ -241,7 +227,7 @@ class ModeSystem:
         qi = np.asarray(qi, float)
         x = self.ws.predict(qi) if x_guess is None else np.array(x_guess, float)
         n_r = len(self.independent_rows)
-        tol = 1e-13 * max(self.model.length_scale, 1e-3)
+        tol = _position_tol(self.model)
         x, done = newton(self._all, x, np.concatenate([np.zeros(n_r), qi]), sel=self._sel,
                          tol=tol)
         if not done:
@@ -272,23 +258,9 @@ class ModeSystem:
         the left null vector: they lose control) and ``joints`` (the elements whose rows
         become dependent)."""
         J = RN.jacobian(self._all, x)[self._sel]
-        if not J.size:
-            return {"rcond": 1.0, "coordinates": [], "joints": []}
-        L = self.model.length_scale
-        angle = np.concatenate([self.rowset.is_angle,
-                                self.model.coord_is_angle])[self._sel]
-        Js = J * np.where(angle, 1.0, 1.0 / L)[:, None] \
-            * np.tile([L, L, 1.0], self.model.n_bodies)[None, :]
-        u, sv, _ = np.linalg.svd(Js)
-        share = u[:, -1] ** 2
-        n_r = len(self.independent_rows)
-        names = self.model.coordinate_names
-        return {"rcond": float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0,
-                "coordinates": [names[c] for c, w in zip(self.coords, share[n_r:], strict=True)
-                                if w > 1e-3],
-                "joints": sorted({self.rowset.elements[r]
-                                  for r, w in zip(self.independent_rows, share[:n_r],
-                                                  strict=True) if w > 1e-3})}
+        rows = [self.rowset.elements[r] for r in self.independent_rows]
+        return _singular_report(_scaled(self.model, J, self._all.is_angle[self._sel]), rows,
+                                self.coord_names)
 
     def state(self, qi, qdoti, x_guess=None, t=None):
         """(x, xdot, B) at independent coordinates and rates."""
@@ -354,7 +326,7 @@ class ModeSystem:
             Reff = R
             if self._slip is not None:
                 Reff = R.copy()
-                Reff[self._slip_rows] += RN.jacobian(self._slip, x)
+                Reff[self.layout.slip_rows] += RN.jacobian(self._slip, x)
             qddi, lam = self._solve_motion(M, B, Reff, rhs, self._rs)
         xddot = B @ qddi + b_
         qddot = G @ xddot + quad_g

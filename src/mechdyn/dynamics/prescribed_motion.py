@@ -14,7 +14,6 @@ the exact right-hand side gamma.  The dead centres are refined on a sweep of the
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from ..errors import AssemblyError, ModelError, SingularPositionError
 from ..kernels import rows_numpy
@@ -23,40 +22,18 @@ from ..kinematics.branch_chart import ChartBook, PathProblem
 from ..kinematics.constraints import _point_kinematics, coordinates, coordinates_jacobian
 from ..kinematics.continuation import Kernel, _kernel, _march, _newton, _node
 from ..kinematics.records import _refine_root
-from ..kinematics.sweep import DEFAULT_MAX_STEP, DEFAULT_MIN_STEP, _motion, _path, sweep
+from ..kinematics.sweep import (
+    DEFAULT_MAX_STEP,
+    DEFAULT_MIN_STEP,
+    _motion,
+    _path,
+    _solve_at,
+    sweep,
+)
 from ..model import Model, as_model
-from ..model.rows import concat
 from .mode_system import _independent_rows
 
-__all__ = ["dead_centres", "ModeRows"]
-
-class ModeRows:
-    """The constraint rows of a variable-structure mode for kinetostatics: the joint
-    rows of the model, then ``extra``, the switchable rows of the mode
-    (:meth:`~mechdyn.dynamics.modes.SwitchedModel.rows`, as in the forward dynamics).
-
-    It stands in for a layout everywhere kinetostatics uses one (``rowset``,
-    ``n_rows``, ``rows`` of the joints and weld locks, ``row_joint``, ``mode``);
-    ``elements`` are the row indices of every switchable element but the weld locks
-    (which report as joints).
-    """
-
-    def __init__(self, model: Model, extra, mode):
-        base = model.layout(frozenset())
-        self.extra = list(extra)
-        self.mode = frozenset(mode)
-        self.n_base = base.n_rows
-        self.rowset = concat(model.n_bodies, model.joint_rows, *[r.rows for r in self.extra])
-        self.n_rows = len(self.rowset)
-        keys = [r.label if r.kind == "stick" else r.element for r in self.extra]
-        self.row_joint = np.array([*base.row_joint, *keys], dtype=object)
-        groups = {k: np.flatnonzero(self.row_joint == k) for k in dict.fromkeys(self.row_joint)}
-        joints = set(base.rows) | set(model.lock.names)
-        self.rows = {k: v for k, v in groups.items() if k in joints}
-        self.elements = {k: v for k, v in groups.items() if k not in joints}
-        slip = [(self.n_base + k, r.friction_rows) for k, r in enumerate(self.extra) if r.slip]
-        self.slip_rows = np.array([k for k, _ in slip], int)
-        self.friction = concat(model.n_bodies, *[f for _, f in slip])
+__all__ = ["dead_centres"]
 
 
 def _steps(kern: Kernel, c: int, tol: float, counter: dict) -> dict:
@@ -82,8 +59,8 @@ def _move(kern: Kernel, node, q, cs, tol: float, counter: dict):
 
 def _start(kern: Kernel, q0, x_start, j: int, tol: float, counter: dict):
     """The node at the held coordinates of q0 (coordinate j as at x_start), by
-    continuation from the pose x_start when it is assembled, else by Newton's method
-    (least squares first when that fails) at q0."""
+    continuation from the pose x_start when it is assembled, else at q0 by the sweep's
+    Newton-else-fit (:func:`~mechdyn.kinematics.sweep._solve_at`)."""
     q_s = coordinates(kern.model, x_start)[kern.idx]
     x, ok, _, J = _newton(kern, x_start, q_s, tol, max_iter=60)
     if ok:
@@ -92,15 +69,7 @@ def _start(kern: Kernel, q0, x_start, j: int, tol: float, counter: dict):
                          [c for c in range(len(q0)) if c != j], tol, counter)
         except (AssemblyError, SingularPositionError):
             pass
-    x, ok, _, J = _newton(kern, x_start, q0, tol, max_iter=60)
-    if not ok:
-        sol = least_squares(lambda xx: kern.system(xx, q0)[0], x_start,
-                            jac=lambda xx: kern.system(xx, q0)[1], method="trf", xtol=1e-15,
-                            ftol=1e-15, gtol=1e-15, max_nfev=2000,
-                            x_scale=kern.col_scale / kern.model.length_scale)
-        x, ok, _, J = _newton(kern, sol.x, q0, tol, max_iter=30)
-        if not ok:
-            raise _error(kern, q0, x)
+    x, _, J = _solve_at(kern, x_start, q0, tol, max_iter=60, error=lambda xx: _error(kern, q0, xx))
     return _node(kern, x, q0, j, J)
 
 
@@ -110,8 +79,7 @@ def _error(kern: Kernel, qd, x):
     model, lay = kern.model, kern.lay
     res = joint_residuals(model, x, lay)
     r = rows_numpy.values(lay.rowset, x)
-    res.update({el: float(np.linalg.norm(r[idx]))
-                for el, idx in getattr(lay, "elements", {}).items()})
+    res.update({el: float(np.linalg.norm(r[idx])) for el, idx in lay.elements.items()})
     names = [model.coordinate_names[k] for k in kern.idx]
     if max(res.values(), default=0.0) < 1e-6 * model.length_scale:
         return SingularPositionError(
@@ -134,13 +102,13 @@ def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=N
     (through bifurcation positions with a chart book), or through anchors when several
     driven coordinates vary.  Also returns the charted samples (mask (n,), x', x'') or
     None and the stats ``position_solves`` and ``bifurcations``."""
-    kern = Kernel(model, lay, didx) if isinstance(lay, ModeRows) else _kernel(model, lay, didx)
+    kern = Kernel(model, lay, didx) if lay.extra else _kernel(model, lay, didx)
     tol, n = 1e-12 * max(model.length_scale, 1e-3), len(qd)
     counter = {"coarse_steps": 0}
     var = np.flatnonzero(np.ptp(qd, axis=0) > 0) if n > 1 else []
     j = int(var[0]) if len(var) == 1 else 0
     book = None
-    if len(var) == 1 and kern.square and not isinstance(lay, ModeRows):
+    if len(var) == 1 and kern.square and not lay.extra:
         book = ChartBook(PathProblem(model, lay, didx, qd[0], j))
     ok = guessed = False
     if x_guess is not None:

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import Status
 from ..kernels import rows_numpy
-from ..kinematics.assembly import SINGULAR_RCOND, _dependent_rows, _scale
+from ..kinematics.assembly import SINGULAR_RCOND, _redundant_rows, _scale
 from ..kinematics.constraints import _perp, coordinates_jacobian, extend
 from ..model import ConstraintLayout, Model
 from .forces import applied_forces, cross, rotate
@@ -37,17 +37,13 @@ def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
     row labels."""
     if x.shape[0] > 64:  # redundancy is structural: a sample of the positions suffices
         x = x[np.unique(np.linspace(0, x.shape[0] - 1, 64).astype(int))]
-    P = rows_numpy.jacobian(lay.rowset, x) * _scale(model)
-    s = np.linalg.svd(P, compute_uv=False)
-    r = np.sum(s > REDUNDANT_RCOND * s[..., :1], axis=-1)
-    n_red = int(lay.n_rows - r.min())
+    rank, rows = _redundant_rows(rows_numpy.jacobian(lay.rowset, x) * _scale(model),
+                                 REDUNDANT_RCOND)
+    n_red = lay.n_rows - rank
     if n_red == 0:
         return 0, [], []
-    k = int(np.argmin(r))
-    rows = _dependent_rows(P[k], int(r[k]))
     joints = sorted({str(lay.row_joint[i]) for i in rows})
-    n_base = getattr(lay, "n_base", lay.n_rows)
-    labels = [lay.extra[i - n_base].label if i >= n_base else
+    labels = [lay.rowset.labels[i] if i >= lay.n_base else
               "{} ({})".format(*lay.rowset.labels[i].rsplit(".", 1)) for i in rows]
     return n_red, joints, labels
 
@@ -209,7 +205,7 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
                                            reacting_loads=reacting)
     Ix = inertia_forces(model, x, xdot, xddot)
     P = rows_numpy.jacobian(lay.rowset, x)  # (n, rows, n_x)
-    if len(getattr(lay, "slip_rows", ())):  # slipping contacts' rows: R - mu s T_x
+    if len(lay.slip_rows):  # slipping contacts' rows: R - mu s T_x
         P[:, lay.slip_rows, :] += rows_numpy.jacobian(lay.friction, x)
     G = coordinates_jacobian(model, x)  # (n, n_q, n_x)
     Gd = G[:, didx, :]
@@ -289,7 +285,7 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     # ------------------------------------------------ switchable elements (modes.py rows)
     el_forces: dict[str, np.ndarray] = {}
     p_el = np.zeros(n)
-    for el, idx in getattr(lay, "elements", {}).items():
+    for el, idx in lay.elements.items():
         # the multiplier in the forward convention (M xddot = F + R^T lambda_m):
         # the normal force of a stop or contact (>= 0), the torque/force of a
         # coordinate lock on its measure, the tangential force of a sticking contact

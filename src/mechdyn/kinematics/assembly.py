@@ -182,7 +182,8 @@ def _assembly_error(model, q, x_start, lay, t):
     q = np.asarray(q, float)
     x = x_start if np.all(np.isfinite(x_start)) else model.x_sketch
     try:  # the coordinates are honoured much more strongly than the joints
-        x = _least_squares(model, x, q, lay, weight=1e3, method="lm")
+        w = np.r_[np.ones(lay.n_rows), np.full(model.n_q, 1e3)]
+        x = _least_squares(lambda xx: system(model, xx, q, lay), x, w, method="lm")
     except Exception:  # noqa: BLE001 - keep the Newton iterate for the report
         pass
     res = joint_residuals(model, x, lay)
@@ -209,23 +210,39 @@ def singularity(model: Model, x, layout: ConstraintLayout | None = None) -> dict
     and ``joints`` (joints whose equations become dependent).
     """
     lay = layout or model.layout()
-    u, s, _ = np.linalg.svd(full_jacobian(model, x, lay) * _scale(model))
+    Js = _scaled(model, full_jacobian(model, x, lay), lay.position_rows.is_angle)
+    return _singular_report(Js, lay.row_joint, model.coordinate_names)
+
+
+def _scaled(model: Model, J, is_angle) -> np.ndarray:
+    """J (..., n_r, n_x) made dimensionless: rows in m divided by the length scale L (rows
+    in rad as they are), the x and y columns times L."""
+    L = model.length_scale
+    return J * np.where(is_angle, 1.0, 1.0 / L)[:, None] * np.tile([L, L, 1.0], model.n_bodies)
+
+
+def _singular_report(Js, rows, coords) -> dict:
+    """The report of :func:`singularity` from a scaled Jacobian ``Js`` whose rows are the
+    constraint rows (their elements ``rows``), then the coordinates ``coords``."""
+    if not Js.size:
+        return {"rcond": 1.0, "sigma_min": np.nan, "coordinates": [], "joints": []}
+    u, s, _ = np.linalg.svd(Js)
     share = u[:, -1] ** 2
-    coords = [model.coordinate_names[c] for c in range(model.n_q)
-              if share[lay.n_rows + c] > 1e-3]
-    joints = sorted({lay.row_joint[r] for r in range(lay.n_rows) if share[r] > 1e-3})
+    n_r = len(rows)
     return {"rcond": float(s[-1] / s[0]) if s[0] > 0 else 0.0, "sigma_min": float(s[-1]),
-            "coordinates": coords, "joints": joints}
+            "coordinates": [c for c, w in zip(coords, share[n_r:], strict=True) if w > 1e-3],
+            "joints": sorted({r for r, w in zip(rows, share[:n_r], strict=True) if w > 1e-3})}
 
 
 def _check_singular(model, x, q, lay, t):
     if model.n_x == 0 or lay.n_rows + model.n_q != model.n_x:
         return
-    s = np.linalg.svd(full_jacobian(model, x, lay) * _scale(model), compute_uv=False)
+    Js = _scaled(model, full_jacobian(model, x, lay), lay.position_rows.is_angle)
+    s = np.linalg.svd(Js, compute_uv=False)
     rc = s[..., -1] / s[..., 0]
     if np.any(rc < SINGULAR_RCOND):
         k = np.unravel_index(np.argmin(rc), rc.shape)
-        rep = singularity(model, x[k], lay)
+        rep = _singular_report(Js[k], lay.row_joint, model.coordinate_names)
         raise SingularPositionError(
             f"dead or toggle position: the constraint Jacobian is singular "
             f"(sigma_min/sigma_max = {rep['rcond']:.2e}); coordinate(s) "
@@ -348,17 +365,15 @@ def _assemble_near(model: Model, q, *, x_guess=None, layout=None, t=None) -> np.
         return solve_position(model, q, x, layout=lay, t=t, check_singular=False, max_iter=8)
     except AssemblyError:
         pass
-    x = _least_squares(model, x, q, lay, method="trf", max_nfev=2000,
+    x = _least_squares(lambda xx: system(model, xx, q, lay), x, method="trf", max_nfev=2000,
                        x_scale=_scale(model) / model.length_scale)
     return solve_position(model, q, x, layout=lay, t=t, check_singular=False)
 
 
-def _least_squares(model, x, q, lay, weight: float = 1.0, **options) -> np.ndarray:
-    """The pose nearest to [Phi; weight (g - q)] = 0 from x, by SciPy's least_squares."""
-    w = np.ones(lay.n_rows + model.n_q)
-    w[lay.n_rows:] = weight
-    return least_squares(lambda xx: system(model, xx, q, lay)[0] * w, x,
-                         jac=lambda xx: system(model, xx, q, lay)[1] * w[:, None],
+def _least_squares(fun, x, w=1.0, **options) -> np.ndarray:
+    """The pose nearest to w F = 0 from x, ``fun(x) -> (F, J)``, by SciPy's least_squares."""
+    w = np.asarray(w, dtype=float)
+    return least_squares(lambda xx: fun(xx)[0] * w, x, jac=lambda xx: fun(xx)[1] * w[..., None],
                          xtol=1e-15, ftol=1e-15, gtol=1e-15, **options).x
 
 
@@ -367,25 +382,27 @@ def rank_report(model: Model, x, layout=None) -> dict:
     lay = layout or model.layout()
     J = full_jacobian(model, x, lay) * _scale(model)
     P, Gq = J[:lay.n_rows], J[lay.n_rows:]
-    tol_rel = 1e-9
-    rank_phi = _rank(P, tol_rel)
-    redundant = sorted({lay.row_joint[r] for r in _dependent_rows(P, rank_phi)})
-    rank_full = _rank(J, tol_rel)
+    rank_phi, redundant = _redundant_rows(P)
+    rank_full = _rank(J)
     dep = []
     if model.n_q and rank_full < rank_phi + model.n_q:
         # coordinate c depends on the others if dropping its row keeps the rank
         dep = [model.coordinate_names[c] for c in range(model.n_q)
-               if _rank(np.concatenate([P, np.delete(Gq, c, axis=0)]), tol_rel) == rank_full]
-    return {"rank_phi": rank_phi, "redundant_joints": redundant, "dependent_coordinates": dep}
+               if _rank(np.concatenate([P, np.delete(Gq, c, axis=0)])) == rank_full]
+    return {"rank_phi": rank_phi, "redundant_joints": sorted({lay.row_joint[r] for r in redundant}),
+            "dependent_coordinates": dep}
 
 
-def _rank(A, tol_rel):
-    """Number of singular values of A above ``tol_rel`` times the largest."""
-    return int(np.linalg.matrix_rank(A, rtol=tol_rel))
+def _rank(A, rtol=1e-9):
+    """Number of singular values of A above ``rtol`` times the largest (batched)."""
+    return np.linalg.matrix_rank(A, rtol=rtol)
 
 
-def _dependent_rows(P, rank: int) -> np.ndarray:
-    """The rows of P (of rank ``rank``) that are linear combinations of the others: those
-    that carry its left null space."""
-    null = np.linalg.svd(P)[0][:, rank:]
-    return np.flatnonzero(np.sum(null**2, axis=1) > 1e-6)
+def _redundant_rows(P, rtol=1e-9):
+    """(rank, dependent rows) of a scaled constraint Jacobian P (n_rows, n_x), or of the one
+    of least rank of a batch (..., n_rows, n_x): the dependent rows are linear combinations
+    of the others (they carry the left null space)."""
+    r = _rank(P, rtol)
+    k = np.unravel_index(np.argmin(r), np.shape(r))
+    null = np.linalg.svd(P[k])[0][:, r[k]:]
+    return int(r[k]), np.flatnonzero(np.sum(null**2, axis=1) > 1e-6)

@@ -53,10 +53,11 @@ import numpy as np
 
 from ..errors import ModelError, SingularPositionError, Status, did_you_mean
 from ..model import Model, as_model
-from .assembly import _position_tol, assemble, singularity
+from .assembly import _least_squares, _position_tol, assemble, singularity
 from .branch_chart import ChartBook, PathProblem
 from .constraints import coordinates
 from .continuation import (
+    _MAX_NEWTON,
     _anchor_indices,
     _hermite5,
     _kernel,
@@ -114,12 +115,23 @@ def _start_pose(model: Model, lay=None, fresh: bool = False) -> np.ndarray:
     return assemble(model, layout=lay) if x0 is None or fresh else x0
 
 
-def _solve_at(kern, x_guess, q, tol):
-    """Pose at q by Newton from ``x_guess`` (else assembled from it), with F and J there."""
-    x, ok, F, J = _newton(kern, np.asarray(x_guess, float), q, tol)
-    if not ok:
+def _solve_at(kern, x_guess, q, tol, max_iter=_MAX_NEWTON, error=None):
+    """Pose at q by Newton from ``x_guess``, else assembled from it, with F and J there:
+    by :func:`assemble` (in the declared assembly modes) or, given ``error`` (a kernel of
+    some coordinates or of a switched mode's rows), by a least-squares fit of the kernel's
+    equations and Newton, raising ``error(x)`` where that fails."""
+    x_guess = np.asarray(x_guess, float)
+    x, ok, F, J = _newton(kern, x_guess, q, tol, max_iter)
+    if ok:
+        return x, F, J
+    if error is None:
         x = assemble(kern.model, q, x_guess=x_guess, layout=kern.lay)
-        F, J = kern.system(x, q)
+        return x, *kern.system(x, q)
+    x = _least_squares(lambda xx: kern.system(xx, q), x_guess, method="trf", max_nfev=2000,
+                       x_scale=kern.col_scale / kern.model.length_scale)
+    x, ok, F, J = _newton(kern, x, q, tol, max_iter=30)
+    if not ok:
+        raise error(x)
     return x, F, J
 
 

@@ -7,7 +7,9 @@ from .drive import Drive, TorqueSpeedCurve
 from .joint import Joint, Lock, Prismatic, Revolute
 from .load import Force, RotarySpring, Spring, Table, Torque, pulse
 from .mechanism import Mechanism
+from .supports import AnchorBolt, Foundation, Isolator
 
 __all__ = ["AssemblyMode", "GROUND", "Body", "Ground", "Coordinate", "COORDINATE_KINDS", "Joint",
            "Revolute", "Prismatic", "Lock", "Mechanism", "Drive", "TorqueSpeedCurve", "Force",
-           "RotarySpring", "Spring", "Table", "Torque", "pulse"]
+           "RotarySpring", "Spring", "Table", "Torque", "pulse", "AnchorBolt", "Isolator",
+           "Foundation"]

@@ -18,6 +18,7 @@ from .assembly_mode import AssemblyMode
 from .body import GROUND, Body, Ground, unknown_point
 from .coordinate import Coordinate, coordinate_problems
 from .joint import Joint, Lock, Prismatic, Revolute
+from .supports import Foundation
 
 __all__ = ["Mechanism"]
 
@@ -35,6 +36,11 @@ class Mechanism:
         (default (0, -9.81): y is up).
     description : str
         Free text kept with the model (shown by ``mechdyn examples``).
+    foundation : Foundation or None
+        The supports of the frame (anchor bolts, isolators; the base's mass and
+        inertia), used by :mod:`mechdyn.foundation` and ``mechdyn foundation``; None
+        (default) when not given.  Set it with :meth:`add_foundation`, ``add(Foundation(
+        ...))`` or ``mech.foundation = ...``; it does not change the motion.
 
     Examples
     --------
@@ -57,12 +63,15 @@ class Mechanism:
     drives: list = field(default_factory=list)
     #: optional extra elements (switches, contacts, process loads ...) by kind
     extras: dict[str, list] = field(default_factory=dict)
+    foundation: Foundation | None = None
 
     # ------------------------------------------------------------------ building
     def add(self, element):
-        """Add a body, ground, joint, coordinate, load or drive; returns it."""
+        """Add a body, ground, joint, coordinate, load, drive or the foundation; returns it."""
         if isinstance(element, Ground):
             self.ground = element
+        elif isinstance(element, Foundation):
+            self.foundation = element
         elif isinstance(element, Body):
             self._check_new(element.name)
             self.bodies[element.name] = element
@@ -88,6 +97,22 @@ class Mechanism:
     def add_ground(self, points=None) -> Ground:
         """Set the named points of the fixed frame (ground frame coordinates, m)."""
         return self.add(Ground(points=dict(points or {})))
+
+    def add_foundation(self, supports, mass=None, inertia=None, com=(0.0, 0.0)) -> Foundation:
+        """Set the supports of the frame: a :class:`~mechdyn.mechanism.supports.Foundation`
+        of ``supports`` (``AnchorBolt``, ``Isolator``), with the base's mass (kg), inertia
+        about its centre of mass (kg m^2) and centre of mass ``com`` (m, ground frame).
+
+        Examples
+        --------
+        >>> from mechdyn.mechanism.supports import AnchorBolt
+        >>> m = Mechanism("press")
+        >>> f = m.add_foundation([AnchorBolt("b1", -0.4, 0.0, 2e8, 1e8),
+        ...                       AnchorBolt("b2", 0.4, 0.0, 2e8, 1e8)], mass=800.0)
+        >>> m.foundation.names
+        ('b1', 'b2')
+        """
+        return self.add(Foundation(supports, mass=mass, inertia=inertia, com=com))
 
     def add_body(self, name: str, **kwargs) -> Body:
         """Add a :class:`Body`; keyword arguments as for ``Body``."""
@@ -199,6 +224,9 @@ class Mechanism:
             for role, (bname, ref) in zip("PQR", am.points, strict=True):
                 where = f"assembly mode {am.name!r}: point {role}"
                 point_problem(bname, ref, where, where)
+        if self.foundation is not None and not isinstance(self.foundation, Foundation):
+            out.append(f"foundation: expected a Foundation (supports, mass, inertia, com), "
+                       f"got {type(self.foundation).__name__}")
         if not self.bodies:
             out.append("the mechanism has no moving bodies")
         if not self.coordinates:

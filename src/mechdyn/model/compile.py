@@ -261,20 +261,47 @@ class Model:
 
 
 class ConstraintLayout:
-    """Which rows of Phi belong to which joint, for one mode."""
+    """Which rows of Phi belong to which joint or element, for one mode.
 
-    def __init__(self, model: Model, mode: frozenset):
-        self.mode = mode
-        self.lock_active = np.array([n in mode for n in model.lock.names], dtype=bool)
-        #: the constraint rows of the mode (joints, then engaged locks), as data
-        self.rowset = R.concat(model.n_bodies, model.joint_rows,
-                               *[model.weld_rows[n] for n in model.lock.names if n in mode])
+    Parameters
+    ----------
+    model : Model
+    mode : frozenset of str
+    extra : list of Row, optional
+        The switchable rows of a variable-structure mode (weld locks included,
+        :meth:`~mechdyn.dynamics.modes.SwitchedModel.rows`): they follow the joint rows
+        instead of the welds of the engaged locks.  ``rows`` then has the joints and weld
+        locks, ``elements`` the others (a sticking contact's row on its own, by its label;
+        ``element_rows`` groups every row by element), ``slip_rows`` and ``friction`` the
+        rows of sliding contacts and their friction terms.
+    """
+
+    def __init__(self, model: Model, mode: frozenset, extra=None):
+        nb = model.n_bodies
+        self.mode = frozenset(mode)
+        self.extra = list(extra or ())
+        welds = [model.weld_rows[n] for n in model.lock.names if n in mode and extra is None]
+        self.rowset = R.concat(nb, model.joint_rows, *welds, *[r.rows for r in self.extra])
         self.n_rows = len(self.rowset)
-        self.row_joint = np.array(self.rowset.elements, dtype=object)
-        self.rows = {n: np.flatnonzero(self.row_joint == n)
-                     for n in dict.fromkeys(self.rowset.elements)}
+        self.n_base = self.n_rows - len(self.extra)
+        self.element_rows = _groups(self.rowset.elements)
+        stick = {self.n_base + k: r.label for k, r in enumerate(self.extra) if r.kind == "stick"}
+        self.row_joint = np.array([stick.get(k, el) for k, el in enumerate(self.rowset.elements)],
+                                  dtype=object)
+        groups = _groups(self.row_joint)
+        self.rows = {k: v for k, v in groups.items() if k in model.mechanism.joints}
+        self.elements = {k: v for k, v in groups.items() if k not in self.rows}
+        slip = [(self.n_base + k, r.friction_rows) for k, r in enumerate(self.extra) if r.slip]
+        self.slip_rows = np.array([k for k, _ in slip], int)
+        self.friction = R.concat(nb, *[f for _, f in slip])
         #: the rows of the position problem [Phi(x); g(x)] = [0; q]
-        self.position_rows = R.concat(model.n_bodies, self.rowset, model.coordinate_rows)
+        self.position_rows = R.concat(nb, self.rowset, model.coordinate_rows)
+
+
+def _groups(keys) -> dict:
+    """{key: indices of its entries} of a sequence, keys in order of first appearance."""
+    keys = np.asarray(keys, dtype=object)
+    return {k: np.flatnonzero(keys == k) for k in dict.fromkeys(keys)}
 
 
 def as_model(mech_or_model) -> Model:

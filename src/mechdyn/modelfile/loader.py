@@ -12,9 +12,9 @@ once in one :class:`~mechdyn.errors.ModelError`:
 
 The format is described in ``docs/model-file.md``.
 
-The tables are read by :mod:`.bodies_joints`, :mod:`.loads_drives` and
-:mod:`.switches`, on the shared reader of :mod:`.reader`; this module holds the
-entry points, the order of the passes and the ``[initial]``, ``[initial_speed]``
+The tables are read by :mod:`.bodies_joints`, :mod:`.loads_drives`,
+:mod:`.switches` and :mod:`.foundation`, on the shared reader of :mod:`.reader`; this
+module holds the entry points, the order of the passes and the ``[initial]``, ``[initial_speed]``
 and ``[[assembly]]`` readers.
 """
 
@@ -26,6 +26,7 @@ from pathlib import Path
 from ..errors import MechdynError, ModelError, UnitError, did_you_mean
 from ..mechanism import GROUND, Ground, Mechanism
 from .bodies_joints import _BodiesJoints
+from .foundation import _FoundationReader
 from .loads_drives import _LOAD_REQUIRED, _LoadsDrives
 from .reader import _Failed
 from .schema import schema_problems
@@ -130,7 +131,7 @@ def build(doc: dict, name: str = "<string>", *, default_title: str | None = None
     return mech
 
 
-class _Builder(_BodiesJoints, _LoadsDrives):
+class _Builder(_BodiesJoints, _LoadsDrives, _FoundationReader):
     """Turns a document into mechanism elements, recording every problem."""
 
     def run(self, default_title: str | None) -> Mechanism:
@@ -195,6 +196,8 @@ class _Builder(_BodiesJoints, _LoadsDrives):
         if any(k in self.doc for k in SWITCH_TABLES):
             for p in parse_switches(self.doc, mech, self.fname, self.bad):
                 self.problem(p)
+        if "foundation" in self.doc:
+            mech.foundation = self.soft(self.foundation)
         return mech
 
     def add(self, mech: Mechanism, read, path: tuple, spec, required: tuple,

@@ -22,6 +22,8 @@ __all__ = ["schema", "schema_problems", "locate", "toml_type"]
 _NAMED_SECTIONS = ("bodies", "joints", "coordinates")
 #: top-level arrays of tables ([[loads]], ...)
 _ARRAY_SECTIONS = ("loads", "drives", "coordinate_locks", "stops", "contacts", "switches")
+#: arrays of tables inside a table ([[foundation.bolts]], ...)
+_NESTED_ARRAYS = (("foundation", "bolts"), ("foundation", "isolators"))
 
 
 @lru_cache(maxsize=1)
@@ -72,15 +74,19 @@ def locate(fname: str, path: Sequence, doc: Any = None) -> str:
     if not path:
         return fname
     head = path[0]
-    if head in _ARRAY_SECTIONS and len(path) >= 2 and isinstance(path[1], int):
-        label = f"[[{head}]] #{path[1] + 1}"
+    array = (path[:1] if head in _ARRAY_SECTIONS
+             else path[:2] if tuple(path[:2]) in _NESTED_ARRAYS else [])
+    if array and len(path) > len(array) and isinstance(path[len(array)], int):
+        k = path[len(array)]
+        label = f"[[{'.'.join(array)}]] #{k + 1}"
         try:
-            name = doc[head][path[1]].get("name")
+            entries = doc[head] if len(array) == 1 else doc[head][path[1]]
+            name = entries[k].get("name")
         except (TypeError, KeyError, IndexError, AttributeError):
             name = None
         if isinstance(name, str):
             label += f" {name!r}"
-        rest = path[2:]
+        rest = path[len(array) + 1:]
     else:
         depth = 1
         if head in _NAMED_SECTIONS and len(path) >= 2:
