@@ -338,8 +338,8 @@ def spectrum_figure(series, *, xlabel: str = "f (Hz)", bars: bool = False, title
         else:
             f.line(units.index(unit), x, a, name, unit)
             x, e = np.asarray(x, float), np.cumsum(np.asarray(a, float) ** 2)
-            if x.size and e[-1] > 0:  # where 99.9 % of the content lies
-                top = max(top, float(x[min(np.searchsorted(e, 0.999 * e[-1]), x.size - 1)]))
+            if x.size and e[-1] > 0:  # where 99 % of the content lies
+                top = max(top, float(x[min(np.searchsorted(e, 0.99 * e[-1]), x.size - 1)]))
     xmax = max((float(np.max(s[0])) for s in series if len(s[0])), default=0.0)
     fig = f.done(x_range=(0.0, min(xmax, 1.5 * top)) if 0.0 < top < xmax / 1.5 else None)
     if bars:
