@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import mechdyn
-from mechdyn.cli.report import report, report_records
+from mechdyn.cli.report import foundation_loads, mounted_loads, report, report_records
 from mechdyn.foundation import AnchorBolt, Foundation, Isolator, support_loads
 from mechdyn.kinematics.sweep import initial_coordinates
 from mechdyn.results.report import report_trajectory, write_report
@@ -133,3 +133,23 @@ def test_run_report_with_isolators_lists_them(press_run, tmp_path):
     rows = _rows(text, "Supports")
     assert [r[:2] for r in rows[1:]] == [["a", "isolator"], ["b", "isolator"]]
     assert "bolt" not in "".join(rows[0])
+
+
+def test_run_report_on_elastic_mounts_compares_the_floor_force(press_run, tmp_path):
+    """press_cycle's [foundation]: levelling mounts with the base's mass and inertia."""
+    mech = mechdyn.examples.load("press_cycle")
+    assert mech.foundation is not None and mech.foundation.mass is not None
+    loads = foundation_loads(mech, press_run)
+    mounted, modes = mounted_loads(mech, loads)
+    text = report_trajectory(press_run, tmp_path / "run.html", animation=False,
+                             supports=loads, mounted=mounted, modes=modes).read_text(
+        encoding="utf-8")
+    rows = _rows(text, "Force passed to the floor")
+    head, rigid, elastic = rows[0], rows[1], rows[2]
+    k = head.index("peak |F| (kN)")
+    frame = np.hypot(loads.applied[:, 0], loads.applied[:, 1]).max() / 1e3
+    floor = np.hypot(mounted.floor[:, 0], mounted.floor[:, 1]).max() / 1e3
+    assert float(rigid[k]) == pytest.approx(frame, rel=1e-3)
+    assert float(elastic[k]) == pytest.approx(floor, rel=1e-3)
+    freqs = _rows(text, "Natural frequencies of the mounted base")
+    assert [float(r[1]) for r in freqs[1:]] == pytest.approx(modes.frequencies, rel=1e-3)

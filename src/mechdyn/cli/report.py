@@ -36,7 +36,7 @@ from ..model import as_model
 from ..results.report import report_trajectory, write_report
 from .options import add_motion_arguments, finish, open_model, simulate_from_args, sweep_values
 
-__all__ = ["register", "run", "report", "report_records", "foundation_loads"]
+__all__ = ["register", "run", "report", "report_records", "foundation_loads", "mounted_loads"]
 
 
 def register(sub) -> None:
@@ -67,8 +67,11 @@ def run(args) -> int:
     mech, model = open_model(args)
     if args.simulate:
         traj = simulate_from_args(model, args, 401)
+        supports = foundation_loads(mech, traj)
+        mounted, modes = mounted_loads(mech, supports)
         out = report_trajectory(traj, args.output, title=args.title, animation=args.animation,
-                                trace=args.trace, supports=foundation_loads(mech, traj))
+                                trace=args.trace, supports=supports, mounted=mounted,
+                                modes=modes)
         print(f"{mech.name}: simulation {traj.status}; report: {out}")
         return finish(args, traj.success, f"{traj.status}: {traj.message}")
 
@@ -165,6 +168,24 @@ def foundation_loads(mech, record):
     except MechdynError as exc:
         warnings.warn(f"report: no support loads: {exc}", stacklevel=2)
         return None
+
+
+def mounted_loads(mech, supports):
+    """For a foundation with ``mass`` and ``inertia``: the base's response on its elastic
+    mounts to the frame-load history of ``supports`` (a run's SupportLoads) and its natural
+    frequencies, ``(MountedResponse, Modes)``; else ``(None, None)``."""
+    fnd = getattr(mech, "foundation", None)
+    if fnd is None or supports is None or fnd.mass is None or fnd.inertia is None:
+        return None, None
+    from ..foundation import mounted_response, natural_frequencies
+
+    try:
+        a = supports.applied
+        return (mounted_response(fnd, supports.t, a[:, 0], a[:, 1], a[:, 2],
+                                 point=supports.point), natural_frequencies(fnd))
+    except MechdynError as exc:
+        warnings.warn(f"report: no response of the mounted base: {exc}", stacklevel=2)
+        return None, None
 
 
 def report(mech_or_model, path, *, speed: float | None = None, over: str | None = None,

@@ -352,9 +352,18 @@ def _coordinates_table(traj) -> str:
     return table("Coordinates", rows, sig=6)
 
 
+def _mean_rpm(traj) -> float | None:
+    """The mean speed of the run's first angle coordinate, rpm (None without one)."""
+    for k, angle in enumerate(traj.coordinate_is_angle or ()):
+        if angle and traj.t.size > 1 and traj.t[-1] > traj.t[0]:
+            return abs(float(traj.q[-1, k] - traj.q[0, k]) / float(traj.t[-1] - traj.t[0])) \
+                * 30 / np.pi
+    return None
+
+
 def report_trajectory(traj, path, *, title: str | None = None, animation: bool = True,
-                      trace=None, max_events: int = 200, supports=None, point=(0.0, 0.0)
-                      ) -> Path:
+                      trace=None, max_events: int = 200, supports=None, mounted=None,
+                      modes=None, point=(0.0, 0.0)) -> Path:
     """Write an HTML report of a simulated motion.
 
     Parameters
@@ -375,6 +384,14 @@ def report_trajectory(traj, path, *, title: str | None = None, animation: bool =
         The loads of a foundation's supports over the run
         (:func:`mechdyn.foundation.support_loads`): per-support peaks in "Loads on the
         building".
+    mounted : MountedResponse, optional
+        The response of the base on elastic mounts to the run's frame loads
+        (:func:`mechdyn.foundation.mounted_response`): the force passed to the floor
+        against the rigid base's, and the base's motion.
+    modes : Modes, optional
+        The natural frequencies of the mounted base
+        (:func:`mechdyn.foundation.natural_frequencies`), beside the excitation orders of
+        the run's mean speed.
     point : (float, float)
         The point the run's frame moment ``M_frame_Nm`` is about, m (the ``point`` of
         :func:`mechdyn.simulate`).
@@ -430,5 +447,5 @@ def report_trajectory(traj, path, *, title: str | None = None, animation: bool =
             Fy=df["Fy_frame_N"].to_numpy(float),
             M=df["M_frame_Nm"].to_numpy(float) if "M_frame_Nm" in df else None,
             point=point, transitions=transitions, spans=spans, supports=supports,
-            div="building-run"))
+            mounted=mounted, modes=modes, rpm=_mean_rpm(traj), div="building-run"))
     return _write_page(path, title or f"{name}: simulation report", sections)

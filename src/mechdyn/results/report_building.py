@@ -14,7 +14,12 @@ from __future__ import annotations
 import numpy as np
 
 from . import spectrum as _spectrum
-from .report_figures import frame_load_figure, spectrum_figure, supports_figure
+from .report_figures import (
+    frame_floor_figure,
+    frame_load_figure,
+    spectrum_figure,
+    supports_figure,
+)
 from .report_html import cleaned, esc, figure_html, join, note, table
 
 __all__ = ["building_section", "has_frame_loads"]
@@ -152,9 +157,55 @@ def _supports_part(x, xlabel, supports, angle, transitions, div: str) -> list[st
                                         title="Loads of the supports"), f"{div}-supports")]
 
 
+def _mounted_part(t, Fx, Fy, M, mounted, modes, rpm, transitions, div: str) -> list[str]:
+    """The base on its elastic mounts: the force passed to the floor against the rigid base,
+    the base's motion, and its natural frequencies beside the excitation orders."""
+    parts = ["<h3>On the elastic mounts</h3>",
+             note("The frame and its base as one rigid body with its mass and inertia on the "
+                  "supports (springs and dampers), driven by the frame load (one way: the "
+                  "base's motion does not act back on the machine).")]
+    if modes is not None:
+        rows = []
+        for k, (f, label) in enumerate(zip(modes.frequencies, modes.labels, strict=True)):
+            row = {"mode": k + 1, "f (Hz)": float(f), "motion": str(label)}
+            if rpm:
+                order = f / (rpm / 60.0)
+                near = [o for o in (1, 2, 3, 4) if abs(f / (o * rpm / 60.0) - 1) <= 0.2]
+                row["order of the running speed"] = float(order)
+                row["near order (±20 %)"] = ", ".join(map(str, near)) or "-"
+            rows.append(row)
+        parts.append(table("Natural frequencies of the mounted base", rows)
+                     + (note(f"Running speed {rpm:.4g} rpm (the mean speed of the run): orders "
+                             f"1 to 4 at " + ", ".join(f"{o * rpm / 60:.4g}" for o in range(1, 5))
+                             + " Hz.") if rpm else ""))
+    if mounted is not None:
+        floor = np.asarray(mounted.floor, float)
+        mt = np.asarray(mounted.t, float)
+        rigid = np.hypot(Fx, Fy)
+        elastic = np.hypot(floor[:, 0], floor[:, 1])
+        kr, ke = int(np.argmax(rigid)), int(np.argmax(elastic))
+        u = np.asarray(mounted.u, float)
+        rows = [{"base": "rigid", "peak |F| (kN)": rigid[kr] / 1e3, "at": _at(t, kr, None),
+                 "peak |M| (kN m)": np.max(np.abs(M)) / 1e3 if M is not None else None},
+                {"base": "on the mounts", "peak |F| (kN)": elastic[ke] / 1e3,
+                 "at": _at(mt, ke, None),
+                 "peak |M| (kN m)": np.max(np.abs(floor[:, 2])) / 1e3,
+                 "peak base motion x (mm)": np.max(np.abs(u[:, 0])) * 1e3,
+                 "y (mm)": np.max(np.abs(u[:, 1])) * 1e3,
+                 "θ (mrad)": np.max(np.abs(u[:, 2])) * 1e3}]
+        ratio = elastic[ke] / rigid[kr] if rigid[kr] > 0 else float("nan")
+        f = frame_floor_figure(t, rigid, mt, elastic, transitions=transitions)
+        parts += [table("Force passed to the floor", rows),
+                  note(f"On the mounts the peak force to the floor is {ratio:.3g} times the "
+                       "rigid base's" + (" (the mounts amplify it)." if ratio > 1 else ".")),
+                  figure_html(f, f"{div}-floor")]
+    return parts
+
+
 def building_section(*, x, Fx, Fy, M=None, point=(0.0, 0.0), angle: bool | None = None,
                      xlabel: str = "t (s)", transitions=(), spans=None, speed=None,
-                     supports=None, div: str = "building", intro: str = "") -> str:
+                     supports=None, mounted=None, modes=None, rpm: float | None = None,
+                     div: str = "building", intro: str = "") -> str:
     """The HTML of "Loads on the building".
 
     Parameters
@@ -177,6 +228,13 @@ def building_section(*, x, Fx, Fy, M=None, point=(0.0, 0.0), angle: bool | None 
         Constant rate of a cycle, rad/s (the frequency of each order).
     supports : SupportLoads, optional
         The loads of the supports of a foundation over the same samples.
+    mounted : MountedResponse, optional
+        The response of the base on elastic mounts to the same history (a run): the force
+        passed to the floor (``floor``, (n, 3)) and the base's motion (``u``).
+    modes : Modes, optional
+        Natural frequencies (``frequencies``, Hz) and ``labels`` of the mounted base.
+    rpm : float, optional
+        Running speed, rpm, for the excitation orders beside the natural frequencies.
     """
     x = np.asarray(x, float)
     Fx, Fy = np.asarray(Fx, float), np.asarray(Fy, float)
@@ -212,5 +270,7 @@ def building_section(*, x, Fx, Fy, M=None, point=(0.0, 0.0), angle: bool | None 
         else:
             parts.append(note("The support loads do not match the frame-load samples: "
                               "not shown."))
+    if (mounted is not None or modes is not None) and angle is None:
+        parts += _mounted_part(x, Fx, Fy, M, mounted, modes, rpm, transitions, div)
     return join(parts)
 

@@ -18,7 +18,8 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["decimate", "Figure", "sweep_figure", "kinetostatics_figure", "trajectory_figure",
-           "frame_load_figure", "spectrum_figure", "supports_figure", "MAX_POINTS"]
+           "frame_load_figure", "spectrum_figure", "supports_figure", "frame_floor_figure",
+           "MAX_POINTS"]
 
 #: points per trace at most
 MAX_POINTS = 2000
@@ -365,3 +366,15 @@ def supports_figure(x, xlabel: str, loads, *, transitions=(), title: str = ""):
     f.events([e.t for e in transitions], [e.label for e in transitions])
     x = np.asarray(x, float)
     return f.done(x_range=(x[0], x[-1]) if x.size > 1 and x[-1] != x[0] else None)
+
+
+def frame_floor_figure(t, rigid, t_mounted, mounted, *, transitions=(), title: str = ""):
+    """The force passed to the floor (kN) by a rigid base (the frame load) and by the base on
+    its elastic mounts, against time."""
+    f = Figure(["force passed to the floor |F|"], ["|F| (kN)"], "t (s)",
+               title=title or "Force to the floor: rigid base and on the mounts")
+    f.line(0, t, np.asarray(rigid, float) / 1e3, "rigid base", "kN")
+    f.line(0, t_mounted, np.asarray(mounted, float) / 1e3, "on the mounts", "kN")
+    f.events([e.t for e in transitions], [e.label for e in transitions])
+    t = np.asarray(t, float)
+    return f.done(x_range=(t[0], t[-1]) if t.size > 1 and t[-1] > t[0] else None)
