@@ -255,12 +255,15 @@ def _kinetostatics_section(ks) -> str:
     elements = [{"element": el, "peak": d["peak"] / (1e3 if d["unit"] == "N" else 1.0),
                  "unit": "kN" if d["unit"] == "N" else d["unit"],
                  "at": _at_text(ang, d["peak_at"])} for el, d in p["elements"].items()]
-    parts += [table("Driving torque", drives), table("Peak joint forces", joints),
+    units = {ks._drive_unit(c)[1] for c in p["driving"]}
+    what = ("Driving torque" if units == {"Nm"} else "Driving force" if units == {"N"}
+            else "Driving torques and forces")
+    parts += [table(what, drives), table("Peak joint forces", joints),
               table("Stops, contacts and locks", elements)]
     parts += [note(f"Warning: {esc(w)}") for w in ks.warnings]
     name = getattr(getattr(ks.model, "mechanism", None), "name", "mechanism")
     parts += ["<h3>Plot</h3>",
-              figure_html(kinetostatics_figure(ks, title=f"{name}: driving torque and joint "
+              figure_html(kinetostatics_figure(ks, title=f"{name}: {what.lower()} and joint "
                                                          "forces"), "kinetostatics")]
     return join(parts)
 

@@ -219,31 +219,38 @@ def default_points(model, trace=None) -> list:
 def sweep_figure(sw, *, trace=None, title: str = ""):
     """Kinematics against the swept coordinate: link angles (deg), angular velocities (rad/s)
     and accelerations (rad/s²) on the left; point positions (mm), velocities (m/s) and
-    accelerations (m/s²) on the right."""
+    accelerations (m/s²) on the right (a side without anything that moves is left out)."""
     model = sw.model
     xs, xunit = _deg_or_mm(sw.values, sw.over_is_angle)
-    f = Figure(["link angles", "point positions", "angular velocities", "point velocities",
-                "angular accelerations", "point accelerations"],
-               ["angle (deg)", "position (mm)", "ω (rad/s)", "velocity (m/s)",
-                "α (rad/s²)", "acceleration (m/s²)"], f"{sw.over} ({xunit})", cols=2,
-               title=title)
-    for b in model.body_names:
-        th, om, al = sw.angular(b)
-        if np.ptp(th) <= 1e-12:
-            continue  # a translating body
-        f.line(0, xs, np.rad2deg(th), f"θ {b}", "deg", group=b)
-        f.line(2, xs, om, f"ω {b}", "rad/s", group=b)
-        f.line(4, xs, al, f"α {b}", "rad/s²", group=b)
+    bodies = [(b, *sw.angular(b)) for b in model.body_names]
+    bodies = [row for row in bodies if np.ptp(row[1]) > 1e-12]  # translating bodies aside
     scale = model.length_scale
+    points = []
     for body, name, label in default_points(model, trace):
         r, v, a = sw.point(body, name)
-        for c, comp in enumerate("xy"):
-            if np.ptp(r[:, c]) <= 1e-12 * scale:
-                continue  # a constant component (y of a horizontal slider)
-            g = f"{comp} {label}"
-            f.line(1, xs, r[:, c] * 1e3, g, "mm", group=g)
-            f.line(3, xs, v[:, c], f"v{comp} {label}", "m/s", group=g)
-            f.line(5, xs, a[:, c], f"a{comp} {label}", "m/s²", group=g)
+        points += [(f"{comp} {label}", r[:, c], v[:, c], a[:, c]) for c, comp in enumerate("xy")
+                   if np.ptp(r[:, c]) > 1e-12 * scale]  # a constant component aside
+    sides = []
+    if bodies:
+        sides.append((["link angles", "angular velocities", "angular accelerations"],
+                      ["angle (deg)", "ω (rad/s)", "α (rad/s²)"]))
+    if points or not bodies:
+        sides.append((["point positions", "point velocities", "point accelerations"],
+                      ["position (mm)", "velocity (m/s)", "acceleration (m/s²)"]))
+    cols = len(sides)
+    titles = [side[0][r] for r in range(3) for side in sides]
+    labels = [side[1][r] for r in range(3) for side in sides]
+    f = Figure(titles, labels, f"{sw.over} ({xunit})", cols=cols, title=title)
+    if bodies:
+        for b, th, om, al in bodies:
+            f.line(0, xs, np.rad2deg(th), f"θ {b}", "deg", group=b)
+            f.line(cols, xs, om, f"ω {b}", "rad/s", group=b)
+            f.line(2 * cols, xs, al, f"α {b}", "rad/s²", group=b)
+    c0 = cols - 1
+    for g, r, v, a in points:
+        f.line(c0, xs, r * 1e3, g, "mm", group=g)
+        f.line(c0 + cols, xs, v, f"v{g}", "m/s", group=g)
+        f.line(c0 + 2 * cols, xs, a, f"a{g}", "m/s²", group=g)
     return f.done(x_range=(xs[0], xs[-1]) if xs.size > 1 else None)
 
 
@@ -253,7 +260,10 @@ def kinetostatics_figure(ks, *, title: str = ""):
     xs, xunit = _deg_or_mm(ks.values, ks.over_is_angle)
     torque = [c for c in ks.driven if ks._drive_unit(c)[1] == "Nm"]
     force = [c for c in ks.driven if c not in torque]
-    titles, labels = ["driving torque"], ["torque (N m)"]
+    titles, labels = [], []
+    if torque:
+        titles.append("driving torque")
+        labels.append("torque (N m)")
     if force:
         titles.append("driving force")
         labels.append("force (kN)")
@@ -263,7 +273,8 @@ def kinetostatics_figure(ks, *, title: str = ""):
     for c in torque:
         f.line(0, xs, ks.driving[c], f"M {c}" + ("" if c == ks.over else " (holding)"), "N m")
     for c in force:
-        f.line(1, xs, np.asarray(ks.driving[c]) / 1e3, f"F {c}", "kN")
+        f.line(int(bool(torque)), xs, np.asarray(ks.driving[c]) / 1e3,
+               f"F {c}" + ("" if c == ks.over else " (holding)"), "kN")
     panel = len(titles) - 1
     for j in ks.reactions:
         f.line(panel, xs, ks.force_magnitude(j) / 1e3, f"|F| {j}", "kN")
