@@ -94,7 +94,7 @@ def test_two_dof_press_gets_kinetostatics_with_the_other_coordinate_held(tmp_pat
     text = write_report(model, tmp_path / "r.html", sweep=sw, kinetostatics=ks,
                         animation=False).read_text(encoding="utf-8")
     assert "<h2>Kinetostatics</h2>" in text
-    stated = re.search(r"<code>psi</code> at (-?[0-9.]+) deg \(their initial values\)", text)
+    stated = re.search(r"<code>psi</code> at (-?[0-9.]+) deg \(its initial value\)", text)
     assert stated and float(stated.group(1)) == pytest.approx(np.rad2deg(psi0), abs=0.006)
     drives = _rows(text, "Driving torque")
     assert [r[:2] for r in drives[1:]] == [["phi", "driven"], ["psi", "held"]]

@@ -221,13 +221,20 @@ def _kinetostatics_section(ks) -> str:
         model = ks.model
         held_text = ""
         if held:
+            try:
+                q0 = initial_coordinates(model) if model is not None else None
+            except Exception:  # noqa: BLE001 - the values held are stated all the same
+                q0 = None
             vals = []
             for c in held:
                 i = ks.coordinate_names.index(c)
                 is_ang = bool(model.coord_is_angle[i]) if model is not None else True
-                vals.append(f"<code>{esc(c)}</code> at {_at_text(is_ang, ks.q[0, i])}")
-            held_text = (f" The other coordinate(s) are held: {', '.join(vals)} (their "
-                         "initial values), each by the holding torque or force shown.")
+                origin = ("its initial value" if q0 is not None
+                          and abs(ks.q[0, i] - q0[i]) <= 1e-9 else "as assembled")
+                vals.append(f"<code>{esc(c)}</code> at {_at_text(is_ang, ks.q[0, i])} "
+                            f"({origin})")
+            held_text = (f" The other coordinate(s) are held: {', '.join(vals)}, each by the "
+                         "holding torque or force shown.")
         parts.append(f"<p>Driven coordinate <code>{esc(ks.over)}</code> at the constant "
                      f"rate {rate_text(float(ks.qdot[0, k]), ang)}, {ks.n} positions; forces "
                      f"include gravity, inertia and the model's loads.{held_text}</p>")
