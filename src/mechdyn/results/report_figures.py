@@ -155,13 +155,15 @@ class Figure:
         if not spans:
             return
         colors: dict = {}
+        shapes = []
         for x0, x1, label in spans:
             first = label not in colors
             color = colors.setdefault(label, _MODE_COLORS[(len(colors) + 5) % 10])
-            self.fig.add_shape(type="rect", xref="x", yref="paper", x0=x0, x1=x1, y0=0, y1=1,
-                               fillcolor=color, opacity=0.12, layer="below",
-                               line={"width": 0}, name=f"mode {label}",
-                               legendgroup=f"mode {label}", showlegend=first)
+            shapes.append({"type": "rect", "xref": "x", "yref": "paper", "x0": x0, "x1": x1,
+                           "y0": 0, "y1": 1, "fillcolor": color, "opacity": 0.12,
+                           "layer": "below", "line": {"width": 0}, "name": f"mode {label}",
+                           "legendgroup": f"mode {label}", "showlegend": first})
+        self.fig.update_layout(shapes=list(self.fig.layout.shapes) + shapes)  # at once: fast
 
     def done(self, *, x_range=None):
         """The plotly figure, axes labelled."""
