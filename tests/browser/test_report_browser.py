@@ -76,6 +76,8 @@ def _open(browser, path: Path):
             if m.type == "error" else None)
     page.on("pageerror", lambda e: errors.append(f"page error: {e}"))
     page.on("requestfailed", lambda r: errors.append(f"request failed: {r.url}"))
+    page.on("request", lambda r: None if r.url.startswith(("file:", "data:", "blob:"))
+            else errors.append(f"network request (the page must work offline): {r.url}"))
     page.goto(path.as_uri(), wait_until="load")
     # plotly draws each figure in its inline script: wait until every div has its layout
     page.wait_for_function(
