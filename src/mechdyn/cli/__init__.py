@@ -22,7 +22,7 @@ __all__ = ["main", "SUBCOMMAND_MODULES", "check_outputs", "PLOT_SUFFIXES"]
 
 #: modules of this package that define subcommands, in the order of ``mechdyn --help``
 SUBCOMMAND_MODULES = ("demo", "examples", "check", "kinematics", "simulate", "kinetostatics",
-                      "reduce", "flywheel", "foundation", "animate", "report")
+                      "reduce", "flywheel", "foundation", "study", "animate", "report")
 
 
 def build_parser() -> argparse.ArgumentParser:

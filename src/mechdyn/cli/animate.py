@@ -25,7 +25,8 @@ def register(sub) -> None:
         "animate",
         help="animated GIF of the motion (a sweep of one coordinate, or a simulation)",
         description="Draw the mechanism -- bodies through their points, joints, ground "
-                    "anchors, slider guides, optionally the path of a point -- at every "
+                    "anchors, slider guides, springs, stops and loads, with the names of "
+                    "bodies and joints, optionally the path of a point -- at every "
                     "position of a sweep of one coordinate (default: one turn of the first) "
                     "or of a forward-dynamics run (--simulate), and write a GIF (MP4 if "
                     "ffmpeg is installed).",
@@ -39,6 +40,8 @@ def register(sub) -> None:
     d.add_argument("--frames", type=int, metavar="N",
                    help="number of frames (default: all positions, at most 200)")
     d.add_argument("--snapshot", metavar="PNG", help="also write the first frame as a PNG")
+    d.add_argument("--no-labels", dest="labels", action="store_false",
+                   help="do not name the bodies, joints and loads on the drawing")
 
 
 def run(args) -> int:
@@ -58,9 +61,10 @@ def run(args) -> int:
         ok, why = record.ok, record.message
         print(f"{mech.name}: {len(record)} of {values.size} positions of {over}")
     out = animate(record, args.output, fps=args.fps, frames=args.frames, trace=args.trace,
-                  title=args.title)
+                  title=args.title, labels=args.labels)
     print(f"  animation: {out}")
     if args.snapshot:
-        still = snapshot(record, args.snapshot, 0, trace=args.trace, title=args.title)
+        still = snapshot(record, args.snapshot, 0, trace=args.trace, title=args.title,
+                         labels=args.labels)
         print(f"  snapshot: {still}")
     return finish(args, ok, f"the motion stopped early: {why}")

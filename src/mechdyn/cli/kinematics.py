@@ -12,9 +12,20 @@ before it are written); 2 bad input (one line on stderr).
 from __future__ import annotations
 
 from ..kinematics.sweep import sweep
+from ..results.animate import _trace_spec
 from ..results.plot import plot_kinematic_sweep
 from ..results.table import deg_or_mm, rate_text
-from .options import add_files, add_model, add_range, finish, open_model, sweep_values, write_files
+from .options import (
+    add_files,
+    add_model,
+    add_plot_columns,
+    add_range,
+    check_plot_columns,
+    finish,
+    open_model,
+    sweep_values,
+    write_files,
+)
 
 __all__ = ["register", "run"]
 
@@ -40,11 +51,17 @@ def register(sub) -> None:
     add_files(p, plot="write a plot of the guided points")
     p.add_argument("--points", nargs="+", metavar="BODY.POINT",
                    help="points to plot (default: the sliders' points)")
+    p.add_argument("--trace", metavar="BODY.POINT",
+                   help="plot the coupler curve of this point (default: a coupler point of a "
+                        "four-bar loop, if any)")
+    add_plot_columns(p)
 
 
 def run(args) -> int:
     """Run ``mechdyn kinematics``; returns the exit code."""
+    check_plot_columns(args)
     mech, model = open_model(args)
+    _trace_spec(model, args.trace)
     over, values, speed = sweep_values(model, args, only=True)
     sw = sweep(model, over, values, speed=speed)
     ends, unit = deg_or_mm(values[[0, -1]], sw.over_is_angle)
@@ -53,5 +70,5 @@ def run(args) -> int:
           f"{rate_text(1.0 if speed is None else speed, sw.over_is_angle)}")
     for line in sw.summary().lines():
         print("  " + line)
-    write_files(args, sw, plot_kinematic_sweep, points=args.points)
+    write_files(args, sw, plot_kinematic_sweep, points=args.points, trace=args.trace)
     return finish(args, sw.status == "success", sw.message)

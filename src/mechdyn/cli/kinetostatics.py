@@ -12,12 +12,24 @@ Exit codes: 0 done; 1 done with a warning that matters (singular positions);
 from __future__ import annotations
 
 import warnings
+from pathlib import Path
 
 from ..dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
-from ..errors import Status
-from ..results.plot_kinetostatics import plot_kinetostatics
+from ..errors import ModelError, Status
+from ..results.plot_kinetostatics import plot_joint_force_polar, plot_kinetostatics
 from ..results.table import rate_text, written
-from .options import add_files, add_model, add_range, finish, open_model, sweep_values, vector
+from .options import (
+    add_files,
+    add_model,
+    add_plot_columns,
+    add_range,
+    check_plot_columns,
+    draw_plot,
+    finish,
+    open_model,
+    sweep_values,
+    vector,
+)
 
 __all__ = ["register", "run"]
 
@@ -52,13 +64,23 @@ def register(sub) -> None:
     add_files(p, plot="write a plot (torque, pin forces, shaking)")
     p.add_argument("--joints", nargs="+", metavar="JOINT",
                    help="joints whose forces are plotted (default: all)")
+    add_plot_columns(p)
+    p.add_argument("--plot-polar", action="append", default=[], metavar="JOINT",
+                   help="with --plot FILE: also the polar diagram of this joint's force, "
+                        "written beside it as FILE_polar_JOINT (repeatable)")
     p.add_argument("--harmonics", type=int, default=6, metavar="K",
                    help="print the shaking-force harmonics up to order K (default 6; 0: none)")
 
 
 def run(args) -> int:
     """Run ``mechdyn kinetostatics``; returns the exit code."""
+    check_plot_columns(args)
+    if args.plot_polar and not args.plot:
+        raise ModelError("--plot-polar needs --plot FILE (the polar diagrams are written "
+                         "beside it)")
     mech, model = open_model(args)
+    for joint in args.plot_polar:
+        model.joint_kind(joint)  # an unknown joint is an error before the analysis
     over, values, speed = sweep_values(model, args, start=0.0)
     point = vector(args.point, ("length", "length"), "--point",
                    "two lengths X,Y, e.g. 0,0 or 100mm,-50mm")
@@ -90,5 +112,9 @@ def run(args) -> int:
             res.to_dataframe().to_csv(tmp, index=False)
         print(f"  table: {args.output}")
     if args.plot:
-        print(f"  plot: {plot_kinetostatics(res, args.plot, joints=args.joints)}")
+        print(f"  plot: {draw_plot(args, res, plot_kinetostatics, joints=args.joints)}")
+        for joint in args.plot_polar:
+            path = Path(args.plot)
+            out = path.with_name(f"{path.stem}_polar_{joint}{path.suffix}")
+            print(f"  polar plot of {joint}: {plot_joint_force_polar(res, joint, out)}")
     return finish(args, res.status != Status.SINGULAR_POSITION, res.message)

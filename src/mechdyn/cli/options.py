@@ -17,13 +17,15 @@ from ..integrate.driver import INTEGRATORS
 from ..kinematics.sweep import initial_coordinates
 from ..modelfile import load
 from ..modelfile.drives import drive_from_table
+from ..results.plot_columns import check_columns, plot_columns, table_of
 from ..results.table import write_csv
 from ..simulate import simulate
 from ..units import parse_quantity, parse_vector
 
 __all__ = ["quantity", "vector", "add_model", "add_files", "add_range", "add_motion_arguments",
            "add_model_arguments", "add_run", "load_model", "open_model", "prepare_model",
-           "sweep_values", "simulate_from_args", "write_files", "finish"]
+           "sweep_values", "simulate_from_args", "write_files", "finish", "add_plot_columns",
+           "check_plot_columns", "draw_plot"]
 
 
 #: kinds whose bare numbers are SI radians, easily mistaken for degrees or rpm
@@ -220,7 +222,7 @@ def write_files(args, record, plot, **kwargs) -> None:
     if args.output:
         print(f"  table: {write_csv(record, args.output)}")
     if args.plot:
-        print(f"  plot: {plot(record, args.plot, **kwargs)}")
+        print(f"  plot: {draw_plot(args, record, plot, **kwargs)}")
 
 
 def finish(args, ok: bool, message: str) -> int:
@@ -229,3 +231,33 @@ def finish(args, ok: bool, message: str) -> int:
         return 0
     print(f"mechdyn {args.command}: warning: {message}", file=sys.stderr)
     return 1
+
+
+def add_plot_columns(p) -> None:
+    """Add ``--plot-columns``: the columns ``--plot`` draws instead of its default panels."""
+    p.add_argument("--plot-columns", metavar="COL,COL...",
+                   help="with --plot: draw these columns of the table instead (names as in "
+                        "the CSV, e.g. phi_deg,omega_rod_rad_s; one panel per unit, angles "
+                        "in deg, lengths in mm)")
+
+
+def check_plot_columns(args, record=None) -> None:
+    """Before the run: ``--plot-columns`` needs ``--plot``; with the record: every column
+    exists (else the error lists the valid columns)."""
+    columns = getattr(args, "plot_columns", None)
+    if columns is None:
+        return
+    if not args.plot:
+        raise ModelError("--plot-columns needs --plot FILE (the image to draw them in)")
+    if record is not None:
+        table = table_of(record)
+        check_columns(columns, [c for c in table.columns if table[c].dtype.kind in "iuf"],
+                      "--plot-columns")
+
+
+def draw_plot(args, record, plot, **kwargs):
+    """Write ``--plot``: the chosen ``--plot-columns``, else ``plot(record, path, **kwargs)``."""
+    if getattr(args, "plot_columns", None):
+        check_plot_columns(args, record)
+        return plot_columns(record, args.plot_columns, args.plot)
+    return plot(record, args.plot, **kwargs)

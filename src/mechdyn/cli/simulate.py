@@ -30,7 +30,16 @@ from ..results.table import deg_or_mm, write_csv, written
 from ..simulate import simulate
 from ..simulate_events import format_events
 from ..units import parse_quantity
-from .options import add_files, add_model, add_run, load_model, quantity
+from .options import (
+    add_files,
+    add_model,
+    add_plot_columns,
+    add_run,
+    check_plot_columns,
+    draw_plot,
+    load_model,
+    quantity,
+)
 
 __all__ = ["register", "run"]
 
@@ -76,6 +85,7 @@ def register(sub) -> None:
     p.add_argument("--points", action="store_true",
                    help="add the positions, velocities, accelerations of every named point")
     add_files(p, plot="write a plot of q, q', q'' and the energies")
+    add_plot_columns(p)
     p.add_argument("--spectrum", metavar="COLUMN",
                    help="frequency content of a column of the table, e.g. Fy_frame_N: print "
                         "its peak, RMS and dominant components; with -o also write "
@@ -103,6 +113,7 @@ def _pairs(items, model, what, kinds):
 
 def run(args) -> int:
     """Run ``mechdyn simulate``; returns the exit code."""
+    check_plot_columns(args)
     mech = load_model(args.model)
     t_end = parse_quantity(args.t_end, "time", where="--t-end")
     t0 = parse_quantity(args.t0, "time", where="--t0")
@@ -142,8 +153,7 @@ def run(args) -> int:
                 events_table(traj.events, traj.coordinate_names).to_csv(tmp, index=False)
             print(f"wrote {ev_path} ({len(traj.events)} events)")
     if args.plot:
-        plot_trajectory(traj, args.plot)
-        print(f"wrote {args.plot}")
+        print(f"wrote {draw_plot(args, traj, plot_trajectory)}")
     if args.spectrum and traj.t.size >= 8:
         _spectrum(traj, args)
     if not traj.success:

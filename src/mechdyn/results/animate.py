@@ -18,7 +18,7 @@ Agg canvas; pyplot is not used.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +26,8 @@ import numpy as np
 from ..errors import MechdynError, ModelError
 from ..kernels import rows_numpy
 from ..kinematics.constraints import extend, travel_rows
+from ..mechanism.load import Force, Spring
+from ..model.variable import parse as parse_variable
 from .figure import figure, save
 from .table import deg_or_mm, output_path, written
 
@@ -34,6 +36,8 @@ __all__ = ["animate", "snapshot", "frame_geometry", "frame_indices", "check_anim
 
 #: largest number of frames drawn by default
 MAX_FRAMES = 200
+#: width of a frame, inches (at the default dpi 100: 900 pixels)
+FRAME_WIDTH = 9.0
 
 
 def _rot(theta: np.ndarray, s: np.ndarray) -> np.ndarray:
@@ -63,6 +67,15 @@ class MechanismDrawing:
         parent frame, m.
     size : float
         Drawing size of joint circles, blocks and anchors, m.
+    springs : dict str -> ((str, ndarray (2,)), (str, ndarray (2,)))
+        The two ends of every linear spring: body and point in its frame, m.
+    stops : dict str -> (str, ndarray (2, 2))
+        Every limit of a stop on a travel or an angle (``"<stop>@lower"``,
+        ``"<stop>@upper"``): the body it is fixed to and a short bar (travel) or ray
+        (angle) at the limit in that body's frame, m.
+    loads : dict str -> (str, ndarray (2,), ndarray (2,), bool)
+        Every force load: body, point in its frame, direction of a positive magnitude,
+        and whether the direction turns with the body.
     """
 
     bodies: dict
@@ -71,6 +84,9 @@ class MechanismDrawing:
     anchors: dict
     guides: dict
     size: float
+    springs: dict = field(default_factory=dict)
+    stops: dict = field(default_factory=dict)
+    loads: dict = field(default_factory=dict)
 
 
 def _drawing(model, x: np.ndarray) -> MechanismDrawing:
@@ -137,7 +153,82 @@ def _drawing(model, x: np.ndarray) -> MechanismDrawing:
         lo, hi = float(np.min(s)), float(np.max(s))
         m = max(2.5 * size, 0.1 * (hi - lo))
         out_guides[name] = (parent, np.array([pp + (lo - m) * u, pp + (hi + m) * u]))
-    return MechanismDrawing(bodies, revolutes, locks, anchors, out_guides, size)
+    springs = {ld.name: ((ld.body1, model.point_local(ld.body1, ld.point1)),
+                         (ld.body2, model.point_local(ld.body2, ld.point2)))
+               for ld in mech.loads if isinstance(ld, Spring)}
+    loads = {ld.name: (ld.body, model.point_local(ld.body, ld.point),
+                       np.asarray(ld.direction, float), ld.frame == "body")
+             for ld in mech.loads if isinstance(ld, Force)}
+    return MechanismDrawing(bodies, revolutes, locks, anchors, out_guides, size, springs,
+                            _stops(model, bodies, size), loads)
+
+
+def _stops(model, bodies: dict, size: float) -> dict:
+    """The limits of the stops on a travel (a bar across the guide) or an angle (a ray from
+    the pivot along the body's arm at the limit), each in the frame of the body it is fixed
+    to; stops on other quantities (a point's x or y) are not drawn."""
+    mech = model.mechanism
+    out = {}
+    for stop in (mech.extras or {}).get("stops", []):
+        var = parse_variable(stop.variable, model.coordinate_names)
+        offset, joint, body = 0.0, None, None
+        if var.kind == "coordinate":
+            c = mech.coordinates[var.name]
+            offset, joint, body = c.offset, c.joint, c.body
+        elif var.kind == "joint":
+            joint = var.name
+        elif var.kind == "angle":
+            body = var.name
+        else:
+            continue
+        for side in stop.sides():
+            limit = getattr(stop, side) - offset
+            seg = _limit_mark(model, bodies, size, joint, body, limit)
+            if seg is not None:
+                out[f"{stop.name}@{side}"] = seg
+    return out
+
+
+def _limit_mark(model, bodies, size, joint, body, limit):
+    """(body, segment (2, 2)) marking the limit ``limit`` of a travel or an angle."""
+    mech = model.mechanism
+    if joint is not None and model.joint_kind(joint) == "prismatic":
+        j = mech.joints[joint]
+        k = model.pri.names.index(joint)
+        u = model.pri.ui[k]
+        c = model.point_local(j.parent, j.parent_point) + limit * u
+        n = np.array([-u[1], u[0]]) * 2.2 * size
+        return j.parent, np.array([c - n, c + n])
+    if joint is not None:  # a revolute: the child's arm at the relative angle, in the parent
+        j = mech.joints[joint]
+        pivot = model.point_local(j.parent, j.parent_point)
+        arm = _arm(model, bodies, j.child, model.point_local(j.child, j.child_point))
+        frame, angle = j.parent, limit
+    elif body is not None:  # an absolute angle: the arm from the body's pivot, in the ground
+        js = [j for j in mech.joints.values() if model.joint_kind(j.name) == "revolute"
+              and body in (j.parent, j.child)]
+        j = next((j for j in js if "ground" in (j.parent, j.child)), js[0] if js else None)
+        if j is None:
+            return None
+        local = model.point_local(body, j.child_point if j.child == body else j.parent_point)
+        other = (j.parent if j.child == body else j.child)
+        pivot = (model.point_local(other, j.parent_point if j.child == body else j.child_point)
+                 if other == "ground" else None)
+        if pivot is None:
+            return None  # the pivot moves: no fixed mark
+        arm, frame, angle = _arm(model, bodies, body, local), "ground", limit
+    else:
+        return None
+    a = angle + np.arctan2(arm[1], arm[0])
+    r = max(float(np.hypot(*arm)), 4.0 * size)
+    return frame, np.array([pivot, pivot + r * np.array([np.cos(a), np.sin(a)])])
+
+
+def _arm(model, bodies, body, pivot_local) -> np.ndarray:
+    """From a pivot to the body's farthest outline point, in the body's frame."""
+    pts = np.asarray(bodies.get(body, (np.zeros((1, 2)), ""))[0], float) - pivot_local
+    far = pts[np.argmax(np.hypot(pts[:, 0], pts[:, 1]))] if len(pts) else np.zeros(2)
+    return far if np.hypot(*far) > 0 else np.array([1.0, 0.0]) * model.length_scale
 
 
 def _world(model, x: np.ndarray, body: str, local: np.ndarray) -> np.ndarray:
@@ -235,7 +326,12 @@ def frame_geometry(record, index=None, *, trace=None) -> dict:
         ``bodies``: name -> (m, k, 2) outline (m frames, k points; style in
         ``styles``); ``revolutes``, ``locks``: joint -> (m, 2) joint point;
         ``anchors``: joint -> (2,) ground point; ``guides``: joint -> (m, 2, 2)
-        guide segment; ``trace``: (m, 2) or absent; ``limits``: ((xmin, xmax),
+        guide segment; ``springs``: spring -> (m, 2, 2) its two ends; ``stops``:
+        ``"<stop>@<side>"`` -> (m, 2, 2) the bar (travel) or ray (angle) at the limit;
+        ``loads``: force load -> (m, 2, 2) tail (the point) and head of an arrow along a
+        positive magnitude; ``reactions``: joint -> (m, 2, 2) the joint force of a
+        kinetostatic record as an arrow from the joint point (``force_scale`` m/N; empty
+        for other records); ``trace``: (m, 2) or absent; ``limits``: ((xmin, xmax),
         (ymin, ymax)) over the whole motion; ``size``: symbol size; all in m.
     """
     model, x = _record_parts(record)
@@ -243,7 +339,10 @@ def frame_geometry(record, index=None, *, trace=None) -> dict:
     g = _geometry(model, x, drawing, index, spec)
     every = g if index is None else _geometry(model, x, drawing, None, spec)  # all frames
     s = g["size"]
-    arrs = [a.reshape(-1, 2) for a in (*every["bodies"].values(), *every["guides"].values())]
+    arrs = [a.reshape(-1, 2) for kind in ("bodies", "guides", "springs", "stops", "loads")
+            for a in every[kind].values()]
+    _reactions(record, g, every, np.concatenate(arrs), index)
+    arrs += [a.reshape(-1, 2) for a in every["reactions"].values()]
     for a in every["anchors"].values():  # the anchor triangles and their ground lines
         arrs.append(np.asarray(a).reshape(1, 2) + [[-1.8 * s, -1.8 * s], [1.8 * s, 0.0]])
     if "trace" in every:
@@ -254,11 +353,36 @@ def frame_geometry(record, index=None, *, trace=None) -> dict:
     return g
 
 
+def _reactions(record, g, every, points, index) -> None:
+    """The joint forces of a kinetostatic record as arrows from the joint points (tail at
+    the point, force on the child from the parent), scaled so that the largest is a fifth
+    of the drawing's size: ``reactions`` (m, 2, 2) and ``force_scale`` (m/N) in ``g``
+    (and ``every``); none for other records."""
+    forces = getattr(record, "reactions", None)
+    where = getattr(record, "joint_points", None)
+    for h in (g, every):
+        h["reactions"], h["force_scale"] = {}, 0.0
+    if not forces or not where:
+        return
+    peak = max((float(np.nanmax(np.hypot(f[:, 0], f[:, 1]))) for f in forces.values()
+                if np.isfinite(f).any()), default=0.0)
+    if peak <= 0:
+        return
+    scale = 0.2 * float(np.max(np.ptp(points, axis=0))) / peak
+    sel = slice(None) if index is None else np.atleast_1d(np.asarray(index, int))
+    for j, f in forces.items():
+        p, f = np.asarray(where[j], float), np.nan_to_num(np.asarray(f, float)[:, :2])
+        arrow = np.stack([p, p + scale * f], axis=1)
+        every["reactions"][j], g["reactions"][j] = arrow, arrow[sel]
+    g["force_scale"] = every["force_scale"] = scale
+
+
 def _geometry(model, x, drawing: MechanismDrawing, index, trace) -> dict:
     sel = np.arange(x.shape[0]) if index is None else np.atleast_1d(np.asarray(index, int))
     xs = x[sel]
     g: dict = {"bodies": {}, "styles": {}, "revolutes": {}, "locks": {}, "guides": {},
-               "anchors": dict(drawing.anchors), "size": drawing.size}
+               "anchors": dict(drawing.anchors), "size": drawing.size, "springs": {},
+               "stops": {}, "loads": {}}
     for b, (local, style) in drawing.bodies.items():
         g["bodies"][b] = _world(model, xs, b, local)
         g["styles"][b] = style
@@ -267,27 +391,60 @@ def _geometry(model, x, drawing: MechanismDrawing, index, trace) -> dict:
             g[kind][j] = _world(model, xs, b, p[None, :])[:, 0]
     for j, (b, seg) in drawing.guides.items():
         g["guides"][j] = np.array(_world(model, xs, b, seg))
+    for name, ((b1, p1), (b2, p2)) in drawing.springs.items():
+        g["springs"][name] = np.stack([_world(model, xs, b1, p1[None, :])[:, 0],
+                                       _world(model, xs, b2, p2[None, :])[:, 0]], axis=1)
+    for name, (b, seg) in drawing.stops.items():
+        g["stops"][name] = _world(model, xs, b, seg)
+    for name, (b, p, d, turns) in drawing.loads.items():
+        tail = _world(model, xs, b, p[None, :])[:, 0]
+        if turns:
+            d = _rot(extend(model, xs)[:, model.body_index(b), 2], d[None, :])[:, 0]
+        g["loads"][name] = np.stack([tail, tail + 4.0 * drawing.size * np.broadcast_to(
+            d, tail.shape)], axis=1)
     if trace is not None:
         body, point = trace
         g["trace"] = _world(model, xs, body, model.point_local(body, point)[None, :])[:, 0]
     return g
 
 
+def _zigzag(a: np.ndarray, b: np.ndarray, size: float, turns: int = 7) -> np.ndarray:
+    """A spring's zigzag from ``a`` to ``b`` (k, 2): straight ends, ``turns`` zigs between."""
+    d = np.asarray(b, float) - np.asarray(a, float)
+    length = float(np.hypot(*d))
+    if length == 0:
+        return np.array([a, b], float)
+    u = d / length
+    n = np.array([-u[1], u[0]])
+    t = np.linspace(0.2, 0.8, 2 * turns + 1)
+    side = np.where(np.arange(t.size) % 2 == 1, 1.0, 0.0) * np.where(
+        np.arange(t.size) % 4 == 1, 1.0, -1.0)
+    pts = a + np.outer(t * length, u) + np.outer(side * 0.7 * size, n)
+    return np.vstack([a, pts, b])
+
+
 class _Scene:
     """The matplotlib artists of one figure, updated frame by frame."""
 
-    def __init__(self, record, *, trace=None, title=None, width: float = 6.4):
-        from matplotlib.patches import Polygon
+    def __init__(self, record, *, trace=None, title=None, width: float = FRAME_WIDTH,
+                 labels: bool = True):
+        from matplotlib.lines import Line2D
+        from matplotlib.patches import FancyArrowPatch, Polygon
 
         model, _ = _record_parts(record)
         self.trace = _trace_spec(model, trace)
         self.g = g = frame_geometry(record, trace=self.trace)  # every frame, drawn by update()
         (x0, x1), (y0, y1) = g["limits"]
         # the figure's shape follows the drawing's (room for title and labels added)
-        height = float(np.clip((width - 1.0) * (y1 - y0) / (x1 - x0) + 1.2, 3.0, 7.5))
+        height = float(np.clip((width - 1.0) * (y1 - y0) / (x1 - x0) + 1.2, 4.5, 10.0))
         self.fig, (ax,) = figure(1, width, height)
         self.ax = ax
-        ax.set(xlim=(x0, x1), ylim=(y0, y1), xlabel="x (m)", ylabel="y (m)",
+        from matplotlib.ticker import FuncFormatter
+
+        mm = FuncFormatter(lambda v, _: f"{v * 1e3:.6g}")  # the drawing in m, the axes in mm
+        ax.xaxis.set_major_formatter(mm)
+        ax.yaxis.set_major_formatter(mm)
+        ax.set(xlim=(x0, x1), ylim=(y0, y1), xlabel="x (mm)", ylabel="y (mm)",
                title=title if title is not None else getattr(model.mechanism, "name", "mechanism"))
         ax.set_aspect("equal", adjustable="box")
         s = g["size"]
@@ -322,9 +479,47 @@ class _Scene:
             else:
                 (art,) = ax.plot([], [], "o", color=c, ms=9, zorder=3, label=b)
             self.bodies[b] = (art, style)
-        (self.revolutes,) = ax.plot([], [], "o", ms=6, mfc="white", mec="black", mew=1.3,
+        (self.revolutes,) = ax.plot([], [], "o", ms=7, mfc="white", mec="black", mew=1.3,
                                     zorder=5, ls="none")
-        (self.locks,) = ax.plot([], [], "s", ms=6, mfc="0.2", mec="black", zorder=5, ls="none")
+        (self.locks,) = ax.plot([], [], "s", ms=7, mfc="0.2", mec="black", zorder=5, ls="none")
+        # springs (zigzags), stops (dark red bars), loads (green arrows), joint forces (red)
+        self.springs = {n: ax.plot([], [], color="tab:brown", lw=1.4, zorder=4)[0]
+                        for n in g["springs"]}
+        self.stops = {n: ax.plot([], [], color="darkred", lw=3.5, solid_capstyle="butt",
+                                 zorder=4)[0] for n in g["stops"]}
+        arrow = {"arrowstyle": "-|>", "mutation_scale": 14, "zorder": 6}
+        self.loads = {n: ax.add_patch(FancyArrowPatch((0, 0), (0, 0), color="tab:green",
+                                                      lw=2.0, **arrow)) for n in g["loads"]}
+        self.reactions = {n: ax.add_patch(FancyArrowPatch((0, 0), (0, 0), color="tab:red",
+                                                          lw=1.6, **arrow))
+                          for n in g["reactions"]}
+        # the names: bodies at their outline's centre, joints beside the pin, loads at the tip
+        self.labels = {}
+        if labels:
+            font = {"fontsize": "small", "zorder": 8, "clip_on": True}
+            for b in g["bodies"]:
+                self.labels[("bodies", b)] = ax.text(0, 0, b, ha="center", va="center",
+                                                     color="0.1", fontweight="bold", **font)
+            for kind in ("revolutes", "locks"):
+                for j in g[kind]:
+                    self.labels[(kind, j)] = ax.text(0, 0, j, ha="left", va="bottom",
+                                                     color="0.25", **font)
+            for n in g["loads"]:
+                self.labels[("loads", n)] = ax.text(0, 0, n, ha="left", va="bottom",
+                                                    color="tab:green", **font)
+        keys = [("spring", "tab:brown", "-", g["springs"]), ("stop", "darkred", "-", g["stops"]),
+                ("load", "tab:green", "-", g["loads"]),
+                ("joint force", "tab:red", "-", g["reactions"])]
+        handles = [Line2D([], [], color=c, ls=ls, lw=2.0, label=lab)
+                   for lab, c, ls, items in keys if items]
+        if handles or self.trace is not None:
+            old_legend = ax.get_legend()
+            ax.legend(handles=(old_legend.legend_handles if old_legend else []) + handles,
+                      loc="upper right", fontsize="small")
+        if g["reactions"]:
+            ax.text(0.98, 0.02, f"joint forces: 1 mm = {1e-3 / g['force_scale']:.4g} N",
+                    transform=ax.transAxes, ha="right", va="bottom", fontsize="small",
+                    color="tab:red")
         self.text = ax.text(0.02, 0.97, "", transform=ax.transAxes, ha="left", va="top",
                             family="monospace", fontsize="medium",
                             bbox={"boxstyle": "round", "fc": "white", "ec": "0.7",
@@ -337,7 +532,9 @@ class _Scene:
         canvas = self.fig.canvas
         self.fig.set_dpi(dpi)
         moving = [a for a, _ in self.bodies.values()] + list(self.guides.values())
-        moving += [self.revolutes, self.locks, self.text]
+        moving += [self.revolutes, self.locks, self.text, *self.springs.values(),
+                   *self.stops.values(), *self.loads.values(), *self.reactions.values(),
+                   *self.labels.values()]
         if self.trace is not None:
             moving += [self.trace_line, self.trace_dot]
         for a in moving:
@@ -370,6 +567,21 @@ class _Scene:
         for j, ln in self.guides.items():
             seg = g["guides"][j][i]
             ln.set_data(seg[:, 0], seg[:, 1])
+        for n, ln in self.springs.items():
+            ln.set_data(*_zigzag(*g["springs"][n][i], g["size"]).T)
+        for n, ln in self.stops.items():
+            ln.set_data(*g["stops"][n][i].T)
+        for kind in ("loads", "reactions"):
+            for n, art in getattr(self, kind).items():
+                art.set_positions(*g[kind][n][i])
+        s = g["size"]
+        for (kind, n), txt in self.labels.items():
+            if kind == "bodies":
+                txt.set_position(np.mean(g["bodies"][n][i], axis=0))
+            elif kind == "loads":
+                txt.set_position(g["loads"][n][i, 1])
+            else:
+                txt.set_position(g[kind][n][i] + 0.6 * s)
         if self.trace is not None:
             path = g["trace"]
             self.trace_line.set_data(path[: i + 1, 0], path[: i + 1, 1])
@@ -378,7 +590,7 @@ class _Scene:
 
 
 def animate(record, path, *, fps: int = 25, frames: int | None = None, trace=None,
-            title: str | None = None, dpi: int = 80) -> Path:
+            title: str | None = None, dpi: int = 100, labels: bool = True) -> Path:
     """Write an animation of a mechanism's motion (GIF, or MP4 when ffmpeg exists).
 
     Parameters
@@ -397,7 +609,9 @@ def animate(record, path, *, fps: int = 25, frames: int | None = None, trace=Non
     title : str, optional
         Title above the drawing (default the mechanism's name).
     dpi : int
-        Resolution of the frames (the figure is 6.4 inches wide).
+        Resolution of the frames (the figure is 9 inches wide: 900 pixels at 100 dpi).
+    labels : bool
+        Name the bodies, joints and loads on the drawing.
 
     Returns
     -------
@@ -419,7 +633,7 @@ def animate(record, path, *, fps: int = 25, frames: int | None = None, trace=Non
         raise ModelError(f"fps must be positive, got {fps}")
     idx = frame_indices(record, frames)
     labels = _labels(record, idx)
-    scene = _Scene(record, trace=trace, title=title)
+    scene = _Scene(record, trace=trace, title=title, labels=labels)
     path = output_path(path)
     if path.suffix.lower() == ".mp4":  # pragma: no cover - needs ffmpeg
         writer = animation.FFMpegWriter(fps=fps)
@@ -467,33 +681,37 @@ def check_animation_path(path) -> Path:
 
 
 def snapshot(record, path, index: int = 0, *, trace=None, title: str | None = None,
-             dpi: int = 110) -> Path:
+             dpi: int = 110, labels: bool = True):
     """Write one frame of the motion as an image (PNG, or any matplotlib format).
 
     Parameters
     ----------
     record : KinematicSweep, Trajectory or Kinetostatics
-    path : str or Path
+    path : str or Path or None
         Image file (format from the suffix, e.g. ``.png``, ``.svg``); a binary
-        file object is also accepted (PNG).
+        file object is also accepted (PNG); None returns the figure.
     index : int
         Sample to draw (negative counts from the end).
     trace : "BODY.POINT" or (body, point), optional
         Draw the path of this point (up to this sample, and faint for all of it).
     title : str, optional
     dpi : int
+    labels : bool
+        Name the bodies, joints and loads on the drawing.
 
     Returns
     -------
-    Path or the file object
+    Path or the file object, or the Figure when ``path`` is None
     """
     model, x = _record_parts(record)
     n = x.shape[0]
     if not -n <= index < n:
         raise ModelError(f"index {index} is outside the record's {n} samples")
     i = int(index) % n
-    scene = _Scene(record, trace=trace, title=title)
+    scene = _Scene(record, trace=trace, title=title, labels=labels)
     scene.update(i, _labels(record, np.array([i]))[0])
+    if path is None:
+        return scene.fig
     if hasattr(path, "write"):
         scene.fig.savefig(path, dpi=dpi, format="png")
         return path

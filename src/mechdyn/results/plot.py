@@ -5,6 +5,10 @@ one, all importable from here), and :func:`plot`, which picks the function for a
 Figures are drawn with matplotlib's Agg canvas directly (:mod:`mechdyn.results.figure`),
 so nothing here needs a screen or changes pyplot's backend.
 
+:func:`plot_columns` draws chosen table columns of any record, and
+:func:`plot_joint_force_polar` the polar diagram of a joint force.  Given ``path=None``
+the plotting functions return the matplotlib figure instead of writing it.
+
 Add a record kind by writing ``plot_<kind>(record, path, ...) -> Path`` and an entry in
 ``PLOTTERS``.
 """
@@ -14,15 +18,16 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
+from .plot_columns import plot_columns
 from .plot_dynamics import plot_trajectory
 from .plot_kinematics import plot_kinematic_sweep
-from .plot_kinetostatics import plot_kinetostatics
+from .plot_kinetostatics import plot_joint_force_polar, plot_kinetostatics
 from .plot_reduction import plot_motor, plot_reduction, plot_startup, plot_steady_cycle
 from .plot_spectrum import plot_spectrum
 
 __all__ = ["plot", "PLOTTERS", "plot_kinematic_sweep", "plot_trajectory", "plot_kinetostatics",
            "plot_reduction", "plot_steady_cycle", "plot_startup", "plot_motor",
-           "plot_spectrum"]
+           "plot_spectrum", "plot_columns", "plot_joint_force_polar"]
 
 
 #: record class name -> plotting function
@@ -44,15 +49,16 @@ def plot(record, path, **kwargs) -> Path:
     record
         A :class:`~mechdyn.kinematics.sweep.KinematicSweep`, ``Trajectory``,
         ``Kinetostatics``, ``Reduction``, ``SteadyCycle`` or ``StartupResult``.
-    path : str or Path
-        The image file (PNG, PDF, SVG ... by its suffix); its folder is created.
+    path : str or Path or None
+        The image file (PNG, PDF, SVG ... by its suffix); its folder is created.  None
+        returns the figure.
     **kwargs
         Options of the record's plotting function (``PLOTTERS[kind]``).
 
     Returns
     -------
-    Path
-        The file written.
+    Path or Figure
+        The file written (the figure when ``path`` is None).
 
     Raises
     ------

@@ -8,19 +8,21 @@ import numpy as np
 
 from .figure import figure as _figure
 from .figure import save as _save
+from .plot_axes import XAxis, model_name, shade_modes, speed_text
 
 __all__ = ["plot_trajectory"]
 
 
-def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
+def plot_trajectory(traj, path=None, *, coordinates=None, degrees: bool = True,
                     energy: bool = True, dpi: int = 120, title: str | None = None) -> Path:
     """Plot q, q' and q'' of a :class:`~mechdyn.results.trajectory.Trajectory` against time.
 
     Parameters
     ----------
     traj : Trajectory
-    path : str or Path
-        Image file to write (format from the suffix, e.g. ``.png``, ``.svg``).
+    path : str or Path, optional
+        Image file to write (format from the suffix, e.g. ``.png``, ``.svg``); None
+        returns the figure.
     coordinates : sequence of str, optional
         Coordinates to plot (default: all).
     degrees : bool
@@ -32,8 +34,16 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
 
     Returns
     -------
-    Path
-        The file written.
+    Path, or Figure when ``path`` is None
+
+    Notes
+    -----
+    Every axis names its unit; angles are in deg, travels in mm (on a right-hand axis when
+    they share a panel with angles), the frame force of a variable-structure run in kN.
+    The title names the model, the mean speed of the first coordinate and the integrator;
+    the modes of a variable-structure run are shaded and named in the legend of the last
+    panel.  Draw a run sampled from the dense output (``t_eval``; the command line's default
+    ``--samples 1001``): one sample per integrator step can be too coarse for a smooth curve.
     """
     names = list(coordinates) if coordinates is not None else list(traj.coordinate_names)
     idx = [traj.coordinate_names.index(n) for n in names]
@@ -57,8 +67,8 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
         if twin is ax:
             ax.set_ylabel(f"{what} [{au if any(is_angle) else 'mm'}{per}]")
         else:
-            ax.set_ylabel(f"{what}: angles")
-            twin.set_ylabel(f"{what}: travels")
+            ax.set_ylabel(f"{what}: angles [{au}{per}]")
+            twin.set_ylabel(f"{what}: travels [mm{per}]")
             ax.legend(handles=ax.lines + twin.lines, loc="best", fontsize="small")
     if show_energy:
         for key, style, label in (("kinetic", "-", "T"), ("potential", "-", "U"),
@@ -71,22 +81,14 @@ def plot_trajectory(traj, path, *, coordinates=None, degrees: bool = True,
         ax.plot(t, frame[:, 0] * 1e-3, label="Fx frame [kN]")
         ax.plot(t, frame[:, 1] * 1e-3, label="Fy frame [kN]")
         ax.set_ylabel("force on the frame [kN]")
-        mode_index = np.asarray(vs["mode_index"])
-        if t.size >= 2 and len(vs["modes"]) >= 2:  # the time span of each mode, one tint a mode
-            from matplotlib import colormaps
-
-            cmap = colormaps["Pastel2"]
-            change = np.flatnonzero(np.diff(mode_index) != 0) + 1
-            for a, b in zip(np.r_[0, change], np.r_[change, t.size - 1], strict=True):
-                for ax_ in axes:
-                    ax_.axvspan(t[a], t[b], color=cmap(int(mode_index[a]) % cmap.N), alpha=0.35,
-                                lw=0)
+        shade_modes(axes, XAxis(t, "t [s]"), vs["mode_index"], vs["modes"], legend_ax=ax)
     for ax in axes:
         if ax.get_legend() is None:
             ax.legend(loc="best", fontsize="small")
     axes[-1].set_xlabel("t [s]")
-    head = title or f"simulation: {traj.stats.get('integrator', '')} " \
-                    f"({traj.stats.get('formulation', '')})"
+    head = title or " ".join(filter(None, (
+        f"{model_name(traj)}: simulation", speed_text(traj),
+        f"- {traj.stats.get('integrator', '')} ({traj.stats.get('formulation', '')})")))
     if not traj.success:
         head += f" - stopped: {traj.status}"
     fig.suptitle(head)

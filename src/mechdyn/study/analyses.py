@@ -1,0 +1,306 @@
+"""What a study computes for each variant: kinetostatic extremes, a kinematic summary,
+a flywheel, or metrics of a simulation.
+
+Each analysis is a small picklable object (it travels to worker processes) called as
+``analysis(model, warm)`` with a compiled variant; it returns an :class:`Outcome`: the
+figures (table columns named with their units), the status and message of the record,
+and what the next variant may start from (``warm``, e.g. this variant's poses).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ModelError, Status
+from ..units import parse_quantity
+
+__all__ = ["Outcome", "KinetostaticExtremes", "KinematicSummary", "FlywheelSize",
+           "SimulationMetrics", "Combined", "ANALYSES"]
+
+_DEG = 180.0 / np.pi
+
+
+@dataclass
+class Outcome:
+    """The figures of one variant and how its analysis ended.
+
+    Attributes
+    ----------
+    figures : dict of str to float
+        Column name with its unit (``"M_drive_phi_peak_Nm"``) -> value.
+    status : str
+        A :class:`mechdyn.errors.Status` value.
+    message : str
+    warm : object
+        What the next variant starts from (None: start from its own sketch).
+    """
+
+    figures: dict
+    status: str = Status.SUCCESS.value
+    message: str = ""
+    warm: object = None
+
+
+def _si(value, kind: str, where: str) -> float:
+    return float(parse_quantity(value, kind, where=where))
+
+
+def _cycle(model, over: str | None, start: float, steps: int):
+    """The driven coordinate (default the first) and ``steps`` values over one turn."""
+    over = model.coordinate_names[0] if over is None else over
+    k = model.coordinate_index(over)
+    if not model.coord_is_angle[k]:
+        raise ModelError(f"coordinate {over!r} is a travel: a study cycle turns an angle")
+    if steps < 2:
+        raise ModelError(f"steps must be at least 2, got {steps}")
+    return over, start + np.linspace(0.0, 2 * np.pi, steps, endpoint=False)
+
+
+@dataclass(frozen=True)
+class KinetostaticExtremes:
+    """Peak and RMS driving torque, peak joint forces and the shaking force over one
+    turn at constant speed (:func:`mechdyn.kinetostatics`).
+
+    Parameters
+    ----------
+    speed : float or str
+        Constant speed of ``over``, rad/s or with a unit (``"1000 rpm"``).
+    steps : int
+        Positions over one turn, ``start + linspace(0, 2 pi, steps, endpoint=False)``.
+    over : str, optional
+        Driven coordinate (default the first).
+    start : float or str
+        First position, rad or with a unit.
+    warm_start : bool
+        Start each variant's position solve from the previous variant's poses (one
+        batched Newton solve instead of the continuation; the result is the same to
+        the solver's tolerance while the variants stay on one assembly branch).
+
+    Examples
+    --------
+    >>> a = KinetostaticExtremes("1000 rpm", steps=36)
+    >>> round(a.speed, 4)
+    104.7198
+    """
+
+    speed: float | str
+    steps: int = 360
+    over: str | None = None
+    start: float | str = 0.0
+    warm_start: bool = True
+    name: str = field(default="kinetostatics", init=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "speed", _si(self.speed, "angular_velocity", "speed"))
+        object.__setattr__(self, "start", _si(self.start, "angle", "start"))
+
+    def values(self, model) -> tuple[str, np.ndarray]:
+        """The driven coordinate and its positions, rad, shape (steps,)."""
+        return _cycle(model, self.over, self.start, self.steps)
+
+    def record(self, model, warm=None):
+        """The :class:`~mechdyn.Kinetostatics` record of a variant (from ``warm`` poses)."""
+        from ..dynamics.kinetostatics import kinetostatics
+
+        over, values = self.values(model)
+        guess = warm if self.warm_start and warm is not None and \
+            np.shape(warm) == (values.size, model.n_x) else None
+        return kinetostatics(model, over=over, speed=self.speed, values=values, x_guess=guess)
+
+    def __call__(self, model, warm=None) -> Outcome:
+        return self.figures(self.record(model, warm))
+
+    @staticmethod
+    def figures(rec) -> Outcome:
+        """The figures of a kinetostatics record (also for a plain loop's records)."""
+        out: dict[str, float] = {}
+        for c in rec.driven:
+            k = rec.coordinate_names.index(c)
+            sym, unit = ("M", "Nm") if rec.model is None or rec.model.coord_is_angle[k] \
+                else ("F", "N")
+            tau = np.asarray(rec.driving[c], float)
+            out[f"{sym}_drive_{c}_peak_{unit}"] = float(np.nanmax(np.abs(tau)))
+            out[f"{sym}_drive_{c}_max_{unit}"] = float(np.nanmax(tau))
+            out[f"{sym}_drive_{c}_min_{unit}"] = float(np.nanmin(tau))
+            out[f"{sym}_drive_{c}_rms_{unit}"] = float(rec.rms(tau))
+            out[f"P_drive_{c}_peak_W"] = float(np.nanmax(np.abs(rec.power[c])))
+        for j in rec.reactions:
+            out[f"F_{j}_peak_N"] = float(np.nanmax(rec.force_magnitude(j)))
+        f = np.hypot(rec.frame_force[:, 0], rec.frame_force[:, 1])
+        out["F_frame_peak_N"] = float(np.nanmax(f))
+        out["F_frame_rms_N"] = float(rec.rms(f))
+        out["M_frame_peak_Nm"] = float(np.nanmax(np.abs(rec.frame_moment)))
+        ok = rec.status in (Status.SUCCESS, Status.REDUNDANT)
+        return Outcome(out, str(rec.status), "" if ok else rec.message,
+                       rec.x if ok else None)
+
+
+@dataclass(frozen=True)
+class KinematicSummary:
+    """Strokes and dead centres of the sliders and the transmission-angle range of the
+    four-bar loops over one turn (:meth:`mechdyn.KinematicSweep.summary`).
+
+    Parameters
+    ----------
+    steps : int
+        Positions over one turn.
+    over : str, optional
+        Swept coordinate (default the first).
+    start : float or str
+        First position, rad or with a unit.
+
+    Examples
+    --------
+    >>> KinematicSummary(steps=90).name
+    'kinematics'
+    """
+
+    steps: int = 361
+    over: str | None = None
+    start: float | str = 0.0
+    name: str = field(default="kinematics", init=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "start", _si(self.start, "angle", "start"))
+
+    def __call__(self, model, warm=None) -> Outcome:
+        from ..kinematics.sweep import sweep
+
+        over, values = _cycle(model, self.over, self.start, self.steps)
+        sw = sweep(model, over, values)
+        s = sw.summary()
+        out: dict[str, float] = {}
+        for j, v in s.strokes.items():
+            out[f"stroke_{j}_m"] = float(v)
+        for d in s.dead_centres:
+            out[f"{d.label}_{d.joint}_at_deg"] = float(np.rad2deg(d.at) % 360.0)
+            out[f"{d.label}_{d.joint}_travel_m"] = float(d.travel)
+        for t in s.transmission:
+            tag = f"{t.loop.coupler}_{t.loop.rocker}"
+            out[f"mu_min_{tag}_deg"] = float(t.min * _DEG)
+            out[f"mu_max_{tag}_deg"] = float(t.max * _DEG)
+            out[f"mu_min_{tag}_at_deg"] = float(np.rad2deg(t.min_at) % 360.0)
+        return Outcome(out, str(sw.status), "" if sw.status == Status.SUCCESS else sw.message)
+
+
+@dataclass(frozen=True)
+class FlywheelSize:
+    """A flywheel for a coefficient of speed fluctuation (:func:`mechdyn.size_flywheel`
+    on the reduced machine of :func:`mechdyn.reduce_model`).
+
+    Parameters
+    ----------
+    delta : float
+        Target coefficient of speed fluctuation, in (0, 2).
+    speed : float or str, optional
+        Mean speed (needed when the drive torque does not depend on the speed).
+    method : {"energy", "refined", "simulation"}, optional
+        See :func:`mechdyn.size_flywheel` (default ``"refined"``: fast, no simulation).
+    steps : int
+        Positions of the reduction table.
+
+    Examples
+    --------
+    >>> FlywheelSize(0.05, speed="1000 rpm").method
+    'refined'
+    """
+
+    delta: float
+    speed: float | str | None = None
+    method: str = "refined"
+    steps: int = 361
+    name: str = field(default="flywheel", init=False)
+
+    def __post_init__(self):
+        if self.speed is not None:
+            object.__setattr__(self, "speed", _si(self.speed, "angular_velocity", "speed"))
+
+    def __call__(self, model, warm=None) -> Outcome:
+        from ..dynamics.flywheel import size_flywheel
+        from ..dynamics.reduction import reduce_model
+
+        machine = reduce_model(model, steps=self.steps, omega=self.speed or 1.0).machine(model)
+        key = "omega_guess" if machine.speed_dependent() else "omega_mean"
+        fs = size_flywheel(machine, float(self.delta), method=self.method,
+                           confirm=self.method == "simulation", **{key: self.speed})
+        out = {"J_fly_kg_m2": fs.J_fly, "delta_E_max_J": fs.delta_E_max,
+               "omega_mean_rpm": fs.omega_mean * 30.0 / np.pi, "J_red_mean_kg_m2": fs.J_red_mean}
+        if fs.J_fly_motor is not None:
+            out["J_fly_motor_kg_m2"] = fs.J_fly_motor
+        if fs.delta_simulated is not None:
+            out["delta_simulated"] = fs.delta_simulated
+        return Outcome({k: float(v) for k, v in out.items()})
+
+
+@dataclass(frozen=True)
+class SimulationMetrics:
+    """Figures of a forward-dynamics run, computed by a function of its
+    :class:`~mechdyn.Trajectory` (:func:`mechdyn.simulate`).
+
+    Parameters
+    ----------
+    metrics : callable
+        ``metrics(trajectory) -> dict`` of column name (with its unit) to value; a
+        module-level function, so that it can be sent to worker processes.
+    t_end : float or str
+        End time of each run, s or with a unit.
+    options : dict
+        More keywords of :func:`mechdyn.simulate` (``integrator``, ``rtol`` ...).
+
+    Examples
+    --------
+    >>> SimulationMetrics(len, "50 ms").t_end
+    0.05
+    """
+
+    metrics: Callable
+    t_end: float | str
+    options: dict = field(default_factory=dict)
+    name: str = field(default="simulation", init=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "t_end", _si(self.t_end, "time", "t_end"))
+
+    def __call__(self, model, warm=None) -> Outcome:
+        from ..simulate import simulate
+
+        traj = simulate(model, self.t_end, progress=False, **self.options)
+        out = {k: float(v) for k, v in dict(self.metrics(traj)).items()}
+        ok = traj.status in ("success", "event")
+        return Outcome(out, str(traj.status), "" if ok else traj.message)
+
+
+@dataclass(frozen=True)
+class Combined:
+    """Several analyses of each variant, their figures in one row (e.g. the stroke of
+    :class:`KinematicSummary` beside the torques of :class:`KinetostaticExtremes`).
+
+    The status is the first that is not a success; the warm state is the first
+    analysis'.
+
+    Examples
+    --------
+    >>> Combined((KinetostaticExtremes("100 rpm"), KinematicSummary())).name
+    'kinetostatics+kinematics'
+    """
+
+    parts: tuple
+
+    @property
+    def name(self) -> str:
+        return "+".join(p.name for p in self.parts)
+
+    def __call__(self, model, warm=None) -> Outcome:
+        outs = [p(model, warm if k == 0 else None) for k, p in enumerate(self.parts)]
+        figures = {k: v for oc in outs for k, v in oc.figures.items()}
+        bad = [oc for oc in outs if oc.status not in (Status.SUCCESS, Status.REDUNDANT)]
+        head = bad[0] if bad else outs[0]
+        return Outcome(figures, head.status, head.message, outs[0].warm)
+
+
+#: the analyses by their CLI name
+ANALYSES = {"kinetostatics": KinetostaticExtremes, "kinematics": KinematicSummary,
+            "flywheel": FlywheelSize}
