@@ -40,7 +40,7 @@ def _motion(record, alt: str, *, animation: bool, trace) -> str:
     """The animation of a record's motion (a GIF) or, without ``animation``, its first frame."""
     if animation:
         return "<h3>Motion</h3>\n" + img(
-            lambda p: animate(record, p, frames=72, dpi=60, trace=trace), alt, "gif")
+            lambda p: animate(record, p, frames=72, dpi=80, trace=trace), alt, "gif")
     return "<h3>Drawing</h3>\n" + img(lambda p: snapshot(record, p, 0, trace=trace), alt)
 
 
