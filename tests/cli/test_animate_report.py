@@ -98,3 +98,13 @@ def test_report_of_a_simulation_has_energy_balance_and_events(tmp_path, capsys):
                     "<h3>Spectrum</h3>", "<h3>Dominant components</h3>"):
         assert section in text, section
     assert text.count('class="plotly-graph-div"') == 3  # the run, frame loads, spectrum
+
+
+def test_report_of_a_two_dof_press_holds_the_other_coordinate(tmp_path, capsys):
+    html = tmp_path / "press.html"
+    rc = main(["report", "clutchless_press", "--steps", "37", "--no-animation", "-o", str(html)])
+    assert rc == 0, capsys.readouterr().err
+    text = html.read_text(encoding="utf-8")
+    assert "<h2>Kinetostatics</h2>" in text and "<h2>Loads on the building</h2>" in text
+    assert re.search(r"held: <code>psi</code> at -?[0-9.]+ deg \(its initial value\)", text)
+    assert re.search(r"<td[^>]*>psi</td>\s*<td[^>]*>held</td>", text)  # its holding torque
