@@ -3,15 +3,18 @@
 Examples::
 
     mechdyn report slider_crank --speed 1500rpm -o slider_crank.html
-    mechdyn report four_bar --animation --trace coupler.P -o four_bar.html
-    mechdyn report slider_crank --simulate --t-end 0.05s -o run.html
+    mechdyn report four_bar --trace coupler.P -o four_bar.html
+    mechdyn report press_cycle --simulate --t-end 0.5s -o run.html
 
 The report holds the model (bodies, joints, coordinates, loads and drives in
 tables with units), the kinematic sweep summary (strokes, dead centres,
-transmission angles, extreme speeds and accelerations) with its plot and, for
-one degree of freedom or a given ``--speed``, the kinetostatic cycle (peak and
-RMS driving torque, peak joint forces, shaking-force harmonics) with its plot;
-with ``--simulate``, the run summary, energy balance and events instead.
+transmission angles, extreme speeds and accelerations) with its interactive plot
+and the animation beside it, the kinetostatic cycle (driving torque, peak joint
+forces; the other coordinates of a machine with several degrees of freedom held
+at their initial values) and the loads on the building (frame force and moment,
+their harmonics, and the peak load of every support when the model has a
+foundation); with ``--simulate``, the run summary, energy balance, events and
+the loads on the building of the run instead.
 
 Exit codes: 0 done; 1 an analysis stopped early (the report says where); 2 bad input.
 The analyses are composed here and written by :mod:`mechdyn.results.report`.
@@ -19,35 +22,41 @@ The analyses are composed here and written by :mod:`mechdyn.results.report`.
 
 from __future__ import annotations
 
+import argparse
 import warnings
 from pathlib import Path
 
 import numpy as np
 
 from ..dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
-from ..errors import ModelError, Status
+from ..errors import MechdynError, ModelError, Status
 from ..kinematics.sweep import initial_coordinates
 from ..kinematics.sweep import sweep as run_sweep
 from ..model import as_model
 from ..results.report import report_trajectory, write_report
 from .options import add_motion_arguments, finish, open_model, simulate_from_args, sweep_values
 
-__all__ = ["register", "run", "report", "report_records"]
+__all__ = ["register", "run", "report", "report_records", "foundation_loads", "mounted_loads"]
 
 
 def register(sub) -> None:
     """Add the ``report`` subcommand to an argparse subparsers object."""
     p = sub.add_parser(
         "report",
-        help="self-contained HTML report: model, kinematics, kinetostatics (or a simulation)",
-        description="Write one HTML file (tables and embedded PNG plots) describing the model "
-                    "and its kinematics over one turn and, for one degree of freedom or with "
-                    "--speed, its kinetostatic cycle; with --simulate, a forward-dynamics run.",
+        help="self-contained HTML report: model, kinematics, kinetostatics, loads on the "
+             "building (or a simulation)",
+        description="Write one HTML file that works offline (tables, interactive plots, the "
+                    "animation) describing the model, its kinematics over one turn, its "
+                    "kinetostatic cycle (other coordinates held at their initial values) and "
+                    "the loads it sends into the building; with --simulate, a forward-dynamics "
+                    "run.",
         epilog="Quantities take units: 60rpm, 0deg, 360 deg, 0.05s (a bare number is SI). "
                "Exit codes: 0 done, 1 an analysis stopped early, 2 bad input.")
     d = add_motion_arguments(p, "HTML", "report to write", steps=361, verb="report",
                              title="title of the report")
-    d.add_argument("--animation", action="store_true", help="embed an animated GIF")
+    d.add_argument("--animation", action=argparse.BooleanOptionalAction, default=True,
+                   help="embed an animated GIF of the motion beside the plots (default; "
+                        "--no-animation: its first frame only, a smaller file)")
     p.add_argument("--speed", metavar="RATE",
                    help="constant rate of the swept coordinate, e.g. 60rpm (default: the "
                         "model's initial rate, else 1 rad/s)")
@@ -58,15 +67,19 @@ def run(args) -> int:
     mech, model = open_model(args)
     if args.simulate:
         traj = simulate_from_args(model, args, 401)
+        supports = foundation_loads(mech, traj)
+        mounted, modes = mounted_loads(mech, supports)
         out = report_trajectory(traj, args.output, title=args.title, animation=args.animation,
-                                trace=args.trace)
+                                trace=args.trace, supports=supports, mounted=mounted,
+                                modes=modes)
         print(f"{mech.name}: simulation {traj.status}; report: {out}")
         return finish(args, traj.success, f"{traj.status}: {traj.message}")
 
     over, values, speed = sweep_values(model, args)
     model, sw, ks = report_records(model, speed=speed, over=over, values=values)
     out = write_report(model, args.output, sweep=sw, kinetostatics=ks, title=args.title,
-                       animation=args.animation, trace=args.trace)
+                       animation=args.animation, trace=args.trace,
+                       supports=foundation_loads(mech, ks))
     print(f"{mech.name}: report: {out}")
     for line in sw.summary().lines() if len(sw) else ():
         print("  " + line)
@@ -78,10 +91,11 @@ def run(args) -> int:
 
 def report_records(mech_or_model, *, speed: float | None = None, over: str | None = None,
                    values=None, steps: int = 361, point=(0.0, 0.0)):
-    """The analyses a :func:`report` shows: a sweep and, when it applies, the kinetostatics.
+    """The analyses a :func:`report` shows: a sweep and the kinetostatic cycle.
 
-    Runs a kinematic sweep of ``over`` and -- for a mechanism with one degree of
-    freedom, or when ``speed`` is given -- the kinetostatic cycle at that speed.
+    Runs a kinematic sweep of ``over`` and the kinetostatic cycle at that speed; the
+    other independent coordinates of a mechanism with several degrees of freedom are
+    held at their initial values (the report says so, with their holding torques).
 
     Parameters
     ----------
@@ -104,7 +118,7 @@ def report_records(mech_or_model, *, speed: float | None = None, over: str | Non
     -------
     model : Model
     sweep : KinematicSweep
-    kinetostatics : Kinetostatics or None
+    kinetostatics : Kinetostatics
 
     Raises
     ------
@@ -120,28 +134,68 @@ def report_records(mech_or_model, *, speed: float | None = None, over: str | Non
         start = float(initial_coordinates(model)[k])
         values = np.linspace(start, start + 2 * np.pi, int(steps))
     values = np.asarray(values, dtype=float)
-    given_speed = speed is not None
     if speed is None:
         qd0 = (model.mechanism.extras.get("initial") or {}).get("qdot") or {}
         speed = (float(qd0.get(over, 0.0)) if isinstance(qd0, dict) else 0.0) or 1.0
     sw = run_sweep(model, over, values, speed=float(speed))
-    ks = None
-    if given_speed or model.mechanism.dof == 1:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", KinetostaticsWarning)  # shown in the report
+    q0 = initial_coordinates(model)
+    hold = {c: float(q0[i]) for i, c in enumerate(model.coordinate_names) if c != over}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", KinetostaticsWarning)  # shown in the report
+        try:  # the other coordinates held at their initial values
+            ks = kinetostatics(model, over=over, speed=float(speed), values=values,
+                               point=point, hold=hold or None)
+        except ModelError:  # a coordinate that the mode fixes cannot be held: the sketch's
             ks = kinetostatics(model, over=over, speed=float(speed), values=values,
                                point=point)
     return model, sw, ks
 
 
+def foundation_loads(mech, record):
+    """The loads of the supports of ``mech.foundation`` (a
+    :class:`~mechdyn.foundation.Foundation`, if the mechanism has one) over a run or a
+    kinetostatic cycle, or None (no foundation, or a record without frame loads).
+
+    The frame loads are taken as the machine exerts them (the weight of the frame and
+    base is not added)."""
+    fnd = getattr(mech, "foundation", None)
+    if fnd is None or record is None:
+        return None
+    from ..foundation import support_loads
+
+    try:
+        return support_loads(fnd, record)
+    except MechdynError as exc:
+        warnings.warn(f"report: no support loads: {exc}", stacklevel=2)
+        return None
+
+
+def mounted_loads(mech, supports):
+    """For a foundation with ``mass`` and ``inertia``: the base's response on its elastic
+    mounts to the frame-load history of ``supports`` (a run's SupportLoads) and its natural
+    frequencies, ``(MountedResponse, Modes)``; else ``(None, None)``."""
+    fnd = getattr(mech, "foundation", None)
+    if fnd is None or supports is None or fnd.mass is None or fnd.inertia is None:
+        return None, None
+    from ..foundation import mounted_response, natural_frequencies
+
+    try:
+        a = supports.applied
+        return (mounted_response(fnd, supports.t, a[:, 0], a[:, 1], a[:, 2],
+                                 point=supports.point), natural_frequencies(fnd))
+    except MechdynError as exc:
+        warnings.warn(f"report: no response of the mounted base: {exc}", stacklevel=2)
+        return None, None
+
+
 def report(mech_or_model, path, *, speed: float | None = None, over: str | None = None,
-           values=None, steps: int = 361, title: str | None = None, animation: bool = False,
+           values=None, steps: int = 361, title: str | None = None, animation: bool = True,
            trace=None, point=(0.0, 0.0)) -> Path:
     """Analyse a model over one turn and write an HTML report.
 
     :func:`report_records` runs the analyses (a sweep of ``over``; the kinetostatic
-    cycle for one degree of freedom or a given ``speed``), :func:`write_report`
-    writes them.
+    cycle, other coordinates held), :func:`write_report` writes them, with the support
+    loads of the mechanism's ``foundation`` when it has one.
 
     Parameters
     ----------
@@ -152,7 +206,7 @@ def report(mech_or_model, path, *, speed: float | None = None, over: str | None 
         As for :func:`report_records`.
     title : str, optional
     animation : bool
-        Embed an animated GIF of the motion.
+        Embed an animated GIF of the motion beside the plots (else its first frame).
     trace : "BODY.POINT" or (body, point), optional
         Draw this point's path.
 
@@ -164,4 +218,5 @@ def report(mech_or_model, path, *, speed: float | None = None, over: str | None 
     model, sw, ks = report_records(mech_or_model, speed=speed, over=over, values=values,
                                    steps=steps, point=point)
     return write_report(model, path, sweep=sw, kinetostatics=ks, title=title,
-                        animation=animation, trace=trace)
+                        animation=animation, trace=trace,
+                        supports=foundation_loads(model.mechanism, ks))

@@ -1,119 +1,47 @@
-"""Self-contained HTML reports for engineers: the model, its kinematics, its forces.
+"""Self-contained HTML reports for engineers: the model, its kinematics, its forces, and
+the loads it sends into the building.
 
 :func:`write_report` and :func:`report_trajectory` only consume result records
 (a :class:`~mechdyn.kinematics.records.KinematicSweep`, a
 :class:`~mechdyn.results.kinetostatics_record.Kinetostatics`, a
-:class:`~mechdyn.results.trajectory.Trajectory`) and the compiled model; they
-run no analysis.  The convenience :func:`mechdyn.cli.report.report` composes
-the standard analyses of a model (a sweep over one turn and, for one degree of
-freedom or a given speed, the kinetostatic cycle) and hands the records to
+:class:`~mechdyn.results.trajectory.Trajectory`, the support loads of a foundation) and
+the compiled model; they run no analysis.  The convenience
+:func:`mechdyn.cli.report.report` composes the standard analyses of a model (a sweep over
+one turn and the kinetostatic cycle, other coordinates held) and hands the records to
 :func:`write_report`.
 
-A report is one HTML file: tables (pandas ``to_html``), plots and a drawing of
-the mechanism embedded as base64 PNG images, a small inline style sheet; no
-other files, no scripts, no network.  Units are in every column heading (the
-column names of ``docs/notation.md``).
+A report is one HTML file that works offline: tables with rounded values and the unit in
+every heading, one interactive plotly figure per section (plotly.js embedded once), the
+animation of the motion beside it (a GIF, or the first frame), a small inline style sheet;
+no other files, no network.  Lengths are in mm and angles in degrees.
 """
 
 from __future__ import annotations
 
-import base64
-import html
-import tempfile
 from dataclasses import fields, is_dataclass
-from datetime import datetime
 from pathlib import Path
 
 import numpy as np
 
-from .._version import __version__
 from ..errors import Status
 from ..kinematics.sweep import initial_coordinates
 from .animate import animate, snapshot
-from .events import events_table
-from .plot import plot_kinematic_sweep
-from .plot_dynamics import plot_trajectory
-from .plot_kinetostatics import plot_kinetostatics
-from .table import deg_or_mm, output_path, rate_text, written
+from .report_building import building_section, has_frame_loads
+from .report_events import events_rows, merged_events, mode_spans
+from .report_figures import kinetostatics_figure, sweep_figure, trajectory_figure
+from .report_html import esc, figure_html, img, join, note, side_by_side, status_html, table
+from .report_html import write_page as _write_page
+from .table import rate_text
 
 __all__ = ["write_report", "report_trajectory", "model_tables"]
 
-_CSS = """
-body { font-family: -apple-system, "Segoe UI", Helvetica, Arial, sans-serif; margin: 2em auto;
-       max-width: 62em; color: #222; line-height: 1.4; padding: 0 1em; }
-h1 { border-bottom: 2px solid #2c5d8f; padding-bottom: .2em; }
-h2 { color: #2c5d8f; margin-top: 1.8em; border-bottom: 1px solid #ccd; }
-h3 { margin-bottom: .3em; }
-table { border-collapse: collapse; margin: .4em 0 1em 0; font-size: .9em; }
-th, td { border: 1px solid #ccd; padding: .25em .6em; text-align: right; }
-th { background: #eef2f7; }
-td:first-child, th:first-child { text-align: left; }
-.note { color: #555; font-size: .9em; }
-.status-ok { color: #1a7f37; font-weight: bold; }
-.status-bad { color: #b42318; font-weight: bold; }
-img { max-width: 100%; border: 1px solid #ddd; margin: .5em 0; }
-code { background: #f3f3f3; padding: 0 .25em; }
-"""
 
-
-# ------------------------------------------------------------------ html helpers
-def _esc(text) -> str:
-    return html.escape(str(text))
-
-
-def _table(title: str | None, rows, *, digits: int = 6) -> str:
-    """A heading (if any) and rows (dicts or a DataFrame) as an HTML table; "" without rows."""
-    import pandas as pd
-
-    if not len(rows):
-        return ""
-    head = f"<h3>{_esc(title)}</h3>\n" if title else ""
-    return head + pd.DataFrame(rows).to_html(index=False, border=0, na_rep="",
-                                             float_format=lambda v: f"{v:.{digits}g}")
-
-
-def _join(parts: list[str]) -> str:
-    return "\n".join(p for p in parts if p)
-
-
-def _img(draw, alt: str, kind: str = "png") -> str:
-    """An embedded image drawn by ``draw(path)`` into a temporary ``.png`` or ``.gif`` file."""
-    with tempfile.TemporaryDirectory() as tmp:
-        p = Path(tmp) / f"image.{kind}"
-        draw(p)
-        b64 = base64.b64encode(p.read_bytes()).decode("ascii")
-    return f'<img alt="{_esc(alt)}" src="data:image/{kind};base64,{b64}">'
-
-
-def _drawing(record, alt: str, *, animation: bool, trace) -> list[str]:
-    """The first frame of a record's motion and, with ``animation``, the GIF of it."""
-    out = ["<h3>Drawing</h3>", _img(lambda p: snapshot(record, p, 0, trace=trace), alt)]
+def _motion(record, alt: str, *, animation: bool, trace) -> str:
+    """The animation of a record's motion (a GIF) or, without ``animation``, its first frame."""
     if animation:
-        out.append(_img(lambda p: animate(record, p, frames=72, dpi=60, trace=trace),
-                        "the motion", "gif"))
-    return out
-
-
-def _write_page(path, title: str, sections: list[str]) -> Path:
-    """Write the HTML page of ``sections`` under ``title``."""
-    stamp = datetime.now().strftime("%Y-%m-%d %H:%M")
-    path = output_path(path)
-    with written(path) as tmp:
-        tmp.write_text(
-            f"<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-            f"<title>{_esc(title)}</title>\n<style>{_CSS}</style>\n</head>\n<body>\n"
-            f"<h1>{_esc(title)}</h1>\n"
-            f"<p class=\"note\">mechdyn {__version__}, {stamp}. SI units unless a column says "
-            f"otherwise; angles counter-clockwise positive; joint reactions are the force "
-            f"on the child body from the parent at the joint point, ground frame.</p>\n"
-            + "\n".join(sections) + "\n</body>\n</html>\n", encoding="utf-8")
-    return path
-
-
-def _status(status: str, ok: bool, message: str = "") -> str:
-    cls = "status-ok" if ok else "status-bad"
-    msg = f" &mdash; {_esc(message)}" if message else ""
-    return f'<p>Status: <span class="{cls}">{_esc(status)}</span>{msg}</p>'
+        return "<h3>Motion</h3>\n" + img(
+            lambda p: animate(record, p, frames=72, dpi=80, trace=trace), alt, "gif")
+    return "<h3>Drawing</h3>\n" + img(lambda p: snapshot(record, p, 0, trace=trace), alt)
 
 
 # ------------------------------------------------------------------ the model
@@ -140,7 +68,7 @@ def _value_text(v) -> str:
 def _element_params(el, skip=("name",)) -> str:
     """Fields of a load or drive dataclass as ``key = value`` text."""
     if not is_dataclass(el):
-        return _esc(repr(el))
+        return esc(repr(el))
     parts = []
     for f in fields(el):
         v = getattr(el, f.name)
@@ -215,17 +143,18 @@ def model_tables(model) -> dict:
 def _model_section(model) -> str:
     mech = model.mechanism
     g = model.gravity
-    return _join(["<h2>Model</h2>", mech.description and f"<p>{_esc(mech.description)}</p>",
-                  f"<p>{model.n_bodies} moving bodies, {len(model.joint_names)} joints, "
-                  f"coordinates {', '.join(model.coordinate_names)} "
-                  f"({mech.dof} degree(s) of freedom); gravity ({g[0]:.4g}, {g[1]:.4g}) "
-                  "m/s&sup2;.</p>"]
-                 + [_table(title.capitalize(), df) for title, df in model_tables(model).items()])
+    return join(["<h2>Model</h2>", mech.description and f"<p>{esc(mech.description)}</p>",
+                 f"<p>{model.n_bodies} moving bodies, {len(model.joint_names)} joints, "
+                 f"coordinates {', '.join(model.coordinate_names)} "
+                 f"({mech.dof} degree(s) of freedom); gravity ({g[0]:.4g}, {g[1]:.4g}) "
+                 "m/s&sup2;.</p>"]
+                + [table(title.capitalize(), df, sig=5)
+                   for title, df in model_tables(model).items()])
 
 
 # ------------------------------------------------------------------ kinematics
 def _at_text(over_is_angle: bool, v: float) -> str:
-    return f"{np.rad2deg(v):.3f} deg" if over_is_angle else f"{_mm(v):.4f} mm"
+    return f"{np.rad2deg(v):.2f} deg" if over_is_angle else f"{v * 1e3:.3f} mm"
 
 
 def _sweep_section(sw, *, animation: bool, trace) -> str:
@@ -233,103 +162,134 @@ def _sweep_section(sw, *, animation: bool, trace) -> str:
     rate = float(sw.qdot[0, sw.over_index]) if len(sw) else 1.0
     rng = (f"{_at_text(ang, sw.values[0])} to {_at_text(ang, sw.values[-1])}"
            if len(sw) else "no positions")
+    k = sw.over_index
+    others = [f"{c} = {_at_text(sw.model.coord_is_angle[i], sw.q[0, i])}"
+              for i, c in enumerate(sw.model.coordinate_names)
+              if i != k and len(sw) and np.ptp(sw.q[:, i]) == 0.0]
     parts = ["<h2>Kinematics</h2>",
-             f"<p>Sweep of <code>{_esc(sw.over)}</code> over {rng}, {len(sw)} positions, "
+             f"<p>Sweep of <code>{esc(sw.over)}</code> over {rng}, {len(sw)} positions, "
              f"at a constant rate of {rate_text(rate, ang)}"
+             + (f"; {', '.join(others)} held" if others else "")
              + (" &mdash; velocities and accelerations are then the first- and "
                 "second-order velocity analogs." if rate == 1.0 else ".") + "</p>",
-             _status(sw.status, sw.ok, sw.message)]
+             status_html(sw.status, sw.ok, sw.message)]
     if not len(sw):
-        return _join(parts)
+        return join(parts)
     summ = sw.summary()
     strokes = []
     for joint, stroke in summ.strokes.items():
-        strokes.append({"slider (joint)": joint, "stroke_mm": f"{_mm(stroke):.4f}"})
+        strokes.append({"slider (joint)": joint, "stroke (mm)": stroke * 1e3})
         for d in summ.dead_centres:
             if d.joint == joint:
                 strokes[-1][f"{d.label} at"] = _at_text(ang, d.at)
-                strokes[-1][f"{d.label} travel_mm"] = f"{_mm(d.travel):.4f}"
+                strokes[-1][f"{d.label} travel (mm)"] = d.travel * 1e3
     mu = [(t, np.rad2deg(t.min), np.rad2deg(t.max)) for t in summ.transmission]
     omegas = [(b, *sw.angular(b)[1:]) for b in sw.model.body_names]
     parts += [
-        _table("Strokes and dead centres", strokes),
-        _table("Transmission angles", [
+        table("Strokes and dead centres", strokes, sig=6),
+        table("Transmission angles", [
             {"loop (coupler/rocker)": f"{t.loop.coupler}/{t.loop.rocker}",
-             "joint": t.loop.joints[2], "mu_min_deg": f"{lo:.3f}",
-             "at (min)": _at_text(ang, t.min_at), "mu_max_deg": f"{hi:.3f}",
-             "at (max)": _at_text(ang, t.max_at),
-             "largest deviation from 90 deg": f"{max(90 - lo, hi - 90):.3f}"}
+             "joint": t.loop.joints[2], "μ min (deg)": lo, "at (min)": _at_text(ang, t.min_at),
+             "μ max (deg)": hi, "at (max)": _at_text(ang, t.max_at),
+             "largest deviation from 90 deg (deg)": max(90 - lo, hi - 90)}
             for t, lo, hi in mu]),
-        _table("Extreme speeds and accelerations of the named points", [
-            {"point": f"{e.body}.{e.point}", "v_max (m/s)": e.v_max,
-             "at (v)": _at_text(ang, e.v_max_at), "a_max (m/s²)": e.a_max,
+        table("Extreme speeds and accelerations of the named points", [
+            {"point": f"{e.body}.{e.point}", "v max (m/s)": e.v_max,
+             "at (v)": _at_text(ang, e.v_max_at), "a max (m/s²)": e.a_max,
              "at (a)": _at_text(ang, e.a_max_at)} for e in summ.extremes]),
-        _table("Angular velocities and accelerations of the bodies", [
-            {"body": b, "omega_min_rad_s": om.min(), "omega_max_rad_s": om.max(),
-             "alpha_min_rad_s2": al.min(), "alpha_max_rad_s2": al.max()}
+        table("Angular velocities and accelerations of the bodies", [
+            {"body": b, "ω min (rad/s)": om.min(), "ω max (rad/s)": om.max(),
+             "|ω| max (rpm)": np.abs(om).max() * 30 / np.pi,
+             "α min (rad/s²)": al.min(), "α max (rad/s²)": al.max()}
             for b, om, al in omegas if np.ptp(om) > 0 or np.any(om)])]
-    parts += _drawing(sw, "the mechanism", animation=animation, trace=trace)
-    parts += ["<h3>Plot</h3>", _img(lambda p: plot_kinematic_sweep(sw, p), "kinematics plot")]
-    return _join(parts)
+    name = getattr(sw.model.mechanism, "name", "mechanism")
+    fig = sweep_figure(sw, trace=trace, title=f"{name}: kinematics at constant "
+                                              f"{sw.over}-rate {rate_text(rate, ang)}")
+    parts += ["<h3>Plot</h3>", side_by_side(
+        figure_html(fig, "kinematics"),
+        _motion(sw, "the mechanism", animation=animation, trace=trace))]
+    return join(parts)
 
 
 # ------------------------------------------------------------------ kinetostatics
-def _kinetostatics_section(ks, *, harmonics: int = 6) -> str:
+def _kinetostatics_section(ks) -> str:
     ang = ks.over_is_angle
     parts = ["<h2>Kinetostatics</h2>"]
     if ks.n:
         k = ks.coordinate_names.index(ks.over)
-        parts.append(f"<p>Driven coordinate(s) {', '.join(ks.driven)} at constant "
-                     f"{_esc(ks.over)}-rate {rate_text(float(ks.qdot[0, k]), ang)}, "
-                     f"{ks.n} positions; forces include gravity, inertia and the model's "
-                     "loads.</p>")
-    parts.append(_status(ks.status, ks.status in (Status.SUCCESS, Status.REDUNDANT), ks.message))
+        held = [c for c in ks.driven if c != ks.over]
+        model = ks.model
+        held_text = ""
+        if held:
+            try:
+                q0 = initial_coordinates(model) if model is not None else None
+            except Exception:  # noqa: BLE001 - the values held are stated all the same
+                q0 = None
+            vals = []
+            for c in held:
+                i = ks.coordinate_names.index(c)
+                is_ang = bool(model.coord_is_angle[i]) if model is not None else True
+                origin = ("its initial value" if q0 is not None
+                          and abs(ks.q[0, i] - q0[i]) <= 1e-9 else "as assembled")
+                vals.append(f"<code>{esc(c)}</code> at {_at_text(is_ang, ks.q[0, i])} "
+                            f"({origin})")
+            held_text = (f" The other coordinate(s) are held: {', '.join(vals)}, each by the "
+                         "holding torque or force shown.")
+        parts.append(f"<p>Driven coordinate <code>{esc(ks.over)}</code> at the constant "
+                     f"rate {rate_text(float(ks.qdot[0, k]), ang)}, {ks.n} positions; forces "
+                     f"include gravity, inertia and the model's loads.{held_text}</p>")
+    parts.append(status_html(ks.status, ks.status in (Status.SUCCESS, Status.REDUNDANT),
+                             ks.message))
     if not ks.n:
-        return _join(parts)
+        return join(parts)
     p = ks.peaks()
-    joints = [{"joint": j, "type": ks.joint_kinds[j], "peak force_N": d["peak"],
-               "at": _at_text(ang, d["peak_at"]), "RMS force_N": d["rms"]}
-              | ({"peak moment_Nm": d["peak_moment"]} if "peak_moment" in d else {})
-              for j, d in p["joints"].items()]
-    fr, drives = p["frame"], []
+    joints = []
+    for j, d in p["joints"].items():
+        row = {"joint": j, "type": ks.joint_kinds[j], "peak |F| (kN)": d["peak"] / 1e3,
+               "at": _at_text(ang, d["peak_at"]), "RMS |F| (kN)": d["rms"] / 1e3}
+        if "peak_moment" in d:
+            row["peak moment (N m)"] = d["peak_moment"]
+        joints.append(row)
+    drives = []
     for c, d in p["driving"].items():
         sym, u = ks._drive_unit(c)
-        drives.append({"drive": c, f"peak |{sym}|_{u}": abs(d["peak_abs"]),
-                       "at": _at_text(ang, d["peak_abs_at"]), f"max_{u}": d["max"],
-                       f"min_{u}": d["min"], f"RMS_{u}": d["rms"], f"mean_{u}": d["mean"],
-                       "peak power_W": d["peak_power"]})
-    parts += [
-        _table("Driving torque", drives),
-        _table("Peak joint forces", joints),
-        _table("Frame (shaking) loads", [
-            {"quantity": "|F| frame (N)", "min": np.nan, "max": fr["force_peak"],
-             "peak at": _at_text(ang, fr["force_peak_at"])},
-            {"quantity": "Fx frame (N)", "min": fr["Fx_min"], "max": fr["Fx_max"], "peak at": ""},
-            {"quantity": "Fy frame (N)", "min": fr["Fy_min"], "max": fr["Fy_max"], "peak at": ""},
-            {"quantity": f"M frame about ({ks.frame_point[0]:.4g}, {ks.frame_point[1]:.4g}) m "
-                         "(N m)", "min": fr["M_min"], "max": fr["M_max"],
-             "peak at": _at_text(ang, fr["moment_peak_at"])}])]
-    if harmonics > 0 and ang:
-        try:
-            h = ks.harmonics(harmonics)
-        except ValueError as exc:
-            parts.append(f'<p class="note">No harmonics: {_esc(exc)}</p>')
-        else:  # the shaking force and moment per order of the turn, round-off noise as 0
-            cols = ["Fx_frame_N", "Fy_frame_N", "M_frame_Nm"]
-            h = h[["order", "f_Hz", *cols]].copy()
-            a = h[cols].abs()
-            h[cols] = h[cols].mask(a < 1e-9 * np.maximum(a.max(), 1e-300), 0.0)
-            parts += ["<h3>Harmonics of the shaking force and moment</h3>",
-                      '<p class="note">Amplitudes per order of the crank turn (order 0: the '
-                      'mean).</p>', _table(None, h)]
-    parts += [f'<p class="note">Warning: {_esc(w)}</p>' for w in ks.warnings]
-    parts += ["<h3>Plot</h3>", _img(lambda p: plot_kinetostatics(ks, p), "kinetostatics plot")]
-    return _join(parts)
+        unit = "N m" if u == "Nm" else "N"
+        drives.append({"coordinate": c, "role": "driven" if c == ks.over else "held",
+                       f"peak |{sym}| ({unit})": abs(d["peak_abs"]),
+                       "at": _at_text(ang, d["peak_abs_at"]), f"max ({unit})": d["max"],
+                       f"min ({unit})": d["min"], f"mean ({unit})": d["mean"],
+                       f"RMS ({unit})": d["rms"], "peak power (kW)": d["peak_power"] / 1e3})
+    elements = [{"element": el, "peak": d["peak"] / (1e3 if d["unit"] == "N" else 1.0),
+                 "unit": "kN" if d["unit"] == "N" else d["unit"],
+                 "at": _at_text(ang, d["peak_at"])} for el, d in p["elements"].items()]
+    units = {ks._drive_unit(c)[1] for c in p["driving"]}
+    what = ("Driving torque" if units == {"Nm"} else "Driving force" if units == {"N"}
+            else "Driving torques and forces")
+    parts += [table(what, drives), table("Peak joint forces", joints),
+              table("Stops, contacts and locks", elements)]
+    parts += [note(f"Warning: {esc(w)}") for w in ks.warnings]
+    name = getattr(getattr(ks.model, "mechanism", None), "name", "mechanism")
+    parts += ["<h3>Plot</h3>",
+              figure_html(kinetostatics_figure(ks, title=f"{name}: {what.lower()} and joint "
+                                                         "forces"), "kinetostatics")]
+    return join(parts)
+
+
+def _kinetostatics_building(ks, supports) -> str:
+    """"Loads on the building" of a kinetostatic cycle."""
+    if not ks.n:
+        return ""
+    k = ks.coordinate_names.index(ks.over)
+    return building_section(
+        x=ks.values, Fx=ks.frame_force[:, 0], Fy=ks.frame_force[:, 1], M=ks.frame_moment,
+        point=tuple(ks.frame_point), angle=ks.over_is_angle,
+        xlabel=f"{ks.over} ({'deg' if ks.over_is_angle else 'mm'})",
+        speed=float(ks.qdot[0, k]), supports=supports, div="building-cycle")
 
 
 # ------------------------------------------------------------------ public
 def write_report(model, path, *, sweep=None, kinetostatics=None, title: str | None = None,
-                 animation: bool = False, trace=None) -> Path:
+                 animation: bool = True, trace=None, supports=None) -> Path:
     """Write an HTML report of a model and of its analysis records.
 
     Parameters
@@ -340,16 +300,21 @@ def write_report(model, path, *, sweep=None, kinetostatics=None, title: str | No
         The HTML file to write.
     sweep : KinematicSweep, optional
         Adds the kinematics section: strokes and dead centres, transmission angles,
-        extreme point speeds and accelerations, a drawing and the plot.
+        extreme point speeds and accelerations, the interactive plot and the animation.
     kinetostatics : Kinetostatics, optional
-        Adds the kinetostatics section: peak and RMS driving torque, peak joint
-        forces, frame loads and their harmonics, and the plot.
+        Adds the kinetostatics section (driving and holding torques, peak joint forces,
+        the plot) and "Loads on the building" (frame force and moment, their harmonics).
     title : str, optional
         Default ``"<mechanism name>: report"``.
     animation : bool
-        Embed an animated GIF of the sweep (adds some 100 kB to 1 MB).
+        Embed an animated GIF of the sweep beside its plot (some 100 kB to 1 MB); else its
+        first frame.
     trace : "BODY.POINT" or (body, point), optional
-        Draw this point's path in the drawing and the animation.
+        Draw this point's path in the drawing and the animation, and plot it.
+    supports : SupportLoads, optional
+        The loads of a foundation's supports over the kinetostatic cycle
+        (:func:`mechdyn.foundation.support_loads`): per-support peaks in "Loads on the
+        building".
 
     Returns
     -------
@@ -362,11 +327,53 @@ def write_report(model, path, *, sweep=None, kinetostatics=None, title: str | No
         sections.append(_sweep_section(sweep, animation=animation, trace=trace))
     if kinetostatics is not None:
         sections.append(_kinetostatics_section(kinetostatics))
+        sections.append(_kinetostatics_building(kinetostatics, supports))
     return _write_page(path, title or f"{name}: report", sections)
 
 
-def report_trajectory(traj, path, *, title: str | None = None, animation: bool = False,
-                      trace=None, max_events: int = 200) -> Path:
+def _run_table(traj) -> str:
+    s = traj.stats or {}
+    run = {label: s.get(key) for label, key in (
+        ("integrator", "integrator"), ("formulation", "formulation"), ("backend", "backend"),
+        ("steps", "steps"), ("rejected steps", "rejected"), ("evaluations", "evaluations"))}
+    if s.get("wall_time_s") is not None:
+        run["wall time (s)"] = f"{float(s['wall_time_s']):.3g}"
+    run["samples"] = traj.n_samples
+    if traj.t.size:
+        run["t start (s)"], run["t end (s)"] = f"{traj.t[0]:.6g}", f"{traj.t[-1]:.6g}"
+    return table("Run", [{"quantity": k, "value": str(v)} for k, v in run.items()
+                         if v is not None])
+
+
+def _coordinates_table(traj) -> str:
+    rows = []
+    for k, c in enumerate(traj.coordinate_names):
+        ang = traj.coordinate_is_angle[k] if traj.coordinate_is_angle else True
+        q = traj.q[:, k]
+        q0, q1, u = ((np.rad2deg(q[0]), np.rad2deg(q[-1]), "deg") if ang
+                     else (q[0] * 1e3, q[-1] * 1e3, "mm"))
+        qd, ur = (traj.qdot[:, k] * 30 / np.pi, "rpm") if ang else (traj.qdot[:, k], "m/s")
+        rows.append({"coordinate": c, "unit": u, "start": q0, "end": q1, "rate unit": ur,
+                     "start rate": qd[0], "end rate": qd[-1], "min rate": np.nanmin(qd),
+                     "max rate": np.nanmax(qd)})
+    for r in rows:  # round-off noise of a held or locked coordinate as 0
+        for key in ("start", "end", "start rate", "end rate", "min rate", "max rate"):
+            r[key] = 0.0 if abs(r[key]) < 1e-9 else r[key]
+    return table("Coordinates", rows, sig=6)
+
+
+def _mean_rpm(traj) -> float | None:
+    """The mean speed of the run's first angle coordinate, rpm (None without one)."""
+    for k, angle in enumerate(traj.coordinate_is_angle or ()):
+        if angle and traj.t.size > 1 and traj.t[-1] > traj.t[0]:
+            return abs(float(traj.q[-1, k] - traj.q[0, k]) / float(traj.t[-1] - traj.t[0])) \
+                * 30 / np.pi
+    return None
+
+
+def report_trajectory(traj, path, *, title: str | None = None, animation: bool = True,
+                      trace=None, max_events: int = 200, supports=None, mounted=None,
+                      modes=None, point=(0.0, 0.0)) -> Path:
     """Write an HTML report of a simulated motion.
 
     Parameters
@@ -378,11 +385,26 @@ def report_trajectory(traj, path, *, title: str | None = None, animation: bool =
     title : str, optional
         Default ``"<mechanism name>: simulation report"``.
     animation : bool
-        Embed an animated GIF of the motion.
+        Embed an animated GIF of the motion beside its plot; else its first frame.
     trace : "BODY.POINT" or (body, point), optional
         Draw this point's path.
     max_events : int
-        Largest number of events listed.
+        Largest number of events listed (after merging the records of one transition).
+    supports : SupportLoads, optional
+        The loads of a foundation's supports over the run
+        (:func:`mechdyn.foundation.support_loads`): per-support peaks in "Loads on the
+        building".
+    mounted : MountedResponse, optional
+        The response of the base on elastic mounts to the run's frame loads
+        (:func:`mechdyn.foundation.mounted_response`): the force passed to the floor
+        against the rigid base's, and the base's motion.
+    modes : Modes, optional
+        The natural frequencies of the mounted base
+        (:func:`mechdyn.foundation.natural_frequencies`), beside the excitation orders of
+        the run's mean speed.
+    point : (float, float)
+        The point the run's frame moment ``M_frame_Nm`` is about, m (the ``point`` of
+        :func:`mechdyn.simulate`).
 
     Returns
     -------
@@ -392,45 +414,48 @@ def report_trajectory(traj, path, *, title: str | None = None, animation: bool =
     model = traj.model
     name = getattr(getattr(model, "mechanism", None), "name", "mechanism")
     sections = [] if model is None else [_model_section(model)]
-    parts = ["<h2>Simulation</h2>", _status(traj.status, traj.success, traj.message)]
-    s = traj.stats or {}
-    run = {label: s.get(key) for label, key in (
-        ("integrator", "integrator"), ("formulation", "formulation"), ("backend", "backend"),
-        ("steps", "steps"), ("rejected steps", "rejected"), ("evaluations", "evaluations"),
-        ("wall time_s", "wall_time_s"))}
-    run["samples"] = traj.n_samples
+    parts = ["<h2>Simulation</h2>", status_html(traj.status, traj.success, traj.message),
+             _run_table(traj)]
     if traj.t.size:
-        run["t start_s"], run["t end_s"] = float(traj.t[0]), float(traj.t[-1])
-    parts.append(_table("Run", [{"quantity": k, "value": str(v)} for k, v in run.items()
-                                if v is not None]))
-    if traj.t.size:
-        rows = []
-        for k, c in enumerate(traj.coordinate_names):
-            ang = traj.coordinate_is_angle[k] if traj.coordinate_is_angle else True
-            (q0, q1), u = deg_or_mm(traj.q[[0, -1], k], ang)
-            qd, ur = (traj.qdot[:, k] * 30 / np.pi, "rpm") if ang else (traj.qdot[:, k], "m/s")
-            rows.append({"coordinate": c, f"start ({u})": q0, f"end ({u})": q1,
-                         f"start rate ({ur})": qd[0], f"end rate ({ur})": qd[-1],
-                         f"min rate ({ur})": qd.min(), f"max rate ({ur})": qd.max()})
-        parts.append(_table("Coordinates", rows, digits=9))
+        parts.append(_coordinates_table(traj))
     if traj.energy and traj.t.size:
         e = traj.energy
-        rows = [{"quantity": q, "start": e[key][0], "end": e[key][-1]} for q, key in (
-            ("kinetic energy T_J", "kinetic"), ("potential energy U_J", "potential"),
-            ("work of non-conservative forces W_nc_J", "work_nc"),
-            ("balance T + U - W_nc_J", "balance"))]
-        parts.append(_table("Energy balance", rows, digits=9))
+        rows = [{"quantity": q, "start (J)": e[key][0], "end (J)": e[key][-1]} for q, key in (
+            ("kinetic energy T", "kinetic"), ("potential energy U", "potential"),
+            ("work of non-conservative forces W_nc", "work_nc"),
+            ("balance T + U - W_nc", "balance"))]
+        parts.append(table("Energy balance", rows, sig=6))
         parts.append(f"<p>The balance drifts by at most {traj.energy_drift():.3e} J; the "
                      f"largest constraint residual is {np.max(e['residual']):.3e} "
                      "(m or rad).</p>")
-    parts += ["<h3>Events</h3>", "" if traj.events else "<p>No events.</p>",
-              _table(None, events_table(traj.events[:max_events], traj.coordinate_names),
-                     digits=9)]
-    if len(traj.events) > max_events:
-        parts.append(f'<p class="note">{len(traj.events) - max_events} more events not listed.</p>')
-    if model is not None and traj.t.size:
-        parts += _drawing(traj, "the mechanism at the start", animation=animation, trace=trace)
+    transitions = merged_events(traj.events)
+    shown = transitions[:max_events]
+    parts += ["<h3>Events</h3>",
+              "" if transitions else "<p>No events.</p>",
+              note(f"{len(transitions)} event(s); the {len(traj.events)} records of the run "
+                   "merged where several elements take part in one transition (same time, "
+                   "same modes before and after).") if len(transitions) < len(traj.events)
+              else "",
+              table(None, events_rows(shown, traj.coordinate_names, traj.coordinate_is_angle))]
+    if len(transitions) > max_events:
+        parts.append(note(f"{len(transitions) - max_events} more events not listed."))
+    vs = traj.switching
+    spans = (mode_spans(traj.t, vs["mode_index"], vs["modes"])
+             if vs is not None and getattr(model, "has_switching", True) else None)
     if traj.t.size:
-        parts += ["<h3>Plot</h3>", _img(lambda p: plot_trajectory(traj, p), "trajectory plot")]
-    sections.append(_join(parts))
+        fig = trajectory_figure(traj, transitions=transitions, spans=spans,
+                                title=f"{name}: simulated motion")
+        motion = (_motion(traj, "the motion", animation=animation, trace=trace)
+                  if model is not None else "")
+        parts += ["<h3>Plot</h3>", side_by_side(figure_html(fig, "simulation"), motion)]
+    sections.append(join(parts))
+    df = traj.to_dataframe(energy=False, bodies=False, degrees=False) \
+        if traj.t.size > 1 and vs is not None else None
+    if has_frame_loads(df):
+        sections.append(building_section(
+            x=df["t_s"].to_numpy(float), Fx=df["Fx_frame_N"].to_numpy(float),
+            Fy=df["Fy_frame_N"].to_numpy(float),
+            M=df["M_frame_Nm"].to_numpy(float) if "M_frame_Nm" in df else None,
+            point=point, transitions=transitions, spans=spans, supports=supports,
+            mounted=mounted, modes=modes, rpm=_mean_rpm(traj), div="building-run"))
     return _write_page(path, title or f"{name}: simulation report", sections)
