@@ -191,7 +191,7 @@ class Mechanism:
                 out.append(f"body {b.name!r}: mass must be >= 0 kg, got {b.mass!r}")
             if not np.isfinite(b.inertia) or b.inertia < 0:
                 out.append(f"body {b.name!r}: inertia must be >= 0 kg*m^2, got {b.inertia!r}")
-            if not np.all(np.isfinite(b.pose)):
+            if b.pose is not None and not np.all(np.isfinite(b.pose)):
                 out.append(f"body {b.name!r}: pose must be finite (x, y, theta), got {b.pose!r}")
             for k, v in [("com", b.com), *b.points.items()]:
                 if not np.all(np.isfinite(v)):
@@ -207,6 +207,14 @@ class Mechanism:
                               f"{where}: {role}", f"{where}: {role}_point")
             if j.parent == j.child:
                 out.append(f"{where}: parent and child are the same body {j.parent!r}")
+            if isinstance(j, Lock) and j.offset is None:
+                unposed = [b for b in (j.parent, j.child)
+                           if b in self.bodies and self.bodies[b].pose is None]
+                if unposed:
+                    out.append(f"{where}: body {unposed[0]!r} has no pose, so the lock's "
+                               "offset cannot be taken from the sketch; give the offset "
+                               "(x, y, angle of the child frame in the parent frame) or the "
+                               "pose")
             if isinstance(j, Prismatic):
                 ax = np.asarray(j.axis, dtype=float)
                 if ax.shape != (2,) or not np.all(np.isfinite(ax)) or np.hypot(*ax) == 0:
