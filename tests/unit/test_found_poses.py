@@ -152,12 +152,19 @@ def test_python_api_and_a_rough_sketch_only_picks_the_branch():
         python_four_bar().compile()
 
 
-def test_lock_without_offset_needs_a_pose():
-    m = python_four_bar(turn="left")
-    m.add_body("weight", mass=1.0)
-    m.add_lock("weld", "rocker", "weight")
-    with pytest.raises(ModelError, match="lock joint 'weld': body 'rocker' has no pose"):
-        m.compile()
+def test_lock_without_offset_takes_it_at_the_initial_coordinates():
+    m = Mechanism("two coaxial discs", gravity=(0.0, 0.0))
+    m.add_body("d1", mass=3.0, inertia=0.2)
+    m.add_body("d2", mass=1.0, inertia=0.05)
+    m.add_revolute("O1", "ground", "d1")
+    m.add_revolute("O2", "ground", "d2")
+    m.add_coordinate("th1", kind="angle", body="d1")
+    m.add_coordinate("th2", kind="angle", body="d2")
+    m.add_lock("clutch", "d1", "d2", engaged=False)
+    m.extras["initial"] = {"q": {"th1": 0.3, "th2": 0.5}}
+    model = m.compile()
+    assert model.lock.angle[0] == pytest.approx(0.2, abs=1e-15)
+    assert model.found_poses["d2"] == pytest.approx((0.0, 0.0, 0.5), abs=1e-15)
 
 
 def test_check_prints_the_poses_found(tmp_path, capsys):
@@ -175,3 +182,25 @@ def test_check_prints_the_poses_found(tmp_path, capsys):
     assert found["coupler"]["x_mm"] == pytest.approx(20.0)
     assert main(["check", "four_bar"]) == 0
     assert "poses found" not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("turn, sign", [("right", 1.0), ("left", -1.0)])
+def test_a_travel_coordinate_places_the_piston_and_the_mode_the_crank(turn, sign):
+    r, ell, s = 0.05, 0.16, 0.19
+    m = Mechanism("slider-crank driven by its piston")
+    m.add_ground({"O": (0.0, 0.0)})
+    m.add_body("crank", mass=1.0, points={"A": (r, 0.0)})
+    m.add_body("rod", mass=1.0, points={"B": (ell, 0.0)})
+    m.add_body("piston", mass=1.0)
+    m.add_revolute("O", "ground", "crank", "O")
+    m.add_revolute("A", "crank", "rod", "A")
+    m.add_revolute("B", "rod", "piston", "B")
+    m.add_prismatic("cylinder", "ground", "piston", "O")
+    m.add_coordinate("s", kind="travel", joint="cylinder")
+    m.add_assembly_mode("crank", ("ground", "O"), ("crank", "A"), ("rod", "B"), turn)
+    m.extras["initial"] = {"q": {"s": s}}
+    found = m.compile().found_poses
+    assert found["piston"] == pytest.approx((s, 0.0, 0.0), abs=1e-12)
+    phi = math.acos((r**2 + s**2 - ell**2) / (2 * r * s))  # law of cosines
+    # O -> A -> B turns right with the crank above the axis (B ahead on the axis)
+    assert found["crank"][2] == pytest.approx(sign * phi, abs=1e-12)

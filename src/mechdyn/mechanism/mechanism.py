@@ -207,14 +207,6 @@ class Mechanism:
                               f"{where}: {role}", f"{where}: {role}_point")
             if j.parent == j.child:
                 out.append(f"{where}: parent and child are the same body {j.parent!r}")
-            if isinstance(j, Lock) and j.offset is None:
-                unposed = [b for b in (j.parent, j.child)
-                           if b in self.bodies and self.bodies[b].pose is None]
-                if unposed:
-                    out.append(f"{where}: body {unposed[0]!r} has no pose, so the lock's "
-                               "offset cannot be taken from the sketch; give the offset "
-                               "(x, y, angle of the child frame in the parent frame) or the "
-                               "pose")
             if isinstance(j, Prismatic):
                 ax = np.asarray(j.axis, dtype=float)
                 if ax.shape != (2,) or not np.all(np.isfinite(ax)) or np.hypot(*ax) == 0:

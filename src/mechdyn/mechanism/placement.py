@@ -4,11 +4,12 @@ A body given without a pose (``Body(..., pose=None)``, or no ``pose`` key in a m
 file) is placed by the initial assembly.  This module gives the assembly its start:
 walking from the ground (and from the bodies whose pose is given) through the joints,
 
-* the angle of a body comes from an ``angle`` coordinate of it (its initial value), a
-  prismatic joint or a lock to a placed body, a ``relative_angle`` coordinate of a
-  revolute to a placed body, or two revolutes to placed bodies (their points aimed);
+* the angle of a body comes from an ``angle`` coordinate of it (its initial value; a
+  coordinate without one counts as 0), a prismatic joint or a lock to a placed body, a
+  ``relative_angle`` coordinate of a revolute to a placed body, or two revolutes to
+  placed bodies (their points aimed);
 * its position from a revolute to a placed body (the joint point), a prismatic joint
-  (the point on the line at the initial ``travel``, else at the line's origin) or a lock;
+  (the point on the line at the initial ``travel``) or a lock;
 * a body joined by one revolute only, with nothing fixing its angle, is placed at that
   pin with angle 0 (the assembly then turns it), one joined to nothing placed at the
   origin.
@@ -58,7 +59,8 @@ def start_poses(mechanism, q0: dict | None = None) -> dict[str, tuple[float, flo
     ----------
     mechanism : Mechanism
     q0 : mapping of str to float, optional
-        Initial coordinates (rad or m) by name; default :func:`initial_values`.
+        Initial coordinates (rad or m) by name; default :func:`initial_values`.  A
+        coordinate without a value counts as 0.
 
     Returns
     -------
@@ -77,7 +79,8 @@ def start_poses(mechanism, q0: dict | None = None) -> dict[str, tuple[float, flo
     >>> [round(v, 6) for v in start_poses(m, {"theta": math.pi / 2})["bar"]]
     [0.1, -0.2, 1.570796]
     """
-    q0 = initial_values(mechanism) if q0 is None else dict(q0)
+    q0 = {**{c: 0.0 for c in mechanism.coordinates},
+          **(initial_values(mechanism) if q0 is None else dict(q0))}
     placed: dict[str, tuple[float, float, float]] = {GROUND: (0.0, 0.0, 0.0)}
     placed.update({n: tuple(b.pose) for n, b in mechanism.bodies.items() if b.pose is not None})
     todo = [n for n in mechanism.bodies if n not in placed]
