@@ -204,3 +204,19 @@ def test_a_travel_coordinate_places_the_piston_and_the_mode_the_crank(turn, sign
     phi = math.acos((r**2 + s**2 - ell**2) / (2 * r * s))  # law of cosines
     # O -> A -> B turns right with the crank above the axis (B ahead on the axis)
     assert found["crank"][2] == pytest.approx(sign * phi, abs=1e-12)
+
+
+def test_a_rough_pose_of_one_body_picks_the_branch_of_a_six_bar():
+    text = examples.path("toggle_press").read_text(encoding="utf-8")
+    posed = mechdyn.loads(text).compile()
+    rough = re.sub(r'(?m)^pose = \["185 mm", "-206.828 mm", "0 deg"\]',
+                   'ROUGH = ["190 mm", "-150 mm", "0 deg"]', text)
+    rough = re.sub(r"(?m)^pose = .*\n", "", rough).replace("ROUGH =", "pose =")
+    assert rough.count("pose =") == 1
+    model = mechdyn.loads(rough).compile()
+    assert "slider" not in model.found_poses and len(model.found_poses) == 4
+    d = model.x0 - posed.x0
+    d[2::3] = np.angle(np.exp(1j * d[2::3]))
+    assert np.max(np.abs(d)) < 1e-9
+    with pytest.raises(ModelError, match="4 assembly branches fit"):
+        mechdyn.loads(re.sub(r"(?m)^pose = .*\n", "", text))

@@ -487,13 +487,14 @@ def ambiguity_message(model: Model, sols: list, q) -> str:
               if any(not _same_pose(model, poses[0][n], p[n]) for p in poses[1:])]
     for k, p in enumerate(poses[:4], 1):
         lines.append(f"branch {k}: " + describe_poses({n: p[n] for n in differ}))
-    hint = suggest_assembly_mode(mech, poses[0], poses[1])
+    hint = suggest_assembly_mode(mech, *poses)
     if hint:
         lines.append(hint)
     else:
-        lines.append("declare an assembly mode (mech.add_assembly_mode, [[assembly]] in a "
-                     "model file) whose turn P -> Q -> R differs between the branches, or "
-                     "give the poses of the bodies")
+        lines.append("declare assembly modes (mech.add_assembly_mode, [[assembly]] in a "
+                     "model file) whose turns P -> Q -> R tell the branches apart")
+    lines.append("or give a rough pose of " + ", ".join(repr(n) for n in differ)
+                 + ": the nearest branch is taken")
     return "; ".join(lines)
 
 

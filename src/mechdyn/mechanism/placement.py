@@ -222,13 +222,23 @@ def _named_points(mechanism, joint, body: str) -> list:
     return out
 
 
-def suggest_assembly_mode(mechanism, poses_a: dict, poses_b: dict) -> str:
-    """An assembly mode that tells two branches apart, as model-file and Python text.
+def suggest_assembly_mode(mechanism, *branches: dict) -> str:
+    """Assembly modes that tell branches apart, as model-file and Python text.
 
-    A revolute Q between bodies i and j, a joint P of body i and a joint R of body j
-    (points with names) whose turn P -> Q -> R differs between the two sets of poses
-    (``{"ground": ..., body: (x, y, theta)}``, the ground may be left out); "" when no
-    such named triple exists.
+    Each mode is a revolute Q between bodies i and j, a joint P of body i and a joint R
+    of body j (points with names) whose turn P -> Q -> R is not straight in any branch;
+    modes are added until every two branches differ in one of them.
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+    *branches : dict
+        The poses of each branch, ``{body: (x, y, theta)}`` (the ground may be left out).
+
+    Returns
+    -------
+    str
+        The text, or "" when the named points cannot tell the branches apart.
 
     Examples
     --------
@@ -251,10 +261,26 @@ def suggest_assembly_mode(mechanism, poses_a: dict, poses_b: dict) -> str:
     'points = ["crank.A", "coupler.B", "ground.C"]'
     >>> text[text.index("turn"):text.index(";")]
     'turn = "right" (branch 1) or "left" (branch 2)'
-
     """
-    pa = {GROUND: (0.0, 0.0, 0.0), **poses_a}
-    pb = {GROUND: (0.0, 0.0, 0.0), **poses_b}
+    poses = [{GROUND: (0.0, 0.0, 0.0), **b} for b in branches]
+    chosen: list = []  # (P, Q, R, signs by branch)
+    for a in range(len(poses)):
+        for b in range(a + 1, len(poses)):
+            if any(c[3][a] != c[3][b] for c in chosen):
+                continue
+            for P, Q, R in _triples(mechanism):
+                pts = [(P[0], P[2]), (Q[0], Q[2]), (R[0], R[2])]
+                signs = [_turn_sign(p, pts) for p in poses]
+                if 0.0 not in signs and signs[a] != signs[b]:
+                    chosen.append((P, Q, R, signs))
+                    break
+            else:
+                return ""
+    return _modes_text(chosen) if chosen else ""
+
+
+def _triples(mechanism):
+    """Every (P, Q, R) of named joint points: Q a revolute, P and R joints of its bodies."""
     joints = list(mechanism.joints.values())
     for jq in joints:
         if not isinstance(jq, Revolute):
@@ -265,18 +291,22 @@ def suggest_assembly_mode(mechanism, poses_a: dict, poses_b: dict) -> str:
                 for P in _named_points(mechanism, jp, i):
                     for Q in _named_points(mechanism, jq, i):
                         for R in _named_points(mechanism, jr, j):
-                            pts = [(P[0], P[2]), (Q[0], Q[2]), (R[0], R[2])]
-                            sa, sb = _turn_sign(pa, pts), _turn_sign(pb, pts)
-                            if sa * sb < 0:
-                                return _mode_text(P, Q, R, sa, sb)
-    return ""
+                            yield P, Q, R
 
 
-def _mode_text(P, Q, R, sa: float, sb: float) -> str:
+def _modes_text(chosen: list) -> str:
     turn = {1.0: "left", -1.0: "right"}
-    names = ", ".join(f'"{b}.{p}"' for b, p, _ in (P, Q, R))
+    parts = []
+    for P, Q, R, signs in chosen:
+        names = ", ".join(f'"{b}.{p}"' for b, p, _ in (P, Q, R))
+        by_turn = {}
+        for k, sg in enumerate(signs, 1):
+            by_turn.setdefault(turn[sg], []).append(str(k))
+        alts = " or ".join(f'"{t}" (branch{"es" if len(ks) > 1 else ""} {", ".join(ks)})'
+                           for t, ks in by_turn.items())
+        parts.append(f"[[assembly]] points = [{names}] with turn = {alts}")
+    P, Q, R, signs = chosen[0]
     args = ", ".join(f'("{b}", "{p}")' for b, p, _ in (P, Q, R))
-    return (f"declare the branch with an assembly mode: in the model file [[assembly]] "
-            f'points = [{names}] with turn = "{turn[sa]}" (branch 1) or "{turn[sb]}" '
-            f'(branch 2); in Python mech.add_assembly_mode("mode", {args}, '
-            f'turn="{turn[sa]}")')
+    return (f"declare the branch with {'an assembly mode' if len(parts) == 1 else 'assembly modes'}"
+            f": in the model file {'; '.join(parts)}; in Python mech.add_assembly_mode("
+            f'"mode", {args}, turn="{turn[signs[0]]}")')
