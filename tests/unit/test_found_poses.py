@@ -132,7 +132,7 @@ def python_four_bar(rocker_pose=None, turn=None):
     m.add_revolute("B", "coupler", "rocker", "B", "B")
     m.add_revolute("C", "ground", "rocker", "C")
     m.add_coordinate("phi", kind="angle", body="crank")
-    m.extras["initial"] = {"q": {"phi": 1.0}}
+    m.set_initial(q={"phi": 1.0})
     if turn:
         m.add_assembly_mode("open", ("crank", "A"), ("coupler", "B"), ("ground", "C"), turn)
     return m
@@ -161,7 +161,7 @@ def test_lock_without_offset_takes_it_at_the_initial_coordinates():
     m.add_coordinate("th1", kind="angle", body="d1")
     m.add_coordinate("th2", kind="angle", body="d2")
     m.add_lock("clutch", "d1", "d2", engaged=False)
-    m.extras["initial"] = {"q": {"th1": 0.3, "th2": 0.5}}
+    m.set_initial(q={"th1": 0.3, "th2": 0.5})
     model = m.compile()
     assert model.lock.angle[0] == pytest.approx(0.2, abs=1e-15)
     assert model.found_poses["d2"] == pytest.approx((0.0, 0.0, 0.5), abs=1e-15)
@@ -198,7 +198,7 @@ def test_a_travel_coordinate_places_the_piston_and_the_mode_the_crank(turn, sign
     m.add_prismatic("cylinder", "ground", "piston", "O")
     m.add_coordinate("s", kind="travel", joint="cylinder")
     m.add_assembly_mode("crank", ("ground", "O"), ("crank", "A"), ("rod", "B"), turn)
-    m.extras["initial"] = {"q": {"s": s}}
+    m.set_initial(q={"s": s})
     found = m.compile().found_poses
     assert found["piston"] == pytest.approx((s, 0.0, 0.0), abs=1e-12)
     phi = math.acos((r**2 + s**2 - ell**2) / (2 * r * s))  # law of cosines

@@ -407,7 +407,7 @@ def find_poses(model: Model, *, layout=None, t=None, n_starts: int = N_STARTS) -
     >>> _ = m.add_body("bar", mass=1.0, points={"P": (0.2, 0.0)})
     >>> _ = m.add_revolute("O", "ground", "bar", (0.0, 0.0), "P")
     >>> _ = m.add_coordinate("theta", kind="angle", body="bar")
-    >>> m.extras["initial"] = {"q": {"theta": 0.5}}
+    >>> _ = m.set_initial(q={"theta": 0.5})
     >>> model = m.compile()
     >>> [round(float(v), 6) for v in model.found_poses["bar"]]
     [-0.175517, -0.095885, 0.5]
