@@ -13,11 +13,13 @@ import numpy as np
 
 from ..errors import AssemblyError, SingularPositionError
 from ..kernels import rows_numpy
+from ..mechanism.placement import describe_poses, initial_values, suggest_assembly_mode
 from ..model import ConstraintLayout, Model
 from ..model.rows import Rows
 from .constraints import _turn, coordinates, extend, full_jacobian, residual, system
 
-__all__ = ["newton", "solve_position", "assemble", "joint_residuals", "singularity", "rank_report",
+__all__ = ["newton", "solve_position", "assemble", "find_poses", "start_coordinates",
+           "joint_residuals", "singularity", "rank_report",
            "branch_sign", "turn_signs", "SINGULAR_RCOND", "DEAD_RCOND"]
 
 #: ratio sigma_min / sigma_max of the scaled Jacobian below which a position is singular
@@ -326,16 +328,27 @@ def assemble(model: Model, q=None, *, x_guess=None, layout=None, t=None) -> np.n
     See :func:`_assemble_near` for the solve; when the mechanism declares
     assembly modes (:class:`~mechdyn.mechanism.assembly_mode.AssemblyMode`) and the
     sketch lands on the other branch of a loop, the bodies meeting at that loop's
-    point Q are mirrored and the mechanism re-assembled from there.
+    point Q are mirrored and the mechanism re-assembled from there.  When some bodies
+    were given without a pose (and neither ``q`` nor ``x_guess`` is given), the poses
+    are found by :func:`find_poses`.
 
     Raises
     ------
     AssemblyError
-        If the declared mode cannot be reached.
+        If the declared mode cannot be reached, or (poses omitted) if several
+        assembly branches fit and nothing picks one.
     """
+    if (q is None and x_guess is None and not np.all(getattr(model, "pose_given", True))
+            and not getattr(model, "found_poses", None)):
+        return find_poses(model, layout=layout, t=t)
     if q is None:
         q = coordinates(model, model.x_sketch if x_guess is None else np.asarray(x_guess, float))
     x = _assemble_near(model, q, x_guess=x_guess, layout=layout, t=t)
+    return _in_modes(model, q, x, layout, t)
+
+
+def _in_modes(model: Model, q, x, layout, t) -> np.ndarray:
+    """``x`` (assembled at q) moved into the declared assembly modes by mirroring."""
     for _ in range(len(model.assembly_modes)):
         wrong = _wrong_modes(model, x)
         if not wrong:
@@ -349,6 +362,139 @@ def assemble(model: Model, q=None, *, x_guess=None, layout=None, t=None) -> np.n
             f"the declared assembly mode(s) {names} could not be reached from the sketch; "
             "draw the sketch in the declared mode or check the points P, Q, R", t=t, q=q)
     return x
+
+
+#: random starts of :func:`find_poses` besides the placement itself
+N_STARTS = 15
+
+
+def start_coordinates(model: Model) -> np.ndarray:
+    """The coordinates at which omitted poses are found, shape (n_q,): the declared initial
+    values (:func:`~mechdyn.mechanism.placement.initial_values`), the others as the
+    start placement has them (rad or m)."""
+    q = coordinates(model, model.x_sketch)
+    for name, v in initial_values(model.mechanism).items():
+        if name in model.coordinate_names:
+            q[model.coordinate_index(name)] = v
+    return q
+
+
+def find_poses(model: Model, *, layout=None, t=None, n_starts: int = N_STARTS) -> np.ndarray:
+    """Assemble a mechanism some of whose bodies have no pose, at the initial coordinates.
+
+    The start placement (``model.x_sketch``, :mod:`mechdyn.mechanism.placement`) and
+    ``n_starts`` seeded random starts (the unposed bodies turned at random) are each
+    assembled at :func:`start_coordinates` and moved into the declared assembly modes;
+    the distinct solutions are the branches.  One branch: it is taken.  Several: the one
+    nearest the given poses if they pick one clearly, else an error lists the branches
+    and an assembly mode that tells them apart.  The poses found are recorded on a model
+    not yet frozen (``x_sketch``, ``found_poses``).
+
+    Returns
+    -------
+    x : ndarray, shape (n_x,)
+
+    Raises
+    ------
+    AssemblyError
+        No start assembles (the message of the last failure), or several branches fit.
+
+    Examples
+    --------
+    >>> from mechdyn import Mechanism
+    >>> m = Mechanism("pendulum")
+    >>> _ = m.add_body("bar", mass=1.0, points={"P": (0.2, 0.0)})
+    >>> _ = m.add_revolute("O", "ground", "bar", (0.0, 0.0), "P")
+    >>> _ = m.add_coordinate("theta", kind="angle", body="bar")
+    >>> _ = m.set_initial(q={"theta": 0.5})
+    >>> model = m.compile()
+    >>> [round(float(v), 6) for v in model.found_poses["bar"]]
+    [-0.175517, -0.095885, 0.5]
+    """
+    lay = layout or model.layout()
+    q = start_coordinates(model)
+    rng = np.random.default_rng(0)
+    free = np.repeat(~np.asarray(model.pose_given, bool), 3)
+    L = model.length_scale
+    sols, error = [], None
+    for k in range(n_starts + 1):
+        xs = np.array(model.x_sketch, float)
+        if k:
+            jitter = np.tile([L, L, np.pi], model.n_bodies) * rng.uniform(-1, 1, model.n_x)
+            xs = np.where(free, xs + jitter, xs)
+        try:
+            x = _in_modes(model, q, _assemble_near(model, q, x_guess=xs, layout=lay, t=t),
+                          lay, t)
+        except (AssemblyError, SingularPositionError, np.linalg.LinAlgError) as exc:
+            error = exc
+            continue
+        if not any(_same_pose(model, x, y) for y in sols):
+            sols.append(x)
+    if not sols:
+        raise error
+    x = _pick_branch(model, sols, q, lay, t)
+    # each angle on the turn of its start (an angle coordinate's value is kept as given)
+    x[2::3] = model.x_sketch[2::3] + np.angle(np.exp(1j * (x[2::3] - model.x_sketch[2::3])))
+    if not model.__dict__.get("_frozen", False):
+        model.x_sketch = np.array(x)
+        model.found_poses = {n: tuple(float(v) for v in x[3 * k:3 * k + 3])
+                             for k, n in enumerate(model.body_names) if not model.pose_given[k]}
+    return x
+
+
+def _same_pose(model: Model, a, b) -> bool:
+    """Whether two poses are one (angles modulo 2 pi)."""
+    d = np.asarray(a, float) - np.asarray(b, float)
+    d[2::3] = np.angle(np.exp(1j * d[2::3]))
+    tol = 1e-7
+    return bool(np.all(np.abs(d[0::3]) <= tol * model.length_scale)
+                and np.all(np.abs(d[1::3]) <= tol * model.length_scale)
+                and np.all(np.abs(d[2::3]) <= tol))
+
+
+def _pick_branch(model: Model, sols: list, q, lay, t) -> np.ndarray:
+    """The one branch of ``sols`` (see :func:`find_poses`), or an AssemblyError."""
+    if len(sols) == 1:
+        return sols[0]
+    J = full_jacobian(model, sols[0], lay) * _scale(model)
+    if _rank(J) < model.n_x:  # not a set of branches: the coordinates do not fix the
+        return sols[0]        # pose (the rank check of the compiler reports it)
+    given = np.repeat(np.asarray(model.pose_given, bool), 3)
+    if given.any():
+        d = np.array([np.linalg.norm(((x - model.x_sketch) / _scale(model))[given])
+                      for x in sols])
+        order = np.argsort(d)
+        if d[order[1]] > 2.0 * d[order[0]] + 1e-6:
+            return sols[order[0]]
+    raise AssemblyError(ambiguity_message(model, sols, q), t=t, q=q)
+
+
+def ambiguity_message(model: Model, sols: list, q) -> str:
+    """The message of several assembly branches fitting the joints at ``q``: the branches
+    (the poses that differ, mm and deg) and an assembly mode that tells them apart."""
+    mech = model.mechanism
+    poses = [{n: tuple(x[3 * k:3 * k + 3]) for k, n in enumerate(model.body_names)}
+             for x in sols]
+    qs = ", ".join(f"{n} = {np.rad2deg(v) if a else 1e3 * v:.6g} {'deg' if a else 'mm'}"
+                   for n, v, a in zip(model.coordinate_names, q, model.coord_is_angle,
+                                      strict=True))
+    declared = ", ".join(repr(am.name) for am, _ in model.assembly_modes)
+    lines = [f"{len(sols)} assembly branches fit the joints at {qs}, and "
+             + (f"the declared assembly mode(s) {declared} do not pick one"
+                if declared else "no assembly mode is declared to pick one")]
+    differ = [n for n in model.body_names
+              if any(not _same_pose(model, poses[0][n], p[n]) for p in poses[1:])]
+    for k, p in enumerate(poses[:4], 1):
+        lines.append(f"branch {k}: " + describe_poses({n: p[n] for n in differ}))
+    hint = suggest_assembly_mode(mech, *poses)
+    if hint:
+        lines.append(hint)
+    else:
+        lines.append("declare assembly modes (mech.add_assembly_mode, [[assembly]] in a "
+                     "model file) whose turns P -> Q -> R tell the branches apart")
+    lines.append("or give a rough pose of " + ", ".join(repr(n) for n in differ)
+                 + ": the nearest branch is taken")
+    return "; ".join(lines)
 
 
 def _assemble_near(model: Model, q, *, x_guess=None, layout=None, t=None) -> np.ndarray:

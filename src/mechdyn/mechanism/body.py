@@ -3,7 +3,9 @@
 A body has its own frame: ``points`` and ``com`` are given in that frame, in m.
 Its ``pose`` is where the frame sits in the initial *sketch* of the mechanism
 (x, y in m, theta in rad); the sketch chooses the assembly branch, which is then
-kept by continuity.
+kept by continuity.  A pose may be omitted (None): the initial assembly then places
+the body from its joints, the coordinates' initial values and the declared assembly
+modes (:mod:`mechdyn.mechanism.placement`, :func:`mechdyn.kinematics.assembly.assemble`).
 """
 
 from __future__ import annotations
@@ -51,8 +53,17 @@ class Body:
         Centre of mass in the body frame, m.
     points : mapping of str to (float, float)
         Named points in the body frame, m.
-    pose : (float, float, float)
-        Position (m) and angle (rad) of the body frame in the initial sketch.
+    pose : (float, float, float) or None
+        Position (m) and angle (rad) of the body frame in the initial sketch; None
+        (default): not given, the initial assembly finds it (the compiled model lists
+        it in ``found_poses``).
+
+    Examples
+    --------
+    >>> Body("crank", mass=1.0, points={"A": (0.04, 0.0)}).pose is None
+    True
+    >>> Body("crank", pose=(0.0, 0.0, 0.5)).pose
+    (0.0, 0.0, 0.5)
     """
 
     name: str
@@ -60,15 +71,16 @@ class Body:
     inertia: float = 0.0
     com: tuple[float, float] = (0.0, 0.0)
     points: dict = field(default_factory=dict)
-    pose: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    pose: tuple[float, float, float] | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "com", _vec(self.com, f"body {self.name!r}: com"))
         pts = {str(k): _vec(v, f"body {self.name!r}: point {k!r}")
                for k, v in dict(self.points).items()}
         object.__setattr__(self, "points", MappingProxyType(pts))
-        object.__setattr__(self, "pose", _vec(self.pose, f"body {self.name!r}: pose",
-                                              "(x, y, theta)"))
+        if self.pose is not None:
+            object.__setattr__(self, "pose", _vec(self.pose, f"body {self.name!r}: pose",
+                                                  "(x, y, theta)"))
         object.__setattr__(self, "mass", float(self.mass))
         object.__setattr__(self, "inertia", float(self.inertia))
 

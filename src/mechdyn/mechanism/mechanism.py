@@ -146,6 +146,31 @@ class Mechanism:
         """Declare a generalized coordinate (see :class:`Coordinate`)."""
         return self.add(Coordinate(name, kind, body, joint, float(offset)))
 
+    def set_initial(self, q=None, qdot=None) -> dict:
+        """Set initial coordinates and rates by name (as a model file's ``[initial]`` and
+        ``[initial_speed]``), SI (rad, m, rad/s, m/s); returns ``extras["initial"]``.
+
+        They start the runs (:func:`mechdyn.initial_state.initial_state`) and place the
+        bodies given without a pose.  Values given replace earlier ones of the same name.
+
+        Examples
+        --------
+        >>> m = Mechanism("pendulum")
+        >>> _ = m.add_body("bar", mass=2.0, points={"P": (0.5, 0.0)})
+        >>> _ = m.add_revolute("O", "ground", "bar")
+        >>> _ = m.add_coordinate("theta", kind="angle", body="bar")
+        >>> m.set_initial(q={"theta": 0.5}, qdot={"theta": 2.0})
+        {'q': {'theta': 0.5}, 'qdot': {'theta': 2.0}}
+        >>> m.compile().found_poses["bar"]
+        (0.0, 0.0, 0.5)
+        """
+        init = self.extras.setdefault("initial", {})
+        for key, given in (("q", q), ("qdot", qdot)):
+            values = dict(init.get(key) or {})
+            values.update({str(k): float(v) for k, v in dict(given or {}).items()})
+            init[key] = values
+        return init
+
     # ------------------------------------------------------------------ queries
     def body(self, name: str) -> Body:
         """The body (or the ground) of that name; a clear error lists valid names."""
@@ -191,7 +216,7 @@ class Mechanism:
                 out.append(f"body {b.name!r}: mass must be >= 0 kg, got {b.mass!r}")
             if not np.isfinite(b.inertia) or b.inertia < 0:
                 out.append(f"body {b.name!r}: inertia must be >= 0 kg*m^2, got {b.inertia!r}")
-            if not np.all(np.isfinite(b.pose)):
+            if b.pose is not None and not np.all(np.isfinite(b.pose)):
                 out.append(f"body {b.name!r}: pose must be finite (x, y, theta), got {b.pose!r}")
             for k, v in [("com", b.com), *b.points.items()]:
                 if not np.all(np.isfinite(v)):

@@ -16,6 +16,7 @@ import numpy as np
 from ..errors import ModelError, did_you_mean
 from ..mechanism.body import GROUND
 from ..mechanism.joint import Lock, Prismatic, Revolute
+from ..mechanism.placement import start_poses
 from . import rows as R
 
 __all__ = ["Model", "RevoluteRows", "PrismaticRows", "LockRows", "as_model"]
@@ -74,7 +75,14 @@ class Model:
     com : ndarray, shape (n_bodies, 2)
         Centres of mass in the body frames, m.
     x_sketch : ndarray, shape (n_x,)
-        The sketch poses, which choose the assembly branch.
+        The sketch poses, which choose the assembly branch.  A body given without a
+        pose starts where :func:`~mechdyn.mechanism.placement.start_poses` places it; the
+        initial assembly then puts the poses it found here.
+    pose_given : ndarray of bool, shape (n_bodies,)
+        Whether each body's pose was given (False: found by the assembly).
+    found_poses : dict
+        Body name -> (x m, y m, theta rad) of the bodies whose pose was omitted, as the
+        initial assembly found them (set with ``x0``; empty when every pose is given).
     length_scale : float
         A characteristic length (m) used to scale tolerances and rotations.
     x0 : ndarray, shape (n_x,)
@@ -95,7 +103,11 @@ class Model:
         self.inertia = np.array([b.inertia for b in bodies], dtype=float)
         self.com = np.array([b.com for b in bodies], dtype=float).reshape(nb, 2)
         self.gravity = np.asarray(mechanism.gravity, dtype=float)
-        self.x_sketch = np.array([v for b in bodies for v in b.pose], dtype=float)
+        start = start_poses(mechanism)
+        self.x_sketch = np.array([v for b in bodies for v in start[b.name]], dtype=float)
+        self.pose_given = np.array([b.pose is not None for b in bodies], dtype=bool)
+        self.found_poses: dict = {}
+        self._start = {GROUND: (0.0, 0.0, 0.0), **start}
 
         revs, pris, locks = ([j for j in mechanism.joints.values() if isinstance(j, kind)]
                              for kind in (Revolute, Prismatic, Lock))
@@ -105,7 +117,7 @@ class Model:
             *self._ends(pris), self._points(pris, "parent"),
             np.array([np.asarray(j.axis, float) / np.hypot(*j.axis) for j in pris]).reshape(-1, 2),
             self._points(pris, "child"),
-            np.array([self._bodies[j.child].pose[2] - self._bodies[j.parent].pose[2]
+            np.array([self._start[j.child][2] - self._start[j.parent][2]
                       if j.angle is None else j.angle for j in pris], dtype=float))
         off = np.array([self._sketch_offset(j) if j.offset is None else j.offset[:3]
                         for j in locks], dtype=float).reshape(-1, 3)
@@ -208,8 +220,8 @@ class Model:
         return (float(ref[0]), float(ref[1]))
 
     def _sketch_offset(self, j):
-        pi = np.asarray(self._bodies[j.parent].pose)
-        pj = np.asarray(self._bodies[j.child].pose)
+        pi = np.asarray(self._start[j.parent])
+        pj = np.asarray(self._start[j.child])
         c, s = np.cos(pi[2]), np.sin(pi[2])
         d = pj[:2] - pi[:2]
         return (c * d[0] + s * d[1], -s * d[0] + c * d[1], pj[2] - pi[2])

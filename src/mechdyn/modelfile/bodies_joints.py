@@ -51,8 +51,7 @@ class _BodiesJoints(_Reader):
                 self.problem(f"{self.where(*P, 'frame_points')}: only used with "
                              "frame = 'sketch'")
                 self.failed = True
-            pose = self.opt(spec, "pose", _POSE_KINDS, *P, default=(0.0, 0.0, 0.0),
-                            read=self.vector)
+            pose = self.opt(spec, "pose", _POSE_KINDS, *P, default=None, read=self.vector)
 
         about = spec.get("inertia_about", "com")
         if about != "com" and not self.failed:
