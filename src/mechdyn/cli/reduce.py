@@ -54,8 +54,8 @@ def register(sub) -> None:
     p.add_argument("--steps", type=int, default=361, metavar="N",
                    help="positions over one turn, ends included (default 361)")
     add_start(p, "first position of the turn")
-    add_speed(p, "speed of the coordinate at which drives and velocity-dependent loads are "
-                 "evaluated")
+    add_speed(p, "speed of the coordinate (with --link: of the link) at which drives and "
+                 "velocity-dependent loads are evaluated")
     add_files(p, plot="write a plot of J_red, dJ_red/dphi, M_red")
 
 
@@ -70,6 +70,8 @@ def run(args) -> int:
         speed, why, start = 1.0, "", 0.0
     else:
         speed, why = speed_from_args(model, coordinate, args)
+        if args.link is not None and args.speed is None:
+            why += f", taken as the speed of link {args.link!r}"
         start = (float(initial_coordinates(model)[0]) if args.start is None
                  else quantity(args.start, "angle", "--from"))
     red = reduce_model(model, link=args.link, point=point, steps=args.steps, start=start,
@@ -78,7 +80,7 @@ def run(args) -> int:
     where = f"link {red.link!r}" if red.link else f"coordinate {red.coordinate!r}"
     print(f"{mech.name}: reduction to {where}, {red.phi.size} positions from "
           f"{np.degrees(red.phi[0]):.6g} deg; status {red.status}")
-    print(speed_line(speed, True, why))
+    print(speed_line(speed, red.link is not None or bool(model.coord_is_angle[0]), why))
     if np.any(fin):
         print(f"  J_red     min {np.min(red.J_red[fin]):.6g}  max {np.max(red.J_red[fin]):.6g}  "
               f"mean {np.mean(red.J_red[fin][:-1] if fin.all() else red.J_red[fin]):.6g} kg m^2")
