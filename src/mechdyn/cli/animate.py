@@ -59,7 +59,8 @@ def run(args) -> int:
         over, values, _ = sweep_values(model, args)
         record = sweep(model, over, values)
         ok, why = record.ok, record.message
-        print(f"{mech.name}: {len(record)} of {values.size} positions of {over}")
+        print(f"{mech.name}: {len(record)} of {values.size} positions of {over} "
+              f"({record.status})")
     out = animate(record, args.output, fps=args.fps, frames=args.frames, trace=args.trace,
                   title=args.title, labels=args.labels)
     print(f"  animation: {out}")

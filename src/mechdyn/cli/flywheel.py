@@ -29,6 +29,7 @@ from .options import (
     add_files,
     add_model_arguments,
     finish,
+    model_speed,
     prepare_model,
     quantity,
     write_files,
@@ -53,8 +54,10 @@ def register(sub) -> None:
     p.add_argument("--delta", required=True, metavar="DELTA",
                    help="target coefficient of speed fluctuation, e.g. 0.05 or 5%%")
     p.add_argument("--speed", metavar="RATE",
-                   help="mean speed of the crank (needed for a constant driving torque; with a "
-                        "motor the start of the steady-state search)")
+                   help="mean speed of the crank for a constant driving torque (default: the "
+                        "model's speed -- the crank's initial speed, else the rated speed of "
+                        "its drive); with a motor only the start of the search for the steady "
+                        "cycle, whose mean speed the motor sets")
     p.add_argument("--method", choices=FLYWHEEL_METHODS,
                    help="energy method (basic or refined for a variable J_red) or iterate on "
                         "the simulated steady cycle (default: simulation with a motor, whose "
@@ -72,22 +75,28 @@ def run(args) -> int:
     """Run ``mechdyn flywheel``; returns the exit code."""
     mech, model = prepare_model(args)
     delta = parse_quantity(args.delta, "ratio", where="--delta")
-    speed = None if args.speed is None else quantity(args.speed, "angular_velocity", "--speed")
     if args.steps < 9:
         raise ModelError(f"--steps must be at least 9, got {args.steps}")
+    given = None if args.speed is None else quantity(args.speed, "angular_velocity", "--speed")
     if args.exact:
         machine = ReducedMachine.from_model(model)
     else:
-        machine = reduce_model(model, steps=args.steps, omega=speed or 1.0).machine(model)
+        machine = reduce_model(model, steps=args.steps, omega=given or 1.0).machine(model)
     dependent = machine.speed_dependent()
+    speed, why = given, "given with --speed"
     if not dependent and speed is None:
-        raise ModelError("the driving torque does not depend on the speed, so the steady "
-                         "speed is not determined by the machine: give the mean speed with "
-                         "--speed (e.g. --speed 43.5rad/s)")
+        speed, why = model_speed(model, model.coordinate_names[0], fallback=None)
+        if speed is None:
+            raise ModelError(f"the driving torque does not depend on the speed, so the steady "
+                             f"speed is not determined by the machine, and {why}: give the "
+                             f"mean speed with --speed (e.g. --speed 43.5rad/s)")
+        if not args.exact:  # the table's velocity-dependent loads at that speed
+            machine = reduce_model(model, steps=args.steps, omega=speed).machine(model)
     speed_kw = "omega_guess" if dependent else "omega_mean"  # a motor picks its own speed
     fs = size_flywheel(machine, delta, method=args.method, **{speed_kw: speed})
     print(f"{mech.name}: flywheel for delta = {delta:.4g} ({fs.method} method)")
-    print(f"  mean speed            {rate_text(fs.omega_mean, True)}")
+    print(f"  mean speed            {rate_text(fs.omega_mean, True)}"
+          + (f" ({why})" if not dependent else " (the steady cycle of the drive)"))
     if fs.delta_without is not None:
         print(f"  delta without flywheel {fs.delta_without:.6g}")
     print(f"  J_red (drive incl.)   mean {fs.J_red_mean:.6g}, min {fs.J_red_min:.6g}, "

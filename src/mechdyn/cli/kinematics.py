@@ -14,15 +14,19 @@ from __future__ import annotations
 from ..kinematics.sweep import sweep
 from ..results.animate import _trace_spec
 from ..results.plot import plot_kinematic_sweep
-from ..results.table import deg_or_mm, rate_text
+from ..results.table import deg_or_mm
 from .options import (
     add_files,
     add_model,
     add_plot_columns,
+    add_points,
     add_range,
+    add_speed,
     check_plot_columns,
     finish,
     open_model,
+    speed_from_args,
+    speed_line,
     sweep_values,
     write_files,
 )
@@ -45,12 +49,9 @@ def register(sub) -> None:
     add_model(p)
     add_range(p, steps=361, over="coordinate to sweep (default: the only one); the others "
                                  "stay at their initial values")
-    p.add_argument("--speed", metavar="RATE",
-                   help="constant rate of the coordinate, e.g. 100rpm (default 1 rad/s or "
-                        "1 m/s: velocities are then the velocity analogs)")
+    add_speed(p, "constant rate of the coordinate")
     add_files(p, plot="write a plot of the guided points")
-    p.add_argument("--points", nargs="+", metavar="BODY.POINT",
-                   help="points to plot (default: the sliders' points)")
+    add_points(p, "to plot", "the sliders' points; the table has every named point")
     p.add_argument("--trace", metavar="BODY.POINT",
                    help="plot the coupler curve of this point (default: a coupler point of a "
                         "four-bar loop, if any)")
@@ -62,13 +63,15 @@ def run(args) -> int:
     check_plot_columns(args)
     mech, model = open_model(args)
     _trace_spec(model, args.trace)
-    over, values, speed = sweep_values(model, args, only=True)
+    over, values, _ = sweep_values(model, args, only=True)
+    speed, why = speed_from_args(model, over, args)
     sw = sweep(model, over, values, speed=speed)
     ends, unit = deg_or_mm(values[[0, -1]], sw.over_is_angle)
     print(f"{mech.name}: {len(sw)} of {values.size} positions, {over} from "
-          f"{ends[0]:.6g} {unit} to {ends[1]:.6g} {unit} at "
-          f"{rate_text(1.0 if speed is None else speed, sw.over_is_angle)}")
+          f"{ends[0]:.6g} {unit} to {ends[1]:.6g} {unit}; status {sw.status}")
+    print(speed_line(speed, sw.over_is_angle, why))
     for line in sw.summary().lines():
         print("  " + line)
-    write_files(args, sw, plot_kinematic_sweep, points=args.points, trace=args.trace)
+    points = args.points if args.points != [] else [f"{b}.{n}" for b, n in model.named_points()]
+    write_files(args, sw, plot_kinematic_sweep, points=points, trace=args.trace)
     return finish(args, sw.status == "success", sw.message)

@@ -17,16 +17,19 @@ from pathlib import Path
 from ..dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
 from ..errors import ModelError, Status
 from ..results.plot_kinetostatics import plot_joint_force_polar, plot_kinetostatics
-from ..results.table import rate_text, written
+from ..results.table import written
 from .options import (
     add_files,
     add_model,
     add_plot_columns,
     add_range,
+    add_speed,
     check_plot_columns,
     draw_plot,
     finish,
     open_model,
+    speed_from_args,
+    speed_line,
     sweep_values,
     vector,
 )
@@ -47,11 +50,9 @@ def register(sub) -> None:
         epilog="Quantities take units: 0deg, 360 deg, 40rpm, 4.2 rad/s, 15 mm (a bare number "
                "is SI: rad, m, rad/s). Exit codes: 0 done, 1 singular positions, 2 bad input.")
     add_model(p)
-    add_range(p, steps=361, start="first position (default 0deg)",
-              over="driven coordinate (default: the first); other independent coordinates "
-                   "are held at their initial values")
-    p.add_argument("--speed", required=True, metavar="RATE",
-                   help="constant speed of the driven coordinate, e.g. 60rpm (0 for statics)")
+    add_range(p, steps=361, over="driven coordinate (default: the first); other independent "
+                                 "coordinates are held at their initial values")
+    add_speed(p, "constant speed of the driven coordinate (0rpm for statics)")
     p.add_argument("--point", default="0,0", metavar="X,Y",
                    help="point of the frame moments (shaking moment), e.g. 0,0 or "
                         "'100mm,-50mm' (default 0,0)")
@@ -81,7 +82,8 @@ def run(args) -> int:
     mech, model = open_model(args)
     for joint in args.plot_polar:
         model.joint_kind(joint)  # an unknown joint is an error before the analysis
-    over, values, speed = sweep_values(model, args, start=0.0)
+    over, values, _ = sweep_values(model, args)
+    speed, why = speed_from_args(model, over, args)
     point = vector(args.point, ("length", "length"), "--point",
                    "two lengths X,Y, e.g. 0,0 or 100mm,-50mm")
     mode = None
@@ -93,7 +95,8 @@ def run(args) -> int:
         res = kinetostatics(model, over=over, speed=speed, values=values, point=point,
                             mode=mode, reacting_loads=tuple(args.bed))
     angle = res.over_is_angle
-    print(f"{mech.name}: kinetostatics at {rate_text(speed, angle)}")
+    print(f"{mech.name}: kinetostatics; status {res.status}")
+    print(speed_line(speed, angle, why))
     for line in res.summary().splitlines():
         print("  " + line if not line.startswith("  ") else line)
     if args.harmonics > 0 and angle and speed != 0:

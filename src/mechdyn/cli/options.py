@@ -3,8 +3,10 @@ speed, the output files, the mode and drive of a reduction, a simulation, the ex
 
 from __future__ import annotations
 
+import argparse
 import re
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -18,14 +20,15 @@ from ..kinematics.sweep import initial_coordinates
 from ..modelfile import load
 from ..modelfile.drives import drive_from_table
 from ..results.plot_columns import check_columns, plot_columns, table_of
-from ..results.table import write_csv
+from ..results.table import rate_text, write_csv
 from ..simulate import simulate
 from ..units import parse_quantity, parse_vector
 
-__all__ = ["quantity", "vector", "add_model", "add_files", "add_range", "add_motion_arguments",
-           "add_model_arguments", "add_run", "load_model", "open_model", "prepare_model",
-           "sweep_values", "simulate_from_args", "write_files", "finish", "add_plot_columns",
-           "check_plot_columns", "draw_plot"]
+__all__ = ["quantity", "vector", "add_model", "add_files", "add_range", "add_start",
+           "add_speed", "add_points", "add_motion_arguments", "add_model_arguments", "add_run",
+           "load_model", "open_model", "prepare_model", "sweep_values", "model_speed",
+           "speed_from_args", "speed_line", "simulate_from_args", "write_files", "finish",
+           "add_plot_columns", "check_plot_columns", "draw_plot", "SPEED_DEFAULT"]
 
 
 #: kinds whose bare numbers are SI radians, easily mistaken for degrees or rpm
@@ -68,11 +71,39 @@ def add_files(p, plot: str, table: str = "write the table to this CSV file") -> 
     p.add_argument("--plot", metavar="PNG", help=plot)
 
 
-def add_range(p, *, steps: int, over: str = "coordinate to sweep (default: the first)",
-              start: str = "first value, e.g. 0deg (default: the initial value)") -> None:
-    """Add the swept range: ``--over``, ``--from``, ``--to``, ``--steps``."""
+#: the default of ``--speed`` in every command, as its help says it
+SPEED_DEFAULT = ("default: the model's speed -- the coordinate's initial speed, else the rated "
+                 "speed of its drive, else 1 rad/s (1 m/s), where velocities are the velocity "
+                 "analogs; the command prints which")
+
+
+def add_start(p, what: str = "first value") -> None:
+    """Add ``--from VALUE`` (default: the coordinate's initial value); ``--start`` is a
+    silent alias of it."""
+    p.add_argument("--from", dest="start", metavar="VALUE",
+                   help=f"{what}, e.g. 0deg (default: the coordinate's initial value)")
+    p.add_argument("--start", dest="start", help=argparse.SUPPRESS)
+
+
+def add_speed(p, what: str) -> None:
+    """Add ``--speed RATE``, ``what`` it is; the default is the model's speed
+    (:func:`model_speed`)."""
+    p.add_argument("--speed", metavar="RATE", help=f"{what}, e.g. 60rpm ({SPEED_DEFAULT})")
+
+
+def add_points(p, what: str, default: str) -> None:
+    """Add ``--points [BODY.POINT ...]``: the named points ``what``; listed, or every named
+    point when none is listed; ``default`` without the option."""
+    p.add_argument("--points", nargs="*", metavar="BODY.POINT",
+                   help=f"named points {what}: those listed, or every named point when the "
+                        f"option is given alone (default: {default})")
+
+
+def add_range(p, *, steps: int, over: str = "coordinate to sweep (default: the first)") -> None:
+    """Add the swept range: ``--over``, ``--from`` (alias ``--start``), ``--to``,
+    ``--steps``."""
     p.add_argument("--over", metavar="COORD", help=over)
-    p.add_argument("--from", dest="start", metavar="VALUE", help=start)
+    add_start(p)
     p.add_argument("--to", dest="stop", metavar="VALUE",
                    help="last value (default: one full turn after --from)")
     p.add_argument("--steps", type=int, default=steps, metavar="N",
@@ -169,12 +200,12 @@ def prepare_model(args):
     return mech, mech.compile()
 
 
-def sweep_values(model, args, *, start: float | None = None, only: bool = False):
+def sweep_values(model, args, *, only: bool = False):
     """The swept coordinate, its values and its rate from ``--over/--from/--to/--steps``
     and ``--speed`` (units parsed).
 
-    Without ``--from`` the range starts at ``start`` (default: the coordinate's initial
-    value); with ``only`` and no ``--over`` the model must have one coordinate.
+    Without ``--from`` the range starts at the coordinate's initial value; with ``only``
+    and no ``--over`` the model must have one coordinate.
 
     Returns
     -------
@@ -193,7 +224,7 @@ def sweep_values(model, args, *, start: float | None = None, only: bool = False)
         raise ModelError(f"--steps must be at least 1, got {args.steps}")
     if args.start is not None:
         start = quantity(args.start, kind, "--from")
-    elif start is None:
+    else:
         start = float(initial_coordinates(model)[k])
     if args.stop is not None:
         stop = quantity(args.stop, kind, "--to")
@@ -205,6 +236,83 @@ def sweep_values(model, args, *, start: float | None = None, only: bool = False)
     if speed is not None:
         speed = quantity(speed, "angular_velocity" if angle else "velocity", "--speed")
     return over, np.linspace(start, stop, args.steps), speed
+
+
+def model_speed(model, over: str, fallback: float | None = 1.0) -> tuple[float | None, str]:
+    """The model's own speed of a coordinate, and where it comes from.
+
+    The coordinate's initial speed (the model file's ``initial_speed``) if it is not
+    zero; else the rated speed of a drive on the coordinate (a motor's rated speed
+    divided by the ratios of its gear stages, a constant-speed drive's speed); else 1
+    (rad/s or m/s: velocities are then the velocity analogs).
+
+    Parameters
+    ----------
+    model : Model
+    over : str
+        The coordinate's name.
+
+    Returns
+    -------
+    (float, str)
+        The speed, rad/s (m/s for a travel), and the reason, e.g. ``"the initial speed of
+        phi in the model"``.
+
+    Raises
+    ------
+    ModelError
+        Unknown coordinate (the message lists the valid ones).
+
+    Examples
+    --------
+    >>> from mechdyn import examples
+    >>> model = examples.load("toggle_press").compile()
+    >>> speed, why = model_speed(model, "phi")
+    >>> round(speed * 30 / np.pi, 9), why
+    (40.0, 'the initial speed of phi in the model')
+    """
+    k = model.coordinate_index(over)
+    mech = model.mechanism
+    qd0 = (mech.extras.get("initial") or {}).get("qdot")
+    if isinstance(qd0, Mapping):
+        rate = float(qd0.get(over, 0.0))
+    else:
+        rate = 0.0 if qd0 is None else float(np.asarray(qd0, float).reshape(-1)[k])
+    if rate != 0.0:
+        return rate, f"the initial speed of {over} in the model"
+    for drive in mech.drives:
+        if getattr(drive, "coordinate", None) != over:
+            continue
+        torque, ratio = getattr(drive, "torque", drive), 1.0
+        while hasattr(torque, "ratio") and hasattr(torque, "motor"):  # gear stages
+            ratio *= float(torque.ratio)
+            torque = torque.motor
+        for attr in ("rated_speed", "speed"):
+            value = getattr(torque, attr, None)
+            if isinstance(value, (int, float)) and value != 0:
+                gear = f" through a gear of ratio {ratio:g}" if ratio != 1.0 else ""
+                return float(value) / ratio, (f"the {attr.replace('_', ' ')} of drive "
+                                              f"{drive.name!r} on {over}{gear}")
+    why = f"the model gives {over} no speed (no initial speed, no drive with a rated speed)"
+    if fallback is None:
+        return None, why
+    unit = "rad/s" if model.coord_is_angle[k] else "m/s"
+    return float(fallback), f"{why}: {fallback:g} {unit}; give --speed"
+
+
+def speed_from_args(model, over: str, args, fallback: float | None = 1.0):
+    """``--speed`` (units parsed) and ``"given with --speed"``, else :func:`model_speed`."""
+    if getattr(args, "speed", None) is None:
+        return model_speed(model, over, fallback)
+    angle = bool(model.coord_is_angle[model.coordinate_index(over)])
+    return (quantity(args.speed, "angular_velocity" if angle else "velocity", "--speed"),
+            "given with --speed")
+
+
+def speed_line(speed: float, is_angle: bool, why: str) -> str:
+    """The line every command prints about the speed it used: ``"  speed 4.18879 rad/s
+    (40 rpm): the initial speed of phi in the model"``."""
+    return f"  speed {rate_text(speed, is_angle)}: {why}"
 
 
 def simulate_from_args(model, args, samples: int):

@@ -16,14 +16,19 @@ import numpy as np
 
 from ..dynamics.reduction import reduce_model
 from ..errors import ModelError
+from ..kinematics.sweep import initial_coordinates
 from ..results.animate import _trace_spec
 from ..results.plot_reduction import plot_reduction
 from .options import (
     add_files,
     add_model_arguments,
+    add_speed,
+    add_start,
     finish,
     prepare_model,
     quantity,
+    speed_from_args,
+    speed_line,
     write_files,
 )
 
@@ -48,11 +53,9 @@ def register(sub) -> None:
     p.add_argument("--point", metavar="BODY.POINT", help="also give the reduced mass at a point")
     p.add_argument("--steps", type=int, default=361, metavar="N",
                    help="positions over one turn, ends included (default 361)")
-    p.add_argument("--from", "--start", dest="start", metavar="ANGLE", default="0deg",
-                   help="first position (default 0deg; --start is the older name)")
-    p.add_argument("--speed", metavar="RATE",
-                   help="speed of the link at which drives and velocity-dependent loads are "
-                        "evaluated (default 1 rad/s; give the working speed for motors)")
+    add_start(p, "first position of the turn")
+    add_speed(p, "speed of the coordinate (with --link: of the link) at which drives and "
+                 "velocity-dependent loads are evaluated")
     add_files(p, plot="write a plot of J_red, dJ_red/dphi, M_red")
 
 
@@ -62,14 +65,22 @@ def run(args) -> int:
     if args.steps < 2:
         raise ModelError(f"--steps must be at least 2, got {args.steps}")
     point = _trace_spec(model, args.point, "--point")
-    speed = 1.0 if args.speed is None else quantity(args.speed, "angular_velocity", "--speed")
-    start = quantity(args.start, "angle", "--start")
+    coordinate = model.coordinate_names[0] if model.n_q == 1 else None
+    if coordinate is None:  # reduce_model names the coordinates
+        speed, why, start = 1.0, "", 0.0
+    else:
+        speed, why = speed_from_args(model, coordinate, args)
+        if args.link is not None and args.speed is None:
+            why += f", taken as the speed of link {args.link!r}"
+        start = (float(initial_coordinates(model)[0]) if args.start is None
+                 else quantity(args.start, "angle", "--from"))
     red = reduce_model(model, link=args.link, point=point, steps=args.steps, start=start,
                        omega=speed)
     fin = np.isfinite(red.J_total)
     where = f"link {red.link!r}" if red.link else f"coordinate {red.coordinate!r}"
     print(f"{mech.name}: reduction to {where}, {red.phi.size} positions from "
-          f"{np.degrees(red.phi[0]):.6g} deg")
+          f"{np.degrees(red.phi[0]):.6g} deg; status {red.status}")
+    print(speed_line(speed, red.link is not None or bool(model.coord_is_angle[0]), why))
     if np.any(fin):
         print(f"  J_red     min {np.min(red.J_red[fin]):.6g}  max {np.max(red.J_red[fin]):.6g}  "
               f"mean {np.mean(red.J_red[fin][:-1] if fin.all() else red.J_red[fin]):.6g} kg m^2")

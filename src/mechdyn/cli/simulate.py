@@ -14,6 +14,7 @@ singular mass matrix ...; the samples computed so far are written); 2 bad input;
 from __future__ import annotations
 
 import argparse
+import copy
 import sys
 from pathlib import Path
 
@@ -23,6 +24,7 @@ from ..dynamics.lagrange import FORMULATIONS
 from ..errors import ModelError, Status, did_you_mean
 from ..mechanism import Drive
 from ..results import spectrum
+from ..results.animate import _trace_spec
 from ..results.events import events_table
 from ..results.plot_dynamics import plot_trajectory
 from ..results.plot_spectrum import plot_spectrum
@@ -34,6 +36,7 @@ from .options import (
     add_files,
     add_model,
     add_plot_columns,
+    add_points,
     add_run,
     check_plot_columns,
     draw_plot,
@@ -82,8 +85,7 @@ def register(sub) -> None:
                           "uniform steps)")
     out.add_argument("--every-step", action="store_true",
                      help="write one row per integrator step instead")
-    p.add_argument("--points", action="store_true",
-                   help="add the positions, velocities, accelerations of every named point")
+    add_points(p, "whose positions, velocities and accelerations the table adds", "none")
     add_files(p, plot="write a plot of q, q', q'' and the energies")
     add_plot_columns(p)
     p.add_argument("--spectrum", metavar="COLUMN",
@@ -123,6 +125,9 @@ def run(args) -> int:
     q0 = _pairs(args.q0, mech, "--q0", ("angle", "length")) or None
     qdot0 = _pairs(args.qdot0, mech, "--qdot0", ("angular_velocity", "velocity")) or None
     d = quantity(args.d, "angle", "--d") if args.d is not None else None
+    model = mech.compile()
+    for point in args.points or ():  # unknown names before the run
+        _trace_spec(model, point, "--points")
     t_eval = None
     fixed = args.integrator.lower() in ("wilson", "rk4")
     if args.samples is None and not (fixed or args.every_step):
@@ -131,7 +136,7 @@ def run(args) -> int:
         if args.samples < 2:
             raise ModelError(f"--samples must be >= 2, got {args.samples}")
         t_eval = np.linspace(t0, t_end, args.samples)
-    traj = simulate(mech, t_end, t0=t0, integrator=args.integrator, steps=args.steps, dt=dt,
+    traj = simulate(model, t_end, t0=t0, integrator=args.integrator, steps=args.steps, dt=dt,
                     rtol=args.rtol, atol=args.atol, q0=q0, qdot0=qdot0, t_eval=t_eval,
                     formulation=args.formulation, d=d, progress=args.progress,
                     backend=args.backend, theta=args.theta,
@@ -145,7 +150,7 @@ def run(args) -> int:
         print(f"at t = {traj.t[-1]:.9g} s: {last}")
     if args.output:
         # its header says the status (an interrupted run is marked so), atomically written
-        write_csv(traj, args.output, points=args.points)
+        write_csv(_with_points(traj, args.points), args.output, points=args.points is not None)
         print(f"wrote {args.output} ({traj.t.size} rows)")
         if traj.events:
             ev_path = _beside(args.output, "_events.csv")
@@ -160,6 +165,22 @@ def run(args) -> int:
         print(f"mechdyn simulate: stopped early: {traj.status}: {traj.message}", file=sys.stderr)
         return 130 if traj.status == Status.INTERRUPTED else 1
     return 0
+
+
+def _with_points(traj, points):
+    """The trajectory whose table keeps the point columns of ``points`` ("BODY.POINT")
+    only; itself when ``points`` lists none (every point, or no point columns)."""
+    if not points:
+        return traj
+    keep = {"_".join(p.split(".", 1)) for p in points}
+    drop = [f"{what}{axis}_{b}_{n}_{unit}" for b, n in traj.model.named_points()
+            if f"{b}_{n}" not in keep
+            for what, unit in (("", "m"), ("v", "m_s"), ("a", "m_s2")) for axis in "xy"]
+    full = traj.to_dataframe
+    view = copy.copy(traj)  # the same record (its header, status, model), fewer columns
+    object.__setattr__(view, "to_dataframe",
+                       lambda **kw: full(**kw).drop(columns=drop, errors="ignore"))
+    return view
 
 
 def _beside(path, tail: str) -> Path:
