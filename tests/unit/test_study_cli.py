@@ -58,10 +58,18 @@ def test_an_optimisation_from_the_command_line(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("extra, match", [
-    (["--analysis", "kinetostatics"], "needs --speed"),
     (["--analysis", "flywheel"], "needs --delta"),
     (["--analysis", "dynamics", "--speed", "1rpm"], "use one of"),
 ])
 def test_bad_options_are_named(tmp_path, extra, match):
     with pytest.raises(ModelError, match=match):
         run(["study", "slider_crank", *VARY, "-o", str(tmp_path / "s.csv"), *extra])
+
+
+def test_the_default_speed_is_the_model_s_own(tmp_path, capsys):
+    """Without --speed the kinetostatic analysis runs at the model's speed, as every
+    command does, and says which: slider_crank's crank starts at 1500 rpm (its file)."""
+    out = tmp_path / "s.csv"
+    assert run(["study", "slider_crank", *VARY, "--samples", "2", "--steps", "12",
+                "-o", str(out)]) == 0
+    assert "speed 157.08 rad/s (1500 rpm): the initial speed of phi" in capsys.readouterr().out

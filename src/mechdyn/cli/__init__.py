@@ -36,7 +36,8 @@ SUBCOMMANDS = {
     "foundation": "loads on anchor bolts and isolators; natural frequencies of the mounted base",
     "study": "design study: many variants of a model, one table row each",
     "animate": "animated GIF of the motion (a sweep of one coordinate, or a simulation)",
-    "report": "self-contained HTML report: model, kinematics, kinetostatics (or a simulation)",
+    "report": "self-contained HTML report: model, kinematics, kinetostatics, loads on the "
+              "building (or a simulation)",
     "warmup": "compile the numba kernels now (once per machine) and report the time",
 }
 

@@ -34,7 +34,16 @@ from ..kinematics.sweep import initial_coordinates
 from ..kinematics.sweep import sweep as run_sweep
 from ..model import as_model
 from ..results.report import report_trajectory, write_report
-from .options import add_motion_arguments, finish, open_model, simulate_from_args, sweep_values
+from .options import (
+    add_motion_arguments,
+    finish,
+    model_speed,
+    open_model,
+    simulate_from_args,
+    speed_from_args,
+    speed_line,
+    sweep_values,
+)
 
 __all__ = ["register", "run", "report", "report_records", "foundation_loads", "mounted_loads"]
 
@@ -75,12 +84,14 @@ def run(args) -> int:
         print(f"{mech.name}: simulation {traj.status}; report: {out}")
         return finish(args, traj.success, f"{traj.status}: {traj.message}")
 
-    over, values, speed = sweep_values(model, args)
+    over, values, _ = sweep_values(model, args)
+    speed, why = speed_from_args(model, over, args)
     model, sw, ks = report_records(model, speed=speed, over=over, values=values)
     out = write_report(model, args.output, sweep=sw, kinetostatics=ks, title=args.title,
                        animation=args.animation, trace=args.trace,
                        supports=foundation_loads(mech, ks))
     print(f"{mech.name}: report: {out}")
+    print(speed_line(speed, bool(model.coord_is_angle[model.coordinate_index(over)]), why))
     for line in sw.summary().lines() if len(sw) else ():
         print("  " + line)
     problems = [] if sw.ok else [sw.message]
@@ -101,8 +112,9 @@ def report_records(mech_or_model, *, speed: float | None = None, over: str | Non
     ----------
     mech_or_model : Mechanism or Model
     speed : float, optional
-        Constant rate of ``over``, rad/s (m/s for a travel).  Default: the model's
-        initial rate of ``over`` if it is not zero, else 1 (velocities are then the
+        Constant rate of ``over``, rad/s (m/s for a travel).  Default: the model's own
+        speed of ``over`` (:func:`mechdyn.cli.options.model_speed`: its initial rate if
+        not zero, else the rated speed of its drive, else 1 with velocities then the
         velocity analogs).
     over : str, optional
         The coordinate to sweep (default the first).
@@ -135,8 +147,7 @@ def report_records(mech_or_model, *, speed: float | None = None, over: str | Non
         values = np.linspace(start, start + 2 * np.pi, int(steps))
     values = np.asarray(values, dtype=float)
     if speed is None:
-        qd0 = (model.mechanism.extras.get("initial") or {}).get("qdot") or {}
-        speed = (float(qd0.get(over, 0.0)) if isinstance(qd0, dict) else 0.0) or 1.0
+        speed = model_speed(model, over)[0]
     sw = run_sweep(model, over, values, speed=float(speed))
     q0 = initial_coordinates(model)
     hold = {c: float(q0[i]) for i, c in enumerate(model.coordinate_names) if c != over}

@@ -40,7 +40,7 @@ from ..study.parameters import BaseModel
 from ..study.plots import axis_label, plot_scatter
 from ..study.report import write_study_report
 from ..units import parse_quantity
-from .options import add_model, quantity
+from .options import add_model, model_speed, quantity, speed_line
 
 __all__ = ["register", "run"]
 
@@ -65,7 +65,8 @@ def register(sub) -> None:
     p.add_argument("--seed", type=int, metavar="S", help="seed of the random designs")
     p.add_argument("--analysis", default="kinetostatics", metavar="NAME[,NAME]",
                    help=f"one or more of {', '.join(ANALYSES)} (default kinetostatics)")
-    p.add_argument("--speed", metavar="RATE", help="crank speed, e.g. 1000rpm")
+    p.add_argument("--speed", metavar="RATE",
+                   help="crank speed, e.g. 1000rpm (default: the model's own speed)")
     p.add_argument("--steps", type=int, default=360, metavar="N",
                    help="positions over one turn (default 360)")
     p.add_argument("--over", metavar="COORD", help="driven coordinate (default the first)")
@@ -94,16 +95,21 @@ def register(sub) -> None:
                         "(default cobyqa)")
 
 
-def _analysis(args):
+def _analysis(args, base):
     parts = []
     for name in [n.strip() for n in args.analysis.split(",") if n.strip()]:
         if name not in ANALYSES:
             raise ModelError(f"--analysis {name!r}: use one of {', '.join(ANALYSES)}")
         if name == "kinetostatics":
-            if args.speed is None:
-                raise ModelError("--analysis kinetostatics needs --speed, e.g. --speed 1000rpm")
-            parts.append(KinetostaticExtremes(
-                quantity(args.speed, "angular_velocity", "--speed"), args.steps, args.over))
+            if args.speed is None:  # the base model's own speed, as in every command
+                model = base.build({}).compile()
+                over = args.over or model.coordinate_names[0]
+                speed, why = model_speed(model, over)
+                print(speed_line(speed, bool(model.coord_is_angle[
+                    model.coordinate_index(over)]), why))
+            else:
+                speed = quantity(args.speed, "angular_velocity", "--speed")
+            parts.append(KinetostaticExtremes(speed, args.steps, args.over))
         elif name == "kinematics":
             parts.append(KinematicSummary(args.steps, args.over))
         else:
@@ -168,7 +174,7 @@ def run(args) -> int:
     """Run ``mechdyn study``; returns the exit code."""
     base = BaseModel(args.model)
     ranges = [parse_range(base, spec) for spec in args.vary]
-    analysis = _analysis(args)
+    analysis = _analysis(args, base)
     t0 = time.perf_counter()
     if args.minimise:
         best = optimise(base, ranges, analysis, args.minimise, method=args.method,
