@@ -12,7 +12,7 @@ before it are written); 2 bad input (one line on stderr).
 from __future__ import annotations
 
 from ..kinematics.sweep import sweep
-from ..results.animate import _trace_spec
+from ..results.frame_geometry import _trace_spec
 from ..results.plot import plot_kinematic_sweep
 from ..results.table import deg_or_mm
 from .options import (

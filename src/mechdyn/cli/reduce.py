@@ -17,7 +17,7 @@ import numpy as np
 from ..dynamics.reduction import reduce_model
 from ..errors import ModelError
 from ..kinematics.sweep import initial_coordinates
-from ..results.animate import _trace_spec
+from ..results.frame_geometry import _trace_spec
 from ..results.plot_reduction import plot_reduction
 from .options import (
     add_files,

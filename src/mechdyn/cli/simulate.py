@@ -24,8 +24,8 @@ from ..dynamics.lagrange import FORMULATIONS
 from ..errors import ModelError, Status, did_you_mean
 from ..mechanism import Drive
 from ..results import spectrum
-from ..results.animate import _trace_spec
 from ..results.events import events_table
+from ..results.frame_geometry import _trace_spec
 from ..results.plot_dynamics import plot_trajectory
 from ..results.plot_spectrum import plot_spectrum
 from ..results.table import deg_or_mm, write_csv, written

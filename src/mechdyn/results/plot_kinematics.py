@@ -8,9 +8,9 @@ from collections.abc import Iterable
 import numpy as np
 
 from ..kinematics.records import four_bar_loops
-from .animate import _trace_spec
 from .figure import mosaic as _mosaic
 from .figure import save as _save
+from .frame_geometry import _trace_spec
 from .plot_axes import model_name, speed_text, x_axis
 from .table import deg_or_mm
 

@@ -209,7 +209,7 @@ def default_points(model, trace=None) -> list:
         pts = [(body, p, _point_label(body, p)) for p in list(mech.bodies[body].points)
                or ["com"]]
     if trace is not None:
-        from .animate import _trace_spec
+        from .frame_geometry import _trace_spec
 
         body, name = _trace_spec(model, trace)
         if not any(b == body and isinstance(n, str) and n == name for b, n, _ in pts):
