@@ -6,6 +6,7 @@ import pytest
 
 from mechdyn import kinetostatics
 from mechdyn.kinematics.sweep import sweep
+from mechdyn.modelfile.loader import build
 from mechdyn.study.analyses import KinematicSummary, KinetostaticExtremes
 from mechdyn.study.designs import design, parse_range
 from mechdyn.study.execute import run_study
@@ -31,8 +32,9 @@ def study(base, variants):
 
 
 def reference_figures(base, values: dict, analysis) -> dict:
-    """The figures of one cold mechdyn.kinetostatics call: the plain loop's."""
-    model = base.build(values).compile()
+    """The figures of one cold mechdyn.kinetostatics call: the plain loop's (the variant
+    read with every check of the loader, then compiled)."""
+    model = build(base.document(values), base.name).compile()
     over, positions = analysis.values(model)
     record = kinetostatics(model, over=over, speed=analysis.speed, values=positions)
     return KinetostaticExtremes.figures(record).figures
@@ -60,6 +62,14 @@ def test_non_assemblable_variants_are_rows_that_name_the_open_loop(base):
     assert "loop through joints" in df.loc[1, "message"]
     assert "does not close" in df.loc[1, "message"]
     assert df.loc[2, "status"] in ("assembly-failed", "singular-position")
+    assert np.isnan(df.loc[1, "M_drive_phi_peak_Nm"])
+
+
+def test_a_variant_with_a_value_out_of_range_is_a_row_that_names_it(base):
+    df = run_study(base, {"bodies.rod.mass": [1.0, -1.0]}, ANALYSIS, workers=1,
+                   progress=False)
+    assert df["status"].tolist() == ["success", "failed"]
+    assert "[bodies.rod] mass: '-1.0 kg': mass must be >= 0 kg" in df.loc[1, "message"]
     assert np.isnan(df.loc[1, "M_drive_phi_peak_Nm"])
 
 

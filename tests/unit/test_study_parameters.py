@@ -78,3 +78,44 @@ def test_designs_are_seeded_and_fill_the_ranges(base):
     assert u.between(0.04, 0.06).all()
     with pytest.raises(ModelError, match="unknown design"):
         design(r, 5, "sobol")
+
+
+def test_a_variant_copies_only_the_tables_on_its_paths(base):
+    p = base.parameter("bodies.crank.points.A.x")
+    doc = base.document({p: 0.045})
+    assert doc["bodies"]["rod"] is base.doc["bodies"]["rod"]  # shared, never changed
+    new, old = doc["bodies"]["crank"]["points"]["A"], base.doc["bodies"]["crank"]["points"]["A"]
+    assert new is not old and new[1] == old[1] and old[0] == "50 mm"
+    assert doc["drives"] is base.doc["drives"]
+
+
+def test_a_variant_is_compiled_once_without_the_schema_pass(monkeypatch):
+    import mechdyn.compiler
+    from mechdyn.modelfile import loader
+
+    base = BaseModel("slider_crank")
+    p = base.parameter("bodies.rod.mass")
+    assert base.structure_known([p])
+    calls = []
+    real = mechdyn.compiler.compile_mechanism
+    monkeypatch.setattr(mechdyn.compiler, "compile_mechanism",
+                        lambda m: calls.append(m) or real(m))
+    monkeypatch.setattr(loader, "schema_problems", None)  # would fail if called
+    model = base.compile({p: 2.5})
+    assert len(calls) == 1 and model.mechanism.bodies["rod"].mass == 2.5
+
+
+def test_a_bad_value_is_still_named_without_the_schema_pass(base):
+    p = base.parameter("bodies.rod.mass")
+    assert base.structure_known([p])
+    with pytest.raises(ModelError, match=r"\[bodies\.rod\] mass: '-1\.0 kg': mass must be >= 0"):
+        base.compile({p: -1.0})
+
+
+def test_a_base_document_of_a_bad_structure_is_checked_for_every_variant():
+    base = BaseModel("slider_crank")
+    base.doc["bodies"]["rod"]["colour"] = "red"
+    p = base.parameter("bodies.rod.mass")
+    assert not base.structure_known([p])
+    with pytest.raises(ModelError, match=r"\[bodies\.rod\]: unknown key 'colour'"):
+        base.compile({p: 1.0})

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import tomllib
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import MechdynError, ModelError, UnitError, did_you_mean
 from ..mechanism import GROUND, Ground, Mechanism
@@ -33,7 +34,10 @@ from .schema import schema_problems
 from .switches import TABLES as SWITCH_TABLES
 from .switches import parse_switches
 
-__all__ = ["load", "loads", "build", "read_document"]
+if TYPE_CHECKING:
+    from ..model import Model
+
+__all__ = ["load", "loads", "build", "build_model", "read_document"]
 
 
 def load(path: str | Path) -> Mechanism:
@@ -112,9 +116,84 @@ def read_document(text: str, name: str = "<string>") -> dict:
     return doc
 
 
-def build(doc: dict, name: str = "<string>", *, default_title: str | None = None) -> Mechanism:
-    """Build and validate a mechanism from a parsed model document (see :func:`loads`)."""
-    msgs, bad_paths = schema_problems(doc, name)
+def build(doc: dict, name: str = "<string>", *, default_title: str | None = None,
+          schema: bool = True) -> Mechanism:
+    """Build and validate a mechanism from a parsed model document (see :func:`loads`).
+
+    Parameters
+    ----------
+    doc : dict
+        The parsed TOML document (:func:`read_document`).
+    name : str
+        Shown as the file name in error messages.
+    default_title : str, optional
+        Mechanism name when the file has no ``[model] name``.
+    schema : bool
+        Check the structure against the JSON schema (pass 1).  ``False`` only for a
+        document whose structure is known good: one that differs from a document
+        that passed the schema only in quantity values at keys that took such values
+        (the variants of a design study, :mod:`mechdyn.study`).  The units, values,
+        names and the mechanism itself (passes 2 and 3) are always checked.
+
+    Returns
+    -------
+    Mechanism
+        The validated mechanism (:func:`build_model` also gives its compiled Model).
+
+    Raises
+    ------
+    ModelError
+        Every problem of the document (a :class:`~mechdyn.errors.UnitError` when all
+        are about units).
+
+    Examples
+    --------
+    >>> doc = read_document('''
+    ... [bodies.bar]
+    ... mass = "2 kg"
+    ... inertia = "0.05 kg*m^2"
+    ... points = { P = ["0.5 m", "0 m"] }
+    ... [joints.O]
+    ... type = "revolute"
+    ... parent = "ground"
+    ... child = "bar"
+    ... [coordinates.theta]
+    ... kind = "angle"
+    ... body = "bar"
+    ... ''', "pendulum.toml")
+    >>> build(doc, "pendulum.toml").bodies["bar"].mass
+    2.0
+    >>> doc["bodies"]["bar"]["mass"] = "-2 kg"
+    >>> build(doc, "pendulum.toml", schema=False)
+    Traceback (most recent call last):
+    ...
+    mechdyn.errors.ModelError: pendulum.toml: [bodies.bar] mass: '-2 kg': mass must be >= 0 kg
+    """
+    return build_model(doc, name, default_title=default_title, schema=schema).mechanism
+
+
+def build_model(doc: dict, name: str = "<string>", *, default_title: str | None = None,
+                schema: bool = True) -> Model:
+    """Build and validate a mechanism from a parsed model document, and give the
+    compiled :class:`~mechdyn.model.Model` that validation made (its ``mechanism`` is
+    the one :func:`build` returns), so that it is not compiled a second time.
+
+    Parameters and Raises as :func:`build`.
+
+    Returns
+    -------
+    Model
+        Compiled and frozen (:func:`mechdyn.compiler.compile_mechanism`).
+
+    Examples
+    --------
+    >>> from mechdyn import examples
+    >>> path = examples.path("slider_crank")
+    >>> model = build_model(read_document(path.read_text(), path.name), path.name)
+    >>> model.coordinate_names, model.mechanism.name
+    (('phi',), 'slider-crank')
+    """
+    msgs, bad_paths = schema_problems(doc, name) if schema else ([], [])
     builder = _Builder(doc, name, bad_paths)
     builder.problems.extend(msgs)
     mech = builder.run(default_title)
@@ -123,12 +202,11 @@ def build(doc: dict, name: str = "<string>", *, default_title: str | None = None
         only_units = all(p in builder.unit_problems for p in builder.problems)
         raise (UnitError if only_units else ModelError)(builder.problems)
     try:
-        mech.validate()
+        return mech.compile()  # what Mechanism.validate does, keeping the Model
     except ModelError as exc:
         raise ModelError([f"{name}: {p}" for p in exc.problems]) from None
     except MechdynError as exc:  # assembly or other analysis errors
         raise ModelError(f"{name}: {exc}") from None
-    return mech
 
 
 class _Builder(_BodiesJoints, _LoadsDrives, _FoundationReader):

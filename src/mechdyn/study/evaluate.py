@@ -90,8 +90,8 @@ def evaluate_variant(task: Task, vid: int, values: tuple[float, ...], warm=None)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the record's status and message say it
-            model = task.base.build(dict(zip(task.parameters, values, strict=True)))
-            outcome = task.analysis(model.compile(), warm)
+            model = task.base.compile(dict(zip(task.parameters, values, strict=True)))
+            outcome = task.analysis(model, warm)
         row.update(outcome.figures)
         row["status"], row["message"] = outcome.status, outcome.message
         if outcome.warm is not None:

@@ -185,6 +185,7 @@ def run_study(model, variants, analysis, *, output: str | Path | None = None,
     if batch_size is None:
         batch_size = max(1, min(50, math.ceil(len(todo) / max(1, 4 * workers))))
     batches = batches_of(ids[todo], values[todo], int(batch_size))
+    base.structure_known(params)  # once, here: the answer travels with the task
     task = Task(base, params, analysis)
     rows: list[dict] = []
     bar = _bar(len(ids), len(ids) - len(todo), progress)

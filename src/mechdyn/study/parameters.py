@@ -6,17 +6,18 @@ its index), ``bodies.rod.mass``, ``drives.motor.gear_ratio`` (an entry of an arr
 of tables by its ``name``, or by its index), ``initial.phi`` (a coordinate's
 initial value).  A variant sets each parameter to a value with its unit (written
 back as ``"0.045 m"``), so the loader's unit checks apply, and builds the model with
-:func:`mechdyn.modelfile.loader.build`.
+:func:`mechdyn.modelfile.loader.build_model` (without the JSON-schema pass when the
+structure is known good: :meth:`BaseModel.structure_known`).
 """
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import ModelError, UnitError, did_you_mean
-from ..modelfile.loader import build, read_document
+from ..modelfile.loader import build_model, read_document
+from ..modelfile.schema import schema_problems
 from ..units import KINDS, parse_quantity
 
 __all__ = ["BaseModel", "Parameter", "column_name", "unit_suffix", "shown_unit", "to_shown",
@@ -115,34 +116,45 @@ class Parameter:
 
 
 def _key(node, key: str, where: list[str]):
-    """The child ``key`` of a table (dict) or of an array of tables (by name or index)."""
+    """(index, child): the child ``key`` of a table (dict) or of an array of tables (by
+    name or index), and its key or index in ``node``."""
     here = ".".join(where) or "(top level)"
     if isinstance(node, dict):
         if key in node:
-            return node[key]
+            return key, node[key]
         raise ModelError(f"study parameter: no key {key!r} at {here}; "
                          + did_you_mean(key, list(node), "key"))
     if isinstance(node, list):
         names = [e.get("name") for e in node if isinstance(e, dict)]
         if key in names:
-            return node[names.index(key)]
+            k = names.index(key)
+            k = [i for i, e in enumerate(node) if isinstance(e, dict)][k]
+            return k, node[k]
         if key.isdigit() and int(key) < len(node):
-            return node[int(key)]
+            return int(key), node[int(key)]
         valid = [n for n in names if n] or [str(i) for i in range(len(node))]
         raise ModelError(f"study parameter: no entry {key!r} in {here}; "
                          + did_you_mean(key, valid, "entry"))
     raise ModelError(f"study parameter: {here} is a value, not a table: it has no key {key!r}")
 
 
-def _locate(doc: dict, path: str):
-    """(container, index) of the value at ``path``: a dict and key, or a list and index."""
+def _locate(doc: dict, path: str, copy: bool = False):
+    """(container, index) of the value at ``path``: a dict and key, or a list and index.
+
+    With ``copy``, each table and array on the way (not ``doc`` itself) is replaced in
+    its parent by a shallow copy, so that the value can be set without changing what
+    ``doc`` shares with another document.
+    """
     parts = path.split(".")
     if not path or any(not p for p in parts):
         raise ModelError(f"study parameter {path!r}: write a dotted model-file path, e.g. "
                          f"bodies.crank.points.A.x")
     node, where = doc, []
     for part in parts[:-1]:
-        node = _key(node, part, where)
+        index, child = _key(node, part, where)
+        if copy and isinstance(child, dict | list):
+            child = node[index] = type(child)(child)
+        node = child
         where.append(part)
     last = parts[-1]
     if isinstance(node, list) and node and not isinstance(node[0], dict):  # a vector
@@ -152,12 +164,12 @@ def _locate(doc: dict, path: str):
             raise ModelError(f"study parameter {path!r}: {'.'.join(where)} is a vector; "
                              f"choose a component: {', '.join(valid)}")
         return node, index
-    child = _key(node, last, where)
+    index, child = _key(node, last, where)
     if isinstance(child, dict | list):
         keys = list(child) if isinstance(child, dict) else list(_COMPONENTS)[:len(child)]
         raise ModelError(f"study parameter {path!r} is a table or vector, not a value; "
                          f"valid keys below it: {', '.join(map(str, keys))}")
-    return node, (last if isinstance(node, dict) else node.index(child))
+    return node, index
 
 
 def _kind_of(old, sample: str | None, path: str) -> str:
@@ -218,6 +230,8 @@ class BaseModel:
         self.name = path.name
         self.title = path.stem
         self.doc = read_document(path.read_text(encoding="utf-8"), path.name)
+        #: :meth:`structure_known` by set of parameters
+        self._structure: dict[tuple, bool] = {}
 
     def parameter(self, path: str, sample: str | float | None = None) -> Parameter:
         """The :class:`Parameter` at ``path``; its kind is what the model's value measures
@@ -235,12 +249,41 @@ class BaseModel:
 
     def document(self, values: dict[Parameter, float]) -> dict:
         """A copy of the document with each parameter set to its SI value (written with
-        its unit)."""
-        doc = copy.deepcopy(self.doc)
+        its unit).
+
+        Only the tables and arrays on the parameters' paths are copied; the rest is
+        shared with :attr:`doc`, which is never changed (nor may the copy's shared
+        parts be).
+        """
+        doc = dict(self.doc)
         for p, v in values.items():
-            node, index = _locate(doc, p.path)
+            node, index = _locate(doc, p.path, copy=True)
             node[index] = p.text(v)
         return doc
+
+    def structure_known(self, parameters) -> bool:
+        """True if every variant of ``parameters`` has a known good structure, so that its
+        documents need no JSON-schema pass (:func:`~mechdyn.modelfile.loader.build` with
+        ``schema=False``): the base document passes the schema, and so does it with each
+        parameter written as a value with its unit.
+
+        A variant differs from that probe only in the numbers of those values, which
+        the schema does not read (it checks tables, keys, TOML types and names; units
+        and values are the loader's second pass, which every variant goes through).
+        The answer is kept for each set of parameters; :attr:`doc` must not change
+        after it.
+
+        Examples
+        --------
+        >>> base = BaseModel("slider_crank")
+        >>> base.structure_known([base.parameter("bodies.rod.mass")])
+        True
+        """
+        key = tuple(sorted({p.path: p for p in parameters}.items()))
+        if key not in self._structure:
+            probe = self.document({p: 1.0 for _, p in key})
+            self._structure[key] = not schema_problems(probe, self.name)[0]
+        return self._structure[key]
 
     def build(self, values: dict[Parameter, float]):
         """The validated :class:`~mechdyn.mechanism.Mechanism` of one variant.
@@ -250,4 +293,25 @@ class BaseModel:
         ModelError
             The variant is not a valid model (its sketch cannot be assembled ...).
         """
-        return build(self.document(values), self.name, default_title=self.title)
+        return self.compile(values).mechanism
+
+    def compile(self, values: dict[Parameter, float]):
+        """The compiled :class:`~mechdyn.model.Model` of one variant: the one its
+        validation made (:func:`~mechdyn.modelfile.loader.build_model`); the JSON-schema
+        pass is skipped when :meth:`structure_known`.
+
+        Raises
+        ------
+        ModelError
+            The variant is not a valid model (a value out of range, its sketch cannot
+            be assembled ...), naming the file, the table and the key.
+
+        Examples
+        --------
+        >>> base = BaseModel("slider_crank")
+        >>> model = base.compile({base.parameter("bodies.rod.mass"): 2.0})
+        >>> model.mechanism.bodies["rod"].mass
+        2.0
+        """
+        return build_model(self.document(values), self.name, default_title=self.title,
+                           schema=not self.structure_known(values))
