@@ -102,7 +102,7 @@ def _analysis(args, base):
             raise ModelError(f"--analysis {name!r}: use one of {', '.join(ANALYSES)}")
         if name == "kinetostatics":
             if args.speed is None:  # the base model's own speed, as in every command
-                model = base.build({}).compile()
+                model = base.compile({})
                 over = args.over or model.coordinate_names[0]
                 speed, why = model_speed(model, over)
                 print(speed_line(speed, bool(model.coord_is_angle[
