@@ -33,15 +33,20 @@ from ..simulate import simulate
 from ..simulate_events import format_events
 from ..units import parse_quantity
 from .options import (
+    add_engage,
     add_files,
     add_model,
+    add_moment_point,
     add_plot_columns,
     add_points,
     add_run,
     check_plot_columns,
     draw_plot,
+    engage_from_args,
     load_model,
+    moment_point,
     quantity,
+    with_lock_poses,
 )
 
 __all__ = ["register", "run"]
@@ -78,6 +83,8 @@ def register(sub) -> None:
                    help="initial value of a coordinate, e.g. phi=-64.1deg (repeatable)")
     p.add_argument("--qdot0", action="append", default=[], metavar="COORD=RATE",
                    help="initial rate of a coordinate, e.g. phi=43.5rad/s (repeatable)")
+    add_engage(p, "locks engaged at the start")
+    add_moment_point(p)
     out = p.add_mutually_exclusive_group()
     out.add_argument("--samples", type=int, metavar="N",
                      help="write N equally spaced samples from the dense output (default "
@@ -116,7 +123,8 @@ def _pairs(items, model, what, kinds):
 def run(args) -> int:
     """Run ``mechdyn simulate``; returns the exit code."""
     check_plot_columns(args)
-    mech = load_model(args.model)
+    engaged, poses = engage_from_args(args)
+    mech = with_lock_poses(load_model(args.model), poses)
     t_end = parse_quantity(args.t_end, "time", where="--t-end")
     t0 = parse_quantity(args.t0, "time", where="--t0")
     dt = parse_quantity(args.dt, "time", where="--dt") if args.dt is not None else None
@@ -140,7 +148,8 @@ def run(args) -> int:
                     rtol=args.rtol, atol=args.atol, q0=q0, qdot0=qdot0, t_eval=t_eval,
                     formulation=args.formulation, d=d, progress=args.progress,
                     backend=args.backend, theta=args.theta,
-                    iterations=args.iterations if fixed else None)
+                    iterations=args.iterations if fixed else None,
+                    mode=engaged, **_moment_point(args))
     print(traj.summary())
     if traj.events:
         print(format_events(traj.events, traj.coordinate_names, limit=40))
@@ -165,6 +174,11 @@ def run(args) -> int:
         print(f"mechdyn simulate: stopped early: {traj.status}: {traj.message}", file=sys.stderr)
         return 130 if traj.status == Status.INTERRUPTED else 1
     return 0
+
+
+def _moment_point(args) -> dict:
+    """``point=`` of :func:`mechdyn.simulate` when ``--moment-point`` is given."""
+    return {} if args.moment_point is None else {"point": moment_point(args)}
 
 
 def _with_points(traj, points):
