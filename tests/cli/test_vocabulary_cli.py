@@ -29,7 +29,8 @@ def _options(text):
     ("kinetostatics", {"--moment-point", "--engage"}, {"--point", "--mode"}),
     ("reduce", {"--mass-at", "--engage"}, {"--point", "--mode"}),
     ("flywheel", {"--engage"}, {"--point", "--mode"}),
-    ("simulate", {"--moment-point", "--engage"}, {"--point", "--mode"}),
+    ("simulate", {"--moment-point", "--engage", "--fixed-steps"}, {"--point", "--mode",
+                                                                   "--steps"}),
 ])
 def test_help_shows_only_the_new_spelling(capsys, command, shown, hidden):
     options = _options(_help(capsys, command))
@@ -134,3 +135,17 @@ def test_reduce_engages_a_list_of_locks(capsys):
                "--drop", "psi", "--steps", "13"])
     assert rc == 0
     assert "reduction to coordinate 'phi'" in capsys.readouterr().out
+
+
+def test_fixed_steps_and_its_old_spelling(tmp_path):
+    """``--steps`` counts positions of a sweep everywhere; the steps of wilson / rk4 are
+    ``--fixed-steps`` (N steps: N + 1 rows, ends included)."""
+    new, old = tmp_path / "new.csv", tmp_path / "old.csv"
+    base = ["simulate", "slider_crank", "--t-end", "10ms", "--integrator", "rk4",
+            "--backend", "numpy", "--no-progress"]
+    assert main([*base, "--fixed-steps", "10", "-o", str(new)]) == 0
+    assert main([*base, "--steps", "10", "-o", str(old)]) == 0
+    new, old = read_csv(new), read_csv(old)
+    assert len(new) == 11
+    np.testing.assert_allclose(np.diff(new["t_s"]), 1e-3, rtol=1e-9)
+    np.testing.assert_array_equal(new["phi_rad"], old["phi_rad"])

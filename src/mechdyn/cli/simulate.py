@@ -3,7 +3,7 @@
 Examples::
 
     mechdyn simulate andrews_squeezer --t-end 0.03 --rtol 1e-10 -o andrews.csv
-    mechdyn simulate clutchless_press --t-end "0.05 s" --integrator wilson --steps 40 \\
+    mechdyn simulate clutchless_press --t-end "0.05 s" --integrator wilson --fixed-steps 40 \\
         --drive phi="34.5 N*m" -o press.csv --plot press.png
 
 Exit codes: 0 done; 1 the run stopped early (dead position, assembly failure,
@@ -67,7 +67,9 @@ def register(sub) -> None:
     add_model(p)
     add_run(p, required=True)
     p.add_argument("--t0", default="0", metavar="TIME", help="start time (default 0 s)")
-    p.add_argument("--steps", type=int, metavar="N", help="steps of wilson / rk4")
+    p.add_argument("--fixed-steps", type=int, metavar="N",
+                   help="number of steps of the fixed-step integrators wilson / rk4")
+    p.add_argument("--steps", dest="fixed_steps", type=int, help=argparse.SUPPRESS)
     p.add_argument("--dt", metavar="TIME", help="step size of wilson / rk4")
     p.add_argument("--atol", type=float, help="absolute tolerance (default 1e-3 rtol)")
     p.add_argument("--theta", type=float, help="Wilson theta (1 or >= 1.37)")
@@ -144,8 +146,8 @@ def run(args) -> int:
         if args.samples < 2:
             raise ModelError(f"--samples must be >= 2, got {args.samples}")
         t_eval = np.linspace(t0, t_end, args.samples)
-    traj = simulate(model, t_end, t0=t0, integrator=args.integrator, steps=args.steps, dt=dt,
-                    rtol=args.rtol, atol=args.atol, q0=q0, qdot0=qdot0, t_eval=t_eval,
+    traj = simulate(model, t_end, t0=t0, integrator=args.integrator, steps=args.fixed_steps,
+                    dt=dt, rtol=args.rtol, atol=args.atol, q0=q0, qdot0=qdot0, t_eval=t_eval,
                     formulation=args.formulation, d=d, progress=args.progress,
                     backend=args.backend, theta=args.theta,
                     iterations=args.iterations if fixed else None,
