@@ -31,7 +31,7 @@ body = "crank"
 def test_toggle_press_cycle_writes_table_and_plot(tmp_path, capsys):
     csv, png = tmp_path / "forces.csv", tmp_path / "forces.png"
     rc = main(["kinetostatics", "toggle_press", "--speed", "40rpm", "--from", "0deg",
-               "--to", "360deg", "--steps", "73", "--point", "0,0", "-o", str(csv),
+               "--to", "360deg", "--steps", "73", "--moment-point", "0,0", "-o", str(csv),
                "--plot", str(png), "--joints", "B", "C", "F"])
     assert rc == 0
     out = capsys.readouterr().out
@@ -50,7 +50,7 @@ def test_statics_from_a_model_file_with_units(tmp_path, capsys):
     model.write_text(PENDULUM_TOML)
     csv = tmp_path / "static.csv"
     rc = main(["kinetostatics", str(model), "--speed", "0 rpm", "--from", "0 deg", "--to",
-               "90 deg", "--steps", "3", "--point", "100mm,0mm", "-o", str(csv)])
+               "90 deg", "--steps", "3", "--moment-point", "100mm,0mm", "-o", str(csv)])
     assert rc == 0
     df = pd.read_csv(csv)
     # holding torque m g r cos(phi)
@@ -65,7 +65,7 @@ def test_bad_input_exits_2_with_one_line(capsys):
     assert rc == 2
     err = capsys.readouterr().err
     assert "--speed" in err and "angular velocity" in err
-    rc = main(["kinetostatics", "toggle_press", "--speed", "40rpm", "--point", "1,2,3"])
+    rc = main(["kinetostatics", "toggle_press", "--speed", "40rpm", "--moment-point", "1,2,3"])
     assert rc == 2
     rc = main(["kinetostatics", "toggle_press", "--speed", "40rpm", "--over", "psi"])
     assert rc == 2
@@ -75,7 +75,7 @@ def test_bad_input_exits_2_with_one_line(capsys):
 @pytest.mark.parametrize("mode", ["rocker_lock", "none"])
 def test_clutchless_press_modes(mode, capsys):
     rc = main(["kinetostatics", "clutchless_press", "--speed", "43.5rad/s", "--steps", "13",
-               "--mode", mode, "--harmonics", "0"])
+               "--engage", mode, "--harmonics", "0"])
     assert rc == 0
     out = capsys.readouterr().out
     assert ("redundant" in out) == (mode == "rocker_lock")

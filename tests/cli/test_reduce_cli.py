@@ -27,7 +27,7 @@ def slider_crank_J(phi):
 
 def test_reduce_writes_a_table_with_units_and_a_plot(tmp_path, capsys):
     csv, png = tmp_path / "reduced.csv", tmp_path / "reduced.png"
-    rc = main(["reduce", "slider_crank", "--steps", "73", "--point", "crank.A",
+    rc = main(["reduce", "slider_crank", "--steps", "73", "--mass-at", "crank.A",
                "-o", str(csv), "--plot", str(png)])
     out = capsys.readouterr().out
     assert rc == 0

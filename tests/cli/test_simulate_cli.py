@@ -43,7 +43,7 @@ def test_stopped_run_exits_1_and_keeps_data(tmp_path, capsys):
     # where the rod is normal to the ram axis (singular for phi, psi) just before 0.05 s
     out = tmp_path / "stop.csv"
     code = main(["simulate", "clutchless_press", "--t-end", "0.06", "--drive", "phi=34.5",
-                 "--integrator", "rk4", "--steps", "240", "-o", str(out)])
+                 "--integrator", "rk4", "--fixed-steps", "240", "-o", str(out)])
     assert code == 1
     cap = capsys.readouterr()
     assert "singular-position" in cap.out and "stopped early" in cap.err
@@ -60,8 +60,9 @@ def test_bad_integrator_is_exit_2(capsys):
 
 @pytest.mark.parametrize("args, match", [
     (["--t-end", "-1 s"], "t_end"),
-    (["--t-end", "0.01", "--integrator", "wilson", "--steps", "0"], "steps"),
-    (["--t-end", "0.01", "--integrator", "wilson", "--steps", "10", "--theta", "1.2"], "theta"),
+    (["--t-end", "0.01", "--integrator", "wilson", "--fixed-steps", "0"], "steps"),
+    (["--t-end", "0.01", "--integrator", "wilson", "--fixed-steps", "10", "--theta", "1.2"],
+     "theta"),
     (["--t-end", "0.01", "--rtol", "0"], "rtol"),
     (["--t-end", "5 kg"], "time"),
     (["--t-end", "0.01", "--drive", "gamma=1"], "coordinate"),

@@ -3,7 +3,7 @@
 Example::
 
     mechdyn kinetostatics toggle_press --speed 40rpm --from 0deg --to 360deg \\
-        --steps 361 --point 0,0 -o forces.csv --plot forces.png
+        --steps 361 --moment-point 0,0 -o forces.csv --plot forces.png
 
 Exit codes: 0 done; 1 done with a warning that matters (singular positions);
 2 bad input (one line on stderr).
@@ -19,19 +19,23 @@ from ..errors import ModelError, Status
 from ..results.plot_kinetostatics import plot_joint_force_polar, plot_kinetostatics
 from ..results.table import written
 from .options import (
+    add_engage,
     add_files,
     add_model,
+    add_moment_point,
     add_plot_columns,
     add_range,
     add_speed,
     check_plot_columns,
     draw_plot,
+    engage_from_args,
     finish,
-    open_model,
+    load_model,
+    moment_point,
     speed_from_args,
     speed_line,
     sweep_values,
-    vector,
+    with_lock_poses,
 )
 
 __all__ = ["register", "run"]
@@ -53,12 +57,8 @@ def register(sub) -> None:
     add_range(p, steps=361, over="driven coordinate (default: the first); other independent "
                                  "coordinates are held at their initial values")
     add_speed(p, "constant speed of the driven coordinate (0rpm for statics)")
-    p.add_argument("--point", default="0,0", metavar="X,Y",
-                   help="point of the frame moments (shaking moment), e.g. 0,0 or "
-                        "'100mm,-50mm' (default 0,0)")
-    p.add_argument("--mode", default=None, metavar="LOCK[,LOCK...]",
-                   help="engaged locks, comma separated (default: as in the model; "
-                        "'none' releases all)")
+    add_moment_point(p, alias="--point")
+    add_engage(p, alias="--mode")
     p.add_argument("--bed", nargs="+", default=(), metavar="LOAD",
                    help="force loads whose reaction the frame carries (e.g. the punch force "
                         "on a press bed)")
@@ -79,21 +79,18 @@ def run(args) -> int:
     if args.plot_polar and not args.plot:
         raise ModelError("--plot-polar needs --plot FILE (the polar diagrams are written "
                          "beside it)")
-    mech, model = open_model(args)
+    engaged, poses = engage_from_args(args)
+    mech = load_model(args.model)
+    model = with_lock_poses(mech, poses).compile()
     for joint in args.plot_polar:
         model.joint_kind(joint)  # an unknown joint is an error before the analysis
     over, values, _ = sweep_values(model, args)
     speed, why = speed_from_args(model, over, args)
-    point = vector(args.point, ("length", "length"), "--point",
-                   "two lengths X,Y, e.g. 0,0 or 100mm,-50mm")
-    mode = None
-    if args.mode is not None:
-        mode = (frozenset() if args.mode.strip().lower() == "none"
-                else frozenset(m.strip() for m in args.mode.split(",") if m.strip()))
+    point = moment_point(args)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", KinetostaticsWarning)  # printed below
         res = kinetostatics(model, over=over, speed=speed, values=values, point=point,
-                            mode=mode, reacting_loads=tuple(args.bed))
+                            mode=engaged, reacting_loads=tuple(args.bed))
     angle = res.over_is_angle
     print(f"{mech.name}: kinetostatics; status {res.status}")
     print(speed_line(speed, angle, why))

@@ -4,6 +4,7 @@ speed, the output files, the mode and drive of a reduction, a simulation, the ex
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import re
 import sys
 from collections.abc import Mapping
@@ -13,10 +14,11 @@ import numpy as np
 
 from .. import examples
 from ..dynamics.reduction import mode_mechanism
-from ..errors import ModelError, UnitError
+from ..errors import ModelError, UnitError, did_you_mean
 from ..integrate.base import DEFAULT_RTOL
 from ..integrate.driver import INTEGRATORS
 from ..kinematics.sweep import initial_coordinates
+from ..mechanism.joint import Lock
 from ..modelfile import load
 from ..modelfile.drives import drive_from_table
 from ..results.plot_columns import check_columns, plot_columns, table_of
@@ -25,7 +27,9 @@ from ..simulate import simulate
 from ..units import parse_quantity, parse_vector
 
 __all__ = ["quantity", "vector", "add_model", "add_files", "add_range", "add_start",
-           "add_speed", "add_points", "add_motion_arguments", "add_model_arguments", "add_run",
+           "add_speed", "add_points", "add_engage", "add_moment_point", "engage_from_args",
+           "engage_locks", "with_lock_poses", "moment_point", "add_motion_arguments",
+           "add_model_arguments", "add_run",
            "load_model", "open_model", "prepare_model", "sweep_values", "model_speed",
            "speed_from_args", "speed_line", "simulate_from_args", "write_files", "finish",
            "add_plot_columns", "check_plot_columns", "draw_plot", "SPEED_DEFAULT"]
@@ -137,12 +141,102 @@ def add_motion_arguments(p, metavar: str, output: str, *, steps: int, verb: str,
     return d
 
 
+def add_engage(p, what: str = "engaged locks", *, alias: str | None = None) -> None:
+    """Add ``--engage LOCK[,LOCK...]`` (repeatable; ``none`` releases every lock; a lock
+    may carry the pose it holds, ``LOCK=X,Y,THETA``); ``alias`` is a hidden old
+    spelling of it (``--mode`` in kinetostatics)."""
+    p.add_argument("--engage", action="append", default=None, metavar="LOCK[,LOCK...]",
+                   help=f"{what}, comma separated or repeated, each optionally with the pose "
+                        f"it holds, e.g. rocker_lock=0mm,0mm,0deg; 'none' releases every "
+                        f"lock (default: as declared in the model)")
+    if alias:
+        p.add_argument(alias, dest="engage", action="append", help=argparse.SUPPRESS)
+
+
+def engage_from_args(args) -> tuple[frozenset | None, dict]:
+    """The engaged locks of ``--engage`` (None when not given; empty for ``none``) and
+    the poses given with them, {lock: (x m, y m, theta rad)}.
+
+    Examples
+    --------
+    >>> ns = argparse.Namespace(engage=["a,b=1m,0,0", "c"])
+    >>> names, poses = engage_from_args(ns)
+    >>> sorted(names), poses
+    (['a', 'b', 'c'], {'b': (1.0, 0.0, 0.0)})
+    """
+    if getattr(args, "engage", None) is None:
+        return None, {}
+    names, poses = [], {}
+    for spec in args.engage:
+        parts = [t.strip() for t in spec.split(",")]
+        while parts:
+            name, sep, first = parts.pop(0).partition("=")
+            name = name.strip()
+            if sep:  # the pose: this value and the next two
+                pose, parts = [first, *parts[:2]], parts[2:]
+                poses[name] = vector(",".join(pose), ("length", "length", "angle"),
+                                     f"--engage {name}",
+                                     f"the pose as X,Y,THETA, e.g. {name}=0mm,0mm,0deg")
+            if name:
+                names.append(name)
+    if [n.lower() for n in names] == ["none"]:
+        return frozenset(), {}
+    if any(n.lower() == "none" for n in names):
+        raise ModelError("--engage: 'none' releases every lock and is given alone")
+    return frozenset(names), poses
+
+
+def engage_locks(mech, engaged: frozenset | None, poses: dict, drop=()):
+    """A copy of the mechanism with exactly the ``engaged`` locks engaged (at their
+    ``poses``; the others released) and the coordinates ``drop`` removed; itself when
+    ``engaged`` is None and nothing is dropped."""
+    if engaged is None and not drop:
+        return mech
+    if engaged is not None:
+        mech = dataclasses.replace(mech, joints={
+            n: dataclasses.replace(j, engaged=False)
+            if isinstance(j, Lock) and n not in engaged and j.engaged else j
+            for n, j in mech.joints.items()})
+    return mode_mechanism(mech, engage=sorted(engaged or ()), offsets=poses, drop=list(drop))
+
+
+def with_lock_poses(mech, poses: dict):
+    """A copy of the mechanism whose locks hold the ``poses`` given with ``--engage`` when
+    engaged (their declared state unchanged: the analysis takes the mode); itself when
+    there are none."""
+    if not poses:
+        return mech
+    locks = [n for n, j in mech.joints.items() if isinstance(j, Lock)]
+    bad = [did_you_mean(n, locks, "lock") for n in poses if n not in locks]
+    if bad:
+        raise ModelError([f"--engage: {b}" for b in bad])
+    return dataclasses.replace(mech, joints={
+        n: dataclasses.replace(j, offset=tuple(map(float, poses[n]))) if n in poses else j
+        for n, j in mech.joints.items()})
+
+
+def add_moment_point(p, *, alias: str | None = None) -> None:
+    """Add ``--moment-point X,Y``: the point the frame moment is taken about; ``alias``
+    a hidden old spelling of it."""
+    p.add_argument("--moment-point", default=None, metavar="X,Y",
+                   help="point the frame moment (shaking moment) is taken about, e.g. 0,0 or "
+                        "'100mm,-50mm' (default 0,0, the ground origin)")
+    if alias:
+        p.add_argument(alias, dest="moment_point", help=argparse.SUPPRESS)
+
+
+def moment_point(args) -> tuple[float, float]:
+    """``--moment-point`` in m (default the ground origin)."""
+    if args.moment_point is None:
+        return (0.0, 0.0)
+    return vector(args.moment_point, ("length", "length"), "--moment-point",
+                  "two lengths X,Y, e.g. 0,0 or 100mm,-50mm")
+
+
 def add_model_arguments(p) -> None:
     """Arguments shared by ``reduce`` and ``flywheel``: the model, its mode and its drive."""
     add_model(p)
-    p.add_argument("--engage", action="append", default=[], metavar="LOCK[=X,Y,THETA]",
-                   help="engage a lock (repeatable), optionally with the pose it holds, "
-                        "e.g. rocker_lock=0mm,0mm,0deg")
+    add_engage(p, "locks engaged in the mode reduced")
     p.add_argument("--drop", action="append", default=[], metavar="COORD",
                    help="remove a coordinate frozen by the engaged locks (repeatable)")
     p.add_argument("--motor", metavar="DESIGNATION",
@@ -174,15 +268,8 @@ def prepare_model(args):
     """(mechanism, model) from the arguments of :func:`add_model_arguments`: load, mode,
     drive; compiled."""
     mech = load_model(args.model)
-    engage, offsets = [], {}
-    for spec in args.engage:
-        name, sep, pose = spec.partition("=")
-        engage.append(name)
-        if sep:
-            offsets[name] = vector(pose, ("length", "length", "angle"), f"--engage {name}",
-                                   f"the pose as X,Y,THETA, e.g. {name}=0mm,0mm,0deg")
-    if engage or args.drop:
-        mech = mode_mechanism(mech, engage=engage, offsets=offsets, drop=args.drop)
+    engaged, poses = engage_from_args(args)
+    mech = engage_locks(mech, engaged, poses, args.drop)
     if args.motor is None and (args.gear_ratio is not None or args.efficiency is not None):
         raise ModelError("--gear-ratio and --efficiency need --motor")
     if args.motor is not None:

@@ -12,6 +12,8 @@ reduction that stops); 2 bad input (one line on stderr).
 
 from __future__ import annotations
 
+import argparse
+
 import numpy as np
 
 from ..dynamics.reduction import reduce_model
@@ -50,7 +52,9 @@ def register(sub) -> None:
     add_model_arguments(p)
     p.add_argument("--link", metavar="BODY",
                    help="link of reduction (default: the generalized coordinate itself)")
-    p.add_argument("--point", metavar="BODY.POINT", help="also give the reduced mass at a point")
+    p.add_argument("--mass-at", metavar="BODY.POINT",
+                   help="also give the reduced mass at this named point, e.g. crank.A")
+    p.add_argument("--point", dest="mass_at", help=argparse.SUPPRESS)
     p.add_argument("--steps", type=int, default=361, metavar="N",
                    help="positions over one turn, ends included (default 361)")
     add_start(p, "first position of the turn")
@@ -64,7 +68,7 @@ def run(args) -> int:
     mech, model = prepare_model(args)
     if args.steps < 2:
         raise ModelError(f"--steps must be at least 2, got {args.steps}")
-    point = _trace_spec(model, args.point, "--point")
+    point = _trace_spec(model, args.mass_at, "--mass-at")
     coordinate = model.coordinate_names[0] if model.n_q == 1 else None
     if coordinate is None:  # reduce_model names the coordinates
         speed, why, start = 1.0, "", 0.0
@@ -92,7 +96,7 @@ def run(args) -> int:
               f"{np.max(red.M_forces[fin]):.6g}, drive {np.min(red.M_drive[fin]):.6g} .. "
               f"{np.max(red.M_drive[fin]):.6g})")
         if red.m_red is not None:
-            print(f"  m_red at {args.point}: min {np.min(red.m_red[fin]):.6g}  max "
+            print(f"  m_red at {args.mass_at}: min {np.min(red.m_red[fin]):.6g}  max "
                   f"{np.max(red.m_red[fin]):.6g} kg")
     write_files(args, red, plot_reduction, title=f"{mech.name}: reduction")
     return finish(args, red.status == "success", red.message)

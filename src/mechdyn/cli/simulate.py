@@ -3,7 +3,7 @@
 Examples::
 
     mechdyn simulate andrews_squeezer --t-end 0.03 --rtol 1e-10 -o andrews.csv
-    mechdyn simulate clutchless_press --t-end "0.05 s" --integrator wilson --steps 40 \\
+    mechdyn simulate clutchless_press --t-end "0.05 s" --integrator wilson --fixed-steps 40 \\
         --drive phi="34.5 N*m" -o press.csv --plot press.png
 
 Exit codes: 0 done; 1 the run stopped early (dead position, assembly failure,
@@ -33,15 +33,20 @@ from ..simulate import simulate
 from ..simulate_events import format_events
 from ..units import parse_quantity
 from .options import (
+    add_engage,
     add_files,
     add_model,
+    add_moment_point,
     add_plot_columns,
     add_points,
     add_run,
     check_plot_columns,
     draw_plot,
+    engage_from_args,
     load_model,
+    moment_point,
     quantity,
+    with_lock_poses,
 )
 
 __all__ = ["register", "run"]
@@ -62,7 +67,9 @@ def register(sub) -> None:
     add_model(p)
     add_run(p, required=True)
     p.add_argument("--t0", default="0", metavar="TIME", help="start time (default 0 s)")
-    p.add_argument("--steps", type=int, metavar="N", help="steps of wilson / rk4")
+    p.add_argument("--fixed-steps", type=int, metavar="N",
+                   help="number of steps of the fixed-step integrators wilson / rk4")
+    p.add_argument("--steps", dest="fixed_steps", type=int, help=argparse.SUPPRESS)
     p.add_argument("--dt", metavar="TIME", help="step size of wilson / rk4")
     p.add_argument("--atol", type=float, help="absolute tolerance (default 1e-3 rtol)")
     p.add_argument("--theta", type=float, help="Wilson theta (1 or >= 1.37)")
@@ -78,6 +85,8 @@ def register(sub) -> None:
                    help="initial value of a coordinate, e.g. phi=-64.1deg (repeatable)")
     p.add_argument("--qdot0", action="append", default=[], metavar="COORD=RATE",
                    help="initial rate of a coordinate, e.g. phi=43.5rad/s (repeatable)")
+    add_engage(p, "locks engaged at the start")
+    add_moment_point(p)
     out = p.add_mutually_exclusive_group()
     out.add_argument("--samples", type=int, metavar="N",
                      help="write N equally spaced samples from the dense output (default "
@@ -116,7 +125,8 @@ def _pairs(items, model, what, kinds):
 def run(args) -> int:
     """Run ``mechdyn simulate``; returns the exit code."""
     check_plot_columns(args)
-    mech = load_model(args.model)
+    engaged, poses = engage_from_args(args)
+    mech = with_lock_poses(load_model(args.model), poses)
     t_end = parse_quantity(args.t_end, "time", where="--t-end")
     t0 = parse_quantity(args.t0, "time", where="--t0")
     dt = parse_quantity(args.dt, "time", where="--dt") if args.dt is not None else None
@@ -136,11 +146,12 @@ def run(args) -> int:
         if args.samples < 2:
             raise ModelError(f"--samples must be >= 2, got {args.samples}")
         t_eval = np.linspace(t0, t_end, args.samples)
-    traj = simulate(model, t_end, t0=t0, integrator=args.integrator, steps=args.steps, dt=dt,
-                    rtol=args.rtol, atol=args.atol, q0=q0, qdot0=qdot0, t_eval=t_eval,
+    traj = simulate(model, t_end, t0=t0, integrator=args.integrator, steps=args.fixed_steps,
+                    dt=dt, rtol=args.rtol, atol=args.atol, q0=q0, qdot0=qdot0, t_eval=t_eval,
                     formulation=args.formulation, d=d, progress=args.progress,
                     backend=args.backend, theta=args.theta,
-                    iterations=args.iterations if fixed else None)
+                    iterations=args.iterations if fixed else None,
+                    mode=engaged, **_moment_point(args))
     print(traj.summary())
     if traj.events:
         print(format_events(traj.events, traj.coordinate_names, limit=40))
@@ -165,6 +176,11 @@ def run(args) -> int:
         print(f"mechdyn simulate: stopped early: {traj.status}: {traj.message}", file=sys.stderr)
         return 130 if traj.status == Status.INTERRUPTED else 1
     return 0
+
+
+def _moment_point(args) -> dict:
+    """``point=`` of :func:`mechdyn.simulate` when ``--moment-point`` is given."""
+    return {} if args.moment_point is None else {"point": moment_point(args)}
 
 
 def _with_points(traj, points):
