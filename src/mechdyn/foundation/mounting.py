@@ -1,0 +1,432 @@
+"""Elastic mounting, coupled: the frame becomes a body on its isolators.
+
+:func:`mounted` turns a machine on a fixed frame into the same machine on a movable
+base: a new body (the frame and base, the :class:`Foundation`'s mass and inertia at its
+centre of mass) takes over every element that was attached to the ground, and the
+isolators hold it to the floor, which is the new ground.  ``mechdyn.simulate`` then runs
+machine and base together, two-way coupled, on the one engine.
+
+How the base is held
+--------------------
+The engine declares coordinates as angles and joint travels, so the base's three
+coordinates come from a chain the base hangs in: the floor, a massless sled sliding
+along x (coordinate ``<base>_x``, the travel of the base's centre of mass from its sketch
+position, m), a massless sled sliding on it along y (``<base>_y``, m) and a pin at the
+base's centre of mass (``<base>_theta``, its absolute angle, rad).  The sleds have no
+mass and every one of their free directions ends on the base, so the chain transmits no
+force: the base is held by the isolators alone (the floor's reactions through the
+chain's joints stay at round-off).
+
+Each isolator is two linear spring-dampers of :class:`~mechdyn.mechanism.load.Spring`
+from the isolator's point on the base to an anchor on the floor ``arm`` (default 100 m)
+away: one along x (kx, cx), one along y (ky, cy), at their free length in the sketch.
+A spring of tension T and length L also resists a sideways displacement with T / L:
+the isolators' x, y stiffness is kx, ky to first order, with an error of about
+|T| / (L k) (the static load of the isolator over arm times stiffness; 1.5e-5 for a
+15 kN share on 1e7 N/m and a 100 m arm), and the damping exact to first order.  The
+anchors lie on the side opposite to gravity, so that the springs carrying the weight
+are in tension (a stabilising, not destabilising, error).
+
+The initial base coordinates are the static equilibrium under the weights of the base
+and of the machine's bodies in their initial (or sketch) pose, solved on the exact spring
+geometry: the base sags by about weight / (sum of ky).  A machine that starts moving
+then sets the base vibrating about it.
+
+What cannot follow the base
+---------------------------
+Quantities that the variable grammar measures in the ground frame (``"angle:BODY"``,
+``"body.point.x"``, a distance to a ground point) in load tables, stops, coordinate locks
+and switches keep being measured against the floor; :func:`mounted` lists them in a
+:class:`FloorFrameWarning` (the shift is the base's motion, often well below a mm).  A
+:class:`~mechdyn.mechanism.drive.Drive` on the absolute angle of a body pinned to the
+ground becomes a drive on the relative angle of that pin (the stator on the base); on the
+absolute angle of any other body it would push against the floor, a
+:class:`~mechdyn.errors.ModelError`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+import warnings
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..errors import ModelError
+from ..mechanism import (
+    GROUND,
+    AssemblyMode,
+    Body,
+    Coordinate,
+    Force,
+    Ground,
+    Mechanism,
+    Prismatic,
+    Revolute,
+    RotarySpring,
+    Spring,
+    Torque,
+)
+from .supports import Foundation
+
+__all__ = ["mounted", "base_coordinates", "isolator_geometry", "FloorFrameWarning",
+           "ARM"]
+
+#: default distance from an isolator's point to its springs' floor anchors, m
+ARM = 100.0
+
+#: the extras kinds that :func:`mounted` knows how to carry over
+_EXTRAS = ("assembly", "stops", "contacts", "coordinate_locks", "switches", "initial")
+_FLOOR_VAR = re.compile(r"(^|[\s(,])(angle:\S+|[^\s(,.]+\.[^\s(,.]+\.[xy])($|[\s),])")
+
+
+class FloorFrameWarning(UserWarning):
+    """Elements of a mounted machine whose variables are measured against the floor."""
+
+
+def base_coordinates(base: str = "base") -> tuple[str, str, str]:
+    """Names of the base's coordinates in a :func:`mounted` machine.
+
+    Examples
+    --------
+    >>> base_coordinates("frame")
+    ('frame_x', 'frame_y', 'frame_theta')
+    """
+    return (f"{base}_x", f"{base}_y", f"{base}_theta")
+
+
+def _foundation(mechanism: Mechanism, foundation: Foundation | None) -> Foundation:
+    f = mechanism.foundation if foundation is None else foundation
+    if f is None:
+        raise ModelError(f"{mechanism.name}: no foundation: give one (Foundation(supports=["
+                         "Isolator(...), ...], mass=..., inertia=..., com=...)) or set the "
+                         "mechanism's foundation ([foundation] in the model file)")
+    if not isinstance(f, Foundation):
+        raise ModelError(f"foundation: expected a Foundation, got {type(f).__name__}")
+    f.mass_matrix()  # mass and inertia are needed
+    bolts = [s.name for s, bolt in zip(f.supports, f.bolts, strict=True) if bolt]
+    if bolts:
+        raise ModelError(f"foundation: the elastic mounting needs isolators; "
+                         f"{', '.join(map(repr, bolts))} are anchor bolts (use Isolator(name, "
+                         "x, y, kx, ky, cx, cy), or the rigid analysis for bolts)")
+    return f
+
+
+def isolator_geometry(foundation: Foundation, gravity=(0.0, -9.81),
+                      arm: float = ARM) -> np.ndarray:
+    """Points of the isolators' springs, shape (n, 2, 2, 2): [isolator, direction (x, y),
+    (point on the base, anchor on the floor), (x, y)] in the sketch, m.
+
+    The x spring's anchor lies ``arm`` to the side opposite to gravity's x component, the
+    y spring's opposite to its y component (+x, +y without one).
+
+    Examples
+    --------
+    >>> from mechdyn.foundation import Isolator
+    >>> f = Foundation([Isolator("L", -0.5, 0.0, 1e5, 1e5), Isolator("R", 0.5, 0.0, 1e5, 1e5)])
+    >>> isolator_geometry(f, arm=10.0)[0].tolist()
+    [[[-0.5, 0.0], [9.5, 0.0]], [[-0.5, 0.0], [-0.5, 10.0]]]
+    """
+    g = np.asarray(gravity, float)
+    side = np.where(g > 0, -1.0, 1.0)
+    out = np.zeros((len(foundation.supports), 2, 2, 2))
+    for i, s in enumerate(foundation.supports):
+        for d in range(2):
+            out[i, d, 0] = out[i, d, 1] = (s.x, s.y)
+            out[i, d, 1, d] += side[d] * arm
+    return out
+
+
+def _replace_ground(name: str, base: str) -> str:
+    return base if name == GROUND else name
+
+
+def _check_floor_vars(mech: Mechanism, base: str) -> list[str]:
+    """Names of elements whose variables measure against the floor."""
+    found = []
+
+    def look(where, spec):
+        if isinstance(spec, str) and (_FLOOR_VAR.search(spec) or f"{GROUND}." in spec):
+            found.append(f"{where} ({spec!r})")
+
+    for ld in mech.loads:
+        mag = getattr(ld, "magnitude", None)
+        look(f"{type(ld).__name__.lower()} {ld.name!r}", getattr(mag, "variable", None))
+    for kind in ("stops", "coordinate_locks", "switches"):
+        for el in mech.extras.get(kind, []):
+            look(f"{kind[:-1].replace('_', ' ')} {el.name!r}", el.variable)
+            for var, _op, _val in getattr(el, "guard", ()):
+                look(f"{kind[:-1].replace('_', ' ')} {el.name!r} guard", var)
+    return found
+
+
+def _coordinates(mech: Mechanism, joints: dict, base: str) -> dict:
+    """The machine's coordinates; absolute angles of bodies pinned to the base that a drive
+    acts on become relative angles of their pin."""
+    driven = {d.coordinate: d.name for d in mech.drives}
+    out = {}
+    for c in mech.coordinates.values():
+        if c.kind == "angle" and c.name in driven:
+            pins = [j for j in joints.values() if isinstance(j, Revolute)
+                    and {j.parent, j.child} == {base, c.body}]
+            if not pins:
+                raise ModelError(
+                    f"drive {driven[c.name]!r}: it drives the absolute angle {c.name!r} of "
+                    f"body {c.body!r}, which is not pinned to the ground, so on a mounted base "
+                    f"its stator would push against the floor; declare {c.name!r} as the "
+                    f"relative angle of a revolute joint (kind = 'relative_angle')")
+            pin = pins[0]
+            if pin.parent != base:  # base as the parent: the angle keeps its sign
+                joints[pin.name] = Revolute(pin.name, base, c.body, pin.child_point,
+                                            pin.parent_point)
+            c = Coordinate(c.name, "relative_angle", joint=pin.name, offset=c.offset)
+        out[c.name] = c
+    return out
+
+
+def _load(ld, base: str):
+    if isinstance(ld, Spring):
+        return dataclasses.replace(ld, body1=_replace_ground(ld.body1, base),
+                                   body2=_replace_ground(ld.body2, base))
+    if isinstance(ld, Torque):
+        return dataclasses.replace(ld, body=_replace_ground(ld.body, base),
+                                   reaction_body=None if ld.reaction_body is None
+                                   else _replace_ground(ld.reaction_body, base))
+    if isinstance(ld, Force | RotarySpring):  # on a moving body / in a joint: unchanged
+        return ld
+    raise ModelError(f"load {getattr(ld, 'name', ld)!r}: a {type(ld).__name__} cannot be "
+                     "carried onto a mounted base; known loads: Spring, RotarySpring, Force, "
+                     "Torque")
+
+
+def _extras(mech: Mechanism, base: str) -> dict:
+    unknown = [k for k in mech.extras if k not in _EXTRAS]
+    if unknown:
+        raise ModelError(f"mounted: elements of kind {', '.join(map(repr, unknown))} cannot be "
+                         f"carried onto a mounted base; known kinds: {', '.join(_EXTRAS)}")
+    out: dict = {}
+    for kind, items in mech.extras.items():
+        if kind == "initial":
+            out[kind] = {k: dict(v or {}) for k, v in (items or {}).items()}
+        elif kind == "assembly":
+            out[kind] = [AssemblyMode(a.name, tuple((_replace_ground(b, base), p)
+                                                    for b, p in a.points), a.turn)
+                         for a in items]
+        elif kind == "contacts":
+            out[kind] = [dataclasses.replace(c, body=_replace_ground(c.body, base),
+                                             line_body=_replace_ground(c.line_body, base))
+                         for c in items]
+        else:
+            out[kind] = list(items)
+    return out
+
+
+def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: str = "base",
+            arm: float = ARM, equilibrium: bool = True, load=None) -> Mechanism:
+    """The machine on its frame mounted on isolators: one mechanism, the floor its ground.
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+        The machine on a fixed frame (not changed).
+    foundation : Foundation, optional
+        Isolators, mass, inertia and centre of mass of the frame and base (default the
+        mechanism's own ``foundation``).
+    base : str
+        Name of the new body (its coordinates: :func:`base_coordinates`).
+    arm : float
+        Distance of the isolator springs' floor anchors, m (the relative stiffness error
+        is about the static isolator load / (arm k)).
+    equilibrium : bool
+        Start the base at its static equilibrium under the weights (default); False
+        starts it at the sketch position, the isolators unloaded.
+    load : (float, float, float), optional
+        The machine's load on its frame at the start, (Fx, Fy) N and the moment about the
+        base's centre of mass, N m (e.g. the first frame load of a rigid run, inertia
+        included), to start the base in its static deflection under it instead of under
+        the machine's weights.
+
+    Returns
+    -------
+    Mechanism
+        A new mechanism: ``base`` with the ground's points, every element once attached
+        to the ground on it, two more massless bodies (``<base>_sled_x``,
+        ``<base>_sled_y``), the isolator springs ``<base>_<isolator>_x`` / ``_y`` and
+        the coordinates ``<base>_x``, ``<base>_y``, ``<base>_theta``.
+
+    Raises
+    ------
+    ModelError
+        No foundation, no mass or inertia, anchor bolts, a name already used, a drive
+        whose stator would push against the floor, an element that cannot be carried
+        onto the base (named).
+
+    Warns
+    -----
+    FloorFrameWarning
+        Tables, stops, locks and switches that measure in the floor's frame.
+
+    Examples
+    --------
+    >>> from mechdyn.foundation import Foundation, Isolator
+    >>> m = Mechanism("pendulum")
+    >>> _ = m.add_body("bar", mass=2.0, inertia=0.05, com=(0.5, 0.0))
+    >>> _ = m.add_revolute("O", "ground", "bar")
+    >>> _ = m.add_coordinate("theta", kind="angle", body="bar")
+    >>> f = Foundation([Isolator("L", -0.5, 0.0, 1e5, 1e5), Isolator("R", 0.5, 0.0, 1e5, 1e5)],
+    ...                mass=100.0, inertia=10.0)
+    >>> mm = mounted(m, f)
+    >>> mm.dof, list(mm.coordinates)
+    (4, ['theta', 'base_x', 'base_y', 'base_theta'])
+    >>> round(mm.extras["initial"]["q"]["base_y"] * 1e3, 6)  # 102 kg * 9.81 / 2e5 N/m, in mm
+    -5.0031
+    """
+    f = _foundation(mechanism, foundation)
+    if not (np.isfinite(arm) and arm > 0):
+        raise ModelError(f"mounted: arm must be a finite length > 0 m, got {arm!r}")
+    sx, sy = f"{base}_sled_x", f"{base}_sled_y"
+    names = [base, sx, sy, f"{base}_x_guide", f"{base}_y_guide", f"{base}_pin",
+             *base_coordinates(base)]
+    taken = [n for n in names if n in mechanism.bodies or n in mechanism.joints
+             or n in mechanism.coordinates]
+    if taken:
+        raise ModelError(f"mounted: the name(s) {', '.join(map(repr, taken))} are taken by the "
+                         f"mechanism; pass another base=... (now {base!r})")
+    floor_vars = _check_floor_vars(mechanism, base)
+    if floor_vars:
+        warnings.warn("on the mounted base these still measure against the floor: "
+                      + "; ".join(floor_vars), FloorFrameWarning, stacklevel=2)
+    com = f.com
+    out = Mechanism(name=mechanism.name, gravity=tuple(mechanism.gravity),
+                    description=mechanism.description, ground=Ground())
+    out.add(Body(base, mass=float(f.mass), inertia=float(f.inertia), com=com,
+                 points=dict(mechanism.ground.points)))
+    for b in mechanism.bodies.values():
+        out.add(b)
+    joints = {}
+    for j in mechanism.joints.values():
+        joints[j.name] = dataclasses.replace(j, parent=_replace_ground(j.parent, base),
+                                             child=_replace_ground(j.child, base))
+    coords = _coordinates(mechanism, joints, base)
+    for j in joints.values():
+        out.add(j)
+    for c in coords.values():
+        out.add(c)
+    for ld in mechanism.loads:
+        out.add(_load(ld, base))
+    for d in mechanism.drives:
+        out.add(d)
+    out.extras = _extras(mechanism, base)
+    # the chain that gives the base its coordinates (it transmits no force)
+    out.add(Body(sx, pose=(com[0], com[1], 0.0)))
+    out.add(Body(sy, pose=(com[0], com[1], 0.0)))
+    out.add(Prismatic(f"{base}_x_guide", GROUND, sx, com, (1.0, 0.0), (0.0, 0.0), 0.0))
+    out.add(Prismatic(f"{base}_y_guide", sx, sy, (0.0, 0.0), (0.0, 1.0), (0.0, 0.0), 0.0))
+    out.add(Revolute(f"{base}_pin", sy, base, (0.0, 0.0), com))
+    cx, cy, cth = base_coordinates(base)
+    out.add(Coordinate(cx, "travel", joint=f"{base}_x_guide"))
+    out.add(Coordinate(cy, "travel", joint=f"{base}_y_guide"))
+    out.add(Coordinate(cth, "angle", body=base))
+    geo = isolator_geometry(f, mechanism.gravity, arm)
+    for s, g, k, c in zip(f.supports, geo, f.stiffnesses(), f.dampings(), strict=True):
+        for d, axis in enumerate("xy"):
+            out.add(Spring(f"{base}_{s.name}_{axis}", GROUND, tuple(g[d, 1]), base,
+                           tuple(g[d, 0]), stiffness=float(k[d]), free_length=float(arm),
+                           damping=float(c[d])))
+    out.foundation = f
+    if equilibrium:
+        u0 = static_equilibrium(mechanism, f, arm, load)
+        init = out.extras.setdefault("initial", {})
+        q = init.setdefault("q", {})
+        q.update({cx: float(u0[0]), cy: float(u0[1]), cth: float(u0[2])})
+    return out
+
+
+def _spring_forces(f: Foundation, geo, u, v=None) -> np.ndarray:
+    """Forces of the isolator springs on the floor anchors, shape (..., n, 2 springs, 2),
+    for the base displacement ``u`` (..., 3) of its centre of mass (and its rate ``v``)."""
+    u = np.asarray(u, float)
+    com = np.asarray(f.com, float)
+    c, s = np.cos(u[..., 2]), np.sin(u[..., 2])
+    r = geo[:, :, 0, :] - com  # (n, 2, 2) arm from the centre of mass
+    shape = u.shape[:-1] + (1, 1)
+    rx = c.reshape(shape) * r[..., 0] - s.reshape(shape) * r[..., 1]
+    ry = s.reshape(shape) * r[..., 0] + c.reshape(shape) * r[..., 1]
+    p = np.stack([rx, ry], axis=-1) + com + u[..., None, None, :2]
+    d = p - geo[:, :, 1, :]
+    L = np.linalg.norm(d, axis=-1)
+    e = d / L[..., None]
+    k, damp = f.stiffnesses(), f.dampings()
+    T = k * (L - geo_arm(geo))
+    if v is not None:
+        v = np.asarray(v, float)
+        w = v[..., 2].reshape(shape)
+        vp = v[..., None, None, :2] + np.stack([-w * ry, w * rx], axis=-1)
+        T = T + damp * np.sum(e * vp, axis=-1)
+    return T[..., None] * e  # a tension pulls the anchor towards the base
+
+
+def geo_arm(geo) -> np.ndarray:
+    """The springs' free lengths (their sketch lengths), shape (n, 2)."""
+    return np.linalg.norm(geo[:, :, 0, :] - geo[:, :, 1, :], axis=-1)
+
+
+def static_equilibrium(mechanism: Mechanism, foundation: Foundation, arm: float = ARM,
+                       weights: Sequence | None = None) -> np.ndarray:
+    """Displacement (x, y, theta) of the base's centre of mass (m, m, rad) at rest on its
+    isolators under the weights of the base and of the machine's bodies (in their sketch
+    pose), on the exact spring geometry of :func:`mounted`.
+
+    ``weights`` (Fx, Fy, M about the base's centre of mass), N, N, N m, replaces the
+    machine's part of the load.
+
+    Examples
+    --------
+    >>> from mechdyn.foundation import Foundation, Isolator
+    >>> f = Foundation([Isolator("L", -0.5, 0.0, 1e5, 2e5), Isolator("R", 0.5, 0.0, 1e5, 2e5)],
+    ...                mass=400.0, inertia=10.0)
+    >>> u = static_equilibrium(Mechanism(), f)
+    >>> round(float(u[1] / (-400.0 * 9.81 / 4e5)), 9)
+    1.0
+    """
+    g = np.asarray(mechanism.gravity, float)
+    com = np.asarray(foundation.com, float)
+    load = np.zeros(3)
+    load[:2] = foundation.mass * g
+    if weights is not None:
+        load += np.asarray(weights, float)
+    else:
+        for b in mechanism.bodies.values():
+            th = b.pose[2]
+            pc = np.asarray(b.pose[:2]) + [np.cos(th) * b.com[0] - np.sin(th) * b.com[1],
+                                           np.sin(th) * b.com[0] + np.cos(th) * b.com[1]]
+            w = b.mass * g
+            load[:2] += w
+            load[2] += (pc[0] - com[0]) * w[1] - (pc[1] - com[1]) * w[0]
+    geo = isolator_geometry(foundation, mechanism.gravity, arm)
+
+    def residual(u):
+        F = _spring_forces(foundation, geo, u)  # on the anchors = what the base pushes
+        tot = F.sum(axis=(0, 1))
+        r = geo[:, :, 0, :] - com
+        c, s = np.cos(u[2]), np.sin(u[2])
+        arms = np.stack([c * r[..., 0] - s * r[..., 1], s * r[..., 0] + c * r[..., 1]], -1)
+        m = np.sum(arms[..., 0] * F[..., 1] - arms[..., 1] * F[..., 0])
+        return np.array([tot[0], tot[1], m]) - load  # the base pushes what it carries
+
+    K = foundation.stiffness_matrix(foundation.com)
+    u = np.linalg.solve(K, load)
+    for _ in range(20):
+        r = residual(u)
+        J = np.empty((3, 3))
+        for i in range(3):
+            h = 1e-7 * max(1.0, abs(u[i]))
+            du = np.zeros(3)
+            du[i] = h
+            J[:, i] = (residual(u + du) - residual(u - du)) / (2 * h)
+        step = np.linalg.solve(J, -r)
+        u = u + step
+        if np.all(np.abs(step) <= 1e-15 * (1.0 + np.abs(u))):
+            break
+    return u
