@@ -4,7 +4,7 @@ transmissibility, the response to a frame-load history), and the machine on its 
 coupled in one simulation (:func:`mounted`, :func:`compare_mounting`).
 See ``docs/foundation.md``."""
 
-from .coupled import FloorForces, MountingComparison, compare_mounting, floor_forces
+from .coupled import MountingComparison, compare_mounting, floor_forces
 from .frame_loads import FrameLoads, frame_loads
 from .isolation import transmissibility
 from .modes import ExcitationWarning, Modes, excitation_warnings, natural_frequencies
@@ -18,4 +18,4 @@ __all__ = ["AnchorBolt", "Isolator", "Foundation", "support_matrix", "shift_mome
            "frame_loads", "Modes", "natural_frequencies", "transmissibility",
            "MountedResponse", "mounted_response", "ExcitationWarning", "excitation_warnings",
            "mounted", "base_coordinates", "static_equilibrium", "FloorFrameWarning",
-           "FloorForces", "floor_forces", "MountingComparison", "compare_mounting"]
+           "floor_forces", "MountingComparison", "compare_mounting"]

@@ -19,41 +19,24 @@ import numpy as np
 from ..errors import ModelError
 from ..mechanism import Mechanism
 from .frame_loads import frame_loads
-from .mounting import ARM, _foundation, _spring_forces, base_coordinates, isolator_geometry, mounted
+from .mounting import (
+    ARM,
+    _foundation,
+    _spring_forces,
+    base_coordinates,
+    isolator_geometry,
+    mounted,
+    to_centre_of_mass,
+)
 from .response import MountedResponse, mounted_response
 from .supports import Foundation, shift_moment
 
-__all__ = ["FloorForces", "floor_forces", "MountingComparison", "compare_mounting"]
-
-
-@dataclass(frozen=True)
-class FloorForces:
-    """The force the isolators of a mounted run pass to the floor.
-
-    Attributes
-    ----------
-    t : ndarray, shape (n,)
-        Time, s.
-    u, v : ndarray, shape (n, 3)
-        Displacement and velocity of the base's centre of mass from its sketch position:
-        x, y (m, m/s), theta (rad, rad/s).
-    floor : ndarray, shape (n, 3)
-        Fx, Fy (N) and the moment about ``point`` (N m) on the floor, all isolators.
-    supports : dict str -> ndarray, shape (n, 2)
-        Force of each isolator on the floor, x and y, N.
-    point : ndarray, shape (2,)
-    """
-
-    t: np.ndarray
-    u: np.ndarray
-    v: np.ndarray
-    floor: np.ndarray
-    supports: dict
-    point: np.ndarray
+__all__ = ["floor_forces", "MountingComparison", "compare_mounting"]
 
 
 def floor_forces(trajectory, foundation: Foundation, base: str = "base",
-                 gravity=(0.0, -9.81), arm: float = ARM, point=(0.0, 0.0)) -> FloorForces:
+                 gravity=(0.0, -9.81), arm: float = ARM, point=(0.0, 0.0),
+                 pivot=(0.0, 0.0)) -> MountedResponse:
     """The isolators' forces on the floor over a run of a :func:`mounted` machine, from the
     base's coordinates and the isolator springs' exact geometry.
 
@@ -69,10 +52,15 @@ def floor_forces(trajectory, foundation: Foundation, base: str = "base",
         As given to :func:`mounted`, m.
     point : (float, float)
         Point of the moment, m.
+    pivot : (float, float)
+        As given to :func:`mounted`, m.
 
     Returns
     -------
-    FloorForces
+    MountedResponse
+        The base's displacement ``u`` and velocity ``v`` from its sketch position (where
+        the isolators are unloaded), the isolators' forces on the floor, ``floor`` and
+        per isolator ``supports``.
 
     Raises
     ------
@@ -88,12 +76,13 @@ def floor_forces(trajectory, foundation: Foundation, base: str = "base",
     idx = [names.index(c) for c in base_coordinates(base)]
     u, v = trajectory.q[:, idx], trajectory.qdot[:, idx]
     geo = isolator_geometry(foundation, gravity, arm)
-    F = _spring_forces(foundation, geo, u, v)  # (n, iso, spring, 2) on the anchors
+    F = _spring_forces(foundation, geo, u, v, pivot)  # (n, iso, spring, 2) on the anchors
     per = F.sum(axis=2)
     anchors = geo[:, :, 1, :] - np.asarray(point, float)  # lines of action through them
     m = np.sum(anchors[..., 0] * F[..., 1] - anchors[..., 1] * F[..., 0], axis=(1, 2))
     floor = np.column_stack([per.sum(axis=1), m])
-    return FloorForces(t=np.asarray(trajectory.t, float), u=u, v=v, floor=floor,
+    u, v = to_centre_of_mass(foundation, u, v, pivot)
+    return MountedResponse(t=np.asarray(trajectory.t, float), u=u, v=v, floor=floor,
                        supports={n: per[:, i] for i, n in enumerate(foundation.names)},
                        point=np.asarray(point, float))
 
@@ -121,8 +110,8 @@ class MountingComparison:
         base's weight (Fx, Fy N, M about ``point`` N m).
     one_way : MountedResponse
         The base on its isolators under ``rigid`` (no feedback into the machine).
-    coupled : FloorForces
-        The coupled run's isolator forces and base motion.
+    coupled : MountedResponse
+        The coupled run's isolator forces and base motion (:func:`floor_forces`).
     rigid_run, coupled_run : Trajectory
         The two runs.
     point : ndarray, shape (2,)
@@ -131,7 +120,7 @@ class MountingComparison:
     t: np.ndarray
     rigid: np.ndarray
     one_way: MountedResponse
-    coupled: FloorForces
+    coupled: MountedResponse
     rigid_run: object
     coupled_run: object
     point: np.ndarray
@@ -193,7 +182,7 @@ def _on(t, ts, values):
 
 def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
                      t_end: float = 1.0, *, samples: int = 2001, base: str = "base",
-                     arm: float = ARM, **simulate_kw) -> MountingComparison:
+                     arm: float = ARM, pivot=(0.0, 0.0), **simulate_kw) -> MountingComparison:
     """Run the machine on a rigid frame and coupled on its isolators, and compare.
 
     Parameters
@@ -206,7 +195,7 @@ def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
         End of both runs, s.
     samples : int
         Points of the common time grid (both runs are sampled on it).
-    base, arm
+    base, arm, pivot
         As for :func:`~mechdyn.foundation.mounting.mounted`.
     **simulate_kw
         Passed to both :func:`mechdyn.simulate` runs (``q0`` and ``qdot0`` as mappings by
@@ -249,17 +238,17 @@ def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
     point = np.zeros(2)
     loads = frame_loads(rigid_run, point)
     start = shift_moment([loads.Fx[0], loads.Fy[0], loads.M[0]], point, f.com)
-    mm = mounted(mechanism, f, base=base, arm=arm, load=start)
+    mm = mounted(mechanism, f, base=base, arm=arm, load=start, pivot=pivot)
     coupled_run = simulate(mm, t_end, **simulate_kw)
     g = np.asarray(mechanism.gravity, float)
     wb = f.mass * g
     weight = np.array([wb[0], wb[1], f.com[0] * wb[1] - f.com[1] * wb[0]])
     rigid = _on(t, loads.t, np.column_stack([loads.Fx, loads.Fy, loads.M])) + weight
     one_way = mounted_response(f, t, rigid[:, 0], rigid[:, 1], rigid[:, 2], point=point)
-    ff = floor_forces(coupled_run, f, base, mechanism.gravity, arm, point)
+    ff = floor_forces(coupled_run, f, base, mechanism.gravity, arm, point, pivot)
     good = np.isfinite(ff.t)
     ts = ff.t[good]
-    coupled = FloorForces(t=t, u=_on(t, ts, ff.u[good]), v=_on(t, ts, ff.v[good]),
+    coupled = MountedResponse(t=t, u=_on(t, ts, ff.u[good]), v=_on(t, ts, ff.v[good]),
                           floor=_on(t, ts, ff.floor[good]),
                           supports={k: _on(t, ts, v[good]) for k, v in ff.supports.items()},
                           point=point)

@@ -10,9 +10,10 @@ How the base is held
 --------------------
 The engine declares coordinates as angles and joint travels, so the base's three
 coordinates come from a chain the base hangs in: the floor, a massless sled sliding
-along x (coordinate ``<base>_x``, the travel of the base's centre of mass from its sketch
-position, m), a massless sled sliding on it along y (``<base>_y``, m) and a pin at the
-base's centre of mass (``<base>_theta``, its absolute angle, rad).  The sleds have no
+along x (coordinate ``<base>_x``, the travel of the base's *pivot* from its sketch
+position, m; the pivot is a point of the base among the machine's joints, by default the
+origin), a massless sled sliding on it along y (``<base>_y``, m) and a pin at the pivot
+(``<base>_theta``, the base's absolute angle, rad).  The sleds have no
 mass and every one of their free directions ends on the base, so the chain transmits no
 force: the base is held by the isolators alone (the floor's reactions through the
 chain's joints stay at round-off).
@@ -41,7 +42,13 @@ and switches keep being measured against the floor; :func:`mounted` lists them i
 :class:`~mechdyn.mechanism.drive.Drive` on the absolute angle of a body pinned to the
 ground becomes a drive on the relative angle of that pin (the stator on the base); on the
 absolute angle of any other body it would push against the floor, a
-:class:`~mechdyn.errors.ModelError`.
+:class:`~mechdyn.errors.ModelError`.  Every absolute angle coordinate of a body pinned to
+the ground, or to a body that only slides on it (a rocker on a ram), becomes such a
+relative angle, equal to the absolute one while the base does not turn: the machine's
+coordinates then leave the base's motion to the base's own three (an absolute angle that
+also turned with the base could be chosen as independent in its place, and stall where it
+turns back).  A joint so used gets the body as its child: its reaction is then reported
+with the opposite sign.
 """
 
 from __future__ import annotations
@@ -161,26 +168,56 @@ def _check_floor_vars(mech: Mechanism, base: str) -> list[str]:
     return found
 
 
+def _turning_with_base(mech: Mechanism, joints: dict, base: str) -> dict:
+    """Bodies whose angle is held to the base's by prismatic joints (and the base):
+    name -> their angle relative to the base, rad."""
+    held = {base: 0.0}
+    grew = True
+    while grew:
+        grew = False
+        for j in joints.values():
+            if not isinstance(j, Prismatic) or (j.parent in held) == (j.child in held):
+                continue
+            sketch = (mech.body(j.child).pose[2] if j.child != base else 0.0) - (
+                mech.body(j.parent).pose[2] if j.parent != base else 0.0)
+            rel = sketch if j.angle is None else float(j.angle)  # child - parent
+            if j.parent in held:
+                held[j.child] = held[j.parent] + rel
+            else:
+                held[j.parent] = held[j.child] - rel
+            grew = True
+    return held
+
+
 def _coordinates(mech: Mechanism, joints: dict, base: str) -> dict:
-    """The machine's coordinates; absolute angles of bodies pinned to the base that a drive
-    acts on become relative angles of their pin."""
+    """The machine's coordinates, measured against the base where they can be: the
+    absolute angle of a body pinned to the base, or to a body that only slides on it,
+    becomes the relative angle of that pin (plus the slider's angle to the base), so that
+    the machine's coordinates say nothing about the base's motion (and a drive on one
+    has its stator on the base)."""
     driven = {d.coordinate: d.name for d in mech.drives}
+    held = _turning_with_base(mech, joints, base)
     out = {}
     for c in mech.coordinates.values():
-        if c.kind == "angle" and c.name in driven:
+        if c.kind == "angle" and c.body not in held:
             pins = [j for j in joints.values() if isinstance(j, Revolute)
-                    and {j.parent, j.child} == {base, c.body}]
-            if not pins:
+                    and c.body in (j.parent, j.child) and ({j.parent, j.child} - {c.body})
+                    <= set(held)]
+            if pins:
+                pin = pins[0]
+                other = pin.parent if pin.child == c.body else pin.child
+                if pin.child != c.body:  # the body as the child: the angle keeps its sign
+                    joints[pin.name] = Revolute(pin.name, other, c.body, pin.child_point,
+                                                pin.parent_point)
+                c = Coordinate(c.name, "relative_angle", joint=pin.name,
+                               offset=c.offset + held[other])
+            elif c.name in driven:
                 raise ModelError(
                     f"drive {driven[c.name]!r}: it drives the absolute angle {c.name!r} of "
-                    f"body {c.body!r}, which is not pinned to the ground, so on a mounted base "
-                    f"its stator would push against the floor; declare {c.name!r} as the "
-                    f"relative angle of a revolute joint (kind = 'relative_angle')")
-            pin = pins[0]
-            if pin.parent != base:  # base as the parent: the angle keeps its sign
-                joints[pin.name] = Revolute(pin.name, base, c.body, pin.child_point,
-                                            pin.parent_point)
-            c = Coordinate(c.name, "relative_angle", joint=pin.name, offset=c.offset)
+                    f"body {c.body!r}, which is pinned neither to the ground nor to a body "
+                    f"sliding on it, so on a mounted base its stator would push against the "
+                    f"floor; declare {c.name!r} as the relative angle of a revolute joint "
+                    f"(kind = 'relative_angle')")
         out[c.name] = c
     return out
 
@@ -223,7 +260,8 @@ def _extras(mech: Mechanism, base: str) -> dict:
 
 
 def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: str = "base",
-            arm: float = ARM, equilibrium: bool = True, load=None) -> Mechanism:
+            arm: float = ARM, equilibrium: bool = True, load=None,
+            pivot=(0.0, 0.0)) -> Mechanism:
     """The machine on its frame mounted on isolators: one mechanism, the floor its ground.
 
     Parameters
@@ -246,6 +284,12 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
         base's centre of mass, N m (e.g. the first frame load of a rigid run, inertia
         included), to start the base in its static deflection under it instead of under
         the machine's weights.
+    pivot : (float, float)
+        The point of the base (ground frame in the sketch, m) whose displacement the
+        coordinates ``<base>_x``, ``<base>_y`` measure and about which ``<base>_theta``
+        turns.  Keep it among the machine's joints on the frame (default the origin): the
+        engine measures the conditioning of the positions on lever arms from it, and far
+        from the joints a vibrating base would read as a dead position.
 
     Returns
     -------
@@ -298,6 +342,7 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
         warnings.warn("on the mounted base these still measure against the floor: "
                       + "; ".join(floor_vars), FloorFrameWarning, stacklevel=2)
     com = f.com
+    pv = tuple(float(v) for v in pivot)
     out = Mechanism(name=mechanism.name, gravity=tuple(mechanism.gravity),
                     description=mechanism.description, ground=Ground())
     out.add(Body(base, mass=float(f.mass), inertia=float(f.inertia), com=com,
@@ -319,11 +364,11 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
         out.add(d)
     out.extras = _extras(mechanism, base)
     # the chain that gives the base its coordinates (it transmits no force)
-    out.add(Body(sx, pose=(com[0], com[1], 0.0)))
-    out.add(Body(sy, pose=(com[0], com[1], 0.0)))
-    out.add(Prismatic(f"{base}_x_guide", GROUND, sx, com, (1.0, 0.0), (0.0, 0.0), 0.0))
+    out.add(Body(sx, pose=(pv[0], pv[1], 0.0)))
+    out.add(Body(sy, pose=(pv[0], pv[1], 0.0)))
+    out.add(Prismatic(f"{base}_x_guide", GROUND, sx, pv, (1.0, 0.0), (0.0, 0.0), 0.0))
     out.add(Prismatic(f"{base}_y_guide", sx, sy, (0.0, 0.0), (0.0, 1.0), (0.0, 0.0), 0.0))
-    out.add(Revolute(f"{base}_pin", sy, base, (0.0, 0.0), com))
+    out.add(Revolute(f"{base}_pin", sy, base, (0.0, 0.0), pv))
     cx, cy, cth = base_coordinates(base)
     out.add(Coordinate(cx, "travel", joint=f"{base}_x_guide"))
     out.add(Coordinate(cy, "travel", joint=f"{base}_y_guide"))
@@ -336,25 +381,27 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
                            damping=float(c[d])))
     out.foundation = f
     if equilibrium:
-        u0 = static_equilibrium(mechanism, f, arm, load)
+        u0 = static_equilibrium(mechanism, f, arm, load, pv)
         init = out.extras.setdefault("initial", {})
         q = init.setdefault("q", {})
         q.update({cx: float(u0[0]), cy: float(u0[1]), cth: float(u0[2])})
     return out
 
 
-def _spring_forces(f: Foundation, geo, u, v=None) -> np.ndarray:
+def _turn(theta, r):
+    """``r`` (..., 2) turned by ``theta`` (broadcast against r's leading axes)."""
+    c, s = np.cos(theta), np.sin(theta)
+    return np.stack([c * r[..., 0] - s * r[..., 1], s * r[..., 0] + c * r[..., 1]], axis=-1)
+
+
+def _spring_forces(f: Foundation, geo, u, v=None, pivot=(0.0, 0.0)) -> np.ndarray:
     """Forces of the isolator springs on the floor anchors, shape (..., n, 2 springs, 2),
-    for the base displacement ``u`` (..., 3) of its centre of mass (and its rate ``v``)."""
+    for the base displacement ``u`` (..., 3) of its ``pivot`` (and its rate ``v``)."""
     u = np.asarray(u, float)
-    com = np.asarray(f.com, float)
-    c, s = np.cos(u[..., 2]), np.sin(u[..., 2])
-    r = geo[:, :, 0, :] - com  # (n, 2, 2) arm from the centre of mass
+    pivot = np.asarray(pivot, float)
     shape = u.shape[:-1] + (1, 1)
-    rx = c.reshape(shape) * r[..., 0] - s.reshape(shape) * r[..., 1]
-    ry = s.reshape(shape) * r[..., 0] + c.reshape(shape) * r[..., 1]
-    p = np.stack([rx, ry], axis=-1) + com + u[..., None, None, :2]
-    d = p - geo[:, :, 1, :]
+    rr = _turn(u[..., 2].reshape(shape), geo[:, :, 0, :] - pivot)  # (..., n, 2, 2)
+    d = rr + pivot + u[..., None, None, :2] - geo[:, :, 1, :]
     L = np.linalg.norm(d, axis=-1)
     e = d / L[..., None]
     k, damp = f.stiffnesses(), f.dampings()
@@ -362,7 +409,7 @@ def _spring_forces(f: Foundation, geo, u, v=None) -> np.ndarray:
     if v is not None:
         v = np.asarray(v, float)
         w = v[..., 2].reshape(shape)
-        vp = v[..., None, None, :2] + np.stack([-w * ry, w * rx], axis=-1)
+        vp = v[..., None, None, :2] + np.stack([-w * rr[..., 1], w * rr[..., 0]], axis=-1)
         T = T + damp * np.sum(e * vp, axis=-1)
     return T[..., None] * e  # a tension pulls the anchor towards the base
 
@@ -372,11 +419,28 @@ def geo_arm(geo) -> np.ndarray:
     return np.linalg.norm(geo[:, :, 0, :] - geo[:, :, 1, :], axis=-1)
 
 
+def to_centre_of_mass(foundation: Foundation, u, v=None, pivot=(0.0, 0.0)):
+    """Displacement (and rate) of the base's centre of mass, shape (..., 3), from those of
+    its ``pivot`` (the base coordinates of :func:`mounted`)."""
+    u = np.asarray(u, float)
+    r = np.asarray(foundation.com, float) - np.asarray(pivot, float)
+    rr = _turn(u[..., 2], r)
+    uc = np.array(u)
+    uc[..., :2] += rr - r
+    if v is None:
+        return uc
+    v = np.asarray(v, float)
+    vc = np.array(v)
+    vc[..., 0] -= v[..., 2] * rr[..., 1]
+    vc[..., 1] += v[..., 2] * rr[..., 0]
+    return uc, vc
+
+
 def static_equilibrium(mechanism: Mechanism, foundation: Foundation, arm: float = ARM,
-                       weights: Sequence | None = None) -> np.ndarray:
-    """Displacement (x, y, theta) of the base's centre of mass (m, m, rad) at rest on its
+                       weights: Sequence | None = None, pivot=(0.0, 0.0)) -> np.ndarray:
+    """Displacement (x, y, theta) of the base's ``pivot`` (m, m, rad) at rest on its
     isolators under the weights of the base and of the machine's bodies (in their sketch
-    pose), on the exact spring geometry of :func:`mounted`.
+    pose, turning with the base), on the exact spring geometry of :func:`mounted`.
 
     ``weights`` (Fx, Fy, M about the base's centre of mass), N, N, N m, replaces the
     machine's part of the load.
@@ -391,32 +455,33 @@ def static_equilibrium(mechanism: Mechanism, foundation: Foundation, arm: float 
     1.0
     """
     g = np.asarray(mechanism.gravity, float)
+    pivot = np.asarray(pivot, float)
     com = np.asarray(foundation.com, float)
-    load = np.zeros(3)
-    load[:2] = foundation.mass * g
+    points, forces = [com], [foundation.mass * g]  # loads at points that turn with the base
     if weights is not None:
-        load += np.asarray(weights, float)
+        w = np.asarray(weights, float)
+        points.append(com)
+        forces.append(w[:2])
+        moment = float(w[2])
     else:
+        moment = 0.0
         for b in mechanism.bodies.values():
-            th = b.pose[2]
-            pc = np.asarray(b.pose[:2]) + [np.cos(th) * b.com[0] - np.sin(th) * b.com[1],
-                                           np.sin(th) * b.com[0] + np.cos(th) * b.com[1]]
-            w = b.mass * g
-            load[:2] += w
-            load[2] += (pc[0] - com[0]) * w[1] - (pc[1] - com[1]) * w[0]
+            points.append(np.asarray(b.pose[:2]) + _turn(b.pose[2], np.asarray(b.com)))
+            forces.append(b.mass * g)
+    r0, F0 = np.array(points) - pivot, np.array(forces)
     geo = isolator_geometry(foundation, mechanism.gravity, arm)
+    r_iso = geo[:, :, 0, :] - pivot
 
     def residual(u):
-        F = _spring_forces(foundation, geo, u)  # on the anchors = what the base pushes
-        tot = F.sum(axis=(0, 1))
-        r = geo[:, :, 0, :] - com
-        c, s = np.cos(u[2]), np.sin(u[2])
-        arms = np.stack([c * r[..., 0] - s * r[..., 1], s * r[..., 0] + c * r[..., 1]], -1)
-        m = np.sum(arms[..., 0] * F[..., 1] - arms[..., 1] * F[..., 0])
-        return np.array([tot[0], tot[1], m]) - load  # the base pushes what it carries
+        F = _spring_forces(foundation, geo, u, pivot=pivot)  # what the base pushes
+        a = _turn(u[2], r_iso)
+        r = _turn(u[2], r0)
+        m = np.sum(a[..., 0] * F[..., 1] - a[..., 1] * F[..., 0])
+        m_load = np.sum(r[:, 0] * F0[:, 1] - r[:, 1] * F0[:, 0]) + moment
+        return np.array([*(F.sum(axis=(0, 1)) - F0.sum(axis=0)), m - m_load])
 
-    K = foundation.stiffness_matrix(foundation.com)
-    u = np.linalg.solve(K, load)
+    K = foundation.stiffness_matrix(pivot)
+    u = np.linalg.solve(K, -residual(np.zeros(3)))
     for _ in range(20):
         r = residual(u)
         J = np.empty((3, 3))
