@@ -89,6 +89,7 @@ def floor_forces(trajectory, foundation: Foundation, base: str = "base",
 
 def _stats(F) -> dict:
     F = np.asarray(F, float)
+    F = F[np.all(np.isfinite(F), axis=1)]  # a run that stopped early: its samples
     mag = np.hypot(F[:, 0], F[:, 1])
     dyn = F - F.mean(axis=0)
     return {"peak_N": float(mag.max()), "peak_Fx_N": float(np.abs(F[:, 0]).max()),
@@ -128,10 +129,11 @@ class MountingComparison:
     def statistics(self) -> dict:
         """Peak force magnitude, peak |Fx|, |Fy| and RMS of the fluctuation of Fx, Fy about
         their means (N), and the peak base motion, for ``"rigid"``, ``"one_way"`` and
-        ``"coupled"``."""
+        ``"coupled"`` (over the samples a run reached)."""
         out = {"rigid": _stats(self.rigid), "one_way": _stats(self.one_way.floor),
                "coupled": _stats(self.coupled.floor)}
         for key, u in (("one_way", self.one_way.u), ("coupled", self.coupled.u)):
+            u = u[np.all(np.isfinite(u), axis=1)]
             d = u - u[0]
             out[key].update(peak_dx_m=float(np.abs(d[:, 0]).max()),
                             peak_dy_m=float(np.abs(d[:, 1]).max()),
@@ -141,7 +143,7 @@ class MountingComparison:
     def summary(self) -> str:
         """A text table of :meth:`statistics` (kN, mm, mrad)."""
         s = self.statistics()
-        rows = [f"  {'':32s}{'rigid':>12s}{'one-way':>12s}{'coupled':>12s}"]
+        rows = [f"  {'(weights included)':32s}{'rigid':>12s}{'one-way':>12s}{'coupled':>12s}"]
         for key, label in (("peak_N", "peak |F| to floor, kN"), ("peak_Fx_N", "peak |Fx|, kN"),
                            ("peak_Fy_N", "peak |Fy|, kN"), ("rms_dFx_N", "RMS of Fx - mean, kN"),
                            ("rms_dFy_N", "RMS of Fy - mean, kN")):
@@ -175,14 +177,18 @@ class MountingComparison:
 
 
 def _on(t, ts, values):
-    """``values`` (m, k) sampled at ``ts`` (m,), linear at ``t`` (n,)."""
+    """``values`` (m, k) sampled at ``ts`` (m,), linear at ``t`` (n,); NaN after ``ts[-1]``
+    (a run that stopped early)."""
     values = np.asarray(values, float)
-    return np.column_stack([np.interp(t, ts, values[:, j]) for j in range(values.shape[1])])
+    out = np.column_stack([np.interp(t, ts, values[:, j]) for j in range(values.shape[1])])
+    out[t > ts[-1] * (1 + 1e-12) + 1e-15] = np.nan
+    return out
 
 
 def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
                      t_end: float = 1.0, *, samples: int = 2001, base: str = "base",
-                     arm: float = ARM, pivot=(0.0, 0.0), **simulate_kw) -> MountingComparison:
+                     arm: float = ARM, pivot=(0.0, 0.0), rigid_run=None,
+                     **simulate_kw) -> MountingComparison:
     """Run the machine on a rigid frame and coupled on its isolators, and compare.
 
     Parameters
@@ -197,6 +203,9 @@ def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
         Points of the common time grid (both runs are sampled on it).
     base, arm, pivot
         As for :func:`~mechdyn.foundation.mounting.mounted`.
+    rigid_run : Trajectory, optional
+        A run of ``mechanism`` on its fixed frame already made with the same options (it
+        is then not run again).
     **simulate_kw
         Passed to both :func:`mechdyn.simulate` runs (``q0`` and ``qdot0`` as mappings by
         coordinate name: the mounted machine has three coordinates more).
@@ -234,7 +243,8 @@ def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
     t0 = float(simulate_kw.get("t0", 0.0))
     t = np.linspace(t0, float(t_end), int(samples))
     simulate_kw.setdefault("t_eval", t)
-    rigid_run = simulate(mechanism, t_end, **simulate_kw)
+    if rigid_run is None:
+        rigid_run = simulate(mechanism, t_end, **simulate_kw)
     point = np.zeros(2)
     loads = frame_loads(rigid_run, point)
     start = shift_moment([loads.Fx[0], loads.Fy[0], loads.M[0]], point, f.com)
