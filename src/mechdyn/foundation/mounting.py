@@ -309,7 +309,9 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
     Warns
     -----
     FloorFrameWarning
-        Tables, stops, locks and switches that measure in the floor's frame.
+        Tables, stops, locks and switches that measure in the floor's frame, and absolute
+        angle coordinates that stay absolute (they turn with the base too; the engine may
+        pick one as independent in place of the base's angle).
 
     Examples
     --------
@@ -337,10 +339,6 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
     if taken:
         raise ModelError(f"mounted: the name(s) {', '.join(map(repr, taken))} are taken by the "
                          f"mechanism; pass another base=... (now {base!r})")
-    floor_vars = _check_floor_vars(mechanism, base)
-    if floor_vars:
-        warnings.warn("on the mounted base these still measure against the floor: "
-                      + "; ".join(floor_vars), FloorFrameWarning, stacklevel=2)
     com = f.com
     pv = tuple(float(v) for v in pivot)
     out = Mechanism(name=mechanism.name, gravity=tuple(mechanism.gravity),
@@ -354,6 +352,12 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
         joints[j.name] = dataclasses.replace(j, parent=_replace_ground(j.parent, base),
                                              child=_replace_ground(j.child, base))
     coords = _coordinates(mechanism, joints, base)
+    floor_vars = _check_floor_vars(mechanism, base) + [
+        f"coordinate {c.name!r} (absolute angle of {c.body!r})" for c in coords.values()
+        if c.kind == "angle"]
+    if floor_vars:
+        warnings.warn("on the mounted base these still measure against the floor: "
+                      + "; ".join(floor_vars), FloorFrameWarning, stacklevel=2)
     for j in joints.values():
         out.add(j)
     for c in coords.values():
