@@ -149,7 +149,7 @@ def _replace_ground(name: str, base: str) -> str:
     return base if name == GROUND else name
 
 
-def _check_floor_vars(mech: Mechanism, base: str) -> list[str]:
+def _check_floor_vars(mech: Mechanism) -> list[str]:
     """Names of elements whose variables measure against the floor."""
     found = []
 
@@ -160,6 +160,8 @@ def _check_floor_vars(mech: Mechanism, base: str) -> list[str]:
     for ld in mech.loads:
         mag = getattr(ld, "magnitude", None)
         look(f"{type(ld).__name__.lower()} {ld.name!r}", getattr(mag, "variable", None))
+    for d in mech.drives:
+        look(f"drive {d.name!r}", getattr(getattr(d, "torque", None), "variable", None))
     for kind in ("stops", "coordinate_locks", "switches"):
         for el in mech.extras.get(kind, []):
             look(f"{kind[:-1].replace('_', ' ')} {el.name!r}", el.variable)
@@ -294,7 +296,8 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
     Returns
     -------
     Mechanism
-        A new mechanism: ``base`` with the ground's points, every element once attached
+        A new mechanism: ``base`` with the ground's points (the floor keeps them too, for
+        variables such as ``"dist(ground.P, ram.Q)"``), every element once attached
         to the ground on it, two more massless bodies (``<base>_sled_x``,
         ``<base>_sled_y``), the isolator springs ``<base>_<isolator>_x`` / ``_y`` and
         the coordinates ``<base>_x``, ``<base>_y``, ``<base>_theta``.
@@ -342,7 +345,8 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
     com = f.com
     pv = tuple(float(v) for v in pivot)
     out = Mechanism(name=mechanism.name, gravity=tuple(mechanism.gravity),
-                    description=mechanism.description, ground=Ground())
+                    description=mechanism.description,
+                    ground=Ground(points=dict(mechanism.ground.points)))
     out.add(Body(base, mass=float(f.mass), inertia=float(f.inertia), com=com,
                  points=dict(mechanism.ground.points)))
     for b in mechanism.bodies.values():
@@ -352,7 +356,7 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
         joints[j.name] = dataclasses.replace(j, parent=_replace_ground(j.parent, base),
                                              child=_replace_ground(j.child, base))
     coords = _coordinates(mechanism, joints, base)
-    floor_vars = _check_floor_vars(mechanism, base) + [
+    floor_vars = _check_floor_vars(mechanism) + [
         f"coordinate {c.name!r} (absolute angle of {c.body!r})" for c in coords.values()
         if c.kind == "angle"]
     if floor_vars:
