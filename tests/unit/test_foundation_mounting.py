@@ -18,7 +18,7 @@ from mechdyn.foundation import (
     base_coordinates,
     mounted,
 )
-from mechdyn.mechanism import Coordinate, Drive, Spring, Torque
+from mechdyn.mechanism import Coordinate, Drive, RotarySpring, Spring, Torque
 from mechdyn.results.table import read_csv
 
 MOUNTS = Foundation([Isolator("L", -0.5, -0.2, 1e6, 1e6, 1e3, 1e3),
@@ -130,3 +130,16 @@ def test_cli_coupled(tmp_path, capsys):
                               "--mass", "50kg", "--inertia", "2kg*m^2", *bolt])
     with pytest.raises(ModelError, match="--coupled needs isolators"):
         cli.run(args)
+
+
+def test_a_pin_whose_angle_is_used_is_not_turned_round():
+    """The crank as the parent of its pin: turning the pin round would flip the sign of
+    the angle its rotary spring reads; then the driven angle cannot move onto the base."""
+    m = crank_and_bar()
+    m.joints["O"] = type(m.joints["O"])("O", "crank", "ground")
+    with pytest.warns(FloorFrameWarning):
+        mm = mounted(m, MOUNTS)
+    assert (mm.joints["O"].parent, mm.joints["O"].child) == ("base", "crank")
+    m.add(RotarySpring("k", "O", stiffness=10.0))
+    with pytest.raises(ModelError, match="drive 'motor'"):
+        mounted(m, MOUNTS)

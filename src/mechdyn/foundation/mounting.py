@@ -205,6 +205,9 @@ def _coordinates(mech: Mechanism, joints: dict, base: str) -> dict:
             pins = [j for j in joints.values() if isinstance(j, Revolute)
                     and c.body in (j.parent, j.child) and ({j.parent, j.child} - {c.body})
                     <= set(held)]
+            # turning a pin round would flip the sign of its angle for its rotary springs
+            # and its "joint:NAME" variables: such pins are used only as they stand
+            pins = [j for j in pins if j.child == c.body or not _angle_used(mech, j.name)]
             if pins:
                 pin = pins[0]
                 other = pin.parent if pin.child == c.body else pin.child
@@ -222,6 +225,17 @@ def _coordinates(mech: Mechanism, joints: dict, base: str) -> dict:
                     f"(kind = 'relative_angle')")
         out[c.name] = c
     return out
+
+
+def _angle_used(mech: Mechanism, joint: str) -> bool:
+    """Whether a rotary spring or a variable (table, stop, lock, switch) uses the relative
+    angle of ``joint``."""
+    specs = [getattr(getattr(ld, "magnitude", None), "variable", None) for ld in mech.loads]
+    for kind in ("stops", "coordinate_locks", "switches"):
+        for el in mech.extras.get(kind, []):
+            specs += [el.variable, *(g[0] for g in getattr(el, "guard", ()))]
+    return (any(isinstance(ld, RotarySpring) and ld.joint == joint for ld in mech.loads)
+            or any(isinstance(v, str) and f"joint:{joint}" in v for v in specs))
 
 
 def _load(ld, base: str):
