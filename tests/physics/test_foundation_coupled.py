@@ -7,6 +7,7 @@ import pytest
 
 import mechdyn
 from mechdyn import Mechanism
+from mechdyn.errors import ModelError
 from mechdyn.foundation import (
     Foundation,
     Isolator,
@@ -15,7 +16,7 @@ from mechdyn.foundation import (
     mounted,
     transmissibility,
 )
-from mechdyn.mechanism import Drive, TorqueSpeedCurve
+from mechdyn.mechanism import Drive, Force, TorqueSpeedCurve
 
 M_ROTOR, ECC, SPEED = 10.0, 0.01, 30.0  # kg, m, rad/s
 
@@ -131,3 +132,25 @@ def test_heavy_base_agrees_with_the_one_way_prediction():
     s = c.statistics()
     assert s["coupled"]["peak_N"] == pytest.approx(s["one_way"]["peak_N"], rel=1e-3)
     assert "coupled" in c.summary() and "Fy_floor_N_coupled" in c.to_dataframe()
+
+
+def test_a_force_whose_reaction_the_frame_carries():
+    """A ram held up on its guide by a force from the frame (a spring pack): with its
+    reaction on the base the floor carries the weights alone and the base stays at rest;
+    the rigid frame's loads get the same reaction (rigid = weights)."""
+    mech = Mechanism("held ram", gravity=(0.0, -9.81))
+    mech.add_body("ram", mass=10.0, pose=(0.0, 0.2, 0.0))
+    mech.add_prismatic("guide", "ground", "ram", (0.0, 0.0), axis=(0.0, 1.0))
+    mech.add_coordinate("s", kind="travel", joint="guide")
+    mech.add(Force("pack", "ram", "com", 10.0 * 9.81, (0.0, 1.0)))
+    f = base(mass=490.0, k=1e5, c=3000.0)
+    weight = 500.0 * 9.81
+    mm = mounted(mech, f, reacting=("pack",))
+    tr = mechdyn.simulate(mm, 0.2, rtol=1e-10, progress=False)
+    assert np.max(np.abs(tr.coordinate("base_y") / (-weight / 2e5) - 1)) < 1e-6
+    c = compare_mounting(mech, f, 0.2, samples=21, reacting=("pack",), rtol=1e-10,
+                         progress=False)
+    np.testing.assert_allclose(c.rigid[:, 1], -weight, rtol=1e-9)
+    np.testing.assert_allclose(c.coupled.floor[:, 1], -weight, rtol=1e-6)
+    with pytest.raises(ModelError, match="unknown force load 'pak'"):
+        mounted(mech, f, reacting=("pak",))

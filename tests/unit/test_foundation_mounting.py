@@ -130,6 +130,10 @@ def test_cli_coupled(tmp_path, capsys):
                               "--mass", "50kg", "--inertia", "2kg*m^2", *bolt])
     with pytest.raises(ModelError, match="--coupled needs isolators"):
         cli.run(args)
+    args = parser.parse_args(["foundation", "slider_crank", "--t-end", "0.05s", "--bed", "x",
+                              "--mass", "50kg", "--inertia", "2kg*m^2", *bolt])
+    with pytest.raises(ModelError, match="--bed goes with --coupled"):
+        cli.run(args)
 
 
 def test_a_pin_whose_angle_is_used_is_not_turned_round():

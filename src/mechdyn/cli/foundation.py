@@ -104,6 +104,10 @@ def register(sub) -> None:
                         "the isolators, two-way coupled, and compare the force to the floor "
                         "and the base's motion with the rigid frame and the one-way "
                         "prediction (writes NAME_coupled.csv with -o)")
+    p.add_argument("--bed", nargs="+", default=(), metavar="LOAD",
+                   help="with --coupled: force loads whose reaction the frame carries (a "
+                        "cylinder or spring pack on the frame, a punch on the bed), put on the "
+                        "base and added to the rigid frame's loads of the comparison")
     add_files(p, plot="plot the loads on the supports (kN)",
               table="write the support loads to this CSV file (and NAME_mounted.csv with "
                     "--mass/--inertia, NAME_coupled.csv with --coupled)")
@@ -195,6 +199,9 @@ def run(args) -> int:
                          f"{args.orders!r}") from None
     if args.samples < 2:
         raise ModelError(f"--samples must be >= 2, got {args.samples}")
+    if args.bed and not args.coupled:
+        raise ModelError("--bed goes with --coupled (the reactions are put on the mounted "
+                         "base)")
     if args.coupled and (foundation.mass is None or any(foundation.bolts)):
         raise ModelError("--coupled needs isolators (not anchor bolts) and the frame's mass "
                          "and inertia (--mass, --inertia or the model's [foundation])")
@@ -250,7 +257,8 @@ def _coupled(args, mech, foundation, traj):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", FloorFrameWarning)
         c = compare_mounting(mech, foundation, t_end, samples=args.samples, rigid_run=traj,
-                             integrator=args.integrator, rtol=args.rtol, progress=None)
+                             reacting=tuple(args.bed), integrator=args.integrator,
+                             rtol=args.rtol, progress=None)
     print("  coupled: the frame as a body on its isolators, one run with the machine")
     for w in caught:
         print(f"  note: {w.message}")

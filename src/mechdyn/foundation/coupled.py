@@ -12,6 +12,7 @@ the feedback of the base's motion into the machine.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -176,6 +177,18 @@ class MountingComparison:
         return pd.DataFrame(cols)
 
 
+def _reaction_loads(run, names, at) -> np.ndarray:
+    """The reactions (Fx, Fy, M about the origin), shape (n, 3), that the frame of ``run``
+    takes from the ``Force`` loads ``names`` (their point of application as it moves),
+    at the samples of the times ``at`` (n,) of the run."""
+    from ..dynamics.forces import applied_forces
+
+    ok = np.all(np.isfinite(run.q), axis=1)
+    args = (run.model, run.t[ok], run.x[ok], run.xdot[ok], run.q[ok], run.qdot[ok])
+    R = applied_forces(*args, reacting_loads=tuple(names))[1] - applied_forces(*args)[1]
+    return R if R.shape[0] == len(at) else _on(np.asarray(at), run.t[ok], R)
+
+
 def _on(t, ts, values):
     """``values`` (m, k) sampled at ``ts`` (m,), linear at ``t`` (n,); NaN after ``ts[-1]``
     (a run that stopped early)."""
@@ -187,8 +200,8 @@ def _on(t, ts, values):
 
 def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
                      t_end: float = 1.0, *, samples: int = 2001, base: str = "base",
-                     arm: float = ARM, pivot=(0.0, 0.0), rigid_run=None,
-                     **simulate_kw) -> MountingComparison:
+                     arm: float = ARM, pivot=(0.0, 0.0), reacting: Sequence[str] = (),
+                     rigid_run=None, **simulate_kw) -> MountingComparison:
     """Run the machine on a rigid frame and coupled on its isolators, and compare.
 
     Parameters
@@ -201,8 +214,9 @@ def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
         End of both runs, s.
     samples : int
         Points of the common time grid (both runs are sampled on it).
-    base, arm, pivot
-        As for :func:`~mechdyn.foundation.mounting.mounted`.
+    base, arm, pivot, reacting
+        As for :func:`~mechdyn.foundation.mounting.mounted`; the reactions of the
+        ``reacting`` forces are also added to the rigid run's frame loads.
     rigid_run : Trajectory, optional
         A run of ``mechanism`` on its fixed frame already made with the same options (it
         is then not run again).
@@ -247,13 +261,17 @@ def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
         rigid_run = simulate(mechanism, t_end, **simulate_kw)
     point = np.zeros(2)
     loads = frame_loads(rigid_run, point)
-    start = shift_moment([loads.Fx[0], loads.Fy[0], loads.M[0]], point, f.com)
-    mm = mounted(mechanism, f, base=base, arm=arm, load=start, pivot=pivot)
+    machine = np.column_stack([loads.Fx, loads.Fy, loads.M])
+    if reacting:
+        machine = machine + _reaction_loads(rigid_run, reacting, loads.t)
+    start = shift_moment(machine[0], point, f.com)
+    mm = mounted(mechanism, f, base=base, arm=arm, load=start, pivot=pivot,
+                 reacting=reacting)
     coupled_run = simulate(mm, t_end, **simulate_kw)
     g = np.asarray(mechanism.gravity, float)
     wb = f.mass * g
     weight = np.array([wb[0], wb[1], f.com[0] * wb[1] - f.com[1] * wb[0]])
-    rigid = _on(t, loads.t, np.column_stack([loads.Fx, loads.Fy, loads.M])) + weight
+    rigid = _on(t, loads.t, machine) + weight
     one_way = mounted_response(f, t, rigid[:, 0], rigid[:, 1], rigid[:, 2], point=point)
     ff = floor_forces(coupled_run, f, base, mechanism.gravity, arm, point, pivot)
     good = np.isfinite(ff.t)

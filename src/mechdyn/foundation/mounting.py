@@ -60,7 +60,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import ModelError, did_you_mean
 from ..mechanism import (
     GROUND,
     AssemblyMode,
@@ -227,6 +227,26 @@ def _coordinates(mech: Mechanism, joints: dict, base: str) -> dict:
     return out
 
 
+def _reactions(mech: Mechanism, names: Sequence[str], base: str) -> list:
+    """The reactions on the base of the ``Force`` loads named ``names``."""
+    forces = {ld.name: ld for ld in mech.loads if isinstance(ld, Force)}
+    out = []
+    for name in names:
+        if name not in forces:
+            raise ModelError("reacting: " + did_you_mean(name, list(forces), "force load"))
+        ld = forces[name]
+        if ld.frame != "ground":
+            raise ModelError(f"reacting: force {name!r} turns with its body (frame = 'body'); "
+                             "only a force of fixed direction (frame = 'ground') can have its "
+                             "reaction on the base")
+        b = mech.body(ld.body)
+        p = b.point(ld.point) if isinstance(ld.point, str) else tuple(ld.point)
+        at = np.asarray(b.pose[:2]) + _turn(b.pose[2], np.asarray(p, float))
+        out.append(Force(f"{name}_reaction", base, tuple(float(v) for v in at), ld.magnitude,
+                         tuple(-v for v in ld.direction), "ground"))
+    return out
+
+
 def _angle_used(mech: Mechanism, joint: str) -> bool:
     """Whether a rotary spring or a variable (table, stop, lock, switch) uses the relative
     angle of ``joint``."""
@@ -277,7 +297,7 @@ def _extras(mech: Mechanism, base: str) -> dict:
 
 def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: str = "base",
             arm: float = ARM, equilibrium: bool = True, load=None,
-            pivot=(0.0, 0.0)) -> Mechanism:
+            pivot=(0.0, 0.0), reacting: Sequence[str] = ()) -> Mechanism:
     """The machine on its frame mounted on isolators: one mechanism, the floor its ground.
 
     Parameters
@@ -306,6 +326,15 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
         turns.  Keep it among the machine's joints on the frame (default the origin): the
         engine measures the conditioning of the positions on lever arms from it, and far
         from the joints a vibrating base would read as a dead position.
+    reacting : sequence of str
+        Names of :class:`~mechdyn.mechanism.load.Force` loads (direction fixed in the
+        ground) whose reaction the frame carries: a cylinder or a spring pack on the frame
+        pushing a ram, a punch load on the bed.  Each gets an equal and opposite force
+        ``<name>_reaction`` on the base, at the point where the force acts in the sketch:
+        exact while that point moves along the force's line (a ram), otherwise with the
+        moment error (displacement of the point) x (force).  Without it such a force is
+        external to machine and base, as on a rigid frame, and pushes the whole mounted
+        machine.
 
     Returns
     -------
@@ -321,7 +350,7 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
     ModelError
         No foundation, no mass or inertia, anchor bolts, a name already used, a drive
         whose stator would push against the floor, an element that cannot be carried
-        onto the base (named).
+        onto the base (named), a ``reacting`` name that is not a ground-frame force.
 
     Warns
     -----
@@ -382,6 +411,8 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
         out.add(c)
     for ld in mechanism.loads:
         out.add(_load(ld, base))
+    for ld in _reactions(mechanism, reacting, base):
+        out.add(ld)
     for d in mechanism.drives:
         out.add(d)
     out.extras = _extras(mechanism, base)
