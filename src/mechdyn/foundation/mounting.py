@@ -145,6 +145,30 @@ def isolator_geometry(foundation: Foundation, gravity=(0.0, -9.81),
     return out
 
 
+def sketch_poses(mech: Mechanism) -> dict:
+    """Pose (x, y, theta) of every body of ``mech`` in its sketch, m and rad: as given, or
+    (a body without a pose) as the assembly places it, and the ground's.
+
+    Examples
+    --------
+    >>> m = Mechanism()
+    >>> _ = m.add_body("bar", pose=(0.1, 0.0, 0.5))
+    >>> sketch_poses(m)["bar"]
+    (0.1, 0.0, 0.5)
+    """
+    poses = {name: getattr(b, "pose", None) for name, b in mech.bodies.items()}
+    if any(p is None for p in poses.values()):
+        from ..kinematics.assembly import assemble
+
+        model = mech.compile()
+        x = getattr(model, "x0", None)
+        x = assemble(model) if x is None else x
+        poses = {n: tuple(float(v) for v in x[3 * i:3 * i + 3])
+                 for i, n in enumerate(model.body_names)}
+    poses[GROUND] = (0.0, 0.0, 0.0)
+    return poses
+
+
 def _replace_ground(name: str, base: str) -> str:
     return base if name == GROUND else name
 
@@ -174,14 +198,15 @@ def _turning_with_base(mech: Mechanism, joints: dict, base: str) -> dict:
     """Bodies whose angle is held to the base's by prismatic joints (and the base):
     name -> their angle relative to the base, rad."""
     held = {base: 0.0}
+    poses = sketch_poses(mech)
     grew = True
     while grew:
         grew = False
         for j in joints.values():
             if not isinstance(j, Prismatic) or (j.parent in held) == (j.child in held):
                 continue
-            sketch = (mech.body(j.child).pose[2] if j.child != base else 0.0) - (
-                mech.body(j.parent).pose[2] if j.parent != base else 0.0)
+            sketch = (poses[j.child][2] if j.child != base else 0.0) - (
+                poses[j.parent][2] if j.parent != base else 0.0)
             rel = sketch if j.angle is None else float(j.angle)  # child - parent
             if j.parent in held:
                 held[j.child] = held[j.parent] + rel
@@ -230,6 +255,7 @@ def _coordinates(mech: Mechanism, joints: dict, base: str) -> dict:
 def _reactions(mech: Mechanism, names: Sequence[str], base: str) -> list:
     """The reactions on the base of the ``Force`` loads named ``names``."""
     forces = {ld.name: ld for ld in mech.loads if isinstance(ld, Force)}
+    poses = sketch_poses(mech) if names else {}
     out = []
     for name in names:
         if name not in forces:
@@ -241,7 +267,8 @@ def _reactions(mech: Mechanism, names: Sequence[str], base: str) -> list:
                              "reaction on the base")
         b = mech.body(ld.body)
         p = b.point(ld.point) if isinstance(ld.point, str) else tuple(ld.point)
-        at = np.asarray(b.pose[:2]) + _turn(b.pose[2], np.asarray(p, float))
+        pose = poses[ld.body]
+        at = np.asarray(pose[:2]) + _turn(pose[2], np.asarray(p, float))
         out.append(Force(f"{name}_reaction", base, tuple(float(v) for v in at), ld.magnitude,
                          tuple(-v for v in ld.direction), "ground"))
     return out
@@ -391,7 +418,7 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
                     description=mechanism.description,
                     ground=Ground(points=dict(mechanism.ground.points)))
     out.add(Body(base, mass=float(f.mass), inertia=float(f.inertia), com=com,
-                 points=dict(mechanism.ground.points)))
+                 points=dict(mechanism.ground.points), pose=(0.0, 0.0, 0.0)))
     for b in mechanism.bodies.values():
         out.add(b)
     joints = {}
@@ -518,8 +545,10 @@ def static_equilibrium(mechanism: Mechanism, foundation: Foundation, arm: float 
         moment = float(w[2])
     else:
         moment = 0.0
+        poses = sketch_poses(mechanism)
         for b in mechanism.bodies.values():
-            points.append(np.asarray(b.pose[:2]) + _turn(b.pose[2], np.asarray(b.com)))
+            pose = poses[b.name]
+            points.append(np.asarray(pose[:2]) + _turn(pose[2], np.asarray(b.com)))
             forces.append(b.mass * g)
     r0, F0 = np.array(points) - pivot, np.array(forces)
     geo = isolator_geometry(foundation, mechanism.gravity, arm)
