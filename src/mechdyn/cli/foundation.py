@@ -18,7 +18,9 @@ ground origin) are shared among the supports of a rigid base by stiffness; with 
 and an inertia (the model's, or ``--mass`` and ``--inertia``) the base is also taken as
 a body on elastic supports: its natural frequencies beside the excitation orders of the
 running speed, and its response to the frame loads (one way: the base's motion does not
-act back on the machine).
+act back on the machine).  With ``--coupled`` the frame also becomes a body on its
+isolators in a second run with the machine (two-way, ``mechdyn.foundation.mounted``): the
+force passed to the floor and the base's motion, rigid, one-way and coupled side by side.
 
 Exit codes: 0 done; 1 the run stopped early (the samples so far are analysed);
 2 bad input.
@@ -26,6 +28,7 @@ Exit codes: 0 done; 1 the run stopped early (the samples so far are analysed);
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -33,8 +36,10 @@ import numpy as np
 from ..errors import ModelError, did_you_mean
 from ..foundation import (
     AnchorBolt,
+    FloorFrameWarning,
     Foundation,
     Isolator,
+    compare_mounting,
     excitation_warnings,
     mounted_response,
     natural_frequencies,
@@ -94,9 +99,18 @@ def register(sub) -> None:
                         "mean speed of the first angle coordinate over the run)")
     p.add_argument("--orders", default="1,2,3,4", metavar="K,...",
                    help="excitation orders to check (default 1,2,3,4)")
+    p.add_argument("--coupled", action="store_true",
+                   help="also run the machine with its frame as a body (mass, inertia) on "
+                        "the isolators, two-way coupled, and compare the force to the floor "
+                        "and the base's motion with the rigid frame and the one-way "
+                        "prediction (writes NAME_coupled.csv with -o)")
+    p.add_argument("--bed", nargs="+", default=(), metavar="LOAD",
+                   help="with --coupled: force loads whose reaction the frame carries (a "
+                        "cylinder or spring pack on the frame, a punch on the bed), put on the "
+                        "base and added to the rigid frame's loads of the comparison")
     add_files(p, plot="plot the loads on the supports (kN)",
               table="write the support loads to this CSV file (and NAME_mounted.csv with "
-                    "--mass/--inertia)")
+                    "--mass/--inertia, NAME_coupled.csv with --coupled)")
 
 
 def parse_support(text: str, cls, flag: str):
@@ -185,6 +199,12 @@ def run(args) -> int:
                          f"{args.orders!r}") from None
     if args.samples < 2:
         raise ModelError(f"--samples must be >= 2, got {args.samples}")
+    if args.bed and not args.coupled:
+        raise ModelError("--bed goes with --coupled (the reactions are put on the mounted "
+                         "base)")
+    if args.coupled and (foundation.mass is None or any(foundation.bolts)):
+        raise ModelError("--coupled needs isolators (not anchor bolts) and the frame's mass "
+                         "and inertia (--mass, --inertia or the model's [foundation])")
     model = mech.compile()
     traj = simulate_from_args(model, args, args.samples)
     if args.weight and foundation.mass is None:
@@ -215,11 +235,35 @@ def run(args) -> int:
               f"rigid, {np.max(np.hypot(*mounted.floor[:, :2].T)) / 1e3:.4g} kN on the "
               f"mounts; base motion peak {np.max(np.abs(mounted.u[:, 0])) * 1e3:.4g} mm "
               f"in x, {np.max(np.abs(mounted.u[:, 1])) * 1e3:.4g} mm in y")
+    coupled = _coupled(args, mech, foundation, traj) if args.coupled else None
     if args.output:
         print(f"  table: {write_csv(loads, args.output)}")
+        out = Path(args.output)
         if mounted is not None:
-            out = Path(args.output)
             print(f"  table: {write_csv(mounted, out.with_name(out.stem + '_mounted.csv'))}")
+        if coupled is not None:
+            print(f"  table: {write_csv(coupled, out.with_name(out.stem + '_coupled.csv'))}")
     if args.plot:
         print(f"  plot: {plot_support_loads(loads, args.plot, mounted)}")
-    return finish(args, traj.success, f"the run stopped early: {traj.status}: {traj.message}")
+    ok = traj.success and (coupled is None or coupled.coupled_run.success)
+    last = traj if traj.success else coupled.coupled_run
+    return finish(args, ok, f"the run stopped early: {last.status}: {last.message}")
+
+
+def _coupled(args, mech, foundation, traj):
+    """``--coupled``: the machine on its isolators in one run beside the rigid run ``traj``;
+    prints the comparison and returns it."""
+    t_end = parse_quantity(args.t_end, "time", where="--t-end")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", FloorFrameWarning)
+        c = compare_mounting(mech, foundation, t_end, samples=args.samples, rigid_run=traj,
+                             reacting=tuple(args.bed), integrator=args.integrator,
+                             rtol=args.rtol, progress=None)
+    print("  coupled: the frame as a body on its isolators, one run with the machine")
+    for w in caught:
+        print(f"  note: {w.message}")
+    run = c.coupled_run
+    if not run.success:
+        print(f"  the coupled run stopped at t = {run.t[-1]:.6g} s: {run.message}")
+    print(c.summary())
+    return c
