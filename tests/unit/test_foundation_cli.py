@@ -24,7 +24,7 @@ def _args(*argv):
 def test_bolts_and_mounts_from_the_command_line(tmp_path, capsys):
     out, png = tmp_path / "loads.csv", tmp_path / "loads.png"
     argv = ["slider_crank", "--t-end", "0.05s", "--samples", "101", "-o", str(out),
-            "--plot", str(png), "--mass", "50kg", "--inertia", "2kg*m^2", "--rpm", "400rpm",
+            "--plot", str(png), "--mass", "50kg", "--inertia", "2kg*m^2", "--speed", "400rpm",
             "--weight",
             "--isolator", "m1: x=0m, y=-0.1m, kx=1e5N/m, ky=2e5N/m, cy=300N*s/m"]
     for b in BOLTS:

@@ -28,6 +28,7 @@ Exit codes: 0 done; 1 the run stopped early (the samples so far are analysed);
 
 from __future__ import annotations
 
+import argparse
 import warnings
 from pathlib import Path
 
@@ -94,9 +95,10 @@ def register(sub) -> None:
     p.add_argument("--weight", action="store_true",
                    help="add the weight of frame and base (--mass, the model's gravity) to "
                         "the loads of the rigid base")
-    p.add_argument("--rpm", metavar="SPEED",
+    p.add_argument("--speed", metavar="RATE",
                    help="running speed for the excitation orders, e.g. 300rpm (default: the "
                         "mean speed of the first angle coordinate over the run)")
+    p.add_argument("--rpm", dest="speed", help=argparse.SUPPRESS)  # the old spelling
     p.add_argument("--orders", default="1,2,3,4", metavar="K,...",
                    help="excitation orders to check (default 1,2,3,4)")
     p.add_argument("--coupled", action="store_true",
@@ -178,9 +180,9 @@ def build_foundation(args, given: Foundation | None = None) -> Foundation:
 
 
 def _rpm(args, traj) -> float | None:
-    """``--rpm``, else the mean speed of the first angle coordinate of the run, rpm."""
-    if args.rpm is not None:
-        return parse_quantity(args.rpm, "angular_velocity", where="--rpm") * 30 / np.pi
+    """``--speed``, else the mean speed of the first angle coordinate of the run, rpm."""
+    if args.speed is not None:
+        return parse_quantity(args.speed, "angular_velocity", where="--speed") * 30 / np.pi
     for k, angle in enumerate(traj.coordinate_is_angle):
         if angle and traj.t.size > 1:
             turn = traj.q[-1, k] - traj.q[0, k]
