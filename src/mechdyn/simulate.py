@@ -44,7 +44,8 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
              events=None, t0: float = 0.0, mode=None, backend: str = "auto",
              iterations: int | None = None, tol: float | None = None,
              theta: float | None = None, first_step: float | None = None,
-             max_step: float | None = None, **switching) -> Trajectory:
+             max_step: float | None = None, sink=None, chunk: int = 2000, keep: bool = True,
+             **switching) -> Trajectory:
     """Simulate the motion of a mechanism under its loads and drives, through every
     switch, impact and contact of a variable-structure mechanism.
 
@@ -115,6 +116,20 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
         as a dead position approached; ``point`` ((2,) m, default the ground origin):
         the point the frame moment ``M_frame_Nm`` is taken about, as in
         :func:`mechdyn.kinetostatics`.
+    sink : callable, optional
+        Receives the table as it is computed: every ``chunk`` output samples (and at the
+        end) ``sink(part, start)`` is called with a :class:`Trajectory` of those samples
+        (forces, frame loads and energies evaluated as for the whole run; the work
+        W_nc and the impact losses run on from the start) and the index of its first row
+        in the run; its force columns cover every joint, lock, stop and contact from the
+        first chunk on.  :class:`mechdyn.results.table.CsvStream` appends them to a CSV.
+    chunk : int
+        Output samples per chunk handed to ``sink`` (default 2000).
+    keep : bool
+        With a ``sink``: also keep every sample for the Trajectory returned (default);
+        ``False`` keeps only the last chunk, so memory does not grow with the run, and
+        ``stats["streamed"]`` gives the run's ``rows``, ``t_first``, ``energy_drift``
+        and largest constraint ``residual``.
 
     Returns
     -------
@@ -177,4 +192,5 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
                            t_eval=sample_times(t0, t_end_f, t_eval), method=integrator,
                            progress=progress, dt=dt, steps=steps, iterations=iterations,
                            tol=tol, theta=theta, events=events, backend=backend,
-                           formulation=formulation, d=d, **switching)
+                           formulation=formulation, d=d, sink=sink, chunk=chunk, keep=keep,
+                           **switching)

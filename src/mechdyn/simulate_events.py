@@ -96,10 +96,11 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                     tol: float | None = None, theta: float | None = None,
                     first_step: float | None = None, events=None,
                     backend: str = "auto", formulation: str = "exact",
-                    d=None) -> Trajectory:
+                    d=None, sink=None, chunk: int = 2000, keep: bool = True) -> Trajectory:
     """The segment loop that runs every simulation: the keywords of
     :func:`mechdyn.simulate` (``method`` is its ``integrator``) and its ``**switching``
     options, without the checks of the keywords that :func:`mechdyn.simulate` makes.
+    ``sink``, ``chunk`` and ``keep``: see :class:`Samples`.
 
     Returns
     -------
@@ -149,7 +150,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     # ---------------------------------------------------------------- records
     # per sample: t, the mode system, the evaluation, w_nc and the impact losses so far;
     # forces and energies are computed at the end, batched over each mode's samples
-    rec: list = []
+    rec = Samples(model, sm, point, sink=sink, chunk=chunk, keep=keep)
     events: list[SwitchEvent] = []
     stats = dict(steps=0, rejected=0, evaluations=0, integrator=method_name,
                  formulation=formulation, backend="numpy", rtol=rtol, atol=atol, segments=0,
@@ -158,7 +159,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     lost_total = 0.0
 
     def store(t, ms, ev, w):
-        rec.append((t, ms, ev, w, lost_total))
+        rec.append((t, ms, ev, w, lost_total), stats)
 
     # ---------------------------------------------------------------- initial state
     status, message = Status.SUCCESS, ""
@@ -208,7 +209,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     except (MechdynError, np.linalg.LinAlgError) as exc:
         if isinstance(exc, ModelError):
             raise
-        return _finish(model, rec, events, stats, wall0, *status_of(exc), sm)
+        return _finish(model, rec, events, stats, wall0, *status_of(exc), sm, point)
 
     qi, qdi = ms.independent(x, xd)
     just_fired: set = set()
@@ -250,7 +251,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             # the start of the run is an output sample with every_step (else when it is
             # one of t_eval); each segment after an event starts with one
             if (every_step or stats["segments"] > 1 or t >= t_end) and (
-                    not rec or rec[-1][0] != t or rec[-1][1].mode != ms.mode):
+                    rec.last is None or rec.last[0] != t or rec.last[1].mode != ms.mode):
                 store(t, ms, ev0, w_nc)
             good = (t, ev0, ms)
             if t >= t_end:
@@ -273,7 +274,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                 return ev
 
             def sample(ts, y, step, ev, ms=ms, evaluate=evaluate):
-                if rec and rec[-1][0] >= ts:
+                if rec.last is not None and rec.last[0] >= ts:
                     return
                 store(ts, ms, ev if ev is not None else evaluate(ts, y), float(y[-1]))
 
@@ -291,7 +292,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             y_hit = dense(t_hit)
             ev_hit = evaluate(t_hit, y_hit)
             w_nc = float(y_hit[-1])
-            if not rec or rec[-1][0] != t_hit:
+            if rec.last is None or rec.last[0] != t_hit:
                 store(t_hit, ms, ev_hit, w_nc)
             user = [e for e in fired if e.kind == "user"]
             fired = [e for e in fired if e.kind != "user"]
@@ -345,7 +346,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             break
         except KeyboardInterrupt:
             status = Status.INTERRUPTED
-            message = (f"interrupted (Ctrl-C) after t = {rec[-1][0] if rec else t:.9g} s; "
+            t_last = t if rec.last is None else rec.last[0]
+            message = (f"interrupted (Ctrl-C) after t = {t_last:.9g} s; "
                        f"the samples computed so far are kept")
             break
         except (MechdynError, np.linalg.LinAlgError, ValueError, ArithmeticError) as exc:
@@ -394,10 +396,94 @@ def _budget(step, ev, ms, stats, span, min_step, max_steps, fixed_step) -> None:
 
 
 # ============================================================================ output
-def _finish(model, rec, events, stats, wall0, status, message, sm,
-            point=(0.0, 0.0)) -> Trajectory:
-    """The Trajectory of a run from its samples: forces, frame loads and energies are
-    evaluated here, batched over the samples of each mode segment."""
+def element_shapes(model, sm) -> dict:
+    """Every element that can carry a force in some mode, with the trailing shape of its
+    force: joints (2,) or (3,), coordinate locks, stops and contacts () (see
+    :func:`~mechdyn.dynamics.reactions.element_forces`)."""
+    out: dict = {j: ((2,) if model.joint_kind(j) == "revolute" else (3,))
+                 for j in model.mechanism.joints}
+    for names in (sm.coord_locks, sm.stops, sm.contacts):
+        out.update({n: () for n in names if n not in out})
+    return out
+
+
+class Samples:
+    """The samples of a run as they are recorded, and their hand-over in chunks.
+
+    Each sample is ``(t, mode system, evaluation, w_nc, impact losses so far)``.  Without
+    a ``sink`` they are all kept and evaluated at the end (:func:`_finish`).  With a
+    ``sink``, every ``chunk`` samples are evaluated (forces, frame loads and energies,
+    batched over each mode's samples: the numbers of the end-of-run table) into a partial
+    :class:`~mechdyn.results.trajectory.Trajectory` that is handed to ``sink(part, start)``
+    (``start``: the index of its first row in the run) and, unless ``keep``, dropped; its
+    force columns cover every element of the model from the first chunk on (zeros while
+    an element is not engaged).
+
+    Parameters
+    ----------
+    model, sm
+        The compiled model and its switchable elements.
+    point : (2,) m
+        The point of the frame moment.
+    sink : callable, optional
+    chunk : int
+        Samples per chunk (>= 1).
+    keep : bool
+        Keep every chunk for the Trajectory returned (else it holds the last chunk, and
+        ``stats["streamed"]`` the run's row count, first time, energy drift and largest
+        constraint residual).
+
+    Raises
+    ------
+    ModelError
+        ``chunk`` is not a positive integer.
+    """
+
+    def __init__(self, model, sm, point, *, sink=None, chunk: int = 2000, keep: bool = True):
+        if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
+            raise ModelError(f"chunk must be a positive number of samples, got {chunk!r}")
+        self.model, self.sm, self.point = model, sm, np.asarray(point, float)
+        self.sink, self.chunk, self.keep = sink, int(chunk), keep or sink is None
+        self.state: tuple = (0, [])  # (samples handed over, samples waiting): set at once
+        self.last = None  # the last sample recorded (also once handed over)
+        self.modes: list = []  # the modes in the order they appeared, over the whole run
+        self.blocks: list = []
+        self.shapes = element_shapes(model, sm) if sink is not None else None
+        self.streamed: dict = {}
+        self.penetration = 0.0
+
+    def append(self, sample, stats) -> None:
+        """Record a sample; hand a full chunk to the sink."""
+        self.state[1].append(sample)
+        self.last = sample
+        if self.sink is not None and len(self.state[1]) >= self.chunk:
+            self.flush(stats)
+
+    def flush(self, stats) -> None:
+        """Evaluate the waiting samples and hand them to the sink."""
+        start, rows = self.state
+        if not rows:
+            return
+        block = _block(self.model, self.sm, rows, self.point, self.modes, self.shapes)
+        self.sink(_trajectory(self.model, block, self.modes, [], {"mode": stats.get("mode")},
+                              Status.SUCCESS, ""), start)
+        self.state = (start + len(rows), [])
+        bal, res = block["balance"], block["residual"]
+        s = self.streamed
+        if not s:
+            s.update(rows=0, t_first=float(block["t"][0]), balance0=float(bal[0]),
+                     energy_drift=0.0, residual=0.0)
+        s["rows"] += len(rows)
+        s["energy_drift"] = max(s["energy_drift"], float(np.max(np.abs(bal - s["balance0"]))))
+        s["residual"] = max(s["residual"], float(np.max(res)))
+        self.penetration = max(self.penetration, block["penetration"])
+        self.blocks = [*self.blocks, block] if self.keep else [block]
+
+
+def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
+    """Forces, frame loads and energies of samples ``rec``, batched over each mode's
+    samples; ``modes`` (the run's modes so far) is extended by the new ones; ``shapes``
+    (element -> trailing shape) makes a force entry of every element listed."""
     n_q, n_x, n = model.n_q, model.n_x, len(rec)
     t = np.array([r[0] for r in rec], float)
     W = np.array([r[3] for r in rec], float)
@@ -406,8 +492,7 @@ def _finish(model, rec, events, stats, wall0, status, message, sm,
                          for k, w in (("x", n_x), ("xdot", n_x), ("q", n_q), ("qdot", n_q),
                                       ("qddot", n_q)))
     frame, res = np.zeros((n, 3)), np.zeros(n)
-    point = np.asarray(point, float)
-    forces: dict = {}
+    forces: dict = {el: np.zeros((n, *shape)) for el, shape in (shapes or {}).items()}
     starts = [k for k in range(n) if k == 0 or rec[k][1] is not rec[k - 1][1]] + [n]
     for a, b in zip(starts[:-1], starts[1:], strict=True):
         ms, sl = rec[a][1], slice(a, b)
@@ -423,30 +508,76 @@ def _finish(model, rec, events, stats, wall0, status, message, sm,
             forces.setdefault(el, np.zeros((n,) + np.shape(v)[1:]))[sl] = v
         if ms.n_rows:
             res[sl] = np.max(np.abs(ms.row_values(x[sl])), axis=-1)
-    modes = list(dict.fromkeys(r[1].mode for r in rec))
+    for r in rec:
+        if r[1].mode not in modes:
+            modes.append(r[1].mode)
+    # the bodies, plus the rotors and gears of the drives reduced to their coordinates
+    T = kinetic_energy(model, x, xd) + 0.5 * (qd**2) @ sm.drive_inertia
+    U = sm.fm.potential_energy(x)
+    # the largest penetration of a stop (lengths only) or contact, m
+    pen = [float(np.max(-g)) for g, angle in gaps(sm, x).values() if not angle] if n else []
+    return dict(t=t, q=q, qdot=qd, qddot=qdd, x=x, xdot=xd, frame=frame, forces=forces,
+                mode=[r[1].mode for r in rec],
+                mode_index=np.array([modes.index(r[1].mode) for r in rec], int),
+                kinetic=T, potential=U, work_nc=W, balance=T + U - W + lost, residual=res,
+                impact_losses=lost, penetration=max([0.0, *pen]))
+
+
+def _joined(blocks: list) -> dict:
+    """The blocks of a run as one block (rows in order)."""
+    if len(blocks) == 1:
+        return blocks[0]
+    out = {k: np.concatenate([b[k] for b in blocks]) for k in blocks[0]
+           if isinstance(blocks[0][k], np.ndarray)}
+    out["mode"] = [m for b in blocks for m in b["mode"]]
+    out["forces"] = {el: np.concatenate([b["forces"][el] for b in blocks])
+                     for el in blocks[0]["forces"]}
+    out["penetration"] = max(b["penetration"] for b in blocks)
+    return out
+
+
+def _trajectory(model, block, modes, events, stats, status, message) -> Trajectory:
+    """The Trajectory of an evaluated block of samples."""
+    b = block
+    stats = dict(stats)
+    stats["penetration"] = b["penetration"]
+    stats["variable_structure"] = SwitchedSamples(
+        mode=b["mode"], modes=list(modes), mode_index=b["mode_index"],
+        frame_force=b["frame"][:, :2], frame_moment=b["frame"][:, 2], forces=b["forces"],
+        impact_losses=b["impact_losses"], penetration=b["penetration"])
+    energy = {k: b[k] for k in ("kinetic", "potential", "work_nc", "balance", "residual")}
+    return Trajectory(b["t"], b["q"], b["qdot"], b["qddot"], b["x"], b["xdot"],
+                      status=status, message=message, events=list(events), stats=stats,
+                      energy=energy, coordinate_names=model.coordinate_names,
+                      body_names=model.body_names,
+                      coordinate_is_angle=tuple(bool(v) for v in model.coord_is_angle),
+                      model=model)
+
+
+def _finish(model, rec: Samples, events, stats, wall0, status, message, sm,
+            point=(0.0, 0.0)) -> Trajectory:
+    """The Trajectory of a run from its samples: forces, frame loads and energies are
+    evaluated here (or chunk by chunk as they were handed to the sink), batched over the
+    samples of each mode segment."""
+    point = np.asarray(point, float)
+    stats = dict(stats)
+    if rec.sink is not None:
+        rec.flush(stats)
+        blocks = rec.blocks
+        if rec.streamed and not rec.keep:
+            stats["streamed"] = dict(rec.streamed)
+    else:
+        blocks = [_block(model, sm, rec.state[1], point, rec.modes)]
+    if not blocks:  # nothing recorded
+        blocks = [_block(model, sm, [], point, rec.modes)]
     key = frame_impulse_key(sm)
     for ev in events:  # the frame's impulse of an impact: its angular part about the point
         if key in ev.impulses:
             f = np.array(ev.impulses[key], float)
             f[2] -= point[0] * f[1] - point[1] * f[0]
             ev.impulses[key] = f
-    # the bodies, plus the rotors and gears of the drives reduced to their coordinates
-    T = kinetic_energy(model, x, xd) + 0.5 * (qd**2) @ sm.drive_inertia
-    U = sm.fm.potential_energy(x)
-    stats = dict(stats)
-    # the largest penetration of a stop (lengths only) or contact, m
-    pen = [float(np.max(-g)) for g, angle in gaps(sm, x).values() if not angle] if n else []
-    stats["penetration"] = max([0.0, *pen])
+    block = _joined(blocks)
+    if rec.sink is not None:
+        block["penetration"] = max(rec.penetration, block["penetration"])
     stats["wall_time_s"] = time.perf_counter() - wall0
-    stats["variable_structure"] = SwitchedSamples(
-        mode=[r[1].mode for r in rec], modes=modes,
-        mode_index=np.array([modes.index(r[1].mode) for r in rec], int),
-        frame_force=frame[:, :2], frame_moment=frame[:, 2], forces=forces,
-        impact_losses=lost,
-        penetration=stats["penetration"])
-    energy = dict(kinetic=T, potential=U, work_nc=W, balance=T + U - W + lost, residual=res)
-    return Trajectory(t, q, qd, qdd, x, xd, status=status, message=message,
-                      events=list(events), stats=stats, energy=energy,
-                      coordinate_names=model.coordinate_names, body_names=model.body_names,
-                      coordinate_is_angle=tuple(bool(v) for v in model.coord_is_angle),
-                      model=model)
+    return _trajectory(model, block, rec.modes, events, stats, status, message)

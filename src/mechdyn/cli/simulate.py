@@ -28,7 +28,7 @@ from ..results.events import events_table
 from ..results.frame_geometry import _trace_spec
 from ..results.plot_dynamics import plot_trajectory
 from ..results.plot_spectrum import plot_spectrum
-from ..results.table import deg_or_mm, write_csv, written
+from ..results.table import CsvStream, deg_or_mm, written
 from ..simulate import simulate
 from ..simulate_events import format_events
 from ..units import parse_quantity
@@ -101,6 +101,10 @@ def register(sub) -> None:
                    help="frequency content of a column of the table, e.g. Fy_frame_N: print "
                         "its peak, RMS and dominant components; with -o also write "
                         "NAME_spectrum.csv, with --plot NAME_spectrum.png")
+    p.add_argument("--chunk", type=int, default=2000, metavar="N",
+                   help="with -o: rows computed and appended to NAME.csv.partial at a time "
+                        "(default 2000); the file becomes NAME.csv when the run ends, so a "
+                        "crashed run leaves NAME.csv.partial, readable up to its last chunk")
     p.add_argument("--backend", default="auto", choices=("auto", "numpy", "numba"),
                    help="right-hand side evaluation (default auto: compiled when possible)")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
@@ -146,12 +150,22 @@ def run(args) -> int:
         if args.samples < 2:
             raise ModelError(f"--samples must be >= 2, got {args.samples}")
         t_eval = np.linspace(t0, t_end, args.samples)
-    traj = simulate(model, t_end, t0=t0, integrator=args.integrator, steps=args.fixed_steps,
-                    dt=dt, rtol=args.rtol, atol=args.atol, q0=q0, qdot0=qdot0, t_eval=t_eval,
-                    formulation=args.formulation, d=d, progress=args.progress,
-                    backend=args.backend, theta=args.theta,
-                    iterations=args.iterations if fixed else None,
-                    mode=engaged, **_moment_point(args))
+    stream = None
+    if args.output:  # rows written as computed; the whole run kept only for plots
+        stream = CsvStream(args.output, table=lambda part: _with_points(
+            part, args.points).to_dataframe(points=args.points is not None))
+    try:
+        traj = simulate(model, t_end, t0=t0, integrator=args.integrator,
+                        steps=args.fixed_steps, dt=dt, rtol=args.rtol, atol=args.atol, q0=q0,
+                        qdot0=qdot0, t_eval=t_eval, formulation=args.formulation, d=d,
+                        progress=args.progress, backend=args.backend, theta=args.theta,
+                        iterations=args.iterations if fixed else None, mode=engaged,
+                        sink=stream, chunk=args.chunk,
+                        keep=bool(args.plot or args.spectrum), **_moment_point(args))
+    except BaseException:
+        if stream is not None:
+            stream.abort()  # NAME.csv.partial stays as written so far
+        raise
     print(traj.summary())
     if traj.events:
         print(format_events(traj.events, traj.coordinate_names, limit=40))
@@ -160,9 +174,9 @@ def run(args) -> int:
             traj.coordinate_names, traj.q[-1], traj.coordinate_is_angle, strict=True))
         print(f"at t = {traj.t[-1]:.9g} s: {last}")
     if args.output:
-        # its header says the status (an interrupted run is marked so), atomically written
-        write_csv(_with_points(traj, args.points), args.output, points=args.points is not None)
-        print(f"wrote {args.output} ({traj.t.size} rows)")
+        # its last lines say the status (an interrupted run is marked so)
+        stream.close(traj)
+        print(f"wrote {args.output} ({stream.rows} rows)")
         if traj.events:
             ev_path = _beside(args.output, "_events.csv")
             with written(ev_path) as tmp:

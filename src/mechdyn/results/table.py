@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["write_csv", "read_csv", "unit_of_column", "UNIT_SUFFIXES", "output_path", "written",
-           "deg_or_mm", "rate_text"]
+__all__ = ["write_csv", "read_csv", "CsvStream", "unit_of_column", "UNIT_SUFFIXES",
+           "output_path", "written", "deg_or_mm", "rate_text"]
 
 #: column-name suffix -> unit, longest suffixes first when matching
 UNIT_SUFFIXES: dict[str, str] = {
@@ -163,24 +163,137 @@ def write_csv(record, path, *, float_format: str = "%.12g", **options) -> Path:
         The file written.
     """
     df = record.to_dataframe(**options)
-    mech = getattr(getattr(record, "model", None), "mechanism", None)
-    lines = [f"mechdyn {type(record).__name__}"
-             + (f" of {mech.name!r}" if mech is not None else "")]
-    for label, attr in (("swept coordinate", "over"), ("status", "status")):
-        if getattr(record, attr, None) is not None:
-            lines.append(f"{label}: {getattr(record, attr)}")
-    message = getattr(record, "message", "")
-    if message:
-        lines.append("message: " + " ".join(str(message).split()))
-    lines.append("column names end with their SI unit (see docs/notation.md); "
-                 "analogs are per rad (angle coordinates) or per m (travels)")
-    lines.append("units: " + ", ".join(f"{c} [{unit_of_column(c) or '-'}]" for c in df.columns))
     path = output_path(path)
     with written(path) as tmp, open(tmp, "w", encoding="utf-8", newline="") as fh:
-        for line in lines:
+        for line in _header(record, df.columns, outcome=True):
             fh.write(f"# {line}\n")
         df.to_csv(fh, index=False, float_format=float_format, lineterminator="\n")
     return path
+
+
+def _header(record, columns, *, outcome: bool) -> list[str]:
+    """The ``#`` lines of a table: the record, its status and message (with ``outcome``),
+    and the unit of every column."""
+    mech = getattr(getattr(record, "model", None), "mechanism", None)
+    lines = [f"mechdyn {type(record).__name__}"
+             + (f" of {mech.name!r}" if mech is not None else "")]
+    if getattr(record, "over", None) is not None:
+        lines.append(f"swept coordinate: {record.over}")
+    lines.extend(_outcome(record) if outcome else [
+        "rows written as they are computed; the run's outcome is on the last lines"])
+    lines.append("column names end with their SI unit (see docs/notation.md); "
+                 "analogs are per rad (angle coordinates) or per m (travels)")
+    lines.append("units: " + ", ".join(f"{c} [{unit_of_column(c) or '-'}]" for c in columns))
+    return lines
+
+
+def _outcome(record) -> list[str]:
+    """The status and message lines of a record."""
+    lines = [] if getattr(record, "status", None) is None else [f"status: {record.status}"]
+    message = getattr(record, "message", "")
+    if message:
+        lines.append("message: " + " ".join(str(message).split()))
+    return lines
+
+
+class CsvStream:
+    """A table written as its rows are computed: the sink of
+    :func:`mechdyn.simulate` (``sink=``).
+
+    ``NAME.csv`` is written as ``NAME.csv.partial``: the ``#`` header and the column
+    names with the first chunk, then every chunk appended in one write; :meth:`close`
+    appends the status and message lines and renames the file to ``NAME.csv``.  A run that
+    crashed leaves ``NAME.csv.partial``, readable by :func:`read_csv` up to its last chunk.
+    A path that is not a regular file (a device, a pipe) is written directly.
+
+    Parameters
+    ----------
+    path : str or Path
+        The table to write; its folder is created if needed.
+    table : callable, optional
+        ``table(part) -> DataFrame`` of a chunk (default ``part.to_dataframe()``).
+    float_format : str
+        printf-style format of the numbers.
+
+    Raises
+    ------
+    RuntimeError
+        A chunk whose columns differ from the first one's.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib, mechdyn
+    >>> from mechdyn import examples
+    >>> out = pathlib.Path(tempfile.mkdtemp()) / "fb.csv"
+    >>> stream = CsvStream(out)
+    >>> traj = mechdyn.simulate(mechdyn.load(examples.path("four_bar")), 0.01,
+    ...                         t_eval=[0, 0.005, 0.01], sink=stream, chunk=2, keep=False)
+    >>> stream.close(traj).name, stream.rows
+    ('fb.csv', 3)
+    >>> len(read_csv(out))
+    3
+    """
+
+    def __init__(self, path, *, table=None, float_format: str = "%.12g"):
+        self.path = output_path(path)
+        direct = self.path.exists() and not self.path.is_file()
+        self.partial = self.path if direct else self.path.with_name(self.path.name + ".partial")
+        self.table = table or (lambda part: part.to_dataframe())
+        self.float_format = float_format
+        self.columns: list | None = None
+        self.rows = 0
+        self._fh = None
+
+    def _write(self, text: str) -> None:
+        data = memoryview(text.encode("utf-8"))
+        while data:  # one write call for a chunk: a killed process leaves whole chunks
+            data = data[self._fh.write(data):]
+
+    def __call__(self, part, start: int) -> None:
+        """Append the rows of ``part`` (a record with ``to_dataframe``) from row ``start``
+        of the run (rows already written are skipped)."""
+        df = self.table(part).iloc[max(self.rows - start, 0):]
+        if self.columns is None:
+            self._fh = open(self.partial, "wb", buffering=0)  # noqa: SIM115 - kept open
+            self.columns = list(df.columns)
+            text = "".join(f"# {line}\n" for line in _header(part, df.columns, outcome=False))
+            self._write(text + ",".join(self.columns) + "\n")
+        elif list(df.columns) != self.columns:
+            raise RuntimeError(f"{self.path}: the columns of a chunk changed: "
+                               f"{sorted(set(df.columns) ^ set(self.columns))}")
+        if len(df):
+            self._write(df.to_csv(None, index=False, header=False,
+                                  float_format=self.float_format, lineterminator="\n"))
+            self.rows += len(df)
+
+    def close(self, record) -> Path:
+        """End the table with ``record``'s status and message and give it its name.
+
+        Parameters
+        ----------
+        record
+            The record of the whole run (its header when no row was written).
+
+        Returns
+        -------
+        Path
+            The table written.
+        """
+        if self.columns is None:  # no chunk came: no row was computed, the header alone
+            self(record, 0)
+        try:
+            self._write("".join(f"# {line}\n" for line in _outcome(record)))
+        finally:
+            self.abort()
+        if self.partial != self.path:
+            os.replace(self.partial, self.path)
+        return self.path
+
+    def abort(self) -> None:
+        """Close the file where it is (``NAME.csv.partial`` stays as written)."""
+        if self._fh is not None:
+            self._fh.close()
+            self._fh = None
 
 
 def read_csv(path):

@@ -149,6 +149,8 @@ class Trajectory:
 
     def energy_drift(self) -> float:
         """Largest |balance - balance[0]| over the run, J (NaN without energy)."""
+        if "streamed" in self.stats:  # a run handed to a sink, of which this is the end
+            return float(self.stats["streamed"]["energy_drift"])
         if not self.energy or self.t.size == 0:
             return float("nan")
         b = self.energy["balance"]
@@ -163,7 +165,11 @@ class Trajectory:
                 f"integrator {s.get('integrator')} ({s.get('formulation')}, backend "
                 f"{s.get('backend')}): {s.get('steps')} steps, {s.get('evaluations')} "
                 f"evaluations, wall time {s.get('wall_time_s', float('nan')):.4g} s")
-        if self.t.size:
+        streamed = s.get("streamed") if s else None
+        if streamed:
+            lines.append(f"samples: {streamed['rows']} (streamed), t = "
+                         f"{streamed['t_first']:.6g} .. {self.t[-1]:.6g} s")
+        elif self.t.size:
             lines.append(f"samples: {self.t.size}, t = {self.t[0]:.6g} .. {self.t[-1]:.6g} s")
         bif = s.get("bifurcations") if s else None
         if bif:
@@ -178,7 +184,7 @@ class Trajectory:
                 f"energy at the end: T = {e['kinetic'][-1]:.9g} J, U = {e['potential'][-1]:.9g}"
                 f" J, W_nc = {e['work_nc'][-1]:.9g} J; balance T + U - W_nc drifts by "
                 f"{self.energy_drift():.3e} J; largest constraint residual "
-                f"{np.max(e['residual']):.3e}")
+                f"{streamed['residual'] if streamed else np.max(e['residual']):.3e}")
         return "\n".join(lines)
 
     # ------------------------------------------------------------------ tables
