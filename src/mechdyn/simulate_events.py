@@ -149,7 +149,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
 
     # ---------------------------------------------------------------- records
     # per sample: t, the mode system, the evaluation, w_nc and the impact losses so far;
-    # forces and energies are computed at the end, batched over each mode's samples
+    # forces and energies are computed at the end (with a sink: chunk by chunk), batched
+    # over each mode's samples
     rec = Samples(model, sm, point, sink=sink, chunk=chunk, keep=keep)
     events: list[SwitchEvent] = []
     stats = dict(steps=0, rejected=0, evaluations=0, integrator=method_name,

@@ -92,7 +92,10 @@ class Trajectory:
         ``steps``, ``rejected``, ``evaluations`` (right-hand sides), ``wall_time_s``,
         ``integrator``, ``formulation``, ``backend`` and the integrator's settings; for a
         variable-structure run also ``segments`` and ``variable_structure``, a
-        :class:`SwitchedSamples` (see :attr:`switching`).
+        :class:`SwitchedSamples` (see :attr:`switching`); for a run handed to a sink
+        without keeping its samples (``simulate(sink=..., keep=False)``, which holds the
+        last chunk) ``streamed``: the run's ``rows``, ``t_first``, ``energy_drift`` and
+        largest constraint ``residual``.
     energy : dict or None
         Arrays of shape (n,): ``kinetic`` T, ``potential`` U, ``work_nc`` (work of
         the non-conservative forces since t0: drives, applied forces and torques,
