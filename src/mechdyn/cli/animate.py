@@ -13,6 +13,7 @@ that stopped; the frames computed so far are written); 2 bad input.
 from __future__ import annotations
 
 from ..kinematics.sweep import sweep
+from ..progress import stage
 from ..results.animate import _trace_spec, animate, check_animation_path, snapshot
 from .options import add_motion_arguments, finish, open_model, simulate_from_args, sweep_values
 
@@ -57,12 +58,15 @@ def run(args) -> int:
               f"({record.status})")
     else:
         over, values, _ = sweep_values(model, args)
-        record = sweep(model, over, values)
+        with stage(f"animate: sweeping {over} over {values.size} positions", args.progress):
+            record = sweep(model, over, values)
         ok, why = record.ok, record.message
         print(f"{mech.name}: {len(record)} of {values.size} positions of {over} "
               f"({record.status})")
-    out = animate(record, args.output, fps=args.fps, frames=args.frames, trace=args.trace,
-                  title=args.title, labels=args.labels)
+    n = min(len(record), 200) if args.frames is None else args.frames
+    with stage(f"animate: drawing {n} frames into {args.output}", args.progress):
+        out = animate(record, args.output, fps=args.fps, frames=args.frames, trace=args.trace,
+                      title=args.title, labels=args.labels)
     print(f"  animation: {out}")
     if args.snapshot:
         still = snapshot(record, args.snapshot, 0, trace=args.trace, title=args.title,
