@@ -1,6 +1,5 @@
-"""Progress on stderr for long runs: a tqdm bar over simulated time (:class:`Progress`),
-over the items of a loop (:func:`bar`), and a line naming a stage still running
-(:func:`stage`).
+"""Progress on stderr for long runs: a tqdm bar over simulated time (:class:`Progress`)
+and a line naming a stage still running (:func:`stage`).
 
 Every one takes a ``progress`` mode: True shows it at once, False never, None (the
 default of the commands) once the work has taken longer than :data:`PROGRESS_AFTER`
@@ -14,7 +13,7 @@ import threading
 import time
 from contextlib import contextmanager
 
-__all__ = ["Progress", "PROGRESS_AFTER", "bar", "stage"]
+__all__ = ["Progress", "PROGRESS_AFTER", "stage"]
 
 #: runs that take longer than this (s of wall time) show a progress bar (progress=None)
 PROGRESS_AFTER = 2.0
@@ -49,40 +48,9 @@ class Progress:
             self.bar.close()
 
 
-def bar(iterable=None, *, total: int | None = None, desc: str = "", unit: str = "it",
-        progress: bool | None = None):
-    """A tqdm bar on stderr over ``iterable`` (or ``total`` items, advanced by ``update``).
-
-    Parameters
-    ----------
-    iterable : iterable, optional
-        The items; the bar yields them.
-    total : int, optional
-        Number of items (default ``len(iterable)``).
-    desc, unit : str
-        The label before the bar and the name of one item.
-    progress : bool or None
-        Show the bar at once (True), never (False) or once the loop has taken longer
-        than :data:`PROGRESS_AFTER` seconds (None).
-
-    Returns
-    -------
-    tqdm
-        The bar (disabled when ``progress`` is False); close it, or exhaust it.
-
-    Examples
-    --------
-    >>> sum(bar(range(4), desc="adding", progress=False))
-    6
-    """
-    from tqdm import tqdm
-
-    return tqdm(iterable, total=total, desc=desc, unit=unit, file=sys.stderr,
-                delay=_delay(progress), disable=progress is False, leave=False)
-
-
 @contextmanager
-def stage(what: str, progress: bool | None = None):
+def stage(what: str, progress: bool | None = None, *, done: str | None = None,
+          after: float | None = None):
     """Say on stderr ``"<what> ..."`` once the block has run longer than
     :data:`PROGRESS_AFTER` seconds (at once for True, never for False), and how long it
     took when it ends; a quick block says nothing.
@@ -92,7 +60,13 @@ def stage(what: str, progress: bool | None = None):
     what : str
         The stage, e.g. ``"report: kinetostatics over 361 positions"``.
     progress : bool or None
-        As for :func:`bar`.
+        Say it at once (True), never (False) or once the block has run longer than
+        :data:`PROGRESS_AFTER` seconds (None).
+    done : str, optional
+        The closing line, ``{:.1f}`` taking the seconds (default ``"<what>: done in
+        {:.1f} s"``).
+    after : float, optional
+        Seconds before the line for ``progress=None`` (default :data:`PROGRESS_AFTER`).
 
     Examples
     --------
@@ -109,14 +83,19 @@ def stage(what: str, progress: bool | None = None):
         said.append(True)
         print(f"{what} ...", file=sys.stderr, flush=True)
 
-    timer = threading.Timer(_delay(progress), announce)
+    wait = _delay(progress) if after is None or progress is True else after
+    timer = threading.Timer(wait, announce)
     timer.daemon = True
-    timer.start()
+    if wait > 0:
+        timer.start()
+    else:  # at once, before the block can end
+        announce()
     try:
         yield
     finally:
         timer.cancel()
-        timer.join()
+        if timer.is_alive():
+            timer.join()
         if said:
-            print(f"{what}: done in {time.perf_counter() - t0:.1f} s", file=sys.stderr,
-                  flush=True)
+            closing = done if done is not None else what + ": done in {:.1f} s"
+            print(closing.format(time.perf_counter() - t0), file=sys.stderr, flush=True)
