@@ -50,7 +50,7 @@ class Progress:
 
 @contextmanager
 def stage(what: str, progress: bool | None = None, *, done: str | None = None,
-          after: float | None = None):
+          after: float | None = None, since: float | None = None):
     """Say on stderr ``"<what> ..."`` once the block has run longer than
     :data:`PROGRESS_AFTER` seconds (at once for True, never for False), and how long it
     took when it ends; a quick block says nothing.
@@ -67,6 +67,10 @@ def stage(what: str, progress: bool | None = None, *, done: str | None = None,
         {:.1f} s"``).
     after : float, optional
         Seconds before the line for ``progress=None`` (default :data:`PROGRESS_AFTER`).
+    since : float, optional
+        The ``time.perf_counter()`` those seconds count from (default now): the stages
+        of one run share the start of the run, so the stage running once the run has
+        taken 2 s is named.
 
     Examples
     --------
@@ -77,13 +81,14 @@ def stage(what: str, progress: bool | None = None, *, done: str | None = None,
         yield
         return
     t0 = time.perf_counter()
+    spent = 0.0 if since is None else t0 - since
     said = []
 
     def announce():
         said.append(True)
         print(f"{what} ...", file=sys.stderr, flush=True)
 
-    wait = _delay(progress) if after is None or progress is True else after
+    wait = (_delay(progress) if after is None or progress is True else after) - spent
     timer = threading.Timer(wait, announce)
     timer.daemon = True
     if wait > 0:

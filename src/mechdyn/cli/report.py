@@ -23,6 +23,7 @@ The analyses are composed here and written by :mod:`mechdyn.results.report`.
 from __future__ import annotations
 
 import argparse
+import time
 import warnings
 from pathlib import Path
 
@@ -74,12 +75,13 @@ def register(sub) -> None:
 
 def run(args) -> int:
     """Run ``mechdyn report``; returns the exit code."""
+    t0 = time.perf_counter()  # the stage running once the run has taken 2 s is named
     mech, model = open_model(args)
     if args.simulate:
         traj = simulate_from_args(model, args, 401)
         supports = foundation_loads(mech, traj)
         mounted, modes = mounted_loads(mech, supports)
-        with stage(f"report: writing {args.output}", args.progress):
+        with stage(f"report: writing {args.output}", args.progress, since=t0):
             out = report_trajectory(traj, args.output, title=args.title,
                                     animation=args.animation, trace=args.trace,
                                     supports=supports, mounted=mounted, modes=modes)
@@ -89,9 +91,9 @@ def run(args) -> int:
     over, values, _ = sweep_values(model, args)
     speed, why = speed_from_args(model, over, args)
     model, sw, ks = report_records(model, speed=speed, over=over, values=values,
-                                   progress=args.progress)
+                                   progress=args.progress, since=t0)
     with stage(f"report: writing {args.output} (plots"
-               + (", animation)" if args.animation else ")"), args.progress):
+               + (", animation)" if args.animation else ")"), args.progress, since=t0):
         out = write_report(model, args.output, sweep=sw, kinetostatics=ks, title=args.title,
                            animation=args.animation, trace=args.trace,
                            supports=foundation_loads(mech, ks))
@@ -107,7 +109,7 @@ def run(args) -> int:
 
 def report_records(mech_or_model, *, speed: float | None = None, over: str | None = None,
                    values=None, steps: int = 361, point=(0.0, 0.0),
-                   progress: bool | None = False):
+                   progress: bool | None = False, since: float | None = None):
     """The analyses a :func:`report` shows: a sweep and the kinetostatic cycle.
 
     Runs a kinematic sweep of ``over`` and the kinetostatic cycle at that speed; the
@@ -134,6 +136,9 @@ def report_records(mech_or_model, *, speed: float | None = None, over: str | Non
     progress : bool or None
         Name each analysis on stderr while it runs: at once (True), never (False, the
         default) or once it has taken longer than 2 s (None, as the command does).
+    since : float, optional
+        The ``time.perf_counter()`` of the start of the run those 2 s count from
+        (default the call).
 
     Returns
     -------
@@ -157,12 +162,14 @@ def report_records(mech_or_model, *, speed: float | None = None, over: str | Non
     values = np.asarray(values, dtype=float)
     if speed is None:
         speed = model_speed(model, over)[0]
-    with stage(f"report: kinematics, {values.size} positions of {over}", progress):
+    with stage(f"report: kinematics, {values.size} positions of {over}", progress,
+               since=since):
         sw = run_sweep(model, over, values, speed=float(speed))
     q0 = initial_coordinates(model)
     hold = {c: float(q0[i]) for i, c in enumerate(model.coordinate_names) if c != over}
     with (warnings.catch_warnings(),
-          stage(f"report: kinetostatics, {values.size} positions of {over}", progress)):
+          stage(f"report: kinetostatics, {values.size} positions of {over}", progress,
+                since=since)):
         warnings.simplefilter("ignore", KinetostaticsWarning)  # shown in the report
         try:  # the other coordinates held at their initial values
             ks = kinetostatics(model, over=over, speed=float(speed), values=values,
