@@ -20,6 +20,8 @@ CASES = [
     (FOUR_BAR_ANIMATION, "a.gif", "animate: sweeping phi over 9 positions"),
     (["animate", "four_bar", "--simulate", "--t-end", "2ms", "--frames", "3"], "s.gif",
      "simulate:"),
+    (["animate", "four_bar", "--simulate", "--t-end", "2ms", "--no-labels"], "d.gif",
+     "animate: drawing 200 frames"),  # the default number of frames of a run
     (["report", "four_bar", "--steps", "13", "--no-animation"], "r.html",
      "report: kinetostatics, 13 positions of phi"),
     (["report", "four_bar", "--steps", "13", "--no-animation"], "r.html", "report: writing"),

@@ -67,7 +67,7 @@ def run(args) -> int:
         ok, why = record.ok, record.message
         print(f"{mech.name}: {len(record)} of {values.size} positions of {over} "
               f"({record.status})")
-    n = min(len(record), 200) if args.frames is None else args.frames
+    n = min(len(record.x), 200) if args.frames is None else args.frames
     with stage(f"animate: drawing {n} frames into {args.output}", args.progress, since=t0):
         out = animate(record, args.output, fps=args.fps, frames=args.frames, trace=args.trace,
                       title=args.title, labels=args.labels)
