@@ -12,7 +12,10 @@ that stopped; the frames computed so far are written); 2 bad input.
 
 from __future__ import annotations
 
+import time
+
 from ..kinematics.sweep import sweep
+from ..progress import stage
 from ..results.animate import _trace_spec, animate, check_animation_path, snapshot
 from .options import add_motion_arguments, finish, open_model, simulate_from_args, sweep_values
 
@@ -46,6 +49,7 @@ def register(sub) -> None:
 
 def run(args) -> int:
     """Run ``mechdyn animate``; returns the exit code."""
+    t0 = time.perf_counter()  # the stage running once the run has taken 2 s is named
     check_animation_path(args.output)  # before any computing
     mech, model = open_model(args)
     _trace_spec(model, args.trace)
@@ -57,12 +61,16 @@ def run(args) -> int:
               f"({record.status})")
     else:
         over, values, _ = sweep_values(model, args)
-        record = sweep(model, over, values)
+        with stage(f"animate: sweeping {over} over {values.size} positions", args.progress,
+                   since=t0):
+            record = sweep(model, over, values)
         ok, why = record.ok, record.message
         print(f"{mech.name}: {len(record)} of {values.size} positions of {over} "
               f"({record.status})")
-    out = animate(record, args.output, fps=args.fps, frames=args.frames, trace=args.trace,
-                  title=args.title, labels=args.labels)
+    n = min(len(record.x), 200) if args.frames is None else args.frames
+    with stage(f"animate: drawing {n} frames into {args.output}", args.progress, since=t0):
+        out = animate(record, args.output, fps=args.fps, frames=args.frames, trace=args.trace,
+                      title=args.title, labels=args.labels)
     print(f"  animation: {out}")
     if args.snapshot:
         still = snapshot(record, args.snapshot, 0, trace=args.trace, title=args.title,

@@ -22,12 +22,14 @@ from ..dynamics.flywheel import FLYWHEEL_METHODS, size_flywheel
 from ..dynamics.reduced_machine import ReducedMachine
 from ..dynamics.reduction import reduce_model
 from ..errors import ModelError
+from ..progress import stage
 from ..results.plot_reduction import plot_steady_cycle
 from ..results.table import rate_text
 from ..units import parse_quantity
 from .options import (
     add_files,
     add_model_arguments,
+    add_progress,
     finish,
     model_speed,
     prepare_model,
@@ -69,6 +71,7 @@ def register(sub) -> None:
                         "the table (slower; needed for time- or speed-dependent loads)")
     add_files(p, plot="plot the steady cycle with the flywheel",
               table="write the steady cycle with the flywheel to this CSV file")
+    add_progress(p)
 
 
 def run(args) -> int:
@@ -78,22 +81,23 @@ def run(args) -> int:
     if args.steps < 9:
         raise ModelError(f"--steps must be at least 9, got {args.steps}")
     given = None if args.speed is None else quantity(args.speed, "angular_velocity", "--speed")
-    if args.exact:
-        machine = ReducedMachine.from_model(model)
-    else:
-        machine = reduce_model(model, steps=args.steps, omega=given or 1.0).machine(model)
-    dependent = machine.speed_dependent()
-    speed, why = given, "given with --speed"
-    if not dependent and speed is None:
-        speed, why = model_speed(model, model.coordinate_names[0], fallback=None)
-        if speed is None:
-            raise ModelError(f"the driving torque does not depend on the speed, so the steady "
-                             f"speed is not determined by the machine, and {why}: give the "
-                             f"mean speed with --speed (e.g. --speed 43.5rad/s)")
-        if not args.exact:  # the table's velocity-dependent loads at that speed
-            machine = reduce_model(model, steps=args.steps, omega=speed).machine(model)
-    speed_kw = "omega_guess" if dependent else "omega_mean"  # a motor picks its own speed
-    fs = size_flywheel(machine, delta, method=args.method, **{speed_kw: speed})
+    with stage("flywheel: reduction table and steady cycle", args.progress):
+        if args.exact:
+            machine = ReducedMachine.from_model(model)
+        else:
+            machine = reduce_model(model, steps=args.steps, omega=given or 1.0).machine(model)
+        dependent = machine.speed_dependent()
+        speed, why = given, "given with --speed"
+        if not dependent and speed is None:
+            speed, why = model_speed(model, model.coordinate_names[0], fallback=None)
+            if speed is None:
+                raise ModelError(f"the driving torque does not depend on the speed, so the "
+                                 f"steady speed is not determined by the machine, and {why}: "
+                                 f"give the mean speed with --speed (e.g. --speed 43.5rad/s)")
+            if not args.exact:  # the table's velocity-dependent loads at that speed
+                machine = reduce_model(model, steps=args.steps, omega=speed).machine(model)
+        speed_kw = "omega_guess" if dependent else "omega_mean"  # a motor picks its own speed
+        fs = size_flywheel(machine, delta, method=args.method, **{speed_kw: speed})
     print(f"{mech.name}: flywheel for delta = {delta:.4g} ({fs.method} method)")
     print(f"  mean speed            {rate_text(fs.omega_mean, True)}"
           + (f" ({why})" if not dependent else " (the steady cycle of the drive)"))

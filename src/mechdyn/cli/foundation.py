@@ -50,7 +50,15 @@ from ..foundation.plot import plot_support_loads
 from ..modelfile.foundation import support_fields
 from ..results.table import write_csv
 from ..units import parse_quantity, parse_vector
-from .options import add_files, add_model, add_run, finish, load_model, simulate_from_args
+from .options import (
+    add_files,
+    add_model,
+    add_progress,
+    add_run,
+    finish,
+    load_model,
+    simulate_from_args,
+)
 
 __all__ = ["register", "run", "parse_support"]
 
@@ -113,6 +121,7 @@ def register(sub) -> None:
     add_files(p, plot="plot the loads on the supports (kN)",
               table="write the support loads to this CSV file (and NAME_mounted.csv with "
                     "--mass/--inertia, NAME_coupled.csv with --coupled)")
+    add_progress(p)
 
 
 def parse_support(text: str, cls, flag: str):
@@ -260,7 +269,7 @@ def _coupled(args, mech, foundation, traj):
         warnings.simplefilter("always", FloorFrameWarning)
         c = compare_mounting(mech, foundation, t_end, samples=args.samples, rigid_run=traj,
                              reacting=tuple(args.bed), integrator=args.integrator,
-                             rtol=args.rtol, progress=None)
+                             rtol=args.rtol, progress=args.progress)
     print("  coupled: the frame as a body on its isolators, one run with the machine")
     for w in caught:
         print(f"  note: {w.message}")

@@ -12,6 +12,7 @@ before it are written); 2 bad input (one line on stderr).
 from __future__ import annotations
 
 from ..kinematics.sweep import sweep
+from ..progress import stage
 from ..results.frame_geometry import _trace_spec
 from ..results.plot import plot_kinematic_sweep
 from ..results.table import deg_or_mm
@@ -20,6 +21,7 @@ from .options import (
     add_model,
     add_plot_columns,
     add_points,
+    add_progress,
     add_range,
     add_speed,
     check_plot_columns,
@@ -56,6 +58,7 @@ def register(sub) -> None:
                    help="plot the coupler curve of this point (default: a coupler point of a "
                         "four-bar loop, if any)")
     add_plot_columns(p)
+    add_progress(p)
 
 
 def run(args) -> int:
@@ -65,7 +68,8 @@ def run(args) -> int:
     _trace_spec(model, args.trace)
     over, values, _ = sweep_values(model, args, only=True)
     speed, why = speed_from_args(model, over, args)
-    sw = sweep(model, over, values, speed=speed)
+    with stage(f"kinematics: sweeping {over} over {values.size} positions", args.progress):
+        sw = sweep(model, over, values, speed=speed)
     ends, unit = deg_or_mm(values[[0, -1]], sw.over_is_angle)
     print(f"{mech.name}: {len(sw)} of {values.size} positions, {over} from "
           f"{ends[0]:.6g} {unit} to {ends[1]:.6g} {unit}; status {sw.status}")

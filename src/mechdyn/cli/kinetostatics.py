@@ -16,6 +16,7 @@ from pathlib import Path
 
 from ..dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
 from ..errors import ModelError, Status
+from ..progress import stage
 from ..results.plot_kinetostatics import plot_joint_force_polar, plot_kinetostatics
 from ..results.table import written
 from .options import (
@@ -24,6 +25,7 @@ from .options import (
     add_model,
     add_moment_point,
     add_plot_columns,
+    add_progress,
     add_range,
     add_speed,
     check_plot_columns,
@@ -66,6 +68,7 @@ def register(sub) -> None:
     p.add_argument("--joints", nargs="+", metavar="JOINT",
                    help="joints whose forces are plotted (default: all)")
     add_plot_columns(p)
+    add_progress(p)
     p.add_argument("--plot-polar", action="append", default=[], metavar="JOINT",
                    help="with --plot FILE: also the polar diagram of this joint's force, "
                         "written beside it as FILE_polar_JOINT (repeatable)")
@@ -87,7 +90,8 @@ def run(args) -> int:
     over, values, _ = sweep_values(model, args)
     speed, why = speed_from_args(model, over, args)
     point = moment_point(args)
-    with warnings.catch_warnings():
+    with (warnings.catch_warnings(),
+          stage(f"kinetostatics: {values.size} positions of {over}", args.progress)):
         warnings.simplefilter("ignore", KinetostaticsWarning)  # printed below
         res = kinetostatics(model, over=over, speed=speed, values=values, point=point,
                             mode=engaged, reacting_loads=tuple(args.bed))

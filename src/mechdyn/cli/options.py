@@ -125,6 +125,14 @@ def add_run(p, *, required: bool) -> None:
                         f"{DEFAULT_RTOL:g})")
 
 
+def add_progress(p) -> None:
+    """Add ``--progress/--no-progress``: always (or never) show progress on stderr; by
+    default once a run takes longer than :data:`mechdyn.progress.PROGRESS_AFTER` (2 s)."""
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="always (or never) show progress on stderr (default: once a run "
+                        "takes more than 2 s)")
+
+
 def add_motion_arguments(p, metavar: str, output: str, *, steps: int, verb: str, title: str):
     """Add what ``mechdyn animate`` and ``report`` share: model, -o, sweep and simulation
     groups; returns the drawing group (``--trace``, ``--title``)."""
@@ -138,6 +146,7 @@ def add_motion_arguments(p, metavar: str, output: str, *, steps: int, verb: str,
     d = p.add_argument_group("drawing")
     d.add_argument("--trace", metavar="BODY.POINT", help="draw the path of this point")
     d.add_argument("--title", help=title)
+    add_progress(p)
     return d
 
 
@@ -408,7 +417,8 @@ def simulate_from_args(model, args, samples: int):
     if args.t_end is None:
         raise ModelError("--simulate needs --t-end, e.g. --t-end 0.05s")
     t_end = parse_quantity(args.t_end, "time", where="--t-end")
-    return simulate(model, t_end, integrator=args.integrator, rtol=args.rtol, progress=None,
+    return simulate(model, t_end, integrator=args.integrator, rtol=args.rtol,
+                    progress=getattr(args, "progress", None),
                     t_eval=np.linspace(0.0, t_end, samples))
 
 

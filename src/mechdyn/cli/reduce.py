@@ -19,11 +19,13 @@ import numpy as np
 from ..dynamics.reduction import reduce_model
 from ..errors import ModelError
 from ..kinematics.sweep import initial_coordinates
+from ..progress import stage
 from ..results.frame_geometry import _trace_spec
 from ..results.plot_reduction import plot_reduction
 from .options import (
     add_files,
     add_model_arguments,
+    add_progress,
     add_speed,
     add_start,
     finish,
@@ -61,6 +63,7 @@ def register(sub) -> None:
     add_speed(p, "speed of the coordinate (with --link: of the link) at which drives and "
                  "velocity-dependent loads are evaluated")
     add_files(p, plot="write a plot of J_red, dJ_red/dphi, M_red")
+    add_progress(p)
 
 
 def run(args) -> int:
@@ -78,8 +81,9 @@ def run(args) -> int:
             why += f", taken as the speed of link {args.link!r}"
         start = (float(initial_coordinates(model)[0]) if args.start is None
                  else quantity(args.start, "angle", "--from"))
-    red = reduce_model(model, link=args.link, point=point, steps=args.steps, start=start,
-                       omega=speed)
+    with stage(f"reduce: {args.steps} positions", args.progress):
+        red = reduce_model(model, link=args.link, point=point, steps=args.steps,
+                           start=start, omega=speed)
     fin = np.isfinite(red.J_total)
     where = f"link {red.link!r}" if red.link else f"coordinate {red.coordinate!r}"
     print(f"{mech.name}: reduction to {where}, {red.phi.size} positions from "

@@ -23,6 +23,7 @@ The analyses are composed here and written by :mod:`mechdyn.results.report`.
 from __future__ import annotations
 
 import argparse
+import time
 import warnings
 from pathlib import Path
 
@@ -33,6 +34,7 @@ from ..errors import MechdynError, ModelError, Status
 from ..kinematics.sweep import initial_coordinates
 from ..kinematics.sweep import sweep as run_sweep
 from ..model import as_model
+from ..progress import stage
 from ..results.report import report_trajectory, write_report
 from .options import (
     add_motion_arguments,
@@ -73,23 +75,28 @@ def register(sub) -> None:
 
 def run(args) -> int:
     """Run ``mechdyn report``; returns the exit code."""
+    t0 = time.perf_counter()  # the stage running once the run has taken 2 s is named
     mech, model = open_model(args)
     if args.simulate:
         traj = simulate_from_args(model, args, 401)
         supports = foundation_loads(mech, traj)
         mounted, modes = mounted_loads(mech, supports)
-        out = report_trajectory(traj, args.output, title=args.title, animation=args.animation,
-                                trace=args.trace, supports=supports, mounted=mounted,
-                                modes=modes)
+        with stage(f"report: writing {args.output}", args.progress, since=t0):
+            out = report_trajectory(traj, args.output, title=args.title,
+                                    animation=args.animation, trace=args.trace,
+                                    supports=supports, mounted=mounted, modes=modes)
         print(f"{mech.name}: simulation {traj.status}; report: {out}")
         return finish(args, traj.success, f"{traj.status}: {traj.message}")
 
     over, values, _ = sweep_values(model, args)
     speed, why = speed_from_args(model, over, args)
-    model, sw, ks = report_records(model, speed=speed, over=over, values=values)
-    out = write_report(model, args.output, sweep=sw, kinetostatics=ks, title=args.title,
-                       animation=args.animation, trace=args.trace,
-                       supports=foundation_loads(mech, ks))
+    model, sw, ks = report_records(model, speed=speed, over=over, values=values,
+                                   progress=args.progress, since=t0)
+    with stage(f"report: writing {args.output} (plots"
+               + (", animation)" if args.animation else ")"), args.progress, since=t0):
+        out = write_report(model, args.output, sweep=sw, kinetostatics=ks, title=args.title,
+                           animation=args.animation, trace=args.trace,
+                           supports=foundation_loads(mech, ks))
     print(f"{mech.name}: report: {out}")
     print(speed_line(speed, bool(model.coord_is_angle[model.coordinate_index(over)]), why))
     for line in sw.summary().lines() if len(sw) else ():
@@ -101,7 +108,8 @@ def run(args) -> int:
 
 
 def report_records(mech_or_model, *, speed: float | None = None, over: str | None = None,
-                   values=None, steps: int = 361, point=(0.0, 0.0)):
+                   values=None, steps: int = 361, point=(0.0, 0.0),
+                   progress: bool | None = False, since: float | None = None):
     """The analyses a :func:`report` shows: a sweep and the kinetostatic cycle.
 
     Runs a kinematic sweep of ``over`` and the kinetostatic cycle at that speed; the
@@ -125,6 +133,12 @@ def report_records(mech_or_model, *, speed: float | None = None, over: str | Non
         Number of positions of the default range (ends included).
     point : (float, float)
         Point of the frame moments (shaking moment), m.
+    progress : bool or None
+        Name each analysis on stderr while it runs: at once (True), never (False, the
+        default) or once it has taken longer than 2 s (None, as the command does).
+    since : float, optional
+        The ``time.perf_counter()`` of the start of the run those 2 s count from
+        (default the call).
 
     Returns
     -------
@@ -148,10 +162,14 @@ def report_records(mech_or_model, *, speed: float | None = None, over: str | Non
     values = np.asarray(values, dtype=float)
     if speed is None:
         speed = model_speed(model, over)[0]
-    sw = run_sweep(model, over, values, speed=float(speed))
+    with stage(f"report: kinematics, {values.size} positions of {over}", progress,
+               since=since):
+        sw = run_sweep(model, over, values, speed=float(speed))
     q0 = initial_coordinates(model)
     hold = {c: float(q0[i]) for i, c in enumerate(model.coordinate_names) if c != over}
-    with warnings.catch_warnings():
+    with (warnings.catch_warnings(),
+          stage(f"report: kinetostatics, {values.size} positions of {over}", progress,
+                since=since)):
         warnings.simplefilter("ignore", KinetostaticsWarning)  # shown in the report
         try:  # the other coordinates held at their initial values
             ks = kinetostatics(model, over=over, speed=float(speed), values=values,

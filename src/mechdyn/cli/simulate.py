@@ -39,6 +39,7 @@ from .options import (
     add_moment_point,
     add_plot_columns,
     add_points,
+    add_progress,
     add_run,
     check_plot_columns,
     draw_plot,
@@ -107,9 +108,7 @@ def register(sub) -> None:
                         "crashed run leaves NAME.csv.partial, readable up to its last chunk")
     p.add_argument("--backend", default="auto", choices=("auto", "numpy", "numba"),
                    help="right-hand side evaluation (default auto: compiled when possible)")
-    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
-                   help="always (or never) show a progress bar (default: once a run takes "
-                        "more than 2 s)")
+    add_progress(p)
 
 
 def _pairs(items, model, what, kinds):

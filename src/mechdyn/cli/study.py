@@ -40,7 +40,7 @@ from ..study.parameters import BaseModel
 from ..study.plots import axis_label, plot_scatter
 from ..study.report import write_study_report
 from ..units import parse_quantity
-from .options import add_model, model_speed, quantity, speed_line
+from .options import add_model, add_progress, model_speed, quantity, speed_line
 
 __all__ = ["register", "run"]
 
@@ -86,6 +86,7 @@ def register(sub) -> None:
     p.add_argument("--plot", metavar="PNG", help="plot the first parameter against --figure")
     p.add_argument("--report", metavar="HTML",
                    help="write an HTML page: ranges, best and failed variants, plots")
+    add_progress(p)
     o = p.add_argument_group("optimisation")
     o.add_argument("--minimise", metavar="COLUMN", help="minimise this figure instead")
     o.add_argument("--constraint", action="append", default=[], metavar="COLUMN>=VALUE",
@@ -192,7 +193,8 @@ def run(args) -> int:
     t0 = time.perf_counter()  # the study, not the start of its cluster
     try:
         df = run_study(base, variants, analysis, output=args.output, client=client,
-                       workers=args.workers, batch_size=args.batch, resume=args.resume)
+                       workers=args.workers, batch_size=args.batch, resume=args.resume,
+                       progress=args.progress)
     except KeyboardInterrupt:
         print(f"mechdyn study: interrupted; the variants done are in {args.output} "
               f"(run again with --resume to go on)", file=sys.stderr)

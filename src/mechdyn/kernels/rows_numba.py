@@ -9,9 +9,6 @@ Python (slow, but the same results).
 
 from __future__ import annotations
 
-import sys
-import threading
-import time
 from contextlib import contextmanager
 
 import numpy as np
@@ -44,24 +41,12 @@ def compiling(what: str, after: float = ANNOUNCE_AFTER):
     >>> with compiling("nothing much"):
     ...     pass
     """
-    t0 = time.perf_counter()
-    said = []
+    from ..progress import stage
 
-    def announce():
-        said.append(True)
-        print(f"mechdyn: compiling the {what} (first use on this machine, cached in "
-              f"{cache_dir()}) ...", file=sys.stderr, flush=True)
-
-    timer = threading.Timer(after, announce)
-    timer.daemon = True
-    timer.start()
-    try:
+    with stage(f"mechdyn: compiling the {what} (first use on this machine, cached in "
+               f"{cache_dir()})", None, after=after,
+               done=f"mechdyn: {what} compiled in {{:.1f}} s"):
         yield
-    finally:
-        timer.cancel()
-        if said:
-            print(f"mechdyn: {what} compiled in {time.perf_counter() - t0:.1f} s",
-                  file=sys.stderr, flush=True)
 
 
 def njit(fn):

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import progress as _progress
 from ..errors import ModelError
 from .evaluate import Task, evaluate_batch, order_variants
 from .output import StudyOutput, order_columns
@@ -63,7 +64,7 @@ def _bar(total: int, initial: int, progress):
     from tqdm import tqdm
 
     return tqdm(total=total, initial=initial, unit="variant", file=sys.stderr, desc="study",
-                delay=0.0 if progress else 2.0)
+                delay=0.0 if progress else _progress.PROGRESS_AFTER)
 
 
 def _quiet_worker() -> None:
