@@ -54,11 +54,11 @@ def _angle_error(a, b):
 
 
 # The residuals stated in the model file's header (identified / paper - 1, in %, and the
-# angle differences in deg), as upper bounds.  Only the pulse's torque fall is matched to
-# the 1 % aim; the idle curve's shape is not (docs/toggle-press-paper.md says why).
-STATED = {"M_max": 36.0, "M_max_deg": 35.0, "M_min": 21.0, "M_min_deg": 129.0,
-          "turn_1_deg": 19.0, "turn_4_deg": 14.0, "M_139_pulse": 1.5,
-          "F_B": 11.0, "F_C": 53.0, "F_F": 77.0}
+# angle differences in deg), as upper bounds.  The idle curve is fitted (extremes within
+# 1 %, four turning points); the figures at 139 deg are not (docs/toggle-press-paper.md).
+STATED = {"M_max": 1.0, "M_max_deg": 2.5, "M_min": 1.0, "M_min_deg": 7.0,
+          "turn_1_deg": 11.5, "turn_4_deg": 2.0, "fall_Nm": 0.01,
+          "F_B": 57.0, "F_C": 52.0, "F_F": 72.0}
 
 
 def test_idle_torque_extremes_and_their_angles_within_the_stated_residuals(runs):
@@ -75,17 +75,18 @@ def test_idle_torque_extremes_and_their_angles_within_the_stated_residuals(runs)
 def test_idle_torque_turning_points_near_the_papers_within_the_stated_residuals(runs):
     tau = runs["idle"]["M_drive_phi_Nm"].to_numpy()
     tps = _turning_points(tau)
-    assert len(tps) >= 4
+    assert len(tps) == 4  # the paper's four
     assert min(_angle_error(a, 1.0) for _, a in tps) <= STATED["turn_1_deg"]
     assert min(_angle_error(a, 341.0) for _, a in tps) <= STATED["turn_4_deg"]
 
 
-def test_pulse_at_139_deg_makes_the_torque_fall_as_the_paper_reports(runs):
+def test_pulse_at_139_deg_makes_the_torque_fall_by_the_papers_amount(runs):
+    """The paper: 9.2786 N m after a fall of 45.5442 %, i.e. by 7.7602 N m.  The fall is
+    matched; the level is not (the idle torque at 139 deg is -12.98 N m, not 17.04)."""
     idle = runs["idle"].iloc[K139]
     load = runs["load"].iloc[K139]
-    assert abs(load["M_drive_phi_Nm"] / 9.2786 - 1.0) * 100 <= STATED["M_139_pulse"]
-    fall = 1.0 - load["M_drive_phi_Nm"] / idle["M_drive_phi_Nm"]
-    assert fall == pytest.approx(0.455442, abs=0.01)
+    fall = idle["M_drive_phi_Nm"] - load["M_drive_phi_Nm"]
+    assert fall == pytest.approx(9.2786 / (1 - 0.455442) - 9.2786, abs=STATED["fall_Nm"])
     # outside the pulse the two runs are the same machine
     far = np.abs(np.rad2deg(PHI) - 139.0) > 2.0
     assert np.allclose(runs["idle"]["M_drive_phi_Nm"][far], runs["load"]["M_drive_phi_Nm"][far],
