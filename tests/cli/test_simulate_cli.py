@@ -80,7 +80,8 @@ def test_switching_run_writes_its_events_beside_the_table(tmp_path, capsys):
     assert code == 0, capsys.readouterr()
     ev = pd.read_csv(tmp_path / "press_events.csv")
     assert list(ev.columns) == ["t_s", "kind", "element", "mode_before", "mode_after",
-                                "energy_lost_J", "phi_after", "psi_after", "p_after"]
+                                "energy_lost_J", "Jx_frame_Ns", "Jy_frame_Ns", "H_frame_Nms",
+                                "phi_after", "psi_after", "p_after"]
     assert ("close", "ram_stop@upper") in set(zip(ev["kind"], ev["element"], strict=True))
 
 

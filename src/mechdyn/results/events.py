@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-__all__ = ["format_events", "events_table"]
+__all__ = ["format_events", "events_table", "frame_impulse"]
 
 
 def format_events(events, coordinate_names=None, *, limit: int | None = None) -> str:
@@ -37,9 +37,29 @@ def format_events(events, coordinate_names=None, *, limit: int | None = None) ->
     return "\n".join(lines)
 
 
+def frame_impulse(event):
+    """The impulse the frame receives at an impact, (Jx N s, Jy N s, angular N m s about
+    the run's reference point), or None for an event without one.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as E
+    >>> frame_impulse(E(impulses={"stop@up": 3.0, "frame": (-2.5, 0.5, 0.1)}))
+    (-2.5, 0.5, 0.1)
+    >>> frame_impulse(E(impulses={})) is None
+    True
+    """
+    imp = getattr(event, "impulses", None) or {}
+    # "frame (total)" where an element of the model is itself named "frame"
+    value = imp.get("frame (total)", imp.get("frame"))
+    return None if value is None else tuple(float(v) for v in value)
+
+
 def events_table(events, coordinate_names=()):
     """One row per event: ``t_s``, ``kind``, ``element``, ``mode_before``, ``mode_after``,
-    ``energy_lost_J`` and the coordinates after it (``<c>_after``): a pandas DataFrame."""
+    ``energy_lost_J``, the impulse the frame receives at an impact (``Jx_frame_Ns``,
+    ``Jy_frame_Ns``, ``H_frame_Nms``; 0 for other events) and the coordinates after it
+    (``<c>_after``): a pandas DataFrame."""
     import pandas as pd
 
     rows = []
@@ -47,6 +67,8 @@ def events_table(events, coordinate_names=()):
         row = {"t_s": ev.t, "kind": ev.kind, "element": ev.element,
                "mode_before": " ".join(sorted(ev.mode_before)),
                "mode_after": " ".join(sorted(ev.mode_after)), "energy_lost_J": ev.energy_lost}
+        jx, jy, h = ((frame_impulse(ev) or ()) + (0.0, 0.0, 0.0))[:3]
+        row.update(Jx_frame_Ns=jx, Jy_frame_Ns=jy, H_frame_Nms=h)
         if ev.q_after is not None:
             row.update({f"{n}_after": v for n, v in zip(coordinate_names, ev.q_after,
                                                         strict=False)})

@@ -13,6 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .events import frame_impulse
+
 __all__ = ["Transition", "merged_events", "mode_label", "mode_spans", "events_rows"]
 
 
@@ -28,6 +30,8 @@ class Transition:
     energy_lost: float
     message: str
     q_after: object = None
+    #: impulse the frame receives (Jx N s, Jy N s, angular N m s), or None
+    frame_impulse: tuple | None = None
 
     @property
     def label(self) -> str:
@@ -78,16 +82,17 @@ def merged_events(events, *, tol: float = 1e-12) -> list[Transition]:
             out[-1] = Transition(
                 last.t, _add(last.kinds, ev.kind), _add(last.elements, str(ev.element)),
                 before, after, max(last.energy_lost, lost),
-                "; ".join(dict.fromkeys(messages)), last.q_after)
+                "; ".join(dict.fromkeys(messages)), last.q_after,
+                last.frame_impulse or frame_impulse(ev))
             continue
         out.append(Transition(float(ev.t), (ev.kind,), (str(ev.element),), before, after, lost,
-                              msg, getattr(ev, "q_after", None)))
+                              msg, getattr(ev, "q_after", None), frame_impulse(ev)))
     return out
 
 
 def events_rows(transitions, coordinate_names=(), coordinate_is_angle=()) -> list[dict]:
-    """Rows of the events table: time, what, elements, modes, energy lost, coordinates after
-    (deg or mm)."""
+    """Rows of the events table: time, what, elements, modes, energy lost, the impulse the
+    frame receives (in a run with impacts), coordinates after (deg or mm)."""
     rows = []
     for e in transitions:
         row = {"t (s)": f"{e.t:.6f}", "event": "/".join(e.kinds),
@@ -95,6 +100,9 @@ def events_rows(transitions, coordinate_names=(), coordinate_is_angle=()) -> lis
                "mode before": mode_label(e.mode_before) if e.mode_before or e.mode_after else "",
                "mode after": mode_label(e.mode_after) if e.mode_before or e.mode_after else "",
                "energy lost (J)": e.energy_lost}
+        if any(t.frame_impulse for t in transitions):  # a run with impacts
+            jx, jy = (e.frame_impulse or (0.0, 0.0))[:2]
+            row["frame impulse x (N s)"], row["frame impulse y (N s)"] = jx, jy
         if e.q_after is not None:
             for k, (name, v) in enumerate(zip(coordinate_names, e.q_after, strict=False)):
                 ang = coordinate_is_angle[k] if k < len(coordinate_is_angle) else True
