@@ -24,6 +24,9 @@ from .assembly import _dense_solve, _scale, newton
 
 #: Newton iterations allowed per step of the continuation
 _MAX_NEWTON = 10
+#: the sweep kernels have been compiled (or loaded) in this process: they are generic over
+#: their arrays, so the first Kernel's warm-up serves every later one
+_WARM = {"done": False}
 
 
 def _c(a) -> np.ndarray:
@@ -70,11 +73,12 @@ class Kernel:
         self._drivers = rows_sweep
         #: evaluate and factor with the compiled drivers (numba installed), else NumPy
         self.compiled = rows_numba.NUMBA
-        if self.compiled:
+        if self.compiled and not _WARM["done"]:
             with rows_numba.compiling("numba kernels of the kinematic sweep"):
                 x = np.random.default_rng(1).normal(size=(1, self.n_x))
                 J = self.system(x, np.zeros((1, self.n_q)))[1]
                 self.apply(J, self.factor(J), J[..., :1])
+            _WARM["done"] = self.square  # a square kernel has compiled the LU path too
 
     def system(self, x, q):
         """F (N, n_eq) (m or rad) and J (N, n_eq, n_x) at poses x (N, n_x), q (N, n_q)."""
