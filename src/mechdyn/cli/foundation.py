@@ -49,7 +49,7 @@ from ..foundation import (
 from ..foundation.plot import plot_support_loads
 from ..modelfile.foundation import support_fields
 from ..results.table import write_csv
-from ..units import parse_quantity, parse_vector
+from ..units import parse_quantity
 from .options import (
     add_files,
     add_model,
@@ -58,6 +58,7 @@ from .options import (
     finish,
     load_model,
     simulate_from_args,
+    vector,
 )
 
 __all__ = ["register", "run", "parse_support"]
@@ -184,7 +185,7 @@ def build_foundation(args, given: Foundation | None = None) -> Foundation:
                          "give --mass and --inertia together (the elastic analysis needs "
                          "both)")
     if args.com is not None:
-        com = tuple(parse_vector(args.com.split(","), ("length", "length"), where="--com"))
+        com = vector(args.com, ("length", "length"), "--com", "two lengths X,Y, e.g. 0,0.3m")
     return Foundation(supports or given.supports, mass=mass, inertia=inertia, com=com)
 
 

@@ -268,9 +268,7 @@ def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
     mm = mounted(mechanism, f, base=base, arm=arm, load=start, pivot=pivot,
                  reacting=reacting)
     coupled_run = simulate(mm, t_end, **simulate_kw)
-    g = np.asarray(mechanism.gravity, float)
-    wb = f.mass * g
-    weight = np.array([wb[0], wb[1], f.com[0] * wb[1] - f.com[1] * wb[0]])
+    weight = shift_moment([*(f.mass * np.asarray(mechanism.gravity, float)), 0.0], f.com, point)
     rigid = _on(t, loads.t, machine) + weight
     one_way = mounted_response(f, t, rigid[:, 0], rigid[:, 1], rigid[:, 2], point=point)
     ff = floor_forces(coupled_run, f, base, mechanism.gravity, arm, point, pivot)

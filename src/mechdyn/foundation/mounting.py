@@ -61,6 +61,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
+from ..kinematics.constraints import _turn
 from ..mechanism import (
     GROUND,
     AssemblyMode,
@@ -466,12 +467,6 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
         q = init.setdefault("q", {})
         q.update({cx: float(u0[0]), cy: float(u0[1]), cth: float(u0[2])})
     return out
-
-
-def _turn(theta, r):
-    """``r`` (..., 2) turned by ``theta`` (broadcast against r's leading axes)."""
-    c, s = np.cos(theta), np.sin(theta)
-    return np.stack([c * r[..., 0] - s * r[..., 1], s * r[..., 0] + c * r[..., 1]], axis=-1)
 
 
 def _spring_forces(f: Foundation, geo, u, v=None, pivot=(0.0, 0.0)) -> np.ndarray:

@@ -196,10 +196,10 @@ def distribute(foundation: Foundation, Fx, Fy, M, point=(0.0, 0.0), t=None,
     >>> print(s.first_opening)
     None
     """
-    load = np.column_stack([np.atleast_1d(np.asarray(v, float)) for v in (Fx, Fy, M)]) \
-        if _same_length(Fx, Fy, M) else None
-    if load is None:
+    columns = [np.atleast_1d(np.asarray(v, float)) for v in (Fx, Fy, M)]
+    if len({c.shape for c in columns}) != 1:
         raise ModelError("distribute: Fx, Fy and M must have the same length")
+    load = np.column_stack(columns)
     n = load.shape[0]
     t = np.arange(n, dtype=float) if t is None else np.atleast_1d(np.asarray(t, float))
     if t.shape != (n,):
@@ -232,10 +232,6 @@ def _weight(foundation: Foundation, gravity, point) -> np.ndarray:
         raise ModelError(f"distribute: gravity must be a finite (gx, gy) in m/s^2, got "
                          f"{gravity!r}")
     return shift_moment([*(foundation.mass * g), 0.0], foundation.com, point)
-
-
-def _same_length(*arrays) -> bool:
-    return len({np.atleast_1d(np.asarray(a, float)).shape for a in arrays}) == 1
 
 
 def support_loads(foundation: Foundation, source, point=None, gravity=None) -> SupportLoads:

@@ -21,6 +21,7 @@ from .report_figures import (
     supports_figure,
 )
 from .report_html import cleaned, esc, figure_html, join, note, table
+from .table import deg_or_mm
 
 __all__ = ["building_section", "has_frame_loads"]
 
@@ -253,7 +254,7 @@ def building_section(*, x, Fx, Fy, M=None, point=(0.0, 0.0), angle: bool | None 
     x, Fx, Fy = x[good], Fx[good], Fy[good]
     M = None if M is None else M[good]
     series = [Fx, Fy, np.hypot(Fx, Fy), M]
-    xplot = x if angle is None else (np.rad2deg(x) if angle else x * 1e3)
+    xplot = x if angle is None else deg_or_mm(x, angle)[0]
     rows, dom = _extremes(x, series, angle)
     parts += [table("Frame load extremes", rows),
               figure_html(frame_load_figure(xplot, xlabel, Fx, Fy, M, point=point,
