@@ -118,9 +118,7 @@ class KinetostaticExtremes:
         """The figures of a kinetostatics record (also for a plain loop's records)."""
         out: dict[str, float] = {}
         for c in rec.driven:
-            k = rec.coordinate_names.index(c)
-            sym, unit = ("M", "Nm") if rec.model is None or rec.model.coord_is_angle[k] \
-                else ("F", "N")
+            sym, unit = rec._drive_unit(c)  # the record's own column names
             tau = np.asarray(rec.driving[c], float)
             out[f"{sym}_drive_{c}_peak_{unit}"] = float(np.nanmax(np.abs(tau)))
             out[f"{sym}_drive_{c}_max_{unit}"] = float(np.nanmax(tau))

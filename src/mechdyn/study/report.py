@@ -3,13 +3,12 @@ the best variants, the failed ones, and the scatter and Pareto plots embedded.""
 
 from __future__ import annotations
 
-import base64
 import html
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from ..results.report_html import img
 from .plots import axis_label, plot_pareto, plot_scatter
 
 __all__ = ["study_section", "write_study_report"]
@@ -20,14 +19,6 @@ _OK = ("success", "redundant")
 
 def _html_table(df) -> str:
     return df.to_html(index=False, border=0, na_rep="", float_format=lambda v: f"{v:.6g}")
-
-
-def _image(draw, alt: str) -> str:
-    with tempfile.TemporaryDirectory() as tmp:
-        p = Path(tmp) / "plot.png"
-        draw(p)
-        b64 = base64.b64encode(p.read_bytes()).decode("ascii")
-    return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,{b64}">'
 
 
 def study_section(table, parameters: list[str], *, figure: str | None = None,
@@ -90,10 +81,10 @@ def study_section(table, parameters: list[str], *, figure: str | None = None,
         top = ok.nsmallest(best, figure)[["variant", *parameters, figure]]
         parts += [f"<h3>Smallest {html.escape(axis_label(figure)[0])}</h3>",
                   _html_table(top)]
-        parts.append(_image(lambda p: plot_scatter(table, parameters[0], figure, p),
-                            f"{figure} over {parameters[0]}"))
+        parts.append(img(lambda p: plot_scatter(table, parameters[0], figure, p),
+                         f"{figure} over {parameters[0]}"))
     if pareto is not None and len(ok):
-        parts.append(_image(lambda p: plot_pareto(table, *pareto, p), "Pareto front"))
+        parts.append(img(lambda p: plot_pareto(table, *pareto, p), "Pareto front"))
     failed = table[~table["status"].isin(_OK)]
     if len(failed):
         parts += ["<h3>Failed variants</h3>",
