@@ -97,29 +97,27 @@ def register(sub) -> None:
 
 
 def _analysis(args, base):
+    given = None if args.speed is None else quantity(args.speed, "angular_velocity", "--speed")
     parts = []
     for name in [n.strip() for n in args.analysis.split(",") if n.strip()]:
         if name not in ANALYSES:
             raise ModelError(f"--analysis {name!r}: use one of {', '.join(ANALYSES)}")
         if name == "kinetostatics":
-            if args.speed is None:  # the base model's own speed, as in every command
+            speed = given
+            if speed is None:  # the base model's own speed, as in every command
                 model = base.compile({})
                 over = args.over or model.coordinate_names[0]
                 speed, why = model_speed(model, over)
                 print(speed_line(speed, bool(model.coord_is_angle[
                     model.coordinate_index(over)]), why))
-            else:
-                speed = quantity(args.speed, "angular_velocity", "--speed")
             parts.append(KinetostaticExtremes(speed, args.steps, args.over))
         elif name == "kinematics":
             parts.append(KinematicSummary(args.steps, args.over))
         else:
             if args.delta is None:
                 raise ModelError("--analysis flywheel needs --delta, e.g. --delta 0.05")
-            speed = None if args.speed is None else \
-                quantity(args.speed, "angular_velocity", "--speed")
             parts.append(FlywheelSize(parse_quantity(args.delta, "ratio", where="--delta"),
-                                      speed))
+                                      given))
     if not parts:
         raise ModelError("--analysis: name at least one analysis")
     return parts[0] if len(parts) == 1 else Combined(tuple(parts))
