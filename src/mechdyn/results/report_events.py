@@ -94,13 +94,14 @@ def events_rows(transitions, coordinate_names=(), coordinate_is_angle=()) -> lis
     """Rows of the events table: time, what, elements, modes, energy lost, the impulse the
     frame receives (in a run with impacts), coordinates after (deg or mm)."""
     rows = []
+    impacts = any(t.frame_impulse for t in transitions)  # a run with impacts
     for e in transitions:
         row = {"t (s)": f"{e.t:.6f}", "event": "/".join(e.kinds),
                "element(s)": " + ".join(e.elements),
                "mode before": mode_label(e.mode_before) if e.mode_before or e.mode_after else "",
                "mode after": mode_label(e.mode_after) if e.mode_before or e.mode_after else "",
                "energy lost (J)": e.energy_lost}
-        if any(t.frame_impulse for t in transitions):  # a run with impacts
+        if impacts:
             jx, jy = (e.frame_impulse or (0.0, 0.0))[:2]
             row["frame impulse x (N s)"], row["frame impulse y (N s)"] = jx, jy
         if e.q_after is not None:
