@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .events import frame_impulse
+from .table import deg_or_mm
 
 __all__ = ["Transition", "merged_events", "mode_label", "mode_spans", "events_rows"]
 
@@ -107,8 +108,8 @@ def events_rows(transitions, coordinate_names=(), coordinate_is_angle=()) -> lis
         if e.q_after is not None:
             for k, (name, v) in enumerate(zip(coordinate_names, e.q_after, strict=False)):
                 ang = coordinate_is_angle[k] if k < len(coordinate_is_angle) else True
-                val = float(np.rad2deg(v)) if ang else float(v) * 1e3
-                row[f"{name} after ({'deg' if ang else 'mm'})"] = 0.0 if abs(val) < 1e-9 else val
+                val, unit = deg_or_mm(float(v), ang)
+                row[f"{name} after ({unit})"] = 0.0 if abs(val) < 1e-9 else float(val)
         if e.message:
             row["note"] = e.message
         rows.append(row)
