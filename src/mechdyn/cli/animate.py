@@ -17,6 +17,7 @@ import time
 from ..kinematics.sweep import sweep
 from ..progress import stage
 from ..results.animate import _trace_spec, animate, check_animation_path, snapshot
+from ..results.frame_geometry import MAX_FRAMES
 from .options import add_motion_arguments, finish, open_model, simulate_from_args, sweep_values
 
 __all__ = ["register", "run"]
@@ -54,7 +55,7 @@ def run(args) -> int:
     mech, model = open_model(args)
     _trace_spec(model, args.trace)
     if args.simulate:
-        n = args.frames if args.frames is not None else 200
+        n = args.frames if args.frames is not None else MAX_FRAMES
         record = simulate_from_args(model, args, max(int(n), 2))
         ok, why = record.success, f"{record.status}: {record.message}"
         print(f"{mech.name}: simulated to t = {record.t[-1] if record.t.size else 0:.6g} s "
@@ -67,7 +68,7 @@ def run(args) -> int:
         ok, why = record.ok, record.message
         print(f"{mech.name}: {len(record)} of {values.size} positions of {over} "
               f"({record.status})")
-    n = min(len(record.x), 200) if args.frames is None else args.frames
+    n = min(len(record.x), MAX_FRAMES) if args.frames is None else args.frames
     with stage(f"animate: drawing {n} frames into {args.output}", args.progress, since=t0):
         out = animate(record, args.output, fps=args.fps, frames=args.frames, trace=args.trace,
                       title=args.title, labels=args.labels)

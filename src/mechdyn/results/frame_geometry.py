@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..kernels import rows_numpy
-from ..kinematics.constraints import extend, travel_rows
+from ..kinematics.constraints import _turn, extend, point_position, travel_rows
 from ..mechanism.load import Force, Spring
 from ..model.variable import parse as parse_variable
 from .table import deg_or_mm
@@ -20,13 +20,6 @@ __all__ = ["frame_geometry", "frame_indices", "MechanismDrawing", "MAX_FRAMES"]
 
 #: largest number of frames drawn by default
 MAX_FRAMES = 200
-
-
-def _rot(theta: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """Rotate body-frame points ``s`` (k, 2) by angles ``theta`` (n,) -> (n, k, 2)."""
-    c, sn = np.cos(theta)[:, None], np.sin(theta)[:, None]
-    return np.stack([c * s[None, :, 0] - sn * s[None, :, 1],
-                     sn * s[None, :, 0] + c * s[None, :, 1]], axis=-1)
 
 
 @dataclass(frozen=True)
@@ -99,7 +92,7 @@ def _drawing(model, x: np.ndarray) -> MechanismDrawing:
             k = model.pri.names.index(name)
             u = model.pri.ui[k]
             if j.child != ground:  # the guide's direction in the child frame
-                guided[j.child] = _rot(-model.pri.angle[k:k + 1], u[None, :])[0, 0]
+                guided[j.child] = _turn(-model.pri.angle[k], u)
             guides[name] = (j.parent, pp, u, j.child)
 
     # the symbols' size follows the region swept by all points and body origins
@@ -216,7 +209,7 @@ def _arm(model, bodies, body, pivot_local) -> np.ndarray:
 def _world(model, x: np.ndarray, body: str, local: np.ndarray) -> np.ndarray:
     """Ground-frame positions (n, k, 2) of body-frame points ``local`` (k, 2) over ``x``."""
     pose = extend(model, x)[:, model.body_index(body)]
-    return pose[:, None, :2] + _rot(pose[:, 2], local)
+    return pose[:, None, :2] + _turn(pose[:, 2, None], local)
 
 
 def _trace_spec(model, trace, what: str = "trace") -> tuple[str, object] | None:
@@ -370,23 +363,23 @@ def _geometry(model, x, drawing: MechanismDrawing, index, trace) -> dict:
         g["styles"][b] = style
     for kind in ("revolutes", "locks"):
         for j, (b, p) in getattr(drawing, kind).items():
-            g[kind][j] = _world(model, xs, b, p[None, :])[:, 0]
+            g[kind][j] = point_position(model, xs, b, p)
     for j, (b, seg) in drawing.guides.items():
         g["guides"][j] = np.array(_world(model, xs, b, seg))
     for name, ((b1, p1), (b2, p2)) in drawing.springs.items():
-        g["springs"][name] = np.stack([_world(model, xs, b1, p1[None, :])[:, 0],
-                                       _world(model, xs, b2, p2[None, :])[:, 0]], axis=1)
+        g["springs"][name] = np.stack([point_position(model, xs, b1, p1),
+                                       point_position(model, xs, b2, p2)], axis=1)
     for name, (b, seg) in drawing.stops.items():
         g["stops"][name] = _world(model, xs, b, seg)
     for name, (b, p, d, turns) in drawing.loads.items():
-        tail = _world(model, xs, b, p[None, :])[:, 0]
+        tail = point_position(model, xs, b, p)
         if turns:
-            d = _rot(extend(model, xs)[:, model.body_index(b), 2], d[None, :])[:, 0]
+            d = _turn(extend(model, xs)[:, model.body_index(b), 2], d)
         g["loads"][name] = np.stack([tail, tail + 4.0 * drawing.size * np.broadcast_to(
             d, tail.shape)], axis=1)
     if trace is not None:
         body, point = trace
-        g["trace"] = _world(model, xs, body, model.point_local(body, point)[None, :])[:, 0]
+        g["trace"] = point_position(model, xs, body, point)
     return g
 
 

@@ -31,7 +31,7 @@ from .report_events import events_rows, merged_events, mode_spans
 from .report_figures import kinetostatics_figure, sweep_figure, trajectory_figure
 from .report_html import esc, figure_html, img, join, note, side_by_side, status_html, table
 from .report_html import write_page as _write_page
-from .table import rate_text
+from .table import deg_or_mm, rate_text
 
 __all__ = ["write_report", "report_trajectory", "model_tables"]
 
@@ -350,8 +350,7 @@ def _coordinates_table(traj) -> str:
     for k, c in enumerate(traj.coordinate_names):
         ang = traj.coordinate_is_angle[k] if traj.coordinate_is_angle else True
         q = traj.q[:, k]
-        q0, q1, u = ((np.rad2deg(q[0]), np.rad2deg(q[-1]), "deg") if ang
-                     else (q[0] * 1e3, q[-1] * 1e3, "mm"))
+        (q0, q1), u = deg_or_mm(q[[0, -1]], ang)
         qd, ur = (traj.qdot[:, k] * 30 / np.pi, "rpm") if ang else (traj.qdot[:, k], "m/s")
         rows.append({"coordinate": c, "unit": u, "start": q0, "end": q1, "rate unit": ur,
                      "start rate": qd[0], "end rate": qd[-1], "min rate": np.nanmin(qd),

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .events import frame_impulse
+from .table import deg_or_mm
 
 __all__ = ["Transition", "merged_events", "mode_label", "mode_spans", "events_rows"]
 
@@ -94,20 +95,21 @@ def events_rows(transitions, coordinate_names=(), coordinate_is_angle=()) -> lis
     """Rows of the events table: time, what, elements, modes, energy lost, the impulse the
     frame receives (in a run with impacts), coordinates after (deg or mm)."""
     rows = []
+    impacts = any(t.frame_impulse for t in transitions)  # a run with impacts
     for e in transitions:
         row = {"t (s)": f"{e.t:.6f}", "event": "/".join(e.kinds),
                "element(s)": " + ".join(e.elements),
                "mode before": mode_label(e.mode_before) if e.mode_before or e.mode_after else "",
                "mode after": mode_label(e.mode_after) if e.mode_before or e.mode_after else "",
                "energy lost (J)": e.energy_lost}
-        if any(t.frame_impulse for t in transitions):  # a run with impacts
+        if impacts:
             jx, jy = (e.frame_impulse or (0.0, 0.0))[:2]
             row["frame impulse x (N s)"], row["frame impulse y (N s)"] = jx, jy
         if e.q_after is not None:
             for k, (name, v) in enumerate(zip(coordinate_names, e.q_after, strict=False)):
                 ang = coordinate_is_angle[k] if k < len(coordinate_is_angle) else True
-                val = float(np.rad2deg(v)) if ang else float(v) * 1e3
-                row[f"{name} after ({'deg' if ang else 'mm'})"] = 0.0 if abs(val) < 1e-9 else val
+                val, unit = deg_or_mm(float(v), ang)
+                row[f"{name} after ({unit})"] = 0.0 if abs(val) < 1e-9 else float(val)
         if e.message:
             row["note"] = e.message
         rows.append(row)

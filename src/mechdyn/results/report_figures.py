@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .table import deg_or_mm
+
 __all__ = ["decimate", "Figure", "sweep_figure", "kinetostatics_figure", "trajectory_figure",
            "frame_load_figure", "spectrum_figure", "supports_figure", "frame_floor_figure",
            "MAX_POINTS"]
@@ -185,11 +187,6 @@ class Figure:
 
 
 # ---------------------------------------------------------------- helpers
-def _deg_or_mm(values, is_angle: bool):
-    v = np.asarray(values, float)
-    return (np.rad2deg(v), "deg") if is_angle else (v * 1e3, "mm")
-
-
 def _point_label(body, name) -> str:
     return f"{body}.{name}" if isinstance(name, str) else \
         f"{body}({name[0] * 1e3:.4g}, {name[1] * 1e3:.4g} mm)"
@@ -223,7 +220,7 @@ def sweep_figure(sw, *, trace=None, title: str = ""):
     and accelerations (rad/s²) on the left; point positions (mm), velocities (m/s) and
     accelerations (m/s²) on the right (a side without anything that moves is left out)."""
     model = sw.model
-    xs, xunit = _deg_or_mm(sw.values, sw.over_is_angle)
+    xs, xunit = deg_or_mm(np.asarray(sw.values, float), sw.over_is_angle)
     bodies = [(b, *sw.angular(b)) for b in model.body_names]
     bodies = [row for row in bodies if np.ptp(row[1]) > 1e-12]  # translating bodies aside
     scale = model.length_scale
@@ -259,7 +256,7 @@ def sweep_figure(sw, *, trace=None, title: str = ""):
 def kinetostatics_figure(ks, *, title: str = ""):
     """Driving torque (N m; a travel's driving force in kN) and joint forces (kN) against the
     driven coordinate, on separate axes."""
-    xs, xunit = _deg_or_mm(ks.values, ks.over_is_angle)
+    xs, xunit = deg_or_mm(np.asarray(ks.values, float), ks.over_is_angle)
     torque = [c for c in ks.driven if ks._drive_unit(c)[1] == "Nm"]
     force = [c for c in ks.driven if c not in torque]
     titles, labels = [], []
