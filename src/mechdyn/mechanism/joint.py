@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["Joint", "Revolute", "Prismatic", "Lock", "PointRef"]
+__all__ = ["Joint", "Revolute", "Prismatic", "Lock", "PointRef", "FRICTION_FIELDS", "has_friction"]
 
 PointRef = str | tuple[float, float]
 
@@ -44,10 +44,28 @@ class Revolute(Joint):
     """A pin: ``parent_point`` of the parent coincides with ``child_point`` of the child.
 
     Two equations; reaction: a force (Fx, Fy) on the child at the pin.
+
+    Parameters
+    ----------
+    friction : float
+        Coulomb coefficient mu of the pin (0: frictionless). The friction moment on
+        the child is mu * pin_radius * |R| against the relative rotation (friction
+        circle), R the pin's reaction force, N.
+    pin_radius : float
+        Radius of the pin, m (needed when ``friction`` > 0).
+    viscous : float
+        Viscous moment coefficient, N*m*s/rad, against the relative angular velocity.
+    smoothing : float
+        0 for true stick-slip; otherwise the relative angular velocity, rad/s, over
+        which the Coulomb moment is regularised (tanh).
     """
 
     parent_point: PointRef = (0.0, 0.0)
     child_point: PointRef = (0.0, 0.0)
+    friction: float = 0.0
+    pin_radius: float = 0.0
+    viscous: float = 0.0
+    smoothing: float = 0.0
     n_equations = 2
 
 
@@ -66,6 +84,19 @@ class Prismatic(Joint):
     angle : float or None
         Relative angle theta_child - theta_parent held by the joint, rad; None
         takes it from the sketch poses.
+    friction : float
+        Coulomb coefficient mu of the guide (0: frictionless): a force against the
+        sliding of magnitude mu times the sum of the normal loads.
+    guide_length : float
+        Length of the guide (gib), m, centred on ``child_point``: 0 takes the normal
+        force N as one load (friction mu |N|); > 0 resolves N and the transverse
+        moment into the two edge loads N/2 -+ M/L that the gibs carry (friction
+        mu (|N/2 - M/L| + |N/2 + M/L|)).
+    viscous : float
+        Viscous force coefficient, N*s/m, against the sliding velocity.
+    smoothing : float
+        0 for true stick-slip; otherwise the sliding speed, m/s, over which the
+        Coulomb force is regularised (tanh).
 
     Two equations; reaction: a force normal to the line and a moment.
     """
@@ -74,7 +105,25 @@ class Prismatic(Joint):
     axis: tuple[float, float] = (1.0, 0.0)
     child_point: PointRef = (0.0, 0.0)
     angle: float | None = None
+    friction: float = 0.0
+    guide_length: float = 0.0
+    viscous: float = 0.0
+    smoothing: float = 0.0
     n_equations = 2
+
+
+#: the friction fields of each joint type: (field, unit kind of the model file)
+FRICTION_FIELDS: dict[str, tuple[tuple[str, str], ...]] = {
+    "revolute": (("friction", "dimensionless"), ("pin_radius", "length"),
+                 ("viscous", "rotational_damping"), ("smoothing", "angular_velocity")),
+    "prismatic": (("friction", "dimensionless"), ("guide_length", "length"),
+                  ("viscous", "damping"), ("smoothing", "velocity")),
+}
+
+
+def has_friction(joint: Joint) -> bool:
+    """Whether a joint dissipates: a Coulomb coefficient or a viscous term set."""
+    return getattr(joint, "friction", 0.0) > 0.0 or getattr(joint, "viscous", 0.0) > 0.0
 
 
 @dataclass(frozen=True)

@@ -9,6 +9,7 @@ here knows about solvers or time.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -17,7 +18,7 @@ from ..errors import ModelError, did_you_mean
 from .assembly_mode import AssemblyMode
 from .body import GROUND, Body, Ground, unknown_point
 from .coordinate import Coordinate, coordinate_problems
-from .joint import Joint, Lock, Prismatic, Revolute
+from .joint import FRICTION_FIELDS, Joint, Lock, Prismatic, Revolute
 from .supports import Foundation
 
 __all__ = ["Mechanism"]
@@ -119,15 +120,17 @@ class Mechanism:
         return self.add(Body(name, **kwargs))
 
     def add_revolute(self, name, parent, child, parent_point=(0.0, 0.0),
-                     child_point=(0.0, 0.0)) -> Revolute:
-        """Add a :class:`Revolute` joint (pin) between two bodies."""
-        return self.add(Revolute(name, parent, child, parent_point, child_point))
+                     child_point=(0.0, 0.0), **friction) -> Revolute:
+        """Add a :class:`Revolute` joint (pin) between two bodies; ``friction``,
+        ``pin_radius``, ``viscous`` and ``smoothing`` as for ``Revolute``."""
+        return self.add(Revolute(name, parent, child, parent_point, child_point, **friction))
 
     def add_prismatic(self, name, parent, child, parent_point=(0.0, 0.0), axis=(1.0, 0.0),
-                      child_point=(0.0, 0.0), angle=None) -> Prismatic:
-        """Add a :class:`Prismatic` joint: ``child`` slides along a line of ``parent``."""
+                      child_point=(0.0, 0.0), angle=None, **friction) -> Prismatic:
+        """Add a :class:`Prismatic` joint: ``child`` slides along a line of ``parent``;
+        ``friction``, ``guide_length``, ``viscous`` and ``smoothing`` as for ``Prismatic``."""
         return self.add(Prismatic(name, parent, child, parent_point, tuple(axis),
-                                  child_point, angle))
+                                  child_point, angle, **friction))
 
     def add_lock(self, name, parent, child, engaged=True, offset=None) -> Lock:
         """Add a switchable weld (:class:`Lock`) between two bodies."""
@@ -232,6 +235,13 @@ class Mechanism:
                               f"{where}: {role}", f"{where}: {role}_point")
             if j.parent == j.child:
                 out.append(f"{where}: parent and child are the same body {j.parent!r}")
+            for key, _ in FRICTION_FIELDS.get(type(j).__name__.lower(), ()):
+                v = getattr(j, key)
+                if not (isinstance(v, int | float) and math.isfinite(v) and v >= 0):
+                    out.append(f"{where}: {key} must be a finite number >= 0, got {v!r}")
+            if isinstance(j, Revolute) and j.friction > 0 and not j.pin_radius > 0:
+                out.append(f"{where}: friction = {j.friction:g} needs the pin's radius "
+                           "(pin_radius > 0, m)")
             if isinstance(j, Prismatic):
                 ax = np.asarray(j.axis, dtype=float)
                 if ax.shape != (2,) or not np.all(np.isfinite(ax)) or np.hypot(*ax) == 0:

@@ -7,6 +7,7 @@ import math
 from ..mechanism import GROUND, Body, Coordinate, Lock, Prismatic, Revolute
 from ..mechanism.body import unknown_point
 from ..mechanism.coordinate import coordinate_problems
+from ..mechanism.joint import FRICTION_FIELDS
 from .reader import _Failed, _Reader
 
 _POSE_KINDS = ("length", "length", "angle")
@@ -93,19 +94,30 @@ class _BodiesJoints(_Reader):
                     self.failed = True
             pp = ref(parent, "point" if both else "parent_point")
             cp = ref(child, "point" if both else "child_point")
+            fr = self.friction(spec, "revolute", *P)
+            if fr.get("friction", 0.0) > 0 and not fr.get("pin_radius", 0.0) > 0:
+                self.problem(f"{self.where(*P, 'friction')}: a pin with friction needs its "
+                             "radius: add pin_radius (e.g. \"15 mm\")")
+                self.failed = True
             self.check()
-            return Revolute(jname, parent, child, pp, cp)
+            return Revolute(jname, parent, child, pp, cp, **fr)
         if spec["type"] == "prismatic":
             pp, cp = ref(parent, "parent_point"), ref(child, "child_point")
             axis = (1.0, 0.0)
             if "axis" in spec and parent is not None:
                 axis = self.soft(self.direction, parent, spec["axis"], *P, "axis", default=axis)
             angle = self.opt(spec, "angle", "angle", *P, default=None)
+            fr = self.friction(spec, "prismatic", *P)
             self.check()
-            return Prismatic(jname, parent, child, pp, axis, cp, angle)
+            return Prismatic(jname, parent, child, pp, axis, cp, angle, **fr)
         offset = self.opt(spec, "offset", _POSE_KINDS, *P, default=None, read=self.vector)
         self.check()
         return Lock(jname, parent, child, bool(spec.get("engaged", True)), offset)
+
+    def friction(self, spec: dict, jtype: str, *P) -> dict:
+        """The friction keys of a joint present in ``spec``, in SI, each >= 0."""
+        return {f: self.opt(spec, f, kind, *P, nonneg=True)
+                for f, kind in FRICTION_FIELDS[jtype] if f in spec}
 
     def coordinate(self, cname: str, spec: dict) -> Coordinate:
         P = ("coordinates", cname)
