@@ -119,6 +119,7 @@ def load_gaps(C_P, P, initial_gaps=None) -> np.ndarray:
     Returns
     -------
     ndarray, shape (k,)
+        The gaps the loads alone would leave, m (negative: the support must push).
 
     Raises
     ------
@@ -517,6 +518,7 @@ def share_by_compliance(E, b, C) -> np.ndarray:
     Returns
     -------
     ndarray, shape (k,)
+        The reactions, in the units of b.
 
     Raises
     ------
