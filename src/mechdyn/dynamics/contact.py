@@ -39,7 +39,7 @@ from ..model.rows import concat
 from .modes import ModeSystem, Row, SwitchedModel
 
 __all__ = ["ContactError", "solve_lcp", "LCPResult", "resolve_mode", "constrained_inverse",
-           "row_terms"]
+           "row_terms", "FrictionalImpulse", "solve_frictional_impact"]
 
 
 class ContactError(MechdynError):
@@ -141,6 +141,121 @@ def solve_lcp(H, r, *, tol: float = 1e-9) -> LCPResult:
         return LCPResult(best[0], best[1], "enumeration", best[2])
     raise ContactError("the contact problem has no solution (no set of compressive contact "
                        "forces keeps every gap from closing further)")
+
+
+@dataclass
+class FrictionalImpulse:
+    """Normal and tangential impulses of an impact with Coulomb friction.
+
+    Attributes
+    ----------
+    normal : ndarray, shape (m,)
+        P_n >= 0 of each unilateral row, N s (N m s for an angle stop).
+    tangent : ndarray, shape (m_f,)
+        P_t of each frictional row along its tangent, N s.
+    states : tuple of str
+        ``"stick"``, ``"slip+"`` or ``"slip-"`` of each frictional row (the sign of
+        the tangential velocity after the impact).
+    qdot_plus : ndarray, shape (n,)
+        The generalized velocities after the impact.
+    """
+
+    normal: np.ndarray
+    tangent: np.ndarray
+    states: tuple
+    qdot_plus: np.ndarray
+
+
+#: the largest number of frictional rows in one impact (3^m friction states are tried)
+MAX_FRICTIONAL_ROWS = 6
+
+
+def solve_frictional_impact(Z, p_minus, Cu, target, Ct, of_row, mu, vt_minus, *,
+                            tol: float = 1e-9) -> FrictionalImpulse:
+    """Impulses of an impact with Newton's restitution and Coulomb friction.
+
+    The impact law (one impulse per contact, Newton-Coulomb): the normal impulses P_n
+    and the normal rates after the impact v_n+ are complementary with the restitution
+    target, P_n >= 0, v_n+ - target >= 0, P_n (v_n+ - target) = 0; each frictional row
+    either sticks (its tangential rate after the impact is zero and |P_t| <= mu P_n) or
+    slides (P_t = -mu P_n s with s the sign of its tangential rate after the impact).
+    The friction states (stick, slip in the direction of the rate before, slip against
+    it) are tried in that order and the first one consistent with Coulomb's law is
+    returned.  The friction impulse thus opposes the sliding *after* the impact
+    (Coulomb's law at the impulse level, as in velocity-level time stepping): where
+    friction alone would reverse the sliding the contact sticks; where the normal
+    impulse reverses it (the end of a rotating rod) the whole friction impulse opposes
+    the final sliding.  Routh's incremental analysis would split the impulse at the
+    reversal; both agree (and Newton's and Poisson's restitution agree) whenever the
+    tangential rate keeps its sign through the impact.
+
+    Parameters
+    ----------
+    Z : ndarray, shape (n, n)
+        qdot = Z (p + impulses) (:func:`constrained_inverse` of the mass matrix).
+    p_minus : ndarray, shape (n,)
+        Generalized momentum before.
+    Cu : ndarray, shape (m, n)
+        Normal rows (gap rates).
+    target : ndarray, shape (m,)
+        e max(0, -v_n-) of each row.
+    Ct : ndarray, shape (m_f, n)
+        Tangential rows of the frictional contacts.
+    of_row : sequence of int, length m_f
+        The normal row of each tangential row.
+    mu : sequence of float, length m_f
+    vt_minus : sequence of float, length m_f
+        Tangential rates before.
+    tol : float
+
+    Returns
+    -------
+    FrictionalImpulse
+
+    Raises
+    ------
+    ContactError
+        Too many frictional rows, or no friction state is consistent.
+    """
+    m, mf = Cu.shape[0], Ct.shape[0]
+    if mf > MAX_FRICTIONAL_ROWS:
+        raise ContactError(f"{mf} frictional contacts in one impact: at most "
+                           f"{MAX_FRICTIONAL_ROWS} are solved")
+    n = Z.shape[0]
+    mu = np.asarray(mu, float)
+    s_pre = np.where(np.asarray(vt_minus, float) < 0, -1, 1)
+    v_scale = max(float(np.max(np.abs(Cu @ Z @ p_minus), initial=0.0)),
+                  float(np.max(np.abs(vt_minus), initial=0.0)), 1e-300)
+    for choice in itertools.product((0, 1, -1), repeat=mf):
+        sgn = np.array(choice, dtype=int) * s_pre  # 0 stick, +-1 slip direction
+        st = np.flatnonzero(sgn == 0)
+        sl = np.flatnonzero(sgn != 0)
+        S = np.zeros((sl.size, m))
+        S[np.arange(sl.size), np.asarray(of_row, int)[sl]] = -mu[sl] * sgn[sl]
+        D = Cu.T + Ct[sl].T @ S
+        Cst = Ct[st]
+        Kp = np.linalg.pinv(Cst @ Z @ Cst.T) if st.size else np.zeros((0, 0))
+        Q = np.eye(n) - Z @ Cst.T @ Kp @ Cst
+        qd0, R = Q @ Z @ p_minus, Q @ Z @ D
+        try:
+            Pn = solve_lcp(Cu @ R, Cu @ qd0 - target, tol=tol).z
+        except ContactError:
+            continue
+        qd = qd0 + R @ Pn
+        Pt = np.zeros(mf)
+        Pt[st] = -Kp @ Cst @ Z @ (p_minus + D @ Pn)
+        Pt[sl] = S @ Pn
+        cone = mu[st] * Pn[np.asarray(of_row, int)[st]]
+        p_scale = max(float(np.max(np.abs(Pn), initial=0.0)), 1e-300)
+        vt = Ct @ qd
+        if np.all(np.abs(Pt[st]) <= cone * (1 + tol) + tol * p_scale) and \
+                np.all(np.abs(vt[st]) <= tol * v_scale) and \
+                np.all(sgn[sl] * vt[sl] >= -tol * v_scale):
+            states = tuple("stick" if g == 0 else "slip+" if vt[k] > 0 or (
+                vt[k] == 0 and g > 0) else "slip-" for k, g in enumerate(sgn))
+            return FrictionalImpulse(Pn, Pt, states, qd)
+    raise ContactError("no stick or slip state of the frictional contacts is consistent "
+                       "with Coulomb's law in this impact")
 
 
 def constrained_inverse(A, C_eq):

@@ -16,25 +16,37 @@ the new constraint rows are C = Phi_new,x B:
 * unilateral rows with Newton's restitution e: the impulses P >= 0 and the
   rows' velocities after the impact v+ >= e max(0, -v-) are complementary
   (v+ = -e v- on every row that receives an impulse), a velocity-level LCP
-  solved by :func:`mechdyn.dynamics.contact.solve_lcp`.
+  solved by :func:`mechdyn.dynamics.contact.solve_lcp`;
+* Coulomb friction in the impact, on contacts and on point stops with ``friction``
+  mu > 0: a tangential impulse P_t along the contact line (the other ground axis for
+  a stop on ``body.point.y|x``) with |P_t| <= mu P_n.  The contact sticks (its
+  tangential velocity after the impact is zero) when the impulse that stops the
+  sliding lies in the cone, and otherwise slides with P_t = -mu P_n sgn(v_t+)
+  (:func:`mechdyn.dynamics.contact.solve_frictional_impact`: Newton's restitution on
+  the normal velocity with Coulomb's law at the impulse level, the friction impulse
+  opposing the sliding after the impact; when the sliding keeps its direction through
+  the impact this is Routh's result, sgn(v_t+) = sgn(v_t-)).
 
 The kinetic energy lost is T- - T+; for a plastic impact it equals
 1/2 (qdot- - qdot+)^T A (qdot- - qdot+).  The impulse of every joint, lock,
 stop and contact (including the pins that carry the impact through) comes from
-M (xdot+ - xdot-) = Phi_x^T Lambda over all rows of the new mode.  Friction is
-not active during the instant of an impact (frictionless impact law).  The impulse that
+M (xdot+ - xdot-) = Phi_x^T Lambda + T_x^T P_t over all rows of the new mode (T the
+tangents of the frictional rows).  The impulse that
 the frame receives (the opposite of the impulses of the rows that act between it and the
 moving bodies) is reported as well: minus the jump of the mechanism's momentum.
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .contact import constrained_inverse, row_terms, solve_lcp
-from .modes import ModeSystem, SwitchedModel, mass_matrix_x
+from ..kernels import rows_numpy
+from ..model.variable import parse_variable
+from .contact import constrained_inverse, row_terms, solve_frictional_impact, solve_lcp
+from .modes import ModeSystem, Row, SwitchedModel, mass_matrix_x
 from .reactions import element_forces, frame_forces
 
 __all__ = ["ImpactResult", "impact", "element_forces", "frame_forces", "frame_impulse_key"]
@@ -84,11 +96,17 @@ class ImpactResult:
         element_forces`): (Px, Py) N s for a revolute joint, (Px, Py, L) N s, N s,
         N m s for a prismatic joint or a weld (L about the child frame origin, the
         weld's point); for each coordinate lock, stop or contact, the impulse of
-        its row (N s or N m s).
+        its row (N s or N m s); for each stop or contact with friction, under
+        ``"NAME.tangent"``, its tangential impulse P_t (N s, along the contact line's
+        direction, or the +x / +y ground axis for a stop on ``body.point.y`` / ``.x``).
         Under the key ``"frame"`` (``"frame (total)"`` if an element is named
         ``"frame"``): :attr:`frame_impulse`.
     velocity_before, velocity_after : dict
-        Rate of each new row (m/s or rad/s) before and after the impact.
+        Rate of each new row (m/s or rad/s) before and after the impact (and the
+        tangential rate ``"NAME.tangent"`` of each frictional stop or contact, m/s).
+    friction_states : dict
+        ``"stick"``, ``"slip+"`` or ``"slip-"`` of each frictional stop or contact in the
+        impact (the sign of its tangential velocity after it).
     frame_impulse : ndarray, shape (3,)
         The impulse that the frame receives (:func:`~mechdyn.dynamics.reactions.
         frame_forces` of the impulses): (Px, Py) N s and the angular impulse about the
@@ -105,6 +123,29 @@ class ImpactResult:
     velocity_before: dict = field(default_factory=dict)
     velocity_after: dict = field(default_factory=dict)
     frame_impulse: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    friction_states: dict = field(default_factory=dict)
+
+
+def _tangent(sm: SwitchedModel, r: Row):
+    """(mu, tangent Measure) of a unilateral row, or None without friction."""
+    if r.kind == "contact":
+        ct, _, slip = sm.contacts[r.element]
+        return (ct.friction, slip) if ct.friction > 0 else None
+    st = sm.stops[r.element][0]
+    if not st.friction > 0:
+        return None
+    cache = sm.model.memo.setdefault("stop_tangents", {})
+    if r.element not in cache:
+        cache[r.element] = parse_variable(sm.model, st.tangent_variable())
+    return st.friction, cache[r.element]
+
+
+def _momentum(x, Q):
+    """Linear and angular (about the ground origin) impulse of the generalized impulse
+    Q (n_x,) (forces and moments about each body's origin at poses x)."""
+    F, pos = Q.reshape(-1, 3), np.asarray(x, float).reshape(-1, 3)
+    return np.array([F[:, 0].sum(), F[:, 1].sum(),
+                     float(np.sum(F[:, 2] + pos[:, 0] * F[:, 1] - pos[:, 1] * F[:, 0]))])
 
 
 def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets: dict,
@@ -170,24 +211,57 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
         if -v_minus[k] <= small_velocity:
             e[k] = 0.0
     target = e * np.maximum(-v_minus, 0.0)
-    sol = solve_lcp(Hm, v0 - target)
-    P_u = sol.z
-    qd_plus = Z @ (p_minus + Cu.T @ P_u)
+    fric = [(k, *ft) for k, r in enumerate(rows_u) if (ft := _tangent(sm, r)) is not None]
+    if fric:
+        Tx = np.array([rows_numpy.jacobian(meas.rows, x)[0] for _, _, meas in fric])
+        Ct = Tx @ B
+        imp = solve_frictional_impact(Z, p_minus, Cu, target, Ct, [k for k, _, _ in fric],
+                                      [mu for _, mu, _ in fric], Ct @ qd_minus)
+        P_u, P_t, qd_plus = imp.normal, imp.tangent, imp.qdot_plus
+        t_labels = [f"{rows_u[k].element}.tangent" for k, _, _ in fric]
+        states = dict(zip([rows_u[k].element for k, _, _ in fric], imp.states, strict=True))
+        _warn_closed_stops(sm, rows_u, fric, v_minus, Cu @ qd_plus, P_u)
+    else:
+        P_u = solve_lcp(Hm, v0 - target).z
+        qd_plus = Z @ (p_minus + Cu.T @ P_u)
+        Tx, Ct, P_t, t_labels, states = (np.zeros((0, model.n_x)), np.zeros((0, B.shape[1])),
+                                         np.zeros(0), [], {})
     xdot_plus = B @ qd_plus
     T0 = 0.5 * float(xdot_minus @ M @ xdot_minus)
     T1 = 0.5 * float(xdot_plus @ M @ xdot_plus)
     # impulses of every row of the mode after the impact
     after = ModeSystem(sm, frozenset(locks_after) | frozenset(uni_tokens), targets, x)
     R = after.row_jacobian(x)
-    dp = M @ (xdot_plus - xdot_minus)
+    Q_t = Tx.T @ P_t  # the friction impulses on the bodies
+    dp = M @ (xdot_plus - xdot_minus) - Q_t
     Lam = np.linalg.lstsq(R.T, dp, rcond=None)[0] if R.size else np.zeros(0)
-    labels = [r.label for r in rows_b + rows_u]
-    C = np.concatenate([Cb, Cu])  # the rates of the new rows
-    on_frame = frame_forces(after, x, Lam, point=np.zeros(2))["total"]
+    labels = [r.label for r in rows_b + rows_u] + t_labels
+    C = np.concatenate([Cb, Cu, Ct])  # the rates of the new rows and the tangents
+    # the frame takes the opposite of the friction impulses between it and the bodies
+    # (those between two moving bodies cancel in the sum)
+    on_frame = frame_forces(after, x, Lam, point=np.zeros(2))["total"] - _momentum(x, Q_t)
     per_element = element_forces(after, x, Lam)
+    per_element.update(zip(t_labels, map(float, P_t), strict=True))
     per_element[frame_impulse_key(sm)] = on_frame
-    return ImpactResult(xdot_plus, T0, T1, T0 - T1,
-                        dict(zip(after.row_labels(), map(float, Lam), strict=True)),
-                        per_element,
+    impulses = dict(zip(after.row_labels(), map(float, Lam), strict=True))
+    impulses.update(zip(t_labels, map(float, P_t), strict=True))
+    return ImpactResult(xdot_plus, T0, T1, T0 - T1, impulses, per_element,
                         dict(zip(labels, map(float, C @ qd_minus), strict=True)),
-                        dict(zip(labels, map(float, C @ qd_plus), strict=True)), on_frame)
+                        dict(zip(labels, map(float, C @ qd_plus), strict=True)), on_frame,
+                        states)
+
+
+def _warn_closed_stops(sm: SwitchedModel, rows_u, fric, v_minus, v_plus, P_n) -> None:
+    """Warn (once per stop) when a stop with friction stays closed after an impact: its
+    friction acts in impacts only, not while it stays closed."""
+    scale = max(float(np.max(np.abs(v_minus), initial=0.0)), 1e-300)
+    told = sm.model.memo.setdefault("stop_friction_warned", set())
+    for k, _, _ in fric:
+        r = rows_u[k]
+        if r.kind == "stop" and P_n[k] > 0 and abs(v_plus[k]) <= 1e-9 * scale \
+                and r.element not in told:
+            told.add(r.element)
+            warnings.warn(f"stop {r.element!r} has friction = "
+                          f"{sm.stops[r.element][0].friction:g}: it acts in its impacts only; "
+                          "while the stop stays closed the point slides along it without "
+                          "friction (use a contact for lasting friction)", stacklevel=3)

@@ -42,6 +42,12 @@ class Stop:
     restitution : float
         Newton's coefficient of restitution e in [0, 1] (0: plastic, the stop
         stays closed after the impact).
+    friction : float
+        Coulomb coefficient mu >= 0 of the tangential impulse in an impact on the stop
+        (:mod:`mechdyn.dynamics.impact`); only for a stop on a point coordinate
+        ``"body.point.x|y"``, whose tangent is the other ground axis.  It acts during
+        impacts only: while the stop stays closed the point slides along it without
+        friction (use a :class:`Contact` for lasting friction).
     """
 
     name: str
@@ -49,10 +55,16 @@ class Stop:
     lower: float | None = None
     upper: float | None = None
     restitution: float = 0.0
+    friction: float = 0.0
     extra_kind = "stops"
 
     def __post_init__(self):
         _store_nonneg(self, f"stop {self.name!r}", "restitution", 1.0)
+        _store_nonneg(self, f"stop {self.name!r}", "friction")
+        if self.friction > 0 and self.tangent_variable() is None:
+            raise ValueError(f"stop {self.name!r}: friction needs a stop on a point "
+                             f"coordinate 'body.point.x' or 'body.point.y' (its tangent is "
+                             f"the other axis), got variable {self.variable!r}")
         for side in ("lower", "upper"):
             v = getattr(self, side)
             if v is not None:
@@ -66,6 +78,14 @@ class Stop:
     def sides(self) -> list[str]:
         """The limited sides, ``"lower"`` and/or ``"upper"``."""
         return [s for s in ("lower", "upper") if getattr(self, s) is not None]
+
+    def tangent_variable(self) -> str | None:
+        """The variable along the stop's face: ``"body.point.y"`` for a stop on
+        ``"body.point.x"`` and the reverse; None for other variables (no tangent)."""
+        parts = str(self.variable).strip().split(".")
+        if len(parts) != 3 or parts[2] not in ("x", "y") or not (parts[0] and parts[1]):
+            return None
+        return f"{parts[0]}.{parts[1]}.{'y' if parts[2] == 'x' else 'x'}"
 
 
 @dataclass(frozen=True)

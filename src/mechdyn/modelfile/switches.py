@@ -147,8 +147,10 @@ class _Switches(_Reader):
             lower = self.opt(e, "lower", kd, *P, default=None)
             upper = self.opt(e, "upper", kd, *P, default=None)
             restitution = self.opt(e, "restitution", "dimensionless", *P)
+            friction = self.opt(e, "friction", "dimensionless", *P)
             if not self.failed:
-                self.add(Stop, P, e["name"], e["variable"], lower, upper, restitution)
+                self.add(Stop, P, e["name"], e["variable"], lower, upper, restitution,
+                         friction)
 
     def contacts(self):
         for P, e in self.entries("contacts"):
