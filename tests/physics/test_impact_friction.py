@@ -159,3 +159,23 @@ def test_stop_friction_is_checked_and_read_from_the_model_file():
         and "friction needs a stop on a point coordinate" in probs[0]
     st = m.extras["stops"][0]
     assert st.friction == 0.25 and st.restitution == 0.3
+
+
+@pytest.mark.parametrize("mu, e, state", [(0.3, 0.5, "slide"), (1.0, 0.5, "stick")])
+def test_a_falling_rod_hits_the_floor_in_a_simulation(mu, e, state):
+    # released at rest in its angle TH, moving sideways at 1 m/s, the centre at 0.5 m:
+    # it falls without turning and A meets the floor after a free fall of h
+    from mechdyn.simulate_events import simulate_events
+
+    m = _rod("stop", mu, e)
+    m.gravity = (0.0, -9.81)
+    h = 0.5 - L / 2 * np.sin(TH)
+    vel = (1.0, -np.sqrt(2 * 9.81 * h), 0.0)
+    want, pt, pn, _, _ = _closed_form(vel, mu, e)
+    assert want == state
+    tr = simulate_events(m, 0.3, q0=[0.0, 0.5, TH], qdot0=[1.0, 0.0, 0.0], dt_out=0.05)
+    assert tr.status == "success", tr.message
+    ev = [ev for ev in tr.events if ev.kind == "impact"][0]
+    assert ev.t == pytest.approx(np.sqrt(2 * h / 9.81), abs=1e-10)
+    np.testing.assert_allclose([ev.impulses["floor"], ev.impulses["floor.tangent"]],
+                               [pn, pt], rtol=1e-8)
