@@ -153,7 +153,7 @@ class SupportSolution:
     forces : ndarray, shape (k,)
         lambda, N (positive: the support pushes).
     gaps : ndarray, shape (k,)
-        g = C lambda + q - A u, m (0 where closed).
+        g = C lambda + q - A u, m (exactly 0 where closed).
     motion : ndarray, shape (m,)
         u, the rigid-body motion of the supported body (the multipliers of the
         equilibrium equations).
@@ -194,7 +194,9 @@ def _kkt(C, q, A, f, closed):
     lam = np.zeros(k)
     lam[s] = z[:s.size]
     u = z[s.size:]
-    return lam, u, C @ lam + q - A @ u
+    g = C @ lam + q - A @ u
+    g[s] = 0.0  # closed: zero by the solve (its rounding dropped)
+    return lam, u, g
 
 
 def _violation(lam, g, uni, lam_scale, gap_scale):
