@@ -158,3 +158,42 @@ def test_bad_problems_are_named():
     # a load beyond the only supports that can push: the beam tips over
     with pytest.raises(ModelError, match="no set of supports holds the body"):
         beam_on_supports([0.0, 1.0], [1e6, 1e6], loads=[(2.0, P)]).solve()
+
+
+def test_random_problems_against_a_general_qp_solver_and_their_optimality_conditions():
+    # a second formulation: SciPy's SLSQP on the same quadratic programme; and the
+    # conditions themselves, checked here
+    from scipy.optimize import minimize
+
+    rng = np.random.default_rng(1)
+    methods = set()
+    for _ in range(40):
+        k, m = int(rng.integers(3, 8)), int(rng.integers(0, 3))
+        R = rng.normal(size=(k, k))
+        C = R @ R.T * 1e-6 + np.eye(k) * 1e-8
+        q = rng.normal(size=k) * 1e-3
+        bil = rng.random(k) < 0.2
+        A = rng.normal(size=(k, m))
+        lam0 = rng.random(k)
+        f = A.T @ lam0  # feasible
+        s = solve_supports(C, q, bilateral=bil, equilibrium=(A, f) if m else None)
+        methods.add(s.method)
+        uni = ~bil
+        g = C @ s.forces + q - A @ s.motion
+        np.testing.assert_allclose(g, s.gaps, atol=1e-15)
+        assert np.all(s.forces[uni] >= -1e-12) and np.all(g[uni] >= -1e-15)
+        scale = np.abs(s.forces).max() * np.abs(q).max()
+        assert np.max(np.abs(s.forces * g)) < 1e-12 * scale and np.all(s.gaps[s.closed] == 0)
+        assert s.closed[bil].all() and np.all(s.forces[~s.closed] == 0)
+        np.testing.assert_allclose(A.T @ s.forces, f, atol=1e-12)
+
+        def obj(lam, C=C, q=q):
+            return 0.5 * lam @ C @ lam + q @ lam
+
+        cons = [{"type": "eq", "fun": lambda lam, A=A, f=f: A.T @ lam - f}] if m else []
+        ref = minimize(obj, lam0, jac=lambda lam, C=C, q=q: C @ lam + q, method="SLSQP",
+                       bounds=[(None, None) if b else (0, None) for b in bil],
+                       constraints=cons, options=dict(ftol=1e-15, maxiter=1000))
+        assert obj(s.forces) <= obj(ref.x) + 1e-12 * abs(obj(ref.x))
+        np.testing.assert_allclose(s.forces, ref.x, atol=1e-4 * max(1, abs(s.forces).max()))
+    assert methods == {"active-set", "enumeration"}  # both ways of finding the set run

@@ -103,6 +103,10 @@ def test_oblique_impact_of_a_rod_end_against_the_closed_form(kind, vel, mu, e, s
     qd = np.asarray(res.xdot_plus)[6:9]
     np.testing.assert_allclose(M * (qd[:2] - [vx, vy]), [pt, pn], rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(res.frame_impulse[:2], [-pt, -pn], rtol=1e-12, atol=1e-12)
+    # and the opposite of the jump of its angular momentum about the ground origin
+    gx, gy = 0.0, L / 2 * np.sin(TH)
+    dH = gx * M * (qd[1] - vy) - gy * M * (qd[0] - vx) + J * (qd[2] - w)
+    np.testing.assert_allclose(res.frame_impulse[2], -dH, rtol=1e-12, atol=1e-12)
     assert res.energy_lost > 0
 
 
