@@ -273,6 +273,25 @@ class FrictionSet:
                            -(k * s)[..., None] * d, spd[p.name])
         return out
 
+    def _patterns(self, x) -> dict:
+        """{joint: (child pattern, parent pattern)}: the generalized force (..., 3) on each
+        of the two bodies (None for the ground) of a unit friction value (a unit moment on
+        the child; a unit force along the axis on the child at the joint point)."""
+        X = extend(self.model, np.asarray(x, float))
+        nb, out = self.model.n_bodies, {}
+        for p in self.pairs:
+            if p.kind == "revolute":
+                unit = np.zeros(X.shape[:-2] + (3,))
+                unit[..., 2] = 1.0
+                g = [unit, -unit]
+            else:
+                P, u = self._point_axis(X, p)
+                g = [sg * np.concatenate([u, cross(P - X[..., b, :2], u)[..., None]], axis=-1)
+                     for b, sg in ((p.child, 1.0), (p.parent, -1.0))]
+            out[p.name] = tuple(gb if b < nb else None
+                                for gb, b in zip(g, (p.child, p.parent), strict=True))
+        return out
+
     def generalized(self, x, xdot, lam, rows: Mapping | None = None):
         """The generalized friction force on the poses and its derivative with respect
         to the multipliers.
@@ -296,27 +315,32 @@ class FrictionSet:
         """
         x, xdot, lam = (np.asarray(a, float) for a in (x, xdot, lam))
         batch = np.broadcast_shapes(x.shape[:-1], lam.shape[:-1])
-        n_x, nb = self.model.n_x, self.model.n_bodies
-        F = np.zeros(batch + (n_x,))
-        dF = np.zeros(batch + (n_x, lam.shape[-1]))
-        X = extend(self.model, x)
+        F = np.zeros(batch + (self.model.n_x,))
+        dF = np.zeros(batch + (self.model.n_x, lam.shape[-1]))
+        pat = self._patterns(x)
         for p, (val, dval, _) in zip(self.pairs, self.magnitudes(x, xdot, lam, rows).values(),
                                      strict=True):
-            if p.kind == "revolute":
-                for b, sg in ((p.child, 1.0), (p.parent, -1.0)):
-                    if b < nb:
-                        F[..., 3 * b + 2] += sg * val
-                        dF[..., 3 * b + 2, :] += sg * dval
-                continue
-            P, u = self._point_axis(X, p)
-            for b, sg in ((p.child, 1.0), (p.parent, -1.0)):
-                if b >= nb:
-                    continue
-                arm = cross(P - X[..., b, :2], u)  # moment about the origin of a unit force u
-                g = sg * np.concatenate([u, arm[..., None]], axis=-1)  # (..., 3)
-                F[..., 3 * b:3 * b + 3] += g * val[..., None]
-                dF[..., 3 * b:3 * b + 3, :] += g[..., :, None] * dval[..., None, :]
+            for b, g in zip((p.child, p.parent), pat[p.name], strict=True):
+                if g is not None:
+                    F[..., 3 * b:3 * b + 3] += g * val[..., None]
+                    dF[..., 3 * b:3 * b + 3, :] += g[..., :, None] * dval[..., None, :]
         return F, dF
+
+    def by_pair(self, x, xdot, lam, rows: Mapping | None = None) -> dict:
+        """{joint: (F (..., n_x), value (...))}: the generalized friction force of each pair
+        on the moving bodies (as :meth:`generalized`) and the friction moment on the child
+        (revolute, N m) or the friction force on the child along the axis (prismatic, N)."""
+        x, xdot, lam = (np.asarray(a, float) for a in (x, xdot, lam))
+        batch = np.broadcast_shapes(x.shape[:-1], lam.shape[:-1])
+        pat, out = self._patterns(x), {}
+        for p, (val, _, _) in zip(self.pairs, self.magnitudes(x, xdot, lam, rows).values(),
+                                  strict=True):
+            F = np.zeros(batch + (self.model.n_x,))
+            for b, g in zip((p.child, p.parent), pat[p.name], strict=True):
+                if g is not None:
+                    F[..., 3 * b:3 * b + 3] += g * val[..., None]
+            out[p.name] = (F, val)
+        return out
 
     def power_lost(self, x, xdot, lam, rows: Mapping | None = None) -> dict:
         """Power dissipated in each pair, {joint: (...)}, W (>= 0): minus the power of
