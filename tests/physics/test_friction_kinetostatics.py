@@ -163,3 +163,44 @@ def test_without_friction_nothing_changes():
                         values=np.linspace(0.0, 2 * np.pi, 37))
     assert res.power_out is None and res.losses == {}
     assert "P_loss_W" not in res.to_dataframe().columns
+
+
+def test_toggle_press_example_with_friction():
+    """The bundled toggle press with friction in every pin and the ram guide: same motion
+    and loads as the frictionless file; per pair, the loss is the law mu r |R| |w_rel|
+    (pins) or mu S |v| (guide, with the edge loads of the reported normal force and
+    moment); the energy balance over the cycle; the friction costs input energy."""
+    from mechdyn import examples
+
+    phi = np.linspace(0.0, 2 * np.pi, 361)
+    w = 40 * 2 * np.pi / 60
+    res = kinetostatics(examples.load("toggle_press_friction"), over="phi", speed=w, values=phi)
+    ideal = kinetostatics(examples.load("toggle_press"), over="phi", speed=w, values=phi)
+    assert res.status == Status.SUCCESS
+    np.testing.assert_allclose(res.x, ideal.x, atol=1e-12)
+    mech = res.model.mechanism
+    body = {n: k for k, n in enumerate(res.model.body_names)}
+    for j in "ABCDEF":
+        jt = mech.joints[j]
+        wc = _spin(res, body, jt.child) - _spin(res, body, jt.parent)
+        law = jt.friction * jt.pin_radius * res.force_magnitude(j) * np.abs(wc)
+        np.testing.assert_allclose(res.losses[j], law, rtol=1e-12, atol=1e-9)
+    g = mech.joints["slide"]
+    N, M = res.joint_frame["slide"][:, 1], res.moments["slide"]
+    S = np.abs(N / 2 - M / g.guide_length) + np.abs(N / 2 + M / g.guide_length)
+    v = res.xdot[:, 3 * body["slider"] + 1]  # the slide is vertical
+    np.testing.assert_allclose(res.losses["slide"], g.friction * S * np.abs(v), rtol=1e-12,
+                               atol=1e-9)
+    np.testing.assert_allclose(res.joint_frame["slide"][:, 0], -g.friction * S * np.sign(v),
+                               rtol=1e-12, atol=1e-9)
+    # over the cycle: input = output + losses (+ the kinetic energy's change, ~0)
+    e = res.energies()
+    assert abs(e["input"] - e["output"] - e["losses"]) < 1e-10 * e["input"]
+    assert 0.2 < res.cycle_efficiency < 0.6
+    assert np.trapezoid(res.driving_total_power, res.t) > np.trapezoid(
+        ideal.driving_total_power, ideal.t)
+
+
+def _spin(res, body, name):
+    """Angular velocity of a body (0 for the ground)."""
+    return res.xdot[:, 3 * body[name] + 2] if name in body else np.zeros(res.n)

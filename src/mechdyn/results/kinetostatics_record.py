@@ -413,7 +413,8 @@ class Kinetostatics:
 
     def _efficiency_line(self) -> str:
         """The summary line of friction: cycle efficiency, energies, the lossiest pair,
-        the lowest instantaneous efficiency and the self-locked positions."""
+        the instantaneous efficiency at the peak driving power and the self-locked
+        positions."""
         e = self.energies()
         eta = self.efficiency
         s = (f"  friction: cycle efficiency {self.cycle_efficiency:.6g} (input "
@@ -422,11 +423,11 @@ class Kinetostatics:
             j = max(self.losses, key=lambda k: np.nan_to_num(e[f"loss_{k}"]))
             s += f", most in {j}: {e[f'loss_{j}']:.6g} J"
         s += ")"
-        if np.isfinite(eta).any():
-            d = self._peak(eta, "low", -eta)
+        if np.isfinite(eta).any():  # at the peak driving power (the working stroke)
+            k = int(np.nanargmax(self.driving_total_power))
             unit, f = ("deg", np.rad2deg(1.0)) if self.over_is_angle else ("m", 1.0)
-            s += (f"; lowest instantaneous efficiency {d['low']:.4g} at {self.over} = "
-                  f"{d['low_at'] * f:.4g} {unit}")
+            s += (f"; instantaneous efficiency at the peak driving power {eta[k]:.4g} "
+                  f"({self.over} = {self.values[k] * f:.4g} {unit})")
         if self.locked is not None and self.locked.any():
             s += f"; {int(self.locked.sum())} self-locked position(s) (see the warnings)"
         return s
