@@ -33,7 +33,8 @@ OMEGA = 10.0  # rad/s
 P0 = 1000.0  # N
 
 
-def slider_crank(r, l, e, mu, mu_o=0.0, r_o=0.0, guide_length=0.0):
+def slider_crank(r, l, e, mu, mu_o=0.0, r_o=0.0, guide_length=0.0, pin_a=(0.0, 0.0),
+                 pin_b=(0.0, 0.0)):
     phi0 = 0.3
     A = r * np.array([np.cos(phi0), np.sin(phi0)])
     xb = A[0] + np.sqrt(l**2 - (e - A[1]) ** 2)
@@ -44,8 +45,8 @@ def slider_crank(r, l, e, mu, mu_o=0.0, r_o=0.0, guide_length=0.0):
                pose=(A[0], A[1], np.arctan2(e - A[1], xb - A[0])))
     m.add_body("slider", pose=(xb, e, 0.0))
     m.add_revolute("O", "ground", "crank", "O", friction=mu_o, pin_radius=r_o)
-    m.add_revolute("A", "crank", "rod", "A")
-    m.add_revolute("B", "rod", "slider", "B")
+    m.add_revolute("A", "crank", "rod", "A", friction=pin_a[0], pin_radius=pin_a[1])
+    m.add_revolute("B", "rod", "slider", "B", friction=pin_b[0], pin_radius=pin_b[1])
     m.add_prismatic("guide", "ground", "slider", "G", (1.0, 0.0), friction=mu,
                     guide_length=guide_length)
     m.add_coordinate("phi", "angle", body="crank")
@@ -204,3 +205,41 @@ def test_toggle_press_example_with_friction():
 def _spin(res, body, name):
     """Angular velocity of a body (0 for the ground)."""
     return res.xdot[:, 3 * body[name] + 2] if name in body else np.zeros(res.n)
+
+
+def test_friction_circles_in_every_pin():
+    """Friction in pins O, A and B and in the guide: the rod is still a two-force member
+    but its force line is tangent to the friction circles at A and B, so it makes an angle
+    delta with the rod: moments about A on the massless rod,
+    l (u x F) = M_fA - M_fB = |F| (rho_B s_B - rho_A s_A), so
+    sin(delta) = sgn(F_c) (rho_B s_B - rho_A s_A) / l, with s_A = sgn(w_rod - omega),
+    s_B = sgn(0 - w_rod) and rho = mu r_pin; the slider and crank as before, the crank
+    also carrying -M_fA: T = A x F + rho_O |F| sgn(omega) - rho_A |F| s_A.  |R| is not
+    linear in the multipliers, so Newton iterates here."""
+    r, l, e, mu = 0.05, 0.2, 0.012, 0.2
+    rho = {"O": 0.1 * 0.01, "A": 0.12 * 0.015, "B": 0.15 * 0.012}
+    m = slider_crank(r, l, e, mu, mu_o=0.1, r_o=0.01, pin_a=(0.12, 0.015), pin_b=(0.15, 0.012))
+    phi = np.deg2rad(np.arange(360.0) + 0.5)  # off 90 and 270 deg, where w_rod = 0
+    res = kinetostatics(m, over="phi", speed=OMEGA, values=phi)
+    assert res.status == Status.SUCCESS and res.stats["friction_iterations"] >= 2
+
+    A = r * np.stack([np.cos(phi), np.sin(phi)], axis=-1)
+    sin_t = (e - A[:, 1]) / l
+    u = np.stack([np.sqrt(1 - sin_t**2), sin_t], axis=-1)
+    w_rod = -r * np.cos(phi) * OMEGA / (l * u[:, 0])
+    v = OMEGA * (-r * np.sin(phi) + r * np.cos(phi) * sin_t / u[:, 0])
+    sA, sB = np.sign(w_rod - OMEGA), np.sign(-w_rod)
+    best, found = np.full(phi.size, np.nan), np.zeros(phi.size, int)
+    for sgn_f in (1.0, -1.0):  # the sign of the rod's compression consistent with the law
+        d = np.arcsin(sgn_f * (rho["B"] * sB - rho["A"] * sA) / l)
+        eF = np.stack([np.cos(d) * u[:, 0] - np.sin(d) * u[:, 1],
+                       np.sin(d) * u[:, 0] + np.cos(d) * u[:, 1]], axis=-1)
+        # slider: F_c eF_x - mu |F_c eF_y| sgn(v) - P0 sgn(v) = 0
+        Fc = P0 * np.sign(v) / (eF[:, 0] - mu * np.abs(eF[:, 1]) * sgn_f * np.sign(v))
+        F = Fc[:, None] * eF
+        T = (A[:, 0] * F[:, 1] - A[:, 1] * F[:, 0]) + rho["O"] * np.abs(Fc) - rho["A"] * np.abs(
+            Fc) * sA
+        best = np.where(np.sign(Fc) == sgn_f, T, best)
+        found += np.sign(Fc) == sgn_f
+    assert (found == 1).all()  # one consistent solution at every position
+    assert np.abs(res.driving["phi"] - best).max() < 1e-10 * np.abs(best).max()

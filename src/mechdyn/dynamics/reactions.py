@@ -235,6 +235,7 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     if fs:  # the friction of the pairs: the nonlinear system, by Newton from z
         z, Ff, locked, finfo = friction_solve(fs, {j: lay.rows[j] for j in fs.names},
                                               lay.n_rows, As, bs, rs, cs, x, xdot, z)
+        locked &= ~mask  # bifurcations: the torque is the limit along the branch
         rhs = rhs - Ff
         bs = rhs * rs
     resid = np.abs(np.einsum("nij,nj->ni", As, z) - bs).max(axis=-1)
