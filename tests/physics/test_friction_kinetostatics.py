@@ -243,3 +243,53 @@ def test_friction_circles_in_every_pin():
         found += np.sign(Fc) == sgn_f
     assert (found == 1).all()  # one consistent solution at every position
     assert np.abs(res.driving["phi"] - best).max() < 1e-10 * np.abs(best).max()
+
+
+def test_self_locking_toggle_position_driven_from_the_slider():
+    """The centred slider-crank driven from the slider (a toggle near each dead centre)
+    against a load torque Q0 resisting the crank's rotation, with the friction circle
+    rho_O = mu_O r_O at the crank pin.  Massless crank: with c = A x u the arm of the rod's
+    force about O, -F_c c - rho_O |F_c| sgn(w) - Q0 sgn(w) = 0 has a solution
+    |F_c| = Q0 / (|c| - rho_O) only where |c| > rho_O: the mechanism locks where the rod's
+    force line passes inside the pin's friction circle.  The drive force on the
+    (frictionless) slider is P = -F_c u_x, F_c = -sgn(c w) |F_c|."""
+    from mechdyn.mechanism import Torque
+
+    r, l, mu_o, r_o, q0 = 0.05, 0.2, 0.3, 0.03, 50.0
+    rho_o = mu_o * r_o
+    phi0 = 4.0  # the lower half-turn: the slider moves +x while the crank turns CCW
+    A0 = r * np.array([np.cos(phi0), np.sin(phi0)])
+    xb0 = A0[0] + np.sqrt(l**2 - A0[1] ** 2)
+    m = md.Mechanism("slider-driven slider-crank")
+    m.add_body("crank", points={"A": (r, 0.0)}, pose=(0.0, 0.0, phi0))
+    m.add_body("rod", points={"B": (l, 0.0)}, pose=(A0[0], A0[1], np.arctan2(-A0[1], xb0 - A0[0])))
+    m.add_body("slider", pose=(xb0, 0.0, 0.0))
+    m.add_revolute("O", "ground", "crank", friction=mu_o, pin_radius=r_o)
+    m.add_revolute("A", "crank", "rod", "A")
+    m.add_revolute("B", "rod", "slider", "B")
+    m.add_prismatic("guide", "ground", "slider")
+    m.add_coordinate("s", "travel", joint="guide")
+    m.add(Torque("load", "crank", lambda c: -q0 * np.sign(c.xdot[..., 2])))
+    s = np.linspace(l - r + 1e-4, l + r - 1e-4, 201)
+    with pytest.warns(md.dynamics.reactions.KinetostaticsWarning, match="self-locking"):
+        res = kinetostatics(m, over="s", speed=0.5, values=s)
+    # the closed form on the lower branch
+    phi = 2 * np.pi - np.arccos((s**2 + r**2 - l**2) / (2 * s * r))
+    A = r * np.stack([np.cos(phi), np.sin(phi)], axis=-1)
+    u = np.stack([s - A[:, 0], -A[:, 1]], axis=-1) / l
+    c = A[:, 0] * u[:, 1] - A[:, 1] * u[:, 0]
+    w = np.gradient(phi, s) * 0.5  # only its sign is used: CCW while s grows
+    assert (w > 0).all()
+    locked = np.abs(c) < rho_o
+    assert locked[:2].all() and locked[-2:].all() and not locked[50:150].any()
+    assert res.status == Status.SELF_LOCKING
+    np.testing.assert_array_equal(res.locked, locked)
+    Fc = -np.sign(c * w) * q0 / (np.abs(c) - rho_o)
+    ok = ~locked
+    P = -Fc * u[:, 0]
+    assert np.abs(res.driving["s"][ok] - P[ok]).max() < 1e-10 * np.abs(P[ok]).max()
+    # reported with the slider's travel where the friction circle starts to hold the
+    # force (crank angle phi[k] there)
+    k = int(np.flatnonzero(~locked)[-1]) + 1  # the first locked sample of the far end
+    assert f"s = {s[k]:.6g} .. {s[-1]:.6g} m" in " ".join(res.warnings)
+    np.testing.assert_allclose(res.x[:, 2] % (2 * np.pi), phi, atol=1e-9)

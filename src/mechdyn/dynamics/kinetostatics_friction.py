@@ -146,15 +146,22 @@ def locking_note(model, didx, t, q, locked, info) -> str:
     samples with the first driven coordinate's values (deg or m) and times, and the
     symptoms."""
     k0 = int(didx[0]) if len(didx) else 0
-    name = model.coordinate_names[k0]
-    ang = bool(model.coord_is_angle[k0])
-    f, unit = (np.rad2deg(1.0), "deg") if ang else (1.0, "m")
+    names = model.coordinate_names
+    # the driven coordinate first, then the others (a crank angle when a slider is driven)
+    order = [k0, *[k for k in range(len(names)) if k != k0]][:3]
+
+    def span(k, a, b):
+        f, unit = (np.rad2deg(1.0), "deg") if model.coord_is_angle[k] else (1.0, "m")
+        v0, v1 = q[a, k] * f, q[b - 1, k] * f
+        return f"{names[k]} = " + (f"{v0:.6g}" if b == a + 1 else f"{v0:.6g} .. {v1:.6g}") \
+            + f" {unit}"
+
     edges = np.flatnonzero(np.diff(np.concatenate([[0], locked.astype(int), [0]])))
     runs = []
     for a, b in zip(edges[0::2], edges[1::2], strict=True):
-        v0, v1 = q[a, k0] * f, q[b - 1, k0] * f
-        span = f"{v0:.6g}" if b - a == 1 else f"{v0:.6g} .. {v1:.6g}"
-        runs.append(f"{name} = {span} {unit} (t = {t[a]:.6g} s, samples {a}..{b - 1})")
+        also = ", ".join(span(k, a, b) for k in order[1:])
+        runs.append(span(k0, a, b) + (f" ({also})" if also else "")
+                    + f" (t = {t[a]:.6g} s, samples {a}..{b - 1})")
     why = [f"{int(info[key].sum())} {text}" for key, text in (
         ("no_solution", "without a solution"), ("unbounded", "with an unbounded torque"),
         ("jammed", "on the jammed side of the friction cone")) if info[key].any()]
