@@ -204,6 +204,22 @@ class FrictionSet:
         P = X[..., p.child, :2] + rotate(X[..., p.child, 2], p.point)
         return P, rotate(X[..., p.parent, 2], p.axis)
 
+    def _row_map(self, rows) -> Mapping:
+        """{joint: indices into the multipliers} from None (:attr:`rows`), a mapping, or
+        an object with ``element_rows`` (a ConstraintLayout or a ModeSystem)."""
+        if rows is None:
+            return self.rows
+        if not isinstance(rows, Mapping):
+            rows = getattr(rows, "element_rows", None)
+            if not isinstance(rows, Mapping):
+                raise TypeError("rows: expected a mapping {joint: row indices}, a "
+                                "ConstraintLayout or a ModeSystem")
+        missing = [n for n in self.names if n not in rows]
+        if missing:
+            raise ValueError("rows: no multipliers given for the joint(s) with friction "
+                             + ", ".join(repr(n) for n in missing))
+        return rows
+
     # ------------------------------------------------------------------ loads
     def loads(self, x, lam, rows: Mapping | None = None) -> dict:
         """The friction-producing load of each pair and its derivative.
@@ -214,8 +230,9 @@ class FrictionSet:
         lam : array_like, shape (..., n_rows)
             Multipliers (forward convention) of a row set whose rows ``rows`` belong
             to the pairs.
-        rows : mapping, optional
-            {joint: indices into the last axis of ``lam``}; default :attr:`rows`.
+        rows : mapping, ConstraintLayout or ModeSystem, optional
+            {joint: indices into the last axis of ``lam``} (or the ``element_rows`` of a
+            layout or mode system); default :attr:`rows`.
 
         Returns
         -------
@@ -224,7 +241,7 @@ class FrictionSet:
             S = |N/2 - M/L| + |N/2 + M/L| (L > 0) or |N| of a prismatic, N.
         """
         x, lam = np.asarray(x, float), np.asarray(lam, float)
-        rows = self.rows if rows is None else rows
+        rows = self._row_map(rows)
         batch = np.broadcast_shapes(x.shape[:-1], lam.shape[:-1])
         X = extend(self.model, x)
         J = rows_numpy.jacobian(self._rowset, x) if self.pairs else None
@@ -302,8 +319,9 @@ class FrictionSet:
             Poses (m, rad) and their rates.
         lam : array_like, shape (..., n_rows)
             Multipliers, forward convention ``M xddot + h = F + Phi_x^T lam``.
-        rows : mapping, optional
-            {joint: indices into the last axis of ``lam``}; default :attr:`rows`.
+        rows : mapping, ConstraintLayout or ModeSystem, optional
+            {joint: indices into the last axis of ``lam``} (or the ``element_rows`` of a
+            layout or mode system); default :attr:`rows`.
 
         Returns
         -------

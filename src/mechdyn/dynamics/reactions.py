@@ -258,6 +258,11 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
                     "joints " + ", ".join(repr(j) for j in red_joints) + " are not unique; "
                     "the minimum-norm solution is reported (forces in N, moments in N m "
                     f"divided by the length scale {L:.4g} m)")
+        rf = [j for j in red_joints if j in fs.names]
+        if rf:
+            warn.append("the friction of joint(s) " + ", ".join(repr(j) for j in rf)
+                        + " depends on their reactions, which are not unique: it is computed "
+                          "from the minimum-norm reactions")
     for where, what, why in (
             (bif, "bifurcation position(s)", "the mechanism goes on on its branch and the "
              "driving torque there is its limit along the branch, but the joint equations are "
