@@ -7,7 +7,7 @@ import pandas as pd
 from mechdyn.cli import main
 
 M, A, G, MU, R_PIN, RPM = 2.0, 0.1, 9.81, 0.1, 0.015, 60.0
-PIN = f"{R_PIN * 1000} mm"
+PIN = f'"{R_PIN * 1000} mm"'
 
 CRANK_TOML = f"""
 [model]
@@ -18,7 +18,7 @@ gravity = ["0 m/s^2", "-{G} m/s^2"]
 crank = {{ mass = "{M} kg", inertia = "0.01 kg*m^2", com = ["{A * 1000} mm", "0 mm"] }}
 
 [joints]
-O = {{ type = "revolute", parent = "ground", child = "crank", friction = {MU}, pin_radius = "{PIN}" }}
+O = {{ type = "revolute", parent = "ground", child = "crank", friction = {MU}, pin_radius = {PIN} }}
 
 [coordinates]
 phi = {{ kind = "angle", body = "crank" }}
