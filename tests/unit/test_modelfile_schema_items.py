@@ -76,3 +76,13 @@ def test_a_long_table_is_checked_without_resolving_every_point(monkeypatch):
     t_plain = time.process_time() - t0
     assert fast == plain == ([], [])
     assert t_fast < t_plain / 3  # about 15 times faster on the machine it was written on
+
+
+def test_a_bad_point_of_a_table_is_named_with_its_place():
+    # the points are read without their place; one that fails is read again with it
+    text = examples.path("four_bar").read_text(encoding="utf-8") + (
+        '\n[[loads]]\ntype = "force"\nname = "tab"\nbody = "crank"\npoint = "com"\n'
+        'magnitude = { x = ["0 s", "1 s", "2 s"], y = ["1 N", "2 kg", "3 N"], variable = "t" }\n')
+    with pytest.raises(ModelError, match=r"bad.toml: \[\[loads\]\] #1 'tab' magnitude.y\[1\]: "
+                                         r"'2 kg'"):
+        loads(text, name="bad.toml")
