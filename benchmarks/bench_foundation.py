@@ -5,10 +5,16 @@ Run ``python -m benchmarks foundation`` or ``python benchmarks/bench_foundation.
 The bundled press cycle (``mechdyn.examples.load("press_cycle")``, the isolators of its
 ``[foundation]`` table) is simulated over the same interval on its fixed frame and
 ``mechdyn.foundation.mounted`` on its isolators (three more coordinates, two massless
-sleds, four isolator springs), one run each after a short warm-up run of each (kernels
-compiled or loaded); the ratio of the wall times is the acceptance figure (at most 1.5).
-The steps, evaluations and events of both runs are reported beside it: the mounted run
-follows the base's vibration (13 to 33 Hz) and its impacts.
+sleds, four isolator springs): as it stands (``external``: the cylinder, spring and
+punch forces push the whole mounted machine) and with the frame carrying their
+reactions (``bed``: ``reacting=BED``, the press as built; ``mechdyn foundation
+press_cycle --coupled --bed ...``).  After a short warm-up run of each (kernels
+compiled or loaded) the runs alternate, a few times each, and the best wall time
+and CPU time of each are kept (the machine is shared: the best is the least disturbed
+run); the ratio of the wall times is the acceptance figure (at most 1.5).  Steps,
+evaluations, segments and events are reported beside them: the mounted runs follow
+the base's vibration (13 to 33 Hz) and its impacts, on a larger system (8 bodies
+against 5).
 """
 
 from __future__ import annotations
@@ -16,45 +22,64 @@ from __future__ import annotations
 import time
 import warnings
 
+import numpy as np
+
 import mechdyn
 from mechdyn.foundation import FloorFrameWarning, mounted
 
 T_END = 1.0  # two cycles: idle, engage, work stroke, release
+BED = ("ram_springs", "cylinder_force", "punch")  # forces whose reaction the frame carries
 
 
-def compare(t_end: float = T_END) -> dict:
-    """Wall time (s) and trajectory of the rigid and the mounted press, one run each."""
+def _models() -> dict:
     rigid = mechdyn.examples.load("press_cycle")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FloorFrameWarning)
-        coupled = mounted(rigid)
-    models = {"rigid": rigid.compile(), "mounted": coupled.compile()}
+        return {"rigid": rigid.compile(), "external": mounted(rigid).compile(),
+                "bed": mounted(rigid, reacting=BED).compile()}
+
+
+def compare(t_end: float = T_END, repeat: int = 3) -> dict:
+    """Best wall and CPU time (s) and the trajectory of the rigid press and of the two
+    mounted ones: ``{name: (wall, cpu, trajectory)}``."""
+    models = _models()
     for model in models.values():
         mechdyn.simulate(model, 1e-3, progress=False)  # kernels compiled / loaded
-    out = {}
-    for name, model in models.items():
-        t0 = time.perf_counter()
-        tr = mechdyn.simulate(model, t_end, progress=False)
-        out[name] = (time.perf_counter() - t0, tr)
-    return out
+    best = {name: [np.inf, np.inf, None] for name in models}
+    for _ in range(repeat):
+        for name, model in models.items():
+            w0, c0 = time.perf_counter(), time.process_time()
+            tr = mechdyn.simulate(model, t_end, progress=False)
+            wall, cpu = time.perf_counter() - w0, time.process_time() - c0
+            b = best[name]
+            b[0], b[1], b[2] = min(b[0], wall), min(b[1], cpu), tr
+    return {name: tuple(b) for name, b in best.items()}
+
+
+def _strokes(tr) -> int:
+    return sum(1 for e in tr.events if (e.kind, e.element) == ("engage", "rocker_lock"))
 
 
 def run(quick: bool = False) -> list[dict]:
     """Rows for ``python -m benchmarks``: name, value, unit, note."""
-    res = compare(0.5 if quick else T_END)
+    res = compare(0.5 if quick else T_END, repeat=1 if quick else 3)
     rows = []
-    for name, (wall, tr) in res.items():
+    for name, (wall, cpu, tr) in res.items():
         rows.append({"name": f"press_cycle {tr.t[-1]:g} s, {name}", "value": wall, "unit": "s",
-                     "note": f"{tr.status}, {tr.stats['steps']} steps, "
-                             f"{tr.stats['evaluations']} evaluations, {len(tr.events)} events"})
-    rows.append({"name": "ratio mounted / rigid", "value": res["mounted"][0] / res["rigid"][0],
-                 "unit": "", "note": "acceptance: at most 1.5"})
+                     "note": f"{tr.status}, CPU {cpu:.3g} s, {tr.stats['steps']} steps, "
+                             f"{tr.stats['evaluations']} evaluations, "
+                             f"{tr.stats['segments']} segments, {len(tr.events)} events, "
+                             f"{_strokes(tr)} work strokes"})
+    for name in ("external", "bed"):
+        rows.append({"name": f"ratio mounted ({name}) / rigid",
+                     "value": res[name][0] / res["rigid"][0], "unit": "",
+                     "note": f"CPU {res[name][1] / res['rigid'][1]:.3g}; acceptance: at most 1.5"})
     return rows
 
 
 def main() -> None:
     for row in run():
-        print(f"{row['name']:<44} {row['value']:10.4g} {row['unit']:<4} {row.get('note', '')}")
+        print(f"{row['name']:<36} {row['value']:10.4g} {row['unit']:<4} {row.get('note', '')}")
 
 
 if __name__ == "__main__":

@@ -21,8 +21,8 @@ def test_an_unknown_column_is_an_error_listing_the_valid_ones(tmp_path, capsys):
                "--plot-columns", "phi_deg,omega_nowhere_rad_s"])
     assert rc == 2
     err = capsys.readouterr().err
-    assert "--plot-columns: unknown column(s) 'omega_nowhere_rad_s'" in err
-    assert "valid columns: " in err and "omega_rod_rad_s" in err
+    assert "--plot-columns: unknown column 'omega_nowhere_rad_s'" in err
+    assert "valid column names: " in err and "'omega_rod_rad_s'" in err
     assert not png.exists()
 
 

@@ -86,6 +86,8 @@ def _external(mech, model, tr, rc):
         var = ld.magnitude.variable
         if var in model.coordinate_names:
             s = tr.q[:, list(model.coordinate_names).index(var)]
+        elif var == "joint:guide":  # the ram's travel on its guide: along x from O (the origin)
+            s = tr.x[:, 3 * names.index("slider")]
         else:
             body, _, axis = var.split(".")
             s = rc[:, names.index(body), "xy".index(axis)]

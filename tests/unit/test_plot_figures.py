@@ -107,8 +107,12 @@ def test_chosen_columns_are_plotted_in_engineering_units(crank_sweep):
     k = np.argsort(xs, kind="stable")
     assert np.allclose(x.get_ydata()[1:-1], df["x_piston_com_m"].to_numpy()[k] * 1e3)
     assert fig.axes[-1].get_xlim() == pytest.approx((0.0, 360.0))
-    with pytest.raises(ModelError, match="unknown column.*'nope_m'.*valid columns: .*phi_deg"):
+    with pytest.raises(ModelError, match="unknown column 'nope_m'; valid column names: .*'phi"):
         plot_columns(crank_sweep, ["phi_deg", "nope_m"], None)
+    with pytest.raises(ModelError, match=r"column 'a_m'; .*'phi_deg'.*\(also unknown: 'b_N'\)"):
+        plot_columns(crank_sweep, ["a_m", "phi_deg", "b_N"], None)
+    with pytest.raises(ModelError, match="no columns given; valid column names: .*'phi_deg'"):
+        plot_columns(crank_sweep, " , ", None)
 
 
 def test_polar_plot_draws_the_joint_force_of_the_record(press_forces):

@@ -102,7 +102,10 @@ class _Reader:
             raise _Failed from None
 
     def quantity(self, value: Any, kind: str, *path, nonneg: bool = False) -> float:
-        out = self.recorded(parse_quantity, value, kind, where=self.where(*path))
+        try:  # the place is needed only for a message: read again with it (the points of a
+            out = parse_quantity(value, kind)  # long table are read without building it)
+        except ModelError:
+            out = self.recorded(parse_quantity, value, kind, where=self.where(*path))
         if nonneg and out < 0:
             self.problem(f"{self.where(*path)}: {value!r}: {path[-1]} must be >= 0 "
                          f"{KINDS[kind].si}")

@@ -6,7 +6,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import ModelError, did_you_mean
 from .figure import figure as _figure
 from .figure import save as _save
 from .plot_axes import display_unit, force_unit, model_name, speed_text, x_axis
@@ -31,15 +31,33 @@ def _stem(column: str) -> str:
 
 
 def check_columns(columns: Sequence[str], valid, flag: str = "columns") -> list[str]:
-    """The column names, or a :class:`~mechdyn.errors.ModelError` naming the unknown ones and
-    listing the valid columns."""
+    """The column names of ``columns`` (a sequence, or one comma-separated str).
+
+    Raises
+    ------
+    ModelError
+        No column, or unknown ones: the message names them and lists the valid columns
+        (:func:`~mechdyn.errors.did_you_mean`).
+
+    Examples
+    --------
+    >>> check_columns("phi_deg, F_A_N", ["phi_deg", "F_A_N", "t_s"])
+    ['phi_deg', 'F_A_N']
+    >>> check_columns(["phi_dg"], ["phi_deg", "t_s"], "-c")
+    Traceback (most recent call last):
+    ...
+    mechdyn.errors.ModelError: -c: unknown column 'phi_dg'; valid column names: 'phi_deg', 't_s'
+    """
     names = [c.strip() for c in (columns.split(",") if isinstance(columns, str) else columns)]
     names = [c for c in names if c]
     valid = list(valid)
     unknown = [c for c in names if c not in valid]
-    if unknown or not names:
-        what = f"unknown column(s) {', '.join(map(repr, unknown))}" if unknown else "no columns"
-        raise ModelError(f"{flag}: {what}; valid columns: {', '.join(valid)}")
+    if unknown:
+        more = f" (also unknown: {', '.join(map(repr, unknown[1:]))})" if unknown[1:] else ""
+        raise ModelError(f"{flag}: {did_you_mean(unknown[0], valid, 'column')}{more}")
+    if not names:
+        raise ModelError(f"{flag}: no columns given; valid column names: "
+                         f"{', '.join(map(repr, sorted(valid)))}")
     return names
 
 

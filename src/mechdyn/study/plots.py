@@ -15,7 +15,8 @@ __all__ = ["axis_label", "pareto_front", "plot_scatter", "plot_pareto"]
 #: column suffix -> (unit shown, factor from the column's unit)
 _UNITS = {"_kg_m2": ("kg m²", 1.0), "_Nm": ("N m", 1.0), "_m": ("mm", 1e3), "_N": ("N", 1.0),
           "_deg": ("deg", 1.0), "_rpm": ("rpm", 1.0), "_kg": ("kg", 1.0), "_W": ("W", 1.0),
-          "_J": ("J", 1.0), "_s": ("s", 1.0), "_rad_s": ("rad/s", 1.0)}
+          "_J": ("J", 1.0), "_s": ("s", 1.0), "_rad_s": ("rad/s", 1.0), "_m_s": ("m/s", 1.0),
+          "_m_s2": ("m/s²", 1.0)}
 _OK = ("success", "redundant")
 
 
@@ -28,6 +29,8 @@ def axis_label(column: str) -> tuple[str, float]:
     ('bodies.crank.points.A.x [mm]', 1000.0)
     >>> axis_label("M_drive_phi_peak_Nm")
     ('M_drive_phi_peak [N m]', 1.0)
+    >>> axis_label("v_ram_peak_m_s")  # the longest suffix: m/s, not "_s" after "v_ram_peak_m"
+    ('v_ram_peak [m/s]', 1.0)
     >>> axis_label("drives.motor.gear_ratio")
     ('drives.motor.gear_ratio [-]', 1.0)
     """
