@@ -29,7 +29,7 @@ from .animate import animate, snapshot
 from .report_building import building_section, has_frame_loads
 from .report_events import events_rows, merged_events, mode_spans
 from .report_figures import kinetostatics_figure, sweep_figure, trajectory_figure
-from .report_html import esc, figure_html, img, join, note, side_by_side, status_html, table
+from .report_html import esc, figure_html, fmt, img, join, note, side_by_side, status_html, table
 from .report_html import write_page as _write_page
 from .table import deg_or_mm, rate_text
 
@@ -237,7 +237,9 @@ def _kinetostatics_section(ks) -> str:
                          "holding torque or force shown.")
         parts.append(f"<p>Driven coordinate <code>{esc(ks.over)}</code> at the constant "
                      f"rate {rate_text(float(ks.qdot[0, k]), ang)}, {ks.n} positions; forces "
-                     f"include gravity, inertia and the model's loads.{held_text}</p>")
+                     f"include gravity, inertia and the model's loads"
+                     + (" and the friction in the pairs" if ks.power_out is not None else "")
+                     + f".{held_text}</p>")
     parts.append(status_html(ks.status, ks.status in (Status.SUCCESS, Status.REDUNDANT),
                              ks.message))
     if not ks.n:
@@ -267,12 +269,43 @@ def _kinetostatics_section(ks) -> str:
             else "Driving torques and forces")
     parts += [table(what, drives), table("Peak joint forces", joints),
               table("Stops, contacts and locks", elements)]
+    if ks.power_out is not None:
+        parts += _friction_part(ks)
     parts += [note(f"Warning: {esc(w)}") for w in ks.warnings]
     name = getattr(getattr(ks.model, "mechanism", None), "name", "mechanism")
     parts += ["<h3>Plot</h3>",
-              figure_html(kinetostatics_figure(ks, title=f"{name}: {what.lower()} and joint "
-                                                         "forces"), "kinetostatics")]
+              figure_html(kinetostatics_figure(
+                  ks, title=f"{name}: {what.lower()}, joint forces" + (
+                      ", friction losses and efficiency" if ks.power_out is not None
+                      else "")), "kinetostatics")]
     return join(parts)
+
+
+def _friction_part(ks) -> list[str]:
+    """Friction in the pairs: the cycle efficiency with the energies in, out and lost, and
+    per pair the energy lost, its share and the peak power lost."""
+    e = ks.energies()
+    ang = ks.over_is_angle
+    line = (f"<p><b>Friction in the pairs:</b> cycle efficiency {fmt(ks.cycle_efficiency)} "
+            f"({fmt(100 * ks.cycle_efficiency, 3)} %); energy in {fmt(e['input'])} J, out "
+            f"{fmt(e['output'])} J, lost {fmt(e['losses'])} J over the cycle")
+    eta = ks.efficiency
+    if np.isfinite(eta).any():
+        k = int(np.nanargmax(ks.driving_total_power))
+        line += (f"; instantaneous efficiency {fmt(eta[k])} at the peak driving power "
+                 f"({_at_text(ang, ks.values[k])})")
+    line += ".</p>"
+    if ks.locked is not None and ks.locked.any():
+        line += note(f"{int(ks.locked.sum())} self-locked position(s): see the warnings.")
+    rows = []
+    for j, p in ks.losses.items():
+        k = int(np.nanargmax(p)) if np.isfinite(p).any() else 0
+        lost = e[f"loss_{j}"]
+        rows.append({"pair": j, "type": ks.joint_kinds.get(j, ""), "energy lost (J)": lost,
+                     "share of the losses (%)": 100 * lost / e["losses"] if e["losses"]
+                     else float("nan"),
+                     "peak power lost (W)": p[k], "at": _at_text(ang, ks.values[k])})
+    return [line, table("Friction losses per pair", rows)]
 
 
 def _kinetostatics_building(ks, supports) -> str:
