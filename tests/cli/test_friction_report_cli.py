@@ -83,5 +83,7 @@ def test_report_states_cycle_efficiency_and_energies(tmp_path, capsys):
                        r"<td>([0-9.e+-]+)</td>", rows)
     assert [p[0] for p in pairs] == ["A", "B", "C", "D", "E", "F", "slide"]
     assert sum(float(p[2]) for p in pairs) == pytest.approx(e_lost, rel=1e-3)
+    joints = text.split("<h3>Joints</h3>", 1)[1].split("</table>", 1)[0]
+    assert "<th>friction mu</th>" in joints and "<th>pin radius / guide length (mm)</th>" in joints
     for label in ("power lost (W)", "efficiency (%)", "torque (N m)"):
         assert label in text  # the axes of the interactive figure

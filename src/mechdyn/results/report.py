@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import Status
 from ..kinematics.sweep import initial_coordinates
+from ..mechanism.joint import has_friction
 from .animate import animate, snapshot
 from .report_building import building_section, has_frame_loads
 from .report_events import events_rows, merged_events, mode_spans
@@ -83,6 +84,18 @@ def _element_params(el, skip=("name",)) -> str:
     return "; ".join(parts)
 
 
+def _friction_cells(joint) -> dict:
+    """The friction columns of a joint's row: mu and the pin radius or guide length (mm),
+    with a viscous term named; {} for a joint without friction."""
+    if not has_friction(joint):
+        return {}
+    size = getattr(joint, "pin_radius", getattr(joint, "guide_length", 0.0))
+    cells = {"friction mu": joint.friction, "pin radius / guide length (mm)": _mm(size)}
+    if joint.viscous > 0:
+        cells["friction mu"] = f"{joint.friction:.4g} (viscous {joint.viscous:.4g} SI)"
+    return cells
+
+
 def model_tables(model) -> dict:
     """Tables describing a compiled model, with units in the column names.
 
@@ -94,7 +107,8 @@ def model_tables(model) -> dict:
     -------
     dict of str to pandas.DataFrame
         ``bodies`` (mass, inertia, centre of mass, named points), ``joints``
-        (type, parent, child, points, axis), ``coordinates`` (kind, what it
+        (type, parent, child, points, axis; with friction in a pair also mu and the pin
+        radius or guide length), ``coordinates`` (kind, what it
         measures, unit, initial value and rate), ``loads`` and ``drives``
         (kind, name, parameters in SI); empty tables are left out.
     """
@@ -119,7 +133,11 @@ def model_tables(model) -> dict:
         rows["joints"].append({"joint": name, "type": kind, "parent": j.parent, "child": j.child,
                                "parent point": "" if lock else _pt_text(j.parent_point),
                                "child point": "" if lock else _pt_text(j.child_point),
-                               "axis / note": note})
+                               "axis / note": note, **_friction_cells(j)})
+    if any("friction mu" in r for r in rows["joints"]):  # friction columns on every row
+        for r in rows["joints"]:
+            r.setdefault("friction mu", "")
+            r.setdefault("pin radius / guide length (mm)", "")
     try:
         q0 = initial_coordinates(model)
     except Exception:  # noqa: BLE001 - the report still lists the coordinates
