@@ -10,11 +10,12 @@ import warnings as _warnings
 
 import numpy as np
 
-from ..errors import Status
+from ..errors import ModelError, Status
 from ..kernels import rows_numpy
 from ..kinematics.assembly import SINGULAR_RCOND, _redundant_rows, _scale
 from ..kinematics.constraints import _perp, coordinates_jacobian, extend
 from ..model import ConstraintLayout, Model
+from .compliance import share_by_compliance
 from .forces import applied_forces, cross, rotate
 from .friction import FrictionSet
 from .inertia import inertia_forces
@@ -192,6 +193,39 @@ def net_on_ground(model: Model, x, D, point) -> np.ndarray:
     return -np.concatenate([Db[..., :2].sum(axis=1), m[:, None]], axis=-1)
 
 
+def _share_by_compliance(model: Model, lay: ConstraintLayout, red_joints, As, bs, cs, z,
+                         ok) -> str:
+    """Where every joint of the redundant set has a compliance (a pin's ``compliance``,
+    m/N, on its two force rows), replace the minimum-norm solution ``z`` (scaled, (n, m))
+    at the samples ``ok`` by the one of least complementary energy
+    (:func:`~mechdyn.dynamics.compliance.share_by_compliance`), in place.  Returns the
+    sentence for the warning ('' where the minimum norm stays)."""
+    joints = model.mechanism.joints
+    given = {j: float(getattr(joints.get(j), "compliance", 0.0) or 0.0) for j in red_joints}
+    if not any(c > 0 for c in given.values()):
+        return ""
+    missing = [j for j, c in given.items() if not c > 0]
+    if missing:
+        return ("the minimum-norm solution is reported: the compliance of joint(s) "
+                + ", ".join(repr(j) for j in missing) + " is not given (every joint of the "
+                "redundant set needs one to share the reactions by compliance)")
+    w = np.zeros(As.shape[2])
+    for j, c in given.items():
+        rows = lay.rows[j]
+        w[rows] = c * cs[rows] ** 2  # the energy in the scaled unknowns z / cs
+    W = np.diag(w)
+    failed = 0
+    for k in np.flatnonzero(ok):
+        try:
+            z[k] = share_by_compliance(As[k], bs[k], W)
+        except ModelError:
+            failed += 1  # the minimum norm stays there
+    return ("they are shared by the joints' compliances (" + ", ".join(
+        f"{j} {c:.4g} m/N" for j, c in given.items()) + "; least complementary energy, "
+        "docs/indeterminacy.md)" + (f", but for {failed} position(s) where that failed "
+                                    "(minimum norm there)" if failed else ""))
+
+
 def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qdot, *,
              skip, reacting, point, charted=None) -> dict:
     """The batched inverse-dynamics solve and the reaction bookkeeping: the record fields
@@ -230,6 +264,10 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
         z = np.linalg.solve(As, bs[..., None])[..., 0]
     else:
         z = (np.linalg.pinv(As, rcond=1e-10) @ bs[..., None])[..., 0]
+    shared = ""
+    if n_red:  # redundant joints with compliances: shared by them, not by the minimum norm
+        shared = _share_by_compliance(model, lay, red_joints, As, bs, cs, z,
+                                      ~singular & ~mask)
     fs = FrictionSet(model)
     Ff, locked = np.zeros_like(F), np.zeros(n, dtype=bool)
     if fs:  # the friction of the pairs: the nonlinear system, by Newton from z
@@ -256,8 +294,8 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
         warn.append(f"{n_red} redundant joint equation(s): the equations "
                     + ", ".join(red_labels) + " are linearly dependent, so the reactions of "
                     "joints " + ", ".join(repr(j) for j in red_joints) + " are not unique; "
-                    "the minimum-norm solution is reported (forces in N, moments in N m "
-                    f"divided by the length scale {L:.4g} m)")
+                    + (shared or "the minimum-norm solution is reported (forces in N, moments "
+                       f"in N m divided by the length scale {L:.4g} m)"))
         rf = [j for j in red_joints if j in fs.names]
         if rf:
             warn.append("the friction of joint(s) " + ", ".join(repr(j) for j in rf)
@@ -338,6 +376,8 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     bal = np.abs(p_in - p_kin)[~locked]
     stats = {"power_balance_rel": float(bal.max() / p_scale) if bal.size else float("nan"),
              "rcond_min": float(np.min(rcond)), "redundant_equations": n_red,
+             "redundant_shared_by": ("compliance" if shared.startswith("they are shared")
+                                     else "minimum norm") if n_red else None,
              "singular_positions": int(singular.sum()),
              "bifurcation_positions": int(bif.sum()),
              **({"self_locked_positions": int(locked.sum()),

@@ -21,6 +21,7 @@ from ..kinematics.constraints import _perp, full_jacobian
 from ..kinematics.sweep import analyze, sweep
 from ..model import Model, as_model
 from .forces import com_arms, force_model
+from .friction_ignored import warn_friction_ignored
 from .inertia import frame_mass_matrix, inertia_forces
 
 __all__ = ["reduced_kinematics"]
@@ -80,6 +81,13 @@ class _ModelEvaluator:
                 f"1-DOF model (for a variable-structure machine: the model of one mode)")
         if coordinate is not None and coordinate not in model.coordinate_names:
             raise ModelError(did_you_mean(coordinate, model.coordinate_names, "coordinate"))
+        self.friction = warn_friction_ignored(
+            model, "the reduction method (reduce_model, ReducedMachine, steady_state, "
+            "size_flywheel, startup)", "the reduced torque leaves out the friction moments "
+            "and forces of these pairs (they depend on the reactions, hence on the speed and "
+            "the acceleration), so the steady speed, the speed fluctuation and the flywheel "
+            "are those of the frictionless machine; mechdyn.kinetostatics gives the losses "
+            "and the driving torque with friction", stacklevel=3)
         self.model = model
         self.mode = mode
         self.coordinate = model.coordinate_names[0]

@@ -207,6 +207,9 @@ def reduce_model(model: Model, *, coordinate: str | None = None, link: str | Non
     Returns
     -------
     Reduction
+        ``stats["friction_ignored"]``: the joints with friction, which the reduction
+        leaves out (a :class:`~mechdyn.dynamics.friction_ignored.FrictionIgnoredWarning`
+        names them).
     """
     model = as_model(model)  # a Mechanism is compiled (and validated) here
     ev = _ModelEvaluator(model, coordinate, mode=mode, x0=x0)
@@ -262,7 +265,8 @@ def reduce_model(model: Model, *, coordinate: str | None = None, link: str | Non
         link_angle=link_angle, ratio=ratio, J_red=J_link, dJ_red_dphi=dJ_link, J_extra=J_extra,
         M_red=M_f + M_d, M_drive=M_d, M_forces=M_f, omega=np.full(n, float(omega)), t=float(t),
         point=point, m_red=m_red, v_ratio=v_ratio, status=status, message=message,
-        stats={"positions": n, "extra_inertia_coordinate": j_extra})
+        stats={"positions": n, "extra_inertia_coordinate": j_extra,
+               "friction_ignored": ev.friction})
 
 
 def mode_mechanism(mechanism, *, engage: Sequence[str] = (), offsets: dict | None = None,

@@ -10,7 +10,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["Joint", "Revolute", "Prismatic", "Lock", "PointRef", "FRICTION_FIELDS", "has_friction"]
+__all__ = ["Joint", "Revolute", "Prismatic", "Lock", "PointRef", "FRICTION_FIELDS",
+           "ELASTIC_FIELDS", "has_friction"]
 
 PointRef = str | tuple[float, float]
 
@@ -58,6 +59,12 @@ class Revolute(Joint):
     smoothing : float
         0 for true stick-slip; otherwise the relative angular velocity, rad/s, over
         which the Coulomb moment is regularised (tanh).
+    compliance : float
+        Compliance of the pin, m/N (0: rigid): its deflection per unit reaction force,
+        the same in every direction.  Used where the pin is one of redundant joints
+        (statically indeterminate reactions): the kinetostatic analysis then shares the
+        reactions by the compliances (least complementary energy) instead of by the
+        minimum norm (``docs/indeterminacy.md``).
     """
 
     parent_point: PointRef = (0.0, 0.0)
@@ -66,6 +73,7 @@ class Revolute(Joint):
     pin_radius: float = 0.0
     viscous: float = 0.0
     smoothing: float = 0.0
+    compliance: float = 0.0
     n_equations = 2
 
 
@@ -118,6 +126,13 @@ FRICTION_FIELDS: dict[str, tuple[tuple[str, str], ...]] = {
                  ("viscous", "rotational_damping"), ("smoothing", "angular_velocity")),
     "prismatic": (("friction", "dimensionless"), ("guide_length", "length"),
                   ("viscous", "damping"), ("smoothing", "velocity")),
+}
+
+
+#: the elastic fields of each joint type: (field, unit kind of the model file)
+ELASTIC_FIELDS: dict[str, tuple[tuple[str, str], ...]] = {
+    "revolute": (("compliance", "compliance"),),
+    "prismatic": (),
 }
 
 

@@ -18,7 +18,7 @@ from ..errors import ModelError, did_you_mean
 from .assembly_mode import AssemblyMode
 from .body import GROUND, Body, Ground, unknown_point
 from .coordinate import Coordinate, coordinate_problems
-from .joint import FRICTION_FIELDS, Joint, Lock, Prismatic, Revolute
+from .joint import ELASTIC_FIELDS, FRICTION_FIELDS, Joint, Lock, Prismatic, Revolute
 from .supports import Foundation
 
 __all__ = ["Mechanism"]
@@ -122,7 +122,8 @@ class Mechanism:
     def add_revolute(self, name, parent, child, parent_point=(0.0, 0.0),
                      child_point=(0.0, 0.0), **friction) -> Revolute:
         """Add a :class:`Revolute` joint (pin) between two bodies; ``friction``,
-        ``pin_radius``, ``viscous`` and ``smoothing`` as for ``Revolute``."""
+        ``pin_radius``, ``viscous``, ``smoothing`` and ``compliance`` as for
+        ``Revolute``."""
         return self.add(Revolute(name, parent, child, parent_point, child_point, **friction))
 
     def add_prismatic(self, name, parent, child, parent_point=(0.0, 0.0), axis=(1.0, 0.0),
@@ -235,7 +236,8 @@ class Mechanism:
                               f"{where}: {role}", f"{where}: {role}_point")
             if j.parent == j.child:
                 out.append(f"{where}: parent and child are the same body {j.parent!r}")
-            for key, _ in FRICTION_FIELDS.get(type(j).__name__.lower(), ()):
+            jtype = type(j).__name__.lower()
+            for key, _ in (*FRICTION_FIELDS.get(jtype, ()), *ELASTIC_FIELDS.get(jtype, ())):
                 v = getattr(j, key)
                 if not (isinstance(v, int | float) and math.isfinite(v) and v >= 0):
                     out.append(f"{where}: {key} must be a finite number >= 0, got {v!r}")

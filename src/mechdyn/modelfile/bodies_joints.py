@@ -7,7 +7,7 @@ import math
 from ..mechanism import GROUND, Body, Coordinate, Lock, Prismatic, Revolute
 from ..mechanism.body import unknown_point
 from ..mechanism.coordinate import coordinate_problems
-from ..mechanism.joint import FRICTION_FIELDS
+from ..mechanism.joint import ELASTIC_FIELDS, FRICTION_FIELDS
 from .reader import _Failed, _Reader
 
 _POSE_KINDS = ("length", "length", "angle")
@@ -115,9 +115,10 @@ class _BodiesJoints(_Reader):
         return Lock(jname, parent, child, bool(spec.get("engaged", True)), offset)
 
     def friction(self, spec: dict, jtype: str, *P) -> dict:
-        """The friction keys of a joint present in ``spec``, in SI, each >= 0."""
+        """The friction (and elastic) keys of a joint present in ``spec``, in SI, each
+        >= 0."""
         return {f: self.opt(spec, f, kind, *P, nonneg=True)
-                for f, kind in FRICTION_FIELDS[jtype] if f in spec}
+                for f, kind in (*FRICTION_FIELDS[jtype], *ELASTIC_FIELDS[jtype]) if f in spec}
 
     def coordinate(self, cname: str, spec: dict) -> Coordinate:
         P = ("coordinates", cname)

@@ -69,10 +69,13 @@ class Kinetostatics:
         see ``sample_modes``).
     redundant_joints : tuple of str
         Joints whose equations are linearly dependent (their reactions are not
-        unique; the minimum-norm solution is reported).
+        unique to rigid-body statics): shared by the joints' compliances where every
+        one of them has a ``compliance`` (``stats["redundant_shared_by"]`` is
+        ``"compliance"``, ``docs/indeterminacy.md``), else the minimum-norm solution.
     status : str
-        "success", "redundant" (non-unique reactions) or "singular-position" (positions where
-        the driven coordinates lose control of the mechanism).
+        "success", "redundant" (dependent joint equations, see ``redundant_joints``) or
+        "singular-position" (positions where the driven coordinates lose control of the
+        mechanism).
     message : str
     warnings : tuple of str
     stats : dict

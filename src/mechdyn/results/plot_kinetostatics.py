@@ -27,8 +27,11 @@ def plot_kinetostatics(record, path=None, *, joints: Sequence[str] | None = None
     Panels: (1) driving torque of every driven angle (N m; driving forces of travels in N on
     a right-hand axis); (2) resultant reaction |R| of the chosen joints (N, or kN when
     large); (3) shaking force components and magnitude (N or kN), with the shaking moment
-    (N m) on a right-hand axis.  One unit per axis; a full turn runs 0..360 deg; the modes
-    of a switched analysis are shaded and named in a legend.
+    (N m) on a right-hand axis; with friction in the pairs (``record.power_out`` set) a
+    fourth panel: (4) the power lost in each pair and in all (W), with the instantaneous
+    efficiency (%) and the cycle efficiency (dashed) on a right-hand axis.  One unit per
+    axis; a full turn runs 0..360 deg; the modes of a switched analysis are shaded and
+    named in a legend.
 
     Parameters
     ----------
@@ -47,7 +50,8 @@ def plot_kinetostatics(record, path=None, *, joints: Sequence[str] | None = None
     for j in names:
         record.force_magnitude(j)  # a clear error for an unknown joint
     xa = x_axis(record)
-    fig, axes = _figure(3, height=3.0)
+    friction = record.power_out is not None
+    fig, axes = _figure(3 + friction, height=3.0)
     ax = axes[0]
     torques = [c for c in record.driven if record._drive_unit(c)[1] == "Nm"]
     forces = [c for c in record.driven if c not in torques]
@@ -82,15 +86,39 @@ def plot_kinetostatics(record, path=None, *, joints: Sequence[str] | None = None
     ax.plot(xa.x, xa.y(np.hypot(ff[:, 0], ff[:, 1])) * f, "k", lw=1.0,
             label=f"|F| frame ({unit})")
     ax.set_ylabel(f"shaking force ({unit})")
-    xa.setup(ax)
     ax2 = ax.twinx()
     ax2.plot(xa.x, xa.y(record.frame_moment), "--", color="tab:red", lw=1.0,
              label="M frame (N m)")
     ax2.set_ylabel("shaking moment (N m)", color="tab:red")
     ax.legend(handles=ax.lines + ax2.lines, loc="best", fontsize="small")
+    if friction:
+        _friction_panel(axes[3], record, xa)
+    xa.setup(axes[-1])
     if record.switched and record.mode_index is not None:
         shade_modes(axes, xa, record.mode_index, record.modes, legend_ax=axes[1])
     return _save(fig, path, dpi)
+
+
+def _friction_panel(ax, record, xa) -> None:
+    """Power lost per pair and in all (W); efficiency (%) on a right-hand axis, kept to
+    -100..200 % where the ratio runs off (near zero input power)."""
+    for j, p in record.losses.items():
+        ax.plot(xa.x, xa.y(p), lw=1.0, label=f"P lost {j} (W)")
+    ax.plot(xa.x, xa.y(record.power_loss), "k", lw=1.4, label="P lost, all pairs (W)")
+    ax.set_ylabel("power lost by friction (W)")
+    ax2 = ax.twinx()
+    eta = 100.0 * np.asarray(record.efficiency, float)
+    ax2.plot(xa.x, xa.y(eta), color="darkgreen", lw=1.8, label="efficiency (%)")
+    cycle = 100.0 * record.cycle_efficiency
+    if np.isfinite(cycle):
+        ax2.axhline(cycle, color="darkgreen", ls="--", lw=1.0,
+                    label=f"cycle efficiency {cycle:.3g} (%)")
+    ok = eta[np.isfinite(eta)]
+    if ok.size and (ok.min() < -100.0 or ok.max() > 200.0):
+        lo, hi = max(float(ok.min()), -100.0), min(float(ok.max()), 200.0)
+        ax2.set_ylim(lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo))
+    ax2.set_ylabel("efficiency (%)", color="darkgreen")
+    ax.legend(handles=ax.lines + ax2.lines, loc="best", fontsize="x-small", ncol=3)
 
 
 def plot_joint_force_polar(record, joint: str, path=None, *, frame: str = "ground",

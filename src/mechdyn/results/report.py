@@ -25,11 +25,12 @@ import numpy as np
 
 from ..errors import Status
 from ..kinematics.sweep import initial_coordinates
+from ..mechanism.joint import has_friction
 from .animate import animate, snapshot
 from .report_building import building_section, has_frame_loads
 from .report_events import events_rows, merged_events, mode_spans
 from .report_figures import kinetostatics_figure, sweep_figure, trajectory_figure
-from .report_html import esc, figure_html, img, join, note, side_by_side, status_html, table
+from .report_html import esc, figure_html, fmt, img, join, note, side_by_side, status_html, table
 from .report_html import write_page as _write_page
 from .table import deg_or_mm, rate_text
 
@@ -83,6 +84,18 @@ def _element_params(el, skip=("name",)) -> str:
     return "; ".join(parts)
 
 
+def _friction_cells(joint) -> dict:
+    """The friction columns of a joint's row: mu and the pin radius or guide length (mm),
+    with a viscous term named; {} for a joint without friction."""
+    if not has_friction(joint):
+        return {}
+    size = getattr(joint, "pin_radius", getattr(joint, "guide_length", 0.0))
+    cells = {"friction mu": joint.friction, "pin radius / guide length (mm)": _mm(size)}
+    if joint.viscous > 0:
+        cells["friction mu"] = f"{joint.friction:.4g} (viscous {joint.viscous:.4g} SI)"
+    return cells
+
+
 def model_tables(model) -> dict:
     """Tables describing a compiled model, with units in the column names.
 
@@ -94,7 +107,8 @@ def model_tables(model) -> dict:
     -------
     dict of str to pandas.DataFrame
         ``bodies`` (mass, inertia, centre of mass, named points), ``joints``
-        (type, parent, child, points, axis), ``coordinates`` (kind, what it
+        (type, parent, child, points, axis; with friction in a pair also mu and the pin
+        radius or guide length), ``coordinates`` (kind, what it
         measures, unit, initial value and rate), ``loads`` and ``drives``
         (kind, name, parameters in SI); empty tables are left out.
     """
@@ -119,7 +133,11 @@ def model_tables(model) -> dict:
         rows["joints"].append({"joint": name, "type": kind, "parent": j.parent, "child": j.child,
                                "parent point": "" if lock else _pt_text(j.parent_point),
                                "child point": "" if lock else _pt_text(j.child_point),
-                               "axis / note": note})
+                               "axis / note": note, **_friction_cells(j)})
+    if any("friction mu" in r for r in rows["joints"]):  # friction columns on every row
+        for r in rows["joints"]:
+            r.setdefault("friction mu", "")
+            r.setdefault("pin radius / guide length (mm)", "")
     try:
         q0 = initial_coordinates(model)
     except Exception:  # noqa: BLE001 - the report still lists the coordinates
@@ -237,7 +255,9 @@ def _kinetostatics_section(ks) -> str:
                          "holding torque or force shown.")
         parts.append(f"<p>Driven coordinate <code>{esc(ks.over)}</code> at the constant "
                      f"rate {rate_text(float(ks.qdot[0, k]), ang)}, {ks.n} positions; forces "
-                     f"include gravity, inertia and the model's loads.{held_text}</p>")
+                     f"include gravity, inertia and the model's loads"
+                     + (" and the friction in the pairs" if ks.power_out is not None else "")
+                     + f".{held_text}</p>")
     parts.append(status_html(ks.status, ks.status in (Status.SUCCESS, Status.REDUNDANT),
                              ks.message))
     if not ks.n:
@@ -267,12 +287,43 @@ def _kinetostatics_section(ks) -> str:
             else "Driving torques and forces")
     parts += [table(what, drives), table("Peak joint forces", joints),
               table("Stops, contacts and locks", elements)]
+    if ks.power_out is not None:
+        parts += _friction_part(ks)
     parts += [note(f"Warning: {esc(w)}") for w in ks.warnings]
     name = getattr(getattr(ks.model, "mechanism", None), "name", "mechanism")
     parts += ["<h3>Plot</h3>",
-              figure_html(kinetostatics_figure(ks, title=f"{name}: {what.lower()} and joint "
-                                                         "forces"), "kinetostatics")]
+              figure_html(kinetostatics_figure(
+                  ks, title=f"{name}: {what.lower()}, joint forces" + (
+                      ", friction losses and efficiency" if ks.power_out is not None
+                      else "")), "kinetostatics")]
     return join(parts)
+
+
+def _friction_part(ks) -> list[str]:
+    """Friction in the pairs: the cycle efficiency with the energies in, out and lost, and
+    per pair the energy lost, its share and the peak power lost."""
+    e = ks.energies()
+    ang = ks.over_is_angle
+    line = (f"<p><b>Friction in the pairs:</b> cycle efficiency {fmt(ks.cycle_efficiency)} "
+            f"({fmt(100 * ks.cycle_efficiency, 3)} %); energy in {fmt(e['input'])} J, out "
+            f"{fmt(e['output'])} J, lost {fmt(e['losses'])} J over the cycle")
+    eta = ks.efficiency
+    if np.isfinite(eta).any():
+        k = int(np.nanargmax(ks.driving_total_power))
+        line += (f"; instantaneous efficiency {fmt(eta[k])} at the peak driving power "
+                 f"({_at_text(ang, ks.values[k])})")
+    line += ".</p>"
+    if ks.locked is not None and ks.locked.any():
+        line += note(f"{int(ks.locked.sum())} self-locked position(s): see the warnings.")
+    rows = []
+    for j, p in ks.losses.items():
+        k = int(np.nanargmax(p)) if np.isfinite(p).any() else 0
+        lost = e[f"loss_{j}"]
+        rows.append({"pair": j, "type": ks.joint_kinds.get(j, ""), "energy lost (J)": lost,
+                     "share of the losses (%)": 100 * lost / e["losses"] if e["losses"]
+                     else float("nan"),
+                     "peak power lost (W)": p[k], "at": _at_text(ang, ks.values[k])})
+    return [line, table("Friction losses per pair", rows)]
 
 
 def _kinetostatics_building(ks, supports) -> str:

@@ -3,7 +3,7 @@
 * :func:`sweep_figure` -- link angles (deg), angular velocities and accelerations, and the
   positions (mm), velocities and accelerations of points against the swept coordinate;
 * :func:`kinetostatics_figure` -- driving torque (N m) and joint forces (kN) on separate
-  axes;
+  axes; with friction the power lost per pair (W) and the efficiency (%);
 * :func:`trajectory_figure` -- coordinates (deg, mm), speeds (rpm, m/s) and the frame force
   (kN) against time, switching events as vertical lines and modes shaded;
 * :func:`frame_load_figure`, :func:`spectrum_figure`, :func:`supports_figure` -- the loads
@@ -255,7 +255,10 @@ def sweep_figure(sw, *, trace=None, title: str = ""):
 
 def kinetostatics_figure(ks, *, title: str = ""):
     """Driving torque (N m; a travel's driving force in kN) and joint forces (kN) against the
-    driven coordinate, on separate axes."""
+    driven coordinate, on separate axes; with friction in the pairs also the power lost in
+    each pair and in all (W) and the instantaneous efficiency (%, with the cycle efficiency
+    as a dashed level; the axis kept to -100..200 % where the ratio runs off, near zero
+    input power)."""
     xs, xunit = deg_or_mm(np.asarray(ks.values, float), ks.over_is_angle)
     torque = [c for c in ks.driven if ks._drive_unit(c)[1] == "Nm"]
     force = [c for c in ks.driven if c not in torque]
@@ -268,19 +271,45 @@ def kinetostatics_figure(ks, *, title: str = ""):
         labels.append("force (kN)")
     titles.append("joint forces |F|")
     labels.append("force (kN)")
+    friction = ks.power_out is not None
+    if friction:
+        titles += ["power lost by friction", "efficiency"]
+        labels += ["power lost (W)", "efficiency (%)"]
     f = Figure(titles, labels, f"{ks.over} ({xunit})", title=title)
     for c in torque:
         f.line(0, xs, ks.driving[c], f"M {c}" + ("" if c == ks.over else " (holding)"), "N m")
     for c in force:
         f.line(int(bool(torque)), xs, np.asarray(ks.driving[c]) / 1e3,
                f"F {c}" + ("" if c == ks.over else " (holding)"), "kN")
-    panel = len(titles) - 1
+    panel = len(titles) - 1 - 2 * friction
     for j in ks.reactions:
         f.line(panel, xs, ks.force_magnitude(j) / 1e3, f"|F| {j}", "kN")
     for el, y in ks.element_forces.items():
         if ks.element_units.get(el, "N") == "N":
             f.line(panel, xs, np.abs(np.asarray(y, float)) / 1e3, f"{el}", "kN")
+    if friction:
+        _friction_panels(f, ks, xs, panel + 1)
     return f.done(x_range=(xs[0], xs[-1]) if xs.size > 1 else None)
+
+
+def _friction_panels(f: Figure, ks, xs, panel: int) -> None:
+    """The power lost in each pair and in all (W) on ``panel``, the instantaneous and the
+    cycle efficiency (%) on the next."""
+    for j, p in ks.losses.items():
+        f.line(panel, xs, p, f"P lost {j}", "W")
+    f.line(panel, xs, ks.power_loss, "P lost, all pairs", "W", dash="dot")
+    eta = 100.0 * ks.efficiency
+    f.line(panel + 1, xs, eta, "η", "%")
+    cycle = 100.0 * ks.cycle_efficiency
+    if np.isfinite(cycle):
+        f.line(panel + 1, xs, np.full(xs.shape, cycle), f"η cycle {cycle:.3g} %", "%",
+               dash="dash")
+    ok = eta[np.isfinite(eta)]
+    if ok.size and (ok.min() < -100.0 or ok.max() > 200.0):  # near zero input power
+        lo, hi = max(float(ok.min()), -100.0), min(float(ok.max()), 200.0)
+        pad = 0.05 * (hi - lo)
+        row, col = f._cell(panel + 1)
+        f.fig.update_yaxes(range=[lo - pad, hi + pad], row=row, col=col)
 
 
 def trajectory_figure(traj, *, transitions=(), spans=None, title: str = ""):
