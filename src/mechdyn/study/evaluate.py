@@ -11,9 +11,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import AssemblyError, MechdynError, SingularPositionError, Status
+from .batch import batch_reason, batched, kinetostatic_batch
 from .parameters import BaseModel, Parameter, to_shown
 
-__all__ = ["Task", "evaluate_batch", "evaluate_variant", "order_variants", "failure"]
+__all__ = ["Task", "evaluate_batch", "evaluate_variant", "order_variants", "failure", "head",
+           "compiled", "analyse"]
 
 
 @dataclass(frozen=True)
@@ -45,7 +47,8 @@ def failure(exc: BaseException) -> tuple[str, str]:
 
 def evaluate_batch(task: Task, batch: list[tuple[int, tuple[float, ...]]],
                    warm=None) -> list[dict]:
-    """Rows of a batch of variants, evaluated in order, each started from the last
+    """Rows of a batch of variants: as one batch (:mod:`.batch`) when the analysis and
+    the variants allow it, else one by one in order, each started from the last
     successful one's ``warm`` state.
 
     Parameters
@@ -60,8 +63,10 @@ def evaluate_batch(task: Task, batch: list[tuple[int, tuple[float, ...]]],
     -------
     list of dict
         One row per variant: ``variant``, the parameters (columns with their units,
-        angles in deg), the analysis' figures, ``status``, ``message`` and
-        ``seconds`` (wall time of the variant).
+        angles in deg), the analysis' figures, ``status``, ``message``,
+        ``evaluated`` ("batch" or "loop": how the variant was analysed) and
+        ``seconds`` (wall time of the variant; of a batched variant, its share of the
+        batch's).
 
     Examples
     --------
@@ -73,6 +78,8 @@ def evaluate_batch(task: Task, batch: list[tuple[int, tuple[float, ...]]],
     >>> [r["status"] for r in rows]
     ['success', 'assembly-failed']
     """
+    if len(batch) > 1 and batched(task.analysis):
+        return _as_batch(task, batch, warm)
     rows = []
     for vid, values in batch:
         row, warm = evaluate_variant(task, vid, values, warm)
@@ -80,17 +87,60 @@ def evaluate_batch(task: Task, batch: list[tuple[int, tuple[float, ...]]],
     return rows
 
 
-def evaluate_variant(task: Task, vid: int, values: tuple[float, ...], warm=None):
-    """(row, warm) of one variant (see :func:`evaluate_batch`); ``warm`` is passed on
-    unchanged when the variant fails."""
+def _as_batch(task: Task, batch, warm=None) -> list[dict]:
+    """:func:`evaluate_batch` through :func:`~.batch.kinetostatic_batch`: every variant
+    compiled, then analysed as one batch if :func:`~.batch.batch_reason` allows it;
+    the variants the batch leaves (and every variant otherwise) analysed one by one."""
     t0 = time.perf_counter()
+    rows = [head(task, vid, values) for vid, values in batch]
+    models, where = [], []
+    for k, (_, values) in enumerate(batch):
+        try:
+            models.append(compiled(task, values))
+            where.append(k)
+        except Exception as exc:  # noqa: BLE001 - a failed variant is a row, not the end
+            rows[k]["status"], rows[k]["message"] = failure(exc)
+            rows[k]["evaluated"] = "batch"
+    outcomes = [None] * len(models)
+    if models and batch_reason(task.analysis, models) is None:
+        outcomes = kinetostatic_batch(models, task.analysis)
+    shared = (time.perf_counter() - t0) / len(batch)
+    for k, model, outcome in zip(where, models, outcomes, strict=True):
+        row, t1 = rows[k], time.perf_counter()
+        if outcome is None:  # on its own: its status and message, or the batch's figures
+            warm = analyse(task, row, model, warm)
+        else:
+            row.update(outcome.figures)
+            row["status"], row["message"] = outcome.status, outcome.message
+            row["evaluated"] = "batch"
+        row["seconds"] = shared + time.perf_counter() - t1
+    for row in rows:
+        row.setdefault("seconds", shared)
+    return rows
+
+
+def head(task: Task, vid: int, values: tuple[float, ...]) -> dict:
+    """The start of a variant's row: its id and its parameters (shown units)."""
     row: dict = {"variant": int(vid)}
     for p, v in zip(task.parameters, values, strict=True):
         row[p.column] = to_shown(v, p.kind)
+    return row
+
+
+def compiled(task: Task, values: tuple[float, ...]):
+    """The compiled model of a variant (warnings silenced: the row's status says it)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return task.base.compile(dict(zip(task.parameters, values, strict=True)))
+
+
+def analyse(task: Task, row: dict, model, warm=None):
+    """Fill ``row`` with the analysis of a compiled variant (its figures, status and
+    message, ``evaluated`` = "loop"); returns the warm state for the next variant
+    (``warm`` unchanged when the variant fails)."""
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the record's status and message say it
-            model = task.base.compile(dict(zip(task.parameters, values, strict=True)))
             outcome = task.analysis(model, warm)
         row.update(outcome.figures)
         row["status"], row["message"] = outcome.status, outcome.message
@@ -98,6 +148,22 @@ def evaluate_variant(task: Task, vid: int, values: tuple[float, ...], warm=None)
             warm = outcome.warm
     except Exception as exc:  # noqa: BLE001 - a failed variant is a row, not the end
         row["status"], row["message"] = failure(exc)
+    row["evaluated"] = "loop"
+    return warm
+
+
+def evaluate_variant(task: Task, vid: int, values: tuple[float, ...], warm=None):
+    """(row, warm) of one variant (see :func:`evaluate_batch`); ``warm`` is passed on
+    unchanged when the variant fails."""
+    t0 = time.perf_counter()
+    row = head(task, vid, values)
+    try:
+        model = compiled(task, values)
+    except Exception as exc:  # noqa: BLE001 - a failed variant is a row, not the end
+        row["status"], row["message"] = failure(exc)
+        row["evaluated"] = "loop"
+    else:
+        warm = analyse(task, row, model, warm)
     row["seconds"] = time.perf_counter() - t0
     return row, warm
 
