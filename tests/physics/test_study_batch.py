@@ -63,7 +63,7 @@ def test_a_study_batch_with_failing_variants(base):
     assert [r["status"] for r in rows[:2]] == ["success", "assembly-failed"]
     assert rows[2]["status"] in ("assembly-failed", "singular-position")
     assert rows[3]["status"] == "success"
-    assert [r["evaluated"] for r in rows] == ["batch", "batch", "loop", "batch"]
+    assert [r["evaluated"] for r in rows] == ["batch", "loop", "loop", "batch"]
     assert "loop through joints" in rows[1]["message"]
     assert "does not close" in rows[1]["message"]
     assert "phi" in rows[2]["message"]  # where the turn stops

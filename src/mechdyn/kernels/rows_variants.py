@@ -22,7 +22,7 @@ import numpy as np
 from .linalg import lu_factor, lu_solve, lu_solve_transposed
 from .rows_numba import njit, rows_jacobian, rows_quad, rows_values
 
-__all__ = ["path_variants", "motion_variants", "inverse_variants"]
+__all__ = ["path_variants", "inverse_variants"]
 
 
 @njit
@@ -50,15 +50,48 @@ def _det_sign(lu, piv, n):
 
 
 @njit
-def path_variants(X0, Q, nb, ints, flts, n_rows, tol, max_iter, min_rc, X, ok, fail):
-    """Continuation of every variant along its own path of driven coordinates.
+def _at_solution(x, qdot, qddot, nb, ints, flts, n_rows, J, lu, piv, xd, xdd, b):
+    """J at a solved pose and its factors; the rates xd = J^-1 [0; qdot] and the
+    accelerations xdd = J^-1 (gamma + [0; qddot]) (qdot, qddot of the driven rows).
+    Returns the pivot ratio (0: singular, rates not set)."""
+    n = x.shape[0]
+    J[:, :] = 0.0
+    rows_jacobian(x, nb, ints, flts, J, 0)
+    lu[:, :] = J
+    rc = lu_factor(lu, piv, n)
+    if rc == 0.0:
+        return rc
+    b[:] = 0.0
+    for c in range(qdot.shape[0]):
+        b[n_rows + c] = qdot[c]
+    lu_solve(lu, piv, b, n)
+    xd[:] = b
+    rows_quad(x, xd, nb, ints, flts, b, 0)
+    for i in range(n):
+        b[i] = -b[i]
+    for c in range(qdot.shape[0]):
+        b[n_rows + c] += qddot[c]
+    lu_solve(lu, piv, b, n)
+    xdd[:] = b
+    return rc
+
+
+@njit
+def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, min_rc,
+                  X, Xd, Xdd, J, LU, piv, rc, ok, fail):
+    """Continuation of every variant along its own path of driven coordinates, with the
+    rates and accelerations at the kept steps.
 
     Parameters
     ----------
     X0 : ndarray, shape (V, n_x)
-        Assembled start poses (m, rad), at or near ``Q[:, 0]``.
+        Start poses (m, rad): assembled, or sketches that the first step assembles.
     Q : ndarray, shape (V, M, n_d)
         The driven coordinates at the M steps of each variant's path.
+    dQ, ddQ : ndarray, shape (M, n_d)
+        Their rates and accelerations (the same for every variant; used at kept steps).
+    keep : ndarray of int, shape (M,)
+        Where each step is stored (-1: not stored).
     nb : int
     ints : ndarray of int, shape (n, 5)
         Packed row integers, shared (``n = n_rows + n_d = n_x``).
@@ -72,8 +105,15 @@ def path_variants(X0, Q, nb, ints, flts, n_rows, tol, max_iter, min_rc, X, ok, f
     min_rc : float
         Smallest pivot ratio min|u_ii| / max|u_ii| of J accepted (below: a dead or
         bifurcation position, left to the single-model continuation).
-    X : ndarray, shape (V, M, n_x)
-        Output: the poses.
+    X, Xd, Xdd : ndarray, shape (V, K, n_x)
+        Output: poses, rates and accelerations at the K kept steps.
+    J, LU : ndarray, shape (V, K, n, n_x)
+        Output: J = [Phi_x; g_d,x] at the kept poses and its LU factors
+        (:func:`~mechdyn.kernels.linalg.lu_factor`), for :func:`inverse_variants`.
+    piv : ndarray of int, shape (V, K, n)
+        Output: the pivots.
+    rc : ndarray, shape (V, K)
+        Output: the pivot ratios.
     ok : ndarray of bool, shape (V,)
         In: variants to solve; out: False where a step failed.
     fail : ndarray of int, shape (V,)
@@ -86,10 +126,12 @@ def path_variants(X0, Q, nb, ints, flts, n_rows, tol, max_iter, min_rc, X, ok, f
     V, M, nd = Q.shape
     n = X0.shape[1]
     F = np.empty(n)
-    J = np.empty((n, n))
+    Jw = np.empty((n, n))
     lu = np.empty((n, n))
-    piv = np.empty(n, np.int64)
+    pv = np.empty(n, np.int64)
     b = np.empty(n)
+    xd = np.empty(n)
+    xdd = np.empty(n)
     T = np.empty((n, nd))
     Tp = np.empty(n)
     for v in range(V):
@@ -110,14 +152,11 @@ def path_variants(X0, Q, nb, ints, flts, n_rows, tol, max_iter, min_rc, X, ok, f
                     if curved:  # the second derivative along q_0 from the last two tangents
                         x[i] += 0.5 * (T[i, 0] - Tp[i]) / hp * h * h
                 hp = h
-            # Newton; the factors of the last Jacobian (at the solution, or one step before
-            # it: within the tolerance's square root) give the branch sign, the pivot ratio
-            # and the tangent dx/dq_d for the next step's start
+            # Newton (at least one step)
             done = False
-            rc = 0.0
             for it in range(max_iter + 1):
                 if it == 0:
-                    _system(x, q, nb, ints, flts[v], n_rows, F, J)
+                    _system(x, q, nb, ints, flts[v], n_rows, F, Jw)
                 else:
                     rows_values(x, nb, ints, flts[v], F, 0)
                     for c in range(nd):
@@ -133,24 +172,27 @@ def path_variants(X0, Q, nb, ints, flts, n_rows, tol, max_iter, min_rc, X, ok, f
                 if it == max_iter:
                     break
                 if it > 0:
-                    J[:, :] = 0.0
-                    rows_jacobian(x, nb, ints, flts[v], J, 0)
-                lu[:, :] = J
-                rc = lu_factor(lu, piv, n)
-                if rc == 0.0:
+                    Jw[:, :] = 0.0
+                    rows_jacobian(x, nb, ints, flts[v], Jw, 0)
+                lu[:, :] = Jw
+                if lu_factor(lu, pv, n) == 0.0:
                     break
                 b[:] = F
-                lu_solve(lu, piv, b, n)
+                lu_solve(lu, pv, b, n)
                 for i in range(n):
                     x[i] -= b[i]
             if not done:
                 ok[v] = False
                 fail[v] = m
                 break
-            s = _det_sign(lu, piv, n)
+            # at the solution: J, its factors, the branch sign, the rates; the tangent
+            k = keep[m]
+            r = _at_solution(x, dQ[m], ddQ[m], nb, ints, flts[v], n_rows, Jw, lu, pv, xd, xdd,
+                             b)
+            s = _det_sign(lu, pv, n)
             if m == 0:
                 sign0 = s
-            if rc < min_rc or s != sign0:
+            if r < min_rc or s != sign0:
                 ok[v] = False
                 fail[v] = m
                 break
@@ -159,73 +201,30 @@ def path_variants(X0, Q, nb, ints, flts, n_rows, tol, max_iter, min_rc, X, ok, f
             for c in range(nd):
                 b[:] = 0.0
                 b[n_rows + c] = 1.0
-                lu_solve(lu, piv, b, n)
+                lu_solve(lu, pv, b, n)
                 for i in range(n):
                     T[i, c] = b[i]
-            for i in range(n):
-                X[v, m, i] = x[i]
-
-
-@njit
-def motion_variants(X, qdot, qddot, nb, ints, flts, n_rows, Xdot, Xddot, J, LU, piv, rc):
-    """Rates and accelerations at the poses of every variant,
-    J xdot = [0; qdot_d] and J xddot = gamma + [0; qddot_d], keeping J = [Phi_x; g_d,x]
-    and its factors for :func:`inverse_variants` and the reactions.
-
-    Parameters
-    ----------
-    X : ndarray, shape (V, N, n_x)
-    qdot, qddot : ndarray, shape (N, n_d)
-        The driven coordinates' rates (the same for every variant).
-    Xdot, Xddot : ndarray, shape (V, N, n_x)
-        Outputs (NaN where J is singular).
-    J, LU : ndarray, shape (V, N, n, n_x)
-        Outputs: the Jacobians and their LU factors (:func:`~mechdyn.kernels.linalg.lu_factor`).
-    piv : ndarray of int, shape (V, N, n)
-        Output: the pivots.
-    rc : ndarray, shape (V, N)
-        Output: the pivot ratio min|u_ii| / max|u_ii| (0: singular).
-    """
-    V, N, n = X.shape
-    nd = qdot.shape[1]
-    F = np.empty(n)
-    b = np.empty(n)
-    qz = np.zeros(nd)
-    for v in range(V):
-        for k in range(N):
-            _system(X[v, k], qz, nb, ints, flts[v], n_rows, F, J[v, k])
-            A, p = LU[v, k], piv[v, k]
-            A[:, :] = J[v, k]
-            rc[v, k] = lu_factor(A, p, n)
-            if rc[v, k] == 0.0:
-                Xdot[v, k, :] = np.nan
-                Xddot[v, k, :] = np.nan
-                continue
-            b[:] = 0.0
-            for c in range(nd):
-                b[n_rows + c] = qdot[k, c]
-            lu_solve(A, p, b, n)
-            Xdot[v, k, :] = b
-            rows_quad(X[v, k], Xdot[v, k], nb, ints, flts[v], b, 0)
-            for i in range(n):
-                b[i] = -b[i]
-            for c in range(nd):
-                b[n_rows + c] += qddot[k, c]
-            lu_solve(A, p, b, n)
-            Xddot[v, k, :] = b
+            if k >= 0:
+                X[v, k, :] = x
+                Xd[v, k, :] = xd
+                Xdd[v, k, :] = xdd
+                J[v, k] = Jw
+                LU[v, k] = lu
+                piv[v, k] = pv
+                rc[v, k] = r
 
 
 @njit
 def inverse_variants(LU, piv, rhs, n_rows, Z):
     """The kinetostatic solve of every position of every variant,
     [-Phi_x^T, g_d,x^T] z = rhs (z: the multipliers, then the driving torques/forces),
-    with the factors of J = [Phi_x; g_d,x] from :func:`motion_variants`: z is J^-T rhs
+    with the factors of J = [Phi_x; g_d,x] from :func:`path_variants`: z is J^-T rhs
     with the multipliers' sign turned.
 
     Parameters
     ----------
     LU, piv : ndarray
-        Factors of :func:`motion_variants`, (V, N, n, n) and (V, N, n).
+        Factors of :func:`path_variants`, (V, N, n, n) and (V, N, n).
     rhs : ndarray, shape (V, N, n)
         Inertia forces minus applied forces (N, N m).
     Z : ndarray, shape (V, N, n)

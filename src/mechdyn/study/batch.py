@@ -28,22 +28,24 @@ status and the message naming the joints whose loop does not close.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..dynamics.forces import applied_forces
+from ..dynamics.forces import ForceModel, applied_forces
 from ..dynamics.inertia import inertia_forces
 from ..dynamics.prescribed_motion import _independent_subset
 from ..dynamics.reactions import joint_reaction, net_on_ground, reaction_frame
 from ..errors import Status
 from ..kernels import rows_numpy
-from ..kernels.rows_variants import inverse_variants, motion_variants, path_variants
+from ..kernels.rows_variants import inverse_variants, path_variants
 from ..kinematics.sweep import DEFAULT_MAX_STEP
+from ..model import Model
 from ..results.kinetostatics_record import Kinetostatics
-from .analyses import KinetostaticExtremes, Outcome
+from .analyses import KinetostaticExtremes, Outcome, extremes
 
-__all__ = ["batched", "batch_reason", "kinetostatic_batch", "MAX_NEWTON", "MIN_PIVOT_RATIO",
-           "SUB_BATCH"]
+__all__ = ["batched", "batch_reason", "kinetostatic_batch", "Variants", "MAX_NEWTON",
+           "MIN_PIVOT_RATIO", "SUB_BATCH"]
 
 #: Newton iterations per step of the batched continuation
 MAX_NEWTON = 12
@@ -124,6 +126,79 @@ def _structure(model) -> tuple:
             model.coord_is_angle.tobytes())
 
 
+@dataclass
+class Variants:
+    """The numbers of V variants of one topology, stacked.
+
+    Attributes
+    ----------
+    base : Model
+        A compiled variant: the structure (names, rows' integers, layout, loads).
+    rows, coords : ndarray, shape (V, n_rows, 9) and (V, n_q, 9)
+        Packed floats of the constraint rows and of the coordinate rows.
+    x_start : ndarray, shape (V, n_x)
+        Start poses: the assembled sketches, or the sketches (the batch's first Newton
+        solve assembles them at their own coordinates, as the compiler does).
+    mass, inertia : ndarray, shape (V, n_bodies)
+    com : ndarray, shape (V, n_bodies, 2)
+    length_scale : ndarray, shape (V,)
+    models : list of Model or None
+        The compiled variants, whose loads are evaluated one by one; None: no loads but
+        the weights under the base's gravity and the drives of the driven coordinates.
+    """
+
+    base: Model
+    rows: np.ndarray
+    coords: np.ndarray
+    x_start: np.ndarray
+    mass: np.ndarray
+    inertia: np.ndarray
+    com: np.ndarray
+    length_scale: np.ndarray
+    models: list | None = None
+
+    @classmethod
+    def of_models(cls, models) -> Variants:
+        """The stacked numbers of compiled variants (:func:`batch_reason` accepted)."""
+        return cls(models[0], np.stack([m.layout().rowset.packed()[1] for m in models]),
+                   np.stack([m.coordinate_rows.packed()[1] for m in models]),
+                   np.stack([m.x0 for m in models]),
+                   np.stack([m.mass for m in models]), np.stack([m.inertia for m in models]),
+                   np.stack([m.com for m in models]),
+                   np.array([m.length_scale for m in models]),
+                   list(models) if _own_loads(models) else None)
+
+    def __len__(self) -> int:
+        return self.rows.shape[0]
+
+    def take(self, index) -> Variants:
+        """The variants at ``index`` (a slice or an index array)."""
+        models = None if self.models is None else list(np.asarray(self.models,
+                                                                  dtype=object)[index])
+        return replace(self, rows=self.rows[index], coords=self.coords[index],
+                       x_start=self.x_start[index], mass=self.mass[index],
+                       inertia=self.inertia[index], com=self.com[index],
+                       length_scale=self.length_scale[index], models=models)
+
+
+def _own_loads(models) -> bool:
+    """True if the variants' applied forces are more than the weights under the first
+    one's gravity (and the drives of the driven coordinates, replaced)."""
+    g = models[0].gravity
+    return bool(models[0].mechanism.loads) or any(np.any(m.gravity != g) for m in models)
+
+
+class _SideBySide:
+    """The moving bodies of V variants side by side as the bodies of one model (V n_b
+    bodies): inertia forces and weights, body by body, need nothing else."""
+
+    def __init__(self, v: Variants, gravity):
+        self.mass, self.inertia = v.mass.reshape(-1), v.inertia.reshape(-1)
+        self.com, self.gravity = v.com.reshape(-1, 2), np.asarray(gravity, float)
+        self.n_bodies = self.mass.size
+        self.n_x, self.n_q = 3 * self.n_bodies, 0
+
+
 def _path_coordinates(q_start, values, held, max_step: float):
     """Each variant's path of driven coordinates: from its start (V, n_d) to the first
     position, then through the positions (N,), in steps of at most ``max_step``; and
@@ -146,21 +221,21 @@ def _path_coordinates(q_start, values, held, max_step: float):
     return np.ascontiguousarray(Q), keep
 
 
-def kinetostatic_batch(models, analysis: KinetostaticExtremes) -> list[Outcome | None]:
+def kinetostatic_batch(variants, analysis: KinetostaticExtremes) -> list[Outcome | None]:
     """The outcome of the kinetostatic cycle of every variant, solved as one batch (see
     the module docstring); None for a variant the batch leaves to the single-model
     analysis.
 
     Parameters
     ----------
-    models : sequence of Model
-        Compiled variants that :func:`batch_reason` accepts.
+    variants : Variants or sequence of Model
+        The variants' numbers, or compiled variants that :func:`batch_reason` accepts.
     analysis : KinetostaticExtremes
 
     Returns
     -------
     list of Outcome or None
-        In the order of ``models``; an Outcome's figures are those of
+        In the order of the variants; an Outcome's figures are those of
         :meth:`KinetostaticExtremes.figures` (its ``warm`` is None).
 
     Examples
@@ -173,117 +248,135 @@ def kinetostatic_batch(models, analysis: KinetostaticExtremes) -> list[Outcome |
     >>> [round(o.figures["M_drive_phi_peak_Nm"], 3) for o in out]
     [21.053, 29.55]
     """
+    if not isinstance(variants, Variants):
+        variants = Variants.of_models(variants)
     out: list[Outcome | None] = []
-    for k in range(0, len(models), SUB_BATCH):
-        out.extend(_cycle(list(models[k:k + SUB_BATCH]), analysis))
+    for k in range(0, len(variants), SUB_BATCH):
+        out.extend(_cycle(variants.take(slice(k, k + SUB_BATCH)), analysis))
     return out
 
 
-def _cycle(models, analysis: KinetostaticExtremes) -> list[Outcome | None]:
+def _cycle(vs: Variants, analysis: KinetostaticExtremes) -> list[Outcome | None]:
     """:func:`kinetostatic_batch` of one sub-batch."""
-    base = models[0]
-    V, nb, n_x = len(models), base.n_bodies, base.n_x
+    base = vs.base
+    V, nb, n_x = len(vs), base.n_bodies, base.n_x
     over, values = analysis.values(base)
     lay0 = base.layout()
-    didx = np.asarray(_independent_subset(base, lay0, base.x0,
-                                          [base.coordinate_index(over)]), dtype=int)
+    x_ref = base.x0 if getattr(base, "x0", None) is not None else base.x_sketch
+    didx = np.asarray(_independent_subset(base, lay0, x_ref, [base.coordinate_index(over)]),
+                      dtype=int)
     n_rows, n_d = lay0.n_rows, len(didx)
     if n_rows + n_d != n_x or n_d != base.n_q:
         return [None] * V  # redundant, or coordinates neither driven nor held
     ints = np.ascontiguousarray(np.concatenate(
         [lay0.rowset.packed()[0], base.coordinate_rows.take(didx).packed()[0]]))
-    cflts = np.stack([m.coordinate_rows.packed()[1] for m in models])
-    flts = np.ascontiguousarray(np.concatenate(
-        [np.stack([m.layout().rowset.packed()[1] for m in models]), cflts[:, didx]], axis=1))
-    X0 = np.stack([m.x0 for m in models])
-    # the coordinates of each variant's assembled sketch (its start and its held values)
-    q0 = rows_numpy.values(rows_numpy.variant_rows(base.coordinate_rows, cflts),
-                           X0[:, None, :])[:, 0, :]
-    L = np.array([m.length_scale for m in models])
+    flts = np.ascontiguousarray(np.concatenate([vs.rows, vs.coords[:, didx]], axis=1))
+    # the coordinates of each variant's start: where it is assembled, and its held values
+    q0 = rows_numpy.values(rows_numpy.variant_rows(base.coordinate_rows, vs.coords),
+                           vs.x_start[:, None, :])[:, 0, :]
     Q, keep = _path_coordinates(q0[:, didx], values, q0[:, didx[1:]], DEFAULT_MAX_STEP)
-    Xp = np.zeros(Q.shape[:2] + (n_x,))
+    N, M = values.size, Q.shape[1]
+    at = np.full(M, -1, dtype=np.int64)
+    at[keep] = np.arange(N)
+    dQ, ddQ = np.zeros((M, n_d)), np.zeros((M, n_d))
+    dQ[keep, 0] = analysis.speed
+    X, Xd, Xdd = (np.empty((V, N, n_x)) for _ in range(3))
+    J, LU = np.empty((V, N, n_x, n_x)), np.empty((V, N, n_x, n_x))
+    piv, rc = np.empty((V, N, n_x), dtype=np.int64), np.empty((V, N))
     ok = np.ones(V, dtype=bool)
     fail = np.empty(V, dtype=np.int64)
-    path_variants(X0, Q, nb, ints, flts, n_rows, 1e-12 * np.maximum(L, 1e-3), MAX_NEWTON,
-                  MIN_PIVOT_RATIO, Xp, ok, fail)
-    N = values.size
-    qd = np.concatenate([np.broadcast_to(values[:, None], (N, 1)),
-                         np.zeros((N, n_d - 1))], axis=1)  # (the held part per variant)
-    qd_dot = np.zeros((N, n_d))
-    qd_dot[:, 0] = analysis.speed
-    qd_ddot = np.zeros((N, n_d))
-    t = (values - values[0]) / analysis.speed if analysis.speed != 0 else np.zeros(N)
+    path_variants(np.ascontiguousarray(vs.x_start), Q, dQ, ddQ, at, nb, ints, flts, n_rows,
+                  1e-12 * np.maximum(vs.length_scale, 1e-3), MAX_NEWTON, MIN_PIVOT_RATIO,
+                  X, Xd, Xdd, J, LU, piv, rc, ok, fail)
     live = np.flatnonzero(ok)
     if not live.size:
         return [None] * V
-    X = np.ascontiguousarray(Xp[live][:, keep])
-    fl = np.ascontiguousarray(flts[live])
-    Xd, Xdd = np.empty_like(X), np.empty_like(X)
-    J = np.empty(X.shape[:2] + (n_x, n_x))
-    LU, piv = np.empty_like(J), np.empty(X.shape, dtype=np.int64)
-    rc = np.empty(X.shape[:2])
-    motion_variants(X, qd_dot, qd_ddot, nb, ints, fl, n_rows, Xd, Xdd, J, LU, piv, rc)
-    rhs = np.empty_like(X)
-    loads = []
-    for i, v in enumerate(live):
-        m = models[v]
-        q = np.empty((N, base.n_q))
-        q[:, didx] = qd
-        q[:, didx[1:]] = q0[v, didx[1:]]
-        qdot = np.zeros((N, base.n_q))
-        qdot[:, didx] = qd_dot
-        F, F_ground, _ = applied_forces(m, t, X[i], Xd[i], q, qdot, skip_drives=didx)
-        rhs[i] = inertia_forces(m, X[i], Xd[i], Xdd[i]) - F
-        loads.append((q, qdot, F_ground))
+    if live.size < V:
+        X, Xd, Xdd, J, LU, piv, rc = (a[live] for a in (X, Xd, Xdd, J, LU, piv, rc))
+    qd_dot = dQ[keep]
+    t = (values - values[0]) / analysis.speed if analysis.speed != 0 else np.zeros(N)
+    # every coordinate is driven or held: q, qdot are the prescribed values
+    q = np.empty((live.size, N, base.n_q))
+    q[:] = q0[live, None, :]
+    q[..., didx[0]] = values
+    qdot = np.zeros_like(q)
+    qdot[..., didx] = qd_dot
+    rhs, F_ground = _rhs(vs.take(live), base, t, X, Xd, Xdd, q, qdot, didx)
     Z = np.empty_like(X)
     inverse_variants(LU, piv, rhs, n_rows, Z)
-    out: list[Outcome | None] = [None] * V
     good = np.all(rc >= MIN_PIVOT_RATIO, axis=1) & np.all(np.isfinite(Z), axis=(1, 2))
     reactions, frame = _reactions(base, lay0, X, J, Z, n_rows)
+    frame += F_ground  # the frame's share of the loads (point of the moments: the origin)
     names = base.coordinate_names
+    driven = {names[k]: Z[..., n_rows + c] for c, k in enumerate(didx)}
+    rec = Kinetostatics(
+        over=names[didx[0]], t=t, values=values, q=q, qdot=qdot, qddot=np.zeros_like(q),
+        x=X, xdot=Xd, xddot=Xdd, coordinate_names=tuple(names),
+        driven=tuple(names[k] for k in didx), reactions=reactions, moments={}, joint_frame={},
+        joint_points={}, driving=driven,
+        power={c: tau * qdot[..., names.index(c)] for c, tau in driven.items()},
+        frame_force=frame[..., :2], frame_moment=frame[..., 2], frame_point=np.zeros(2),
+        frame_loads={}, multipliers=Z[..., :n_rows], joint_kinds={}, mode=lay0.mode,
+        redundant_joints=(), status=Status.SUCCESS, message="", warnings=(), stats={},
+        model=base)
+
+    def rms(y):  # the record's rule, variant by variant
+        return np.array([Kinetostatics.rms(rec, row) for row in y])
+
+    figs = extremes(rec, rec.driving, rec.power, rec.reactions, rec.frame_force,
+                    rec.frame_moment, rms)
+    out: list[Outcome | None] = [None] * V
     for i, v in enumerate(live):
-        if not good[i]:
-            continue
-        q, qdot, F_ground = loads[i]
-        tau = Z[i, :, n_rows:]
-        rec = Kinetostatics(
-            over=names[didx[0]], t=t, values=values, q=q, qdot=qdot,
-            qddot=np.zeros_like(q), x=X[i], xdot=Xd[i], xddot=Xdd[i],
-            coordinate_names=tuple(names), driven=tuple(names[k] for k in didx),
-            reactions={j: f[i] for j, f in reactions.items()}, moments={}, joint_frame={},
-            joint_points={}, driving={names[k]: tau[:, c] for c, k in enumerate(didx)},
-            power={names[k]: tau[:, c] * qdot[:, k] for c, k in enumerate(didx)},
-            frame_force=frame[i, :, :2] + F_ground[:, :2], frame_moment=frame[i, :, 2]
-            + F_ground[:, 2], frame_point=np.zeros(2), frame_loads={},
-            multipliers=Z[i, :, :n_rows], joint_kinds={}, mode=lay0.mode, redundant_joints=(),
-            status=Status.SUCCESS, message="", warnings=(), stats={}, model=models[v])
-        fig = KinetostaticExtremes.figures(rec)
-        out[v] = Outcome(fig.figures, fig.status, fig.message)
+        if good[i]:
+            out[v] = Outcome({k: float(a[i]) for k, a in figs.items()}, str(Status.SUCCESS))
     return out
+
+
+def _rhs(vs: Variants, base, t, X, Xd, Xdd, q, qdot, didx):
+    """Inertia forces minus applied forces, (V, N, n_x), and the loads on the frame
+    (V, N, 3): the bodies of all variants side by side as one model
+    (:func:`~mechdyn.dynamics.inertia.inertia_forces`, and the weights of
+    :class:`~mechdyn.dynamics.forces.ForceModel`), or each variant's loads
+    (:func:`~mechdyn.dynamics.forces.applied_forces`) when it has more than gravity."""
+    V, N, n_x = X.shape
+
+    def side(a):  # (V, N, n_x) -> (N, V n_x)
+        return np.ascontiguousarray(a.transpose(1, 0, 2)).reshape(N, V * n_x)
+
+    def back(a):
+        return a.reshape(N, V, n_x).transpose(1, 0, 2)
+
+    sbs = _SideBySide(vs, base.gravity)
+    rhs = back(inertia_forces(sbs, side(X), side(Xd), side(Xdd)))
+    F_ground = np.zeros((V, N, 3))
+    if vs.models is None:
+        return rhs - back(ForceModel(sbs, [], [], [], [], []).conservative(side(X))), F_ground
+    for i, m in enumerate(vs.models):
+        F, F_ground[i], _ = applied_forces(m, t, X[i], Xd[i], q[i], qdot[i], skip_drives=didx)
+        rhs[i] -= F
+    return rhs, F_ground
 
 
 def _reactions(base, lay, X, J, Z, n_rows):
     """The joint reactions {joint: (V, N, 2)} N (on the child from the parent, as
     :func:`~mechdyn.dynamics.reactions.joint_reaction`), and what the frame receives
     from the joints to the ground and from the drives' stators, (V, N, 3): Fx, Fy (N)
-    and the moment about the ground origin (N m) (as ``_inverse``'s frame loads)."""
+    and the moment about the ground origin (N m) (as ``_inverse``'s frame loads; they
+    are linear in the forces on the bodies, so their sum is taken once)."""
     V, N, n_x = X.shape
     x = X.reshape(V * N, n_x)
     P = J[..., :n_rows, :].reshape(V * N, n_rows, n_x)
     lam = Z[..., :n_rows].reshape(V * N, n_rows)
-    point = np.zeros(2)
     # the drives' stators: the driving torques on the poses, D = g_d,x^T tau
     D = np.einsum("nd,ndx->nx", Z[..., n_rows:].reshape(V * N, -1),
                   J[..., n_rows:, :].reshape(V * N, -1, n_x))
-    frame = net_on_ground(base, x, D, point)
+    C = P * lam[:, :, None]  # each row's force on the poses, Phi_x^T lambda
     reactions = {}
     for name in (n for n in base.joint_names if n in lay.rows):
-        idx = lay.rows[name]
-        gen = -np.einsum("nrx,nr->nx", P[:, idx, :], lam[:, idx])
+        gen = -C[:, lay.rows[name], :].sum(axis=1)
         # the force does not depend on the joint point (the base's serves every variant)
         f, _, _ = joint_reaction(base, name, x, gen)
         reactions[name] = f.reshape(V, N, 2)
         if base.n_bodies in reaction_frame(base, name)[1:3]:
-            frame = frame + net_on_ground(base, x, gen, point)
-    return reactions, frame.reshape(V, N, 3)
-
+            D += gen
+    return reactions, net_on_ground(base, x, D, np.zeros(2)).reshape(V, N, 3)

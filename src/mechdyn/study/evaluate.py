@@ -4,6 +4,7 @@ that fails is a row with its status and message."""
 
 from __future__ import annotations
 
+import functools
 import time
 import warnings
 from dataclasses import dataclass
@@ -12,10 +13,11 @@ import numpy as np
 
 from ..errors import AssemblyError, MechdynError, SingularPositionError, Status
 from .batch import batch_reason, batched, kinetostatic_batch
+from .batch_numbers import affine_variants
 from .parameters import BaseModel, Parameter, to_shown
 
 __all__ = ["Task", "evaluate_batch", "evaluate_variant", "order_variants", "failure", "head",
-           "compiled", "analyse"]
+           "compiled", "analyse", "attempt"]
 
 
 @dataclass(frozen=True)
@@ -88,35 +90,54 @@ def evaluate_batch(task: Task, batch: list[tuple[int, tuple[float, ...]]],
 
 
 def _as_batch(task: Task, batch, warm=None) -> list[dict]:
-    """:func:`evaluate_batch` through :func:`~.batch.kinetostatic_batch`: every variant
-    compiled, then analysed as one batch if :func:`~.batch.batch_reason` allows it;
-    the variants the batch leaves (and every variant otherwise) analysed one by one."""
+    """:func:`evaluate_batch` through :func:`~.batch.kinetostatic_batch`: the variants'
+    numbers from a few compiled probes (:func:`~.batch_numbers.affine_variants`), or
+    else every variant compiled; analysed as one batch if :func:`~.batch.batch_reason`
+    allows it.  The variants the batch leaves (and every variant otherwise) are
+    compiled and analysed one by one."""
     t0 = time.perf_counter()
     rows = [head(task, vid, values) for vid, values in batch]
-    models, where = [], []
-    for k, (_, values) in enumerate(batch):
-        try:
-            models.append(compiled(task, values))
-            where.append(k)
-        except Exception as exc:  # noqa: BLE001 - a failed variant is a row, not the end
-            rows[k]["status"], rows[k]["message"] = failure(exc)
-            rows[k]["evaluated"] = "batch"
-    outcomes = [None] * len(models)
-    if models and batch_reason(task.analysis, models) is None:
-        outcomes = kinetostatic_batch(models, task.analysis)
+    values = np.array([v for _, v in batch], dtype=float)
+    models: list = [None] * len(batch)
+    outcomes: list = [None] * len(batch)
+    variants = affine_variants(task, values, functools.partial(attempt, task))
+    if variants is None:
+        for k, v in enumerate(values):
+            models[k] = attempt(task, v)
+            if isinstance(models[k], tuple):
+                rows[k]["status"], rows[k]["message"] = models[k]
+                rows[k]["evaluated"] = "batch"
+        good = [k for k, m in enumerate(models) if not isinstance(m, tuple)]
+        if good and batch_reason(task.analysis, [models[k] for k in good]) is None:
+            for k, o in zip(good, kinetostatic_batch([models[k] for k in good],
+                                                     task.analysis), strict=True):
+                outcomes[k] = o
+    else:
+        outcomes = kinetostatic_batch(variants, task.analysis)
     shared = (time.perf_counter() - t0) / len(batch)
-    for k, model, outcome in zip(where, models, outcomes, strict=True):
+    for k, outcome in enumerate(outcomes):
         row, t1 = rows[k], time.perf_counter()
-        if outcome is None:  # on its own: its status and message, or the batch's figures
-            warm = analyse(task, row, model, warm)
-        else:
+        if outcome is not None:
             row.update(outcome.figures)
             row["status"], row["message"] = outcome.status, outcome.message
             row["evaluated"] = "batch"
+        elif "status" not in row:  # on its own: its status and message, or its figures
+            model = attempt(task, values[k]) if models[k] is None else models[k]
+            if isinstance(model, tuple):
+                row["status"], row["message"] = model
+                row["evaluated"] = "loop"
+            else:
+                warm = analyse(task, row, model, warm)
         row["seconds"] = shared + time.perf_counter() - t1
-    for row in rows:
-        row.setdefault("seconds", shared)
     return rows
+
+
+def attempt(task: Task, values):
+    """The compiled model of a variant, or the (status, message) of its failure."""
+    try:
+        return compiled(task, tuple(float(v) for v in values))
+    except Exception as exc:  # noqa: BLE001 - a failed variant is a row, not the end
+        return failure(exc)
 
 
 def head(task: Task, vid: int, values: tuple[float, ...]) -> dict:
