@@ -209,10 +209,9 @@ def _path_coordinates(q_start, values, held, max_step: float):
     first = q_start[:, :1] + s[None, :] * (values[0] - q_start[:, :1])  # (V, lead + 1)
     # within the positions: substeps where they are farther apart than max_step
     gaps = np.maximum(1, np.ceil(np.abs(np.diff(values)) / max_step).astype(int))
-    inner = [values[:1]]
-    for k, g in enumerate(gaps):
-        inner.append(values[k] + (values[k + 1] - values[k]) * np.arange(1, g + 1) / g)
-    inner = np.concatenate(inner)
+    k = np.repeat(np.arange(gaps.size), gaps)  # the interval of each substep
+    j = np.arange(k.size) - np.repeat(np.cumsum(gaps) - gaps, gaps) + 1  # 1 .. gap
+    inner = np.concatenate([values[:1], values[k] + np.diff(values)[k] * j / gaps[k]])
     keep = lead + np.concatenate([[0], np.cumsum(gaps)])
     drive = np.concatenate([first, np.broadcast_to(inner[1:], (V, inner.size - 1))], axis=1)
     Q = np.concatenate([drive[..., None],
@@ -320,7 +319,9 @@ def _cycle(vs: Variants, analysis: KinetostaticExtremes) -> list[Outcome | None]
         redundant_joints=(), status=Status.SUCCESS, message="", warnings=(), stats={},
         model=base)
 
-    def rms(y):  # the record's rule, variant by variant
+    def rms(y):  # the record's rule (Kinetostatics.rms): time-weighted, here at once
+        if np.isfinite(y).all() and np.all(np.diff(t) > 0):
+            return np.sqrt(np.trapezoid(y**2, t, axis=-1) / (t[-1] - t[0]))
         return np.array([Kinetostatics.rms(rec, row) for row in y])
 
     figs = extremes(rec, rec.driving, rec.power, rec.reactions, rec.frame_force,
@@ -364,16 +365,14 @@ def _reactions(base, lay, X, J, Z, n_rows):
     and the moment about the ground origin (N m) (as ``_inverse``'s frame loads; they
     are linear in the forces on the bodies, so their sum is taken once)."""
     V, N, n_x = X.shape
-    x = X.reshape(V * N, n_x)
-    P = J[..., :n_rows, :].reshape(V * N, n_rows, n_x)
-    lam = Z[..., :n_rows].reshape(V * N, n_rows)
+    x, Jf, Zf = X.reshape(V * N, n_x), J.reshape(V * N, n_x, n_x), Z.reshape(V * N, n_x)
     # the drives' stators: the driving torques on the poses, D = g_d,x^T tau
-    D = np.einsum("nd,ndx->nx", Z[..., n_rows:].reshape(V * N, -1),
-                  J[..., n_rows:, :].reshape(V * N, -1, n_x))
-    C = P * lam[:, :, None]  # each row's force on the poses, Phi_x^T lambda
+    D = np.einsum("nd,ndx->nx", Zf[:, n_rows:], Jf[:, n_rows:, :])
     reactions = {}
     for name in (n for n in base.joint_names if n in lay.rows):
-        gen = -C[:, lay.rows[name], :].sum(axis=1)
+        idx = lay.rows[name]
+        rows = slice(idx[0], idx[-1] + 1) if np.all(np.diff(idx) == 1) else idx
+        gen = -np.einsum("nr,nrx->nx", Zf[:, rows], Jf[:, rows, :])  # -Phi_e,x^T lambda_e
         # the force does not depend on the joint point (the base's serves every variant)
         f, _, _ = joint_reaction(base, name, x, gen)
         reactions[name] = f.reshape(V, N, 2)
