@@ -92,3 +92,19 @@ def test_variant_rows_evaluate_each_variant_with_its_own_numbers(base):
         np.testing.assert_array_equal(v[k], rows_numpy.values(r, x[k]))
         np.testing.assert_array_equal(J[k], rows_numpy.jacobian(r, x[k]))
         np.testing.assert_array_equal(quad[k], rows_numpy.quad(r, x[k], 2 * x[k]))
+
+
+def test_a_model_with_loads_batched_equals_the_loop():
+    """Andrews' squeezer has a spring: each variant's loads are its own (every variant
+    compiled), the continuation and the solve still one batch."""
+    base = BaseModel("andrews_squeezer")
+    model = base.compile({})
+    body = model.body_names[-1]
+    p = base.parameter(f"bodies.{body}.mass")
+    analysis = KinetostaticExtremes("100 rpm", steps=72)
+    values = [float(model.mass[-1]) * f for f in (0.8, 1.25)]
+    rows = evaluate_batch(Task(base, (p,), analysis), [(0, (values[0],)), (1, (values[1],))])
+    assert [r["evaluated"] for r in rows] == ["batch", "batch"]
+    for row, v in zip(rows, values, strict=True):
+        for col, want in loop_figures(base, {p: v}, analysis).items():
+            assert row[col] == pytest.approx(want, rel=1e-9, abs=1e-9), col
