@@ -146,8 +146,9 @@ def _summary(df, args, ranges, seconds: float) -> None:
           + ", ".join(f"{v} {k}" for k, v in counts.items()))
     if "evaluated" in df:  # as one batch (study.batch) or one by one
         how = df["evaluated"].value_counts().to_dict()
+        why = df.attrs.get("one_by_one", "")
         print(f"  evaluated: {how.get('batch', 0)} as batches of variants, "
-              f"{how.get('loop', 0)} one by one")
+              f"{how.get('loop', 0)} one by one" + (f" ({why})" if why else ""))
     params = [r.parameter.column for r in ranges]
     figures = [c for c in df if c not in ("variant", "status", "message", "evaluated", "seconds",
                                           "objective", "feasible") and c not in params]

@@ -15,7 +15,7 @@ import numpy as np
 
 from .. import progress as _progress
 from ..errors import ModelError
-from .batch import batched
+from .batch import batch_reason, batched
 from .evaluate import Task, evaluate_batch, order_variants
 from .output import StudyOutput, order_columns
 from .parameters import BaseModel, Parameter, to_shown
@@ -109,6 +109,18 @@ def _dask(task, batches, client, retries: int):
         client.cancel(futures)
 
 
+def _one_by_one(base: BaseModel, analysis) -> str:
+    """Why the study's variants are analysed one by one rather than as batches ("" when
+    the base model and the analysis allow batches)."""
+    if not batched(analysis):
+        return batch_reason(analysis, []) or ""
+    try:
+        model = base.compile({})
+    except Exception:  # noqa: BLE001 - the variants' rows say what is wrong
+        return ""
+    return batch_reason(analysis, [model]) or ""
+
+
 def run_study(model, variants, analysis, *, output: str | Path | None = None,
               client=None, workers: int | None = None, batch_size: int | None = None,
               resume: bool = False, progress: bool | None = None, order: bool = True,
@@ -154,8 +166,11 @@ def run_study(model, variants, analysis, *, output: str | Path | None = None,
     pandas.DataFrame
         One row per variant, sorted by ``variant`` (the design's row index): the
         parameters (columns with units, angles in deg), the figures, ``status``,
-        ``message``, ``seconds``; ``attrs["analysed"]``: the variants analysed in this
-        call (the others were resumed).
+        ``message``, ``evaluated`` (``batch``: analysed as one batch of variants,
+        :mod:`~mechdyn.study.batch`; ``loop``: on its own), ``seconds``;
+        ``attrs["analysed"]``: the variants analysed in this call (the others were
+        resumed); ``attrs["one_by_one"]``: why the analysis or the model does not allow
+        batches ("" when they do).
 
     Raises
     ------
@@ -226,4 +241,5 @@ def run_study(model, variants, analysis, *, output: str | Path | None = None,
     table.attrs["model"] = base.spec
     table.attrs["analysis"] = getattr(analysis, "name", type(analysis).__name__)
     table.attrs["analysed"] = len(rows)  # in this call (the others were resumed)
+    table.attrs["one_by_one"] = _one_by_one(base, analysis)
     return table
