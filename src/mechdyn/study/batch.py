@@ -37,7 +37,7 @@ from ..dynamics.inertia import inertia_forces
 from ..dynamics.prescribed_motion import _independent_subset
 from ..dynamics.reactions import joint_reaction, net_on_ground, reaction_frame
 from ..errors import Status
-from ..kernels import rows_numpy
+from ..kernels import rows_numba, rows_numpy
 from ..kernels.rows_variants import inverse_variants, path_variants
 from ..kinematics.sweep import DEFAULT_MAX_STEP
 from ..model import Model
@@ -45,16 +45,20 @@ from ..results.kinetostatics_record import Kinetostatics
 from .analyses import KinetostaticExtremes, Outcome, extremes
 
 __all__ = ["batched", "batch_reason", "kinetostatic_batch", "Variants", "MAX_NEWTON",
-           "MIN_PIVOT_RATIO", "SUB_BATCH"]
+           "MIN_PIVOT_RATIO", "SUB_BATCH", "SUB_BATCH_FLOATS"]
 
 #: Newton iterations per step of the batched continuation
 MAX_NEWTON = 12
 #: pivot ratio min|u_ii| / max|u_ii| of a Jacobian below which a variant leaves the batch
 #: (a dead, toggle or bifurcation position: the single-model analysis decides)
 MIN_PIVOT_RATIO = 1e-6
-#: variants whose cycle is solved in one call (bounds the memory: the Jacobians of a
-#: sub-batch are kept for the reactions, SUB_BATCH x steps x n x n_x floats)
+#: most variants whose cycle is solved in one call
 SUB_BATCH = 64
+#: floats of the Jacobians and their factors kept for one call (the call's variants x
+#: positions x n x n_x, twice): bounds its memory (32 MB)
+SUB_BATCH_FLOATS = 4_000_000
+#: the compiled kernels have been loaded (or compiled) in this process
+_WARM = {"done": False}
 
 
 def _friction(model) -> bool:
@@ -249,9 +253,17 @@ def kinetostatic_batch(variants, analysis: KinetostaticExtremes) -> list[Outcome
     """
     if not isinstance(variants, Variants):
         variants = Variants.of_models(variants)
+    n = variants.base.n_x
+    size = max(1, min(SUB_BATCH, SUB_BATCH_FLOATS // (2 * analysis.steps * n * n)))
     out: list[Outcome | None] = []
-    for k in range(0, len(variants), SUB_BATCH):
-        out.extend(_cycle(variants.take(slice(k, k + SUB_BATCH)), analysis))
+    for k in range(0, len(variants), size):
+        part = variants.take(slice(k, k + size))
+        if _WARM["done"]:
+            out.extend(_cycle(part, analysis))
+            continue
+        with rows_numba.compiling("numba kernels of the batched study"):
+            out.extend(_cycle(part, analysis))
+        _WARM["done"] = True
     return out
 
 
