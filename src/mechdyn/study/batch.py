@@ -256,19 +256,30 @@ def kinetostatic_batch(variants, analysis: KinetostaticExtremes) -> list[Outcome
     n = variants.base.n_x
     size = max(1, min(SUB_BATCH, SUB_BATCH_FLOATS // (2 * analysis.steps * n * n)))
     out: list[Outcome | None] = []
+    work: dict = {}
     for k in range(0, len(variants), size):
         part = variants.take(slice(k, k + size))
         if _WARM["done"]:
-            out.extend(_cycle(part, analysis))
+            out.extend(_cycle(part, analysis, work))
             continue
         with rows_numba.compiling("numba kernels of the batched study"):
-            out.extend(_cycle(part, analysis))
+            out.extend(_cycle(part, analysis, work))
         _WARM["done"] = True
     return out
 
 
-def _cycle(vs: Variants, analysis: KinetostaticExtremes) -> list[Outcome | None]:
-    """:func:`kinetostatic_batch` of one sub-batch."""
+def _scratch(work: dict, name: str, shape: tuple, dtype=float) -> np.ndarray:
+    """An array of ``shape`` from the reusable memory ``work`` (its contents undefined):
+    the calls of one batch share their large arrays instead of each mapping new ones."""
+    size = math.prod(shape)
+    a = work.get(name)
+    if a is None or a.size < size or a.dtype != dtype:
+        a = work[name] = np.empty(size, dtype=dtype)
+    return a[:size].reshape(shape)
+
+
+def _cycle(vs: Variants, analysis: KinetostaticExtremes, work: dict) -> list[Outcome | None]:
+    """:func:`kinetostatic_batch` of one sub-batch (``work``: see :func:`_scratch`)."""
     base = vs.base
     V, nb, n_x = len(vs), base.n_bodies, base.n_x
     over, values = analysis.values(base)
@@ -291,9 +302,9 @@ def _cycle(vs: Variants, analysis: KinetostaticExtremes) -> list[Outcome | None]
     at[keep] = np.arange(N)
     dQ, ddQ = np.zeros((M, n_d)), np.zeros((M, n_d))
     dQ[keep, 0] = analysis.speed
-    X, Xd, Xdd = (np.empty((V, N, n_x)) for _ in range(3))
-    J, LU = np.empty((V, N, n_x, n_x)), np.empty((V, N, n_x, n_x))
-    piv, rc = np.empty((V, N, n_x), dtype=np.int64), np.empty((V, N))
+    X, Xd, Xdd = (_scratch(work, k, (V, N, n_x)) for k in ("X", "Xd", "Xdd"))
+    J, LU = _scratch(work, "J", (V, N, n_x, n_x)), _scratch(work, "LU", (V, N, n_x, n_x))
+    piv, rc = _scratch(work, "piv", (V, N, n_x), np.int64), _scratch(work, "rc", (V, N))
     ok = np.ones(V, dtype=bool)
     fail = np.empty(V, dtype=np.int64)
     path_variants(np.ascontiguousarray(vs.x_start), Q, dQ, ddQ, at, nb, ints, flts, n_rows,
