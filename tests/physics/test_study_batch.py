@@ -2,6 +2,7 @@
 mechdyn.kinetostatics, one cold call per variant; the variants the batch leaves."""
 
 import warnings
+from functools import partial
 
 import numpy as np
 import pytest
@@ -11,8 +12,9 @@ from mechdyn.kernels import rows_numpy
 from mechdyn.modelfile.loader import build
 from mechdyn.study.analyses import KinematicSummary, KinetostaticExtremes
 from mechdyn.study.batch import batch_reason, kinetostatic_batch
+from mechdyn.study.batch_numbers import affine_variants
 from mechdyn.study.designs import design, parse_range
-from mechdyn.study.evaluate import Task, evaluate_batch
+from mechdyn.study.evaluate import Task, attempt, evaluate_batch
 from mechdyn.study.parameters import BaseModel
 
 RANGES = ("bodies.crank.points.A.x=40mm..60mm", "bodies.rod.points.B.x=140mm..200mm",
@@ -108,3 +110,20 @@ def test_a_model_with_loads_batched_equals_the_loop():
     for row, v in zip(rows, values, strict=True):
         for col, want in loop_figures(base, {p: v}, analysis).items():
             assert row[col] == pytest.approx(want, rel=1e-9, abs=1e-9), col
+
+
+def test_numbers_that_are_not_affine_in_the_parameter_compile_every_variant(base):
+    """The slider's axis is normalised by the compiler (not affine in its y): the probes'
+    fit fails, every variant is compiled, and the batch still equals the loop."""
+    p = base.parameter("joints.cylinder.axis.y")
+    task = Task(base, (p,), ANALYSIS)
+    values = np.array([[0.0], [0.05], [0.1]])
+    assert affine_variants(task, values, partial(attempt, task)) is None
+    q = base.parameter("bodies.rod.mass")
+    assert affine_variants(Task(base, (q,), ANALYSIS), values + 1.0,
+                           partial(attempt, Task(base, (q,), ANALYSIS))) is not None
+    rows = evaluate_batch(task, [(k, tuple(v)) for k, v in enumerate(values)])
+    assert [r["evaluated"] for r in rows] == ["batch"] * 3
+    for row, v in zip(rows, values[:, 0], strict=True):
+        want = loop_figures(base, {p: v}, ANALYSIS)["M_drive_phi_peak_Nm"]
+        assert row["M_drive_phi_peak_Nm"] == pytest.approx(want, rel=1e-9)

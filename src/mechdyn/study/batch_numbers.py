@@ -42,7 +42,7 @@ def affine_variants(task, values, attempt) -> Variants | None:
     the order of ``task.parameters``) from compiled probes, or None when they do not
     fit one affine function, a corner of the box fails a value check, the model has
     loads besides gravity, a body without a sketch pose or assembly modes, or the
-    reference variant (the first) does not compile.
+    reference variant (the one nearest the middle of the box) does not compile.
 
     ``attempt(values)`` compiles one variant: its Model, or the (status, message) of its
     failure (:func:`~mechdyn.study.evaluate.attempt`).
@@ -62,26 +62,29 @@ def affine_variants(task, values, attempt) -> Variants | None:
     [[0.04, 0.0], [0.05, 0.0], [0.06, 0.0]]
     """
     values = np.asarray(values, float)
-    ref = attempt(values[0])
+    lo, hi = values.min(axis=0), values.max(axis=0)
+    # the reference: the variant nearest the middle of the box (likely to assemble)
+    mid = np.abs((values - 0.5 * (lo + hi)) / np.where(hi > lo, hi - lo, 1.0)).max(axis=1)
+    p0 = values[int(np.argmin(mid))]
+    ref = attempt(p0)
     if isinstance(ref, tuple) or batch_reason(task.analysis, [ref]) is not None:
         return None
     if ref.mechanism.loads or not ref.pose_given.all() or ref.assembly_modes:
         return None
-    lo, hi = values.min(axis=0), values.max(axis=0)
     var = np.flatnonzero(hi > lo)
     if var.size > MAX_CORNER_PARAMETERS:
         return None
     for corner in itertools.product(*[(lo[i], hi[i]) for i in var]):
-        p = values[0].copy()
+        p = p0.copy()
         p[var] = corner
         got = attempt(p)
         if isinstance(got, tuple) and got[0] != Status.ASSEMBLY_FAILED.value:
             return None  # a value check fails in the box: each variant says its own
     # probes near the reference (they assemble where it does), a quarter of the box away
-    step = np.where(values[0] - lo > hi - values[0], lo - values[0], hi - values[0]) / 4
-    points = [values[0] + np.eye(values.shape[1])[i] * step[i] for i in var]
+    step = np.where(p0 - lo > hi - p0, lo - p0, hi - p0) / 4
+    points = [p0 + np.eye(values.shape[1])[i] * step[i] for i in var]
     rng = np.random.default_rng(len(values))
-    check = values[0].copy()
+    check = p0.copy()
     check[var] += step[var] * rng.uniform(0.2, 0.8, var.size)
     models = [ref]
     for p in [*points, check]:
@@ -91,7 +94,7 @@ def affine_variants(task, values, attempt) -> Variants | None:
         models.append(m)
     nums = [_numbers(m) for m in models]
     A = np.column_stack([np.ones(len(models)),
-                         np.array([values[0], *points, check])[:, var] - values[0, var]])
+                         np.array([p0, *points, check])[:, var] - p0[var]])
     fit = {}
     for key in nums[0]:
         Y = np.stack([n[key].ravel() for n in nums])
@@ -99,7 +102,7 @@ def affine_variants(task, values, attempt) -> Variants | None:
         scale = max(float(np.abs(Y).max()), 1e-300)
         if np.abs(A[-1] @ coef - Y[-1]).max() > FIT_RTOL * scale:
             return None  # not affine (a normalised axis, a derived offset ...)
-        dv = values[:, var] - values[0, var]
+        dv = values[:, var] - p0[var]
         fit[key] = (coef[0] + dv @ coef[1:]).reshape((len(values),) + nums[0][key].shape)
     L = min(m.length_scale for m in models)  # the Newton tolerance's scale
     return Variants(ref, fit["rows"], fit["coords"], fit["x_start"], fit["mass"],
