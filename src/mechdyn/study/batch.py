@@ -7,22 +7,30 @@ its own floats (:func:`mechdyn.kernels.rows_numpy.variant_rows`,
 :mod:`mechdyn.kernels.rows_variants`), so that
 
 * the continuation solves every variant's poses at one crank angle together (Newton
-  on each variant's Jacobian, warm-started from the previous angle plus the tangent),
-  keeping each variant's assembly branch by the sign of det J;
-* the rates and accelerations, and the kinetostatic solve
-  ``[-Phi_x^T, g_d,x^T] z = I - F`` of :func:`mechdyn.dynamics.reactions._inverse`
-  (the same balanced units), are solved for every variant and position in one call;
-* the applied and inertia forces are those of :mod:`mechdyn.dynamics.forces` and
-  :mod:`mechdyn.dynamics.inertia` (one call per variant over all its positions), the
-  joint reactions and frame loads those of :mod:`mechdyn.dynamics.reactions`, and
-  the figures those of :meth:`KinetostaticExtremes.figures
-  <mechdyn.study.analyses.KinetostaticExtremes.figures>` on a
-  :class:`~mechdyn.Kinetostatics` record of each variant.
+  on each variant's Jacobian, warm-started from the previous angle plus the tangent and
+  the curvature), keeping each variant's assembly branch by the sign of det J; the
+  rates and accelerations come from the factors of J at the solved poses;
+* the kinetostatic solve ``[-Phi_x^T, g_d,x^T] z = I - F`` of
+  :func:`mechdyn.dynamics.reactions._inverse`, whose matrix is J transposed (its
+  balancing scales cancel in the solution), reuses those factors for every variant and
+  position;
+* the inertia forces and weights are those of
+  :func:`~mechdyn.dynamics.inertia.inertia_forces` and
+  :class:`~mechdyn.dynamics.forces.ForceModel`, called once with the bodies of all
+  variants side by side; other loads those of
+  :func:`~mechdyn.dynamics.forces.applied_forces`, one call per variant over its
+  positions; the joint reactions and frame loads those of
+  :mod:`mechdyn.dynamics.reactions` (:func:`~mechdyn.dynamics.reactions.joint_reaction`,
+  :func:`~mechdyn.dynamics.reactions.net_on_ground`), and the figures those of
+  :func:`~mechdyn.study.analyses.extremes`, which
+  :meth:`KinetostaticExtremes.figures <mechdyn.study.analyses.KinetostaticExtremes.figures>`
+  applies to one record.
 
-A variant the batch cannot finish -- its path meets a dead or bifurcation position, a
-Newton step fails, its kinetostatic matrix is (nearly) singular -- is returned as None:
-the caller analyses it on its own (:func:`mechdyn.kinetostatics`), which gives its
-status and the message naming the joints whose loop does not close.
+A variant the batch cannot finish -- its sketch does not assemble, its path meets a dead
+or bifurcation position, a Newton step fails, its kinetostatic matrix is nearly
+singular -- is returned as None: the caller analyses it on its own
+(:func:`mechdyn.kinetostatics`), which gives its status and the message naming the
+joints whose loop does not close.
 """
 
 from __future__ import annotations
