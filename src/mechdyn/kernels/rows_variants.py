@@ -50,13 +50,15 @@ def _det_sign(lu, piv, n):
 
 
 @njit
-def _at_solution(x, qdot, qddot, nb, ints, flts, n_rows, J, lu, piv, xd, xdd, b):
-    """J at a solved pose and its factors; the rates xd = J^-1 [0; qdot] and the
-    accelerations xdd = J^-1 (gamma + [0; qddot]) (qdot, qddot of the driven rows).
-    Returns the pivot ratio (0: singular, rates not set)."""
+def _at_solution(x, qdot, qddot, nb, ints, flts, n_rows, J, fresh, lu, piv, xd, xdd, b):
+    """J at a solved pose (evaluated into J unless ``fresh``: J holds it) and its factors;
+    the rates xd = J^-1 [0; qdot] and the accelerations xdd = J^-1 (gamma + [0; qddot])
+    (qdot, qddot of the driven rows).  Returns the pivot ratio (0: singular, rates not
+    set)."""
     n = x.shape[0]
-    J[:, :] = 0.0
-    rows_jacobian(x, nb, ints, flts, J, 0)
+    if not fresh:
+        J[:, :] = 0.0
+        rows_jacobian(x, nb, ints, flts, J, 0)
     lu[:, :] = J
     rc = lu_factor(lu, piv, n)
     if rc == 0.0:
@@ -77,8 +79,8 @@ def _at_solution(x, qdot, qddot, nb, ints, flts, n_rows, J, lu, piv, xd, xdd, b)
 
 
 @njit
-def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, min_rc,
-                  X, Xd, Xdd, J, LU, piv, rc, ok, fail):
+def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, short,
+                  min_rc, X, Xd, Xdd, J, LU, piv, rc, ok, fail):
     """Continuation of every variant along its own path of driven coordinates, with the
     rates and accelerations at the kept steps.
 
@@ -102,6 +104,10 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, m
         Residual tolerance of each variant's Newton solve (m or rad).
     max_iter : int
         Newton iterations per step.
+    short : float
+        A first Newton step no longer than ``short * tol`` is checked without evaluating
+        the residual (see the code); with tol = 1e-12 L, 1e7 is 1e-5 L, whose cubed
+        remainder is far below the tolerance.
     min_rc : float
         Smallest pivot ratio min|u_ii| / max|u_ii| of J accepted (below: a dead or
         bifurcation position, left to the single-model continuation).
@@ -127,6 +133,7 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, m
     n = X0.shape[1]
     F = np.empty(n)
     Jw = np.empty((n, n))
+    J1 = np.empty((n, n))
     lu = np.empty((n, n))
     pv = np.empty(n, np.int64)
     b = np.empty(n)
@@ -152,11 +159,15 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, m
                     if curved:  # the second derivative along q_0 from the last two tangents
                         x[i] += 0.5 * (T[i, 0] - Tp[i]) / hp * h * h
                 hp = h
-            # Newton (at least one step)
+            # Newton (at least one step).  After a first step dx from x0 to x1 the residual
+            # is F(x1) = -(J(x1) - J(x0)) dx / 2 + O(|dx|^3) (trapezoid rule along the
+            # step): a short step is checked with J(x1), which the solution needs anyway
             done = False
+            fresh = False  # Jw is J at x
             for it in range(max_iter + 1):
                 if it == 0:
                     _system(x, q, nb, ints, flts[v], n_rows, F, Jw)
+                    fresh = True
                 else:
                     rows_values(x, nb, ints, flts[v], F, 0)
                     for c in range(nd):
@@ -171,7 +182,7 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, m
                     break
                 if it == max_iter:
                     break
-                if it > 0:
+                if not fresh:
                     Jw[:, :] = 0.0
                     rows_jacobian(x, nb, ints, flts[v], Jw, 0)
                 lu[:, :] = Jw
@@ -179,16 +190,33 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, m
                     break
                 b[:] = F
                 lu_solve(lu, pv, b, n)
+                step = 0.0
                 for i in range(n):
                     x[i] -= b[i]
+                    step = max(step, abs(b[i]))
+                fresh = False
+                if it == 0 and step <= short * tol[v]:
+                    J1[:, :] = 0.0
+                    rows_jacobian(x, nb, ints, flts[v], J1, 0)
+                    err = 0.0
+                    for i in range(n):
+                        r = 0.0
+                        for j in range(n):
+                            r += (J1[i, j] - Jw[i, j]) * b[j]
+                        err = max(err, abs(0.5 * r))
+                    Jw[:, :] = J1
+                    fresh = True
+                    if err <= tol[v]:
+                        done = True
+                        break
             if not done:
                 ok[v] = False
                 fail[v] = m
                 break
             # at the solution: J, its factors, the branch sign, the rates; the tangent
             k = keep[m]
-            r = _at_solution(x, dQ[m], ddQ[m], nb, ints, flts[v], n_rows, Jw, lu, pv, xd, xdd,
-                             b)
+            r = _at_solution(x, dQ[m], ddQ[m], nb, ints, flts[v], n_rows, Jw, fresh, lu, pv,
+                             xd, xdd, b)
             s = _det_sign(lu, pv, n)
             if m == 0:
                 sign0 = s

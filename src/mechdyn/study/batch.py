@@ -53,10 +53,13 @@ from ..results.kinetostatics_record import Kinetostatics
 from .analyses import KinetostaticExtremes, Outcome, extremes
 
 __all__ = ["batched", "batch_reason", "kinetostatic_batch", "Variants", "MAX_NEWTON",
-           "MIN_PIVOT_RATIO", "SUB_BATCH", "SUB_BATCH_FLOATS"]
+           "MIN_PIVOT_RATIO", "SHORT_STEP", "SUB_BATCH", "SUB_BATCH_FLOATS"]
 
 #: Newton iterations per step of the batched continuation
 MAX_NEWTON = 12
+#: a first Newton step of at most SHORT_STEP x its tolerance (1e-5 of the length scale) is
+#: checked by the change of the Jacobian along it, without evaluating the residual
+SHORT_STEP = 1e7
 #: pivot ratio min|u_ii| / max|u_ii| of a Jacobian below which a variant leaves the batch
 #: (a dead, toggle or bifurcation position: the single-model analysis decides)
 MIN_PIVOT_RATIO = 1e-6
@@ -316,8 +319,8 @@ def _cycle(vs: Variants, analysis: KinetostaticExtremes, work: dict) -> list[Out
     ok = np.ones(V, dtype=bool)
     fail = np.empty(V, dtype=np.int64)
     path_variants(np.ascontiguousarray(vs.x_start), Q, dQ, ddQ, at, nb, ints, flts, n_rows,
-                  1e-12 * np.maximum(vs.length_scale, 1e-3), MAX_NEWTON, MIN_PIVOT_RATIO,
-                  X, Xd, Xdd, J, LU, piv, rc, ok, fail)
+                  1e-12 * np.maximum(vs.length_scale, 1e-3), MAX_NEWTON, SHORT_STEP,
+                  MIN_PIVOT_RATIO, X, Xd, Xdd, J, LU, piv, rc, ok, fail)
     live = np.flatnonzero(ok)
     if not live.size:
         return [None] * V
