@@ -37,6 +37,8 @@ def test_a_kinetostatic_study_writes_the_table_and_prints_a_summary(tmp_path, ca
             "M_drive_phi_peak_Nm"} <= set(df.columns)
     text = capsys.readouterr().out
     assert "6 variants" in text and "6 success" in text
+    assert "evaluated: 6 as batches of variants, 0 one by one" in text
+    assert (df["evaluated"] == "batch").all()
     assert "smallest M_drive_phi_peak [N m]" in text and "bodies.crank.points.A.x [mm]" in text
     assert (tmp_path / "s.png").is_file()
     assert "Design study: 6 variants" in (tmp_path / "s.html").read_text(encoding="utf-8")

@@ -144,8 +144,13 @@ def _summary(df, args, ranges, seconds: float) -> None:
     print(f"{args.model}: {n} variants ({now} analysed in {seconds:.1f} s, "
           f"{1e3 * seconds / max(now, 1):.1f} ms each of wall time{resumed}); "
           + ", ".join(f"{v} {k}" for k, v in counts.items()))
+    if "evaluated" in df:  # as one batch (study.batch) or one by one
+        how = df["evaluated"].value_counts().to_dict()
+        why = df.attrs.get("one_by_one", "")
+        print(f"  evaluated: {how.get('batch', 0)} as batches of variants, "
+              f"{how.get('loop', 0)} one by one" + (f" ({why})" if why else ""))
     params = [r.parameter.column for r in ranges]
-    figures = [c for c in df if c not in ("variant", "status", "message", "seconds",
+    figures = [c for c in df if c not in ("variant", "status", "message", "evaluated", "seconds",
                                           "objective", "feasible") and c not in params]
     if not figures:
         return

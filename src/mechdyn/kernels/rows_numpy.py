@@ -23,7 +23,8 @@ import numpy as np
 if TYPE_CHECKING:  # the row data is lowered by mechdyn.model, which imports these kernels
     from ..model.rows import Rows
 
-__all__ = ["Parts", "parts", "values", "jacobian", "quad", "evaluate"]
+__all__ = ["Parts", "parts", "values", "jacobian", "quad", "evaluate", "VariantRows",
+           "variant_rows"]
 
 
 class Parts:
@@ -123,3 +124,47 @@ def evaluate(rows: Rows, x, xdot=None):
     p = Parts(rows, x)
     return values(rows, x, p), jacobian(rows, x, p), (
         None if xdot is None else quad(rows, x, xdot, p))
+
+
+class VariantRows:
+    """Rows of V variants of one topology: the integers (bodies) of one
+    :class:`~mechdyn.model.rows.Rows`, the numbers (points, directions, angle factors and
+    offsets) of each variant, shaped (V, 1, n) so that every evaluator of this module
+    takes poses ``x`` (V, N, n_x) (N poses of each variant) and gives results (V, N, ...).
+
+    Build with :func:`variant_rows`.
+    """
+
+    __slots__ = ("nb", "b1", "b2", "d", "a", "bb", "scatter", "columns", "ka", "kb", "c")
+
+    def __init__(self, rows: Rows, flts):
+        f = np.asarray(flts, dtype=float)
+        self.nb, self.b1, self.b2, self.d = rows.nb, rows.b1, rows.b2, rows.d
+        self.a, self.bb, self.scatter = rows.a, rows.bb, rows.scatter
+        self.columns = tuple(np.ascontiguousarray(f[:, None, :, k]) for k in range(6))
+        self.ka, self.kb, self.c = (np.ascontiguousarray(f[:, None, :, k]) for k in (6, 7, 8))
+
+    def __len__(self) -> int:
+        return self.c.shape[-1]
+
+    @property
+    def n_x(self) -> int:
+        """Length of the pose vector, 3 nb."""
+        return 3 * self.nb
+
+
+def variant_rows(rows: Rows, flts) -> VariantRows:
+    """The rows of V variants: the structure of ``rows``, the numbers ``flts`` (V, n, 9)
+    of each variant (in the layout of :meth:`~mechdyn.model.rows.Rows.packed`: s1, s2,
+    u, ka, kb, c).
+
+    Examples
+    --------
+    >>> from mechdyn.model import rows as R
+    >>> r = R.revolute("A", 0, (0.1, 0.0), 1, (0.0, 0.0), nb=2)
+    >>> f = np.stack([r.packed()[1], r.packed()[1] * [2, 1, 1, 1, 1, 1, 1, 1, 1]])
+    >>> x = np.zeros((2, 1, 6))
+    >>> values(variant_rows(r, f), x).round(12).tolist()
+    [[[0.1, 0.0]], [[0.2, 0.0]]]
+    """
+    return VariantRows(rows, flts)

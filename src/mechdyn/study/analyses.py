@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import ModelError, Status
 from ..units import parse_quantity
 
-__all__ = ["Outcome", "KinetostaticExtremes", "KinematicSummary", "FlywheelSize",
+__all__ = ["Outcome", "KinetostaticExtremes", "extremes", "KinematicSummary", "FlywheelSize",
            "SimulationMetrics", "Combined", "ANALYSES"]
 
 _DEG = 180.0 / np.pi
@@ -116,24 +116,51 @@ class KinetostaticExtremes:
     @staticmethod
     def figures(rec) -> Outcome:
         """The figures of a kinetostatics record (also for a plain loop's records)."""
-        out: dict[str, float] = {}
-        for c in rec.driven:
-            sym, unit = rec._drive_unit(c)  # the record's own column names
-            tau = np.asarray(rec.driving[c], float)
-            out[f"{sym}_drive_{c}_peak_{unit}"] = float(np.nanmax(np.abs(tau)))
-            out[f"{sym}_drive_{c}_max_{unit}"] = float(np.nanmax(tau))
-            out[f"{sym}_drive_{c}_min_{unit}"] = float(np.nanmin(tau))
-            out[f"{sym}_drive_{c}_rms_{unit}"] = float(rec.rms(tau))
-            out[f"P_drive_{c}_peak_W"] = float(np.nanmax(np.abs(rec.power[c])))
-        for j in rec.reactions:
-            out[f"F_{j}_peak_N"] = float(np.nanmax(rec.force_magnitude(j)))
-        f = np.hypot(rec.frame_force[:, 0], rec.frame_force[:, 1])
-        out["F_frame_peak_N"] = float(np.nanmax(f))
-        out["F_frame_rms_N"] = float(rec.rms(f))
-        out["M_frame_peak_Nm"] = float(np.nanmax(np.abs(rec.frame_moment)))
+        out = extremes(rec, rec.driving, rec.power, rec.reactions, rec.frame_force,
+                       rec.frame_moment, rec.rms)
         ok = rec.status in (Status.SUCCESS, Status.REDUNDANT)
-        return Outcome(out, str(rec.status), "" if ok else rec.message,
-                       rec.x if ok else None)
+        return Outcome({k: float(v) for k, v in out.items()}, str(rec.status),
+                       "" if ok else rec.message, rec.x if ok else None)
+
+
+def extremes(rec, driving: dict, power: dict, reactions: dict, frame_force, frame_moment,
+             rms) -> dict:
+    """The figures of :class:`KinetostaticExtremes` from the series of a kinetostatics
+    record, over the last axis (the positions); leading axes (variants) are kept.
+
+    Parameters
+    ----------
+    rec : Kinetostatics
+        Names the driven coordinates and their units (``driven``, ``_drive_unit``).
+    driving, power : dict of str to ndarray, shape (..., n)
+    reactions : dict of str to ndarray, shape (..., n, 2)
+    frame_force : ndarray, shape (..., n, 2)
+    frame_moment : ndarray, shape (..., n)
+    rms : callable
+        RMS over the positions of a series (..., n) -> (...) (the record's rule,
+        :meth:`~mechdyn.Kinetostatics.rms`).
+
+    Returns
+    -------
+    dict of str to ndarray, shape (...)
+        Column name (with its unit) -> value.
+    """
+    out: dict = {}
+    for c in rec.driven:
+        sym, unit = rec._drive_unit(c)  # the record's own column names
+        tau = np.asarray(driving[c], float)
+        out[f"{sym}_drive_{c}_peak_{unit}"] = np.nanmax(np.abs(tau), axis=-1)
+        out[f"{sym}_drive_{c}_max_{unit}"] = np.nanmax(tau, axis=-1)
+        out[f"{sym}_drive_{c}_min_{unit}"] = np.nanmin(tau, axis=-1)
+        out[f"{sym}_drive_{c}_rms_{unit}"] = rms(tau)
+        out[f"P_drive_{c}_peak_W"] = np.nanmax(np.abs(power[c]), axis=-1)
+    for j, r in reactions.items():
+        out[f"F_{j}_peak_N"] = np.nanmax(np.hypot(r[..., 0], r[..., 1]), axis=-1)
+    f = np.hypot(frame_force[..., 0], frame_force[..., 1])
+    out["F_frame_peak_N"] = np.nanmax(f, axis=-1)
+    out["F_frame_rms_N"] = rms(f)
+    out["M_frame_peak_Nm"] = np.nanmax(np.abs(frame_moment), axis=-1)
+    return out
 
 
 @dataclass(frozen=True)

@@ -15,11 +15,18 @@ import numpy as np
 
 from .. import progress as _progress
 from ..errors import ModelError
+from .batch import batch_reason, batched
 from .evaluate import Task, evaluate_batch, order_variants
 from .output import StudyOutput, order_columns
 from .parameters import BaseModel, Parameter, to_shown
 
-__all__ = ["run_study", "variant_table", "batches_of"]
+__all__ = ["run_study", "variant_table", "batches_of", "MAX_BATCH", "MAX_BATCHED"]
+
+#: default largest batch (task) of variants analysed one by one
+MAX_BATCH = 50
+#: default largest batch of variants analysed as one (:mod:`.batch`): its probes and
+#: compiled kernels are shared by more variants
+MAX_BATCHED = 2000
 
 
 def variant_table(base: BaseModel, variants):
@@ -102,6 +109,18 @@ def _dask(task, batches, client, retries: int):
         client.cancel(futures)
 
 
+def _one_by_one(base: BaseModel, analysis) -> str:
+    """Why the study's variants are analysed one by one rather than as batches ("" when
+    the base model and the analysis allow batches)."""
+    if not batched(analysis):
+        return batch_reason(analysis, []) or ""
+    try:
+        model = base.compile({})
+    except Exception:  # noqa: BLE001 - the variants' rows say what is wrong
+        return ""
+    return batch_reason(analysis, [model]) or ""
+
+
 def run_study(model, variants, analysis, *, output: str | Path | None = None,
               client=None, workers: int | None = None, batch_size: int | None = None,
               resume: bool = False, progress: bool | None = None, order: bool = True,
@@ -126,7 +145,9 @@ def run_study(model, variants, analysis, *, output: str | Path | None = None,
         Local worker processes (default ``os.cpu_count()``; 1: in this process); with
         ``client``, sets the batch size only (default the cluster's workers).
     batch_size : int, optional
-        Variants per batch (task); default about four batches per worker, at most 50.
+        Variants per batch (task); default about four batches per worker, at most
+        :data:`MAX_BATCH` (:data:`MAX_BATCHED` for an analysis of variants as one batch,
+        :func:`~mechdyn.study.batch.batched`).
     resume : bool
         Keep what ``output`` already holds and analyse only the other variants (the
         design must be the same); otherwise an existing output is replaced.
@@ -134,7 +155,9 @@ def run_study(model, variants, analysis, *, output: str | Path | None = None,
         A progress bar on stderr: always, never, or (None) after 2 s.
     order : bool
         Analyse the variants in nearest-neighbour order so that each starts from the
-        previous one's poses (the table is still sorted by variant).
+        previous one's poses (the table is still sorted by variant); for an analysis of
+        variants as one batch, sorted by their parameters, so that each batch spans a
+        small box.
     retries : int
         Dask: times a batch is run again when its worker is lost.
 
@@ -143,8 +166,11 @@ def run_study(model, variants, analysis, *, output: str | Path | None = None,
     pandas.DataFrame
         One row per variant, sorted by ``variant`` (the design's row index): the
         parameters (columns with units, angles in deg), the figures, ``status``,
-        ``message``, ``seconds``; ``attrs["analysed"]``: the variants analysed in this
-        call (the others were resumed).
+        ``message``, ``evaluated`` (``batch``: analysed as one batch of variants,
+        :mod:`~mechdyn.study.batch`; ``loop``: on its own), ``seconds``;
+        ``attrs["analysed"]``: the variants analysed in this call (the others were
+        resumed); ``attrs["one_by_one"]``: why the analysis or the model does not allow
+        batches ("" when they do).
 
     Raises
     ------
@@ -177,14 +203,17 @@ def run_study(model, variants, analysis, *, output: str | Path | None = None,
         else:
             out.clear()
     todo = np.array([k for k, i in enumerate(ids) if int(i) not in done], int)
-    if order and len(todo) > 1:
+    if order and len(todo) > 1 and batched(analysis):  # slabs along the first parameter
+        todo = todo[np.lexsort(values[todo].T[::-1])]
+    elif order and len(todo) > 1:
         todo = todo[order_variants(values[todo])]
     if workers is None:
         workers = len(client.scheduler_info()["workers"]) if client is not None else \
             (os.cpu_count() or 1)
     workers = max(1, int(workers))
-    if batch_size is None:
-        batch_size = max(1, min(50, math.ceil(len(todo) / max(1, 4 * workers))))
+    if batch_size is None:  # about four batches per worker; larger ones when batched
+        most = MAX_BATCHED if batched(analysis) else MAX_BATCH
+        batch_size = max(1, min(most, math.ceil(len(todo) / max(1, 4 * workers))))
     batches = batches_of(ids[todo], values[todo], int(batch_size))
     base.structure_known(params)  # once, here: the answer travels with the task
     task = Task(base, params, analysis)
@@ -212,4 +241,5 @@ def run_study(model, variants, analysis, *, output: str | Path | None = None,
     table.attrs["model"] = base.spec
     table.attrs["analysis"] = getattr(analysis, "name", type(analysis).__name__)
     table.attrs["analysed"] = len(rows)  # in this call (the others were resumed)
+    table.attrs["one_by_one"] = _one_by_one(base, analysis)
     return table

@@ -149,8 +149,8 @@ class StudyOutput:
 
 
 def order_columns(df):
-    """``variant`` first, then the other columns as they are, ``status``, ``message`` and
-    ``seconds`` last."""
-    tail = [c for c in ("status", "message", "seconds") if c in df]
+    """``variant`` first, then the other columns as they are, ``status``, ``message``,
+    ``evaluated`` and ``seconds`` last."""
+    tail = [c for c in ("status", "message", "evaluated", "seconds") if c in df]
     head = ["variant"] if "variant" in df else []
     return df[head + [c for c in df if c not in head and c not in tail] + tail]

@@ -249,7 +249,7 @@ class BaseModel:
 
     def document(self, values: dict[Parameter, float]) -> dict:
         """A copy of the document with each parameter set to its SI value (written with
-        its unit).
+        its unit; a dimensionless one as a number).
 
         Only the tables and arrays on the parameters' paths are copied; the rest is
         shared with :attr:`doc`, which is never changed (nor may the copy's shared
@@ -258,7 +258,9 @@ class BaseModel:
         doc = dict(self.doc)
         for p, v in values.items():
             node, index = _locate(doc, p.path, copy=True)
-            node[index] = p.text(v)
+            # a pure number as a TOML number (a vector's component, a ratio), else with
+            # its unit
+            node[index] = float(v) if p.kind == "dimensionless" else p.text(v)
         return doc
 
     def structure_known(self, parameters) -> bool:

@@ -13,7 +13,7 @@ from .plots import axis_label, plot_pareto, plot_scatter
 
 __all__ = ["study_section", "write_study_report"]
 
-_META = ("variant", "status", "message", "seconds", "objective", "feasible")
+_META = ("variant", "status", "message", "evaluated", "seconds", "objective", "feasible")
 _OK = ("success", "redundant")
 
 

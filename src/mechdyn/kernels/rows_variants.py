@@ -1,0 +1,268 @@
+"""Compiled drivers over a batch of VARIANTS of one topology: the position continuation,
+the rates and the kinetostatic solve, with a variant axis through the row data.
+
+The kinetostatic equations ``[-Phi_x^T, g_d,x^T] z = I - F`` of
+:func:`mechdyn.dynamics.reactions._inverse` have the transposed Jacobian of the
+position problem as their matrix: one factorization per position serves the rates,
+the accelerations and the multipliers.
+
+Variants of one model differ only in numbers: their rows share the packed integers
+``ints`` (n, 5) of :meth:`mechdyn.model.rows.Rows.packed` and each has its own floats,
+``flts`` (V, n, 9) (local points, directions, factors and offsets).  The position
+problem is F(x) = [Phi(x); g_d(x) - q_d] = 0 (``n_rows`` constraint rows, then the
+driven coordinates' rows), square; its Jacobian J is factored by
+:func:`mechdyn.kernels.linalg.lu_factor`.  The rows are evaluated by the compiled
+evaluators of :mod:`mechdyn.kernels.rows_numba` (no formula of their own here).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .linalg import lu_factor, lu_solve, lu_solve_transposed
+from .rows_numba import njit, rows_jacobian, rows_quad, rows_values
+
+__all__ = ["path_variants", "inverse_variants"]
+
+
+@njit
+def _system(x, q, nb, ints, flts, n_rows, F, J):
+    """F = [Phi; g_d - q] and J at one pose of one variant (in place)."""
+    rows_values(x, nb, ints, flts, F, 0)
+    for k in range(q.shape[0]):
+        F[n_rows + k] -= q[k]
+    J[:, :] = 0.0
+    rows_jacobian(x, nb, ints, flts, J, 0)
+
+
+@njit
+def _det_sign(lu, piv, n):
+    """Sign of the determinant from the factors of ``lu_factor``."""
+    s = 1.0
+    for k in range(n):
+        if piv[k] != k:
+            s = -s
+        if lu[k, k] < 0.0:
+            s = -s
+        elif lu[k, k] == 0.0:
+            return 0.0
+    return s
+
+
+@njit
+def _at_solution(x, qdot, qddot, nb, ints, flts, n_rows, J, fresh, lu, piv, xd, xdd, b):
+    """J at a solved pose (evaluated into J unless ``fresh``: J holds it) and its factors;
+    the rates xd = J^-1 [0; qdot] and the accelerations xdd = J^-1 (gamma + [0; qddot])
+    (qdot, qddot of the driven rows).  Returns the pivot ratio (0: singular, rates not
+    set)."""
+    n = x.shape[0]
+    if not fresh:
+        J[:, :] = 0.0
+        rows_jacobian(x, nb, ints, flts, J, 0)
+    lu[:, :] = J
+    rc = lu_factor(lu, piv, n)
+    if rc == 0.0:
+        return rc
+    b[:] = 0.0
+    for c in range(qdot.shape[0]):
+        b[n_rows + c] = qdot[c]
+    lu_solve(lu, piv, b, n)
+    xd[:] = b
+    rows_quad(x, xd, nb, ints, flts, b, 0)
+    for i in range(n):
+        b[i] = -b[i]
+    for c in range(qdot.shape[0]):
+        b[n_rows + c] += qddot[c]
+    lu_solve(lu, piv, b, n)
+    xdd[:] = b
+    return rc
+
+
+@njit
+def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, short,
+                  min_rc, X, Xd, Xdd, J, LU, piv, rc, ok, fail):
+    """Continuation of every variant along its own path of driven coordinates, with the
+    rates and accelerations at the kept steps.
+
+    Parameters
+    ----------
+    X0 : ndarray, shape (V, n_x)
+        Start poses (m, rad): assembled, or sketches that the first step assembles.
+    Q : ndarray, shape (V, M, n_d)
+        The driven coordinates at the M steps of each variant's path.
+    dQ, ddQ : ndarray, shape (M, n_d)
+        Their rates and accelerations (the same for every variant; used at kept steps).
+    keep : ndarray of int, shape (M,)
+        Where each step is stored (-1: not stored).
+    nb : int
+    ints : ndarray of int, shape (n, 5)
+        Packed row integers, shared (``n = n_rows + n_d = n_x``).
+    flts : ndarray, shape (V, n, 9)
+        Packed row floats of each variant.
+    n_rows : int
+    tol : ndarray, shape (V,)
+        Residual tolerance of each variant's Newton solve (m or rad).
+    max_iter : int
+        Newton iterations per step.
+    short : float
+        A first Newton step no longer than ``short * tol`` is checked without evaluating
+        the residual (see the code); with tol = 1e-12 L, 1e7 is 1e-5 L, whose cubed
+        remainder is far below the tolerance.
+    min_rc : float
+        Smallest pivot ratio min|u_ii| / max|u_ii| of J accepted (below: a dead or
+        bifurcation position, left to the single-model continuation).
+    X, Xd, Xdd : ndarray, shape (V, K, n_x)
+        Output: poses, rates and accelerations at the K kept steps.
+    J, LU : ndarray, shape (V, K, n, n_x)
+        Output: J = [Phi_x; g_d,x] at the kept poses and its LU factors
+        (:func:`~mechdyn.kernels.linalg.lu_factor`), for :func:`inverse_variants`.
+    piv : ndarray of int, shape (V, K, n)
+        Output: the pivots.
+    rc : ndarray, shape (V, K)
+        Output: the pivot ratios.
+    ok : ndarray of bool, shape (V,)
+        In: variants to solve; out: False where a step failed.
+    fail : ndarray of int, shape (V,)
+        Output: the step where a variant failed (-1: none).
+
+    Each step starts from the previous pose plus the tangent times the change of the
+    coordinates and the curvature along q_0 from the last two tangents; the branch is
+    kept by the sign of det J, which must not change along the path.
+    """
+    V, M, nd = Q.shape
+    n = X0.shape[1]
+    F = np.empty(n)
+    Jw = np.empty((n, n))
+    J1 = np.empty((n, n))
+    lu = np.empty((n, n))
+    pv = np.empty(n, np.int64)
+    b = np.empty(n)
+    xd = np.empty(n)
+    xdd = np.empty(n)
+    T = np.empty((n, nd))
+    Tp = np.empty(n)
+    for v in range(V):
+        fail[v] = -1
+        if not ok[v]:
+            continue
+        x = X0[v].copy()
+        sign0 = 0.0
+        hp = 0.0
+        for m in range(M):
+            q = Q[v, m]
+            if m > 0:
+                h = q[0] - Q[v, m - 1, 0]
+                curved = m > 1 and hp != 0.0
+                for i in range(n):
+                    for c in range(nd):
+                        x[i] += T[i, c] * (q[c] - Q[v, m - 1, c])
+                    if curved:  # the second derivative along q_0 from the last two tangents
+                        x[i] += 0.5 * (T[i, 0] - Tp[i]) / hp * h * h
+                hp = h
+            # Newton (at least one step).  After a first step dx from x0 to x1 the residual
+            # is F(x1) = -(J(x1) - J(x0)) dx / 2 + O(|dx|^3) (trapezoid rule along the
+            # step): a short step is checked with J(x1), which the solution needs anyway
+            done = False
+            fresh = False  # Jw is J at x
+            for it in range(max_iter + 1):
+                if it == 0:
+                    _system(x, q, nb, ints, flts[v], n_rows, F, Jw)
+                    fresh = True
+                else:
+                    rows_values(x, nb, ints, flts[v], F, 0)
+                    for c in range(nd):
+                        F[n_rows + c] -= q[c]
+                err = 0.0
+                for i in range(n):
+                    err = max(err, abs(F[i]))
+                if not np.isfinite(err):
+                    break
+                if err <= tol[v] and it > 0:
+                    done = True
+                    break
+                if it == max_iter:
+                    break
+                if not fresh:
+                    Jw[:, :] = 0.0
+                    rows_jacobian(x, nb, ints, flts[v], Jw, 0)
+                lu[:, :] = Jw
+                if lu_factor(lu, pv, n) == 0.0:
+                    break
+                b[:] = F
+                lu_solve(lu, pv, b, n)
+                step = 0.0
+                for i in range(n):
+                    x[i] -= b[i]
+                    step = max(step, abs(b[i]))
+                fresh = False
+                if it == 0 and step <= short * tol[v]:
+                    J1[:, :] = 0.0
+                    rows_jacobian(x, nb, ints, flts[v], J1, 0)
+                    err = 0.0
+                    for i in range(n):
+                        r = 0.0
+                        for j in range(n):
+                            r += (J1[i, j] - Jw[i, j]) * b[j]
+                        err = max(err, abs(0.5 * r))
+                    Jw[:, :] = J1
+                    fresh = True
+                    if err <= tol[v]:
+                        done = True
+                        break
+            if not done:
+                ok[v] = False
+                fail[v] = m
+                break
+            # at the solution: J, its factors, the branch sign, the rates; the tangent
+            k = keep[m]
+            r = _at_solution(x, dQ[m], ddQ[m], nb, ints, flts[v], n_rows, Jw, fresh, lu, pv,
+                             xd, xdd, b)
+            s = _det_sign(lu, pv, n)
+            if m == 0:
+                sign0 = s
+            if r < min_rc or s != sign0:
+                ok[v] = False
+                fail[v] = m
+                break
+            for i in range(n):
+                Tp[i] = T[i, 0]
+            for c in range(nd):
+                b[:] = 0.0
+                b[n_rows + c] = 1.0
+                lu_solve(lu, pv, b, n)
+                for i in range(n):
+                    T[i, c] = b[i]
+            if k >= 0:
+                X[v, k, :] = x
+                Xd[v, k, :] = xd
+                Xdd[v, k, :] = xdd
+                J[v, k] = Jw
+                LU[v, k] = lu
+                piv[v, k] = pv
+                rc[v, k] = r
+
+
+@njit
+def inverse_variants(LU, piv, rhs, n_rows, Z):
+    """The kinetostatic solve of every position of every variant,
+    [-Phi_x^T, g_d,x^T] z = rhs (z: the multipliers, then the driving torques/forces),
+    with the factors of J = [Phi_x; g_d,x] from :func:`path_variants`: z is J^-T rhs
+    with the multipliers' sign turned.
+
+    Parameters
+    ----------
+    LU, piv : ndarray
+        Factors of :func:`path_variants`, (V, N, n, n) and (V, N, n).
+    rhs : ndarray, shape (V, N, n)
+        Inertia forces minus applied forces (N, N m).
+    Z : ndarray, shape (V, N, n)
+        Output.
+    """
+    V, N, n = rhs.shape
+    b = np.empty(n)
+    for v in range(V):
+        for k in range(N):
+            b[:] = rhs[v, k]
+            lu_solve_transposed(LU[v, k], piv[v, k], b, n)
+            for c in range(n):
+                Z[v, k, c] = -b[c] if c < n_rows else b[c]
