@@ -38,6 +38,7 @@ import numpy as np
 from .dynamics.contact import gaps, touching
 from .dynamics.dead_position import diagnose, status_of, turning_point
 from .dynamics.impact import frame_impulse_key
+from .dynamics.joint_friction import stick_slip_joints
 from .dynamics.lagrange import kinetic_energy
 from .dynamics.mode_equations import ModeEquations
 from .dynamics.modes import ModeSystem, switched_model
@@ -203,7 +204,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             st, meas = sm.stops[n]
             raise ModelError(f"stop {n!r}: the initial state violates its limits ({meas.label} "
                              f"= {meas.value(x):.9g}, lower {st.lower}, upper {st.upper})")
-        if sm.has_switching:  # the mode the state is in: touching stops and contacts
+        if sm.has_switching or stick_slip_joints(model):
+            # the mode the state is in: touching stops and contacts, sticking pairs
             ms, x, xd, _ = apply_switch(sm, t, ms, x, xd, targets, events, fired=[],
                                         small_velocity=small_velocity, gap_tol=gap_tol,
                                         force_scale=force_scale, initial=True)

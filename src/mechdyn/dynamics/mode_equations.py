@@ -9,7 +9,10 @@ run in one mode.  The right-hand side runs on the compiled kernel
 (:mod:`mechdyn.dynamics.compiled`) whenever the mode allows (numba installed,
 every load compiled, no sliding friction); otherwise, and to diagnose a failure,
 on the NumPy evaluation of the mode (:meth:`ModeSystem.evaluate`), which also
-gives every multiplier.
+gives every multiplier.  Friction in the joints (:mod:`mechdyn.dynamics.joint_friction`)
+runs on the NumPy path: its force depends on the multipliers, and each evaluation
+solves the coupled system by Newton's method on them (the compiled kernel, whose
+signature frictionless runs keep, has no friction).
 
 Two formulations evaluate the same physics: ``"exact"`` (the exact velocity
 analogs, every mode) and ``"analogs"``, the source paper's finite-difference
@@ -46,6 +49,7 @@ from ..kinematics.constraints import extend
 from .compiled import compile_mode_kernel
 from .dead_position import _dependent, _where
 from .forces import com_arms
+from .joint_friction import friction_joints
 from .mode_system import solve_mass
 from .modes import ModeEval
 
@@ -109,6 +113,9 @@ class ModeEquations:
         self.watching, self._s_last = True, None
         self.d = default_displacement(model)
         if formulation == "analogs":
+            if ms.friction is not None:
+                raise ModelError(f"joint {friction_joints(model)[0]!r} has friction; formulation "
+                                 "'analogs' does not model friction yet (use 'exact')")
             if ms.rows or ms.n_i != model.n_q:
                 raise ModelError("formulation 'analogs' needs a mode in which every declared "
                                  "coordinate is independent (no engaged lock, closed stop or "
@@ -125,6 +132,10 @@ class ModeEquations:
         elif backend != "numpy":
             if any(r.slip for r in ms.rows):
                 self.note = "sliding friction is evaluated on the NumPy path"
+            elif ms.friction is not None:
+                self.note = ("the friction of joint(s) " + ", ".join(
+                    repr(j) for j in friction_joints(model)) + " is evaluated on the NumPy "
+                    "path (Newton on the multipliers per evaluation)")
             else:
                 self.kernel, self.note = compile_mode_kernel(
                     model, sm.fm, ms.rowset.take(ms.independent_rows), ms.coords)
@@ -134,6 +145,7 @@ class ModeEquations:
             self.kernel.reset(ms.x_ref)
         loops = len(model.rev.names) + len(model.pri.names) > model.n_bodies  # not a tree
         if (formulation == "exact" and loops and not ms.rows and model.n_q == ms.n_i == 1
+                and ms.friction is None
                 and len(ms.independent_rows) == ms.n_rows == model.n_x - 1):
             lay = model.layout(sorted(ms.mode.locks))
             self.book = ChartBook(PathProblem(model, lay, [0], [0.0], 0))

@@ -1,0 +1,308 @@
+"""Friction of the joints in forward dynamics: the coupled solve and the stick-slip states.
+
+The friction of a revolute or prismatic pair (the law: :mod:`mechdyn.dynamics.friction`)
+depends on the pair's reaction, so on the multipliers lambda, which depend on the
+accelerations.  In a mode the equations of motion with friction
+
+    [M B, -Phi_x^T] [qddot_I; lambda] = F - h - M b + F_f(x, xdot, lambda)
+
+are solved per evaluation of the right-hand side by Newton's method on the
+multipliers, started from the frictionless solution, with the exact derivative
+dF_f/dlambda of the law: r(lambda) = lambda - P K^-1 (rhs + F_f(lambda)) (P picks the
+multipliers out of the solution), r' = I - P K^-1 dF_f/dlambda, one factorization of
+K for every iterate.  A few iterations reach machine precision (the law is linear in
+lambda except through |R|); a Newton matrix that is singular or iterates that do not
+converge mean that friction locks the mechanism (self-locking): the run stops with
+the time and the position.
+
+True Coulomb friction (``smoothing = 0``) of a pair is a matter of modes.  Each such
+pair carries a state token in the mode, ``"B:stick"``, ``"B:slip+"`` or
+``"B:slip-"`` (the tokens of a contact's friction, :class:`~mechdyn.model.state.Mode`):
+
+* sticking, the pair's travel (prismatic) or relative angle (revolute) is held at the
+  value it had when it stuck, by one more row (a ``"stick"`` row, as a coordinate
+  lock); its multiplier is the friction force (N) or moment (N m) needed to hold;
+* slipping in direction s = +1 / -1, the law applies with sgn(v) = s for the whole
+  segment (so that the right-hand side stays smooth up to the event).
+
+Events (:func:`mechdyn.dynamics.switching.event_functions`): slip -> stick when
+s v falls to zero, and the pair sticks there if the friction needed to hold is at
+most mu S (else it slips the other way); stick -> slip when the needed friction
+|lambda_stick| exceeds the capacity mu S (mu r |R| for a pin), in the direction the
+holding force resisted.  With ``smoothing > 0`` the pair has no state: the law's
+tanh regularisation applies everywhere.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import IntegrationError, LockupError
+from ..kernels import rows_numpy as RN
+from ..mechanism.joint import has_friction
+from ..model.state import Mode
+from ..model.variable import parse_variable
+
+__all__ = ["friction_joints", "stick_slip_joints", "joint_states", "split_mode",
+           "stick_row", "capture_stick", "JointFriction", "STATES", "MAX_ITER",
+           "state_tokens", "resolve_joints"]
+
+#: the friction states of a stick-slip pair
+STATES = ("stick", "slip+", "slip-")
+#: Newton iterations on the multipliers before the solve is declared failed
+MAX_ITER = 30
+
+
+def friction_joints(model) -> tuple:
+    """The revolute and prismatic joints of a model with friction (Coulomb or viscous)."""
+    memo = model.memo.get("friction_joints")
+    if memo is None:
+        memo = model.memo["friction_joints"] = tuple(
+            n for n, j in model.mechanism.joints.items()
+            if has_friction(j) and model.joint_kind(n) in ("revolute", "prismatic"))
+    return memo
+
+
+def stick_slip_joints(model) -> tuple:
+    """The joints with true Coulomb friction (``friction > 0``, ``smoothing = 0``): the
+    pairs that stick and slip as modes."""
+    joints = model.mechanism.joints
+    return tuple(n for n in friction_joints(model)
+                 if joints[n].friction > 0 and joints[n].smoothing == 0)
+
+
+def joint_states(model, mode) -> dict:
+    """{joint: 'stick' | 'slip+' | 'slip-'} of the stick-slip pairs in a mode."""
+    ss = stick_slip_joints(model)
+    return {k: v for k, v in Mode(mode).friction.items() if k in ss}
+
+
+def split_mode(model, mode) -> tuple[Mode, dict]:
+    """(the mode without the joints' friction tokens, :func:`joint_states`)."""
+    st = joint_states(model, mode)
+    return Mode(t for t in mode if t.split(":")[0] not in st or ":" not in t), st
+
+
+def _measure(model, joint: str):
+    """The pair's travel (m) or relative angle (rad), a Measure (memoized)."""
+    key = ("joint_measure", joint)
+    meas = model.memo.get(key)
+    if meas is None:
+        meas = model.memo[key] = parse_variable(model, f"joint:{joint}")
+    return meas
+
+
+def capture_stick(model, joint: str, x, targets: dict) -> None:
+    """Store in ``targets`` the travel or relative angle a pair sticks at, pose x (n_x,)."""
+    targets[f"{joint}:stick"] = _measure(model, joint).value(x)
+
+
+def stick_row(model, joint: str, targets: dict):
+    """The ``"stick"`` row holding a sticking pair (a :class:`~mechdyn.dynamics.modes.Row`
+    of element ``joint``)."""
+    from .modes import Row  # modes imports mode_system, which imports this module
+    return Row(joint, f"{joint}:stick", "stick", _measure(model, joint),
+               float(targets[f"{joint}:stick"]))
+
+
+def friction_set(model):
+    """The friction law's :class:`~mechdyn.dynamics.friction.FrictionSet` of a model,
+    built once."""
+    fs = model.memo.get("friction_set")
+    if fs is None:
+        from .friction import FrictionSet
+        fs = model.memo["friction_set"] = FrictionSet(model)
+    return fs
+
+
+class JointFriction:
+    """The friction of the joints in one mode.
+
+    Parameters
+    ----------
+    ms : ModeSystem
+
+    Attributes
+    ----------
+    states : dict
+        {joint: state} of the stick-slip pairs (:func:`joint_states`).
+    sliding : list of str
+        The pairs whose friction the law gives (all friction joints but the sticking
+        ones).
+    signs : dict
+        {joint: +1 / -1}: sgn(v) of the slipping stick-slip pairs.
+    stick_index : dict
+        {joint: index into ``ms.rowset`` of its stick row}.
+    """
+
+    def __init__(self, ms):
+        self.ms = ms
+        model = ms.model
+        self.model = model
+        self.fs = friction_set(model)
+        self.states = joint_states(model, ms.mode)
+        self.sliding = [j for j in friction_joints(model) if self.states.get(j) != "stick"]
+        self.signs = {j: (1.0 if s == "slip+" else -1.0) for j, s in self.states.items()
+                      if s != "stick"}
+        self.stick_index = {r.element: ms.n_base + k for k, r in enumerate(ms.rows)
+                            if r.kind == "stick" and r.element in self.states}
+
+    # ------------------------------------------------------------------ the law
+    def forces(self, x, xdot, lam, joints=None, signs=None):
+        """(F_f (n_x,), dF_f/dlambda (n_x, n_rows)): the generalized friction force of
+        the sliding pairs (``joints``, default :attr:`sliding`) on the body poses, N and
+        N m, and its derivative with respect to the multipliers of the mode's rows."""
+        joints = self.sliding if joints is None else joints
+        if not joints:
+            n = self.model.n_x
+            return np.zeros(n), np.zeros((n, self.ms.n_rows))
+        return self.fs.generalized(x, xdot, lam, self.ms.layout, joints=joints,
+                                   signs=self.signs if signs is None else signs)
+
+    def velocity(self, joint: str, x, xdot) -> float:
+        """The pair's sliding velocity (m/s) or relative angular velocity (rad/s)."""
+        return _measure(self.model, joint).rate(x, xdot)
+
+    def capacity(self, joint: str, x, lam) -> float:
+        """mu S of a pair (N; mu r |R|, N m, for a pin): the largest friction the pair
+        can give at the multipliers ``lam``, from the law at a unit sliding direction."""
+        J = RN.jacobian(_measure(self.model, joint).rows, x)[0]
+        F, _ = self.forces(x, np.zeros_like(J), lam, joints=[joint], signs={joint: 1.0})
+        return float(-F @ J / (J @ J))
+
+    def margin(self, joint: str, x, lam) -> float:
+        """Capacity minus the friction needed to hold a sticking pair (< 0: it slips)."""
+        return self.capacity(joint, x, lam) - abs(float(lam[self.stick_index[joint]]))
+
+    # ------------------------------------------------------------------ the solve
+    def solve(self, lin, n_i: int, rhs, x, xdot, t=None, q=None):
+        """The accelerations and multipliers with friction, by Newton on the multipliers.
+
+        Parameters
+        ----------
+        lin : callable
+            ``lin(r) -> K^-1 r``, r (n_x,) or (n_x, k): the mode's linear solve for
+            [qddot_I; lambda] (one factorization).
+        n_i : int
+            Number of independent accelerations (the first entries of a solution).
+        rhs : ndarray, shape (n_x,)
+            F - h - M b without friction.
+        x, xdot : ndarray, shape (n_x,)
+        t, q : optional
+            Where, for the messages.
+
+        Returns
+        -------
+        sol : ndarray, shape (n_i + n_rows,)
+        F_f : ndarray, shape (n_x,)
+
+        Raises
+        ------
+        LockupError
+            The Newton matrix is singular: friction locks the mechanism.
+        IntegrationError
+            The iteration does not converge.
+        """
+        sol = lin(rhs)
+        if not self.sliding:
+            return sol, np.zeros_like(rhs)
+        lam = sol[n_i:]
+        prev = np.inf
+        for it in range(MAX_ITER):
+            F, D = self.forces(x, xdot, lam)
+            sol = lin(rhs + F)
+            r = lam - sol[n_i:]
+            rn = float(np.linalg.norm(r))
+            scale = max(float(np.linalg.norm(sol[n_i:])), 1e-300)
+            if rn <= 1e-14 * scale or (it >= 2 and rn <= 1e-9 * scale and rn > 0.5 * prev):
+                return sol, F
+            Jn = np.eye(lam.size) - lin(D)[n_i:]
+            try:
+                step = np.linalg.solve(Jn, r)
+            except np.linalg.LinAlgError:
+                raise LockupError(self._where("the friction of " + ", ".join(
+                    repr(j) for j in self.sliding) + " locks the mechanism (self-locking: "
+                    "the Newton matrix of the friction solve is singular)"), t=t, q=q) from None
+            lam, prev = lam - step, rn
+        raise IntegrationError(self._where(
+            f"the friction solve did not converge in {MAX_ITER} Newton iterations "
+            f"(residual {rn:.3g} of {scale:.3g}); the friction of "
+            + ", ".join(repr(j) for j in self.sliding) + " may lock the mechanism"), t=t, q=q)
+
+    def _where(self, msg: str) -> str:
+        from .mode_system import fmt_mode
+        return f"{msg} in mode {fmt_mode(self.ms.mode)}"
+
+
+def state_tokens(states: dict) -> frozenset:
+    """The mode tokens of joint friction states: ``{"B:stick", "C:slip+"}``."""
+    return frozenset(f"{j}:{s}" for j, s in states.items())
+
+
+def resolve_joints(sm, t, x, xdot, mode, targets: dict, *, before: dict, forced_slip: dict,
+                   forced_stick, velocity_tol: float, force_tol: float, workspace=None) -> dict:
+    """The friction state of every stick-slip pair at a switching instant.
+
+    A pair slips in the direction of its sliding velocity when that exceeds
+    ``velocity_tol``, in the direction given by ``forced_slip`` ({joint: +1/-1}: it just
+    broke away), and is tried sticking otherwise (or when listed in ``forced_stick``:
+    its sliding velocity just vanished).  The trial pairs stick together if each one's
+    needed friction is within its capacity mu S; else the most overloaded one slips
+    against its holding force and the others are tried again.
+
+    Parameters
+    ----------
+    sm : SwitchedModel
+    t : float
+    x, xdot : ndarray, shape (n_x,)
+        A consistent state of ``mode``.
+    mode : frozenset of str
+        The mode without joint friction tokens (locks, stops, contacts).
+    targets : dict
+        Held values; the stick values of the pairs that stick are stored here.
+    before : dict
+        The states of the mode left (:func:`joint_states`).
+    forced_slip, forced_stick
+        See above.
+    velocity_tol, force_tol : float
+        m/s or rad/s; N (N m for a pin: times the model's length scale).
+
+    Returns
+    -------
+    dict
+        {joint: 'stick' | 'slip+' | 'slip-'}.
+    """
+    from .mode_system import ModeSystem
+    model = sm.model
+    states: dict = {}
+    for j in stick_slip_joints(model):
+        if j in forced_slip:
+            states[j] = "slip+" if forced_slip[j] > 0 else "slip-"
+            continue
+        v = _measure(model, j).rate(x, xdot)
+        if j not in forced_stick and abs(v) > velocity_tol:
+            states[j] = "slip+" if v > 0 else "slip-"
+            continue
+        if before.get(j) != "stick" or f"{j}:stick" not in targets:
+            capture_stick(model, j, x, targets)
+        states[j] = "stick"
+    L = model.length_scale
+    while any(s == "stick" for s in states.values()):
+        ms = ModeSystem(sm, frozenset(mode) | state_tokens(states), targets, x,
+                        workspace=workspace)
+        lam = ms.evaluate_x(t, x, xdot).lam
+        jf = ms.friction
+        worst, worst_ratio = None, 0.0
+        for j, k in jf.stick_index.items():
+            tol = force_tol * (L if _measure(model, j).is_angle else 1.0)
+            cap = jf.capacity(j, x, lam)
+            over = abs(float(lam[k])) - cap - tol
+            if over > 0 and (worst is None or over / max(cap, tol) > worst_ratio):
+                worst, worst_ratio = j, over / max(cap, tol)
+        if worst is None:
+            break
+        states[worst] = "slip-" if lam[jf.stick_index[worst]] > 0 else "slip+"
+    for j, s in states.items():
+        if s != "stick":
+            targets.pop(f"{j}:stick", None)
+    return states
