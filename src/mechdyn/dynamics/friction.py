@@ -1,0 +1,325 @@
+"""The friction law of revolute and prismatic pairs (issue 12), written once for every
+analysis: kinetostatics, forward dynamics and the reporters.
+
+The law (``docs/friction.md``), with R the reaction on the CHILD from the PARENT at the
+joint point (:func:`mechdyn.dynamics.reactions.joint_reaction`, ground frame):
+
+* revolute (friction circle): the moment on the child
+  ``M_f = -(mu r |R| s(w) + c_v w)``, ``w = theta_dot_child - theta_dot_parent``;
+  ``-M_f`` acts on the parent (a couple: no force);
+* prismatic: the sliding velocity ``v`` of the child's joint point along the guide
+  axis relative to the parent's material point there; ``N`` the normal force and ``M``
+  the moment (about the joint point) of the reaction; with the guide length ``L > 0``
+  the gib edge loads ``N/2 - M/L`` and ``N/2 + M/L`` and the total normal load
+  ``S = |N/2 - M/L| + |N/2 + M/L|`` (``L = 0``: ``S = |N|``); the friction force on the
+  child ``f = -(mu S s(v) + c_v v)`` along the axis, at the joint point; ``-f`` on the
+  parent at the same point;
+* ``s(v) = tanh(v / smoothing)`` when the joint's ``smoothing`` > 0; ``sgn(v)``
+  otherwise (true Coulomb: ``sgn(0) = 0``, sticking is a matter of modes and events).
+
+The multipliers ``lam`` are those of the forward convention
+``M xddot + h = F + Phi_x^T lam`` (so the reaction on the child is linear in them);
+the generalized forces are forces (N) and moments about each body frame origin (N m)
+on the poses x, as everywhere in mechdyn.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..kernels import rows_numpy
+from ..kinematics.constraints import _perp, extend
+from ..model import Model
+from .forces import cross, rotate
+
+__all__ = ["FrictionPair", "FrictionSet", "friction_joints"]
+
+
+@dataclass(frozen=True)
+class FrictionPair:
+    """One joint with friction, its parameters and where it lives in ``x``.
+
+    Attributes
+    ----------
+    name : str
+    kind : {"revolute", "prismatic"}
+    parent, child : int
+        Body indices in ``x`` (the ground is ``model.n_bodies``).
+    point : ndarray, shape (2,)
+        The joint point in the child frame, m.
+    axis : ndarray, shape (2,)
+        Unit guide axis in the parent frame (prismatic; zeros for a revolute).
+    mu : float
+        Coulomb coefficient.
+    length : float
+        The pin radius (revolute) or the guide length (prismatic), m.
+    viscous : float
+        N m s/rad (revolute) or N s/m (prismatic).
+    smoothing : float
+        rad/s or m/s; 0 for true Coulomb.
+    rows : ndarray of int
+        The joint's rows in ``model.joint_rows`` (the same indices in every mode's
+        row set, whose joint rows come first).
+    """
+
+    name: str
+    kind: str
+    parent: int
+    child: int
+    point: np.ndarray
+    axis: np.ndarray
+    mu: float
+    length: float
+    viscous: float
+    smoothing: float
+    rows: np.ndarray
+
+
+def friction_joints(model: Model) -> tuple[str, ...]:
+    """Names of the revolute and prismatic joints of a model that dissipate (a Coulomb
+    coefficient or a viscous term set), in the model's joint order."""
+    from ..mechanism.joint import has_friction
+    joints = model.mechanism.joints
+    return tuple(n for n in model.joint_names
+                 if model.joint_kind(n) in ("revolute", "prismatic") and has_friction(joints[n]))
+
+
+def _sign(v, smoothing: float):
+    """s(v): tanh(v / smoothing) when smoothing > 0, else sgn(v) (0 at 0)."""
+    return np.tanh(v / smoothing) if smoothing > 0 else np.sign(v)
+
+
+class FrictionSet:
+    """The friction of the pairs of a model, evaluated batched over positions.
+
+    Parameters
+    ----------
+    model : Model
+    joints : sequence of str, optional
+        The pairs to include (default every joint with friction,
+        :func:`friction_joints`).
+
+    Attributes
+    ----------
+    pairs : tuple of FrictionPair
+    names : tuple of str
+    rows : dict
+        {joint: indices of its rows in ``model.joint_rows``}, the default ``rows`` of
+        the methods (valid for every mode: the joint rows come first in a mode's rows).
+
+    Raises
+    ------
+    ModelError
+        A name that is not a revolute or prismatic joint.
+
+    Notes
+    -----
+    |R| and S are not differentiable where they vanish; there the derivative given
+    is the zero subgradient (the friction is taken as not growing with the
+    multipliers), which a Newton iteration steps away from.
+
+    Examples
+    --------
+    A pin of radius 10 mm with mu = 0.1 carrying a 100 N reaction, the child turning
+    at +2 rad/s relative to the ground: the friction moment on it is -0.1 N m, and
+    0.2 W is lost.
+
+    >>> import numpy as np, mechdyn as md
+    >>> from mechdyn.dynamics.friction import FrictionSet
+    >>> m = md.Mechanism("pin")
+    >>> _ = m.add_body("arm", mass=1.0, inertia=0.1)
+    >>> _ = m.add_revolute("O", "ground", "arm", friction=0.1, pin_radius=0.01)
+    >>> _ = m.add_coordinate("phi", kind="angle", body="arm")
+    >>> fs = FrictionSet(m.compile())
+    >>> x, xdot = np.zeros(3), np.array([0.0, 0.0, 2.0])
+    >>> lam = np.array([0.0, -100.0])        # reaction (0, 100) N on the arm
+    >>> F, dF = fs.generalized(x, xdot, lam)
+    >>> float(F[2]), float(dF[2, 1])
+    (-0.1, 0.001)
+    >>> round(float(fs.power_lost(x, xdot, lam)["O"]), 12)
+    0.2
+    """
+
+    def __init__(self, model: Model, joints=None):
+        from ..errors import ModelError, did_you_mean
+        self.model = model
+        names = friction_joints(model) if joints is None else tuple(joints)
+        labels = model.joint_rows.elements
+        pairs = []
+        for nm in names:
+            kind = model.joint_kind(nm) if nm in model.joint_names else None
+            if kind not in ("revolute", "prismatic"):
+                raise ModelError(did_you_mean(nm, [n for n in model.joint_names if
+                                                   model.joint_kind(n) != "lock"],
+                                              "revolute or prismatic joint"))
+            jt = model.mechanism.joints[nm]
+            tab = model.rev if kind == "revolute" else model.pri
+            k = tab.names.index(nm)
+            pairs.append(FrictionPair(
+                nm, kind, int(tab.i[k]), int(tab.j[k]), np.asarray(tab.sj[k], float),
+                np.asarray(tab.ui[k], float) if kind == "prismatic" else np.zeros(2),
+                float(jt.friction), float(jt.pin_radius if kind == "revolute"
+                                          else jt.guide_length),
+                float(jt.viscous), float(jt.smoothing),
+                np.array([r for r, e in enumerate(labels) if e == nm], int)))
+        self.pairs = tuple(pairs)
+        self.names = tuple(p.name for p in pairs)
+        self.rows = {p.name: p.rows for p in pairs}
+        self._rowset = model.joint_rows.take(
+            np.concatenate([p.rows for p in pairs]) if pairs else np.zeros(0, int))
+        self._slices, at = {}, 0
+        for p in pairs:
+            self._slices[p.name] = slice(at, at + len(p.rows))
+            at += len(p.rows)
+
+    def __len__(self) -> int:
+        return len(self.pairs)
+
+    def __bool__(self) -> bool:
+        return bool(self.pairs)
+
+    # ------------------------------------------------------------------ kinematics
+    def speeds(self, x, xdot) -> dict:
+        """Relative speed of each pair: w (rad/s) of a revolute, v (m/s) of a prismatic
+        (the child's joint point along the axis relative to the parent), shape (...)."""
+        X, V = extend(self.model, np.asarray(x, float)), extend(self.model, np.asarray(xdot, float))
+        out = {}
+        for p in self.pairs:
+            if p.kind == "revolute":
+                out[p.name] = V[..., p.child, 2] - V[..., p.parent, 2]
+                continue
+            P, u = self._point_axis(X, p)
+            vc = V[..., p.child, :2] + V[..., p.child, 2, None] * _perp(P - X[..., p.child, :2])
+            vp = V[..., p.parent, :2] + V[..., p.parent, 2, None] * _perp(
+                P - X[..., p.parent, :2])
+            out[p.name] = np.sum((vc - vp) * u, axis=-1)
+        return out
+
+    @staticmethod
+    def _point_axis(X, p: FrictionPair):
+        """The joint point (..., 2) and the guide axis (..., 2) in the ground frame."""
+        P = X[..., p.child, :2] + rotate(X[..., p.child, 2], p.point)
+        return P, rotate(X[..., p.parent, 2], p.axis)
+
+    # ------------------------------------------------------------------ loads
+    def loads(self, x, lam, rows: Mapping | None = None) -> dict:
+        """The friction-producing load of each pair and its derivative.
+
+        Parameters
+        ----------
+        x : array_like, shape (..., n_x)
+        lam : array_like, shape (..., n_rows)
+            Multipliers (forward convention) of a row set whose rows ``rows`` belong
+            to the pairs.
+        rows : mapping, optional
+            {joint: indices into the last axis of ``lam``}; default :attr:`rows`.
+
+        Returns
+        -------
+        dict
+            {joint: (load (...), dload_dlam (..., n_rows))}: |R| of a revolute, N;
+            S = |N/2 - M/L| + |N/2 + M/L| (L > 0) or |N| of a prismatic, N.
+        """
+        x, lam = np.asarray(x, float), np.asarray(lam, float)
+        rows = self.rows if rows is None else rows
+        batch = np.broadcast_shapes(x.shape[:-1], lam.shape[:-1])
+        X = extend(self.model, x)
+        J = rows_numpy.jacobian(self._rowset, x) if self.pairs else None
+        out = {}
+        for p in self.pairs:
+            idx = np.asarray(rows[p.name], int)
+            Je = J[..., self._slices[p.name], :]  # (..., n_e, n_x)
+            b, sgn = (p.child, 1.0) if p.child < self.model.n_bodies else (p.parent, -1.0)
+            Af = sgn * np.swapaxes(Je[..., 3 * b:3 * b + 2], -1, -2)  # (..., 2, n_e)
+            R = np.einsum("...ke,...e->...k", Af, lam[..., idx])
+            d = np.zeros(batch + lam.shape[-1:])
+            if p.kind == "revolute":
+                mag = np.hypot(R[..., 0], R[..., 1])
+                unit = R / np.where(mag > 0, mag, 1.0)[..., None]  # 0 where |R| = 0
+                d[..., idx] = np.einsum("...k,...ke->...e", unit, Af)
+                out[p.name] = (mag, d)
+                continue
+            P, u = self._point_axis(X, p)
+            aN = np.einsum("...k,...ke->...e", _perp(u), Af)
+            aM = sgn * (Je[..., 3 * b + 2] - cross(P[..., None, :] - X[..., None, b, :2],
+                                                   Je[..., 3 * b:3 * b + 2]))
+            if p.length > 0:
+                e1, e2 = 0.5 * aN - aM / p.length, 0.5 * aN + aM / p.length
+                l1, l2 = (np.einsum("...e,...e->...", a, lam[..., idx]) for a in (e1, e2))
+                S = np.abs(l1) + np.abs(l2)
+                d[..., idx] = np.sign(l1)[..., None] * e1 + np.sign(l2)[..., None] * e2
+            else:
+                N = np.einsum("...e,...e->...", aN, lam[..., idx])
+                S = np.abs(N)
+                d[..., idx] = np.sign(N)[..., None] * aN
+            out[p.name] = (S, d)
+        return out
+
+    # ------------------------------------------------------------------ the law
+    def magnitudes(self, x, xdot, lam, rows: Mapping | None = None) -> dict:
+        """{joint: (value (...), dvalue_dlam (..., n_rows), speed (...))}: the friction
+        moment on the child (revolute, N m) or the friction force on the child along the
+        guide axis (prismatic, N), its derivative with respect to the multipliers and
+        the relative speed."""
+        spd = self.speeds(x, xdot)
+        out = {}
+        for p, (load, d) in zip(self.pairs, self.loads(x, lam, rows).values(), strict=True):
+            s = _sign(spd[p.name], p.smoothing)
+            k = p.mu * (p.length if p.kind == "revolute" else 1.0)
+            out[p.name] = (-(k * load * s + p.viscous * spd[p.name]),
+                           -(k * s)[..., None] * d, spd[p.name])
+        return out
+
+    def generalized(self, x, xdot, lam, rows: Mapping | None = None):
+        """The generalized friction force on the poses and its derivative with respect
+        to the multipliers.
+
+        Parameters
+        ----------
+        x, xdot : array_like, shape (..., n_x)
+            Poses (m, rad) and their rates.
+        lam : array_like, shape (..., n_rows)
+            Multipliers, forward convention ``M xddot + h = F + Phi_x^T lam``.
+        rows : mapping, optional
+            {joint: indices into the last axis of ``lam``}; default :attr:`rows`.
+
+        Returns
+        -------
+        F : ndarray, shape (..., n_x)
+            Forces (N) and moments about each body frame origin (N m) of the friction
+            of every pair on the moving bodies.
+        dF_dlam : ndarray, shape (..., n_x, n_rows)
+            Its exact derivative (the zero subgradient where a pair's load vanishes).
+        """
+        x, xdot, lam = (np.asarray(a, float) for a in (x, xdot, lam))
+        batch = np.broadcast_shapes(x.shape[:-1], lam.shape[:-1])
+        n_x, nb = self.model.n_x, self.model.n_bodies
+        F = np.zeros(batch + (n_x,))
+        dF = np.zeros(batch + (n_x, lam.shape[-1]))
+        X = extend(self.model, x)
+        for p, (val, dval, _) in zip(self.pairs, self.magnitudes(x, xdot, lam, rows).values(),
+                                     strict=True):
+            if p.kind == "revolute":
+                for b, sg in ((p.child, 1.0), (p.parent, -1.0)):
+                    if b < nb:
+                        F[..., 3 * b + 2] += sg * val
+                        dF[..., 3 * b + 2, :] += sg * dval
+                continue
+            P, u = self._point_axis(X, p)
+            for b, sg in ((p.child, 1.0), (p.parent, -1.0)):
+                if b >= nb:
+                    continue
+                arm = cross(P - X[..., b, :2], u)  # moment about the origin of a unit force u
+                g = sg * np.concatenate([u, arm[..., None]], axis=-1)  # (..., 3)
+                F[..., 3 * b:3 * b + 3] += g * val[..., None]
+                dF[..., 3 * b:3 * b + 3, :] += g[..., :, None] * dval[..., None, :]
+        return F, dF
+
+    def power_lost(self, x, xdot, lam, rows: Mapping | None = None) -> dict:
+        """Power dissipated in each pair, {joint: (...)}, W (>= 0): minus the power of
+        the friction moment or force on the relative motion."""
+        return {nm: -val * spd for nm, (val, _, spd)
+                in self.magnitudes(x, xdot, lam, rows).items()}
