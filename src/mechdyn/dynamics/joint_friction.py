@@ -35,11 +35,13 @@ tanh regularisation applies everywhere.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from functools import cached_property
+
 import numpy as np
 
 from ..errors import IntegrationError, LockupError
 from ..kernels import rows_numpy as RN
-from ..mechanism.joint import has_friction
 from ..model.state import Mode
 from ..model.variable import parse_variable
 
@@ -54,12 +56,12 @@ MAX_ITER = 30
 
 
 def friction_joints(model) -> tuple:
-    """The revolute and prismatic joints of a model with friction (Coulomb or viscous)."""
+    """The revolute and prismatic joints of a model with friction (Coulomb or viscous),
+    memoized (:func:`mechdyn.dynamics.friction.friction_joints`)."""
     memo = model.memo.get("friction_joints")
     if memo is None:
-        memo = model.memo["friction_joints"] = tuple(
-            n for n, j in model.mechanism.joints.items()
-            if has_friction(j) and model.joint_kind(n) in ("revolute", "prismatic"))
+        from .friction import friction_joints as joints
+        memo = model.memo["friction_joints"] = joints(model)
     return memo
 
 
@@ -97,21 +99,45 @@ def capture_stick(model, joint: str, x, targets: dict) -> None:
     targets[f"{joint}:stick"] = _measure(model, joint).value(x)
 
 
-def stick_row(model, joint: str, targets: dict):
-    """The ``"stick"`` row holding a sticking pair (a :class:`~mechdyn.dynamics.modes.Row`
-    of element ``joint``)."""
-    from .modes import Row  # modes imports mode_system, which imports this module
-    return Row(joint, f"{joint}:stick", "stick", _measure(model, joint),
-               float(targets[f"{joint}:stick"]))
+@dataclass(frozen=True)
+class StickRow:
+    """The row holding a sticking pair: its travel or relative angle at ``target``; the
+    interface of :class:`mechdyn.dynamics.modes.Row` (kind ``"stick"``, element the
+    joint), which this module cannot import (modes -> mode_system -> here)."""
+
+    element: str
+    label: str
+    measure: object
+    target: float
+    kind: str = "stick"
+    sign: float = 1.0
+    mu: float = 0.0
+    slip: int = 0
+    tangent: object = None
+    compliance: float = 0.0
+    unilateral: bool = False
+    friction_rows: object = None
+
+    @cached_property
+    def rows(self):
+        """The row as data, with its label and element."""
+        return self.measure.rows.scaled(1.0, -self.target).renamed(self.label, self.element)
 
 
-def friction_set(model):
-    """The friction law's :class:`~mechdyn.dynamics.friction.FrictionSet` of a model,
-    built once."""
-    fs = model.memo.get("friction_set")
+def stick_row(model, joint: str, targets: dict) -> StickRow:
+    """The row holding a sticking pair at its captured value."""
+    return StickRow(joint, f"{joint}:stick", _measure(model, joint),
+                    float(targets[f"{joint}:stick"]))
+
+
+def friction_set(model, joints):
+    """The friction law (:class:`~mechdyn.dynamics.friction.FrictionSet`) of some joints of
+    a model, built once per set."""
+    key = ("friction_set", tuple(joints))
+    fs = model.memo.get(key)
     if fs is None:
         from .friction import FrictionSet
-        fs = model.memo["friction_set"] = FrictionSet(model)
+        fs = model.memo[key] = FrictionSet(model, joints)
     return fs
 
 
@@ -139,7 +165,6 @@ class JointFriction:
         self.ms = ms
         model = ms.model
         self.model = model
-        self.fs = friction_set(model)
         self.states = joint_states(model, ms.mode)
         self.sliding = [j for j in friction_joints(model) if self.states.get(j) != "stick"]
         self.signs = {j: (1.0 if s == "slip+" else -1.0) for j, s in self.states.items()
@@ -148,16 +173,35 @@ class JointFriction:
                             if r.kind == "stick" and r.element in self.states}
 
     # ------------------------------------------------------------------ the law
-    def forces(self, x, xdot, lam, joints=None, signs=None):
+    def forces(self, x, xdot, lam):
         """(F_f (n_x,), dF_f/dlambda (n_x, n_rows)): the generalized friction force of
-        the sliding pairs (``joints``, default :attr:`sliding`) on the body poses, N and
-        N m, and its derivative with respect to the multipliers of the mode's rows."""
-        joints = self.sliding if joints is None else joints
-        if not joints:
-            n = self.model.n_x
-            return np.zeros(n), np.zeros((n, self.ms.n_rows))
-        return self.fs.generalized(x, xdot, lam, self.ms.layout, joints=joints,
-                                   signs=self.signs if signs is None else signs)
+        the sliding pairs (:attr:`sliding`) on the body poses, N and N m, and its
+        derivative with respect to the multipliers of the mode's rows.
+
+        A slipping stick-slip pair whose velocity is zero or against its direction s
+        (the start of its segment, trial states beyond the event) gets the Coulomb
+        friction of sgn(v) = s, so that the right-hand side of the segment stays smooth
+        up to the event: the law at a velocity of direction s, minus the law's viscous
+        part there, plus the viscous part at the actual velocity.
+        """
+        n_x, lam = self.model.n_x, np.asarray(lam, float)
+        F, D = np.zeros(n_x), np.zeros((n_x, lam.size))
+        back = [j for j, s in self.signs.items() if s * self.velocity(j, x, xdot) <= 0.0]
+        usual = tuple(j for j in self.sliding if j not in back)
+        if usual:
+            F[:], D[:] = friction_set(self.model, usual).generalized(x, xdot, lam)
+        for j in back:
+            fs = friction_set(self.model, (j,))
+            xd = xdot + (self.signs[j] - self.velocity(j, x, xdot)) * self._unit(j, x)
+            Fj, Dj = fs.generalized(x, xd, lam)
+            F += Fj - fs.generalized(x, xd, 0.0 * lam)[0] + fs.generalized(x, xdot, 0.0 * lam)[0]
+            D += Dj
+        return F, D
+
+    def _unit(self, joint: str, x) -> np.ndarray:
+        """A velocity of the poses (n_x,) with unit sliding velocity of ``joint``."""
+        J = RN.jacobian(_measure(self.model, joint).rows, x)[0]
+        return J / (J @ J)
 
     def velocity(self, joint: str, x, xdot) -> float:
         """The pair's sliding velocity (m/s) or relative angular velocity (rad/s)."""
@@ -165,10 +209,12 @@ class JointFriction:
 
     def capacity(self, joint: str, x, lam) -> float:
         """mu S of a pair (N; mu r |R|, N m, for a pin): the largest friction the pair
-        can give at the multipliers ``lam``, from the law at a unit sliding direction."""
-        J = RN.jacobian(_measure(self.model, joint).rows, x)[0]
-        F, _ = self.forces(x, np.zeros_like(J), lam, joints=[joint], signs={joint: 1.0})
-        return float(-F @ J / (J @ J))
+        can give at the multipliers ``lam`` (the law's friction at a unit sliding
+        velocity, less its viscous part)."""
+        mag = friction_set(self.model, (joint,)).magnitudes
+        xd = self._unit(joint, x)
+        lam = np.asarray(lam, float)
+        return float(mag(x, xd, 0.0 * lam)[joint][0] - mag(x, xd, lam)[joint][0])
 
     def margin(self, joint: str, x, lam) -> float:
         """Capacity minus the friction needed to hold a sticking pair (< 0: it slips)."""
@@ -230,8 +276,7 @@ class JointFriction:
             + ", ".join(repr(j) for j in self.sliding) + " may lock the mechanism"), t=t, q=q)
 
     def _where(self, msg: str) -> str:
-        from .mode_system import fmt_mode
-        return f"{msg} in mode {fmt_mode(self.ms.mode)}"
+        return f"{msg} in mode {{{', '.join(sorted(self.ms.mode))}}}"
 
 
 def state_tokens(states: dict) -> frozenset:
@@ -239,8 +284,9 @@ def state_tokens(states: dict) -> frozenset:
     return frozenset(f"{j}:{s}" for j, s in states.items())
 
 
-def resolve_joints(sm, t, x, xdot, mode, targets: dict, *, before: dict, forced_slip: dict,
-                   forced_stick, velocity_tol: float, force_tol: float, workspace=None) -> dict:
+def resolve_joints(system, sm, t, x, xdot, mode, targets: dict, *, before: dict,
+                   forced_slip: dict, forced_stick, velocity_tol: float, force_tol: float,
+                   workspace=None) -> dict:
     """The friction state of every stick-slip pair at a switching instant.
 
     A pair slips in the direction of its sliding velocity when that exceeds
@@ -252,6 +298,9 @@ def resolve_joints(sm, t, x, xdot, mode, targets: dict, *, before: dict, forced_
 
     Parameters
     ----------
+    system : type
+        :class:`~mechdyn.dynamics.mode_system.ModeSystem` (passed in: it imports this
+        module).
     sm : SwitchedModel
     t : float
     x, xdot : ndarray, shape (n_x,)
@@ -272,7 +321,6 @@ def resolve_joints(sm, t, x, xdot, mode, targets: dict, *, before: dict, forced_
     dict
         {joint: 'stick' | 'slip+' | 'slip-'}.
     """
-    from .mode_system import ModeSystem
     model = sm.model
     states: dict = {}
     for j in stick_slip_joints(model):
@@ -288,10 +336,17 @@ def resolve_joints(sm, t, x, xdot, mode, targets: dict, *, before: dict, forced_
         states[j] = "stick"
     L = model.length_scale
     while any(s == "stick" for s in states.values()):
-        ms = ModeSystem(sm, frozenset(mode) | state_tokens(states), targets, x,
-                        workspace=workspace)
-        lam = ms.evaluate_x(t, x, xdot).lam
+        ms = system(sm, frozenset(mode) | state_tokens(states), targets, x,
+                    workspace=workspace)
         jf = ms.friction
+        passing = [j for j, k in jf.stick_index.items() if k not in ms.independent_rows]
+        if passing:  # the velocity passes zero by the kinematics (a slider at a dead
+            # centre): holding the pair would lock the others, it slips on
+            j = passing[0]
+            states[j] = _passing_direction(system, sm, t, x, xdot, mode, targets, states, j,
+                                           before.get(j), workspace)
+            continue
+        lam = ms.evaluate_x(t, x, xdot).lam
         worst, worst_ratio = None, 0.0
         for j, k in jf.stick_index.items():
             tol = force_tol * (L if _measure(model, j).is_angle else 1.0)
@@ -306,3 +361,22 @@ def resolve_joints(sm, t, x, xdot, mode, targets: dict, *, before: dict, forced_
         if s != "stick":
             targets.pop(f"{j}:stick", None)
     return states
+
+
+def _passing_direction(system, sm, t, x, xdot, mode, targets, states, joint, prev,
+                       workspace) -> str:
+    """The slip state of a pair whose sliding velocity passes zero where holding it is
+    not independent of the other rows: the direction s whose sliding acceleration has
+    the sign of s (the reverse of ``prev`` tried first)."""
+    meas = _measure(sm.model, joint)
+    order = ("slip-", "slip+") if prev == "slip+" else ("slip+", "slip-")
+    for st in order:
+        trial = dict(states, **{joint: st})
+        ms = system(sm, frozenset(mode) | state_tokens(trial), targets, x,
+                    workspace=workspace)
+        ev = ms.evaluate_x(t, x, xdot)
+        acc = float(RN.jacobian(meas.rows, ev.x)[0] @ ev.xddot
+                    + RN.quad(meas.rows, ev.x, ev.xdot)[0])
+        if acc * (1.0 if st == "slip+" else -1.0) > 0:
+            return st
+    return order[0]

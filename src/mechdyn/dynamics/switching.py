@@ -196,7 +196,8 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
         forced_stick=forced_stick - set(ss))
     if ss:  # the friction state of the stick-slip pairs
         mode_after = frozenset(mode_after) | state_tokens(resolve_joints(
-            sm, t, x, xd_plus, mode_after, targets, before=joint_states(sm.model, mode_before),
+            ModeSystem, sm, t, x, xd_plus, mode_after, targets,
+            before=joint_states(sm.model, mode_before),
             forced_slip={k: v for k, v in forced_slip.items() if k in ss},
             forced_stick=forced_stick & set(ss), velocity_tol=vtol,
             force_tol=1e-10 * force_scale, workspace=ms.ws))
