@@ -190,19 +190,28 @@ class ModeEquations:
         return p + float(sum(-r.mu * r.slip * ev.lam[ms.n_base + k] * r.tangent.rate(ev.x, ev.xdot)
                              for k, r in enumerate(ms.rows) if r.slip))
 
+    def _powers(self, ev) -> np.ndarray:
+        """[P_nc] or, with friction in the joints, [P_nc, P_f]: P_f = -F_f . xdot >= 0
+        the power the joints' friction dissipates (its work is recorded on its own)."""
+        if ev.F_friction is None:
+            return np.array([self._power(ev)])
+        return np.array([self._power(ev), -float(ev.F_friction @ ev.xdot)])
+
     def numpy_rhs(self, t: float, qi, qdi):
-        """(q_I'', array([P_nc])) on the NumPy path; raises the diagnosed error of a
-        failure (assembly, lock-up)."""
+        """(q_I'', array([P_nc]) or array([P_nc, P_f]) with friction in the joints) on
+        the NumPy path; raises the diagnosed error of a failure (assembly, lock-up)."""
         if self.formulation == "analogs":
             tm = self.analogs_terms(t, qi, qdi)
             return tm["qddot"], np.array([tm["power_nc"]])
         ev = self._numpy_evaluate(t, qi, qdi)
-        return ev.qddot[self.ms.coords], np.array([self._power(ev)])
+        return ev.qddot[self.ms.coords], self._powers(ev)
 
     def rhs(self, t: float, qi, qdi):
-        """(q_I'' (n_i,), array([P_nc])) at (t, q_I, q_I')."""
+        """(q_I'' (n_i,), array([P_nc]) or, with friction in the joints,
+        array([P_nc, P_f])) at (t, q_I, q_I')."""
         n = self.ms.n_i
-        out = self._first_order(t, np.concatenate([qi, qdi, [0.0]]))
+        w0 = [0.0, 0.0] if self.ms.friction is not None else [0.0]
+        out = self._first_order(t, np.concatenate([qi, qdi, w0]))
         return out[n:2 * n], out[2 * n:]
 
     def first_order_function(self):

@@ -74,6 +74,9 @@ class ModeEval:
     F_conservative : ndarray, shape (n_x,) or None
         Forces of gravity and spring stiffness alone at the pose, when they
         came out of the same evaluation of the loads (None otherwise).
+    F_friction : ndarray, shape (n_x,) or None
+        The friction of the sliding joints on the poses (included in ``F``), or None
+        for a model without friction in its joints.
     """
 
     x: np.ndarray
@@ -85,6 +88,7 @@ class ModeEval:
     lam: np.ndarray
     F: np.ndarray = field(repr=False, default=None)
     F_conservative: np.ndarray | None = field(repr=False, default=None)
+    F_friction: np.ndarray | None = field(repr=False, default=None)
 
 
 class ModeSystem:
@@ -324,6 +328,7 @@ class ModeSystem:
         F = F + G.T @ Qd
         M, h = self.sm.with_drive_inertia(*mass_matrix_x(self.model, x, xdot), G, quad_g)
         rhs = F - h - M @ b_
+        Ff = None if self.friction is None else np.zeros_like(F)
         if b is not None:
             qddi = np.linalg.solve(B.T @ M @ B, B.T @ rhs)
             lam = np.linalg.lstsq(R.T, M @ (B @ qddi) - rhs, rcond=None)[0]
@@ -341,7 +346,7 @@ class ModeSystem:
                 qddi, lam = self._solve_motion(M, B, Reff, rhs, self._rs)
         xddot = B @ qddi + b_
         qddot = G @ xddot + quad_g
-        return ModeEval(x, xdot, xddot, q, qdot, qddot, lam, F, Fc)
+        return ModeEval(x, xdot, xddot, q, qdot, qddot, lam, F, Fc, Ff)
 
     def _solve_motion(self, M, B, Reff, rhs, rs):
         """Solve [M B, -Reff^T] [qddot_i; lam] = rhs (rows scaled by ``rs``) for the
