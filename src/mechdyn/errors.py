@@ -41,6 +41,8 @@ class Status(StrEnum):
     EVENT = "event"
     #: a dead, toggle or bifurcation position: the coordinates lose control there
     SINGULAR_POSITION = "singular-position"
+    #: positions where friction locks the mechanism: no finite driving torque moves it
+    SELF_LOCKING = "self-locking"
     #: the mechanism cannot be assembled at the coordinates reached
     ASSEMBLY_FAILED = "assembly-failed"
     #: the generalized mass matrix is singular (a coordinate without inertia)

@@ -12,7 +12,8 @@ from mechdyn.kinematics.constraints import point_position
 
 NAMES = ["andrews_squeezer", "bolt_buffer", "clutchless_press", "clutchless_press_lumped",
          "clutchless_press_paper",
-         "four_bar", "press_cycle", "slider_crank", "toggle_press", "toggle_press_paper"]
+         "four_bar", "press_cycle", "slider_crank", "toggle_press", "toggle_press_friction",
+         "toggle_press_paper"]
 
 
 def test_every_example_is_listed_with_a_description():
@@ -26,7 +27,8 @@ def test_unknown_example_lists_the_names():
                                          "'andrews_squeezer', 'bolt_buffer', 'clutchless_press', "
                                          "'clutchless_press_lumped', 'clutchless_press_paper', "
                                          "'four_bar', 'press_cycle', 'slider_crank', "
-                                         "'toggle_press', 'toggle_press_paper'"):
+                                         "'toggle_press', 'toggle_press_friction', "
+                                         "'toggle_press_paper'"):
         examples.path("fourbar")
     assert examples.path("four_bar.toml") == examples.path("four_bar")
 

@@ -127,3 +127,18 @@ def test_derivative_against_central_differences_batched():
 def test_unknown_joint_named():
     with pytest.raises(ModelError, match="revolute or prismatic"):
         FrictionSet(_crank_rod(), joints=["Q"])
+
+
+def test_rows_of_a_layout_and_missing_rows():
+    model = _slider_crank_friction()
+    fs = FrictionSet(model)
+    lay = model.layout()
+    rng = np.random.default_rng(2)
+    x, xdot = model.x_sketch, rng.standard_normal(model.n_x)
+    lam = rng.standard_normal(lay.n_rows)
+    F, dF = fs.generalized(x, xdot, lam)
+    F2, dF2 = fs.generalized(x, xdot, lam, lay)
+    np.testing.assert_array_equal(F, F2)
+    np.testing.assert_array_equal(dF, dF2)
+    with pytest.raises(ValueError, match="'guide'"):
+        fs.generalized(x, xdot, lam, {"O": [0, 1], "A": [2, 3], "B": [4, 5]})

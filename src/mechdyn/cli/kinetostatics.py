@@ -5,8 +5,11 @@ Example::
     mechdyn kinetostatics toggle_press --speed 40rpm --from 0deg --to 360deg \\
         --steps 361 --moment-point 0,0 -o forces.csv --plot forces.png
 
-Exit codes: 0 done; 1 done with a warning that matters (singular positions);
-2 bad input (one line on stderr).
+With friction in the pairs (``docs/friction.md``) it also prints the cycle efficiency
+and the energy lost in each pair, and the table gets the loss and efficiency columns.
+
+Exit codes: 0 done; 1 done with a warning that matters (singular or self-locking
+positions); 2 bad input (one line on stderr).
 """
 
 from __future__ import annotations
@@ -54,7 +57,9 @@ def register(sub) -> None:
                     "receives (shaking force and moment); write a CSV with unit-suffixed "
                     "columns and optionally a plot; print peaks, RMS torque and harmonics.",
         epilog="Quantities take units: 0deg, 360 deg, 40rpm, 4.2 rad/s, 15 mm (a bare number "
-               "is SI: rad, m, rad/s). Exit codes: 0 done, 1 singular positions, 2 bad input.")
+               "is SI: rad, m, rad/s). Joints with friction add the power lost per pair and the "
+               "efficiency (docs/friction.md). Exit codes: 0 done, 1 singular or "
+               "self-locking positions, 2 bad input.")
     add_model(p)
     add_range(p, steps=361, over="driven coordinate (default: the first); other independent "
                                  "coordinates are held at their initial values")
@@ -111,6 +116,11 @@ def run(args) -> int:
                 print(f"    {int(row['order']):3d} ({row['f_Hz']:.4g} Hz): "
                       f"{row['Fx_frame_N']:.6g} {row['Fy_frame_N']:.6g} "
                       f"{row['M_frame_Nm']:.6g}")
+    if res.losses:
+        e = res.energies()
+        print(f"  cycle efficiency {res.cycle_efficiency:.6g}; energy lost per pair: "
+              + ", ".join(f"{j} {e[f'loss_{j}']:.6g} J" for j in res.losses)
+              + " (columns P_loss_<joint>_W, P_loss_W, P_out_W, efficiency in the table)")
     if args.output:
         with written(args.output) as tmp:
             res.to_dataframe().to_csv(tmp, index=False)
@@ -121,4 +131,5 @@ def run(args) -> int:
             path = Path(args.plot)
             out = path.with_name(f"{path.stem}_polar_{joint}{path.suffix}")
             print(f"  polar plot of {joint}: {plot_joint_force_polar(res, joint, out)}")
-    return finish(args, res.status != Status.SINGULAR_POSITION, res.message)
+    return finish(args, res.status not in (Status.SINGULAR_POSITION, Status.SELF_LOCKING),
+                  res.message)

@@ -204,6 +204,22 @@ class FrictionSet:
         P = X[..., p.child, :2] + rotate(X[..., p.child, 2], p.point)
         return P, rotate(X[..., p.parent, 2], p.axis)
 
+    def _row_map(self, rows) -> Mapping:
+        """{joint: indices into the multipliers} from None (:attr:`rows`), a mapping, or
+        an object with ``element_rows`` (a ConstraintLayout or a ModeSystem)."""
+        if rows is None:
+            return self.rows
+        if not isinstance(rows, Mapping):
+            rows = getattr(rows, "element_rows", None)
+            if not isinstance(rows, Mapping):
+                raise TypeError("rows: expected a mapping {joint: row indices}, a "
+                                "ConstraintLayout or a ModeSystem")
+        missing = [n for n in self.names if n not in rows]
+        if missing:
+            raise ValueError("rows: no multipliers given for the joint(s) with friction "
+                             + ", ".join(repr(n) for n in missing))
+        return rows
+
     # ------------------------------------------------------------------ loads
     def loads(self, x, lam, rows: Mapping | None = None) -> dict:
         """The friction-producing load of each pair and its derivative.
@@ -214,8 +230,9 @@ class FrictionSet:
         lam : array_like, shape (..., n_rows)
             Multipliers (forward convention) of a row set whose rows ``rows`` belong
             to the pairs.
-        rows : mapping, optional
-            {joint: indices into the last axis of ``lam``}; default :attr:`rows`.
+        rows : mapping, ConstraintLayout or ModeSystem, optional
+            {joint: indices into the last axis of ``lam``} (or the ``element_rows`` of a
+            layout or mode system); default :attr:`rows`.
 
         Returns
         -------
@@ -224,7 +241,7 @@ class FrictionSet:
             S = |N/2 - M/L| + |N/2 + M/L| (L > 0) or |N| of a prismatic, N.
         """
         x, lam = np.asarray(x, float), np.asarray(lam, float)
-        rows = self.rows if rows is None else rows
+        rows = self._row_map(rows)
         batch = np.broadcast_shapes(x.shape[:-1], lam.shape[:-1])
         X = extend(self.model, x)
         J = rows_numpy.jacobian(self._rowset, x) if self.pairs else None
@@ -273,6 +290,25 @@ class FrictionSet:
                            -(k * s)[..., None] * d, spd[p.name])
         return out
 
+    def _patterns(self, x) -> dict:
+        """{joint: (child pattern, parent pattern)}: the generalized force (..., 3) on each
+        of the two bodies (None for the ground) of a unit friction value (a unit moment on
+        the child; a unit force along the axis on the child at the joint point)."""
+        X = extend(self.model, np.asarray(x, float))
+        nb, out = self.model.n_bodies, {}
+        for p in self.pairs:
+            if p.kind == "revolute":
+                unit = np.zeros(X.shape[:-2] + (3,))
+                unit[..., 2] = 1.0
+                g = [unit, -unit]
+            else:
+                P, u = self._point_axis(X, p)
+                g = [sg * np.concatenate([u, cross(P - X[..., b, :2], u)[..., None]], axis=-1)
+                     for b, sg in ((p.child, 1.0), (p.parent, -1.0))]
+            out[p.name] = tuple(gb if b < nb else None
+                                for gb, b in zip(g, (p.child, p.parent), strict=True))
+        return out
+
     def generalized(self, x, xdot, lam, rows: Mapping | None = None):
         """The generalized friction force on the poses and its derivative with respect
         to the multipliers.
@@ -283,8 +319,9 @@ class FrictionSet:
             Poses (m, rad) and their rates.
         lam : array_like, shape (..., n_rows)
             Multipliers, forward convention ``M xddot + h = F + Phi_x^T lam``.
-        rows : mapping, optional
-            {joint: indices into the last axis of ``lam``}; default :attr:`rows`.
+        rows : mapping, ConstraintLayout or ModeSystem, optional
+            {joint: indices into the last axis of ``lam``} (or the ``element_rows`` of a
+            layout or mode system); default :attr:`rows`.
 
         Returns
         -------
@@ -296,27 +333,32 @@ class FrictionSet:
         """
         x, xdot, lam = (np.asarray(a, float) for a in (x, xdot, lam))
         batch = np.broadcast_shapes(x.shape[:-1], lam.shape[:-1])
-        n_x, nb = self.model.n_x, self.model.n_bodies
-        F = np.zeros(batch + (n_x,))
-        dF = np.zeros(batch + (n_x, lam.shape[-1]))
-        X = extend(self.model, x)
+        F = np.zeros(batch + (self.model.n_x,))
+        dF = np.zeros(batch + (self.model.n_x, lam.shape[-1]))
+        pat = self._patterns(x)
         for p, (val, dval, _) in zip(self.pairs, self.magnitudes(x, xdot, lam, rows).values(),
                                      strict=True):
-            if p.kind == "revolute":
-                for b, sg in ((p.child, 1.0), (p.parent, -1.0)):
-                    if b < nb:
-                        F[..., 3 * b + 2] += sg * val
-                        dF[..., 3 * b + 2, :] += sg * dval
-                continue
-            P, u = self._point_axis(X, p)
-            for b, sg in ((p.child, 1.0), (p.parent, -1.0)):
-                if b >= nb:
-                    continue
-                arm = cross(P - X[..., b, :2], u)  # moment about the origin of a unit force u
-                g = sg * np.concatenate([u, arm[..., None]], axis=-1)  # (..., 3)
-                F[..., 3 * b:3 * b + 3] += g * val[..., None]
-                dF[..., 3 * b:3 * b + 3, :] += g[..., :, None] * dval[..., None, :]
+            for b, g in zip((p.child, p.parent), pat[p.name], strict=True):
+                if g is not None:
+                    F[..., 3 * b:3 * b + 3] += g * val[..., None]
+                    dF[..., 3 * b:3 * b + 3, :] += g[..., :, None] * dval[..., None, :]
         return F, dF
+
+    def by_pair(self, x, xdot, lam, rows: Mapping | None = None) -> dict:
+        """{joint: (F (..., n_x), value (...))}: the generalized friction force of each pair
+        on the moving bodies (as :meth:`generalized`) and the friction moment on the child
+        (revolute, N m) or the friction force on the child along the axis (prismatic, N)."""
+        x, xdot, lam = (np.asarray(a, float) for a in (x, xdot, lam))
+        batch = np.broadcast_shapes(x.shape[:-1], lam.shape[:-1])
+        pat, out = self._patterns(x), {}
+        for p, (val, _, _) in zip(self.pairs, self.magnitudes(x, xdot, lam, rows).values(),
+                                  strict=True):
+            F = np.zeros(batch + (self.model.n_x,))
+            for b, g in zip((p.child, p.parent), pat[p.name], strict=True):
+                if g is not None:
+                    F[..., 3 * b:3 * b + 3] += g * val[..., None]
+            out[p.name] = (F, val)
+        return out
 
     def power_lost(self, x, xdot, lam, rows: Mapping | None = None) -> dict:
         """Power dissipated in each pair, {joint: (...)}, W (>= 0): minus the power of

@@ -7,7 +7,11 @@ Driving constraints ``g_d(x) - q_d(t) = 0`` are appended to the joint constraint
 
     -Phi_x^T lambda + g_d,x^T tau = I(x, xdot, xddot) - F(t, x, xdot)
 
-(``I`` the inertia forces, ``F`` the applied forces).  The sign conventions of
+(``I`` the inertia forces, ``F`` the applied forces).  With friction in the pairs
+``F`` also holds their friction, which depends on the reactions: the system becomes
+nonlinear and is solved by Newton's method per position
+(:mod:`~mechdyn.dynamics.kinetostatics_friction`, ``docs/friction.md``), which also
+finds the self-locking positions.  The sign conventions of
 reactions, driving torques and frame loads, and the two ways of treating ``Drive``
 elements (``model_drives``), are stated once, in ``docs/kinetostatics.md``, section
 "Reactions and driving torques".
@@ -97,6 +101,10 @@ def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
     Returns
     -------
     Kinetostatics
+        With friction in the pairs (``docs/friction.md``) also the power lost in each
+        pair (``losses``), the useful output power (``power_out``), the efficiencies
+        (``efficiency``, ``cycle_efficiency``) and the self-locked positions
+        (``locked``; status ``"self-locking"``, their torques and reactions NaN).
 
     Raises
     ------

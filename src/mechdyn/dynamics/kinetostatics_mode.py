@@ -28,6 +28,8 @@ MESSAGES = {
                       "solution reported)",
     Status.SINGULAR_POSITION: "completed with singular positions: the driven coordinates "
                               "lose control there and the reactions are unbounded",
+    Status.SELF_LOCKING: "completed with self-locking positions: friction locks the "
+                         "mechanism there (no finite driving torque; NaN torques and reactions)",
     Status.PARTIAL: "completed in part: segments whose mode could not be analysed are NaN "
                     "(see warnings)"}
 

@@ -117,7 +117,11 @@ def kinetostatics_switched(model: Model, trajectory, vs, *, over=None,
     series = {attr: merged(attr, keys, *tail) for attr, keys, *tail in (
         ("reactions", joints, 2), ("moments", joints), ("joint_frame", joints, 2),
         ("joint_points", joints, 2), ("driving", driven), ("power", driven),
-        ("frame_loads", loads, 3), ("element_forces", elements))}
+        ("frame_loads", loads, 3), ("element_forces", elements),
+        ("losses", dict.fromkeys(k for r in done for k in r.losses)))}
+    friction = any(r.losses for r in done)
+    if friction:
+        arrays.update(power_out=nan(), locked=np.zeros(n, dtype=bool))
     warn: list[str] = []
     notes: list[str] = []
     seg_stats = []
@@ -131,7 +135,8 @@ def kinetostatics_switched(model: Model, trajectory, vs, *, over=None,
                         f"their forces are NaN")
             continue
         for k, v in arrays.items():
-            v[a:b] = getattr(r, k)
+            got = getattr(r, k)
+            v[a:b] = got if got is not None else (False if k == "locked" else np.nan)
         multipliers[a:b, :r.multipliers.shape[1]] = r.multipliers
         warn.extend(w for w in (f"mode {fmt_mode(mode)}: {w}" for w in r.warnings) if w not in warn)
         notes.extend(nt for nt in r.message.split("; ")[1:] if nt not in notes)
@@ -139,7 +144,8 @@ def kinetostatics_switched(model: Model, trajectory, vs, *, over=None,
                     **{k: r.stats[k] for k in ("power_balance_rel", "rcond_min")})
 
     statuses = {Status.PARTIAL if r is None else r.status for *_, r, _ in parts}
-    status = next((s for s in (Status.PARTIAL, Status.SINGULAR_POSITION, Status.REDUNDANT)
+    status = next((s for s in (Status.PARTIAL, Status.SELF_LOCKING, Status.SINGULAR_POSITION,
+                               Status.REDUNDANT)
                    if s in statuses), Status.SUCCESS)
     head = (f"{MESSAGES[status]} for a switched trajectory: {len(parts)} segment(s) in "
             f"{len(modes)} mode(s)")

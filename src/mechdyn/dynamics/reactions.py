@@ -16,7 +16,9 @@ from ..kinematics.assembly import SINGULAR_RCOND, _redundant_rows, _scale
 from ..kinematics.constraints import _perp, coordinates_jacobian, extend
 from ..model import ConstraintLayout, Model
 from .forces import applied_forces, cross, rotate
+from .friction import FrictionSet
 from .inertia import inertia_forces
+from .kinetostatics_friction import friction_solve, locking_note
 
 __all__ = ["KinetostaticsWarning", "joint_reaction", "reaction_frame", "element_forces",
            "frame_forces", "touches_ground"]
@@ -228,14 +230,24 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
         z = np.linalg.solve(As, bs[..., None])[..., 0]
     else:
         z = (np.linalg.pinv(As, rcond=1e-10) @ bs[..., None])[..., 0]
+    fs = FrictionSet(model)
+    Ff, locked = np.zeros_like(F), np.zeros(n, dtype=bool)
+    if fs:  # the friction of the pairs: the nonlinear system, by Newton from z
+        z, Ff, locked, finfo = friction_solve(fs, {j: lay.rows[j] for j in fs.names},
+                                              lay.n_rows, As, bs, rs, cs, x, xdot, z)
+        locked &= ~mask  # bifurcations: the torque is the limit along the branch
+        rhs = rhs - Ff
+        bs = rhs * rs
     resid = np.abs(np.einsum("nij,nj->ni", As, z) - bs).max(axis=-1)
     singular |= resid > 1e-6 * np.maximum(np.maximum(np.abs(bs).max(axis=-1), 1e-300),
                                           np.abs(As).max(axis=(1, 2)) * np.abs(z).max(axis=-1))
     z = z * cs
+    z[locked] = np.nan  # no finite driving torque moves the mechanism there
     lam = z[:, :lay.n_rows]
     tau = z[:, lay.n_rows:]
     if mask.any() and n_d == 1:
         tau[mask, 0] = np.einsum("nx,nx->n", charted[1], rhs[mask])
+    singular &= ~locked
     bif = singular & mask
     singular &= ~mask
     status = Status.SUCCESS
@@ -246,6 +258,11 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
                     "joints " + ", ".join(repr(j) for j in red_joints) + " are not unique; "
                     "the minimum-norm solution is reported (forces in N, moments in N m "
                     f"divided by the length scale {L:.4g} m)")
+        rf = [j for j in red_joints if j in fs.names]
+        if rf:
+            warn.append("the friction of joint(s) " + ", ".join(repr(j) for j in rf)
+                        + " depends on their reactions, which are not unique: it is computed "
+                          "from the minimum-norm reactions")
     for where, what, why in (
             (bif, "bifurcation position(s)", "the mechanism goes on on its branch and the "
              "driving torque there is its limit along the branch, but the joint equations are "
@@ -256,7 +273,10 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
             status, k = Status.SINGULAR_POSITION, int(np.argmax(where))
             warn.append(f"{int(where.sum())} {what} (first at index {k}, t = {t[k]:.6g} s): "
                         + why)
-    near = (rcond < NEAR_SINGULAR_RCOND) & ~singular & ~bif
+    if locked.any():
+        status = Status.SELF_LOCKING
+        warn.append(locking_note(model, didx, t, q, locked, finfo))
+    near = (rcond < NEAR_SINGULAR_RCOND) & ~singular & ~bif & ~locked
     if near.any():
         k = int(np.argmin(np.where(near, rcond, np.inf)))
         warn.append(f"{int(near.sum())} position(s) close to a singular position (smallest "
@@ -270,10 +290,16 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     C = -P * lam[:, :, None]  # row contributions to generalized forces (n, rows, n_x)
     reactions, moments, jframe, jpoints, kinds = {}, {}, {}, {}, {}
     frame_loads: dict[str, np.ndarray] = {}
+    lam_f = {j: lay.rows[j] for j in fs.names}
+    F_pair = fs.by_pair(x, xdot, -lam, lam_f) if fs else {}
     for name in (n for n in model.joint_names if n in lay.rows):
         kind, i, j, _ = reaction_frame(model, name)
         gen = C[:, lay.rows[name], :].sum(axis=1)
+        if name in F_pair:  # the friction of the pair is part of its reaction
+            gen = gen + F_pair[name][0]
         f, mP, Pt = joint_reaction(model, name, x, gen)
+        if name in F_pair and kind == "revolute":
+            mP = F_pair[name][1]  # the friction moment on the child
         reactions[name], moments[name], jpoints[name], kinds[name] = f, mP, Pt, kind
         # prismatic: along and normal to the axis; else along the parent's x and y axes
         u = rotate(X[:, i, 2], model.pri.ui[model.pri.names.index(name)]
@@ -302,17 +328,24 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     tot = sum(frame_loads.values())
     # ------------------------------------------------ power balance (self-check)
     # (p_el: power of the switchable rows, zero but for sliding friction)
-    p_in = (np.einsum("nd,nd->n", tau, qdot[:, didx]) + np.einsum("nx,nx->n", F, xdot)
-            + p_el)
+    p_out = -np.einsum("nx,nx->n", F, xdot)  # useful: against the applied loads
+    p_in = np.einsum("nd,nd->n", tau, qdot[:, didx]) - p_out + p_el
+    losses = fs.power_lost(x, xdot, -lam, lam_f) if fs else {}
+    p_in -= sum(losses.values(), np.zeros(n))
     p_kin = np.einsum("nx,nx->n", Ix, xdot)
-    p_scale = max(np.abs(p_kin).max(), np.abs(p_in).max(), np.abs(F * xdot).max(), 1e-300)
-    stats = {"power_balance_rel": float(np.max(np.abs(p_in - p_kin)) / p_scale),
+    p_scale = np.nanmax([np.nanmax(np.abs(p_kin)), np.nanmax(np.abs(p_in)),
+                         np.nanmax(np.abs(F * xdot)), 1e-300])
+    bal = np.abs(p_in - p_kin)[~locked]
+    stats = {"power_balance_rel": float(bal.max() / p_scale) if bal.size else float("nan"),
              "rcond_min": float(np.min(rcond)), "redundant_equations": n_red,
              "singular_positions": int(singular.sum()),
-             "bifurcation_positions": int(bif.sum())}
+             "bifurcation_positions": int(bif.sum()),
+             **({"self_locked_positions": int(locked.sum()),
+                 "friction_iterations": finfo["iterations"]} if fs else {})}
     return {"reactions": reactions, "moments": moments, "joint_frame": jframe,
             "joint_points": jpoints, "joint_kinds": kinds, "frame_loads": frame_loads,
             "frame_force": tot[:, :2].copy(), "frame_moment": tot[:, 2].copy(),
             "multipliers": lam, "element_forces": el_forces, "redundant_joints": tuple(red_joints),
-            "tau": tau, "status": status, "warnings": warn, "stats": stats}
+            "tau": tau, "status": status, "warnings": warn, "stats": stats,
+            **({"losses": losses, "power_out": p_out, "locked": locked} if fs else {})}
 

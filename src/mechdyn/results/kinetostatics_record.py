@@ -95,6 +95,18 @@ class Kinetostatics:
         Switched trajectory: index of each sample's mode in ``modes``.
     modes : tuple of frozenset
         Switched trajectory: the distinct modes in order of appearance.
+    losses : dict str -> ndarray, shape (n,)
+        Models with friction in their pairs (``docs/friction.md``): the power lost in
+        each pair with friction, W (>= 0); empty without friction.  With friction the
+        reactions include it: a prismatic joint's tangential component is its friction
+        force, a revolute joint's ``moments`` entry its friction moment on the child.
+    power_out : ndarray, shape (n,), or None
+        With friction: the useful output power, W: minus the power of the applied
+        forces (loads, process forces, gravity, springs, dampers, drives kept as
+        loads) on the motion, i.e. the power the mechanism delivers against them.
+    locked : ndarray of bool, shape (n,), or None
+        With friction: the self-locked positions (no finite driving torque moves the
+        mechanism in the prescribed direction; their torques and reactions are NaN).
     """
 
     over: str
@@ -132,6 +144,9 @@ class Kinetostatics:
     sample_modes: tuple | None = None
     mode_index: np.ndarray | None = None
     modes: tuple = ()
+    losses: dict = field(default_factory=dict)
+    power_out: np.ndarray | None = None
+    locked: np.ndarray | None = None
 
     def __repr__(self) -> str:
         sw = f", {len(self.modes)} modes" if self.sample_modes is not None else ""
@@ -183,6 +198,47 @@ class Kinetostatics:
         """Sum of the driving powers, W, shape (n,)."""
         return sum(self.power.values(), np.zeros(self.n))
 
+    # ------------------------------------------------------------ friction and efficiency
+    @property
+    def power_loss(self) -> np.ndarray:
+        """Power lost in all the pairs, W, shape (n,) (zeros without friction)."""
+        return sum(self.losses.values(), np.zeros(self.n))
+
+    @property
+    def efficiency(self) -> np.ndarray:
+        """Instantaneous efficiency ``power_out / P_in``, shape (n,), ``P_in`` the total
+        driving power; NaN where the drives do not deliver power (``P_in <= 0``: the
+        loads drive the motion) or without friction data (``power_out`` None)."""
+        if self.power_out is None:
+            return np.full(self.n, np.nan)
+        p_in = self.driving_total_power
+        ok = p_in > 0
+        return np.where(ok, self.power_out / np.where(ok, p_in, 1.0), np.nan)
+
+    def energies(self) -> dict:
+        """Energies over the analysed motion, J (trapezoidal rule in time): ``input``
+        (the drives), ``output`` (useful, against the applied forces), ``losses`` (all
+        pairs) and per pair ``loss_<joint>``; NaN for a static analysis, without
+        friction data, or if a position is self-locked."""
+        t = self.t
+        moving = self.n > 1 and t[-1] > t[0] and self.power_out is not None
+
+        def work(p):
+            return float(np.trapezoid(p, t)) if moving else float("nan")
+
+        out = {"input": work(self.driving_total_power),
+               "output": work(self.power_out) if moving else float("nan"),
+               "losses": work(self.power_loss)}
+        out.update({f"loss_{j}": work(p) for j, p in self.losses.items()})
+        return out
+
+    @property
+    def cycle_efficiency(self) -> float:
+        """Efficiency over the analysed motion (a cycle): output energy / input energy
+        (see :meth:`energies`)."""
+        e = self.energies()
+        return e["output"] / e["input"] if e["input"] != 0 else float("nan")
+
     # ------------------------------------------------------------ tables
     def to_dataframe(self):
         """One row per position, unit-suffixed columns.
@@ -194,7 +250,9 @@ class Kinetostatics:
         ``angle_F_<J>_deg``, for prismatic joints ``Ft_<J>_N``, ``Fn_<J>_N`` and
         ``M_<J>_Nm``, for locks ``M_<J>_Nm``; per joint to the ground
         ``Fx_frame_<J>_N``, ``Fy_frame_<J>_N``, ``M_frame_<J>_Nm``; and the
-        totals ``Fx_frame_N``, ``Fy_frame_N``, ``F_frame_N``, ``M_frame_Nm``.
+        totals ``Fx_frame_N``, ``Fy_frame_N``, ``F_frame_N``, ``M_frame_Nm``; with
+        friction ``P_loss_<J>_W`` per pair with friction, ``P_loss_W``, ``P_out_W``
+        (useful output power), ``efficiency`` (instantaneous) and ``self_locked``.
         """
         import pandas as pd
 
@@ -225,6 +283,13 @@ class Kinetostatics:
                 cols.update(force_columns(f"frame_{j}", L))
         cols.update(force_columns("frame", self.frame_force, magnitude=True))
         cols["M_frame_Nm"] = self.frame_moment
+        if self.power_out is not None:  # friction: losses and efficiency
+            for j, p in self.losses.items():
+                cols[f"P_loss_{j}_W"] = p
+            cols["P_loss_W"] = self.power_loss
+            cols["P_out_W"] = self.power_out
+            cols["efficiency"] = self.efficiency
+            cols["self_locked"] = self.locked
         return pd.DataFrame(cols)
 
     # ------------------------------------------------------------ summaries
@@ -340,9 +405,32 @@ class Kinetostatics:
             f" Fy {fr['Fy_min']:.6g}..{fr['Fy_max']:.6g} N); shaking moment about "
             f"({self.frame_point[0]:.4g}, {self.frame_point[1]:.4g}) m: "
             f"{fr['M_min']:.6g}..{fr['M_max']:.6g} N m")
+        if self.power_out is not None:
+            lines.append(self._efficiency_line())
         for w in self.warnings:
             lines.append(f"  warning: {w}")
         return "\n".join(lines)
+
+    def _efficiency_line(self) -> str:
+        """The summary line of friction: cycle efficiency, energies, the lossiest pair,
+        the instantaneous efficiency at the peak driving power and the self-locked
+        positions."""
+        e = self.energies()
+        eta = self.efficiency
+        s = (f"  friction: cycle efficiency {self.cycle_efficiency:.6g} (input "
+             f"{e['input']:.6g} J, output {e['output']:.6g} J, losses {e['losses']:.6g} J")
+        if self.losses:
+            j = max(self.losses, key=lambda k: np.nan_to_num(e[f"loss_{k}"]))
+            s += f", most in {j}: {e[f'loss_{j}']:.6g} J"
+        s += ")"
+        if np.isfinite(eta).any():  # at the peak driving power (the working stroke)
+            k = int(np.nanargmax(self.driving_total_power))
+            unit, f = ("deg", np.rad2deg(1.0)) if self.over_is_angle else ("m", 1.0)
+            s += (f"; instantaneous efficiency at the peak driving power {eta[k]:.4g} "
+                  f"({self.over} = {self.values[k] * f:.4g} {unit})")
+        if self.locked is not None and self.locked.any():
+            s += f"; {int(self.locked.sum())} self-locked position(s) (see the warnings)"
+        return s
 
     def harmonics(self, n_orders: int | None = None):
         """Harmonics of the shaking force and moment per order of the ``over`` cycle.
