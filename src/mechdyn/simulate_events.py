@@ -513,6 +513,12 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
         drives = np.einsum("nqx,nq->nx", RN.jacobian(model.coordinate_rows, x[sl]), Qd)
         frame[sl] = (frame_forces(ms, x[sl], lam, point=point)["total"] + on_ground
                      + net_on_ground(model, x[sl], drives, point))
+        if ms.friction is not None:
+            # the friction of the pairs: a pair between two bodies adds no net force or
+            # moment to them, so the net of the friction on the bodies is that of the
+            # pairs with the frame, whose opposite the frame receives
+            Ff = np.array([r[2].F_friction for r in rec[a:b]], float).reshape(b - a, n_x)
+            frame[sl] += net_on_ground(model, x[sl], Ff, point)
         for el, v in element_forces(ms, x[sl], lam).items():
             forces.setdefault(el, np.zeros((n,) + np.shape(v)[1:]))[sl] = v
         if ms.n_rows:

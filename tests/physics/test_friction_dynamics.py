@@ -56,6 +56,11 @@ def test_block_slides_at_g_sin_minus_mu_cos_above_the_friction_angle(guide_lengt
     np.testing.assert_allclose(tr.qddot[:, 0], acc, rtol=1e-10)
     np.testing.assert_allclose(tr.q[:, 0], 0.5 * acc * tr.t**2, rtol=0, atol=1e-10)
     np.testing.assert_allclose(tr.qdot[:, 0], acc * tr.t, rtol=0, atol=1e-10)
+    # the frame carries the normal force and the friction: m g - m a (ground frame)
+    m, u = 2.0, np.array([np.cos(a), np.sin(a)])
+    frame = tr.stats["variable_structure"]["frame_force"]
+    np.testing.assert_allclose(frame, np.broadcast_to(-m * acc * u - [0.0, m * G], frame.shape),
+                               rtol=0, atol=1e-10)
     assert "NumPy path" in tr.stats["backend_note"]
 
 
