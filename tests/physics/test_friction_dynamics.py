@@ -3,7 +3,7 @@ an independent integration of the one-coordinate equation written here."""
 
 import numpy as np
 import pytest
-from dynamics_models import slider_crank
+from dynamics_models import four_bar, slider_crank
 from scipy.integrate import simpson, solve_ivp
 from scipy.optimize import brentq
 
@@ -131,6 +131,20 @@ def test_breakaway_under_a_growing_pull():
 
 
 # ----------------------------------------------------------------------------- (b) pendulum
+def _pendulum_acceleration(th, w, s, m, a, Jc, mu, r):
+    """theta'' of a compound pendulum (pivot at the origin, centre of mass a along the
+    bar, theta from the horizontal) with pin friction mu r |R| against the rotation
+    direction s: J_O theta'' = -m g a cos(theta) - s mu r |R|, R = m a_c - m g the pin
+    force (a_c: radial -a theta'^2, tangential a theta''), solved for theta''."""
+    J_O = Jc + m * a * a
+    er, et = np.array([np.cos(th), np.sin(th)]), np.array([-np.sin(th), np.cos(th)])
+
+    def f(al):
+        R = m * a * (-w * w * er + al * et) - m * np.array([0.0, -G])
+        return J_O * al + m * G * a * np.cos(th) + s * mu * r * np.hypot(*R)
+    return brentq(f, -1e3, 1e3, xtol=1e-15, rtol=1e-15)
+
+
 def test_pendulum_with_pin_friction_loses_amplitude_as_its_one_coordinate_equation():
     """Compound pendulum released from rest at 90 deg from the hanging position, friction
     moment mu r |R| at its pin.  Oracle: J_O theta'' = -m g a cos(theta) - s mu r |R|,
@@ -145,15 +159,8 @@ def test_pendulum_with_pin_friction_loses_amplitude_as_its_one_coordinate_equati
     tr = mechdyn.simulate(mech, 2.0, q0=[0.0], qdot0=[0.0], rtol=1e-12, progress=False)
     assert tr.status == "success", tr.message
 
-    J_O = Jc + m * a * a
-
     def theta_dd(th, w, s):
-        er, et = np.array([np.cos(th), np.sin(th)]), np.array([-np.sin(th), np.cos(th)])
-
-        def f(al):
-            R = m * a * (-w * w * er + al * et) - m * np.array([0.0, -G])
-            return J_O * al + m * G * a * np.cos(th) + s * mu * r * np.hypot(*R)
-        return brentq(f, -1e3, 1e3, xtol=1e-15, rtol=1e-15)
+        return _pendulum_acceleration(th, w, s, m, a, Jc, mu, r)
 
     def half_swing(th0, s):
         def turn(t, y):
@@ -176,6 +183,54 @@ def test_pendulum_with_pin_friction_loses_amplitude_as_its_one_coordinate_equati
     assert lost == pytest.approx(np.pi / 2 - abs(th1 - down), abs=1e-8)
     assert lost > 0.01
     assert tr.energy_drift() < 1e-9
+
+
+@pytest.mark.parametrize("deg, holds", [(-80.0, True), (-70.0, False)])
+def test_pendulum_at_rest_sticks_where_pin_friction_holds_it(deg, holds):
+    """At rest the pin carries the weight, |R| = m g: the pin holds the pendulum where
+    m g a |cos theta| <= mu r m g, |cos theta| <= mu r / a = 0.2 (78.5 deg from the
+    horizontal); else it starts sliding as the one-coordinate equation says."""
+    m, a, Jc, mu, r = 2.0, 0.05, 0.01, 0.5, 0.02
+    th0 = np.deg2rad(deg)
+    mech = Mechanism("pendulum at rest", gravity=(0.0, -G))
+    mech.add_body("bar", mass=m, inertia=Jc, com=(a, 0.0), pose=(0.0, 0.0, th0))
+    mech.add_revolute("O", "ground", "bar", friction=mu, pin_radius=r)
+    mech.add_coordinate("theta", kind="angle", body="bar")
+    tr = mechdyn.simulate(mech, 0.2, q0=[th0], qdot0=[0.0], t_eval=[0.0, 0.1, 0.2],
+                          progress=False)
+    assert tr.status == "success", tr.message
+    assert tr.events[0].message == ("stick" if holds else "slip-")
+    if holds:
+        assert np.ptp(tr.q[:, 0]) == 0.0
+    else:
+        acc0 = _pendulum_acceleration(th0, 0.0, -1.0, m, a, Jc, mu, r)
+        assert tr.qddot[0, 0] == pytest.approx(acc0, rel=1e-10)
+
+
+def test_four_bar_with_pin_friction_reverses_every_pin_at_once():
+    """A four-bar swinging under gravity with friction in its four pins.  A single pin
+    whose relative rotation passes zero while the mechanism moves (the rocker turning
+    back while the crank goes on) slips on the other way; at the mechanism's turning
+    point (crank at rest) every pin reverses at the same instant: the pins hold one
+    freedom together and break away together.  The energy balance closes."""
+    mech = four_bar()
+    for n in ("O", "A", "B", "C"):
+        mech.joints[n] = type(mech.joints[n])(**{**mech.joints[n].__dict__, "friction": 0.2,
+                                                  "pin_radius": 0.01})
+    tr = mechdyn.simulate(mech, 0.8, q0=[np.pi / 2], qdot0=[0.0], progress=False)
+    assert tr.status == "success", tr.message
+    at: dict = {}
+    for e in tr.events:
+        if e.t > 0:
+            at.setdefault(e.t, []).append(e)
+    whole = [t for t, evs in at.items() if len(evs) == 4]
+    assert len(whole) == 1  # the turning point of the crank
+    assert abs(at[whole[0]][0].qdot_before[0]) < 1e-9
+    assert {e.element for e in at[whole[0]]} == {"O", "A", "B", "C"}
+    passing = [evs[0] for t, evs in at.items() if len(evs) == 1]
+    assert passing and all(abs(e.qdot_before[0]) > 1.0 for e in passing)
+    assert tr.energy_drift() < 1e-9
+    assert tr.energy["work_friction"][-1] > 0
 
 
 # ----------------------------------------------------------------------------- (c) energy

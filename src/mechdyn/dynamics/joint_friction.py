@@ -220,6 +220,39 @@ class JointFriction:
         """Capacity minus the friction needed to hold a sticking pair (< 0: it slips)."""
         return self.capacity(joint, x, lam) - abs(float(lam[self.stick_index[joint]]))
 
+    def group(self, x) -> dict | None:
+        """The sticking pairs that hold ONE freedom together (their stick rows redundant:
+        the pins of a one-degree-of-freedom mechanism at rest), as {joint: c_j}, c_j the
+        pair's velocity along the unit motion e that the other rows leave free; None when
+        the sticking rows are independent (or free more than one motion together)."""
+        ms, stick = self.ms, self.stick_index
+        if len(stick) < 2 or all(k in ms.independent_rows for k in stick.values()):
+            return None
+        rest = [i for i in range(ms.n_rows) if i not in stick.values()]
+        R = ms.row_jacobian(x)[rest]
+        R = R / np.maximum(np.linalg.norm(R, axis=1), 1e-300)[:, None]
+        sv, vt = np.linalg.svd(R)[1:]
+        rank = int(np.sum(sv > 1e-9 * (sv[0] if sv.size else 1.0)))
+        if vt.shape[0] - rank != 1:
+            return None
+        e = vt[rank]
+        c = {j: float(RN.jacobian(_measure(self.model, j).rows, x)[0] @ e) for j in stick}
+        big = max(abs(v) for v in c.values())
+        c = {j: v for j, v in c.items() if abs(v) > 1e-9 * big}
+        return c if len(c) > 1 else None
+
+    def group_terms(self, c: dict, x, lam) -> tuple[float, float]:
+        """(H, C) of a group (:meth:`group`): the holding force of its stick rows along
+        the free motion e, H = sum lam_j c_j (the same for every share of the redundant
+        multipliers), and its capacity C = sum mu S_j |c_j|."""
+        H = sum(float(lam[self.stick_index[j]]) * cj for j, cj in c.items())
+        return H, sum(self.capacity(j, x, lam) * abs(cj) for j, cj in c.items())
+
+    def group_margin(self, c: dict, x, lam) -> float:
+        """C - |H| of a group: < 0 where its friction cannot hold the freedom."""
+        H, C = self.group_terms(c, x, lam)
+        return C - abs(H)
+
     # ------------------------------------------------------------------ the solve
     def solve(self, lin, n_i: int, rhs, x, xdot, t=None, q=None):
         """The accelerations and multipliers with friction, by Newton on the multipliers.
@@ -292,9 +325,16 @@ def resolve_joints(system, sm, t, x, xdot, mode, targets: dict, *, before: dict,
     A pair slips in the direction of its sliding velocity when that exceeds
     ``velocity_tol``, in the direction given by ``forced_slip`` ({joint: +1/-1}: it just
     broke away), and is tried sticking otherwise (or when listed in ``forced_stick``:
-    its sliding velocity just vanished).  The trial pairs stick together if each one's
-    needed friction is within its capacity mu S; else the most overloaded one slips
-    against its holding force and the others are tried again.
+    its sliding velocity just vanished).  A pair whose velocity passes zero by the
+    kinematics alone (its stick row depends on the rows of the joints there: a slider at
+    a dead centre) slips on, in the direction its sliding acceleration takes.  The trial
+    pairs stick if each one's needed friction is within its capacity mu S; else the most
+    overloaded one slips against its holding force and the others are tried again.
+    Pairs whose stick rows hold ONE freedom together (:meth:`JointFriction.group`: the
+    pins of a mechanism at rest) stick or slip as one: they hold while the holding
+    force along the freedom, |H| = |sum lambda_j c_j| (whatever share of the redundant
+    multipliers), is within C = sum mu S_j |c_j|; they break away together, each in the
+    direction of the motion against H.
 
     Parameters
     ----------
@@ -323,9 +363,13 @@ def resolve_joints(system, sm, t, x, xdot, mode, targets: dict, *, before: dict,
     """
     model = sm.model
     states: dict = {}
+    pending = set()  # pairs that broke away from sticking: with their group, if they had one
     for j in stick_slip_joints(model):
         if j in forced_slip:
             states[j] = "slip+" if forced_slip[j] > 0 else "slip-"
+            if before.get(j) == "stick" and f"{j}:stick" in targets:
+                states[j] = "stick"
+                pending.add(j)
             continue
         v = _measure(model, j).rate(x, xdot)
         if j not in forced_stick and abs(v) > velocity_tol:
@@ -335,20 +379,36 @@ def resolve_joints(system, sm, t, x, xdot, mode, targets: dict, *, before: dict,
             capture_stick(model, j, x, targets)
         states[j] = "stick"
     L = model.length_scale
+    sliding = {j: s for j, s in states.items() if s != "stick"}
+    for j in [j for j, s in states.items() if s == "stick"]:
+        # a pair whose velocity passes zero by the kinematics alone (a slider at a dead
+        # centre: its stick row depends on the joints' rows there) slips on
+        ms = system(sm, frozenset(mode) | state_tokens({**sliding, j: "stick"}), targets, x,
+                    workspace=workspace)
+        if ms.friction.stick_index[j] not in ms.independent_rows:
+            states[j] = _passing_direction(system, sm, t, x, xdot, mode, targets, sliding, j,
+                                           before.get(j), workspace)
     while any(s == "stick" for s in states.values()):
         ms = system(sm, frozenset(mode) | state_tokens(states), targets, x,
                     workspace=workspace)
         jf = ms.friction
-        passing = [j for j, k in jf.stick_index.items() if k not in ms.independent_rows]
-        if passing:  # the velocity passes zero by the kinematics (a slider at a dead
-            # centre): holding the pair would lock the others, it slips on
-            j = passing[0]
-            states[j] = _passing_direction(system, sm, t, x, xdot, mode, targets, states, j,
-                                           before.get(j), workspace)
-            continue
         lam = ms.evaluate_x(t, x, xdot).lam
+        c = jf.group(x) or {}
+        if c:  # pairs holding one freedom together: they stick or slip as one
+            H, C = jf.group_terms(c, x, lam)
+            if pending & set(c) or C - abs(H) < -1e-9 * (C + abs(H)):
+                # the motion e goes against the holding force H
+                states.update({j: "slip+" if -cj * H > 0 else "slip-" for j, cj in c.items()})
+                pending -= set(c)
+                continue
+        if pending:  # the others broke away alone, as the event said
+            states.update({j: "slip+" if forced_slip[j] > 0 else "slip-" for j in pending})
+            pending = set()
+            continue
         worst, worst_ratio = None, 0.0
         for j, k in jf.stick_index.items():
+            if j in c:
+                continue
             tol = force_tol * (L if _measure(model, j).is_angle else 1.0)
             cap = jf.capacity(j, x, lam)
             over = abs(float(lam[k])) - cap - tol

@@ -107,16 +107,24 @@ def _joint_events(ms: ModeSystem, force_scale, L) -> list[EventFunction]:
     jf, out = ms.friction, []
     if jf is None:
         return out
+    group = jf.group(ms.x_ref) or {}
+    if group:  # pairs holding one freedom together: one event for the group
+        out.append(EventFunction("cone", min(group), lambda tt, ev, c=group:
+                                 jf.group_margin(c, ev.x, ev.lam), 1e-7 * force_scale * L,
+                                 arm=1e-10 * force_scale * L))
     for j, s in sorted(jf.states.items()):
         unit = L if ms.model.joint_kind(j) == "revolute" else 1.0  # N m or N
+        if j in group:
+            continue
         if s == "stick":
             out.append(EventFunction("cone", j, lambda tt, ev, j=j: jf.margin(j, ev.x, ev.lam),
                                      1e-7 * force_scale * unit,
                                      arm=1e-10 * force_scale * unit))
         else:
             sg = 1.0 if s == "slip+" else -1.0
+            # fires also where the pair moves against s (a direction that did not hold)
             out.append(EventFunction("slip", j, lambda tt, ev, j=j, sg=sg:
-                                     sg * jf.velocity(j, ev.x, ev.xdot), np.inf,
+                                     sg * jf.velocity(j, ev.x, ev.xdot), 1e-6 * L / unit,
                                      arm=1e-12 * L / unit))
     return out
 
