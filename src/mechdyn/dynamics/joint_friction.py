@@ -74,7 +74,23 @@ def stick_slip_joints(model) -> tuple:
 
 
 def joint_states(model, mode) -> dict:
-    """{joint: 'stick' | 'slip+' | 'slip-'} of the stick-slip pairs in a mode."""
+    """{joint: 'stick' | 'slip+' | 'slip-'} of the stick-slip pairs in a mode.
+
+    Examples
+    --------
+    >>> import mechdyn as md
+    >>> m = md.Mechanism("block")
+    >>> _ = m.add_body("block", mass=1.0, inertia=0.1)
+    >>> _ = m.add_prismatic("guide", "ground", "block", friction=0.3)
+    >>> _ = m.add_coordinate("s", kind="travel", joint="guide")
+    >>> model = m.compile()
+    >>> stick_slip_joints(model)
+    ('guide',)
+    >>> joint_states(model, {"guide:stick", "clutch"})
+    {'guide': 'stick'}
+    >>> sorted(split_mode(model, {"guide:slip+", "clutch"})[0])
+    ['clutch']
+    """
     ss = stick_slip_joints(model)
     return {k: v for k, v in Mode(mode).friction.items() if k in ss}
 
