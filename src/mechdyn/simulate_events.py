@@ -38,7 +38,7 @@ import numpy as np
 from .dynamics.contact import gaps, touching
 from .dynamics.dead_position import diagnose, status_of, turning_point
 from .dynamics.impact import frame_impulse_key
-from .dynamics.joint_friction import friction_joints, stick_slip_joints
+from .dynamics.joint_friction import SelfLockingError, friction_joints, stick_slip_joints
 from .dynamics.lagrange import kinetic_energy
 from .dynamics.mode_equations import ModeEquations
 from .dynamics.modes import ModeSystem, switched_model
@@ -215,7 +215,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     except (MechdynError, np.linalg.LinAlgError) as exc:
         if isinstance(exc, ModelError):
             raise
-        return _finish(model, rec, events, stats, wall0, *status_of(exc), sm, point)
+        return _finish(model, rec, events, stats, wall0, *_status(exc, None), sm, point)
 
     qi, qdi = ms.independent(x, xd)
     just_fired: set = set()
@@ -361,7 +361,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         except (MechdynError, np.linalg.LinAlgError, ValueError, ArithmeticError) as exc:
             if isinstance(exc, IntegratorOptionError):
                 raise
-            status, message = diagnose(exc, good)
+            status, message = _status(exc, good)
             break
         finally:
             stats["bifurcations"] += eqs.report()
@@ -369,6 +369,14 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         "numpy" if backends <= {"numpy"} else "numba+numpy")
     bar.close()
     return _finish(model, rec, events, stats, wall0, status, message, sm, point)
+
+
+def _status(exc, good):
+    """(status, message) of the error that ended a run (:func:`diagnose`), with friction
+    locking the pairs as ``"self-locking"``."""
+    if isinstance(exc, SelfLockingError):
+        return Status.SELF_LOCKING, str(exc)
+    return status_of(exc) if good is None else diagnose(exc, good)
 
 
 #: steps below this fraction of the run, where sigma_min/sigma_max of the position

@@ -84,6 +84,24 @@ def test_gib_edge_loads_of_an_offset_block():
     np.testing.assert_allclose(_reaction(tr, "guide")[:, 1:], [[m * G, M]] * 3, rtol=1e-10)
 
 
+@pytest.mark.parametrize("h", [0.2, 0.3])
+def test_tall_block_braking_on_short_gibs_jams(h):
+    """A block sliding forward on a level guide with no force but gravity, its centre of
+    mass h above the joint point, gibs of length L: braking at acc = -mu g needs the
+    reaction moment M = h m mu g, and the edge loads stay those of N = m g only while
+    2 |M| / L <= N, i.e. 2 mu h / L <= 1.  Beyond, sliding friction admits no motion (a
+    Painleve-type jam): the run stops at once with status self-locking."""
+    m, L, mu = 2.0, 0.1, 0.2
+    tr = mechdyn.simulate(_block(0.0, mu, m, guide_length=L, com=(0.0, h)), 0.2, q0=[0.0],
+                          qdot0=[1.0], t_eval=[0.0, 0.1, 0.2], progress=False)
+    if 2 * mu * h / L <= 1:
+        assert tr.status == "success", tr.message
+        np.testing.assert_allclose(tr.qddot[:, 0], -mu * G, rtol=1e-12)
+    else:
+        assert tr.status == "self-locking"
+        assert "'guide'" in tr.message and "t = 0 s" in tr.message
+
+
 def test_friction_oscillator_reverses_then_sticks():
     """Mass on a spring on a rough level guide, released at x0: each half swing is
     harmonic about +-d (d = mu m g / k) and loses 2 d of amplitude; it sticks at the

@@ -40,14 +40,20 @@ from functools import cached_property
 
 import numpy as np
 
-from ..errors import IntegrationError, LockupError
+from ..errors import LockupError
 from ..kernels import rows_numpy as RN
 from ..model.state import Mode
 from ..model.variable import parse_variable
 
-__all__ = ["friction_joints", "stick_slip_joints", "joint_states", "split_mode",
+__all__ = ["SelfLockingError", "friction_joints", "stick_slip_joints", "joint_states", "split_mode",
            "stick_row", "capture_stick", "JointFriction", "STATES", "MAX_ITER",
            "state_tokens", "resolve_joints"]
+
+class SelfLockingError(LockupError):
+    """Friction in the pairs admits no motion consistent with the law (self-locking, or a
+    Painleve-type inconsistency of sliding friction): the friction solve has a singular
+    Newton matrix or does not converge.  A run stops with status ``"self-locking"``."""
+
 
 #: the friction states of a stick-slip pair
 STATES = ("stick", "slip+", "slip-")
@@ -293,10 +299,9 @@ class JointFriction:
 
         Raises
         ------
-        LockupError
-            The Newton matrix is singular: friction locks the mechanism.
-        IntegrationError
-            The iteration does not converge.
+        SelfLockingError
+            The Newton matrix is singular (friction locks the mechanism) or the
+            iteration does not converge (no motion is consistent with the law).
         """
         sol = lin(rhs)
         if not self.sliding:
@@ -315,11 +320,11 @@ class JointFriction:
             try:
                 step = np.linalg.solve(Jn, r)
             except np.linalg.LinAlgError:
-                raise LockupError(self._where("the friction of " + ", ".join(
+                raise SelfLockingError(self._where("the friction of " + ", ".join(
                     repr(j) for j in self.sliding) + " locks the mechanism (self-locking: "
                     "the Newton matrix of the friction solve is singular)"), t=t, q=q) from None
             lam, prev = lam - step, rn
-        raise IntegrationError(self._where(
+        raise SelfLockingError(self._where(
             f"the friction solve did not converge in {MAX_ITER} Newton iterations "
             f"(residual {rn:.3g} of {scale:.3g}); the friction of "
             + ", ".join(repr(j) for j in self.sliding) + " may lock the mechanism"), t=t, q=q)
