@@ -16,6 +16,11 @@ everything computed so far.
 The work of the non-conservative forces is integrated with the motion, as an
 extra state w' = P_nc, so that the energy balance T + U - W_nc = const holds
 to the integrator's tolerance.
+
+Friction in the pairs (docs/friction.md) enters the equations of every mode with its
+dependence on the reactions (Newton on the multipliers at every evaluation,
+:mod:`mechdyn.dynamics.joint_friction`); true Coulomb pairs stick and slip as modes of
+the run, and the friction work is a second quadrature state (``energy["work_friction"]``).
 """
 
 from __future__ import annotations
@@ -137,7 +142,8 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
         ``t``, ``q``, ``qdot``, ``qddot`` (all declared coordinates), ``x``,
         ``xdot``; ``events`` (an :class:`~mechdyn.integrate.events.EventRecord` per
         switching instant and per caller's event); ``energy`` (kinetic, potential,
-        work_nc, balance = T + U - W_nc + impact losses, residual);
+        work_nc, balance = T + U - W_nc + impact losses, residual; with friction in the
+        pairs also work_friction, the energy they dissipated, J, included in work_nc);
         ``stats["variable_structure"]``
         (:class:`~mechdyn.results.trajectory.SwitchedSamples`: the mode of each
         sample, the force on the frame, the force of every joint, lock, stop and

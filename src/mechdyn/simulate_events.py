@@ -38,6 +38,7 @@ import numpy as np
 from .dynamics.contact import gaps, touching
 from .dynamics.dead_position import diagnose, status_of, turning_point
 from .dynamics.impact import frame_impulse_key
+from .dynamics.joint_friction import SelfLockingError, friction_joints, stick_slip_joints
 from .dynamics.lagrange import kinetic_energy
 from .dynamics.mode_equations import ModeEquations
 from .dynamics.modes import ModeSystem, switched_model
@@ -148,7 +149,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     user_events = as_events(events)
 
     # ---------------------------------------------------------------- records
-    # per sample: t, the mode system, the evaluation, w_nc and the impact losses so far;
+    # per sample: t, the mode system, the evaluation, the work (w_nc and, with friction in
+    # the joints, the friction work w_f) and the impact losses so far;
     # forces and energies are computed at the end (with a sink: chunk by chunk), batched
     # over each mode's samples
     rec = Samples(model, sm, point, sink=sink, chunk=chunk, keep=keep)
@@ -173,7 +175,9 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     welds = sorted(locks & set(sm.welds))
     q_init, qd_init, x_guess = initial_state(model, q0, qdot0, mode=welds)
     t = t0
-    w_nc = 0.0
+    # the integrated work: W_nc (every non-conservative force, friction included) and,
+    # with friction in the joints, the work W_f lost to it (>= 0)
+    w = np.zeros(2 if friction_joints(model) else 1)
     ws = Workspace()  # the run's caches, shared by the mode systems of the run
     try:
         x = x_guess
@@ -203,14 +207,15 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             st, meas = sm.stops[n]
             raise ModelError(f"stop {n!r}: the initial state violates its limits ({meas.label} "
                              f"= {meas.value(x):.9g}, lower {st.lower}, upper {st.upper})")
-        if sm.has_switching:  # the mode the state is in: touching stops and contacts
+        if sm.has_switching or stick_slip_joints(model):
+            # the mode the state is in: touching stops and contacts, sticking pairs
             ms, x, xd, _ = apply_switch(sm, t, ms, x, xd, targets, events, fired=[],
                                         small_velocity=small_velocity, gap_tol=gap_tol,
                                         force_scale=force_scale, initial=True)
     except (MechdynError, np.linalg.LinAlgError) as exc:
         if isinstance(exc, ModelError):
             raise
-        return _finish(model, rec, events, stats, wall0, *status_of(exc), sm, point)
+        return _finish(model, rec, events, stats, wall0, *_status(exc, None), sm, point)
 
     qi, qdi = ms.independent(x, xd)
     just_fired: set = set()
@@ -244,7 +249,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             cache[key] = ev
             return ev
 
-        y0 = np.concatenate([qi, qdi, [w_nc]])
+        y0 = np.concatenate([qi, qdi, w])
         efns = event_functions(sm, ms, t, fired_once, force_scale, gap_tol, L)
         efns += user_event_functions(user_events)
         try:
@@ -253,7 +258,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             # one of t_eval); each segment after an event starts with one
             if (every_step or stats["segments"] > 1 or t >= t_end) and (
                     rec.last is None or rec.last[0] != t or rec.last[1].mode != ms.mode):
-                store(t, ms, ev0, w_nc)
+                store(t, ms, ev0, w)
             good = (t, ev0, ms)
             if t >= t_end:
                 break
@@ -277,14 +282,16 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             def sample(ts, y, step, ev, ms=ms, evaluate=evaluate):
                 if rec.last is not None and rec.last[0] >= ts:
                     return
-                store(ts, ms, ev if ev is not None else evaluate(ts, y), float(y[-1]))
+                store(ts, ms, ev if ev is not None else evaluate(ts, y), y[2 * ms.n_i:].copy())
 
+            integ = segment_integrator(scale[ms.coords], first)
+            if w.size > 1 and np.ndim(getattr(integ, "atol", None)):
+                integ.atol = np.append(integ.atol, integ.atol[-1])  # W_f: as W_nc
             hit, next_out = run_segment(
-                segment_integrator(scale[ms.coords], first), eqs, t, y0, t_end, efns,
-                evaluate=evaluate,
+                integ, eqs, t, y0, t_end, efns, evaluate=evaluate,
                 after_step=after_step, sample=sample, t_eval=t_eval, next_out=next_out,
                 every_step=every_step, stats=stats, bar=bar,
-                deadline=None if max_wall_time is None else wall0 + max_wall_time)
+                deadline=None if max_wall_time is None else wall0 + max_wall_time, n=ms.n_i)
             if hit is None:
                 t = t_end
                 break
@@ -292,9 +299,9 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             t_hit, fired, dense = hit
             y_hit = dense(t_hit)
             ev_hit = evaluate(t_hit, y_hit)
-            w_nc = float(y_hit[-1])
+            w = y_hit[2 * ms.n_i:].copy()
             if rec.last is None or rec.last[0] != t_hit:
-                store(t_hit, ms, ev_hit, w_nc)
+                store(t_hit, ms, ev_hit, w)
             user = [e for e in fired if e.kind == "user"]
             fired = [e for e in fired if e.kind != "user"]
             events.extend(user_event_records(user, t_hit, np.concatenate([ev_hit.q, ev_hit.qdot]),
@@ -341,7 +348,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             t = t_hit
             qi, qdi = ms.independent(x, xd)
             ev_after = ms.evaluate_x(t, x, xd)
-            store(t, ms, ev_after, w_nc)
+            store(t, ms, ev_after, w)
         except Stop as exc:
             status, message = exc.status, exc.message
             break
@@ -354,7 +361,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         except (MechdynError, np.linalg.LinAlgError, ValueError, ArithmeticError) as exc:
             if isinstance(exc, IntegratorOptionError):
                 raise
-            status, message = diagnose(exc, good)
+            status, message = _status(exc, good)
             break
         finally:
             stats["bifurcations"] += eqs.report()
@@ -362,6 +369,14 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         "numpy" if backends <= {"numpy"} else "numba+numpy")
     bar.close()
     return _finish(model, rec, events, stats, wall0, status, message, sm, point)
+
+
+def _status(exc, good):
+    """(status, message) of the error that ended a run (:func:`diagnose`), with friction
+    locking the pairs as ``"self-locking"``."""
+    if isinstance(exc, SelfLockingError):
+        return Status.SELF_LOCKING, str(exc)
+    return status_of(exc) if good is None else diagnose(exc, good)
 
 
 #: steps below this fraction of the run, where sigma_min/sigma_max of the position
@@ -411,7 +426,7 @@ def element_shapes(model, sm) -> dict:
 class Samples:
     """The samples of a run as they are recorded, and their hand-over in chunks.
 
-    Each sample is ``(t, mode system, evaluation, w_nc, impact losses so far)``.  Without
+    Each sample is ``(t, mode system, evaluation, (w_nc[, w_f]), impact losses so far)``.  Without
     a ``sink`` they are all kept and evaluated at the end (:func:`_finish`).  With a
     ``sink``, every ``chunk`` samples are evaluated (forces, frame loads and energies,
     batched over each mode's samples: the numbers of the end-of-run table) into a partial
@@ -487,7 +502,8 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
     (element -> trailing shape) makes a force entry of every element listed."""
     n_q, n_x, n = model.n_q, model.n_x, len(rec)
     t = np.array([r[0] for r in rec], float)
-    W = np.array([r[3] for r in rec], float)
+    W = np.array([r[3][0] for r in rec], float)
+    W_f = np.array([r[3][1] if len(r[3]) > 1 else 0.0 for r in rec], float)
     lost = np.array([r[4] for r in rec], float)
     x, xd, q, qd, qdd = (np.array([getattr(r[2], k) for r in rec], float).reshape(n, w)
                          for k, w in (("x", n_x), ("xdot", n_x), ("q", n_q), ("qdot", n_q),
@@ -505,6 +521,12 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
         drives = np.einsum("nqx,nq->nx", RN.jacobian(model.coordinate_rows, x[sl]), Qd)
         frame[sl] = (frame_forces(ms, x[sl], lam, point=point)["total"] + on_ground
                      + net_on_ground(model, x[sl], drives, point))
+        if ms.friction is not None:
+            # the friction of the pairs: a pair between two bodies adds no net force or
+            # moment to them, so the net of the friction on the bodies is that of the
+            # pairs with the frame, whose opposite the frame receives
+            Ff = np.array([r[2].F_friction for r in rec[a:b]], float).reshape(b - a, n_x)
+            frame[sl] += net_on_ground(model, x[sl], Ff, point)
         for el, v in element_forces(ms, x[sl], lam).items():
             forces.setdefault(el, np.zeros((n,) + np.shape(v)[1:]))[sl] = v
         if ms.n_rows:
@@ -520,7 +542,8 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
     return dict(t=t, q=q, qdot=qd, qddot=qdd, x=x, xdot=xd, frame=frame, forces=forces,
                 mode=[r[1].mode for r in rec],
                 mode_index=np.array([modes.index(r[1].mode) for r in rec], int),
-                kinetic=T, potential=U, work_nc=W, balance=T + U - W + lost, residual=res,
+                kinetic=T, potential=U, work_nc=W, work_friction=W_f,
+                balance=T + U - W + lost, residual=res,
                 impact_losses=lost, penetration=max([0.0, *pen]))
 
 
@@ -547,6 +570,8 @@ def _trajectory(model, block, modes, events, stats, status, message) -> Trajecto
         frame_force=b["frame"][:, :2], frame_moment=b["frame"][:, 2], forces=b["forces"],
         impact_losses=b["impact_losses"], penetration=b["penetration"])
     energy = {k: b[k] for k in ("kinetic", "potential", "work_nc", "balance", "residual")}
+    if friction_joints(model):
+        energy["work_friction"] = b["work_friction"]
     return Trajectory(b["t"], b["q"], b["qdot"], b["qddot"], b["x"], b["xdot"],
                       status=status, message=message, events=list(events), stats=stats,
                       energy=energy, coordinate_names=model.coordinate_names,

@@ -9,7 +9,10 @@ run in one mode.  The right-hand side runs on the compiled kernel
 (:mod:`mechdyn.dynamics.compiled`) whenever the mode allows (numba installed,
 every load compiled, no sliding friction); otherwise, and to diagnose a failure,
 on the NumPy evaluation of the mode (:meth:`ModeSystem.evaluate`), which also
-gives every multiplier.
+gives every multiplier.  Friction in the joints (:mod:`mechdyn.dynamics.joint_friction`)
+runs on the NumPy path: its force depends on the multipliers, and each evaluation
+solves the coupled system by Newton's method on them (the compiled kernel, whose
+signature frictionless runs keep, has no friction).
 
 Two formulations evaluate the same physics: ``"exact"`` (the exact velocity
 analogs, every mode) and ``"analogs"``, the source paper's finite-difference
@@ -46,6 +49,7 @@ from ..kinematics.constraints import extend
 from .compiled import compile_mode_kernel
 from .dead_position import _dependent, _where
 from .forces import com_arms
+from .joint_friction import friction_joints
 from .mode_system import solve_mass
 from .modes import ModeEval
 
@@ -109,6 +113,9 @@ class ModeEquations:
         self.watching, self._s_last = True, None
         self.d = default_displacement(model)
         if formulation == "analogs":
+            if ms.friction is not None:
+                raise ModelError(f"joint {friction_joints(model)[0]!r} has friction; formulation "
+                                 "'analogs' does not model friction yet (use 'exact')")
             if ms.rows or ms.n_i != model.n_q:
                 raise ModelError("formulation 'analogs' needs a mode in which every declared "
                                  "coordinate is independent (no engaged lock, closed stop or "
@@ -125,6 +132,10 @@ class ModeEquations:
         elif backend != "numpy":
             if any(r.slip for r in ms.rows):
                 self.note = "sliding friction is evaluated on the NumPy path"
+            elif ms.friction is not None:
+                self.note = ("the friction of joint(s) " + ", ".join(
+                    repr(j) for j in friction_joints(model)) + " is evaluated on the NumPy "
+                    "path (Newton on the multipliers per evaluation)")
             else:
                 self.kernel, self.note = compile_mode_kernel(
                     model, sm.fm, ms.rowset.take(ms.independent_rows), ms.coords)
@@ -134,6 +145,7 @@ class ModeEquations:
             self.kernel.reset(ms.x_ref)
         loops = len(model.rev.names) + len(model.pri.names) > model.n_bodies  # not a tree
         if (formulation == "exact" and loops and not ms.rows and model.n_q == ms.n_i == 1
+                and ms.friction is None
                 and len(ms.independent_rows) == ms.n_rows == model.n_x - 1):
             lay = model.layout(sorted(ms.mode.locks))
             self.book = ChartBook(PathProblem(model, lay, [0], [0.0], 0))
@@ -178,19 +190,28 @@ class ModeEquations:
         return p + float(sum(-r.mu * r.slip * ev.lam[ms.n_base + k] * r.tangent.rate(ev.x, ev.xdot)
                              for k, r in enumerate(ms.rows) if r.slip))
 
+    def _powers(self, ev) -> np.ndarray:
+        """[P_nc] or, with friction in the joints, [P_nc, P_f]: P_f = -F_f . xdot >= 0
+        the power the joints' friction dissipates (its work is recorded on its own)."""
+        if ev.F_friction is None:
+            return np.array([self._power(ev)])
+        return np.array([self._power(ev), -float(ev.F_friction @ ev.xdot)])
+
     def numpy_rhs(self, t: float, qi, qdi):
-        """(q_I'', array([P_nc])) on the NumPy path; raises the diagnosed error of a
-        failure (assembly, lock-up)."""
+        """(q_I'', array([P_nc]) or array([P_nc, P_f]) with friction in the joints) on
+        the NumPy path; raises the diagnosed error of a failure (assembly, lock-up)."""
         if self.formulation == "analogs":
             tm = self.analogs_terms(t, qi, qdi)
             return tm["qddot"], np.array([tm["power_nc"]])
         ev = self._numpy_evaluate(t, qi, qdi)
-        return ev.qddot[self.ms.coords], np.array([self._power(ev)])
+        return ev.qddot[self.ms.coords], self._powers(ev)
 
     def rhs(self, t: float, qi, qdi):
-        """(q_I'' (n_i,), array([P_nc])) at (t, q_I, q_I')."""
+        """(q_I'' (n_i,), array([P_nc]) or, with friction in the joints,
+        array([P_nc, P_f])) at (t, q_I, q_I')."""
         n = self.ms.n_i
-        out = self._first_order(t, np.concatenate([qi, qdi, [0.0]]))
+        w0 = [0.0, 0.0] if self.ms.friction is not None else [0.0]
+        out = self._first_order(t, np.concatenate([qi, qdi, w0]))
         return out[n:2 * n], out[2 * n:]
 
     def first_order_function(self):

@@ -42,6 +42,7 @@ from ..model import ConstraintLayout
 from ..model.state import Mode
 from ..model.workspace import Workspace
 from .inertia import mass_matrix_x
+from .joint_friction import JointFriction, friction_joints, split_mode, stick_row
 from .reactions import touches_ground
 
 if TYPE_CHECKING:
@@ -73,6 +74,9 @@ class ModeEval:
     F_conservative : ndarray, shape (n_x,) or None
         Forces of gravity and spring stiffness alone at the pose, when they
         came out of the same evaluation of the loads (None otherwise).
+    F_friction : ndarray, shape (n_x,) or None
+        The friction of the sliding joints on the poses (included in ``F``), or None
+        for a model without friction in its joints.
     """
 
     x: np.ndarray
@@ -84,6 +88,7 @@ class ModeEval:
     lam: np.ndarray
     F: np.ndarray = field(repr=False, default=None)
     F_conservative: np.ndarray | None = field(repr=False, default=None)
+    F_friction: np.ndarray | None = field(repr=False, default=None)
 
 
 class ModeSystem:
@@ -132,7 +137,9 @@ class ModeSystem:
         self.model = model
         self.mode = Mode(mode)
         self.targets = dict(targets)
-        self.rows = sm.rows(self.mode, targets)
+        base, jstates = split_mode(model, self.mode)
+        self.rows = sm.rows(base, targets) + [stick_row(model, j, targets)
+                                              for j, s in sorted(jstates.items()) if s == "stick"]
         self.layout = lay = ConstraintLayout(model, self.mode, self.rows)
         self.rowset, self.n_rows, self.n_base = lay.rowset, lay.n_rows, lay.n_base
         #: the rows of each element (joint, lock, stop, contact), indices into rowset
@@ -154,6 +161,8 @@ class ModeSystem:
         self._rs = 1.0 / _scale(model)
         self.ws = Workspace() if workspace is None else workspace
         self.ws.reset(self.x_ref)
+        #: the friction of the joints in this mode (None for a model without it)
+        self.friction = JointFriction(self) if friction_joints(model) else None
 
     def _choose_coordinates(self, Ri, prefer, avoid) -> np.ndarray:
         """Pivots of G N (G the scaled coordinate Jacobian, N the null space of the
@@ -319,6 +328,7 @@ class ModeSystem:
         F = F + G.T @ Qd
         M, h = self.sm.with_drive_inertia(*mass_matrix_x(self.model, x, xdot), G, quad_g)
         rhs = F - h - M @ b_
+        Ff = None if self.friction is None else np.zeros_like(F)
         if b is not None:
             qddi = np.linalg.solve(B.T @ M @ B, B.T @ rhs)
             lam = np.linalg.lstsq(R.T, M @ (B @ qddi) - rhs, rcond=None)[0]
@@ -327,24 +337,42 @@ class ModeSystem:
             if self._slip is not None:
                 Reff = R.copy()
                 Reff[self.layout.slip_rows] += RN.jacobian(self._slip, x)
-            qddi, lam = self._solve_motion(M, B, Reff, rhs, self._rs)
+            if self.friction is not None and self.friction.sliding:
+                sol, Ff = self.friction.solve(self._linear_solve(M, B, Reff, self._rs),
+                                              self.n_i, rhs, x, xdot, t=t, q=q)
+                qddi, lam = sol[:self.n_i], sol[self.n_i:]
+                F = F + Ff
+            else:
+                qddi, lam = self._solve_motion(M, B, Reff, rhs, self._rs)
         xddot = B @ qddi + b_
         qddot = G @ xddot + quad_g
-        return ModeEval(x, xdot, xddot, q, qdot, qddot, lam, F, Fc)
+        return ModeEval(x, xdot, xddot, q, qdot, qddot, lam, F, Fc, Ff)
 
     def _solve_motion(self, M, B, Reff, rhs, rs):
         """Solve [M B, -Reff^T] [qddot_i; lam] = rhs (rows scaled by ``rs``) for the
         independent accelerations and the multipliers; redundant sets by least squares."""
+        sol = self._linear_solve(M, B, Reff, rs)(rhs)
+        return sol[:self.n_i], sol[self.n_i:]
+
+    def _linear_solve(self, M, B, Reff, rs):
+        """``lin(rhs) -> [qddot_i; lam]`` of [M B, -Reff^T] (rows scaled by ``rs``),
+        rhs (n_x,) or (n_x, k); redundant sets by least squares."""
         Ks = np.concatenate([M @ B, -Reff.T], axis=1) * rs[:, None]
-        try:
-            sol = np.linalg.solve(Ks, rhs * rs) if Ks.shape[0] == Ks.shape[1] else None
-        except np.linalg.LinAlgError:
-            sol = None
-        if sol is None:
+
+        square = Ks.shape[0] == Ks.shape[1]
+
+        def lin(rhs):
+            r = rhs * (rs if rhs.ndim == 1 else rs[:, None])
+            if square:
+                try:
+                    return np.linalg.solve(Ks, r)
+                except np.linalg.LinAlgError:
+                    pass
             if self.n_i:  # a coordinate without inertia is named, not solved around
                 solve_mass(self.coord_names, B.T @ M @ B, np.zeros(self.n_i), None, None)
-            sol = self._redundant_solve(Ks, rhs * rs)
-        return sol[:self.n_i], sol[self.n_i:]
+            return self._redundant_solve(Ks, r)
+
+        return lin
 
     def _redundant_solve(self, Ks, rhs):
         """Least-squares solution of a rank-deficient [M B, -Phi^T] system whose

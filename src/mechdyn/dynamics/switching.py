@@ -21,6 +21,7 @@ from ..integrate.events import EventRecord
 from ..integrate.segment import EventFunction
 from .contact import gap_measures, resolve_mode, touching
 from .impact import impact
+from .joint_friction import joint_states, resolve_joints, state_tokens, stick_slip_joints
 from .modes import (
     ModeSystem,
     SwitchedModel,
@@ -82,7 +83,10 @@ def event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_scal
         if r.unilateral:
             out.append(EventFunction("force", r.label, lambda tt, ev, i=ms.n_base + k: ev.lam[i],
                                      1e-7 * force_scale, arm=1e-10 * force_scale))
+    out += _joint_events(ms, force_scale, L)
     for c, s in mode_friction(ms.mode).items():
+        if c not in sm.contacts:  # a joint's friction state: _joint_events
+            continue
         ct, _, slip = sm.contacts[c]
         if s == "stick":
             kn, kt = _row(ms, c, "contact"), _row(ms, c, "stick")
@@ -93,6 +97,35 @@ def event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_scal
             sg = 1.0 if s == "slip+" else -1.0
             out.append(EventFunction("slip", c, lambda tt, ev, m=slip, sg=sg:
                                      sg * m.rate(ev.x, ev.xdot), np.inf, arm=1e-12 * L))
+    return out
+
+
+def _joint_events(ms: ModeSystem, force_scale, L) -> list[EventFunction]:
+    """The events of the stick-slip pairs (:mod:`mechdyn.dynamics.joint_friction`): the
+    friction needed to hold a sticking pair reaching its capacity mu S (``"cone"``), the
+    sliding velocity of a slipping one falling to zero (``"slip"``)."""
+    jf, out = ms.friction, []
+    if jf is None:
+        return out
+    group = jf.group(ms.x_ref) or {}
+    if group:  # pairs holding one freedom together: one event for the group
+        out.append(EventFunction("cone", min(group), lambda tt, ev, c=group:
+                                 jf.group_margin(c, ev.x, ev.lam), 1e-7 * force_scale * L,
+                                 arm=1e-10 * force_scale * L))
+    for j, s in sorted(jf.states.items()):
+        unit = L if ms.model.joint_kind(j) == "revolute" else 1.0  # N m or N
+        if j in group:
+            continue
+        if s == "stick":
+            out.append(EventFunction("cone", j, lambda tt, ev, j=j: jf.margin(j, ev.x, ev.lam),
+                                     1e-7 * force_scale * unit,
+                                     arm=1e-10 * force_scale * unit))
+        else:
+            sg = 1.0 if s == "slip+" else -1.0
+            # fires also where the pair moves against s (a direction that did not hold)
+            out.append(EventFunction("slip", j, lambda tt, ev, j=j, sg=sg:
+                                     sg * jf.velocity(j, ev.x, ev.xdot), 1e-6 * L / unit,
+                                     arm=1e-12 * L / unit))
     return out
 
 
@@ -162,11 +195,20 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
     vmax = float(np.max(np.abs(xd_plus), initial=0.0))
     cand = [tok for tok, v in _rates(sm, touch, targets, x, xd_plus)
             if v <= max(small_velocity * 1e-3, 1e-9 * vmax)]
+    ss = stick_slip_joints(sm.model)
+    vtol = 1e-9 * max(vmax, small_velocity) + 1e-12
     mode_after, _ = resolve_mode(
         sm, t, x, xd_plus, locks, targets, cand,
-        slip_velocity_tol=1e-9 * max(vmax, small_velocity) + 1e-12,
-        force_tol=1e-10 * force_scale, forced_open=forced_open, forced_slip=forced_slip,
-        forced_stick=forced_stick)
+        slip_velocity_tol=vtol, force_tol=1e-10 * force_scale, forced_open=forced_open,
+        forced_slip={k: v for k, v in forced_slip.items() if k not in ss},
+        forced_stick=forced_stick - set(ss))
+    if ss:  # the friction state of the stick-slip pairs
+        mode_after = frozenset(mode_after) | state_tokens(resolve_joints(
+            ModeSystem, sm, t, x, xd_plus, mode_after, targets,
+            before=joint_states(sm.model, mode_before),
+            forced_slip={k: v for k, v in forced_slip.items() if k in ss},
+            forced_stick=forced_stick & set(ss), velocity_tol=vtol,
+            force_tol=1e-10 * force_scale, workspace=ms.ws))
     ms_new = ModeSystem(sm, mode_after, targets, x, prefer=ms.coord_names, avoid=frees,
                         workspace=ms.ws)
     # an engaging lock must hold the pose it engages at (no position jump)
@@ -216,6 +258,10 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
     for c in sorted(set(fb) | set(fa)):
         if fb.get(c) != fa.get(c) and c in fa and f"{c}@contact" in closed_before:
             add("stick" if fa[c] == "stick" else "slip", c, fa[c])
+    jb, ja = joint_states(sm.model, mode_before), joint_states(sm.model, mode_after)
+    for j in sorted(ja):
+        if jb.get(j) != ja[j]:
+            add("stick" if ja[j] == "stick" else "slip", j, ja[j])
     for kind, name, msg in notes:
         add(kind, name, msg)
     if len(events) == 0 or events[-1].t != t:

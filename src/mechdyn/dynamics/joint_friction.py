@@ -1,0 +1,463 @@
+"""Friction of the joints in forward dynamics: the coupled solve and the stick-slip states.
+
+The friction of a revolute or prismatic pair (the law: :mod:`mechdyn.dynamics.friction`)
+depends on the pair's reaction, so on the multipliers lambda, which depend on the
+accelerations.  In a mode the equations of motion with friction
+
+    [M B, -Phi_x^T] [qddot_I; lambda] = F - h - M b + F_f(x, xdot, lambda)
+
+are solved per evaluation of the right-hand side by Newton's method on the
+multipliers, started from the frictionless solution, with the exact derivative
+dF_f/dlambda of the law: r(lambda) = lambda - P K^-1 (rhs + F_f(lambda)) (P picks the
+multipliers out of the solution), r' = I - P K^-1 dF_f/dlambda, one factorization of
+K for every iterate.  A few iterations reach machine precision (the law is linear in
+lambda except through |R|); a Newton matrix that is singular or iterates that do not
+converge mean that friction locks the mechanism (self-locking): the run stops with
+the time and the position.
+
+True Coulomb friction (``smoothing = 0``) of a pair is a matter of modes.  Each such
+pair carries a state token in the mode, ``"B:stick"``, ``"B:slip+"`` or
+``"B:slip-"`` (the tokens of a contact's friction, :class:`~mechdyn.model.state.Mode`):
+
+* sticking, the pair's travel (prismatic) or relative angle (revolute) is held at the
+  value it had when it stuck, by one more row (a ``"stick"`` row, as a coordinate
+  lock); its multiplier is the friction force (N) or moment (N m) needed to hold;
+* slipping in direction s = +1 / -1, the law applies with sgn(v) = s for the whole
+  segment (so that the right-hand side stays smooth up to the event).
+
+Events (:func:`mechdyn.dynamics.switching.event_functions`): slip -> stick when
+s v falls to zero, and the pair sticks there if the friction needed to hold is at
+most mu S (else it slips the other way); stick -> slip when the needed friction
+|lambda_stick| exceeds the capacity mu S (mu r |R| for a pin), in the direction the
+holding force resisted.  With ``smoothing > 0`` the pair has no state: the law's
+tanh regularisation applies everywhere.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from ..errors import LockupError
+from ..kernels import rows_numpy as RN
+from ..model.state import Mode
+from ..model.variable import parse_variable
+
+__all__ = ["SelfLockingError", "friction_joints", "stick_slip_joints", "joint_states", "split_mode",
+           "stick_row", "capture_stick", "JointFriction", "STATES", "MAX_ITER",
+           "state_tokens", "resolve_joints"]
+
+class SelfLockingError(LockupError):
+    """Friction in the pairs admits no motion consistent with the law (self-locking, or a
+    Painleve-type inconsistency of sliding friction): the friction solve has a singular
+    Newton matrix or does not converge.  A run stops with status ``"self-locking"``."""
+
+
+#: the friction states of a stick-slip pair
+STATES = ("stick", "slip+", "slip-")
+#: Newton iterations on the multipliers before the solve is declared failed
+MAX_ITER = 30
+
+
+def friction_joints(model) -> tuple:
+    """The revolute and prismatic joints of a model with friction (Coulomb or viscous),
+    memoized (:func:`mechdyn.dynamics.friction.friction_joints`)."""
+    memo = model.memo.get("friction_joints")
+    if memo is None:
+        from .friction import friction_joints as joints
+        memo = model.memo["friction_joints"] = joints(model)
+    return memo
+
+
+def stick_slip_joints(model) -> tuple:
+    """The joints with true Coulomb friction (``friction > 0``, ``smoothing = 0``): the
+    pairs that stick and slip as modes."""
+    joints = model.mechanism.joints
+    return tuple(n for n in friction_joints(model)
+                 if joints[n].friction > 0 and joints[n].smoothing == 0)
+
+
+def joint_states(model, mode) -> dict:
+    """{joint: 'stick' | 'slip+' | 'slip-'} of the stick-slip pairs in a mode.
+
+    Examples
+    --------
+    >>> import mechdyn as md
+    >>> m = md.Mechanism("block")
+    >>> _ = m.add_body("block", mass=1.0, inertia=0.1)
+    >>> _ = m.add_prismatic("guide", "ground", "block", friction=0.3)
+    >>> _ = m.add_coordinate("s", kind="travel", joint="guide")
+    >>> model = m.compile()
+    >>> stick_slip_joints(model)
+    ('guide',)
+    >>> joint_states(model, {"guide:stick", "clutch"})
+    {'guide': 'stick'}
+    >>> sorted(split_mode(model, {"guide:slip+", "clutch"})[0])
+    ['clutch']
+    """
+    ss = stick_slip_joints(model)
+    return {k: v for k, v in Mode(mode).friction.items() if k in ss}
+
+
+def split_mode(model, mode) -> tuple[Mode, dict]:
+    """(the mode without the joints' friction tokens, :func:`joint_states`)."""
+    st = joint_states(model, mode)
+    return Mode(t for t in mode if t.split(":")[0] not in st or ":" not in t), st
+
+
+def _measure(model, joint: str):
+    """The pair's travel (m) or relative angle (rad), a Measure (memoized)."""
+    key = ("joint_measure", joint)
+    meas = model.memo.get(key)
+    if meas is None:
+        meas = model.memo[key] = parse_variable(model, f"joint:{joint}")
+    return meas
+
+
+def capture_stick(model, joint: str, x, targets: dict) -> None:
+    """Store in ``targets`` the travel or relative angle a pair sticks at, pose x (n_x,)."""
+    targets[f"{joint}:stick"] = _measure(model, joint).value(x)
+
+
+@dataclass(frozen=True)
+class StickRow:
+    """The row holding a sticking pair: its travel or relative angle at ``target``; the
+    interface of :class:`mechdyn.dynamics.modes.Row` (kind ``"stick"``, element the
+    joint), which this module cannot import (modes -> mode_system -> here)."""
+
+    element: str
+    label: str
+    measure: object
+    target: float
+    kind: str = "stick"
+    sign: float = 1.0
+    mu: float = 0.0
+    slip: int = 0
+    tangent: object = None
+    compliance: float = 0.0
+    unilateral: bool = False
+    friction_rows: object = None
+
+    @cached_property
+    def rows(self):
+        """The row as data, with its label and element."""
+        return self.measure.rows.scaled(1.0, -self.target).renamed(self.label, self.element)
+
+
+def stick_row(model, joint: str, targets: dict) -> StickRow:
+    """The row holding a sticking pair at its captured value."""
+    return StickRow(joint, f"{joint}:stick", _measure(model, joint),
+                    float(targets[f"{joint}:stick"]))
+
+
+def friction_set(model, joints):
+    """The friction law (:class:`~mechdyn.dynamics.friction.FrictionSet`) of some joints of
+    a model, built once per set."""
+    key = ("friction_set", tuple(joints))
+    fs = model.memo.get(key)
+    if fs is None:
+        from .friction import FrictionSet
+        fs = model.memo[key] = FrictionSet(model, joints)
+    return fs
+
+
+class JointFriction:
+    """The friction of the joints in one mode.
+
+    Parameters
+    ----------
+    ms : ModeSystem
+
+    Attributes
+    ----------
+    states : dict
+        {joint: state} of the stick-slip pairs (:func:`joint_states`).
+    sliding : list of str
+        The pairs whose friction the law gives (all friction joints but the sticking
+        ones).
+    signs : dict
+        {joint: +1 / -1}: sgn(v) of the slipping stick-slip pairs.
+    stick_index : dict
+        {joint: index into ``ms.rowset`` of its stick row}.
+    """
+
+    def __init__(self, ms):
+        self.ms = ms
+        model = ms.model
+        self.model = model
+        self.states = joint_states(model, ms.mode)
+        self.sliding = [j for j in friction_joints(model) if self.states.get(j) != "stick"]
+        self.signs = {j: (1.0 if s == "slip+" else -1.0) for j, s in self.states.items()
+                      if s != "stick"}
+        self.stick_index = {r.element: ms.n_base + k for k, r in enumerate(ms.rows)
+                            if r.kind == "stick" and r.element in self.states}
+
+    # ------------------------------------------------------------------ the law
+    def forces(self, x, xdot, lam):
+        """(F_f (n_x,), dF_f/dlambda (n_x, n_rows)): the generalized friction force of
+        the sliding pairs (:attr:`sliding`) on the body poses, N and N m, and its
+        derivative with respect to the multipliers of the mode's rows.
+
+        A slipping stick-slip pair whose velocity is zero or against its direction s
+        (the start of its segment, trial states beyond the event) gets the Coulomb
+        friction of sgn(v) = s, so that the right-hand side of the segment stays smooth
+        up to the event: the law at a velocity of direction s, minus the law's viscous
+        part there, plus the viscous part at the actual velocity.
+        """
+        n_x, lam = self.model.n_x, np.asarray(lam, float)
+        F, D = np.zeros(n_x), np.zeros((n_x, lam.size))
+        back = [j for j, s in self.signs.items() if s * self.velocity(j, x, xdot) <= 0.0]
+        usual = tuple(j for j in self.sliding if j not in back)
+        if usual:
+            F[:], D[:] = friction_set(self.model, usual).generalized(x, xdot, lam)
+        for j in back:
+            fs = friction_set(self.model, (j,))
+            xd = xdot + (self.signs[j] - self.velocity(j, x, xdot)) * self._unit(j, x)
+            Fj, Dj = fs.generalized(x, xd, lam)
+            F += Fj - fs.generalized(x, xd, 0.0 * lam)[0] + fs.generalized(x, xdot, 0.0 * lam)[0]
+            D += Dj
+        return F, D
+
+    def _unit(self, joint: str, x) -> np.ndarray:
+        """A velocity of the poses (n_x,) with unit sliding velocity of ``joint``."""
+        J = RN.jacobian(_measure(self.model, joint).rows, x)[0]
+        return J / (J @ J)
+
+    def velocity(self, joint: str, x, xdot) -> float:
+        """The pair's sliding velocity (m/s) or relative angular velocity (rad/s)."""
+        return _measure(self.model, joint).rate(x, xdot)
+
+    def capacity(self, joint: str, x, lam) -> float:
+        """mu S of a pair (N; mu r |R|, N m, for a pin): the largest friction the pair
+        can give at the multipliers ``lam`` (the law's friction at a unit sliding
+        velocity, less its viscous part)."""
+        mag = friction_set(self.model, (joint,)).magnitudes
+        xd = self._unit(joint, x)
+        lam = np.asarray(lam, float)
+        return float(mag(x, xd, 0.0 * lam)[joint][0] - mag(x, xd, lam)[joint][0])
+
+    def margin(self, joint: str, x, lam) -> float:
+        """Capacity minus the friction needed to hold a sticking pair (< 0: it slips)."""
+        return self.capacity(joint, x, lam) - abs(float(lam[self.stick_index[joint]]))
+
+    def group(self, x) -> dict | None:
+        """The sticking pairs that hold ONE freedom together (their stick rows redundant:
+        the pins of a one-degree-of-freedom mechanism at rest), as {joint: c_j}, c_j the
+        pair's velocity along the unit motion e that the other rows leave free; None when
+        the sticking rows are independent (or free more than one motion together)."""
+        ms, stick = self.ms, self.stick_index
+        if len(stick) < 2 or all(k in ms.independent_rows for k in stick.values()):
+            return None
+        rest = [i for i in range(ms.n_rows) if i not in stick.values()]
+        R = ms.row_jacobian(x)[rest]
+        R = R / np.maximum(np.linalg.norm(R, axis=1), 1e-300)[:, None]
+        sv, vt = np.linalg.svd(R)[1:]
+        rank = int(np.sum(sv > 1e-9 * (sv[0] if sv.size else 1.0)))
+        if vt.shape[0] - rank != 1:
+            return None
+        e = vt[rank]
+        c = {j: float(RN.jacobian(_measure(self.model, j).rows, x)[0] @ e) for j in stick}
+        big = max(abs(v) for v in c.values())
+        c = {j: v for j, v in c.items() if abs(v) > 1e-9 * big}
+        return c if len(c) > 1 else None
+
+    def group_terms(self, c: dict, x, lam) -> tuple[float, float]:
+        """(H, C) of a group (:meth:`group`): the holding force of its stick rows along
+        the free motion e, H = sum lam_j c_j (the same for every share of the redundant
+        multipliers), and its capacity C = sum mu S_j |c_j|."""
+        H = sum(float(lam[self.stick_index[j]]) * cj for j, cj in c.items())
+        return H, sum(self.capacity(j, x, lam) * abs(cj) for j, cj in c.items())
+
+    def group_margin(self, c: dict, x, lam) -> float:
+        """C - |H| of a group: < 0 where its friction cannot hold the freedom."""
+        H, C = self.group_terms(c, x, lam)
+        return C - abs(H)
+
+    # ------------------------------------------------------------------ the solve
+    def solve(self, lin, n_i: int, rhs, x, xdot, t=None, q=None):
+        """The accelerations and multipliers with friction, by Newton on the multipliers.
+
+        Parameters
+        ----------
+        lin : callable
+            ``lin(r) -> K^-1 r``, r (n_x,) or (n_x, k): the mode's linear solve for
+            [qddot_I; lambda] (one factorization).
+        n_i : int
+            Number of independent accelerations (the first entries of a solution).
+        rhs : ndarray, shape (n_x,)
+            F - h - M b without friction.
+        x, xdot : ndarray, shape (n_x,)
+        t, q : optional
+            Where, for the messages.
+
+        Returns
+        -------
+        sol : ndarray, shape (n_i + n_rows,)
+        F_f : ndarray, shape (n_x,)
+
+        Raises
+        ------
+        SelfLockingError
+            The Newton matrix is singular (friction locks the mechanism) or the
+            iteration does not converge (no motion is consistent with the law).
+        """
+        sol = lin(rhs)
+        if not self.sliding:
+            return sol, np.zeros_like(rhs)
+        lam = sol[n_i:]
+        prev = np.inf
+        for it in range(MAX_ITER):
+            F, D = self.forces(x, xdot, lam)
+            sol = lin(rhs + F)
+            r = lam - sol[n_i:]
+            rn = float(np.linalg.norm(r))
+            scale = max(float(np.linalg.norm(sol[n_i:])), 1e-300)
+            if rn <= 1e-14 * scale or (it >= 2 and rn <= 1e-9 * scale and rn > 0.5 * prev):
+                return sol, F
+            Jn = np.eye(lam.size) - lin(D)[n_i:]
+            try:
+                step = np.linalg.solve(Jn, r)
+            except np.linalg.LinAlgError:
+                raise SelfLockingError(self._where("the friction of " + ", ".join(
+                    repr(j) for j in self.sliding) + " locks the mechanism (self-locking: "
+                    "the Newton matrix of the friction solve is singular)"), t=t, q=q) from None
+            lam, prev = lam - step, rn
+        raise SelfLockingError(self._where(
+            f"the friction solve did not converge in {MAX_ITER} Newton iterations "
+            f"(residual {rn:.3g} of {scale:.3g}); the friction of "
+            + ", ".join(repr(j) for j in self.sliding) + " may lock the mechanism"), t=t, q=q)
+
+    def _where(self, msg: str) -> str:
+        return f"{msg} in mode {{{', '.join(sorted(self.ms.mode))}}}"
+
+
+def state_tokens(states: dict) -> frozenset:
+    """The mode tokens of joint friction states: ``{"B:stick", "C:slip+"}``."""
+    return frozenset(f"{j}:{s}" for j, s in states.items())
+
+
+def resolve_joints(system, sm, t, x, xdot, mode, targets: dict, *, before: dict,
+                   forced_slip: dict, forced_stick, velocity_tol: float, force_tol: float,
+                   workspace=None) -> dict:
+    """The friction state of every stick-slip pair at a switching instant.
+
+    A pair slips in the direction of its sliding velocity when that exceeds
+    ``velocity_tol``, in the direction given by ``forced_slip`` ({joint: +1/-1}: it just
+    broke away), and is tried sticking otherwise (or when listed in ``forced_stick``:
+    its sliding velocity just vanished).  A pair whose velocity passes zero by the
+    kinematics alone (its stick row depends on the rows of the joints there: a slider at
+    a dead centre) slips on, in the direction its sliding acceleration takes.  The trial
+    pairs stick if each one's needed friction is within its capacity mu S; else the most
+    overloaded one slips against its holding force and the others are tried again.
+    Pairs whose stick rows hold ONE freedom together (:meth:`JointFriction.group`: the
+    pins of a mechanism at rest) stick or slip as one: they hold while the holding
+    force along the freedom, |H| = |sum lambda_j c_j| (whatever share of the redundant
+    multipliers), is within C = sum mu S_j |c_j|; they break away together, each in the
+    direction of the motion against H.
+
+    Parameters
+    ----------
+    system : type
+        :class:`~mechdyn.dynamics.mode_system.ModeSystem` (passed in: it imports this
+        module).
+    sm : SwitchedModel
+    t : float
+    x, xdot : ndarray, shape (n_x,)
+        A consistent state of ``mode``.
+    mode : frozenset of str
+        The mode without joint friction tokens (locks, stops, contacts).
+    targets : dict
+        Held values; the stick values of the pairs that stick are stored here.
+    before : dict
+        The states of the mode left (:func:`joint_states`).
+    forced_slip, forced_stick
+        See above.
+    velocity_tol, force_tol : float
+        m/s or rad/s; N (N m for a pin: times the model's length scale).
+
+    Returns
+    -------
+    dict
+        {joint: 'stick' | 'slip+' | 'slip-'}.
+    """
+    model = sm.model
+    states: dict = {}
+    pending = set()  # pairs that broke away from sticking: with their group, if they had one
+    for j in stick_slip_joints(model):
+        if j in forced_slip:
+            states[j] = "slip+" if forced_slip[j] > 0 else "slip-"
+            if before.get(j) == "stick" and f"{j}:stick" in targets:
+                states[j] = "stick"
+                pending.add(j)
+            continue
+        v = _measure(model, j).rate(x, xdot)
+        if j not in forced_stick and abs(v) > velocity_tol:
+            states[j] = "slip+" if v > 0 else "slip-"
+            continue
+        if before.get(j) != "stick" or f"{j}:stick" not in targets:
+            capture_stick(model, j, x, targets)
+        states[j] = "stick"
+    L = model.length_scale
+    sliding = {j: s for j, s in states.items() if s != "stick"}
+    for j in [j for j, s in states.items() if s == "stick"]:
+        # a pair whose velocity passes zero by the kinematics alone (a slider at a dead
+        # centre: its stick row depends on the joints' rows there) slips on
+        ms = system(sm, frozenset(mode) | state_tokens({**sliding, j: "stick"}), targets, x,
+                    workspace=workspace)
+        if ms.friction.stick_index[j] not in ms.independent_rows:
+            states[j] = _passing_direction(system, sm, t, x, xdot, mode, targets, sliding, j,
+                                           before.get(j), workspace)
+    while any(s == "stick" for s in states.values()):
+        ms = system(sm, frozenset(mode) | state_tokens(states), targets, x,
+                    workspace=workspace)
+        jf = ms.friction
+        lam = ms.evaluate_x(t, x, xdot).lam
+        c = jf.group(x) or {}
+        if c:  # pairs holding one freedom together: they stick or slip as one
+            H, C = jf.group_terms(c, x, lam)
+            if pending & set(c) or C - abs(H) < -1e-9 * (C + abs(H)):
+                # the motion e goes against the holding force H
+                states.update({j: "slip+" if -cj * H > 0 else "slip-" for j, cj in c.items()})
+                pending -= set(c)
+                continue
+        if pending:  # the others broke away alone, as the event said
+            states.update({j: "slip+" if forced_slip[j] > 0 else "slip-" for j in pending})
+            pending = set()
+            continue
+        worst, worst_ratio = None, 0.0
+        for j, k in jf.stick_index.items():
+            if j in c:
+                continue
+            tol = force_tol * (L if _measure(model, j).is_angle else 1.0)
+            cap = jf.capacity(j, x, lam)
+            over = abs(float(lam[k])) - cap - tol
+            if over > 0 and (worst is None or over / max(cap, tol) > worst_ratio):
+                worst, worst_ratio = j, over / max(cap, tol)
+        if worst is None:
+            break
+        states[worst] = "slip-" if lam[jf.stick_index[worst]] > 0 else "slip+"
+    for j, s in states.items():
+        if s != "stick":
+            targets.pop(f"{j}:stick", None)
+    return states
+
+
+def _passing_direction(system, sm, t, x, xdot, mode, targets, states, joint, prev,
+                       workspace) -> str:
+    """The slip state of a pair whose sliding velocity passes zero where holding it is
+    not independent of the other rows: the direction s whose sliding acceleration has
+    the sign of s (the reverse of ``prev`` tried first)."""
+    meas = _measure(sm.model, joint)
+    order = ("slip-", "slip+") if prev == "slip+" else ("slip+", "slip-")
+    for st in order:
+        trial = dict(states, **{joint: st})
+        ms = system(sm, frozenset(mode) | state_tokens(trial), targets, x,
+                    workspace=workspace)
+        ev = ms.evaluate_x(t, x, xdot)
+        acc = float(RN.jacobian(meas.rows, ev.x)[0] @ ev.xddot
+                    + RN.quad(meas.rows, ev.x, ev.xdot)[0])
+        if acc * (1.0 if st == "slip+" else -1.0) > 0:
+            return st
+    return order[0]
