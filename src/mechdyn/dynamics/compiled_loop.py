@@ -80,15 +80,21 @@ def buffers(kernel) -> _Buffers:
     return b
 
 
-def _eval(b, ms, k):
-    """The ModeEval of output sample k."""
+def _evals(b, ms, n) -> list:
+    """The ModeEval records of the first n output samples (views into one copy of each
+    block)."""
     nx, _, nq, nc, _ = b.dims
-    e = b.o_ext[k]
-    lam = np.zeros(ms.n_rows)
-    lam[ms.independent_rows] = e[nx + 3 * nq:nx + 3 * nq + nc]
-    return ModeEval(b.o_x[k].copy(), b.o_xd[k].copy(), e[:nx].copy(), e[nx:nx + nq].copy(),
-                    e[nx + nq:nx + 2 * nq].copy(), e[nx + 2 * nq:nx + 3 * nq].copy(), lam,
-                    e[nx + 3 * nq + nc:].copy())
+    X, XD, E = b.o_x[:n].copy(), b.o_xd[:n].copy(), b.o_ext[:n].copy()
+    rows = ms.independent_rows
+    if np.array_equal(rows, np.arange(ms.n_rows)):
+        LAM = E[:, nx + 3 * nq:nx + 3 * nq + nc]
+    else:
+        LAM = np.zeros((n, ms.n_rows))
+        LAM[:, rows] = E[:, nx + 3 * nq:nx + 3 * nq + nc]
+    XDD, Q, QD, QDD, F = (E[:, a:b] for a, b in ((0, nx), (nx, nx + nq), (nx + nq, nx + 2 * nq),
+                                                 (nx + 2 * nq, nx + 3 * nq),
+                                                 (nx + 3 * nq + nc, 2 * nx + 3 * nq + nc)))
+    return [ModeEval(X[k], XD[k], XDD[k], Q[k], QD[k], QDD[k], LAM[k], F[k]) for k in range(n)]
 
 
 def _step(b, i0, i1, dense=None) -> Step:
@@ -183,10 +189,11 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
 
     def hand(upto=np.inf):
         n = int(ipar[L.I_NOUT])
-        k = 0
-        while k < n and b.o_t[k] <= upto:
-            sample(float(b.o_t[k]), b.o_y[k].copy(), None, _eval(b, ms, k))
-            k += 1
+        k = int(np.searchsorted(b.o_t[:n], upto, side="right"))
+        if k:
+            T, Y = b.o_t[:k].tolist(), b.o_y[:k].copy()
+            for j, ev in enumerate(_evals(b, ms, k)):
+                sample(T[j], Y[j], None, ev)
         if k < n:  # keep the rest for later
             b.o_t[:n - k], b.o_y[:n - k] = b.o_t[k:n].copy(), b.o_y[k:n].copy()
             b.o_x[:n - k], b.o_xd[:n - k] = b.o_x[k:n].copy(), b.o_xd[k:n].copy()

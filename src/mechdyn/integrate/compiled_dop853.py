@@ -33,20 +33,8 @@ __all__ = ["DOP853"]
 class DOP853(ScipyIntegrator):
     """The Dormand-Prince 8(5,3) integrator, in the compiled loop where it can run.
 
-    Parameters
-    ----------
-    rtol : float
-        Relative tolerance (> 0), default ``DEFAULT_RTOL`` (1e-10).
-    atol : float or array_like
-        Absolute tolerance, SI units of each state component (> 0); a scalar, or an
-        array of length 2 n + n_w over (q, q', w).  Default ``1e-3 rtol``.
-    first_step, max_step : float, optional
-        Initial and largest step sizes, s.
-
-    Raises
-    ------
-    IntegratorOptionError
-        A bad tolerance or step size (the message names it).
+    Parameters and errors: those of :class:`~mechdyn.integrate.scipy_ivp.ScipyIntegrator`
+    (``rtol``, ``atol``, ``first_step``, ``max_step``), without its ``method``.
     """
 
     #: segments on a compiled kernel run in the compiled loop

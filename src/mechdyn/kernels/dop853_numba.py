@@ -65,6 +65,15 @@ def _rhs(t, y, f, ni, ip, fp, ri, rf, dims, ws, ext, full, sc, piv):
 
 
 @njit
+def _counted(ts, ys, fout, ni, ip, fp, ri, rf, dims, ws, ext, full, sc, piv, ipar):
+    """One evaluation, counted; False where the kernel failed (its status in ipar)."""
+    ipar[I_EVALS] += 1
+    st = _rhs(ts, ys, fout, ni, ip, fp, ri, rf, dims, ws, ext, full, sc, piv)
+    ipar[I_STATUS] = st
+    return st == 0
+
+
+@njit
 def _stage(y, K, s, h, ys):
     """ys = y + h sum_j a_sj K_j."""
     m = y.size
@@ -94,10 +103,8 @@ def _dense(y, ynew, f, fnew, K, h, t, dns, ys, ni, ip, fp, ri, rf, dims, ws, ext
     kernel failed."""
     for s in range(N_STAGES + 1, N_STAGES + 4):
         _stage(y, K, s, h, ys)
-        ipar[I_EVALS] += 1
-        st = _rhs(t + C[s] * h, ys, K[s], ni, ip, fp, ri, rf, dims, ws, ext, False, sc, piv)
-        if st != 0:
-            ipar[I_STATUS] = st
+        if not _counted(t + C[s] * h, ys, K[s], ni, ip, fp, ri, rf, dims, ws, ext, False, sc,
+                        piv, ipar):
             return False
     m = y.size
     for i in range(m):
@@ -180,10 +187,7 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
     hmax = par[P_HMAX]
     every = ipar[I_EVERY] != 0
     if ipar[I_FSAL] == 0:
-        ipar[I_EVALS] += 1
-        st = _rhs(t, y, f, ni, ip, fp, ri, rf, dims, ws, ext, False, sc, piv)
-        if st != 0:
-            ipar[I_STATUS] = st
+        if not _counted(t, y, f, ni, ip, fp, ri, rf, dims, ws, ext, False, sc, piv, ipar):
             return FAILED
         ipar[I_FSAL] = 1
     h = par[P_H]
@@ -222,11 +226,8 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
             K[0, i] = f[i]
         for s in range(1, N_STAGES):
             _stage(y, K, s, h, ys)
-            ipar[I_EVALS] += 1
-            st = _rhs(t + C[s] * h, ys, K[s], ni, ip, fp, ri, rf, dims, ws, ext, False, sc,
-                      piv)
-            if st != 0:
-                ipar[I_STATUS] = st
+            if not _counted(t + C[s] * h, ys, K[s], ni, ip, fp, ri, rf, dims, ws, ext, False,
+                            sc, piv, ipar):
                 par[P_T], par[P_H] = t, h
                 return FAILED
             _watch(ys[0], ws, nx, par, ipar, x_end)
@@ -265,11 +266,8 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
                 end_sample = True
             k += 1
         fnew = K[N_STAGES]
-        ipar[I_EVALS] += 1
-        st = _rhs(t_new, ynew, fnew, ni, ip, fp, ri, rf, dims, ws, ext_end, end_sample, sc,
-                  piv)
-        if st != 0:
-            ipar[I_STATUS] = st
+        if not _counted(t_new, ynew, fnew, ni, ip, fp, ri, rf, dims, ws, ext_end, end_sample,
+                        sc, piv, ipar):
             par[P_T], par[P_H] = t, h
             return FAILED
         _watch(ynew[0], ws, nx, par, ipar, x_end)
@@ -324,11 +322,11 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
             if ts <= par[P_LAST] or ts >= t_new:
                 continue
             dense_at(dns, y, t, h, ts, ys)
-            st = _rhs(ts, ys, K[N_STAGES + 1], ni, ip, fp, ri, rf, dims, ws, ext, True, sc,
-                      piv)
-            if st != 0:
-                ipar[I_STATUS] = st
+            if not _counted(ts, ys, K[N_STAGES + 1], ni, ip, fp, ri, rf, dims, ws, ext, True,
+                            sc, piv, ipar):
+                ipar[I_EVALS] -= 1  # an output sample, not a step's evaluation
                 return FAILED
+            ipar[I_EVALS] -= 1
             _record(ipar[I_NOUT], ts, ys, ws, ext, nx, ni, o_t, o_y, o_x, o_xd, o_ext)
             ipar[I_NOUT] += 1
             par[P_LAST] = ts
