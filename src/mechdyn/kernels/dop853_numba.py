@@ -48,8 +48,8 @@ F_TURN, F_PIVOT, F_STALL = 1, 2, 8
 # (centre, half width), last sample time, start and size of the last step, coordinate of a
 # watch due
 P_T, P_TEND, P_H, P_RTOL, P_HMAX, P_STALL, P_PIVOT, P_WC0, P_WC1, P_LAST, P_TOLD, P_HOLD, \
-    P_WS = range(13)
-N_PAR = 13
+    P_WS, P_BETA, P_ERROLD = range(15)
+N_PAR = 15
 # ipar: evaluations, accepted and rejected steps, samples in the buffers, next t_eval,
 # flags, f valid, every step sampled, watch on, steps per call, kernel status, history,
 # a watch due
@@ -248,7 +248,7 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
         err = abs(h) * e5n / np.sqrt(m * (deno if deno > 0.0 else 1.0))
         if not err == err:
             err = np.inf
-        fac11 = err ** 0.125
+        fac11 = err ** (0.125 - 0.2 * par[P_BETA])
         if err > 1.0:  # rejected
             ipar[I_REJ] += 1
             rejected = True
@@ -273,7 +273,9 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
         _watch(ynew[0], ws, nx, par, ipar, x_end)
         steps += 1
         ipar[I_STEPS] += 1
-        fac = max(1.0 / 6.0, min(3.0, fac11 / 0.9))
+        fac = fac11 / par[P_ERROLD] ** par[P_BETA] if par[P_BETA] != 0.0 else fac11
+        par[P_ERROLD] = max(err, 1e-4)
+        fac = max(1.0 / 6.0, min(3.0, fac / 0.9))
         h_next = h / fac
         if rejected:
             h_next = min(h_next, h)
