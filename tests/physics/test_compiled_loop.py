@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from dynamics_models import four_bar, pendulum
 
-from mechdyn import Mechanism
+from mechdyn import Mechanism, examples
 from mechdyn.dynamics import compiled
 from mechdyn.dynamics.compiled import numba_available
 from mechdyn.dynamics.compiled_loop import PIVOT_FLAG
@@ -113,3 +113,18 @@ def test_pendulum_turning_points_are_checked_and_passed(loop_calls):
 
 def test_pivot_flag_is_the_singularity_check_threshold():
     assert PIVOT_FLAG == PIVOT_CHECK
+
+
+@pytest.mark.parametrize("name", [n for n in examples.names()
+                                  if not examples.load(n).compile().has_switching])
+def test_bundled_fixed_structure_examples_agree_with_scipy(name, loop_calls):
+    model = examples.load(name).compile()
+    t_eval = np.linspace(0.0, 0.05, 11)
+    ours, ref = (simulate(model, 0.05, rtol=1e-12, t_eval=t_eval, integrator=i, progress=False)
+                 for i in ("dop853", "scipy-dop853"))
+    assert ours.status == ref.status and np.array_equal(ours.t, ref.t)
+    if ours.stats["backend"] == "numba":
+        assert loop_calls == [True]
+    scale = np.where(model.coord_is_angle, 1.0, model.length_scale)
+    assert np.max(np.abs(ours.q - ref.q) / scale) < 1e-9
+    assert np.max(np.abs(ours.qdot - ref.qdot)) < 1e-8 * max(1.0, np.max(np.abs(ref.qdot)))
