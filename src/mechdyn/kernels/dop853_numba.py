@@ -59,16 +59,13 @@ N_IPAR = 13
 
 
 @njit
-def _rhs(t, y, f, ni, ip, fp, ri, rf, dims, ws, ext, full, sc, piv):
-    return evaluate_into(t, y[:ni], y[ni:2 * ni], ip, fp, ri, rf, dims, ws, f, ext, full, sc,
-                         piv)
-
-
-@njit
 def _counted(ts, ys, fout, ni, ip, fp, ri, rf, dims, ws, ext, full, sc, piv, ipar):
-    """One evaluation, counted; False where the kernel failed (its status in ipar)."""
+    """One evaluation y' = (q_I', q_I'', P_nc) at (ts, ys), counted; False where the kernel
+    failed (its status in ipar).  ``full`` must be a runtime boolean: a literal True or
+    False would compile the kernel once more for each (minutes of first use)."""
     ipar[I_EVALS] += 1
-    st = _rhs(ts, ys, fout, ni, ip, fp, ri, rf, dims, ws, ext, full, sc, piv)
+    st = evaluate_into(ts, ys[:ni], ys[ni:2 * ni], ip, fp, ri, rf, dims, ws, fout, ext, full,
+                       sc, piv)
     ipar[I_STATUS] = st
     return st == 0
 
@@ -97,15 +94,8 @@ def dense_at(dns, y_old, t_old, h, ts, out):
 
 
 @njit
-def _dense(y, ynew, f, fnew, K, h, t, dns, ys, ni, ip, fp, ri, rf, dims, ws, ext, sc, piv,
-           ipar):
-    """The three extra stages and the coefficients of the dense output; False where the
-    kernel failed."""
-    for s in range(N_STAGES + 1, N_STAGES + 4):
-        _stage(y, K, s, h, ys)
-        if not _counted(t + C[s] * h, ys, K[s], ni, ip, fp, ri, rf, dims, ws, ext, False, sc,
-                        piv, ipar):
-            return False
+def _dense(y, ynew, f, fnew, K, h, dns):
+    """The coefficients of the dense output, the three extra stages in K."""
     m = y.size
     for i in range(m):
         dy = ynew[i] - y[i]
@@ -117,7 +107,6 @@ def _dense(y, ynew, f, fnew, K, h, t, dns, ys, ni, ip, fp, ri, rf, dims, ws, ext
             for j in range(N_STAGES + 4):
                 acc += D[k, j] * K[j, i]
             dns[3 + k, i] = h * acc
-    return True
 
 
 @njit
@@ -142,9 +131,8 @@ def _record(k, ts, y, ws, ext, nx, ni, o_t, o_y, o_x, o_xd, o_ext):
 
 
 @njit
-def _initial_step(t, y, f, atol, rtol, hmax, K, ni, ip, fp, ri, rf, dims, ws, ext, sc, piv,
-                  ipar):
-    """Hairer's starting step for order 8 (one evaluation)."""
+def _initial_guess(y, f, atol, rtol, hmax):
+    """Hairer's starting step for order 8, first part: ``(h, |f|^2)``."""
     m = y.size
     dnf = 0.0
     dny = 0.0
@@ -153,14 +141,13 @@ def _initial_step(t, y, f, atol, rtol, hmax, K, ni, ip, fp, ri, rf, dims, ws, ex
         dnf += (f[i] / sk) ** 2
         dny += (y[i] / sk) ** 2
     h = 1e-6 if (dnf <= 1e-10 or dny <= 1e-10) else 0.01 * np.sqrt(dny / dnf)
-    h = min(h, hmax)
-    y1 = K[1]
-    f1 = K[2]
-    for i in range(m):
-        y1[i] = y[i] + h * f[i]
-    ipar[I_EVALS] += 1
-    if _rhs(t + h, y1, f1, ni, ip, fp, ri, rf, dims, ws, ext, False, sc, piv) != 0:
-        return min(h, hmax)
+    return min(h, hmax), dnf
+
+
+@njit
+def _initial_step(y, f, f1, h, dnf, atol, rtol, hmax):
+    """Hairer's starting step, second part, from f1 = f(t + h, y + h f)."""
+    m = y.size
     der2 = 0.0
     for i in range(m):
         sk = atol[i] + rtol * abs(y[i])
@@ -186,14 +173,19 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
     rtol = par[P_RTOL]
     hmax = par[P_HMAX]
     every = ipar[I_EVERY] != 0
+    off = ipar[I_FSAL] < 0  # False and True at run time (see _counted)
+    on = not off
     if ipar[I_FSAL] == 0:
-        if not _counted(t, y, f, ni, ip, fp, ri, rf, dims, ws, ext, False, sc, piv, ipar):
+        if not _counted(t, y, f, ni, ip, fp, ri, rf, dims, ws, ext, off, sc, piv, ipar):
             return FAILED
         ipar[I_FSAL] = 1
     h = par[P_H]
     if not h > 0.0:
-        h = _initial_step(t, y, f, atol, rtol, hmax, K, ni, ip, fp, ri, rf, dims, ws, ext,
-                          sc, piv, ipar)
+        h, dnf = _initial_guess(y, f, atol, rtol, hmax)
+        for i in range(m):
+            K[1, i] = y[i] + h * f[i]
+        if _counted(t + h, K[1], K[2], ni, ip, fp, ri, rf, dims, ws, ext, off, sc, piv, ipar):
+            h = _initial_step(y, f, K[2], h, dnf, atol, rtol, hmax)
     rejected = False
     steps = 0
     ipar[I_FLAGS] = 0
@@ -226,7 +218,7 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
             K[0, i] = f[i]
         for s in range(1, N_STAGES):
             _stage(y, K, s, h, ys)
-            if not _counted(t + C[s] * h, ys, K[s], ni, ip, fp, ri, rf, dims, ws, ext, False,
+            if not _counted(t + C[s] * h, ys, K[s], ni, ip, fp, ri, rf, dims, ws, ext, off,
                             sc, piv, ipar):
                 par[P_T], par[P_H] = t, h
                 return FAILED
@@ -305,10 +297,13 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
         par[P_TOLD], par[P_HOLD] = t, h
         interior = ipar[I_NEXT] < n_te and t_eval[ipar[I_NEXT]] < t_new
         if flags != 0 or interior:
-            if not _dense(y, ynew, f, fnew, K, h, t, dns, ys, ni, ip, fp, ri, rf, dims, ws,
-                          ext, sc, piv, ipar):
-                par[P_T], par[P_H] = t, h
-                return FAILED
+            for s in range(N_STAGES + 1, N_STAGES + 4):  # the stages of the dense output
+                _stage(y, K, s, h, ys)
+                if not _counted(t + C[s] * h, ys, K[s], ni, ip, fp, ri, rf, dims, ws, ext, off,
+                                sc, piv, ipar):
+                    par[P_T], par[P_H] = t, h
+                    return FAILED
+            _dense(y, ynew, f, fnew, K, h, dns)
         if flags != 0:
             ipar[I_FLAGS] = flags
             for i in range(m):
@@ -324,7 +319,7 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
             if ts <= par[P_LAST] or ts >= t_new:
                 continue
             dense_at(dns, y, t, h, ts, ys)
-            if not _counted(ts, ys, K[N_STAGES + 1], ni, ip, fp, ri, rf, dims, ws, ext, True,
+            if not _counted(ts, ys, K[N_STAGES + 1], ni, ip, fp, ri, rf, dims, ws, ext, on,
                             sc, piv, ipar):
                 ipar[I_EVALS] -= 1  # an output sample, not a step's evaluation
                 return FAILED
@@ -364,6 +359,6 @@ def evaluate_states(t, Y, reps, ip, fp, ri, rf, dims, ws, sc, piv):
     for _ in range(reps):
         for k in range(Y.shape[0]):
             if evaluate_into(t[k], Y[k, :ni], Y[k, ni:], ip, fp, ri, rf, dims, ws, out, ext,
-                             False, sc, piv):
+                             reps < 0, sc, piv):  # a runtime False (see _counted)
                 bad += 1
     return bad

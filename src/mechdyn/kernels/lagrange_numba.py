@@ -153,6 +153,8 @@ def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
     constraint rows from the same factorization (M x'' + h - F = Phi_x^T lambda, solved
     with the transposed LU of the position Jacobian) and the applied forces on the
     poses, drives included.  (Allocates its scratch; :func:`evaluate_into` does not.)"""
+    # (``full`` is a runtime boolean in every call of the package: a literal True or False
+    # would compile this and evaluate_into once more for each -- seconds of first use)
     nx = 3 * ip[H_NB]
     sc = np.empty(scratch_size(nx, dims[D_NI], dims[D_NQ], dims[D_NV]))
     piv = np.empty(nx, dtype=np.int64)
@@ -351,10 +353,11 @@ def first_order(t, y, ip, fp, ri, rf, dims, ws, status):
     ni = dims[D_NI]
     out = np.empty(2 * ni + 1)
     status[0] = evaluate(t, y[:ni], y[ni:2 * ni], ip, fp, ri, rf, dims, ws, out,
-                          np.empty(0), False)
+                          np.empty(0), status.size < 0)  # a runtime False (one compilation)
     return out
 
 
 @njit
 def full(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, status):
-    status[0] = evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, True)
+    status[0] = evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext,
+                         status.size > 0)  # a runtime True (one compilation of evaluate)
