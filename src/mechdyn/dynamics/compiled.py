@@ -36,6 +36,7 @@ from ..mechanism.mechanism import Mechanism
 from ..model import Model
 from ..model.rows import concat
 from ..model.variable import lower, parse
+from .compiled_loop import fast_forward, warm_up_loop
 from .forces import force_model
 
 __all__ = ["compile_mode_kernel", "CompiledKernel", "numba_available"]
@@ -145,6 +146,15 @@ class CompiledKernel:
         """Evaluations of the equations by this kernel so far."""
         return int(self.ws[-N_FLAGS + W_COUNT])
 
+    def fast_forward(self, integ, eqs, t, y0, t_end, **callbacks):
+        """Run a segment in the compiled DOP853 loop as far as it can go: ``(t, y, next_out,
+        done)`` (see :func:`mechdyn.dynamics.compiled_loop.fast_forward`); a mode whose
+        multipliers are not all the kernel's (redundant rows) is not run there."""
+        ms = eqs.ms
+        if len(ms.independent_rows) != ms.n_rows or y0.size != 2 * self.n_i + 1:
+            return t, y0, callbacks["next_out"], False
+        return fast_forward(self, integ, eqs, t, y0, t_end, **callbacks)
+
     def first_order_function(self, on_failure):
         """A function ``fun(t, y) -> y'`` for y = (q_I, q_I', w) calling the kernel directly
         (the path with the least Python per evaluation); ``on_failure(t, y)`` is called
@@ -193,6 +203,7 @@ def _warm_up() -> float:
         kernel.reset(model.x_sketch)
         kernel.rhs(0.0, [0.3], [1.0])
         kernel.evaluation(0.0, [0.3], [1.0])
+        warm_up_loop(kernel)
     _COMPILED["done"] = True
     _COMPILED["time"] = time.perf_counter() - t0
     return _COMPILED["time"]

@@ -16,6 +16,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from .base import DEFAULT_RTOL, Integrator, IntegratorOptionError
+from .compiled_dop853 import DOP853
 from .events import as_events
 from .runge_kutta import RungeKutta4
 from .scipy_ivp import SCIPY_METHODS, ScipyIntegrator
@@ -25,8 +26,9 @@ from .wilson import Wilson
 __all__ = ["INTEGRATORS", "make_integrator", "segment_integrators", "solve", "Solution",
            "sample_times"]
 
-#: valid integrator names
-INTEGRATORS = ("wilson", "rk4", *SCIPY_METHODS)
+#: valid integrator names: "dop853" runs in the compiled loop where it can
+#: (:mod:`mechdyn.integrate.compiled_dop853`), "scipy-dop853" is SciPy's everywhere
+INTEGRATORS = ("wilson", "rk4", *SCIPY_METHODS, "scipy-dop853")
 _WILSON_OPTIONS = ("iterations", "tol", "theta")
 _ADAPTIVE_OPTIONS = ("first_step", "max_step")
 
@@ -82,7 +84,11 @@ def make_integrator(name: str | Integrator = "dop853", *, steps: int | None = No
             f"integrator {key!r} is adaptive and does not take option(s) {', '.join(bad)}; "
             f"its options: rtol, atol, {', '.join(_ADAPTIVE_OPTIONS)} (fixed-step "
             f"integrators taking steps/dt: wilson, rk4)")
-    return ScipyIntegrator(key, rtol, atol, **options)
+    if key == "dop853":
+        return DOP853(rtol, atol, **options)
+    integ = ScipyIntegrator(key.removeprefix("scipy-"), rtol, atol, **options)
+    integ.name = key
+    return integ
 
 
 @dataclass

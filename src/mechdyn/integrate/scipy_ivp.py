@@ -43,6 +43,9 @@ class ScipyIntegrator(Integrator):
     """
 
     adaptive = True
+    #: whether a segment on a compiled kernel may run in a compiled loop (see
+    #: :class:`mechdyn.integrate.compiled_dop853.DOP853`)
+    compiled = False
 
     def __init__(self, method: str = "dop853", rtol: float = DEFAULT_RTOL, atol=None, *,
                  first_step: float | None = None, max_step: float | None = None):

@@ -39,8 +39,8 @@ from .loads_numba import (
 )
 from .rows_numba import njit, rows_jacobian, rows_quad, rows_values
 
-__all__ = ["evaluate", "first_order", "full", "work_size", "D_NC", "D_NI",
-           "D_NQ", "D_NV", "W_VALID", "W_PIVOT", "W_COUNT", "N_FLAGS"]
+__all__ = ["evaluate", "evaluate_into", "scratch_size", "first_order", "full", "work_size",
+           "D_NC", "D_NI", "D_NQ", "D_NV", "W_VALID", "W_PIVOT", "W_COUNT", "N_FLAGS"]
 
 # dims: n_c (constraint rows), n_i (independent coordinates), n_q (declared coordinates),
 # n_v (rows of table variables); the row arrays hold these four blocks in this order
@@ -137,6 +137,13 @@ def _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb):
 
 
 @njit
+def scratch_size(n_x, n_i, n_q, n_v):
+    """Length of the scratch array of :func:`evaluate_into` (every intermediate of one
+    evaluation, so that a compiled loop evaluates without allocating)."""
+    return n_x * n_x + 6 * n_x + 4 * n_q + n_q * n_x + n_q * n_i + n_i * n_i + 4 * n_i + n_v
+
+
+@njit
 def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
     """q_I'' and P_nc at (t, q_I, q_I'); out = [q_I' | q_I'' | P_nc].  Status: 0 ok,
     1 position solve failed, 2 mass matrix not positive definite, 3 non-finite.
@@ -145,14 +152,40 @@ def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
     F (n_x)]: the accelerations, every declared coordinate, the multipliers of the
     constraint rows from the same factorization (M x'' + h - F = Phi_x^T lambda, solved
     with the transposed LU of the position Jacobian) and the applied forces on the
-    poses, drives included."""
+    poses, drives included.  (Allocates its scratch; :func:`evaluate_into` does not.)"""
+    # (``full`` is a runtime boolean in every call of the package: a literal True or False
+    # would compile this and evaluate_into once more for each -- seconds of first use)
+    nx = 3 * ip[H_NB]
+    sc = np.empty(scratch_size(nx, dims[D_NI], dims[D_NQ], dims[D_NV]))
+    piv = np.empty(nx, dtype=np.int64)
+    return evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
+
+
+@njit
+def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv):
+    """:func:`evaluate` with the caller's scratch arrays: ``sc`` (float,
+    :func:`scratch_size`) and ``piv`` (int64, n_x)."""
     nb = ip[H_NB]
     nx = 3 * nb
     nc, ni, nq, nv = dims[D_NC], dims[D_NI], dims[D_NQ], dims[D_NV]
     ls = fp[2]
-    J = np.empty((nx, nx))
-    piv = np.empty(nx, dtype=np.int64)
-    F = np.empty(nx)
+    o = nx * nx
+    J = sc[:o].reshape((nx, nx))
+    F, col, bb = sc[o:o + nx], sc[o + nx:o + 2 * nx], sc[o + 2 * nx:o + 3 * nx]
+    Fa, Fnc, z = sc[o + 3 * nx:o + 4 * nx], sc[o + 4 * nx:o + 5 * nx], sc[o + 5 * nx:o + 6 * nx]
+    o += 6 * nx
+    q, qdot, Gb, Qd = sc[o:o + nq], sc[o + nq:o + 2 * nq], sc[o + 2 * nq:o + 3 * nq], \
+        sc[o + 3 * nq:o + 4 * nq]
+    o += 4 * nq
+    G = sc[o:o + nq * nx].reshape((nq, nx))
+    o += nq * nx
+    GB = sc[o:o + nq * ni].reshape((nq, ni))
+    o += nq * ni
+    A = sc[o:o + ni * ni].reshape((ni, ni))
+    o += ni * ni
+    cc, bcx, bcy, rhs = sc[o:o + ni], sc[o + ni:o + 2 * ni], sc[o + 2 * ni:o + 3 * ni], \
+        sc[o + 3 * ni:o + 4 * ni]
+    varv = sc[o + 4 * ni:o + 4 * ni + nv]
     ws[ws.size - N_FLAGS + W_COUNT] += 1.0
     st = _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb)
     if st != 0:
@@ -162,7 +195,6 @@ def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
     v = ws[nx + ni + nx * ni:nx + ni + nx * ni + nx]
     flags = ws[ws.size - N_FLAGS:]
     # velocity analogs B (row r, column c stored at r * ni + c)
-    col = np.empty(nx)
     for c in range(ni):
         for r in range(nx):
             col[r] = 0.0
@@ -177,18 +209,18 @@ def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
             s += Bl[r * ni + c] * qdi[c]
         v[r] = s
     # acceleration bias: J b = -quad
-    bb = np.empty(nx)
     rows_quad(x, v, nb, ri[:nc + ni], rf[:nc + ni], bb, 0)
     for r in range(nx):
         bb[r] = -bb[r]
     _solve_scaled(J, piv, bb, nx, nb, ls)
     # declared coordinates, their rates, analogs G B and bias G b + quad_g
     gi, gf = ri[nc + ni:nc + ni + nq], rf[nc + ni:nc + ni + nq]
-    q = np.empty(nq)
-    G = np.zeros((nq, nx))
-    qdot = np.zeros(nq)
-    Gb = np.empty(nq)
-    GB = np.zeros((nq, ni))
+    for k in range(nq):
+        qdot[k] = 0.0
+        for r in range(nx):
+            G[k, r] = 0.0
+        for c in range(ni):
+            GB[k, c] = 0.0
     rows_values(x, nb, gi, gf, q, 0)
     rows_jacobian(x, nb, gi, gf, G, 0)
     rows_quad(x, v, nb, gi, gf, Gb, 0)
@@ -201,11 +233,11 @@ def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
                 for c in range(ni):
                     GB[k, c] += g * Bl[r * ni + c]
     # mass matrix and c from the centre-of-mass analogs
-    A = np.zeros((ni, ni))
-    cc = np.zeros(ni)
+    for i in range(ni):
+        cc[i] = 0.0
+        for j in range(ni):
+            A[i, j] = 0.0
     ob = ip[H_FOFF + S_BODY]
-    bcx = np.empty(ni)
-    bcy = np.empty(ni)
     for b in range(nb):
         m, Jc, ax, ay = body_inertia(fp, ob, b, x)
         w = v[3 * b + 2]
@@ -232,13 +264,8 @@ def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
                 for j in range(i, ni):
                     A[i, j] += je * GB[c, i] * GB[c, j]
     # forces
-    Fa = np.empty(nx)
-    Fnc = np.empty(nx)
-    Qd = np.empty(nq)
-    varv = np.empty(nv)
     rows_values(x, nb, ri[nc + ni + nq:], rf[nc + ni + nq:], varv, 0)
     forces(t, q, qdot, x, v, ip, fp, Fa, Fnc, Qd, varv)
-    rhs = np.empty(ni)
     P = 0.0
     for r in range(nx):
         P += Fnc[r] * v[r]
@@ -255,7 +282,7 @@ def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
         return 2
     if full:
         _reactions(x, v, bb, rhs, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, ni, nq,
-                   ext)
+                   ext, z)
     ok = P == P
     for c in range(ni):
         out[c] = qdi[c]
@@ -269,7 +296,7 @@ def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
 
 @njit
 def _reactions(x, v, bb, qdd, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, ni, nq,
-               ext):
+               ext, z):
     """Fill ``ext`` (see :func:`evaluate`) after the solve for q_I''."""
     nx = 3 * nb
     ls = fp[2]
@@ -289,7 +316,6 @@ def _reactions(x, v, bb, qdd, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb
             s += GB[k, c] * qdd[c]
         rows_a[k] = s
     # residual of the free bodies: M x'' + h - F (F with the drives on their coordinates)
-    z = np.empty(nx)
     Ftot = ext[o + 3 * nq + nc:o + 3 * nq + nc + nx]
     ob = ip[H_FOFF + S_BODY]
     for r in range(nx):
@@ -327,10 +353,11 @@ def first_order(t, y, ip, fp, ri, rf, dims, ws, status):
     ni = dims[D_NI]
     out = np.empty(2 * ni + 1)
     status[0] = evaluate(t, y[:ni], y[ni:2 * ni], ip, fp, ri, rf, dims, ws, out,
-                          np.empty(0), False)
+                          np.empty(0), status.size < 0)  # a runtime False (one compilation)
     return out
 
 
 @njit
 def full(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, status):
-    status[0] = evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, True)
+    status[0] = evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext,
+                         status.size > 0)  # a runtime True (one compilation of evaluate)

@@ -427,6 +427,11 @@ class ChartBook:
         """Whether a pose at s would be checked by :meth:`watch` (cheap)."""
         return self._checked is None or abs(s - self._checked[0]) >= self._checked[1]
 
+    def watch_window(self) -> tuple[float, float]:
+        """``(centre, half width)``: :meth:`due` is true where |s - centre| >= half width
+        (a compiled loop checks it without calling back)."""
+        return (0.0, 0.0) if self._checked is None else self._checked
+
     def watch(self, s: float, x, *, force_at: float | None = None) -> BranchChart | None:
         """Check the solved pose x at s for a singular position within reach and build
         its chart.  Returns the chart built by this call, else None.

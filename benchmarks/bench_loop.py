@@ -1,0 +1,140 @@
+"""How close a run is to its limit: wall time against evaluations x the kernel's cost.
+
+For four fixed-structure runs on the compiled (Numba) backend -- Andrews' squeezer to
+0.03 s at rtol 1e-9, the clutchless press (paper case) over 0.05 s at rtol 1e-9, the
+bundled slider-crank spun up by its motor from 1500 rpm for 2 s at rtol 1e-11 and the
+bundled four-bar over 3 s at rtol 1e-11 -- one run reports, for the compiled loop
+(``dop853``, the default) and SciPy's DOP853 stepped from Python (``scipy-dop853``, the
+loop of the releases before):
+
+* the wall time of ``mechdyn.simulate`` (best of a few, model compiled beforehand);
+* the number of right-hand-side evaluations of the integrator;
+* the kernel's own cost per evaluation, timed in a compiled loop over the states of the
+  run (in order, so that every Newton solve starts from the previous pose as in a run),
+  without allocating (:func:`mechdyn.kernels.dop853_numba.evaluate_states`);
+* the ratio wall / (evaluations x cost): 1 is the limit, the overhead above it is the
+  integration loop, the per-step work in Python and the fixed cost per run;
+* the accuracy: Andrews against the Test Set reference (significant digits), the others
+  against a run at rtol 1e-13 (digits in the coordinate and its rate) and the energy
+  drift (J, conservative runs).
+
+``python -m benchmarks loop`` runs it (``python -m benchmarks.bench_loop`` prints one line
+per run).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from mechdyn.dynamics.mode_equations import ModeEquations
+from mechdyn.dynamics.mode_system import ModeSystem
+from mechdyn.dynamics.modes import switched_model
+from mechdyn.examples import andrews, load
+from mechdyn.examples.paper_case import press_idle
+from mechdyn.kernels.rows_numba import NUMBA
+from mechdyn.model.workspace import Workspace
+from mechdyn.simulate import simulate
+
+from .bench_dynamics import _best_of
+
+#: (name, model factory, t_end s, simulate keywords)
+CASES = (
+    ("andrews 0.03 s rtol 1e-9", lambda: andrews.build(), 0.03, {"rtol": 1e-9, "atol": 1e-12}),
+    ("press 0.05 s rtol 1e-9", lambda: press_idle(), 0.05, {"rtol": 1e-9}),
+    ("slider-crank spin-up 2 s rtol 1e-11", lambda: load("slider_crank"), 2.0,
+     {"rtol": 1e-11}),
+    ("four-bar 3 s rtol 1e-11", lambda: load("four_bar"), 3.0, {"rtol": 1e-11}),
+)
+
+
+def kernel_cost(model, tr, passes: int = 40) -> float:
+    """Seconds per evaluation of the mode's compiled kernel, timed in a compiled loop over
+    the states of the run ``tr`` (in order): the best of many short passes (the machine
+    is shared; a pass is about 2000 evaluations)."""
+    from mechdyn.dynamics.compiled_loop import buffers
+    from mechdyn.kernels.dop853_numba import evaluate_states
+
+    sm = switched_model(model)
+    ms = ModeSystem(sm, frozenset(), {}, tr.x[0], workspace=Workspace())
+    k = ModeEquations(sm, ms, "numba").kernel
+    b = buffers(k)
+    Y = np.ascontiguousarray(np.hstack([tr.q[:, ms.coords], tr.qdot[:, ms.coords]]))
+    best = np.inf
+    for start in range(passes):
+        a = (start * 2000) % max(1, len(Y) - 2000) if len(Y) > 2000 else 0
+        chunk = slice(a, a + 2000)
+        reps = max(1, 2000 // len(Y[chunk]))
+        k.reset(tr.x[chunk.start])
+        t0 = time.perf_counter()
+        evaluate_states(tr.t[chunk], Y[chunk], reps, *k._arrays, k.ws, b.sc, b.piv)
+        best = min(best, (time.perf_counter() - t0) / (reps * len(Y[chunk])))
+    return best
+
+
+def _digits(model, name, tr, t_end, opts):
+    if name.startswith("andrews"):
+        ang = andrews.test_set_angles(model, tr.x[-1])
+        ref = andrews.REFERENCE_T003
+        return -np.log10(max(abs(ang[k] - ref[k]) / abs(ref[k]) for k in ref)), np.nan
+    ref = simulate(model, t_end, progress=False, t_eval=[t_end],
+                   **{**opts, "rtol": 1e-13, "atol": 1e-16, "integrator": "scipy-dop853"})
+    eq = abs(tr.q[-1, 0] - ref.q[-1, 0]) / max(abs(ref.q[-1, 0]), 1e-300)
+    ed = abs(tr.qdot[-1, 0] - ref.qdot[-1, 0]) / max(abs(ref.qdot[-1, 0]), 1e-300)
+    return -np.log10(max(eq, 1e-17)), -np.log10(max(ed, 1e-17))
+
+
+def table(integrators=("dop853", "scipy-dop853"), repeat: int = 7) -> list[dict]:
+    """One row per (case, integrator): wall, evaluations, cost, ratio, accuracy (the runs
+    of the integrators interleaved, the best wall time of each)."""
+    out = []
+    for name, build, t_end, opts in CASES:
+        model = build().compile()
+        simulate(model, min(t_end, 1e-3), progress=False, **opts)  # compile / load kernels
+        best = dict.fromkeys(integrators, np.inf)
+        runs = {}
+        for _ in range(repeat):
+            for integ in integrators:
+                wall, runs[integ] = _best_of(lambda m=model, te=t_end, o=opts, i=integ: simulate(
+                    m, te, progress=False, integrator=i, **o), 1)
+                best[integ] = min(best[integ], wall)
+        cost = None
+        for integ in integrators:
+            tr = runs[integ]
+            assert tr.success, tr.message
+            if cost is None:
+                cost = kernel_cost(model, tr)
+            evals = tr.stats["evaluations"]
+            d_q, d_v = _digits(model, name, tr, t_end, opts)
+            drift = tr.energy_drift() if np.all(tr.energy["work_nc"] == 0.0) else np.nan
+            out.append(dict(case=name, integrator=integ, wall=best[integ], evals=evals,
+                            cost=cost, ratio=best[integ] / (evals * cost),
+                            steps=tr.stats["steps"],
+                            # SciPy's solver classes do not report their rejected steps
+                            rejected=tr.stats["rejected"] if integ == "dop853" else "?",
+                            digits_q=d_q, digits_v=d_v, drift=drift))
+    return out
+
+
+def run(quick: bool = False) -> list[dict]:
+    if not NUMBA:
+        return [{"name": "compiled loop", "value": "skipped", "note": "numba not installed"}]
+    rows = []
+    for r in table(repeat=2 if quick else 7):
+        head = f"{r['case']} {r['integrator']}"
+        rows.append({"name": f"{head} wall", "value": r["wall"] * 1e3, "unit": "ms",
+                     "note": f"{r['evals']} evals ({r['steps']} steps, {r['rejected']} "
+                             f"rejected), {r['digits_q']:.1f}/{r['digits_v']:.1f} digits, "
+                             f"drift {r['drift']:.1e} J"})
+        rows.append({"name": f"{head} kernel cost", "value": r["cost"] * 1e6, "unit": "us"})
+        rows.append({"name": f"{head} wall/(evals x cost)", "value": r["ratio"], "unit": ""})
+    return rows
+
+
+if __name__ == "__main__":
+    for r in table():
+        print(f"{r['case']:38s} {r['integrator']:13s} wall {r['wall'] * 1e3:8.2f} ms  "
+              f"evals {r['evals']:6d}  cost {r['cost'] * 1e6:6.2f} us  ratio {r['ratio']:5.2f}  "
+              f"steps {r['steps']:5d}/{r['rejected']:>4}  digits {r['digits_q']:4.1f}/"
+              f"{r['digits_v']:4.1f}  drift {r['drift']:.1e}")

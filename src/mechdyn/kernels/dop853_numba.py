@@ -1,0 +1,364 @@
+"""The compiled integration loop: DOP853 fused with a mode's kernel.
+
+:func:`run` integrates y = (q_I, q_I', w), y' = (q_I', q_I'', P_nc) with the embedded
+Dormand-Prince 8(5,3) pair (:mod:`mechdyn.integrate.dop853_tableau`), its step control
+(the error norm of orders 5 and 3 of Hairer's DOP853, step factors within [1/6, 3] with
+safety 0.9, no increase right after a rejection) and its dense output of order 7, every
+stage evaluated by :func:`mechdyn.kernels.lagrange_numba.evaluate_into` -- the position
+solve from the last pose, the analogs, the mass matrix and its factorization -- without
+allocating and without going back to Python.  It returns only
+
+* ``BATCH``: the output buffers are full (or ``max_steps`` steps were taken): the
+  caller records the samples and calls again;
+* ``DONE``: ``t_end`` reached;
+* ``FLAGGED``: the step just accepted needs a check in Python (``flags``: a coordinate
+  rate changed sign -- a dead position may be near --, a small pivot of the position
+  Jacobian, a stalling step); its samples are not recorded and its dense output is in
+  ``dns``;
+* ``WATCH``: the watch of the branch charts is due (at the coordinate ``par[P_WS]`` and
+  the pose ``x_end[2 n_x:]`` of the first evaluation where it was); the step is done;
+* ``FAILED``: the kernel failed at a stage, or the step fell below the smallest step;
+  the state is the last accepted one.
+
+The arrays of a call (all preallocated by the caller, see
+:class:`mechdyn.dynamics.compiled_loop.LoopBuffers`): ``par`` (float) and ``ipar`` (int)
+hold the scalars named by the ``P_*`` and ``I_*`` indices below.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..integrate.dop853_tableau import E3, E5, N_STAGES, A, C, D
+from .lagrange_numba import D_NI, N_FLAGS, W_PIVOT, evaluate_into
+from .rows_numba import njit
+
+__all__ = ["run", "evaluate_states", "dense_at", "DONE", "BATCH", "FLAGGED", "FAILED", "WATCH",
+           "F_TURN", "F_PIVOT", "F_STALL", "P_T", "P_TEND", "P_H", "P_RTOL",
+           "P_HMAX", "P_STALL", "P_PIVOT", "P_WC0", "P_WC1", "P_LAST", "P_TOLD", "P_HOLD",
+           "I_EVALS", "I_STEPS", "I_REJ", "I_NOUT", "I_NEXT", "I_FLAGS", "I_FSAL",
+           "I_EVERY", "I_WATCH", "I_MAXSTEPS", "I_STATUS", "I_PREV", "I_WPEND", "P_WS",
+           "N_PAR", "N_IPAR"]
+
+# return codes of run
+DONE, BATCH, FLAGGED, FAILED, WATCH = 0, 1, 2, 3, 4
+# flags of a FLAGGED step
+F_TURN, F_PIVOT, F_STALL = 1, 2, 8
+# par: time, end, step, rtol, largest step, stall step, pivot ratio to check, watch window
+# (centre, half width), last sample time, start and size of the last step, coordinate of a
+# watch due
+P_T, P_TEND, P_H, P_RTOL, P_HMAX, P_STALL, P_PIVOT, P_WC0, P_WC1, P_LAST, P_TOLD, P_HOLD, \
+    P_WS, P_BETA, P_ERROLD = range(15)
+N_PAR = 15
+# ipar: evaluations, accepted and rejected steps, samples in the buffers, next t_eval,
+# flags, f valid, every step sampled, watch on, steps per call, kernel status, history,
+# a watch due
+I_EVALS, I_STEPS, I_REJ, I_NOUT, I_NEXT, I_FLAGS, I_FSAL, I_EVERY, I_WATCH, I_MAXSTEPS, \
+    I_STATUS, I_PREV, I_WPEND = range(13)
+N_IPAR = 13
+
+
+@njit
+def _counted(ts, ys, fout, ni, ip, fp, ri, rf, dims, ws, ext, full, sc, piv, ipar):
+    """One evaluation y' = (q_I', q_I'', P_nc) at (ts, ys), counted; False where the kernel
+    failed (its status in ipar).  ``full`` must be a runtime boolean: a literal True or
+    False would compile the kernel once more for each (minutes of first use)."""
+    ipar[I_EVALS] += 1
+    st = evaluate_into(ts, ys[:ni], ys[ni:2 * ni], ip, fp, ri, rf, dims, ws, fout, ext, full,
+                       sc, piv)
+    ipar[I_STATUS] = st
+    return st == 0
+
+
+@njit
+def _stage(y, K, s, h, ys):
+    """ys = y + h sum_j a_sj K_j."""
+    m = y.size
+    for i in range(m):
+        acc = 0.0
+        for j in range(s):
+            a = A[s, j]
+            if a != 0.0:
+                acc += a * K[j, i]
+        ys[i] = y[i] + h * acc
+
+
+@njit
+def dense_at(dns, y_old, t_old, h, ts, out):
+    """The dense output of order 7 of a step at ``ts`` into ``out``."""
+    s = (ts - t_old) / h
+    s1 = 1.0 - s
+    for i in range(y_old.size):
+        out[i] = y_old[i] + s * (dns[0, i] + s1 * (dns[1, i] + s * (dns[2, i] + s1 * (
+            dns[3, i] + s * (dns[4, i] + s1 * (dns[5, i] + s * dns[6, i]))))))
+
+
+@njit
+def _dense(y, ynew, f, fnew, K, h, dns):
+    """The coefficients of the dense output, the three extra stages in K."""
+    m = y.size
+    for i in range(m):
+        dy = ynew[i] - y[i]
+        dns[0, i] = dy
+        dns[1, i] = h * f[i] - dy
+        dns[2, i] = 2.0 * dy - h * (f[i] + fnew[i])
+        for k in range(4):
+            acc = 0.0
+            for j in range(N_STAGES + 4):
+                acc += D[k, j] * K[j, i]
+            dns[3 + k, i] = h * acc
+
+
+@njit
+def _watch(s, ws, nx, par, ipar, x_end):
+    """Keep the first evaluation (coordinate s, pose) where the watch of the branch charts
+    is due (its pose in x_end[2 n_x:])."""
+    if ipar[I_WATCH] != 0 and ipar[I_WPEND] == 0 and abs(s - par[P_WC0]) >= par[P_WC1]:
+        ipar[I_WPEND] = 1
+        par[P_WS] = s
+        for i in range(nx):
+            x_end[2 * nx + i] = ws[i]
+
+
+@njit
+def _record(k, ts, y, ws, ext, nx, ni, o_t, o_y, o_x, o_xd, o_ext):
+    o_t[k] = ts
+    o_y[k, :] = y
+    o_x[k, :] = ws[:nx]
+    o = nx + ni + nx * ni
+    o_xd[k, :] = ws[o:o + nx]
+    o_ext[k, :] = ext
+
+
+@njit
+def _initial_guess(y, f, atol, rtol, hmax):
+    """Hairer's starting step for order 8, first part: ``(h, |f|^2)``."""
+    m = y.size
+    dnf = 0.0
+    dny = 0.0
+    for i in range(m):
+        sk = atol[i] + rtol * abs(y[i])
+        dnf += (f[i] / sk) ** 2
+        dny += (y[i] / sk) ** 2
+    h = 1e-6 if (dnf <= 1e-10 or dny <= 1e-10) else 0.01 * np.sqrt(dny / dnf)
+    return min(h, hmax), dnf
+
+
+@njit
+def _initial_step(y, f, f1, h, dnf, atol, rtol, hmax):
+    """Hairer's starting step, second part, from f1 = f(t + h, y + h f)."""
+    m = y.size
+    der2 = 0.0
+    for i in range(m):
+        sk = atol[i] + rtol * abs(y[i])
+        der2 += ((f1[i] - f[i]) / sk) ** 2
+    der2 = np.sqrt(der2) / h
+    der12 = max(der2, np.sqrt(dnf))
+    h1 = max(1e-6, h * 1e-3) if der12 <= 1e-15 else (0.01 / der12) ** (1.0 / 8.0)
+    return min(100.0 * h, h1, hmax)
+
+
+@njit
+def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_xd, o_ext,
+        ext, ext_end, x_end, ip, fp, ri, rf, dims, ws, sc, piv):
+    """Integrate from ``par[P_T]`` (state ``y``, rates ``f`` when ``ipar[I_FSAL]``) towards
+    ``par[P_TEND]``; returns DONE, BATCH, FLAGGED or FAILED (see the module)."""
+    ni = dims[D_NI]
+    nx = x_end.size // 3
+    m = y.size
+    cap = o_t.size
+    n_te = t_eval.size
+    t = par[P_T]
+    t_end = par[P_TEND]
+    rtol = par[P_RTOL]
+    hmax = par[P_HMAX]
+    every = ipar[I_EVERY] != 0
+    off = ipar[I_FSAL] < 0  # False and True at run time (see _counted)
+    on = not off
+    if ipar[I_FSAL] == 0:
+        if not _counted(t, y, f, ni, ip, fp, ri, rf, dims, ws, ext, off, sc, piv, ipar):
+            return FAILED
+        ipar[I_FSAL] = 1
+    h = par[P_H]
+    if not h > 0.0:
+        h, dnf = _initial_guess(y, f, atol, rtol, hmax)
+        for i in range(m):
+            K[1, i] = y[i] + h * f[i]
+        if _counted(t + h, K[1], K[2], ni, ip, fp, ri, rf, dims, ws, ext, off, sc, piv, ipar):
+            h = _initial_step(y, f, K[2], h, dnf, atol, rtol, hmax)
+    rejected = False
+    steps = 0
+    ipar[I_FLAGS] = 0
+    while True:
+        if t >= t_end:
+            par[P_T], par[P_H] = t, h
+            return DONE
+        if steps >= ipar[I_MAXSTEPS]:
+            par[P_T], par[P_H] = t, h
+            return BATCH
+        hmin = 10.0 * abs(np.nextafter(t, np.inf) - t)
+        h = min(max(h, hmin), hmax)
+        last = t + 1.01 * h >= t_end
+        if last:
+            h = t_end - t
+        # room in the buffers for the samples this step can give
+        k = ipar[I_NEXT]
+        while k < n_te and t_eval[k] <= t + h:
+            k += 1
+        need = k - ipar[I_NEXT] + (1 if every else 0)
+        if ipar[I_NOUT] + need > cap:
+            if ipar[I_NOUT] > 0:
+                par[P_T], par[P_H] = t, h
+                return BATCH
+            h = t_eval[ipar[I_NEXT] + cap - 2] - t  # at most cap - 1 samples in a step
+            last = False
+        t_new = t_end if last else t + h
+        # the stages
+        for i in range(m):
+            K[0, i] = f[i]
+        for s in range(1, N_STAGES):
+            _stage(y, K, s, h, ys)
+            if not _counted(t + C[s] * h, ys, K[s], ni, ip, fp, ri, rf, dims, ws, ext, off,
+                            sc, piv, ipar):
+                par[P_T], par[P_H] = t, h
+                return FAILED
+            _watch(ys[0], ws, nx, par, ipar, x_end)
+        _stage(y, K, N_STAGES, h, ynew)
+        # the error estimate (orders 5 and 3)
+        e5n = 0.0
+        e3n = 0.0
+        for i in range(m):
+            sk = atol[i] + rtol * max(abs(y[i]), abs(ynew[i]))
+            a5 = 0.0
+            a3 = 0.0
+            for j in range(N_STAGES):
+                a5 += E5[j] * K[j, i]
+                a3 += E3[j] * K[j, i]
+            e5n += (a5 / sk) ** 2
+            e3n += (a3 / sk) ** 2
+        deno = e5n + 0.01 * e3n
+        err = abs(h) * e5n / np.sqrt(m * (deno if deno > 0.0 else 1.0))
+        if not err == err:
+            err = np.inf
+        fac11 = err ** (0.125 - 0.2 * par[P_BETA])
+        if err > 1.0:  # rejected
+            ipar[I_REJ] += 1
+            rejected = True
+            h = h / min(3.0, fac11 / 0.9)
+            if h < hmin:
+                par[P_T], par[P_H] = t, h
+                ipar[I_STATUS] = -1
+                return FAILED
+            continue
+        # accepted: the rates at the new point (with every output there when sampled)
+        end_sample = every
+        k = ipar[I_NEXT]
+        while k < n_te and t_eval[k] <= t_new:
+            if t_eval[k] >= t_new:
+                end_sample = True
+            k += 1
+        fnew = K[N_STAGES]
+        if not _counted(t_new, ynew, fnew, ni, ip, fp, ri, rf, dims, ws, ext_end, end_sample,
+                        sc, piv, ipar):
+            par[P_T], par[P_H] = t, h
+            return FAILED
+        _watch(ynew[0], ws, nx, par, ipar, x_end)
+        steps += 1
+        ipar[I_STEPS] += 1
+        fac = fac11 / par[P_ERROLD] ** par[P_BETA] if par[P_BETA] != 0.0 else fac11
+        par[P_ERROLD] = max(err, 1e-4)
+        fac = max(1.0 / 6.0, min(3.0, fac / 0.9))
+        h_next = h / fac
+        if rejected:
+            h_next = min(h_next, h)
+        rejected = False
+        # what Python must look at
+        flags = 0
+        for c in range(ni):
+            if (y[ni + c] > 0.0 and ynew[ni + c] < 0.0) or (y[ni + c] < 0.0
+                                                           and ynew[ni + c] > 0.0):
+                flags |= F_TURN
+        if ws[ws.size - N_FLAGS + W_PIVOT] < par[P_PIVOT]:
+            flags |= F_PIVOT
+        if h < par[P_STALL]:
+            flags |= F_STALL
+        o = nx + ni + nx * ni
+        for i in range(nx):
+            x_end[i] = ws[i]
+            x_end[nx + i] = ws[o + i]
+        # history: start of the previous step, start and end of this one
+        hist[0, :] = hist[1, :]
+        hist[1, 0] = t
+        hist[1, 1:m + 1] = y
+        hist[1, m + 1:] = f
+        hist[2, 0] = t_new
+        hist[2, 1:m + 1] = ynew
+        hist[2, m + 1:] = fnew
+        par[P_TOLD], par[P_HOLD] = t, h
+        interior = ipar[I_NEXT] < n_te and t_eval[ipar[I_NEXT]] < t_new
+        if flags != 0 or interior:
+            for s in range(N_STAGES + 1, N_STAGES + 4):  # the stages of the dense output
+                _stage(y, K, s, h, ys)
+                if not _counted(t + C[s] * h, ys, K[s], ni, ip, fp, ri, rf, dims, ws, ext, off,
+                                sc, piv, ipar):
+                    par[P_T], par[P_H] = t, h
+                    return FAILED
+            _dense(y, ynew, f, fnew, K, h, dns)
+        if flags != 0:
+            ipar[I_FLAGS] = flags
+            for i in range(m):
+                y[i] = ynew[i]
+                f[i] = fnew[i]
+            ipar[I_PREV] += 1
+            par[P_T], par[P_H] = t_new, h_next
+            return FLAGGED
+        # the samples of the step: t_eval inside it (dense output), then its end
+        while ipar[I_NEXT] < n_te and t_eval[ipar[I_NEXT]] <= t_new:
+            ts = t_eval[ipar[I_NEXT]]
+            ipar[I_NEXT] += 1
+            if ts <= par[P_LAST] or ts >= t_new:
+                continue
+            dense_at(dns, y, t, h, ts, ys)
+            if not _counted(ts, ys, K[N_STAGES + 1], ni, ip, fp, ri, rf, dims, ws, ext, on,
+                            sc, piv, ipar):
+                ipar[I_EVALS] -= 1  # an output sample, not a step's evaluation
+                return FAILED
+            ipar[I_EVALS] -= 1
+            _record(ipar[I_NOUT], ts, ys, ws, ext, nx, ni, o_t, o_y, o_x, o_xd, o_ext)
+            ipar[I_NOUT] += 1
+            par[P_LAST] = ts
+        if end_sample and t_new > par[P_LAST]:
+            k = ipar[I_NOUT]
+            o_t[k] = t_new
+            o_y[k, :] = ynew
+            o_x[k, :] = x_end[:nx]
+            o_xd[k, :] = x_end[nx:2 * nx]
+            o_ext[k, :] = ext_end
+            ipar[I_NOUT] += 1
+            par[P_LAST] = t_new
+        for i in range(m):
+            y[i] = ynew[i]
+            f[i] = fnew[i]
+        ipar[I_PREV] += 1
+        t = t_new
+        h = h_next
+        if ipar[I_WPEND] != 0:
+            par[P_T], par[P_H] = t, h
+            return WATCH
+
+
+@njit
+def evaluate_states(t, Y, reps, ip, fp, ri, rf, dims, ws, sc, piv):
+    """Evaluate the kernel ``reps`` times over the states ``Y`` (rows (q_I, q_I')) in order,
+    without allocating (the timing loop of the benchmarks); returns the number of
+    failures."""
+    ni = dims[D_NI]
+    out = np.empty(2 * ni + 1)
+    ext = np.empty(0)
+    bad = 0
+    for _ in range(reps):
+        for k in range(Y.shape[0]):
+            if evaluate_into(t[k], Y[k, :ni], Y[k, ni:], ip, fp, ri, rf, dims, ws, out, ext,
+                             reps < 0, sc, piv):  # a runtime False (see _counted)
+                bad += 1
+    return bad
