@@ -128,3 +128,21 @@ def test_python_errors_name_the_coordinate():
     m.add_coordinate("Z", kind="y", body="blok")
     with pytest.raises(ModelError, match=r"coordinate 'Z': body: .*'blok'.*'block'"):
         m.compile()
+
+
+def test_a_stop_on_a_body_position_is_not_drawn_as_an_angle():
+    """A pendulum whose coordinate is the x of its origin (0.5 m from the pin): a stop on
+    it is not drawn as a ray (that of a stop on an angle); one on the pin's angle is."""
+    from mechdyn.mechanism.contact import Stop
+    from mechdyn.results.animate import frame_geometry
+
+    m = Mechanism("pendulum")
+    m.add_body("bar", mass=1.0, com=(0.5, 0.0), points={"P": (0.5, 0.0)},
+               pose=(-0.5 * np.cos(1.2), -0.5 * np.sin(1.2), 1.2))
+    m.add_revolute("O", "ground", "bar", (0.0, 0.0), "P")
+    m.add_coordinate("X", kind="x", body="bar")
+    m.add(Stop("wall", "X", upper=0.45))
+    m.add(Stop("pin_limit", "joint:O", upper=3.0))
+    tr = mechdyn.simulate(m, 0.1, t_eval=np.linspace(0.0, 0.1, 3), progress=False)
+    assert tr.x[0, 2] == pytest.approx(1.2, abs=1e-9)
+    assert set(frame_geometry(tr, 1)["stops"]) == {"pin_limit@upper"}
