@@ -4,16 +4,16 @@ Run ``python -m benchmarks foundation`` or ``python benchmarks/bench_foundation.
 
 The bundled press cycle (``mechdyn.examples.load("press_cycle")``, the isolators of its
 ``[foundation]`` table) is simulated over the same interval on its fixed frame and
-``mechdyn.foundation.mounted`` on its isolators (three more coordinates, two massless
-sleds, four isolator springs): as it stands (``external``: the cylinder, spring and
-punch forces push the whole mounted machine) and with the frame carrying their
-reactions (``bed``: ``reacting=BED``, the press as built; ``mechdyn foundation
+``mechdyn.foundation.mounted`` on its isolators (one more body, the base, free with
+three more coordinates, and four isolator springs): as it stands (``external``: the
+cylinder, spring and punch forces push the whole mounted machine) and with the frame
+carrying their reactions (``bed``: ``reacting=BED``, the press as built; ``mechdyn foundation
 press_cycle --coupled --bed ...``).  After a short warm-up run of each (kernels
 compiled or loaded) the runs alternate, a few times each, and the best wall time
 and CPU time of each are kept (the machine is shared: the best is the least disturbed
 run); the ratio of the wall times is the acceptance figure (at most 1.5).  Steps,
 evaluations, segments and events are reported beside them: the mounted runs follow
-the base's vibration (13 to 33 Hz) and its impacts, on a larger system (8 bodies
+the base's vibration (13 to 33 Hz) and its impacts, on a larger system (6 bodies
 against 5).
 """
 

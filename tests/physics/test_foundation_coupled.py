@@ -79,7 +79,8 @@ def test_unbalance_transmissibility_closed_form(spinning):
 
 def test_floor_force_is_the_frame_force_of_the_floor(spinning):
     """The isolator springs' forces (our geometry) against the engine's frame loads of
-    the new ground (its reactions and spring ends): the sleds transmit nothing."""
+    the new ground (its reactions and spring ends): no joint holds the base to the
+    floor."""
     f, tr = spinning
     ff = floor_forces(tr, f, gravity=(0.0, 0.0))
     df = tr.to_dataframe(energy=False, bodies=False, degrees=False)

@@ -12,6 +12,8 @@ which bisects for the edge of the assembly region).
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from ..errors import (
@@ -21,10 +23,12 @@ from ..errors import (
     SingularPositionError,
     Status,
 )
+from ..kernels import rows_numpy as RN
 from ..kinematics.assembly import DEAD_RCOND
+from ..mechanism.coordinate import BODY_KINDS
 from .contact import ContactError
 
-__all__ = ["turning_point", "diagnose", "status_of", "TURN_RCOND"]
+__all__ = ["turning_point", "rigid_coordinates", "diagnose", "status_of", "TURN_RCOND"]
 
 
 def _where(ms, q) -> str:
@@ -44,11 +48,100 @@ def _dependent(rep) -> str:
 TURN_RCOND = 1e-2
 
 
+#: mode system -> the indices of :func:`rigid_coordinates` (found once per mode system)
+_RIGID: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _assembly(rows, b: int) -> set[int]:
+    """Body ``b`` and every body that the rows join to it, not passing through the ground
+    (a row joins the bodies of its points, when it has a direction, and of its angles;
+    the body of its direction alone does not count)."""
+    nb = rows.nb
+    uses = [set() for _ in range(len(rows))]
+    for r in range(len(rows)):
+        if np.any(rows.u[r] != 0.0):
+            uses[r].update((int(rows.b1[r]), int(rows.b2[r])))
+        if rows.ka[r] != 0.0:
+            uses[r].add(int(rows.a[r]))
+        if rows.kb[r] != 0.0:
+            uses[r].add(int(rows.bb[r]))
+    found, grew = {b}, True
+    while grew:
+        grew = False
+        for u in uses:
+            if u & found and not u <= found:
+                found |= u
+                grew = True
+    return found if nb not in found else set()
+
+
+def rigid_coordinates(ms, x) -> frozenset:
+    """The mode's coordinates that cannot carry a dead position: their positions in
+    ``ms.coord_names``.
+
+    The rule: a coordinate that measures a body B (kind ``"x"``, ``"y"`` or ``"angle"``)
+    qualifies when moving B rigidly (along x, along y, or turning about B's origin)
+    together with every body the mode's constraint rows join to it, none of the rows
+    reaching the ground, changes no row and no other coordinate.  That motion w then
+    gives J w = e_k for the position Jacobian J = [rows_I; g_I] of the mode and the
+    coordinate's row k, so every left null vector u of J has u_k = u^T J w = 0: the
+    coordinate never carries a singular position, and the reversals of its rate (a
+    base vibrating on its isolators) need no check.  The simplest case is a body whose
+    only constraint rows are its coordinate rows (a free body); the base of a
+    :func:`~mechdyn.foundation.mounted` machine, with the machine's joints on it and its
+    own ``x``, ``y`` and angle coordinates, is the case this is for.  The assembly is
+    found from the rows' bodies; J w = e_k is then verified at the pose ``x``.
+
+    Parameters
+    ----------
+    ms : ModeSystem
+    x : ndarray, shape (n_x,)
+        A pose of the mode (the check of J w = e_k).
+
+    Returns
+    -------
+    frozenset of int
+    """
+    if ms in _RIGID:
+        return _RIGID[ms]
+    model = ms.model
+    coords = list(model.mechanism.coordinates.values())
+    rows = ms.layout.position_rows
+    n_ind = len(ms.independent_rows)
+    sel = np.concatenate([ms.independent_rows, ms.n_rows + np.asarray(ms.coords, int)])
+    J = None
+    out = set()
+    for k, ci in enumerate(ms.coords):
+        c = coords[ci]
+        if c.kind not in BODY_KINDS:
+            continue
+        b = model.body_names.index(c.body)
+        bodies = _assembly(ms.rowset, b)
+        if not bodies:
+            continue  # joined to the ground
+        w = np.zeros(model.n_x)
+        for i in bodies:
+            if c.kind == "angle":  # turning about B's origin
+                w[3 * i:3 * i + 3] = (-(x[3 * i + 1] - x[3 * b + 1]), x[3 * i] - x[3 * b], 1.0)
+            else:
+                w[3 * i + "xy".index(c.kind)] = 1.0
+        J = RN.jacobian(rows, x)[sel] if J is None else J
+        e = np.zeros(len(sel))
+        e[n_ind + k] = 1.0
+        Jw = J @ w
+        if np.abs(Jw - e).max() <= 1e-9 * max(1.0, np.abs(J).max() * np.abs(w).max()):
+            out.add(k)
+    _RIGID[ms] = frozenset(out)
+    return _RIGID[ms]
+
+
 def turning_point(eqs, step, qd_old, x_good) -> str | None:
     """A coordinate whose rate changes sign during the step may turn back at a dead
     position (the rate of the driving coordinate vanishes there and the mechanism would
     have to change assembly branch to go on): locate the turn on the dense output and
-    test the position there.
+    test the position there.  The coordinates of :func:`rigid_coordinates` (the pose of
+    a free body or of a mounted base, which no singular position can involve) are not
+    tested.
 
     Parameters
     ----------
@@ -66,6 +159,9 @@ def turning_point(eqs, step, qd_old, x_good) -> str | None:
         The message of a dead position, or None.
     """
     turns = np.flatnonzero(np.sign(qd_old) * np.sign(step.qdot) < 0)
+    if turns.size:
+        rigid = rigid_coordinates(eqs.ms, x_good)
+        turns = np.array([k for k in turns if k not in rigid], dtype=int)
     if not turns.size:
         return None
     # the dense output and the solves below must leave the run as it is

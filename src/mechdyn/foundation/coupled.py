@@ -36,8 +36,8 @@ __all__ = ["floor_forces", "MountingComparison", "compare_mounting"]
 
 
 def floor_forces(trajectory, foundation: Foundation, base: str = "base",
-                 gravity=(0.0, -9.81), arm: float = ARM, point=(0.0, 0.0),
-                 pivot=(0.0, 0.0)) -> MountedResponse:
+                 gravity=(0.0, -9.81), arm: float = ARM,
+                 point=(0.0, 0.0)) -> MountedResponse:
     """The isolators' forces on the floor over a run of a :func:`mounted` machine, from the
     base's coordinates and the isolator springs' exact geometry.
 
@@ -53,8 +53,6 @@ def floor_forces(trajectory, foundation: Foundation, base: str = "base",
         As given to :func:`mounted`, m.
     point : (float, float)
         Point of the moment, m.
-    pivot : (float, float)
-        As given to :func:`mounted`, m.
 
     Returns
     -------
@@ -77,12 +75,12 @@ def floor_forces(trajectory, foundation: Foundation, base: str = "base",
     idx = [names.index(c) for c in base_coordinates(base)]
     u, v = trajectory.q[:, idx], trajectory.qdot[:, idx]
     geo = isolator_geometry(foundation, gravity, arm)
-    F = _spring_forces(foundation, geo, u, v, pivot)  # (n, iso, spring, 2) on the anchors
+    F = _spring_forces(foundation, geo, u, v)  # (n, iso, spring, 2) on the anchors
     per = F.sum(axis=2)
     anchors = geo[:, :, 1, :] - np.asarray(point, float)  # lines of action through them
     m = np.sum(anchors[..., 0] * F[..., 1] - anchors[..., 1] * F[..., 0], axis=(1, 2))
     floor = np.column_stack([per.sum(axis=1), m])
-    u, v = to_centre_of_mass(foundation, u, v, pivot)
+    u, v = to_centre_of_mass(foundation, u, v)
     return MountedResponse(t=np.asarray(trajectory.t, float), u=u, v=v, floor=floor,
                        supports={n: per[:, i] for i, n in enumerate(foundation.names)},
                        point=np.asarray(point, float))
@@ -200,7 +198,7 @@ def _on(t, ts, values):
 
 def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
                      t_end: float = 1.0, *, samples: int = 2001, base: str = "base",
-                     arm: float = ARM, pivot=(0.0, 0.0), reacting: Sequence[str] = (),
+                     arm: float = ARM, reacting: Sequence[str] = (),
                      rigid_run=None, **simulate_kw) -> MountingComparison:
     """Run the machine on a rigid frame and coupled on its isolators, and compare.
 
@@ -214,7 +212,7 @@ def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
         End of both runs, s.
     samples : int
         Points of the common time grid (both runs are sampled on it).
-    base, arm, pivot, reacting
+    base, arm, reacting
         As for :func:`~mechdyn.foundation.mounting.mounted`; the reactions of the
         ``reacting`` forces are also added to the rigid run's frame loads.
     rigid_run : Trajectory, optional
@@ -265,13 +263,12 @@ def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
     if reacting:
         machine = machine + _reaction_loads(rigid_run, reacting, loads.t)
     start = shift_moment(machine[0], point, f.com)
-    mm = mounted(mechanism, f, base=base, arm=arm, load=start, pivot=pivot,
-                 reacting=reacting)
+    mm = mounted(mechanism, f, base=base, arm=arm, load=start, reacting=reacting)
     coupled_run = simulate(mm, t_end, **simulate_kw)
     weight = shift_moment([*(f.mass * np.asarray(mechanism.gravity, float)), 0.0], f.com, point)
     rigid = _on(t, loads.t, machine) + weight
     one_way = mounted_response(f, t, rigid[:, 0], rigid[:, 1], rigid[:, 2], point=point)
-    ff = floor_forces(coupled_run, f, base, mechanism.gravity, arm, point, pivot)
+    ff = floor_forces(coupled_run, f, base, mechanism.gravity, arm, point)
     good = np.isfinite(ff.t)
     ts = ff.t[good]
     coupled = MountedResponse(t=t, u=_on(t, ts, ff.u[good]), v=_on(t, ts, ff.v[good]),

@@ -8,15 +8,11 @@ machine and base together, two-way coupled, on the one engine.
 
 How the base is held
 --------------------
-The engine declares coordinates as angles and joint travels, so the base's three
-coordinates come from a chain the base hangs in: the floor, a massless sled sliding
-along x (coordinate ``<base>_x``, the travel of the base's *pivot* from its sketch
-position, m; the pivot is a point of the base among the machine's joints, by default the
-origin), a massless sled sliding on it along y (``<base>_y``, m) and a pin at the pivot
-(``<base>_theta``, the base's absolute angle, rad).  The sleds have no
-mass and every one of their free directions ends on the base, so the chain transmits no
-force: the base is held by the isolators alone (the floor's reactions through the
-chain's joints stay at round-off).
+The base is a free body: its three coordinates are the pose of its frame, ``<base>_x``
+and ``<base>_y`` (coordinate kinds ``"x"`` and ``"y"``: the ground position of the
+base frame's origin, which in the sketch is the ground origin, so they are its
+displacement, m) and ``<base>_theta`` (kind ``"angle"``, its absolute angle, rad).  No
+joint holds it to the floor: it is held by the isolators alone.
 
 Each isolator is two linear spring-dampers of :class:`~mechdyn.mechanism.load.Spring`
 from the isolator's point on the base to an anchor on the floor ``arm`` (default 100 m)
@@ -325,7 +321,7 @@ def _extras(mech: Mechanism, base: str) -> dict:
 
 def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: str = "base",
             arm: float = ARM, equilibrium: bool = True, load=None,
-            pivot=(0.0, 0.0), reacting: Sequence[str] = ()) -> Mechanism:
+            reacting: Sequence[str] = ()) -> Mechanism:
     """The machine on its frame mounted on isolators: one mechanism, the floor its ground.
 
     Parameters
@@ -348,12 +344,6 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
         base's centre of mass, N m (e.g. the first frame load of a rigid run, inertia
         included), to start the base in its static deflection under it instead of under
         the machine's weights.
-    pivot : (float, float)
-        The point of the base (ground frame in the sketch, m) whose displacement the
-        coordinates ``<base>_x``, ``<base>_y`` measure and about which ``<base>_theta``
-        turns.  Keep it among the machine's joints on the frame (default the origin): the
-        engine measures the conditioning of the positions on lever arms from it, and far
-        from the joints a vibrating base would read as a dead position.
     reacting : sequence of str
         Names of :class:`~mechdyn.mechanism.load.Force` loads (direction fixed in the
         ground) whose reaction the frame carries: a cylinder or a spring pack on the frame
@@ -369,9 +359,9 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
     Mechanism
         A new mechanism: ``base`` with the ground's points (the floor keeps them too, for
         variables such as ``"dist(ground.P, ram.Q)"``), every element once attached
-        to the ground on it, two more massless bodies (``<base>_sled_x``,
-        ``<base>_sled_y``), the isolator springs ``<base>_<isolator>_x`` / ``_y`` and
-        the coordinates ``<base>_x``, ``<base>_y``, ``<base>_theta``.
+        to the ground on it, the isolator springs ``<base>_<isolator>_x`` / ``_y`` and
+        the base's coordinates ``<base>_x``, ``<base>_y`` (kinds ``"x"``, ``"y"``: its
+        origin's displacement from the sketch, m) and ``<base>_theta`` (rad).
 
     Raises
     ------
@@ -405,16 +395,13 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
     f = _foundation(mechanism, foundation)
     if not (np.isfinite(arm) and arm > 0):
         raise ModelError(f"mounted: arm must be a finite length > 0 m, got {arm!r}")
-    sx, sy = f"{base}_sled_x", f"{base}_sled_y"
-    names = [base, sx, sy, f"{base}_x_guide", f"{base}_y_guide", f"{base}_pin",
-             *base_coordinates(base)]
+    names = [base, *base_coordinates(base)]
     taken = [n for n in names if n in mechanism.bodies or n in mechanism.joints
              or n in mechanism.coordinates]
     if taken:
         raise ModelError(f"mounted: the name(s) {', '.join(map(repr, taken))} are taken by the "
                          f"mechanism; pass another base=... (now {base!r})")
     com = f.com
-    pv = tuple(float(v) for v in pivot)
     out = Mechanism(name=mechanism.name, gravity=tuple(mechanism.gravity),
                     description=mechanism.description,
                     ground=Ground(points=dict(mechanism.ground.points)))
@@ -444,15 +431,10 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
     for d in mechanism.drives:
         out.add(d)
     out.extras = _extras(mechanism, base)
-    # the chain that gives the base its coordinates (it transmits no force)
-    out.add(Body(sx, pose=(pv[0], pv[1], 0.0)))
-    out.add(Body(sy, pose=(pv[0], pv[1], 0.0)))
-    out.add(Prismatic(f"{base}_x_guide", GROUND, sx, pv, (1.0, 0.0), (0.0, 0.0), 0.0))
-    out.add(Prismatic(f"{base}_y_guide", sx, sy, (0.0, 0.0), (0.0, 1.0), (0.0, 0.0), 0.0))
-    out.add(Revolute(f"{base}_pin", sy, base, (0.0, 0.0), pv))
+    # the base is a free body: its coordinates are its frame's pose (sketch pose 0, 0, 0)
     cx, cy, cth = base_coordinates(base)
-    out.add(Coordinate(cx, "travel", joint=f"{base}_x_guide"))
-    out.add(Coordinate(cy, "travel", joint=f"{base}_y_guide"))
+    out.add(Coordinate(cx, "x", body=base))
+    out.add(Coordinate(cy, "y", body=base))
     out.add(Coordinate(cth, "angle", body=base))
     geo = isolator_geometry(f, mechanism.gravity, arm)
     for s, g, k, c in zip(f.supports, geo, f.stiffnesses(), f.dampings(), strict=True):
@@ -462,7 +444,7 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
                            damping=float(c[d])))
     out.foundation = f
     if equilibrium:
-        u0 = static_equilibrium(mechanism, f, arm, load, pv)
+        u0 = static_equilibrium(mechanism, f, arm, load)
         init = out.extras.setdefault("initial", {})
         q = init.setdefault("q", {})
         q.update({cx: float(u0[0]), cy: float(u0[1]), cth: float(u0[2])})

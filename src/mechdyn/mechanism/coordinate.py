@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 from ..errors import did_you_mean
 
-__all__ = ["Coordinate", "COORDINATE_KINDS", "coordinate_problems"]
+__all__ = ["Coordinate", "COORDINATE_KINDS", "BODY_KINDS", "LENGTH_KINDS", "coordinate_problems"]
 
 #: kind -> what it measures
 COORDINATE_KINDS = {
@@ -15,7 +15,13 @@ COORDINATE_KINDS = {
     "relative_angle": "relative angle of a revolute joint, rad "
                       "(theta_child - theta_parent + offset)",
     "travel": "travel of a prismatic joint along its axis, m (from the axis point, + offset)",
+    "x": "ground x of a body's origin, m (x_body + offset)",
+    "y": "ground y of a body's origin, m (y_body + offset)",
 }
+#: the kinds that measure a body (``body=``); the others measure a joint (``joint=``)
+BODY_KINDS = ("angle", "x", "y")
+#: the kinds measured in m (their rates in m/s); the others in rad
+LENGTH_KINDS = ("travel", "x", "y")
 
 
 @dataclass(frozen=True)
@@ -26,15 +32,21 @@ class Coordinate:
     ----------
     name : str
         Name used in results and on the command line (``phi``, ``psi``, ...).
-    kind : {"angle", "relative_angle", "travel"}
-        What the coordinate measures.
+    kind : {"angle", "relative_angle", "travel", "x", "y"}
+        What the coordinate measures (:data:`COORDINATE_KINDS`).
     body : str
-        For ``kind="angle"``: the body whose absolute angle it is.
+        For ``kind="angle"``: the body whose absolute angle it is; for ``kind="x"`` and
+        ``kind="y"``: the body whose origin's ground x or y it is.
     joint : str
         For ``kind="relative_angle"`` (a revolute) and ``kind="travel"`` (a prismatic).
     offset : float
         Added to the measured value (rad or m), so that e.g. a crank angle can be
         measured from a line other than the body's x axis.
+
+    Examples
+    --------
+    >>> Coordinate("h", "y", body="block").is_angle
+    False
     """
 
     name: str
@@ -45,7 +57,8 @@ class Coordinate:
 
     @property
     def is_angle(self) -> bool:
-        return self.kind in ("angle", "relative_angle")
+        """Whether the coordinate is an angle (rad), not a length (m)."""
+        return self.kind not in LENGTH_KINDS
 
 
 def coordinate_problems(kind: str, body: str | None, joint: str | None,
@@ -69,11 +82,12 @@ def coordinate_problems(kind: str, body: str | None, joint: str | None,
     if kind not in COORDINATE_KINDS:
         return [("kind", f"unknown kind {kind!r}; valid kinds: "
                  + ", ".join(repr(k) for k in COORDINATE_KINDS))]
-    if kind == "angle":
+    if kind in BODY_KINDS:
+        what = "absolute angle" if kind == "angle" else f"ground {kind} of the origin"
         if joint is not None:
-            return [("joint", "kind 'angle' measures a body; give 'body', not 'joint'")]
+            return [("joint", f"kind {kind!r} measures a body; give 'body', not 'joint'")]
         if body is None:
-            return [("", "kind 'angle' needs a body (it measures the absolute angle of a body)")]
+            return [("", f"kind {kind!r} needs a body (it measures the {what} of a body)")]
         return [] if body in bodies else [("body", did_you_mean(body, bodies, "body"))]
     want = "revolute" if kind == "relative_angle" else "prismatic"
     if body is not None:

@@ -8,8 +8,9 @@ walking from the ground (and from the bodies whose pose is given) through the jo
   coordinate without one counts as 0), a prismatic joint or a lock to a placed body, a
   ``relative_angle`` coordinate of a revolute to a placed body, or two revolutes to
   placed bodies (their points aimed);
-* its position from a revolute to a placed body (the joint point), a prismatic joint
-  (the point on the line at the initial ``travel``) or a lock;
+* its position from its ``x`` and ``y`` coordinates (their initial values; one of them
+  alone sets that component only), else from a revolute to a placed body (the joint
+  point), a prismatic joint (the point on the line at the initial ``travel``) or a lock;
 * a body joined by one revolute only, with nothing fixing its angle, is placed at that
   pin with angle 0 (the assembly then turns it), one joined to nothing placed at the
   origin.
@@ -90,7 +91,8 @@ def start_poses(mechanism, q0: dict | None = None) -> dict[str, tuple[float, flo
             if done:
                 break
         else:
-            placed[todo[0]] = (0.0, 0.0, 0.0)  # joined to nothing placed yet
+            # joined to nothing placed yet: at the origin, or where its coordinates say
+            _put(placed, todo[0], 0.0, 0.0, 0.0, _position(mechanism, todo[0], q0))
             done = [todo[0]]
         todo = [n for n in todo if n not in done]
     return {n: placed[n] for n in mechanism.bodies}
@@ -117,6 +119,22 @@ def _angle(mechanism, name: str, placed: dict, q0: dict):
     return None
 
 
+def _position(mechanism, name: str, q0: dict) -> list:
+    """[x, y] of the origin of body ``name`` set by its ``x`` / ``y`` coordinates (None for
+    a component without one)."""
+    out = [None, None]
+    for c in mechanism.coordinates.values():
+        if c.kind in ("x", "y") and c.body == name and c.name in q0:
+            out["xy".index(c.kind)] = q0[c.name] - c.offset
+    return out
+
+
+def _put(placed: dict, name: str, x: float, y: float, th: float, pos: list) -> bool:
+    """Place ``name`` at (x, y, th), its ``x`` / ``y`` coordinates overriding."""
+    placed[name] = (x if pos[0] is None else pos[0], y if pos[1] is None else pos[1], th)
+    return True
+
+
 def _pins(mechanism, name: str, placed: dict) -> list:
     """(point of ``name``, world point) of its revolutes to placed bodies."""
     out = []
@@ -136,21 +154,24 @@ def _place(mechanism, name: str, placed: dict, q0: dict, strict: bool) -> bool:
     its angle is known too); returns whether it was placed."""
     th = _angle(mechanism, name, placed, q0)
     pins = _pins(mechanism, name, placed)
+    pos = _position(mechanism, name, q0)
     if th is None and len(pins) >= 2:
         (s1, w1), (s2, w2) = pins[0], pins[1]
         if math.hypot(s2[0] - s1[0], s2[1] - s1[1]) > 0:
             th = (math.atan2(w2[1] - w1[1], w2[0] - w1[0])
                   - math.atan2(s2[1] - s1[1], s2[0] - s1[0]))
             th = math.atan2(math.sin(th), math.cos(th))
+    free = None not in pos  # the coordinates place it without a joint
     if th is None:
-        if strict or not pins:
+        if strict or not (pins or free):
             return False
         th = 0.0
+    if free:
+        return _put(placed, name, 0.0, 0.0, th, pos)
     if pins:
         s, w = pins[0]
         d = _rot(th, s)
-        placed[name] = (w[0] - d[0], w[1] - d[1], th)
-        return True
+        return _put(placed, name, w[0] - d[0], w[1] - d[1], th, pos)
     for j in mechanism.joints.values():
         if isinstance(j, Prismatic) and name in (j.parent, j.child):
             other = j.parent if j.child == name else j.child
@@ -168,8 +189,7 @@ def _place(mechanism, name: str, placed: dict, q0: dict, strict: bool) -> bool:
             else:
                 p = _world(placed[other], sc)
                 d = _rot(th, (sp[0] + travel * j.axis[0] / n, sp[1] + travel * j.axis[1] / n))
-            placed[name] = (p[0] - d[0], p[1] - d[1], th)
-            return True
+            return _put(placed, name, p[0] - d[0], p[1] - d[1], th, pos)
         if isinstance(j, Lock) and j.offset is not None and name in (j.parent, j.child):
             other = j.parent if j.child == name else j.child
             if other not in placed:
@@ -180,8 +200,7 @@ def _place(mechanism, name: str, placed: dict, q0: dict, strict: bool) -> bool:
             else:
                 d = _rot(th, o[:2])
                 p = (placed[other][0] - d[0], placed[other][1] - d[1])
-            placed[name] = (p[0], p[1], th)
-            return True
+            return _put(placed, name, p[0], p[1], th, pos)
     return False
 
 

@@ -21,8 +21,9 @@ from . import rows as R
 
 __all__ = ["Model", "RevoluteRows", "PrismaticRows", "LockRows", "as_model"]
 
-COORD_ANGLE, COORD_RELATIVE, COORD_TRAVEL = 0, 1, 2
-_KIND_CODE = {"angle": COORD_ANGLE, "relative_angle": COORD_RELATIVE, "travel": COORD_TRAVEL}
+COORD_ANGLE, COORD_RELATIVE, COORD_TRAVEL, COORD_X, COORD_Y = 0, 1, 2, 3, 4
+_KIND_CODE = {"angle": COORD_ANGLE, "relative_angle": COORD_RELATIVE, "travel": COORD_TRAVEL,
+              "x": COORD_X, "y": COORD_Y}
 
 
 @dataclass(frozen=True)
@@ -148,9 +149,7 @@ class Model:
               for k, n in enumerate(pr.names)])
         self.weld_rows = {n: R.weld(n, lk.i[k], lk.c[k], lk.j[k], lk.angle[k], nb=nb)
                           for k, n in enumerate(lk.names)}
-        self.coordinate_rows = R.concat(nb, *[
-            R.angle(c.name, self._bindex[c.body], c.offset, nb=nb) if c.kind == "angle"
-            else self.joint_variable(c.name, c.joint, c.offset) for c in coords])
+        self.coordinate_rows = R.concat(nb, *[self._coordinate_row(c) for c in coords])
 
         #: the engaged locks at the start (frozenset of lock names)
         self.initial_mode = frozenset(j.name for j in locks if j.engaged)
@@ -169,6 +168,15 @@ class Model:
         #: sweep kernels ...): constants of the model computed on first use, never
         #: the state of a run
         self.memo: dict = {}
+
+    def _coordinate_row(self, c) -> R.Rows:
+        """The row of one coordinate (:mod:`mechdyn.model.rows`, lowering rules)."""
+        if c.kind == "angle":
+            return R.angle(c.name, self._bindex[c.body], c.offset, nb=self.n_bodies)
+        if c.kind in ("x", "y"):  # the ground x or y of the body's origin
+            return R.point(c.name, self._bindex[c.body], (0.0, 0.0), "xy".index(c.kind),
+                           offset=c.offset, nb=self.n_bodies)
+        return self.joint_variable(c.name, c.joint, c.offset)
 
     def joint_variable(self, label: str, joint: str, offset: float = 0.0) -> R.Rows:
         """The row of the relative angle theta_child - theta_parent of a revolute joint (rad)

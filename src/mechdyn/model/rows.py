@@ -23,7 +23,8 @@ Lowering rules (parent i, child j):
   theta_j - theta_i - angle;
 * coordinates: an absolute angle is ka = 1 on its body; a relative angle
   theta_j - theta_i; a travel w = A(theta_i) u_i with p1 = child point,
-  p2 = parent point; each plus its offset in ``c``.
+  p2 = parent point; a body position (kinds ``x``, ``y``) w = e_x or e_y of the
+  ground with p1 = the body's origin, p2 = the ground's; each plus its offset in ``c``.
 """
 
 from __future__ import annotations
@@ -211,9 +212,17 @@ def relative_angle(label: str, i: int, j: int, offset: float = 0.0, *, nb: int,
                            element=element, is_angle=True)])
 
 
-def point(label: str, b: int, s, comp: int, *, nb: int, element: str = "") -> Rows:
-    """Ground x (comp 0) or y (comp 1) of a body point, m."""
-    return _rows(nb, [_one(nb, b1=b, s1=s, u=EX if comp == 0 else EY, label=label,
+def point(label: str, b: int, s, comp: int, *, offset: float = 0.0, nb: int,
+          element: str = "") -> Rows:
+    """Ground x (comp 0) or y (comp 1) of a body point, plus ``offset``, m.
+
+    Examples
+    --------
+    >>> r = point("h", 0, (0.0, 0.0), 1, offset=-0.5, nb=1)
+    >>> r.u.tolist(), r.c.tolist()
+    ([[0.0, 1.0]], [-0.5])
+    """
+    return _rows(nb, [_one(nb, b1=b, s1=s, u=EX if comp == 0 else EY, c=offset, label=label,
                            element=element)])
 
 

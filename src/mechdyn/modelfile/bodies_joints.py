@@ -6,7 +6,7 @@ import math
 
 from ..mechanism import GROUND, Body, Coordinate, Lock, Prismatic, Revolute
 from ..mechanism.body import unknown_point
-from ..mechanism.coordinate import coordinate_problems
+from ..mechanism.coordinate import LENGTH_KINDS, coordinate_problems
 from ..mechanism.joint import ELASTIC_FIELDS, FRICTION_FIELDS
 from .reader import _Failed, _Reader
 
@@ -127,5 +127,5 @@ class _BodiesJoints(_Reader):
         for key, msg in coordinate_problems(kind, body, joint, bodies, self.joint_types):
             self.problem(f"{self.where(*P, key)}: {msg}")
             raise _Failed
-        offset = self.opt(spec, "offset", "length" if kind == "travel" else "angle", *P)
+        offset = self.opt(spec, "offset", "length" if kind in LENGTH_KINDS else "angle", *P)
         return Coordinate(cname, kind, body, joint, offset)

@@ -14,6 +14,7 @@ from typing import Any
 
 from ..errors import did_you_mean
 from ..mechanism import GROUND
+from ..mechanism.coordinate import LENGTH_KINDS
 from ..mechanism.drive import Drive, TorqueSpeedCurve
 from ..mechanism.load import Force, RotarySpring, Spring, Table, Torque, pulse
 from .drives import drive_from_table
@@ -172,7 +173,7 @@ class _LoadsDrives(_Reader):
             raise _Failed
         if "type" in spec:  # a motor model (induction motor, DC motor, ...)
             return self.recorded(drive_from_table, {"name": name, **spec}, where=self.where(*P))
-        travel = self.coord_kinds[coord] == "travel"
+        travel = self.coord_kinds[coord] in LENGTH_KINDS  # a force drives it
         tkind = "force" if travel else "torque"
         raw = spec["torque"]
         if isinstance(raw, dict) and "omega" in raw:

@@ -9,6 +9,7 @@ from typing import Any
 
 from ..errors import ModelError, UnitError, did_you_mean
 from ..mechanism.body import GROUND, unknown_point
+from ..mechanism.coordinate import LENGTH_KINDS
 from ..model.variable import parse
 from ..units import KINDS, parse_quantity, parse_vector
 from .schema import locate
@@ -207,7 +208,7 @@ class _Reader:
         return val if isinstance(val, kind) else kind()
 
     def coord_value_kind(self, cname: str, rate: bool) -> str:
-        travel = self.coord_kinds.get(cname) == "travel"
+        travel = self.coord_kinds.get(cname) in LENGTH_KINDS
         if rate:
             return "velocity" if travel else "angular_velocity"
         return "length" if travel else "angle"

@@ -149,6 +149,8 @@ def _stops(model, bodies: dict, size: float) -> dict:
         offset, joint, body = 0.0, None, None
         if var.kind == "coordinate":
             c = mech.coordinates[var.name]
+            if c.kind in ("x", "y"):
+                continue  # a body's position, like a point's x or y
             offset, joint, body = c.offset, c.joint, c.body
         elif var.kind == "joint":
             joint = var.name
