@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import Status
 from ..kinematics.sweep import initial_coordinates
+from ..mechanism.coordinate import BODY_KINDS
 from ..mechanism.joint import has_friction
 from .animate import animate, snapshot
 from .report_building import building_section, has_frame_loads
@@ -147,7 +148,7 @@ def model_tables(model) -> dict:
         ang = c.is_angle
         rate = float(qd0.get(name, 0.0)) if isinstance(qd0, dict) else 0.0
         rows["coordinates"].append({
-            "coordinate": name, "kind": c.kind, "of": c.body if c.kind == "angle" else c.joint,
+            "coordinate": name, "kind": c.kind, "of": c.body if c.kind in BODY_KINDS else c.joint,
             "unit": "rad" if ang else "m",
             "initial": f"{np.rad2deg(q0[k]):.6g} deg" if ang else f"{_mm(q0[k]):.6g} mm",
             "initial rate": f"{rate * 30 / np.pi:.6g} rpm" if ang else f"{rate:.6g} m/s"})
