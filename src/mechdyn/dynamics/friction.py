@@ -276,15 +276,24 @@ class FrictionSet:
         return out
 
     # ------------------------------------------------------------------ the law
-    def magnitudes(self, x, xdot, lam, rows: Mapping | None = None) -> dict:
+    def magnitudes(self, x, xdot, lam, rows: Mapping | None = None,
+                   signs: Mapping | None = None) -> dict:
         """{joint: (value (...), dvalue_dlam (..., n_rows), speed (...))}: the friction
         moment on the child (revolute, N m) or the friction force on the child along the
         guide axis (prismatic, N), its derivative with respect to the multipliers and
-        the relative speed."""
+        the relative speed.
+
+        ``signs`` ({joint: +1 / -1}, optional): the slip direction s of stick-slip pairs
+        in a slipping mode; where such a pair's speed is zero or against s (the first
+        instant of its segment), its Coulomb friction is that of sgn(v) = s (the
+        viscous part stays that of the actual speed)."""
         spd = self.speeds(x, xdot)
+        signs = signs or {}
         out = {}
         for p, (load, d) in zip(self.pairs, self.loads(x, lam, rows).values(), strict=True):
             s = _sign(spd[p.name], p.smoothing)
+            if p.name in signs:
+                s = np.where(signs[p.name] * spd[p.name] > 0, s, float(signs[p.name]))
             k = p.mu * (p.length if p.kind == "revolute" else 1.0)
             out[p.name] = (-(k * load * s + p.viscous * spd[p.name]),
                            -(k * s)[..., None] * d, spd[p.name])
@@ -309,7 +318,8 @@ class FrictionSet:
                                 for gb, b in zip(g, (p.child, p.parent), strict=True))
         return out
 
-    def generalized(self, x, xdot, lam, rows: Mapping | None = None):
+    def generalized(self, x, xdot, lam, rows: Mapping | None = None,
+                    signs: Mapping | None = None):
         """The generalized friction force on the poses and its derivative with respect
         to the multipliers.
 
@@ -322,6 +332,8 @@ class FrictionSet:
         rows : mapping, ConstraintLayout or ModeSystem, optional
             {joint: indices into the last axis of ``lam``} (or the ``element_rows`` of a
             layout or mode system); default :attr:`rows`.
+        signs : mapping, optional
+            {joint: +1 / -1}: slip directions of stick-slip pairs (:meth:`magnitudes`).
 
         Returns
         -------
@@ -336,7 +348,8 @@ class FrictionSet:
         F = np.zeros(batch + (self.model.n_x,))
         dF = np.zeros(batch + (self.model.n_x, lam.shape[-1]))
         pat = self._patterns(x)
-        for p, (val, dval, _) in zip(self.pairs, self.magnitudes(x, xdot, lam, rows).values(),
+        for p, (val, dval, _) in zip(self.pairs,
+                                     self.magnitudes(x, xdot, lam, rows, signs).values(),
                                      strict=True):
             for b, g in zip((p.child, p.parent), pat[p.name], strict=True):
                 if g is not None:
@@ -344,14 +357,16 @@ class FrictionSet:
                     dF[..., 3 * b:3 * b + 3, :] += g[..., :, None] * dval[..., None, :]
         return F, dF
 
-    def by_pair(self, x, xdot, lam, rows: Mapping | None = None) -> dict:
+    def by_pair(self, x, xdot, lam, rows: Mapping | None = None,
+                signs: Mapping | None = None) -> dict:
         """{joint: (F (..., n_x), value (...))}: the generalized friction force of each pair
         on the moving bodies (as :meth:`generalized`) and the friction moment on the child
         (revolute, N m) or the friction force on the child along the axis (prismatic, N)."""
         x, xdot, lam = (np.asarray(a, float) for a in (x, xdot, lam))
         batch = np.broadcast_shapes(x.shape[:-1], lam.shape[:-1])
         pat, out = self._patterns(x), {}
-        for p, (val, _, _) in zip(self.pairs, self.magnitudes(x, xdot, lam, rows).values(),
+        for p, (val, _, _) in zip(self.pairs,
+                                  self.magnitudes(x, xdot, lam, rows, signs).values(),
                                   strict=True):
             F = np.zeros(batch + (self.model.n_x,))
             for b, g in zip((p.child, p.parent), pat[p.name], strict=True):
@@ -360,8 +375,9 @@ class FrictionSet:
             out[p.name] = (F, val)
         return out
 
-    def power_lost(self, x, xdot, lam, rows: Mapping | None = None) -> dict:
+    def power_lost(self, x, xdot, lam, rows: Mapping | None = None,
+                   signs: Mapping | None = None) -> dict:
         """Power dissipated in each pair, {joint: (...)}, W (>= 0): minus the power of
         the friction moment or force on the relative motion."""
         return {nm: -val * spd for nm, (val, _, spd)
-                in self.magnitudes(x, xdot, lam, rows).items()}
+                in self.magnitudes(x, xdot, lam, rows, signs).items()}
