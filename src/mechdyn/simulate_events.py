@@ -42,7 +42,7 @@ from .dynamics.joint_friction import SelfLockingError, friction_joints, stick_sl
 from .dynamics.lagrange import kinetic_energy
 from .dynamics.mode_equations import ModeEquations
 from .dynamics.modes import ModeSystem, switched_model
-from .dynamics.reactions import element_forces, frame_forces, net_on_ground
+from .dynamics.reactions import element_forces, element_width, frame_forces, net_on_ground
 from .dynamics.switching import apply_switch, event_functions
 from .errors import (
     LockupError,
@@ -416,8 +416,7 @@ def element_shapes(model, sm) -> dict:
     """Every element that can carry a force in some mode, with the trailing shape of its
     force: joints (2,) or (3,), coordinate locks, stops and contacts () (see
     :func:`~mechdyn.dynamics.reactions.element_forces`)."""
-    out: dict = {j: ((2,) if model.joint_kind(j) == "revolute" else (3,))
-                 for j in model.mechanism.joints}
+    out: dict = {j: (element_width(model, j),) for j in model.mechanism.joints}
     for names in (sm.coord_locks, sm.stops, sm.contacts):
         out.update({n: () for n in names if n not in out})
     return out
@@ -521,13 +520,15 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
         drives = np.einsum("nqx,nq->nx", RN.jacobian(model.coordinate_rows, x[sl]), Qd)
         frame[sl] = (frame_forces(ms, x[sl], lam, point=point)["total"] + on_ground
                      + net_on_ground(model, x[sl], drives, point))
+        pairs = None
         if ms.friction is not None:
             # the friction of the pairs: a pair between two bodies adds no net force or
             # moment to them, so the net of the friction on the bodies is that of the
             # pairs with the frame, whose opposite the frame receives
             Ff = np.array([r[2].F_friction for r in rec[a:b]], float).reshape(b - a, n_x)
             frame[sl] += net_on_ground(model, x[sl], Ff, point)
-        for el, v in element_forces(ms, x[sl], lam).items():
+            pairs = ms.friction.by_pair(x[sl], xd[sl], lam)  # part of their reactions
+        for el, v in element_forces(ms, x[sl], lam, pairs).items():
             forces.setdefault(el, np.zeros((n,) + np.shape(v)[1:]))[sl] = v
         if ms.n_rows:
             res[sl] = np.max(np.abs(ms.row_values(x[sl])), axis=-1)

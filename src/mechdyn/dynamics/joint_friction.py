@@ -220,6 +220,13 @@ class JointFriction:
             D += Dj
         return F, D
 
+    def by_pair(self, x, xdot, lam) -> dict:
+        """{joint: generalized force (..., n_x) of its friction on the poses, N and N m} of
+        the sliding pairs, batched over samples x, xdot (..., n_x), lam (..., n_rows): the
+        forces of :meth:`forces`, pair by pair (the friction part of their reactions)."""
+        fs = friction_set(self.model, tuple(self.sliding))
+        return {j: F for j, (F, _) in fs.by_pair(x, xdot, lam, signs=self.signs).items()}
+
     def _unit(self, joint: str, x) -> np.ndarray:
         """A velocity of the poses (n_x,) with unit sliding velocity of ``joint``."""
         J = RN.jacobian(_measure(self.model, joint).rows, x)[0]

@@ -22,7 +22,7 @@ from .joint_friction import friction_joints, friction_set, joint_states
 from .kinetostatics_friction import friction_solve, locking_note
 
 __all__ = ["KinetostaticsWarning", "joint_reaction", "reaction_frame", "element_forces",
-           "frame_forces", "touches_ground"]
+           "element_width", "frame_forces", "touches_ground"]
 
 #: relative singular value below which constraint equations count as dependent
 REDUNDANT_RCOND = 1e-9
@@ -118,7 +118,7 @@ def joint_reaction(model: Model, name: str, x, gen, friction=None):
     return sgn * gen[..., 3 * b:3 * b + 2], sgn * m, P
 
 
-def element_forces(ms, x, lam) -> dict:
+def element_forces(ms, x, lam, friction=None) -> dict:
     """The force of every element of a mode from its multipliers (batched over poses).
 
     Parameters
@@ -127,29 +127,54 @@ def element_forces(ms, x, lam) -> dict:
     x : ndarray, shape (..., n_x)
     lam : ndarray, shape (..., n_rows)
         Multipliers of ``ms.rowset`` (forward convention); impulses give impulses.
+    friction : dict, optional
+        {joint: generalized force (..., n_x) of its friction} of the slipping pairs
+        (:meth:`~mechdyn.dynamics.joint_friction.JointFriction.by_pair`).
 
     Returns
     -------
     dict
         Joints and weld locks: their reaction (:func:`joint_reaction`), (..., 2)
         (Fx, Fy) N for a revolute joint, (..., 3) (Fx, Fy, M) N, N, N m for a
-        prismatic joint or a weld; coordinate locks, stops and contacts: the
+        prismatic joint, a weld or a revolute joint with friction (M its friction
+        moment on the child); coordinate locks, stops and contacts: the
         multiplier of their (first) row, shape (...) (the normal force of a stop or
         contact, N or N m, the torque or force of a coordinate lock along its variable).
+        The friction of a pair is part of its reaction: the law's (``friction``) or,
+        when it sticks, the force of its stick row (:mod:`~mechdyn.dynamics.joint_friction`),
+        as :func:`mechdyn.kinetostatics` reports it.
     """
     model = ms.model
     R = ms.row_jacobian(x)
     lam = np.asarray(lam, float)
+    fj = friction_joints(model)
+    friction = friction or {}
     out: dict = {}
     for el, idx in ms.element_rows.items():
         if el not in model.mechanism.joints:
             out[el] = lam[..., idx[0]] if lam.ndim > 1 else float(lam[idx[0]])
             continue
-        gen = np.einsum("...rx,...r->...x", R[..., idx, :], lam[..., idx])
-        f, m, _ = joint_reaction(model, el, x, gen)
-        out[el] = f if model.joint_kind(el) == "revolute" else np.concatenate(
+        is_stick = np.array([k >= ms.n_base and ms.rows[k - ms.n_base].kind == "stick"
+                             for k in idx], bool)
+        base, stick = idx[~is_stick], idx[is_stick]
+        gen = np.einsum("...rx,...r->...x", R[..., base, :], lam[..., base])
+        fric = friction.get(el)
+        if stick.size:  # a sticking pair: its stick row holds it by friction
+            held = np.einsum("...rx,...r->...x", R[..., stick, :], lam[..., stick])
+            fric = held if fric is None else fric + held
+        if el in fj and fric is None:
+            fric = np.zeros_like(gen)
+        f, m, _ = joint_reaction(model, el, x, gen, fric)
+        out[el] = f if model.joint_kind(el) == "revolute" and el not in fj else np.concatenate(
             [f, np.asarray(m)[..., None]], axis=-1)
     return out
+
+
+def element_width(model, name: str) -> int:
+    """The width of a joint's or weld's force in :func:`element_forces`: 2 (Fx, Fy) for a
+    revolute joint without friction, else 3 (Fx, Fy, M)."""
+    return 2 if model.joint_kind(name) == "revolute" and name not in friction_joints(model) \
+        else 3
 
 
 def frame_forces(ms, x, lam, point=None) -> dict:
