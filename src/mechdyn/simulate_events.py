@@ -507,7 +507,7 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
     x, xd, q, qd, qdd = (np.array([getattr(r[2], k) for r in rec], float).reshape(n, w)
                          for k, w in (("x", n_x), ("xdot", n_x), ("q", n_q), ("qdot", n_q),
                                       ("qddot", n_q)))
-    frame, res = np.zeros((n, 3)), np.zeros(n)
+    frame, res, p_f = np.zeros((n, 3)), np.zeros(n), np.zeros(n)
     forces: dict = {el: np.zeros((n, *shape)) for el, shape in (shapes or {}).items()}
     starts = [k for k in range(n) if k == 0 or rec[k][1] is not rec[k - 1][1]] + [n]
     for a, b in zip(starts[:-1], starts[1:], strict=True):
@@ -527,6 +527,7 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
             # pairs with the frame, whose opposite the frame receives
             Ff = np.array([r[2].F_friction for r in rec[a:b]], float).reshape(b - a, n_x)
             frame[sl] += net_on_ground(model, x[sl], Ff, point)
+            p_f[sl] = -np.einsum("nx,nx->n", Ff, xd[sl])  # the power friction dissipates
             pairs = ms.friction.by_pair(x[sl], xd[sl], lam)  # part of their reactions
         for el, v in element_forces(ms, x[sl], lam, pairs).items():
             forces.setdefault(el, np.zeros((n,) + np.shape(v)[1:]))[sl] = v
@@ -543,7 +544,7 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
     return dict(t=t, q=q, qdot=qd, qddot=qdd, x=x, xdot=xd, frame=frame, forces=forces,
                 mode=[r[1].mode for r in rec],
                 mode_index=np.array([modes.index(r[1].mode) for r in rec], int),
-                kinetic=T, potential=U, work_nc=W, work_friction=W_f,
+                kinetic=T, potential=U, work_nc=W, work_friction=W_f, power_friction=p_f,
                 balance=T + U - W + lost, residual=res,
                 impact_losses=lost, penetration=max([0.0, *pen]))
 
@@ -572,7 +573,7 @@ def _trajectory(model, block, modes, events, stats, status, message) -> Trajecto
         impact_losses=b["impact_losses"], penetration=b["penetration"])
     energy = {k: b[k] for k in ("kinetic", "potential", "work_nc", "balance", "residual")}
     if friction_joints(model):
-        energy["work_friction"] = b["work_friction"]
+        energy.update(work_friction=b["work_friction"], power_friction=b["power_friction"])
     return Trajectory(b["t"], b["q"], b["qdot"], b["qddot"], b["x"], b["xdot"],
                       status=status, message=message, events=list(events), stats=stats,
                       energy=energy, coordinate_names=model.coordinate_names,
