@@ -388,21 +388,18 @@ class PreparedFriction:
         maps, pat = fs._maps(x), fs._patterns(x)
         signs = signs or {}
         pairs = fs.pairs
-        gain, visc = [], []
+        self.gain, self.visc = (np.zeros(self.batch + (len(pairs),)) for _ in range(2))
         self.G = np.zeros(self.batch + (self.n_x, len(pairs)))  # unit friction -> F
         for c, p in enumerate(pairs):  # value = gain * load + viscous
             v = self.speeds[p.name]
             s = _sign(v, p.smoothing)
             if p.name in signs:
                 s = np.where(signs[p.name] * v > 0, s, float(signs[p.name]))
-            gain.append(np.broadcast_to(-p.mu * (p.length if p.kind == "revolute" else 1.0)
-                                        * s, self.batch))
-            visc.append(np.broadcast_to(-p.viscous * v, self.batch))
+            self.gain[..., c] = -p.mu * (p.length if p.kind == "revolute" else 1.0) * s
+            self.visc[..., c] = -p.viscous * v
             for b, g in zip((p.child, p.parent), pat[p.name], strict=True):
                 if g is not None:
                     self.G[..., 3 * b:3 * b + 3, c] += g
-        self.gain = np.stack(gain, axis=-1) if pairs else np.zeros(self.batch + (0,))
-        self.visc = np.stack(visc, axis=-1) if pairs else np.zeros(self.batch + (0,))
         self.maps = [maps[p.name] for p in pairs]
         k = [m.shape[-2] for m in self.maps]
         self.starts = np.cumsum([0, *k[:-1]]).astype(int)
