@@ -143,7 +143,8 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
         ``xdot``; ``events`` (an :class:`~mechdyn.integrate.events.EventRecord` per
         switching instant and per caller's event); ``energy`` (kinetic, potential,
         work_nc, balance = T + U - W_nc + impact losses, residual; with friction in the
-        pairs also work_friction, the energy they dissipated, J, included in work_nc);
+        pairs also work_friction, the energy they dissipated, J, included in work_nc,
+        and power_friction, W);
         ``stats["variable_structure"]``
         (:class:`~mechdyn.results.trajectory.SwitchedSamples`: the mode of each
         sample, the force on the frame, the force of every joint, lock, stop and

@@ -42,7 +42,7 @@ from .dynamics.joint_friction import SelfLockingError, friction_joints, stick_sl
 from .dynamics.lagrange import kinetic_energy
 from .dynamics.mode_equations import ModeEquations
 from .dynamics.modes import ModeSystem, switched_model
-from .dynamics.reactions import element_forces, frame_forces, net_on_ground
+from .dynamics.reactions import element_forces, element_width, frame_forces, net_on_ground
 from .dynamics.switching import apply_switch, event_functions
 from .errors import (
     LockupError,
@@ -416,8 +416,7 @@ def element_shapes(model, sm) -> dict:
     """Every element that can carry a force in some mode, with the trailing shape of its
     force: joints (2,) or (3,), coordinate locks, stops and contacts () (see
     :func:`~mechdyn.dynamics.reactions.element_forces`)."""
-    out: dict = {j: ((2,) if model.joint_kind(j) == "revolute" else (3,))
-                 for j in model.mechanism.joints}
+    out: dict = {j: (element_width(model, j),) for j in model.mechanism.joints}
     for names in (sm.coord_locks, sm.stops, sm.contacts):
         out.update({n: () for n in names if n not in out})
     return out
@@ -508,7 +507,7 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
     x, xd, q, qd, qdd = (np.array([getattr(r[2], k) for r in rec], float).reshape(n, w)
                          for k, w in (("x", n_x), ("xdot", n_x), ("q", n_q), ("qdot", n_q),
                                       ("qddot", n_q)))
-    frame, res = np.zeros((n, 3)), np.zeros(n)
+    frame, res, p_f = np.zeros((n, 3)), np.zeros(n), np.zeros(n)
     forces: dict = {el: np.zeros((n, *shape)) for el, shape in (shapes or {}).items()}
     starts = [k for k in range(n) if k == 0 or rec[k][1] is not rec[k - 1][1]] + [n]
     for a, b in zip(starts[:-1], starts[1:], strict=True):
@@ -521,13 +520,16 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
         drives = np.einsum("nqx,nq->nx", RN.jacobian(model.coordinate_rows, x[sl]), Qd)
         frame[sl] = (frame_forces(ms, x[sl], lam, point=point)["total"] + on_ground
                      + net_on_ground(model, x[sl], drives, point))
+        pairs = None
         if ms.friction is not None:
             # the friction of the pairs: a pair between two bodies adds no net force or
             # moment to them, so the net of the friction on the bodies is that of the
             # pairs with the frame, whose opposite the frame receives
             Ff = np.array([r[2].F_friction for r in rec[a:b]], float).reshape(b - a, n_x)
             frame[sl] += net_on_ground(model, x[sl], Ff, point)
-        for el, v in element_forces(ms, x[sl], lam).items():
+            p_f[sl] = -np.einsum("nx,nx->n", Ff, xd[sl])  # the power friction dissipates
+            pairs = ms.friction.by_pair(x[sl], xd[sl], lam)  # part of their reactions
+        for el, v in element_forces(ms, x[sl], lam, pairs).items():
             forces.setdefault(el, np.zeros((n,) + np.shape(v)[1:]))[sl] = v
         if ms.n_rows:
             res[sl] = np.max(np.abs(ms.row_values(x[sl])), axis=-1)
@@ -542,7 +544,7 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
     return dict(t=t, q=q, qdot=qd, qddot=qdd, x=x, xdot=xd, frame=frame, forces=forces,
                 mode=[r[1].mode for r in rec],
                 mode_index=np.array([modes.index(r[1].mode) for r in rec], int),
-                kinetic=T, potential=U, work_nc=W, work_friction=W_f,
+                kinetic=T, potential=U, work_nc=W, work_friction=W_f, power_friction=p_f,
                 balance=T + U - W + lost, residual=res,
                 impact_losses=lost, penetration=max([0.0, *pen]))
 
@@ -571,7 +573,7 @@ def _trajectory(model, block, modes, events, stats, status, message) -> Trajecto
         impact_losses=b["impact_losses"], penetration=b["penetration"])
     energy = {k: b[k] for k in ("kinetic", "potential", "work_nc", "balance", "residual")}
     if friction_joints(model):
-        energy["work_friction"] = b["work_friction"]
+        energy.update(work_friction=b["work_friction"], power_friction=b["power_friction"])
     return Trajectory(b["t"], b["q"], b["qdot"], b["qddot"], b["x"], b["xdot"],
                       status=status, message=message, events=list(events), stats=stats,
                       energy=energy, coordinate_names=model.coordinate_names,

@@ -288,7 +288,7 @@ def test_energy_balance_of_a_slider_crank_with_friction_in_every_pair():
     xd = tr.xdot  # bodies crank, rod, slider
     th_d = xd[:, 2::3]
     w_rel = {"O": th_d[:, 0], "A": th_d[:, 1] - th_d[:, 0], "B": th_d[:, 2] - th_d[:, 1]}
-    P = sum(0.1 * 0.01 * np.hypot(*f[n].T) * np.abs(w_rel[n]) for n in ("O", "A", "B"))
+    P = sum(0.1 * 0.01 * np.hypot(*f[n][:, :2].T) * np.abs(w_rel[n]) for n in ("O", "A", "B"))
     N, M = f["guide"][:, 1], f["guide"][:, 2]
     S = np.abs(N / 2 - M / 0.04) + np.abs(N / 2 + M / 0.04)
     P = P + 0.15 * S * np.abs(xd[:, 6])

@@ -50,6 +50,25 @@ def test_smoothing_and_rest():
     assert not F.any() and not dF.any()      # true Coulomb at rest: no sliding force
 
 
+def test_slip_direction_of_a_mode_at_zero_or_reverse_speed():
+    """signs={joint: s}: where the speed is zero or against s, the Coulomb part is that of
+    sgn(v) = s (mu S s by hand), the viscous part that of the actual speed; with the speed
+    along s, the law as it is."""
+    fs = FrictionSet(_block())
+    x, lam = np.array([0.5, -0.1, 0.0]), np.array([40.0, 6.0])
+    S = 100.0  # as in test_prismatic_edge_loads_by_hand
+    for v, s, want in ((0.0, 1.0, -0.2 * S), (0.0, -1.0, 0.2 * S),
+                       (-0.1, 1.0, -0.2 * S + 0.3), (0.3, 1.0, -0.2 * S - 0.9)):
+        F, _ = fs.generalized(x, np.array([v, 0.0, 0.0]), lam, signs={"guide": s})
+        assert F[0] == pytest.approx(want, abs=1e-13)
+    # prepared once at a pose and rates, evaluated at several multipliers
+    law = fs.prepare(x, np.array([0.3, 0.0, 0.0]))
+    for lam in (np.array([40.0, 6.0]), np.array([-10.0, 2.0])):
+        for a, b in zip(law.generalized(lam), fs.generalized(x, np.array([0.3, 0.0, 0.0]), lam),
+                        strict=True):
+            np.testing.assert_array_equal(a, b)
+
+
 def _crank_rod():
     """Crank (pin O to the ground) and rod (pin A on the crank), both pins with friction."""
     m = Mechanism("crank-rod")

@@ -35,7 +35,7 @@ from ..kinematics.constraints import _perp, extend
 from ..model import Model
 from .forces import cross, rotate
 
-__all__ = ["FrictionPair", "FrictionSet", "friction_joints"]
+__all__ = ["FrictionPair", "FrictionSet", "PreparedFriction", "friction_joints"]
 
 
 @dataclass(frozen=True)
@@ -221,6 +221,52 @@ class FrictionSet:
         return rows
 
     # ------------------------------------------------------------------ loads
+    def _maps(self, x) -> dict:
+        """The per-pose part of the loads: {joint: linear maps (..., k, n_e) from the
+        pair's multipliers to the reaction force (revolute, k = 2), to the two gib edge
+        loads (prismatic, L > 0, k = 2) or to the normal force (L = 0, k = 1)}."""
+        x = np.asarray(x, float)
+        X = extend(self.model, x)
+        J = rows_numpy.jacobian(self._rowset, x) if self.pairs else None
+        out = {}
+        for p in self.pairs:
+            Je = J[..., self._slices[p.name], :]  # (..., n_e, n_x)
+            b, sgn = (p.child, 1.0) if p.child < self.model.n_bodies else (p.parent, -1.0)
+            Af = sgn * np.swapaxes(Je[..., 3 * b:3 * b + 2], -1, -2)  # (..., 2, n_e)
+            if p.kind == "revolute":
+                out[p.name] = Af
+                continue
+            P, u = self._point_axis(X, p)
+            aN = np.einsum("...k,...ke->...e", _perp(u), Af)
+            if p.length > 0:
+                aM = sgn * (Je[..., 3 * b + 2] - cross(P[..., None, :] - X[..., None, b, :2],
+                                                       Je[..., 3 * b:3 * b + 2]))
+                out[p.name] = np.stack([0.5 * aN - aM / p.length, 0.5 * aN + aM / p.length],
+                                       axis=-2)
+            else:
+                out[p.name] = aN[..., None, :]
+        return out
+
+    def _loads(self, maps: dict, lam, rows) -> dict:
+        """:meth:`loads` from the per-pose maps (:meth:`_maps`)."""
+        lam = np.asarray(lam, float)
+        rows = self._row_map(rows)
+        out = {}
+        for p in self.pairs:
+            idx = np.asarray(rows[p.name], int)
+            A = maps[p.name]
+            batch = np.broadcast_shapes(A.shape[:-2], lam.shape[:-1])
+            v = np.einsum("...ke,...e->...k", A, lam[..., idx])
+            d = np.zeros(batch + lam.shape[-1:])
+            if p.kind == "revolute":  # |R|, its derivative R/|R| (0 where |R| = 0)
+                mag = np.hypot(v[..., 0], v[..., 1])
+                unit = v / np.where(mag > 0, mag, 1.0)[..., None]
+            else:  # S = sum |edge load| (or |N|), its derivative sum sgn(load) a
+                mag, unit = np.sum(np.abs(v), axis=-1), np.sign(v)
+            d[..., idx] = np.einsum("...k,...ke->...e", unit, A)
+            out[p.name] = (mag, d)
+        return out
+
     def loads(self, x, lam, rows: Mapping | None = None) -> dict:
         """The friction-producing load of each pair and its derivative.
 
@@ -240,55 +286,28 @@ class FrictionSet:
             {joint: (load (...), dload_dlam (..., n_rows))}: |R| of a revolute, N;
             S = |N/2 - M/L| + |N/2 + M/L| (L > 0) or |N| of a prismatic, N.
         """
-        x, lam = np.asarray(x, float), np.asarray(lam, float)
-        rows = self._row_map(rows)
-        batch = np.broadcast_shapes(x.shape[:-1], lam.shape[:-1])
-        X = extend(self.model, x)
-        J = rows_numpy.jacobian(self._rowset, x) if self.pairs else None
-        out = {}
-        for p in self.pairs:
-            idx = np.asarray(rows[p.name], int)
-            Je = J[..., self._slices[p.name], :]  # (..., n_e, n_x)
-            b, sgn = (p.child, 1.0) if p.child < self.model.n_bodies else (p.parent, -1.0)
-            Af = sgn * np.swapaxes(Je[..., 3 * b:3 * b + 2], -1, -2)  # (..., 2, n_e)
-            R = np.einsum("...ke,...e->...k", Af, lam[..., idx])
-            d = np.zeros(batch + lam.shape[-1:])
-            if p.kind == "revolute":
-                mag = np.hypot(R[..., 0], R[..., 1])
-                unit = R / np.where(mag > 0, mag, 1.0)[..., None]  # 0 where |R| = 0
-                d[..., idx] = np.einsum("...k,...ke->...e", unit, Af)
-                out[p.name] = (mag, d)
-                continue
-            P, u = self._point_axis(X, p)
-            aN = np.einsum("...k,...ke->...e", _perp(u), Af)
-            aM = sgn * (Je[..., 3 * b + 2] - cross(P[..., None, :] - X[..., None, b, :2],
-                                                   Je[..., 3 * b:3 * b + 2]))
-            if p.length > 0:
-                e1, e2 = 0.5 * aN - aM / p.length, 0.5 * aN + aM / p.length
-                l1, l2 = (np.einsum("...e,...e->...", a, lam[..., idx]) for a in (e1, e2))
-                S = np.abs(l1) + np.abs(l2)
-                d[..., idx] = np.sign(l1)[..., None] * e1 + np.sign(l2)[..., None] * e2
-            else:
-                N = np.einsum("...e,...e->...", aN, lam[..., idx])
-                S = np.abs(N)
-                d[..., idx] = np.sign(N)[..., None] * aN
-            out[p.name] = (S, d)
-        return out
+        return self._loads(self._maps(x), lam, rows)
 
     # ------------------------------------------------------------------ the law
-    def magnitudes(self, x, xdot, lam, rows: Mapping | None = None) -> dict:
+    def prepare(self, x, xdot, rows: Mapping | None = None,
+                signs: Mapping | None = None) -> PreparedFriction:
+        """The law at fixed poses and rates, for any multipliers: everything that does not
+        depend on them (Jacobians, speeds, directions, force patterns) computed once, as a
+        Newton iteration on the multipliers needs (:class:`PreparedFriction`)."""
+        return PreparedFriction(self, x, xdot, rows, signs)
+
+    def magnitudes(self, x, xdot, lam, rows: Mapping | None = None,
+                   signs: Mapping | None = None) -> dict:
         """{joint: (value (...), dvalue_dlam (..., n_rows), speed (...))}: the friction
         moment on the child (revolute, N m) or the friction force on the child along the
         guide axis (prismatic, N), its derivative with respect to the multipliers and
-        the relative speed."""
-        spd = self.speeds(x, xdot)
-        out = {}
-        for p, (load, d) in zip(self.pairs, self.loads(x, lam, rows).values(), strict=True):
-            s = _sign(spd[p.name], p.smoothing)
-            k = p.mu * (p.length if p.kind == "revolute" else 1.0)
-            out[p.name] = (-(k * load * s + p.viscous * spd[p.name]),
-                           -(k * s)[..., None] * d, spd[p.name])
-        return out
+        the relative speed.
+
+        ``signs`` ({joint: +1 / -1}, optional): the slip direction s of stick-slip pairs
+        in a slipping mode; where such a pair's speed is zero or against s (the first
+        instant of its segment), its Coulomb friction is that of sgn(v) = s (the
+        viscous part stays that of the actual speed)."""
+        return self.prepare(x, xdot, rows, signs).magnitudes(lam)
 
     def _patterns(self, x) -> dict:
         """{joint: (child pattern, parent pattern)}: the generalized force (..., 3) on each
@@ -309,7 +328,8 @@ class FrictionSet:
                                 for gb, b in zip(g, (p.child, p.parent), strict=True))
         return out
 
-    def generalized(self, x, xdot, lam, rows: Mapping | None = None):
+    def generalized(self, x, xdot, lam, rows: Mapping | None = None,
+                    signs: Mapping | None = None):
         """The generalized friction force on the poses and its derivative with respect
         to the multipliers.
 
@@ -322,6 +342,8 @@ class FrictionSet:
         rows : mapping, ConstraintLayout or ModeSystem, optional
             {joint: indices into the last axis of ``lam``} (or the ``element_rows`` of a
             layout or mode system); default :attr:`rows`.
+        signs : mapping, optional
+            {joint: +1 / -1}: slip directions of stick-slip pairs (:meth:`magnitudes`).
 
         Returns
         -------
@@ -331,37 +353,101 @@ class FrictionSet:
         dF_dlam : ndarray, shape (..., n_x, n_rows)
             Its exact derivative (the zero subgradient where a pair's load vanishes).
         """
-        x, xdot, lam = (np.asarray(a, float) for a in (x, xdot, lam))
-        batch = np.broadcast_shapes(x.shape[:-1], lam.shape[:-1])
-        F = np.zeros(batch + (self.model.n_x,))
-        dF = np.zeros(batch + (self.model.n_x, lam.shape[-1]))
-        pat = self._patterns(x)
-        for p, (val, dval, _) in zip(self.pairs, self.magnitudes(x, xdot, lam, rows).values(),
-                                     strict=True):
-            for b, g in zip((p.child, p.parent), pat[p.name], strict=True):
-                if g is not None:
-                    F[..., 3 * b:3 * b + 3] += g * val[..., None]
-                    dF[..., 3 * b:3 * b + 3, :] += g[..., :, None] * dval[..., None, :]
-        return F, dF
+        return self.prepare(x, xdot, rows, signs).generalized(lam)
 
-    def by_pair(self, x, xdot, lam, rows: Mapping | None = None) -> dict:
+    def by_pair(self, x, xdot, lam, rows: Mapping | None = None,
+                signs: Mapping | None = None) -> dict:
         """{joint: (F (..., n_x), value (...))}: the generalized friction force of each pair
         on the moving bodies (as :meth:`generalized`) and the friction moment on the child
         (revolute, N m) or the friction force on the child along the axis (prismatic, N)."""
-        x, xdot, lam = (np.asarray(a, float) for a in (x, xdot, lam))
-        batch = np.broadcast_shapes(x.shape[:-1], lam.shape[:-1])
-        pat, out = self._patterns(x), {}
-        for p, (val, _, _) in zip(self.pairs, self.magnitudes(x, xdot, lam, rows).values(),
-                                  strict=True):
-            F = np.zeros(batch + (self.model.n_x,))
-            for b, g in zip((p.child, p.parent), pat[p.name], strict=True):
-                if g is not None:
-                    F[..., 3 * b:3 * b + 3] += g * val[..., None]
-            out[p.name] = (F, val)
-        return out
+        return self.prepare(x, xdot, rows, signs).by_pair(lam)
 
-    def power_lost(self, x, xdot, lam, rows: Mapping | None = None) -> dict:
+    def power_lost(self, x, xdot, lam, rows: Mapping | None = None,
+                   signs: Mapping | None = None) -> dict:
         """Power dissipated in each pair, {joint: (...)}, W (>= 0): minus the power of
         the friction moment or force on the relative motion."""
         return {nm: -val * spd for nm, (val, _, spd)
-                in self.magnitudes(x, xdot, lam, rows).items()}
+                in self.magnitudes(x, xdot, lam, rows, signs).items()}
+
+
+class PreparedFriction:
+    """The friction law of a :class:`FrictionSet` at fixed poses ``x`` and rates ``xdot``
+    (..., n_x), evaluated at any multipliers: the per-pose maps of the loads, the speeds,
+    the Coulomb directions and the force patterns are computed once
+    (:meth:`FrictionSet.prepare`), and every pair is evaluated at once (its load maps
+    stacked, k rows a pair, over the multipliers); the methods are those of the set
+    without x and xdot.
+    """
+
+    def __init__(self, fs: FrictionSet, x, xdot, rows=None, signs=None):
+        x, xdot = np.asarray(x, float), np.asarray(xdot, float)
+        self.fs, self.n_x = fs, fs.model.n_x
+        self.rows = fs._row_map(rows)
+        self.batch = np.broadcast_shapes(x.shape[:-1], xdot.shape[:-1])
+        self.speeds = fs.speeds(x, xdot)
+        maps, pat = fs._maps(x), fs._patterns(x)
+        signs = signs or {}
+        pairs = fs.pairs
+        self.gain, self.visc = (np.zeros(self.batch + (len(pairs),)) for _ in range(2))
+        self.G = np.zeros(self.batch + (self.n_x, len(pairs)))  # unit friction -> F
+        for c, p in enumerate(pairs):  # value = gain * load + viscous
+            v = self.speeds[p.name]
+            s = _sign(v, p.smoothing)
+            if p.name in signs:
+                s = np.where(signs[p.name] * v > 0, s, float(signs[p.name]))
+            self.gain[..., c] = -p.mu * (p.length if p.kind == "revolute" else 1.0) * s
+            self.visc[..., c] = -p.viscous * v
+            for b, g in zip((p.child, p.parent), pat[p.name], strict=True):
+                if g is not None:
+                    self.G[..., 3 * b:3 * b + 3, c] += g
+        self.maps = [maps[p.name] for p in pairs]
+        k = [m.shape[-2] for m in self.maps]
+        self.starts = np.cumsum([0, *k[:-1]]).astype(int)
+        self.owner = np.repeat(np.arange(len(pairs)), k)
+        self.is_rev = np.array([p.kind == "revolute" for p in pairs], bool)
+        self._E: dict = {}
+
+    def _stacked(self, n_rows: int) -> np.ndarray:
+        """The load maps of every pair over the multipliers, (..., K, n_rows)."""
+        E = self._E.get(n_rows)
+        if E is None:
+            K = self.owner.size
+            E = np.zeros(self.batch + (K, n_rows))
+            for p, A, a in zip(self.fs.pairs, self.maps, self.starts, strict=True):
+                E[..., a:a + A.shape[-2], np.asarray(self.rows[p.name], int)] = A
+            self._E[n_rows] = E
+        return E
+
+    def _values(self, lam):
+        """(value (..., P), dvalue_dlam (..., P, n_rows)) of every pair."""
+        lam = np.asarray(lam, float)
+        if not self.fs.pairs:
+            batch = np.broadcast_shapes(self.batch, lam.shape[:-1])
+            return np.zeros(batch + (0,)), np.zeros(batch + (0, lam.shape[-1]))
+        E = self._stacked(lam.shape[-1])
+        v = np.einsum("...ke,...e->...k", E, lam)
+        sq = np.sqrt(np.add.reduceat(v * v, self.starts, axis=-1))
+        load = np.where(self.is_rev, sq, np.add.reduceat(np.abs(v), self.starts, axis=-1))
+        # d load / d lam: R / |R| of a pin (0 where |R| = 0), sgn(edge loads) of a guide
+        own = load[..., self.owner]
+        unit = np.where(self.is_rev[self.owner], v / np.where(own > 0, own, 1.0), np.sign(v))
+        d = np.add.reduceat(unit[..., None] * E, self.starts, axis=-2)
+        return self.gain * load + self.visc, self.gain[..., None] * d
+
+    def magnitudes(self, lam) -> dict:
+        """As :meth:`FrictionSet.magnitudes`."""
+        val, dval = self._values(lam)
+        return {p.name: (val[..., c], dval[..., c, :], self.speeds[p.name])
+                for c, p in enumerate(self.fs.pairs)}
+
+    def generalized(self, lam):
+        """As :meth:`FrictionSet.generalized`: (F (..., n_x), dF_dlam (..., n_x, n_rows))."""
+        val, dval = self._values(lam)
+        return (np.einsum("...xp,...p->...x", self.G, val),
+                np.einsum("...xp,...pe->...xe", self.G, dval))
+
+    def by_pair(self, lam) -> dict:
+        """As :meth:`FrictionSet.by_pair`: {joint: (F (..., n_x), value (...))}."""
+        val, _ = self._values(lam)
+        return {p.name: (self.G[..., c] * val[..., c, None], val[..., c])
+                for c, p in enumerate(self.fs.pairs)}

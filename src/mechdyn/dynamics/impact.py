@@ -27,6 +27,13 @@ the new constraint rows are C = Phi_new,x B:
   opposing the sliding after the impact; when the sliding keeps its direction through
   the impact this is Routh's result, sgn(v_t+) = sgn(v_t-)).
 
+The pairs' own friction (revolute and prismatic joints with ``friction``,
+:mod:`mechdyn.dynamics.friction`) is not part of the impulse problem: their impulsive
+reactions would make impulsive friction, mu times the impulse, which is not modelled.
+The pairs are taken as frictionless during the impact, and a warning
+(:class:`~mechdyn.dynamics.friction_ignored.FrictionIgnoredWarning`) names, once per
+event, the pairs with friction that carry an impulse (``docs/friction.md``).
+
 The kinetic energy lost is T- - T+; for a plastic impact it equals
 1/2 (qdot- - qdot+)^T A (qdot- - qdot+).  The impulse of every joint, lock,
 stop and contact (including the pins that carry the impact through) comes from
@@ -46,6 +53,8 @@ import numpy as np
 from ..kernels import rows_numpy
 from ..model.variable import parse_variable
 from .contact import constrained_inverse, row_terms, solve_frictional_impact, solve_lcp
+from .friction_ignored import FrictionIgnoredWarning
+from .joint_friction import friction_joints
 from .modes import ModeSystem, Row, SwitchedModel, mass_matrix_x
 from .reactions import element_forces, frame_forces
 
@@ -241,6 +250,9 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     # (those between two moving bodies cancel in the sum)
     on_frame = frame_forces(after, x, Lam, point=np.zeros(2))["total"] - _momentum(x, Q_t)
     per_element = element_forces(after, x, Lam)
+    _warn_pair_friction(sm, per_element, [*(f"lock {n!r} engaging" for n in sorted(new_locks)),
+                                          *(f"{r.label!r} closing" for k, r in enumerate(rows_u)
+                                            if v_minus[k] < 0)], t)
     per_element.update(zip(t_labels, map(float, P_t), strict=True))
     per_element[frame_impulse_key(sm)] = on_frame
     impulses = dict(zip(after.row_labels(), map(float, Lam), strict=True))
@@ -249,6 +261,31 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
                         dict(zip(labels, map(float, C @ qd_minus), strict=True)),
                         dict(zip(labels, map(float, C @ qd_plus), strict=True)), on_frame,
                         states)
+
+
+def _warn_pair_friction(sm: SwitchedModel, per_element: dict, event: list, t) -> None:
+    """Warn (once per event) that the pairs with friction carrying an impulse were taken
+    as frictionless in the impact (``per_element``: the impulses of the mode's elements,
+    :func:`element_forces`)."""
+    fj = friction_joints(sm.model)
+    if not fj or not event:
+        return
+    size = {j: float(np.hypot(*np.asarray(per_element[j])[:2])) for j in fj
+            if j in per_element}
+    big = max(size.values(), default=0.0)
+    pairs = [j for j, v in size.items() if v > 1e-9 * big]
+    told = sm.model.memo.setdefault("impact_pair_friction_warned", set())
+    key = tuple(event)
+    if not pairs or key in told:
+        return
+    told.add(key)
+    when = "" if t is None else f" at t = {float(t):.6g} s"
+    warnings.warn(
+        f"impact{when} ({', '.join(event)}): joint(s) " + ", ".join(repr(j) for j in pairs)
+        + " with friction carry impulsive reactions; the impulse problem takes the pairs as "
+        "frictionless (their impulsive friction, mu times the impulse, is not modelled: "
+        "docs/friction.md); the friction acts again from the instant after the impact",
+        FrictionIgnoredWarning, stacklevel=4)
 
 
 def _warn_closed_stops(sm: SwitchedModel, rows_u, fric, v_minus, v_plus, P_n) -> None:

@@ -202,28 +202,23 @@ class JointFriction:
 
         A slipping stick-slip pair whose velocity is zero or against its direction s
         (the start of its segment, trial states beyond the event) gets the Coulomb
-        friction of sgn(v) = s, so that the right-hand side of the segment stays smooth
-        up to the event: the law at a velocity of direction s, minus the law's viscous
-        part there, plus the viscous part at the actual velocity.
+        friction of sgn(v) = s (its viscous part that of the actual velocity), so that
+        the right-hand side of the segment stays smooth up to the event.
         """
-        n_x, lam = self.model.n_x, np.asarray(lam, float)
-        F, D = np.zeros(n_x), np.zeros((n_x, lam.size))
-        back = [j for j, s in self.signs.items() if s * self.velocity(j, x, xdot) <= 0.0]
-        usual = tuple(j for j in self.sliding if j not in back)
-        if usual:
-            F[:], D[:] = friction_set(self.model, usual).generalized(x, xdot, lam)
-        for j in back:
-            fs = friction_set(self.model, (j,))
-            xd = xdot + (self.signs[j] - self.velocity(j, x, xdot)) * self._unit(j, x)
-            Fj, Dj = fs.generalized(x, xd, lam)
-            F += Fj - fs.generalized(x, xd, 0.0 * lam)[0] + fs.generalized(x, xdot, 0.0 * lam)[0]
-            D += Dj
-        return F, D
+        return self.prepared(x, xdot).generalized(lam)
 
-    def _unit(self, joint: str, x) -> np.ndarray:
-        """A velocity of the poses (n_x,) with unit sliding velocity of ``joint``."""
-        J = RN.jacobian(_measure(self.model, joint).rows, x)[0]
-        return J / (J @ J)
+    def prepared(self, x, xdot):
+        """The law of the sliding pairs at a pose and its rates, for any multipliers
+        (:class:`~mechdyn.dynamics.friction.PreparedFriction`), with the mode's slip
+        directions."""
+        return friction_set(self.model, tuple(self.sliding)).prepare(x, xdot, signs=self.signs)
+
+    def by_pair(self, x, xdot, lam) -> dict:
+        """{joint: generalized force (..., n_x) of its friction on the poses, N and N m} of
+        the sliding pairs, batched over samples x, xdot (..., n_x), lam (..., n_rows): the
+        forces of :meth:`forces`, pair by pair (the friction part of their reactions)."""
+        fs = friction_set(self.model, tuple(self.sliding))
+        return {j: F for j, (F, _) in fs.by_pair(x, xdot, lam, signs=self.signs).items()}
 
     def velocity(self, joint: str, x, xdot) -> float:
         """The pair's sliding velocity (m/s) or relative angular velocity (rad/s)."""
@@ -231,12 +226,11 @@ class JointFriction:
 
     def capacity(self, joint: str, x, lam) -> float:
         """mu S of a pair (N; mu r |R|, N m, for a pin): the largest friction the pair
-        can give at the multipliers ``lam`` (the law's friction at a unit sliding
-        velocity, less its viscous part)."""
-        mag = friction_set(self.model, (joint,)).magnitudes
-        xd = self._unit(joint, x)
-        lam = np.asarray(lam, float)
-        return float(mag(x, xd, 0.0 * lam)[joint][0] - mag(x, xd, lam)[joint][0])
+        can give at the multipliers ``lam``."""
+        fs = friction_set(self.model, (joint,))
+        p = fs.pairs[0]
+        load = fs.loads(x, np.asarray(lam, float))[joint][0]
+        return float(p.mu * (p.length if p.kind == "revolute" else 1.0) * load)
 
     def margin(self, joint: str, x, lam) -> float:
         """Capacity minus the friction needed to hold a sticking pair (< 0: it slips)."""
@@ -308,8 +302,9 @@ class JointFriction:
             return sol, np.zeros_like(rhs)
         lam = sol[n_i:]
         prev = np.inf
+        law = self.prepared(x, xdot)  # the per-pose part, once for the iteration
         for it in range(MAX_ITER):
-            F, D = self.forces(x, xdot, lam)
+            F, D = law.generalized(lam)
             sol = lin(rhs + F)
             r = lam - sol[n_i:]
             rn = float(np.linalg.norm(r))

@@ -36,11 +36,11 @@ MAX_ITER = 60
 RTOL = 1e-13
 
 
-def _residual(fs: FrictionSet, rows, As, bs, rs, cs_l, x, xdot, zs):
+def _residual(fs: FrictionSet, rows, As, bs, rs, cs_l, x, xdot, zs, signs=None):
     """Residual (n, m), Jacobian (n, m, m) of the scaled system and the friction force
     F_f (n, n_x) at scaled unknowns zs (n, m)."""
     n_l = cs_l.size
-    Ff, dF = fs.generalized(x, xdot, -zs[:, :n_l] * cs_l, rows)
+    Ff, dF = fs.generalized(x, xdot, -zs[:, :n_l] * cs_l, rows, signs)
     r = np.einsum("nij,nj->ni", As, zs) - bs + rs * Ff
     J = As.copy()
     J[:, :, :n_l] -= rs[None, :, None] * dF * cs_l
@@ -57,7 +57,8 @@ def _step(J, r):
     return -(np.linalg.pinv(J, rcond=1e-12) @ r[..., None])[..., 0]
 
 
-def friction_solve(fs: FrictionSet, rows, n_rows: int, As, bs, rs, cs, x, xdot, zs0):
+def friction_solve(fs: FrictionSet, rows, n_rows: int, As, bs, rs, cs, x, xdot, zs0, *,
+                   signs=None):
     """Solve the scaled kinetostatic system with friction at every position.
 
     Parameters
@@ -77,6 +78,9 @@ def friction_solve(fs: FrictionSet, rows, n_rows: int, As, bs, rs, cs, x, xdot, 
     x, xdot : ndarray, shape (n, n_x)
     zs0 : ndarray, shape (n, m)
         The frictionless (scaled) solution: the start.
+    signs : mapping, optional
+        {joint: +1 / -1}: the slip directions of a switched mode's stick-slip pairs
+        (:meth:`FrictionSet.magnitudes`).
 
     Returns
     -------
@@ -93,7 +97,7 @@ def friction_solve(fs: FrictionSet, rows, n_rows: int, As, bs, rs, cs, x, xdot, 
     cs_l = cs[:n_rows]
     zs = zs0.copy()
     n = zs.shape[0]
-    r, J, Ff = _residual(fs, rows, As, bs, rs, cs_l, x, xdot, zs)
+    r, J, Ff = _residual(fs, rows, As, bs, rs, cs_l, x, xdot, zs, signs)
 
     def scale(z, F):
         return np.maximum.reduce([np.abs(bs).max(axis=-1),
@@ -113,7 +117,7 @@ def friction_solve(fs: FrictionSet, rows, n_rows: int, As, bs, rs, cs, x, xdot, 
         for _ in range(40):  # backtracking: accept the first step that lowers |r|
             zt = za[todo] + alpha[todo, None] * dz[todo]
             rt, Jt, Ft = _residual(fs, rows, As[a][todo], bs[a][todo], rs, cs_l, x[a][todo],
-                                   xdot[a][todo], zt)
+                                   xdot[a][todo], zt, signs)
             ok = np.linalg.norm(rt, axis=-1) <= (1 - 1e-4 * alpha[todo]) * nrm0[todo]
             ok |= ~np.isfinite(nrm0[todo])
             idx = np.flatnonzero(todo)[ok]

@@ -20,6 +20,7 @@ from ..errors import MechdynError, Status
 from ..model import ConstraintLayout, Model
 from ..results.kinetostatics_record import Kinetostatics
 from .forces import force_model
+from .joint_friction import capture_stick, split_mode, stick_row
 from .kinetostatics_mode import MESSAGES, _kinetostatics
 from .mode_system import fmt_mode
 from .modes import SwitchedModel, mode_friction, mode_locks, switched_model
@@ -29,15 +30,21 @@ __all__ = ["kinetostatics_switched"]
 
 def _mode_rows(model: Model, sm: SwitchedModel, mode: frozenset, x0, first):
     """(layout, candidates) of a mode whose first pose is ``x0``: the rows of
-    the forward dynamics (:meth:`SwitchedModel.rows`), the locks holding what they held,
-    and the order in which coordinates are tried as driven (``first``, the others, and
-    last those the mode's locks free)."""
+    the forward dynamics (:meth:`SwitchedModel.rows`, and the stick rows of the pairs
+    that stick, :func:`~mechdyn.dynamics.joint_friction.stick_row`), the locks and
+    sticking pairs holding what they held, and the order in which coordinates are tried
+    as driven (``first``, the others, and last those the mode's locks free)."""
     targets: dict = {}
-    sticks = [f"{c}:stick" for c, s in mode_friction(mode).items() if s == "stick"]
-    for n in [*mode_locks(mode), *sticks]:
+    base, jstates = split_mode(model, mode)  # the joints' stick-slip states apart
+    sticks = [f"{c}:stick" for c, s in mode_friction(base).items() if s == "stick"]
+    for n in [*mode_locks(base), *sticks]:
         sm.capture_target(n, x0, targets)
-    extra = sm.rows(mode, targets)
-    lay = ConstraintLayout(model, mode, extra) if extra else model.layout(frozenset())
+    held = sorted(j for j, s in jstates.items() if s == "stick")
+    for j in held:  # a sticking pair is held at its travel or angle where it stuck
+        capture_stick(model, j, x0, targets)
+    extra = sm.rows(base, targets) + [stick_row(model, j, targets) for j in held]
+    # (the mode's joint friction states, kept with the layout, give the slip directions)
+    lay = ConstraintLayout(model, mode, extra) if extra or jstates else model.layout(frozenset())
     late = {model.coordinate_index(f) for n in mode_locks(mode) for f in sm.lock_frees(n)
             if f in model.coordinate_names}
     return lay, sorted(dict.fromkeys([*first, *range(model.n_q)]), key=late.__contains__)

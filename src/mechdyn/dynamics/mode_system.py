@@ -378,7 +378,10 @@ class ModeSystem:
         """Least-squares solution of a rank-deficient [M B, -Phi^T] system whose
         multipliers are not unique: among all solutions, the one minimizing
         sum c_k lambda_k^2 over the compliant contact rows (c_k their compliances;
-        1 for rigid unilateral rows, ~0 for the rigid joints and locks)."""
+        1 for rigid unilateral rows, ~0 for the rigid joints and locks); among those
+        of the joints and locks, the least sum (lambda_k / s_k)^2, s_k the model's
+        length scale for an angle row (a moment) and 1 for a force: the minimum norm
+        of :func:`mechdyn.kinetostatics`, so that both report the same reactions."""
         sol0, *_ = np.linalg.lstsq(Ks, rhs, rcond=None)
         u, s, vt = np.linalg.svd(Ks)
         rank = int(np.sum(s > 1e-11 * (s[0] if s.size else 1.0)))
@@ -386,6 +389,7 @@ class ModeSystem:
         if N.shape[1] == 0:
             return sol0
         w = np.full(Ks.shape[1], 1e-9)
+        w[self.n_i:] /= np.where(self.rowset.is_angle, self.model.length_scale, 1.0) ** 2
         comp = np.array([r.compliance for r in self.rows], float)
         cpos = comp[comp > 0]
         cref = float(np.mean(cpos)) if cpos.size else 1.0

@@ -17,12 +17,12 @@ from ..kinematics.constraints import _perp, coordinates_jacobian, extend
 from ..model import ConstraintLayout, Model
 from .compliance import share_by_compliance
 from .forces import applied_forces, cross, rotate
-from .friction import FrictionSet
 from .inertia import inertia_forces
+from .joint_friction import friction_joints, friction_set, joint_states
 from .kinetostatics_friction import friction_solve, locking_note
 
 __all__ = ["KinetostaticsWarning", "joint_reaction", "reaction_frame", "element_forces",
-           "frame_forces", "touches_ground"]
+           "element_width", "frame_forces", "touches_ground"]
 
 #: relative singular value below which constraint equations count as dependent
 REDUNDANT_RCOND = 1e-9
@@ -67,7 +67,7 @@ def reaction_frame(model: Model, name: str) -> tuple[str, int, int, np.ndarray]:
     return "lock", int(model.lock.i[k]), int(model.lock.j[k]), np.zeros(2)
 
 
-def joint_reaction(model: Model, name: str, x, gen):
+def joint_reaction(model: Model, name: str, x, gen, friction=None):
     """The reaction of a joint or weld lock: the force and the moment on the CHILD body
     from the PARENT, at the joint point (:func:`reaction_frame`), in the ground frame.
 
@@ -82,13 +82,20 @@ def joint_reaction(model: Model, name: str, x, gen):
         The constraint force of the element's rows on the poses, Phi_e,x^T lambda_e
         (force, N, and moment about each body frame origin, N m), in the
         convention M xddot + h = F + Phi_x^T lambda.
+    friction : array_like, shape (..., n_x), optional
+        The generalized force of the pair's friction on the poses (the law's,
+        :meth:`~mechdyn.dynamics.friction.FrictionSet.by_pair`, or the constraint force
+        of the stick row of a sticking pair): part of the reaction.  A revolute joint's
+        moment is then the moment of this friction about the pin (the friction moment
+        on the child).
 
     Returns
     -------
     force : ndarray, shape (..., 2)
         N.
     moment : ndarray, shape (...)
-        N m about the joint point; zero for a revolute joint.  With the ground as
+        N m about the joint point; zero for a revolute joint without ``friction``.
+        With the ground as
         the child, minus the parent's share (action and reaction).
     point : ndarray, shape (..., 2)
         The joint point in the ground frame, m.
@@ -98,12 +105,20 @@ def joint_reaction(model: Model, name: str, x, gen):
     gen = np.asarray(gen, float)
     P = X[..., j, :2] + rotate(X[..., j, 2], sj)
     b, sgn = (j, 1.0) if j < model.n_bodies else (i, -1.0)
-    f = gen[..., 3 * b:3 * b + 2]
-    m = gen[..., 3 * b + 2] - cross(P - X[..., b, :2], f)
-    return sgn * f, (sgn * m if kind != "revolute" else np.zeros(np.shape(m))), P
+
+    def about_p(g):
+        return g[..., 3 * b + 2] - cross(P - X[..., b, :2], g[..., 3 * b:3 * b + 2])
+
+    if friction is not None:
+        friction = np.asarray(friction, float)
+        gen = gen + friction
+    m = about_p(gen)
+    if kind == "revolute":  # the pin transmits no moment but its friction's
+        m = about_p(friction) if friction is not None else np.zeros(np.shape(m))
+    return sgn * gen[..., 3 * b:3 * b + 2], sgn * m, P
 
 
-def element_forces(ms, x, lam) -> dict:
+def element_forces(ms, x, lam, friction=None) -> dict:
     """The force of every element of a mode from its multipliers (batched over poses).
 
     Parameters
@@ -112,29 +127,54 @@ def element_forces(ms, x, lam) -> dict:
     x : ndarray, shape (..., n_x)
     lam : ndarray, shape (..., n_rows)
         Multipliers of ``ms.rowset`` (forward convention); impulses give impulses.
+    friction : dict, optional
+        {joint: generalized force (..., n_x) of its friction} of the slipping pairs
+        (:meth:`~mechdyn.dynamics.joint_friction.JointFriction.by_pair`).
 
     Returns
     -------
     dict
         Joints and weld locks: their reaction (:func:`joint_reaction`), (..., 2)
         (Fx, Fy) N for a revolute joint, (..., 3) (Fx, Fy, M) N, N, N m for a
-        prismatic joint or a weld; coordinate locks, stops and contacts: the
+        prismatic joint, a weld or a revolute joint with friction (M its friction
+        moment on the child); coordinate locks, stops and contacts: the
         multiplier of their (first) row, shape (...) (the normal force of a stop or
         contact, N or N m, the torque or force of a coordinate lock along its variable).
+        The friction of a pair is part of its reaction: the law's (``friction``) or,
+        when it sticks, the force of its stick row (:mod:`~mechdyn.dynamics.joint_friction`),
+        as :func:`mechdyn.kinetostatics` reports it.
     """
     model = ms.model
     R = ms.row_jacobian(x)
     lam = np.asarray(lam, float)
+    fj = friction_joints(model)
+    friction = friction or {}
     out: dict = {}
     for el, idx in ms.element_rows.items():
         if el not in model.mechanism.joints:
             out[el] = lam[..., idx[0]] if lam.ndim > 1 else float(lam[idx[0]])
             continue
-        gen = np.einsum("...rx,...r->...x", R[..., idx, :], lam[..., idx])
-        f, m, _ = joint_reaction(model, el, x, gen)
-        out[el] = f if model.joint_kind(el) == "revolute" else np.concatenate(
+        is_stick = np.array([k >= ms.n_base and ms.rows[k - ms.n_base].kind == "stick"
+                             for k in idx], bool)
+        base, stick = idx[~is_stick], idx[is_stick]
+        gen = np.einsum("...rx,...r->...x", R[..., base, :], lam[..., base])
+        fric = friction.get(el)
+        if stick.size:  # a sticking pair: its stick row holds it by friction
+            held = np.einsum("...rx,...r->...x", R[..., stick, :], lam[..., stick])
+            fric = held if fric is None else fric + held
+        if el in fj and fric is None:
+            fric = np.zeros_like(gen)
+        f, m, _ = joint_reaction(model, el, x, gen, fric)
+        out[el] = f if model.joint_kind(el) == "revolute" and el not in fj else np.concatenate(
             [f, np.asarray(m)[..., None]], axis=-1)
     return out
+
+
+def element_width(model, name: str) -> int:
+    """The width of a joint's or weld's force in :func:`element_forces`: 2 (Fx, Fy) for a
+    revolute joint without friction, else 3 (Fx, Fy, M)."""
+    return 2 if model.joint_kind(name) == "revolute" and name not in friction_joints(model) \
+        else 3
 
 
 def frame_forces(ms, x, lam, point=None) -> dict:
@@ -268,11 +308,21 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     if n_red:  # redundant joints with compliances: shared by them, not by the minimum norm
         shared = _share_by_compliance(model, lay, red_joints, As, bs, cs, z,
                                       ~singular & ~mask)
-    fs = FrictionSet(model)
+    # the friction of the pairs: the law's for the slipping ones (in the direction of a
+    # switched mode's slip state where their speed is zero), the stick rows' multipliers
+    # for those that stick (docs/friction.md)
+    fj = friction_joints(model)
+    states = joint_states(model, lay.mode)
+    fs = friction_set(model, tuple(j for j in fj if states.get(j) != "stick"))
+    signs = {j: 1.0 if st == "slip+" else -1.0 for j, st in states.items() if st != "stick"}
+    held = {r.element: lay.n_base + k for k, r in enumerate(lay.extra)
+            if r.kind == "stick" and r.element in fj}
     Ff, locked = np.zeros_like(F), np.zeros(n, dtype=bool)
-    if fs:  # the friction of the pairs: the nonlinear system, by Newton from z
+    finfo = {"iterations": 0}
+    if fs:  # the nonlinear system, by Newton from z
         z, Ff, locked, finfo = friction_solve(fs, {j: lay.rows[j] for j in fs.names},
-                                              lay.n_rows, As, bs, rs, cs, x, xdot, z)
+                                              lay.n_rows, As, bs, rs, cs, x, xdot, z,
+                                              signs=signs)
         locked &= ~mask  # bifurcations: the torque is the limit along the branch
         rhs = rhs - Ff
         bs = rhs * rs
@@ -329,15 +379,14 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     reactions, moments, jframe, jpoints, kinds = {}, {}, {}, {}, {}
     frame_loads: dict[str, np.ndarray] = {}
     lam_f = {j: lay.rows[j] for j in fs.names}
-    F_pair = fs.by_pair(x, xdot, -lam, lam_f) if fs else {}
+    F_pair = {j: Fp for j, (Fp, _) in fs.by_pair(x, xdot, -lam, lam_f, signs).items()}
+    F_pair.update({j: C[:, k, :] for j, k in held.items()})  # a sticking pair's friction
     for name in (n for n in model.joint_names if n in lay.rows):
         kind, i, j, _ = reaction_frame(model, name)
         gen = C[:, lay.rows[name], :].sum(axis=1)
-        if name in F_pair:  # the friction of the pair is part of its reaction
-            gen = gen + F_pair[name][0]
-        f, mP, Pt = joint_reaction(model, name, x, gen)
-        if name in F_pair and kind == "revolute":
-            mP = F_pair[name][1]  # the friction moment on the child
+        # the friction of the pair is part of its reaction (a pin's: its moment)
+        f, mP, Pt = joint_reaction(model, name, x, gen, F_pair.get(name))
+        gen = gen + F_pair.get(name, 0.0)
         reactions[name], moments[name], jpoints[name], kinds[name] = f, mP, Pt, kind
         # prismatic: along and normal to the axis; else along the parent's x and y axes
         u = rotate(X[:, i, 2], model.pri.ui[model.pri.names.index(name)]
@@ -354,6 +403,8 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
         # the normal force of a stop or contact (>= 0), the torque/force of a
         # coordinate lock on its measure, the tangential force of a sticking contact
         el_forces[el] = -lam[:, idx[0]]
+        if idx[0] in held.values():  # a sticking pair's friction: in its joint's loads
+            continue
         Del = C[:, idx, :].sum(axis=1)
         p_el += np.einsum("nx,nx->n", Del, xdot)
         frame_loads[el] = net_on_ground(model, x, Del, point)
@@ -368,7 +419,8 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     # (p_el: power of the switchable rows, zero but for sliding friction)
     p_out = -np.einsum("nx,nx->n", F, xdot)  # useful: against the applied loads
     p_in = np.einsum("nd,nd->n", tau, qdot[:, didx]) - p_out + p_el
-    losses = fs.power_lost(x, xdot, -lam, lam_f) if fs else {}
+    lost = fs.power_lost(x, xdot, -lam, lam_f, signs)
+    losses = {j: lost.get(j, np.zeros(n)) for j in fj}  # none in a sticking pair
     p_in -= sum(losses.values(), np.zeros(n))
     p_kin = np.einsum("nx,nx->n", Ix, xdot)
     p_scale = np.nanmax([np.nanmax(np.abs(p_kin)), np.nanmax(np.abs(p_in)),
@@ -381,11 +433,11 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
              "singular_positions": int(singular.sum()),
              "bifurcation_positions": int(bif.sum()),
              **({"self_locked_positions": int(locked.sum()),
-                 "friction_iterations": finfo["iterations"]} if fs else {})}
+                 "friction_iterations": finfo["iterations"]} if fj else {})}
     return {"reactions": reactions, "moments": moments, "joint_frame": jframe,
             "joint_points": jpoints, "joint_kinds": kinds, "frame_loads": frame_loads,
             "frame_force": tot[:, :2].copy(), "frame_moment": tot[:, 2].copy(),
             "multipliers": lam, "element_forces": el_forces, "redundant_joints": tuple(red_joints),
             "tau": tau, "status": status, "warnings": warn, "stats": stats,
-            **({"losses": losses, "power_out": p_out, "locked": locked} if fs else {})}
+            **({"losses": losses, "power_out": p_out, "locked": locked} if fj else {})}
 

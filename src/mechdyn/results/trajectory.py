@@ -100,7 +100,10 @@ class Trajectory:
         Arrays of shape (n,): ``kinetic`` T, ``potential`` U, ``work_nc`` (work of
         the non-conservative forces since t0: drives, applied forces and torques,
         dampers), all in J; ``balance`` = T + U - W_nc (constant for exact
-        dynamics); ``residual``, the largest constraint residual (m or rad).
+        dynamics); ``residual``, the largest constraint residual (m or rad); with
+        friction in the pairs ``work_friction`` (the energy they dissipated since t0,
+        J, included in ``work_nc``) and ``power_friction`` (the power they dissipate,
+        W, >= 0).
     coordinate_names, body_names : tuple of str
     coordinate_is_angle : tuple of bool
     model : Model or None
@@ -201,7 +204,10 @@ class Trajectory:
             Add position, velocity and acceleration of every named body point
             (``x_rod_B_m``, ``vx_rod_B_m_s``, ``ax_rod_B_m_s2`` ...).
         energy : bool
-            Add ``T_J``, ``U_J``, ``W_nc_J``, ``E_balance_J`` and ``residual``.
+            Add ``T_J``, ``U_J``, ``W_nc_J``, ``E_balance_J`` and ``residual``; with
+            friction in the pairs also ``W_friction_J`` (the work friction has
+            dissipated, J, ``energy["work_friction"]``) and ``P_friction_W`` (the power
+            it dissipates, W, ``energy["power_friction"]``).
         bodies : bool
             Add the body frame poses and velocities (``x_rod_m``, ``theta_rod_rad``,
             ``omega_rod_rad_s`` ...).
@@ -231,6 +237,9 @@ class Trajectory:
             cols.update({col: self.energy[key] for col, key in (
                 ("T_J", "kinetic"), ("U_J", "potential"), ("W_nc_J", "work_nc"),
                 ("E_balance_J", "balance"), ("residual", "residual"))})
+            cols.update({col: self.energy[key] for col, key in (
+                ("W_friction_J", "work_friction"), ("P_friction_W", "power_friction"))
+                if key in self.energy})
         vs = self.switching
         if vs and self.t.size:  # the forces of a run (see docs/variable-structure.md)
             if getattr(self.model, "has_switching", True):  # else one mode: no mode column
