@@ -43,7 +43,7 @@ from ..model.state import Mode
 from ..model.workspace import Workspace
 from .inertia import mass_matrix_x
 from .joint_friction import JointFriction, friction_joints, split_mode, stick_row
-from .reactions import touches_ground
+from .reactions import ground_rows
 
 if TYPE_CHECKING:
     from .modes import SwitchedModel
@@ -210,8 +210,8 @@ class ModeSystem:
     @cached_property
     def grounded(self) -> frozenset:
         """The elements whose rows act between the frame and the moving bodies."""
-        return frozenset(el for el, idx in self.element_rows.items()
-                         if touches_ground(self.rowset.take(idx)))
+        on_ground = ground_rows(self.rowset)
+        return frozenset(el for el, idx in self.element_rows.items() if np.any(on_ground[idx]))
 
     def _coord_jac(self, x) -> np.ndarray:
         """Jacobian of all declared coordinates, shape (n_q, n_x)."""

@@ -22,7 +22,7 @@ from .inertia import inertia_forces
 from .kinetostatics_friction import friction_solve, locking_note
 
 __all__ = ["KinetostaticsWarning", "joint_reaction", "reaction_frame", "element_forces",
-           "frame_forces", "touches_ground"]
+           "frame_forces", "touches_ground", "ground_rows"]
 
 #: relative singular value below which constraint equations count as dependent
 REDUNDANT_RCOND = 1e-9
@@ -103,7 +103,7 @@ def joint_reaction(model: Model, name: str, x, gen):
     return sgn * f, (sgn * m if kind != "revolute" else np.zeros(np.shape(m))), P
 
 
-def element_forces(ms, x, lam) -> dict:
+def element_forces(ms, x, lam, R=None) -> dict:
     """The force of every element of a mode from its multipliers (batched over poses).
 
     Parameters
@@ -112,6 +112,8 @@ def element_forces(ms, x, lam) -> dict:
     x : ndarray, shape (..., n_x)
     lam : ndarray, shape (..., n_rows)
         Multipliers of ``ms.rowset`` (forward convention); impulses give impulses.
+    R : ndarray, shape (..., n_rows, n_x), optional
+        The row Jacobian at ``x`` (``ms.row_jacobian(x)``) when the caller has it.
 
     Returns
     -------
@@ -123,7 +125,7 @@ def element_forces(ms, x, lam) -> dict:
         contact, N or N m, the torque or force of a coordinate lock along its variable).
     """
     model = ms.model
-    R = ms.row_jacobian(x)
+    R = ms.row_jacobian(x) if R is None else R
     lam = np.asarray(lam, float)
     out: dict = {}
     for el, idx in ms.element_rows.items():
@@ -137,13 +139,14 @@ def element_forces(ms, x, lam) -> dict:
     return out
 
 
-def frame_forces(ms, x, lam, point=None) -> dict:
+def frame_forces(ms, x, lam, point=None, R=None) -> dict:
     """Forces (Fx, Fy), shape (..., 2), N, that the mechanism exerts on the frame through
     each element of a mode attached to the ground (joint, lock, stop or contact);
     key ``"total"`` sums them (batched over poses ``x`` (..., n_x) and multipliers
     ``lam`` (..., n_rows)).  With ``point`` (2,) m, each entry is (Fx, Fy, M), shape
-    (..., 3), with the moment M about that point, N m."""
-    R = ms.row_jacobian(x)
+    (..., 3), with the moment M about that point, N m.  ``R``: the row Jacobian at ``x``
+    when the caller has it."""
+    R = ms.row_jacobian(x) if R is None else R
     lam = np.asarray(lam, float)
     width = 2 if point is None else 3
     p = np.zeros(2) if point is None else np.asarray(point, float)
@@ -159,13 +162,19 @@ def frame_forces(ms, x, lam, point=None) -> dict:
 
 
 def touches_ground(rows) -> bool:
-    """True if constraint rows act between the frame and a moving body: a point on
-    the ground, an angle of the ground, or an absolute angle."""
+    """True if constraint rows act between the frame and a moving body
+    (:func:`ground_rows`)."""
+    return bool(np.any(ground_rows(rows)))
+
+
+def ground_rows(rows) -> np.ndarray:
+    """Which constraint rows act between the frame and a moving body, shape (n,) bool: a
+    point on the ground, an angle of the ground, or an absolute angle."""
     g = rows.nb
     pts = np.any(rows.u != 0.0, axis=1) & ((rows.b1 == g) | (rows.b2 == g))
     ang = ((rows.ka != 0.0) & (rows.a == g)) | ((rows.kb != 0.0) & (rows.bb == g)) | (
         (rows.ka != 0.0) != (rows.kb != 0.0))
-    return bool(np.any(pts | ang))
+    return pts | ang
 
 
 def net_on_ground(model: Model, x, D, point) -> np.ndarray:
