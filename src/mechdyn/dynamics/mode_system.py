@@ -48,7 +48,7 @@ from .reactions import ground_rows
 if TYPE_CHECKING:
     from .modes import SwitchedModel
 
-__all__ = ["ModeSystem", "ModeEval", "mass_matrix_x", "fmt_mode", "solve_mass"]
+__all__ = ["ModeSystem", "ModeEval", "mass_matrix_x", "fmt_mode", "solve_mass", "held_key"]
 
 
 def fmt_mode(mode) -> str:
@@ -434,10 +434,23 @@ def solve_mass(names, A, rhs, t, q) -> np.ndarray:
 MODE_ROWS_KEPT = 64
 
 
-def _held(value) -> bytes:
-    """The bytes of a held value (a number, or a tuple of arrays and numbers)."""
-    parts = value if isinstance(value, tuple) else (value,)
-    return np.concatenate([np.ravel(np.asarray(p, float)) for p in parts]).tobytes()
+def held_key(targets: dict) -> tuple | None:
+    """The held values of the engaged locks and sticking contacts as a hashable key (their
+    names and bytes), equal for equal values; None for a held value that is not numbers.
+
+    Examples
+    --------
+    >>> held_key({"lock": 0.5}) == held_key({"lock": 0.5}), held_key({"lock": 0.5}) == ()
+    (True, False)
+    """
+    def held(value) -> bytes:
+        parts = value if isinstance(value, tuple) else (value,)
+        return np.concatenate([np.ravel(np.asarray(p, float)) for p in parts]).tobytes()
+
+    try:
+        return tuple(sorted((k, held(v)) for k, v in targets.items()))
+    except (TypeError, ValueError):
+        return None
 
 
 def _mode_rows(sm: SwitchedModel, mode: Mode, targets: dict):
@@ -445,10 +458,8 @@ def _mode_rows(sm: SwitchedModel, mode: Mode, targets: dict):
     values: pure data of the compiled model, kept in ``model.memo`` so that the runs of a
     model build them once (the rows list is the caller's own copy)."""
     model = sm.model
-    try:
-        key = (mode, tuple(sorted((k, _held(v)) for k, v in targets.items())))
-    except (TypeError, ValueError):  # a held value that is not numbers: not kept
-        key = None
+    held = held_key(targets)
+    key = None if held is None else (mode, held)  # a held value that is not numbers: not kept
     kept = model.memo.setdefault("mode rows", {})
     got = kept.get(key) if key is not None else None
     if got is None:

@@ -22,6 +22,7 @@ from ..integrate.segment import EventFunction
 from .contact import gap_measures, resolve_mode, touching
 from .impact import impact
 from .joint_friction import joint_states, resolve_joints, state_tokens, stick_slip_joints
+from .mode_system import held_key
 from .modes import (
     ModeSystem,
     SwitchedModel,
@@ -209,7 +210,8 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
             forced_slip={k: v for k, v in forced_slip.items() if k in ss},
             forced_stick=forced_stick & set(ss), velocity_tol=vtol,
             force_tol=1e-10 * force_scale, workspace=ms.ws))
-    if initial and mode_after == ms.mode and not engage and targets == ms.targets:
+    if (initial and mode_after == ms.mode and not engage
+            and held_key(targets) == held_key(ms.targets) is not None):
         # the mode the run starts in, built a moment ago: the same rows and coordinates,
         # restarted at this pose as a new one would be (a second build costs ~1 ms a run)
         ms_new = ms
