@@ -144,38 +144,47 @@ def check_loads(model: Model) -> Model:
 
 def warmup() -> dict[str, float]:
     """Compile every Numba kernel now (or load it from the disk cache), so that the first
-    analysis does not wait for it.
+    analysis of each kind does not wait for it.
 
     The kernels are generic over their arrays: compiling them on a small pendulum of
     their own compiles them for every model.  They are kept in
     :func:`mechdyn.kernels.cache_dir`, once per machine; a later call, or a later
-    process, only loads them.
+    process, only loads them.  Each group compiled for the first time on the machine is
+    announced on stderr with its time, as on first use.
 
     Returns
     -------
     dict of str to float
-        Wall time (s) of each group of kernels -- ``"dynamics"`` (the equations of
-        motion of :func:`mechdyn.simulate`) and ``"kinematic sweep"`` (the position
-        problem of :func:`mechdyn.sweep`) -- and ``"total"``.  Empty when Numba is not
-        installed (the analyses then run on NumPy, nothing to compile).
+        Wall time (s) of each group of kernels and ``"total"``: ``"dynamics"`` (the
+        evaluations of the equations of motion of :func:`mechdyn.simulate`),
+        ``"integration loop"`` (its compiled DOP853 loop, :mod:`mechdyn.kernels.dop853_numba`),
+        ``"kinematic sweep"`` (the position problem of :func:`mechdyn.sweep`) and
+        ``"batched study"`` (the kinetostatics of many variants at once of
+        :mod:`mechdyn.study`, :mod:`mechdyn.kernels.rows_variants`).  A group already
+        compiled in this process counts 0 s.  Empty when Numba is not installed (the
+        analyses then run on NumPy, nothing to compile).
 
     Examples
     --------
     >>> times = warmup()
-    >>> sorted(times) in ([], ["dynamics", "kinematic sweep", "total"])
+    >>> sorted(times) in ([], ["batched study", "dynamics", "integration loop",
+    ...                        "kinematic sweep", "total"])
     True
     """
     import time
 
-    from .dynamics.compiled import _warm_up, numba_available
+    from .dynamics.compiled import _COMPILED, _warm_up, numba_available
+    from .kernels.rows_numba import compiling
     from .kinematics.continuation import Kernel
     from .mechanism import Mechanism
 
     if not numba_available():
         return {}
     t0 = time.perf_counter()
+    fresh = not _COMPILED["done"]
     _warm_up()
     t1 = time.perf_counter()
+    times = dict(_COMPILED["groups"]) if fresh else {"dynamics": 0.0, "integration loop": 0.0}
     mech = Mechanism("warm-up pendulum")
     mech.add_body("bar", mass=1.0, inertia=0.1, com=(0.5, 0.0))
     mech.add_revolute("O", "ground", "bar")
@@ -184,4 +193,32 @@ def warmup() -> dict[str, float]:
     kernel = Kernel(model, model.layout())  # compiles the sweep's drivers on construction
     kernel.gamma(model.x0, np.zeros(model.n_x))
     t2 = time.perf_counter()
-    return {"dynamics": t1 - t0, "kinematic sweep": t2 - t1, "total": t2 - t0}
+    with compiling("numba kernels of the batched study"):
+        _warm_up_study(model)
+    t3 = time.perf_counter()
+    times.update({"kinematic sweep": t2 - t1, "batched study": t3 - t2, "total": t3 - t0})
+    return times
+
+
+def _warm_up_study(model: Model) -> None:
+    """Compile (or load) the batched kinetostatics of :mod:`mechdyn.study`
+    (:mod:`mechdyn.kernels.rows_variants`) on a one-coordinate ``model``: one variant along
+    two positions, with arrays of the types the study passes."""
+    from .kernels.rows_variants import inverse_variants, path_variants
+
+    lay = model.layout()
+    crd = model.coordinate_rows
+    ints = np.ascontiguousarray(np.concatenate([lay.rowset.packed()[0], crd.packed()[0]]))
+    flts = np.ascontiguousarray(np.concatenate([lay.rowset.packed()[1], crd.packed()[1]])[None])
+    n, n_x, m = len(ints), model.n_x, 2
+    Q = np.array([[[0.0], [0.1]]])
+    dQ, ddQ = np.ones((m, 1)), np.zeros((m, 1))
+    X, Xd, Xdd = (np.empty((1, m, n_x)) for _ in range(3))
+    J, LU = np.empty((1, m, n, n_x)), np.empty((1, m, n, n_x))
+    piv, rc = np.empty((1, m, n), dtype=np.int64), np.empty((1, m))
+    ok, fail = np.ones(1, dtype=bool), np.empty(1, dtype=np.int64)
+    path_variants(np.ascontiguousarray(model.x0[None]), Q, dQ, ddQ, np.arange(m), model.n_bodies,
+                  ints, flts, lay.n_rows, np.full(1, 1e-12), 12, 1e7, 1e-9, X, Xd, Xdd, J, LU,
+                  piv, rc, ok, fail)
+    rhs = np.zeros((1, m, 2 * n))[..., :n]  # the study's right-hand sides are strided views
+    inverse_variants(LU, piv, rhs, lay.n_rows, np.empty((1, m, n)))

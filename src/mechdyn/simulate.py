@@ -63,8 +63,15 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
     t_end : float
         End time, s (>= ``t0``).
     integrator : str or Integrator
-        ``"dop853"`` (default), ``"rk45"``, ``"rk23"``, ``"radau"``, ``"bdf"``,
-        ``"lsoda"`` (adaptive, SciPy), ``"rk4"`` or ``"wilson"`` (fixed step; the
+        One of :data:`mechdyn.integrate.INTEGRATORS`: ``"dop853"`` (default: the
+        Dormand-Prince 8(5,3) pair, in the compiled loop of
+        :mod:`mechdyn.kernels.dop853_numba` where it can run -- a segment on the compiled
+        (Numba) kernel without event functions: a fixed-structure model, no ``events``,
+        no redundant constraints, no friction in the joints -- and SciPy's DOP853
+        elsewhere: the NumPy backend, variable-structure modes, runs with ``events``);
+        ``"scipy-dop853"`` (SciPy's DOP853 everywhere, stepped from Python: the same
+        method, for cross-checks); ``"rk45"``, ``"rk23"``, ``"radau"``, ``"bdf"``,
+        ``"lsoda"`` (adaptive, SciPy); ``"rk4"`` or ``"wilson"`` (fixed step; the
         source paper's linear-acceleration method; they step on a grid of ``dt`` from
         the start of every mode segment, its last step shortened to the event).
     steps, dt

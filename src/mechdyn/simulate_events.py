@@ -513,12 +513,14 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
     for a, b in zip(starts[:-1], starts[1:], strict=True):
         ms, sl = rec[a][1], slice(a, b)
         lam = np.array([r[2].lam for r in rec[a:b]], float).reshape(b - a, ms.n_rows)
+        parts = RN.Parts(ms.rowset, x[sl])  # the rows' Jacobian and values share them
+        R = RN.jacobian(ms.rowset, x[sl], parts)
         # the frame also carries the load elements anchored on it (spring ends, torque
         # reactions) and the stators of the drives between it and the bodies
         _, on_ground, Qd = sm.fm.loads(t[sl], x[sl], xd[sl], q[sl], qd[sl])
         on_ground[:, 2] -= point[0] * on_ground[:, 1] - point[1] * on_ground[:, 0]  # about P
         drives = np.einsum("nqx,nq->nx", RN.jacobian(model.coordinate_rows, x[sl]), Qd)
-        frame[sl] = (frame_forces(ms, x[sl], lam, point=point)["total"] + on_ground
+        frame[sl] = (frame_forces(ms, x[sl], lam, point=point, R=R)["total"] + on_ground
                      + net_on_ground(model, x[sl], drives, point))
         pairs = None
         if ms.friction is not None:
@@ -529,10 +531,10 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
             frame[sl] += net_on_ground(model, x[sl], Ff, point)
             p_f[sl] = -np.einsum("nx,nx->n", Ff, xd[sl])  # the power friction dissipates
             pairs = ms.friction.by_pair(x[sl], xd[sl], lam)  # part of their reactions
-        for el, v in element_forces(ms, x[sl], lam, pairs).items():
+        for el, v in element_forces(ms, x[sl], lam, pairs, R=R).items():
             forces.setdefault(el, np.zeros((n,) + np.shape(v)[1:]))[sl] = v
         if ms.n_rows:
-            res[sl] = np.max(np.abs(ms.row_values(x[sl])), axis=-1)
+            res[sl] = np.max(np.abs(RN.values(ms.rowset, x[sl], parts)), axis=-1)
     for r in rec:
         if r[1].mode not in modes:
             modes.append(r[1].mode)

@@ -12,7 +12,9 @@ def register(sub) -> None:
         help="compile the numba kernels now (once per machine) and report the time",
         description="Compile every Numba kernel now -- or load it from the cache, when an "
                     "earlier run compiled it -- so that the first analysis does not wait "
-                    "for it; print where they are cached and how long each group took. "
+                    "for it; print where they are cached and how long each group took "
+                    "(the dynamics, its compiled integration loop, the kinematic sweep, the "
+                    "batched study). "
                     "Without it they are compiled on their first use.",
         epilog="The cache folder is NUMBA_CACHE_DIR when set, else the user's cache folder "
                "for mechdyn (e.g. ~/.cache/mechdyn).")

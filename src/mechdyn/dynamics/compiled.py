@@ -176,7 +176,10 @@ class CompiledKernel:
         return fun
 
 
-_COMPILED = {"done": False, "time": 0.0}
+#: the first compilation (or load from the disk cache) of this process: done, and the
+#: seconds it took in all and per group ("dynamics": the kernel's evaluations,
+#: "integration loop": the compiled DOP853 loop of :mod:`mechdyn.kernels.dop853_numba`)
+_COMPILED: dict = {"done": False, "time": 0.0, "groups": {}}
 
 
 def _warm_up() -> float:
@@ -184,8 +187,10 @@ def _warm_up() -> float:
     pendulum (a bar pinned to the ground, its angle as coordinate, gravity): the kernels
     are generic over their arrays, so compiling them on this model compiles them for
     every model -- and never evaluates a user's model at a position its run does not
-    visit (a spring whose ends meet at the sketch ...).  A compilation that takes longer
-    than a few seconds is announced on stderr (the first run of a fresh installation)."""
+    visit (a spring whose ends meet at the sketch ...).  The evaluations of the dynamics
+    and the compiled integration loop are compiled one after the other, each announced on
+    stderr when it takes longer than a few seconds (the first run of a fresh
+    installation); their times are kept in ``_COMPILED["groups"]``."""
     if _COMPILED["done"]:
         return 0.0
     t0 = time.perf_counter()
@@ -203,9 +208,12 @@ def _warm_up() -> float:
         kernel.reset(model.x_sketch)
         kernel.rhs(0.0, [0.3], [1.0])
         kernel.evaluation(0.0, [0.3], [1.0])
+    t1 = time.perf_counter()
+    with compiling("compiled integration loop (DOP853) of the dynamics"):
         warm_up_loop(kernel)
-    _COMPILED["done"] = True
-    _COMPILED["time"] = time.perf_counter() - t0
+    t2 = time.perf_counter()
+    _COMPILED.update(done=True, time=t2 - t0,
+                     groups={"dynamics": t1 - t0, "integration loop": t2 - t1})
     return _COMPILED["time"]
 
 

@@ -43,12 +43,12 @@ from ..model.state import Mode
 from ..model.workspace import Workspace
 from .inertia import mass_matrix_x
 from .joint_friction import JointFriction, friction_joints, split_mode, stick_row
-from .reactions import touches_ground
+from .reactions import ground_rows
 
 if TYPE_CHECKING:
     from .modes import SwitchedModel
 
-__all__ = ["ModeSystem", "ModeEval", "mass_matrix_x", "fmt_mode", "solve_mass"]
+__all__ = ["ModeSystem", "ModeEval", "mass_matrix_x", "fmt_mode", "solve_mass", "held_key"]
 
 
 def fmt_mode(mode) -> str:
@@ -137,10 +137,8 @@ class ModeSystem:
         self.model = model
         self.mode = Mode(mode)
         self.targets = dict(targets)
-        base, jstates = split_mode(model, self.mode)
-        self.rows = sm.rows(base, targets) + [stick_row(model, j, targets)
-                                              for j, s in sorted(jstates.items()) if s == "stick"]
-        self.layout = lay = ConstraintLayout(model, self.mode, self.rows)
+        self.rows, self.layout = _mode_rows(sm, self.mode, self.targets)
+        lay = self.layout
         self.rowset, self.n_rows, self.n_base = lay.rowset, lay.n_rows, lay.n_base
         #: the rows of each element (joint, lock, stop, contact), indices into rowset
         self.element_rows = lay.element_rows
@@ -210,8 +208,8 @@ class ModeSystem:
     @cached_property
     def grounded(self) -> frozenset:
         """The elements whose rows act between the frame and the moving bodies."""
-        return frozenset(el for el, idx in self.element_rows.items()
-                         if touches_ground(self.rowset.take(idx)))
+        on_ground = ground_rows(self.rowset)
+        return frozenset(el for el, idx in self.element_rows.items() if np.any(on_ground[idx]))
 
     def _coord_jac(self, x) -> np.ndarray:
         """Jacobian of all declared coordinates, shape (n_q, n_x)."""
@@ -435,11 +433,61 @@ def solve_mass(names, A, rhs, t, q) -> np.ndarray:
             f"no inertia", t=t, q=q) from None
 
 
+#: (mode, held values) kept per model with their rows and layout (bounded: locks that
+#: capture a new held value every cycle make a new entry each time)
+MODE_ROWS_KEPT = 64
+
+
+def held_key(targets: dict) -> tuple | None:
+    """The held values of the engaged locks and sticking contacts as a hashable key (their
+    names and bytes), equal for equal values; None for a held value that is not numbers.
+
+    Examples
+    --------
+    >>> held_key({"lock": 0.5}) == held_key({"lock": 0.5}), held_key({"lock": 0.5}) == ()
+    (True, False)
+    """
+    def held(value) -> bytes:
+        parts = value if isinstance(value, tuple) else (value,)
+        return np.concatenate([np.ravel(np.asarray(p, float)) for p in parts]).tobytes()
+
+    try:
+        return tuple(sorted((k, held(v)) for k, v in targets.items()))
+    except (TypeError, ValueError):
+        return None
+
+
+def _mode_rows(sm: SwitchedModel, mode: Mode, targets: dict):
+    """(switchable rows, :class:`~mechdyn.model.ConstraintLayout`) of a mode with its held
+    values: pure data of the compiled model, kept in ``model.memo`` so that the runs of a
+    model build them once (the rows list is the caller's own copy)."""
+    model = sm.model
+    held = held_key(targets)
+    key = None if held is None else (mode, held)  # a held value that is not numbers: not kept
+    kept = model.memo.setdefault("mode rows", {})
+    got = kept.get(key) if key is not None else None
+    if got is None:
+        base, jstates = split_mode(model, mode)
+        rows = sm.rows(base, targets) + [stick_row(model, j, targets)
+                                         for j, s in sorted(jstates.items()) if s == "stick"]
+        got = (tuple(rows), ConstraintLayout(model, mode, rows))
+        if key is not None and len(kept) < MODE_ROWS_KEPT:
+            kept[key] = got
+    return list(got[0]), got[1]
+
+
 def _independent_rows(Rs, tol=1e-9) -> np.ndarray:
     """Indices of a maximal set of linearly independent rows, earlier rows first."""
     keep = []
     basis = np.zeros((0, Rs.shape[1]))
     scale = max(np.max(np.abs(Rs)) if Rs.size else 1.0, 1e-300)
+    if 0 < Rs.shape[0] <= Rs.shape[1]:
+        # every row at least sigma_min away from the span of the others: all are kept by
+        # the test below (with a margin of 10 for its rounding), found with one SVD
+        A = Rs / scale
+        floor = max(tol * float(np.max(np.linalg.norm(A, axis=1))), 1e-12)
+        if np.linalg.svd(A, compute_uv=False)[-1] > 10.0 * floor:
+            return np.arange(Rs.shape[0])
     for k in range(Rs.shape[0]):
         r = Rs[k] / scale
         if basis.shape[0]:

@@ -22,7 +22,7 @@ from .joint_friction import friction_joints, friction_set, joint_states
 from .kinetostatics_friction import friction_solve, locking_note
 
 __all__ = ["KinetostaticsWarning", "joint_reaction", "reaction_frame", "element_forces",
-           "element_width", "frame_forces", "touches_ground"]
+           "element_width", "frame_forces", "touches_ground", "ground_rows"]
 
 #: relative singular value below which constraint equations count as dependent
 REDUNDANT_RCOND = 1e-9
@@ -118,7 +118,7 @@ def joint_reaction(model: Model, name: str, x, gen, friction=None):
     return sgn * gen[..., 3 * b:3 * b + 2], sgn * m, P
 
 
-def element_forces(ms, x, lam, friction=None) -> dict:
+def element_forces(ms, x, lam, friction=None, R=None) -> dict:
     """The force of every element of a mode from its multipliers (batched over poses).
 
     Parameters
@@ -130,6 +130,8 @@ def element_forces(ms, x, lam, friction=None) -> dict:
     friction : dict, optional
         {joint: generalized force (..., n_x) of its friction} of the slipping pairs
         (:meth:`~mechdyn.dynamics.joint_friction.JointFriction.by_pair`).
+    R : ndarray, shape (..., n_rows, n_x), optional
+        The row Jacobian at ``x`` (``ms.row_jacobian(x)``) when the caller has it.
 
     Returns
     -------
@@ -145,7 +147,7 @@ def element_forces(ms, x, lam, friction=None) -> dict:
         as :func:`mechdyn.kinetostatics` reports it.
     """
     model = ms.model
-    R = ms.row_jacobian(x)
+    R = ms.row_jacobian(x) if R is None else R
     lam = np.asarray(lam, float)
     fj = friction_joints(model)
     friction = friction or {}
@@ -177,13 +179,14 @@ def element_width(model, name: str) -> int:
         else 3
 
 
-def frame_forces(ms, x, lam, point=None) -> dict:
+def frame_forces(ms, x, lam, point=None, R=None) -> dict:
     """Forces (Fx, Fy), shape (..., 2), N, that the mechanism exerts on the frame through
     each element of a mode attached to the ground (joint, lock, stop or contact);
     key ``"total"`` sums them (batched over poses ``x`` (..., n_x) and multipliers
     ``lam`` (..., n_rows)).  With ``point`` (2,) m, each entry is (Fx, Fy, M), shape
-    (..., 3), with the moment M about that point, N m."""
-    R = ms.row_jacobian(x)
+    (..., 3), with the moment M about that point, N m.  ``R``: the row Jacobian at ``x``
+    when the caller has it."""
+    R = ms.row_jacobian(x) if R is None else R
     lam = np.asarray(lam, float)
     width = 2 if point is None else 3
     p = np.zeros(2) if point is None else np.asarray(point, float)
@@ -199,13 +202,19 @@ def frame_forces(ms, x, lam, point=None) -> dict:
 
 
 def touches_ground(rows) -> bool:
-    """True if constraint rows act between the frame and a moving body: a point on
-    the ground, an angle of the ground, or an absolute angle."""
+    """True if constraint rows act between the frame and a moving body
+    (:func:`ground_rows`)."""
+    return bool(np.any(ground_rows(rows)))
+
+
+def ground_rows(rows) -> np.ndarray:
+    """Which constraint rows act between the frame and a moving body, shape (n,) bool: a
+    point on the ground, an angle of the ground, or an absolute angle."""
     g = rows.nb
     pts = np.any(rows.u != 0.0, axis=1) & ((rows.b1 == g) | (rows.b2 == g))
     ang = ((rows.ka != 0.0) & (rows.a == g)) | ((rows.kb != 0.0) & (rows.bb == g)) | (
         (rows.ka != 0.0) != (rows.kb != 0.0))
-    return bool(np.any(pts | ang))
+    return pts | ang
 
 
 def net_on_ground(model: Model, x, D, point) -> np.ndarray:

@@ -22,6 +22,7 @@ from ..integrate.segment import EventFunction
 from .contact import gap_measures, resolve_mode, touching
 from .impact import impact
 from .joint_friction import joint_states, resolve_joints, state_tokens, stick_slip_joints
+from .mode_system import held_key
 from .modes import (
     ModeSystem,
     SwitchedModel,
@@ -209,8 +210,16 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
             forced_slip={k: v for k, v in forced_slip.items() if k in ss},
             forced_stick=forced_stick & set(ss), velocity_tol=vtol,
             force_tol=1e-10 * force_scale, workspace=ms.ws))
-    ms_new = ModeSystem(sm, mode_after, targets, x, prefer=ms.coord_names, avoid=frees,
-                        workspace=ms.ws)
+    if (initial and mode_after == ms.mode and not engage
+            and held_key(targets) == held_key(ms.targets) is not None):
+        # the mode the run starts in, built a moment ago: the same rows and coordinates,
+        # restarted at this pose as a new one would be (a second build costs ~1 ms a run)
+        ms_new = ms
+        ms_new.x_ref = np.array(x, float)
+        ms_new.ws.reset(ms_new.x_ref)
+    else:
+        ms_new = ModeSystem(sm, mode_after, targets, x, prefer=ms.coord_names, avoid=frees,
+                            workspace=ms.ws)
     # an engaging lock must hold the pose it engages at (no position jump)
     tol_pos = 1e-8 * sm.model.length_scale
     bad = {lab: float(v) for lab, v, el in zip(ms_new.row_labels(), ms_new.row_values(x),

@@ -1,0 +1,45 @@
+"""The fixed cost of a run: what a mode system keeps on the model and its shortcuts give
+what the full computation gives."""
+
+import numpy as np
+
+from mechdyn.dynamics import mode_system as MS
+from mechdyn.dynamics.modes import ModeSystem, switched_model
+from mechdyn.examples.paper_case import press_idle
+
+
+def _greedy(Rs):
+    """Rows kept, earlier first, where each raises the rank of those kept (by SVD rank,
+    a second way of deciding independence)."""
+    keep: list = []
+    for k in range(Rs.shape[0]):
+        if np.linalg.matrix_rank(Rs[keep + [k]]) > len(keep):
+            keep.append(k)
+    return keep
+
+
+def test_independent_rows_shortcut_agrees_with_gram_schmidt():
+    rng = np.random.default_rng(3)
+    for m, n in ((3, 6), (6, 6), (5, 9)):
+        A = rng.normal(size=(m, n))
+        assert MS._independent_rows(A).tolist() == _greedy(A) == list(range(m))
+        B = np.vstack([A, A[0] + 2 * A[1]])  # a dependent row: the greedy path
+        if B.shape[0] <= n:
+            assert MS._independent_rows(B).tolist() == _greedy(B) == list(range(m))
+        C = A.copy()
+        C[1] = 3.0 * C[0]  # dependent among the first rows
+        assert MS._independent_rows(C).tolist() == _greedy(C)
+
+
+def test_mode_rows_kept_on_the_model_give_the_same_mode_system():
+    model = press_idle().compile()
+    sm = switched_model(model)
+    a = ModeSystem(sm, frozenset(), {}, model.x0)
+    b = ModeSystem(sm, frozenset(), {}, model.x0)
+    assert b.layout is a.layout  # built once, kept in model.memo
+    assert b.rows is not a.rows  # each mode system has its own list
+    assert a.coords.tolist() == b.coords.tolist()
+    assert a.independent_rows.tolist() == b.independent_rows.tolist()
+    assert MS.held_key({"w": (np.array([1.0, 2.0]), 0.5)}) == MS.held_key(
+        {"w": (np.array([1.0, 2.0]), 0.5)})
+    assert MS.held_key({"w": 1.0}) != MS.held_key({"w": 1.0 + 1e-15})
