@@ -20,19 +20,20 @@ from __future__ import annotations
 import numpy as np
 
 from .linalg import lu_factor, lu_solve, lu_solve_transposed
-from .rows_numba import njit, rows_jacobian, rows_quad, rows_values
+from .rows_numba import body_rotations, njit, rows_jacobian_cs, rows_quad_cs, rows_values_cs
 
-__all__ = ["path_variants", "inverse_variants"]
+__all__ = ["path_variants", "inverse_variants", "loads_variants"]
 
 
 @njit
-def _system(x, q, nb, ints, flts, n_rows, F, J):
-    """F = [Phi; g_d - q] and J at one pose of one variant (in place)."""
-    rows_values(x, nb, ints, flts, F, 0)
+def _system(x, q, nb, ints, flts, n_rows, cs, F, J):
+    """F = [Phi; g_d - q] and J at one pose of one variant (in place; ``cs``: the
+    rotations of x, :func:`~mechdyn.kernels.rows_numba.body_rotations`)."""
+    rows_values_cs(x, nb, ints, flts, cs, F, 0)
     for k in range(q.shape[0]):
         F[n_rows + k] -= q[k]
     J[:, :] = 0.0
-    rows_jacobian(x, nb, ints, flts, J, 0)
+    rows_jacobian_cs(x, nb, ints, flts, cs, J, 0)
 
 
 @njit
@@ -50,15 +51,17 @@ def _det_sign(lu, piv, n):
 
 
 @njit
-def _at_solution(x, qdot, qddot, nb, ints, flts, n_rows, J, fresh, lu, piv, xd, xdd, b):
-    """J at a solved pose (evaluated into J unless ``fresh``: J holds it) and its factors;
+def _at_solution(x, qdot, qddot, nb, ints, flts, n_rows, cs, J, fresh, lu, piv, xd, xdd,
+                 b):
+    """J at a solved pose x (``cs``: its rotations; J evaluated into J unless ``fresh``:
+    J holds it) and its factors;
     the rates xd = J^-1 [0; qdot] and the accelerations xdd = J^-1 (gamma + [0; qddot])
     (qdot, qddot of the driven rows).  Returns the pivot ratio (0: singular, rates not
     set)."""
     n = x.shape[0]
     if not fresh:
         J[:, :] = 0.0
-        rows_jacobian(x, nb, ints, flts, J, 0)
+        rows_jacobian_cs(x, nb, ints, flts, cs, J, 0)
     lu[:, :] = J
     rc = lu_factor(lu, piv, n)
     if rc == 0.0:
@@ -68,7 +71,7 @@ def _at_solution(x, qdot, qddot, nb, ints, flts, n_rows, J, fresh, lu, piv, xd, 
         b[n_rows + c] = qdot[c]
     lu_solve(lu, piv, b, n)
     xd[:] = b
-    rows_quad(x, xd, nb, ints, flts, b, 0)
+    rows_quad_cs(x, xd, nb, ints, flts, cs, b, 0)
     for i in range(n):
         b[i] = -b[i]
     for c in range(qdot.shape[0]):
@@ -141,6 +144,7 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
     xdd = np.empty(n)
     T = np.empty((n, nd))
     Tp = np.empty(n)
+    cs = np.empty((nb + 1, 2))  # the rotations of x, once per pose
     for v in range(V):
         fail[v] = -1
         if not ok[v]:
@@ -165,11 +169,12 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
             done = False
             fresh = False  # Jw is J at x
             for it in range(max_iter + 1):
+                body_rotations(x, nb, cs)
                 if it == 0:
-                    _system(x, q, nb, ints, flts[v], n_rows, F, Jw)
+                    _system(x, q, nb, ints, flts[v], n_rows, cs, F, Jw)
                     fresh = True
                 else:
-                    rows_values(x, nb, ints, flts[v], F, 0)
+                    rows_values_cs(x, nb, ints, flts[v], cs, F, 0)
                     for c in range(nd):
                         F[n_rows + c] -= q[c]
                 err = 0.0
@@ -184,7 +189,7 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
                     break
                 if not fresh:
                     Jw[:, :] = 0.0
-                    rows_jacobian(x, nb, ints, flts[v], Jw, 0)
+                    rows_jacobian_cs(x, nb, ints, flts[v], cs, Jw, 0)
                 lu[:, :] = Jw
                 if lu_factor(lu, pv, n) == 0.0:
                     break
@@ -196,8 +201,9 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
                     step = max(step, abs(b[i]))
                 fresh = False
                 if it == 0 and step <= short * tol[v]:
+                    body_rotations(x, nb, cs)
                     J1[:, :] = 0.0
-                    rows_jacobian(x, nb, ints, flts[v], J1, 0)
+                    rows_jacobian_cs(x, nb, ints, flts[v], cs, J1, 0)
                     err = 0.0
                     for i in range(n):
                         r = 0.0
@@ -215,8 +221,8 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
                 break
             # at the solution: J, its factors, the branch sign, the rates; the tangent
             k = keep[m]
-            r = _at_solution(x, dQ[m], ddQ[m], nb, ints, flts[v], n_rows, Jw, fresh, lu, pv,
-                             xd, xdd, b)
+            r = _at_solution(x, dQ[m], ddQ[m], nb, ints, flts[v], n_rows, cs, Jw, fresh, lu,
+                             pv, xd, xdd, b)
             s = _det_sign(lu, pv, n)
             if m == 0:
                 sign0 = s
@@ -266,3 +272,55 @@ def inverse_variants(LU, piv, rhs, n_rows, Z):
             lu_solve_transposed(LU[v, k], piv[v, k], b, n)
             for c in range(n):
                 Z[v, k, c] = -b[c] if c < n_rows else b[c]
+
+
+@njit
+def loads_variants(J, Z, weight, group, cols, sign, D, Fj):
+    """Sums of the row forces ``Phi_x^T lambda`` (and ``g_d,x^T tau``) of every position
+    of every variant, from J = [Phi_x; g_d,x] and the solution z of
+    :func:`inverse_variants` (the multipliers with their sign turned, then the driving
+    torques/forces):
+
+    * ``D[v, k] = sum_r weight[r] z_r J_r`` (n_x,): the rows' forces on the bodies
+      chosen by ``weight`` (for instance the drives' stators and the joints to the
+      frame);
+    * ``Fj[g, v, k, c] = -sign[g] sum_{r: group[r] = g} z_r J[r, cols[g, c]]``: two
+      columns (c = 0, 1) of the constraint force of the rows of each group g (a joint's
+      force on one body, oriented by ``sign``).
+
+    Parameters
+    ----------
+    J : ndarray, shape (V, N, n, n_x)
+    Z : ndarray, shape (V, N, n)
+    weight : ndarray, shape (n,)
+    group : ndarray of int, shape (n,)
+        The group of each row (-1: none).
+    cols : ndarray of int, shape (G, 2)
+    sign : ndarray, shape (G,)
+    D : ndarray, shape (V, N, n_x)
+        Output.
+    Fj : ndarray, shape (G, V, N, 2)
+        Output.
+    """
+    V, N, n, nx = J.shape
+    G = cols.shape[0]
+    for v in range(V):
+        for k in range(N):
+            for i in range(nx):
+                D[v, k, i] = 0.0
+            for g in range(G):
+                Fj[g, v, k, 0] = 0.0
+                Fj[g, v, k, 1] = 0.0
+            for r in range(n):
+                z = Z[v, k, r]
+                w = weight[r] * z
+                if w != 0.0:
+                    for i in range(nx):
+                        D[v, k, i] += w * J[v, k, r, i]
+                g = group[r]
+                if g >= 0:
+                    Fj[g, v, k, 0] -= z * J[v, k, r, cols[g, 0]]
+                    Fj[g, v, k, 1] -= z * J[v, k, r, cols[g, 1]]
+            for g in range(G):
+                Fj[g, v, k, 0] *= sign[g]
+                Fj[g, v, k, 1] *= sign[g]

@@ -46,7 +46,7 @@ from ..dynamics.prescribed_motion import _independent_subset
 from ..dynamics.reactions import joint_reaction, net_on_ground, reaction_frame
 from ..errors import Status
 from ..kernels import rows_numba, rows_numpy
-from ..kernels.rows_variants import inverse_variants, path_variants
+from ..kernels.rows_variants import inverse_variants, loads_variants, path_variants
 from ..kinematics.sweep import DEFAULT_MAX_STEP
 from ..model import Model
 from ..results.kinetostatics_record import Kinetostatics
@@ -338,7 +338,10 @@ def _cycle(vs: Variants, analysis: KinetostaticExtremes, work: dict) -> list[Out
     Z = np.empty_like(X)
     inverse_variants(LU, piv, rhs, n_rows, Z)
     good = np.all(rc >= MIN_PIVOT_RATIO, axis=1) & np.all(np.isfinite(Z), axis=(1, 2))
-    reactions, frame = _reactions(base, lay0, X, J, Z, n_rows)
+    loads = _reactions(base, lay0, X, J, Z, n_rows)
+    if loads is None:
+        return [None] * V
+    reactions, frame = loads
     frame += F_ground  # the frame's share of the loads (point of the moments: the origin)
     names = base.coordinate_names
     driven = {names[k]: Z[..., n_rows + c] for c, k in enumerate(didx)}
@@ -397,19 +400,36 @@ def _reactions(base, lay, X, J, Z, n_rows):
     :func:`~mechdyn.dynamics.reactions.joint_reaction`), and what the frame receives
     from the joints to the ground and from the drives' stators, (V, N, 3): Fx, Fy (N)
     and the moment about the ground origin (N m) (as ``_inverse``'s frame loads; they
-    are linear in the forces on the bodies, so their sum is taken once)."""
+    are linear in the forces on the bodies, so their sum is taken once); None when a
+    joint's reaction is not a column of its rows' force (left to the single-model
+    analysis).
+
+    The sums over the rows are compiled
+    (:func:`~mechdyn.kernels.rows_variants.loads_variants`): a joint's force is two
+    columns of ``-Phi_e,x^T lambda_e`` with a sign, which :func:`joint_reaction` tells
+    by its answer to each unit column."""
     V, N, n_x = X.shape
-    x, Jf, Zf = X.reshape(V * N, n_x), J.reshape(V * N, n_x, n_x), Z.reshape(V * N, n_x)
-    # the drives' stators: the driving torques on the poses, D = g_d,x^T tau
-    D = np.einsum("nd,ndx->nx", Zf[:, n_rows:], Jf[:, n_rows:, :])
-    reactions = {}
-    for name in (n for n in base.joint_names if n in lay.rows):
-        idx = lay.rows[name]
-        rows = slice(idx[0], idx[-1] + 1) if np.all(np.diff(idx) == 1) else idx
-        gen = -np.einsum("nr,nrx->nx", Zf[:, rows], Jf[:, rows, :])  # -Phi_e,x^T lambda_e
-        # the force does not depend on the joint point (the base's serves every variant)
-        f, _, _ = joint_reaction(base, name, x, gen)
-        reactions[name] = f.reshape(V, N, 2)
+    names = [n for n in base.joint_names if n in lay.rows]
+    group = np.full(n_x, -1, dtype=np.int64)
+    weight = np.zeros(n_x)
+    weight[n_rows:] = 1.0  # the drives' stators: the driving torques on the poses
+    cols = np.zeros((len(names), 2), dtype=np.int64)
+    sign = np.zeros(len(names))
+    probe = np.broadcast_to(X[0, 0], (n_x, n_x))
+    for g, name in enumerate(names):
+        idx = np.asarray(lay.rows[name])
+        group[idx] = g
+        f = joint_reaction(base, name, probe, np.eye(n_x))[0]  # (n_x, 2): its columns
+        cols[g] = np.argmax(np.abs(f), axis=0)
+        sign[g] = f[cols[g, 0], 0]
+        select = np.zeros((n_x, 2))
+        select[cols[g], [0, 1]] = sign[g]
+        if abs(sign[g]) != 1.0 or not np.array_equal(f, select):
+            return None
         if base.n_bodies in reaction_frame(base, name)[1:3]:
-            D += gen
-    return reactions, net_on_ground(base, x, D, np.zeros(2)).reshape(V, N, 3)
+            weight[idx] = -1.0  # -Phi_e,x^T lambda_e: the joint's force on the bodies
+    D, Fj = np.empty((V, N, n_x)), np.empty((len(names), V, N, 2))
+    loads_variants(J, Z, weight, group, cols, sign, D, Fj)
+    reactions = {name: Fj[g] for g, name in enumerate(names)}
+    frame = net_on_ground(base, X.reshape(V * N, n_x), D.reshape(V * N, n_x), np.zeros(2))
+    return reactions, frame.reshape(V, N, 3)
