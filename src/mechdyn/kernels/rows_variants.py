@@ -324,3 +324,48 @@ def loads_variants(J, Z, weight, group, cols, sign, D, Fj):
             for g in range(G):
                 Fj[g, v, k, 0] *= sign[g]
                 Fj[g, v, k, 1] *= sign[g]
+
+
+@njit
+def body_loads_variants(X, Xd, Xdd, mass, inertia, com, gravity, rhs):
+    """Inertia forces minus weights on the body poses, of every position of every
+    variant: the right-hand side of :func:`inverse_variants` when the bodies' weights
+    are the only applied loads.
+
+    Per body (as :func:`mechdyn.dynamics.inertia.inertia_forces` and the weights of
+    :class:`mechdyn.dynamics.forces.ForceModel`): ``m a_c - m g`` (N) and
+    ``J_c alpha + a x (m a_c - m g)`` (N m, about the frame origin), with the
+    centre-of-mass arm ``a = A(theta) c`` and ``a_c = rddot + alpha perp(a) - omega^2 a``.
+
+    Parameters
+    ----------
+    X, Xd, Xdd : ndarray, shape (V, N, n_x)
+        Poses (m, rad), rates and accelerations.
+    mass, inertia : ndarray, shape (V, n_b)
+        kg and kg m^2 (about the centre of mass).
+    com : ndarray, shape (V, n_b, 2)
+        Centres of mass in the body frames, m.
+    gravity : ndarray, shape (2,)
+        m/s^2.
+    rhs : ndarray, shape (V, N, n_x)
+        Output.
+    """
+    V, N, nx = X.shape
+    nb = mass.shape[1]
+    for v in range(V):
+        for b in range(nb):
+            m, Jc = mass[v, b], inertia[v, b]
+            cx, cy = com[v, b, 0], com[v, b, 1]
+            gx, gy = m * gravity[0], m * gravity[1]
+            for k in range(N):
+                th = X[v, k, 3 * b + 2]
+                c, s = np.cos(th), np.sin(th)
+                ax = c * cx - s * cy
+                ay = s * cx + c * cy
+                w2 = Xd[v, k, 3 * b + 2] ** 2
+                al = Xdd[v, k, 3 * b + 2]
+                fx = m * (Xdd[v, k, 3 * b] + al * -ay - w2 * ax)
+                fy = m * (Xdd[v, k, 3 * b + 1] + al * ax - w2 * ay)
+                rhs[v, k, 3 * b] = fx - gx
+                rhs[v, k, 3 * b + 1] = fy - gy
+                rhs[v, k, 3 * b + 2] = (Jc * al + (ax * fy - ay * fx)) - (ax * gy - ay * gx)

@@ -16,12 +16,14 @@ its own floats (:func:`mechdyn.kernels.rows_numpy.variant_rows`,
   position;
 * the inertia forces and weights are those of
   :func:`~mechdyn.dynamics.inertia.inertia_forces` and
-  :class:`~mechdyn.dynamics.forces.ForceModel`, called once with the bodies of all
-  variants side by side; other loads those of
+  :class:`~mechdyn.dynamics.forces.ForceModel`, compiled over the variant axis
+  (:func:`~mechdyn.kernels.rows_variants.body_loads_variants`); other loads those of
   :func:`~mechdyn.dynamics.forces.applied_forces`, one call per variant over its
-  positions; the joint reactions and frame loads those of
-  :mod:`mechdyn.dynamics.reactions` (:func:`~mechdyn.dynamics.reactions.joint_reaction`,
-  :func:`~mechdyn.dynamics.reactions.net_on_ground`), and the figures those of
+  positions (with the inertia forces of the bodies of all variants side by side); the
+  joint reactions and frame loads those of :mod:`mechdyn.dynamics.reactions`
+  (:func:`~mechdyn.dynamics.reactions.joint_reaction`,
+  :func:`~mechdyn.dynamics.reactions.net_on_ground`), their sums over the rows compiled
+  (:func:`~mechdyn.kernels.rows_variants.loads_variants`), and the figures those of
   :func:`~mechdyn.study.analyses.extremes`, which
   :meth:`KinetostaticExtremes.figures <mechdyn.study.analyses.KinetostaticExtremes.figures>`
   applies to one record.
@@ -40,13 +42,18 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..dynamics.forces import ForceModel, applied_forces
+from ..dynamics.forces import applied_forces
 from ..dynamics.inertia import inertia_forces
 from ..dynamics.prescribed_motion import _independent_subset
 from ..dynamics.reactions import joint_reaction, net_on_ground, reaction_frame
 from ..errors import Status
 from ..kernels import rows_numba, rows_numpy
-from ..kernels.rows_variants import inverse_variants, loads_variants, path_variants
+from ..kernels.rows_variants import (
+    body_loads_variants,
+    inverse_variants,
+    loads_variants,
+    path_variants,
+)
 from ..kinematics.sweep import DEFAULT_MAX_STEP
 from ..model import Model
 from ..results.kinetostatics_record import Kinetostatics
@@ -372,10 +379,10 @@ def _cycle(vs: Variants, analysis: KinetostaticExtremes, work: dict) -> list[Out
 
 def _rhs(vs: Variants, base, t, X, Xd, Xdd, q, qdot, didx):
     """Inertia forces minus applied forces, (V, N, n_x), and the loads on the frame
-    (V, N, 3): the bodies of all variants side by side as one model
-    (:func:`~mechdyn.dynamics.inertia.inertia_forces`, and the weights of
-    :class:`~mechdyn.dynamics.forces.ForceModel`), or each variant's loads
-    (:func:`~mechdyn.dynamics.forces.applied_forces`) when it has more than gravity."""
+    (V, N, 3): compiled when the weights are the only loads
+    (:func:`~mechdyn.kernels.rows_variants.body_loads_variants`), else the bodies of all
+    variants side by side as one model (:func:`~mechdyn.dynamics.inertia.inertia_forces`)
+    and each variant's loads (:func:`~mechdyn.dynamics.forces.applied_forces`)."""
     V, N, n_x = X.shape
 
     def side(a):  # (V, N, n_x) -> (N, V n_x)
@@ -384,11 +391,14 @@ def _rhs(vs: Variants, base, t, X, Xd, Xdd, q, qdot, didx):
     def back(a):
         return a.reshape(N, V, n_x).transpose(1, 0, 2)
 
-    sbs = _SideBySide(vs, base.gravity)
-    rhs = back(inertia_forces(sbs, side(X), side(Xd), side(Xdd)))
     F_ground = np.zeros((V, N, 3))
-    if vs.models is None:
-        return rhs - back(ForceModel(sbs, [], [], [], [], []).conservative(side(X))), F_ground
+    if vs.models is None:  # the weights alone: compiled
+        rhs = np.empty((V, N, n_x))
+        body_loads_variants(X, Xd, Xdd, np.ascontiguousarray(vs.mass),
+                            np.ascontiguousarray(vs.inertia), np.ascontiguousarray(vs.com),
+                            np.asarray(base.gravity, float), rhs)
+        return rhs, F_ground
+    rhs = back(inertia_forces(_SideBySide(vs, base.gravity), side(X), side(Xd), side(Xdd)))
     for i, m in enumerate(vs.models):
         F, F_ground[i], _ = applied_forces(m, t, X[i], Xd[i], q[i], qdot[i], skip_drives=didx)
         rhs[i] -= F
