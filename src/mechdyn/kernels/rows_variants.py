@@ -51,13 +51,12 @@ def _det_sign(lu, piv, n):
 
 
 @njit
-def _at_solution(x, qdot, qddot, nb, ints, flts, n_rows, cs, J, fresh, lu, piv, xd, xdd,
+def _at_solution(x, qdot, qddot, nb, ints, flts, n_rows, cs, J, fresh, lu, piv, T, xd, xdd,
                  b):
     """J at a solved pose x (``cs``: its rotations; J evaluated into J unless ``fresh``:
-    J holds it) and its factors;
-    the rates xd = J^-1 [0; qdot] and the accelerations xdd = J^-1 (gamma + [0; qddot])
-    (qdot, qddot of the driven rows).  Returns the pivot ratio (0: singular, rates not
-    set)."""
+    J holds it) and its factors; the tangents T = J^-1 [0; I] (n_x, n_d), the rates
+    xd = T qdot and the accelerations xdd = J^-1 (gamma + [0; qddot]) (qdot, qddot of
+    the driven rows).  Returns the pivot ratio (0: singular, T and the rates not set)."""
     n = x.shape[0]
     if not fresh:
         J[:, :] = 0.0
@@ -66,11 +65,14 @@ def _at_solution(x, qdot, qddot, nb, ints, flts, n_rows, cs, J, fresh, lu, piv, 
     rc = lu_factor(lu, piv, n)
     if rc == 0.0:
         return rc
-    b[:] = 0.0
+    xd[:] = 0.0
     for c in range(qdot.shape[0]):
-        b[n_rows + c] = qdot[c]
-    lu_solve(lu, piv, b, n)
-    xd[:] = b
+        b[:] = 0.0
+        b[n_rows + c] = 1.0
+        lu_solve(lu, piv, b, n)
+        for i in range(n):
+            T[i, c] = b[i]
+            xd[i] += b[i] * qdot[c]
     rows_quad_cs(x, xd, nb, ints, flts, cs, b, 0)
     for i in range(n):
         b[i] = -b[i]
@@ -221,8 +223,10 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
                 break
             # at the solution: J, its factors, the branch sign, the rates; the tangent
             k = keep[m]
+            for i in range(n):
+                Tp[i] = T[i, 0]
             r = _at_solution(x, dQ[m], ddQ[m], nb, ints, flts[v], n_rows, cs, Jw, fresh, lu,
-                             pv, xd, xdd, b)
+                             pv, T, xd, xdd, b)
             s = _det_sign(lu, pv, n)
             if m == 0:
                 sign0 = s
@@ -230,14 +234,6 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
                 ok[v] = False
                 fail[v] = m
                 break
-            for i in range(n):
-                Tp[i] = T[i, 0]
-            for c in range(nd):
-                b[:] = 0.0
-                b[n_rows + c] = 1.0
-                lu_solve(lu, pv, b, n)
-                for i in range(n):
-                    T[i, c] = b[i]
             if k >= 0:
                 X[v, k, :] = x
                 Xd[v, k, :] = xd
@@ -275,21 +271,24 @@ def inverse_variants(LU, piv, rhs, n_rows, Z):
 
 
 @njit
-def loads_variants(J, Z, weight, group, cols, sign, D, Fj):
+def loads_variants(X, J, Z, weight, group, cols, sign, frame, Fj):
     """Sums of the row forces ``Phi_x^T lambda`` (and ``g_d,x^T tau``) of every position
     of every variant, from J = [Phi_x; g_d,x] and the solution z of
     :func:`inverse_variants` (the multipliers with their sign turned, then the driving
     torques/forces):
 
-    * ``D[v, k] = sum_r weight[r] z_r J_r`` (n_x,): the rows' forces on the bodies
-      chosen by ``weight`` (for instance the drives' stators and the joints to the
-      frame);
+    * ``frame[v, k]``: minus the net force and moment about the ground origin of the
+      rows' forces ``D = sum_r weight[r] z_r J_r`` on the bodies (for instance the
+      drives' stators and the joints to the frame), as
+      :func:`mechdyn.dynamics.reactions.net_on_ground`: (Fx, Fy) N and the moment, N m;
     * ``Fj[g, v, k, c] = -sign[g] sum_{r: group[r] = g} z_r J[r, cols[g, c]]``: two
       columns (c = 0, 1) of the constraint force of the rows of each group g (a joint's
       force on one body, oriented by ``sign``).
 
     Parameters
     ----------
+    X : ndarray, shape (V, N, n_x)
+        Poses (m, rad).
     J : ndarray, shape (V, N, n, n_x)
     Z : ndarray, shape (V, N, n)
     weight : ndarray, shape (n,)
@@ -297,17 +296,17 @@ def loads_variants(J, Z, weight, group, cols, sign, D, Fj):
         The group of each row (-1: none).
     cols : ndarray of int, shape (G, 2)
     sign : ndarray, shape (G,)
-    D : ndarray, shape (V, N, n_x)
+    frame : ndarray, shape (V, N, 3)
         Output.
     Fj : ndarray, shape (G, V, N, 2)
         Output.
     """
     V, N, n, nx = J.shape
     G = cols.shape[0]
+    D = np.empty(nx)
     for v in range(V):
         for k in range(N):
-            for i in range(nx):
-                D[v, k, i] = 0.0
+            D[:] = 0.0
             for g in range(G):
                 Fj[g, v, k, 0] = 0.0
                 Fj[g, v, k, 1] = 0.0
@@ -316,7 +315,7 @@ def loads_variants(J, Z, weight, group, cols, sign, D, Fj):
                 w = weight[r] * z
                 if w != 0.0:
                     for i in range(nx):
-                        D[v, k, i] += w * J[v, k, r, i]
+                        D[i] += w * J[v, k, r, i]
                 g = group[r]
                 if g >= 0:
                     Fj[g, v, k, 0] -= z * J[v, k, r, cols[g, 0]]
@@ -324,6 +323,15 @@ def loads_variants(J, Z, weight, group, cols, sign, D, Fj):
             for g in range(G):
                 Fj[g, v, k, 0] *= sign[g]
                 Fj[g, v, k, 1] *= sign[g]
+            fx = fy = mz = 0.0
+            for b in range(nx // 3):
+                fx += D[3 * b]
+                fy += D[3 * b + 1]
+                mz += D[3 * b + 2] + (X[v, k, 3 * b] * D[3 * b + 1]
+                                      - X[v, k, 3 * b + 1] * D[3 * b])
+            frame[v, k, 0] = -fx
+            frame[v, k, 1] = -fy
+            frame[v, k, 2] = -mz
 
 
 @njit

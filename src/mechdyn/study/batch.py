@@ -22,7 +22,7 @@ its own floats (:func:`mechdyn.kernels.rows_numpy.variant_rows`,
   positions (with the inertia forces of the bodies of all variants side by side); the
   joint reactions and frame loads those of :mod:`mechdyn.dynamics.reactions`
   (:func:`~mechdyn.dynamics.reactions.joint_reaction`,
-  :func:`~mechdyn.dynamics.reactions.net_on_ground`), their sums over the rows compiled
+  :func:`~mechdyn.dynamics.reactions.net_on_ground`), compiled
   (:func:`~mechdyn.kernels.rows_variants.loads_variants`), and the figures those of
   :func:`~mechdyn.study.analyses.extremes`, which
   :meth:`KinetostaticExtremes.figures <mechdyn.study.analyses.KinetostaticExtremes.figures>`
@@ -45,7 +45,7 @@ import numpy as np
 from ..dynamics.forces import applied_forces
 from ..dynamics.inertia import inertia_forces
 from ..dynamics.prescribed_motion import _independent_subset
-from ..dynamics.reactions import joint_reaction, net_on_ground, reaction_frame
+from ..dynamics.reactions import joint_reaction, reaction_frame
 from ..errors import Status
 from ..kernels import rows_numba, rows_numpy
 from ..kernels.rows_variants import (
@@ -438,8 +438,6 @@ def _reactions(base, lay, X, J, Z, n_rows):
             return None
         if base.n_bodies in reaction_frame(base, name)[1:3]:
             weight[idx] = -1.0  # -Phi_e,x^T lambda_e: the joint's force on the bodies
-    D, Fj = np.empty((V, N, n_x)), np.empty((len(names), V, N, 2))
-    loads_variants(J, Z, weight, group, cols, sign, D, Fj)
-    reactions = {name: Fj[g] for g, name in enumerate(names)}
-    frame = net_on_ground(base, X.reshape(V * N, n_x), D.reshape(V * N, n_x), np.zeros(2))
-    return reactions, frame.reshape(V, N, 3)
+    frame, Fj = np.empty((V, N, 3)), np.empty((len(names), V, N, 2))
+    loads_variants(X, J, Z, weight, group, cols, sign, frame, Fj)
+    return {name: Fj[g] for g, name in enumerate(names)}, frame
