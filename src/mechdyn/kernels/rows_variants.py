@@ -22,7 +22,8 @@ import numpy as np
 from .linalg import lu_factor, lu_solve, lu_solve_transposed
 from .rows_numba import body_rotations, njit, rows_jacobian_cs, rows_quad_cs, rows_values_cs
 
-__all__ = ["path_variants", "inverse_variants", "loads_variants"]
+__all__ = ["path_variants", "inverse_variants", "loads_variants", "body_loads_variants",
+           "cycle_variants"]
 
 
 @njit
@@ -377,3 +378,35 @@ def body_loads_variants(X, Xd, Xdd, mass, inertia, com, gravity, rhs):
                 rhs[v, k, 3 * b] = fx - gx
                 rhs[v, k, 3 * b + 1] = fy - gy
                 rhs[v, k, 3 * b + 2] = (Jc * al + (ax * fy - ay * fx)) - (ax * gy - ay * gx)
+
+
+@njit
+def cycle_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, short, min_rc,
+                   mass, inertia, com, gravity, weight, group, cols, sign, X, Xd, Xdd, Z, frame,
+                   Fj, rc, ok, fail):
+    """The whole kinetostatic cycle of every variant whose weights are its only loads,
+    variant by variant: :func:`path_variants`, :func:`body_loads_variants`,
+    :func:`inverse_variants` and :func:`loads_variants` of one variant in turn, its
+    Jacobians and factors kept in one variant's memory (in the processor's cache)
+    instead of the batch's.
+
+    The arguments are those of these functions (X0 ... min_rc and X, Xd, Xdd, rc, ok,
+    fail: :func:`path_variants`; mass, inertia, com, gravity:
+    :func:`body_loads_variants`; weight ... sign, frame, Fj: :func:`loads_variants`);
+    Z, shape (V, K, n): the solutions of :func:`inverse_variants`.  A variant that
+    leaves the continuation (``ok`` False) has no loads.
+    """
+    V, K, n = Z.shape
+    J = np.empty((1, K, n, n))
+    LU = np.empty((1, K, n, n))
+    piv = np.empty((1, K, n), np.int64)
+    rhs = np.empty((1, K, n))
+    for v in range(V):
+        w = slice(v, v + 1)
+        path_variants(X0[w], Q[w], dQ, ddQ, keep, nb, ints, flts[w], n_rows, tol[w], max_iter,
+                      short, min_rc, X[w], Xd[w], Xdd[w], J, LU, piv, rc[w], ok[w], fail[w])
+        if not ok[v]:
+            continue
+        body_loads_variants(X[w], Xd[w], Xdd[w], mass[w], inertia[w], com[w], gravity, rhs)
+        inverse_variants(LU, piv, rhs, n_rows, Z[w])
+        loads_variants(X[w], J, Z[w], weight, group, cols, sign, frame[w], Fj[:, w])

@@ -26,7 +26,11 @@ its own floats (:func:`mechdyn.kernels.rows_numpy.variant_rows`,
   (:func:`~mechdyn.kernels.rows_variants.loads_variants`), and the figures those of
   :func:`~mechdyn.study.analyses.extremes`, which
   :meth:`KinetostaticExtremes.figures <mechdyn.study.analyses.KinetostaticExtremes.figures>`
-  applies to one record.
+  applies to one record;
+* when the weights are the only loads, the continuation, the inertia forces, the solve
+  and the reactions of one variant after another are one compiled call
+  (:func:`~mechdyn.kernels.rows_variants.cycle_variants`): a variant's Jacobians and
+  factors stay in the processor's cache.
 
 A variant the batch cannot finish -- its sketch does not assemble, its path meets a dead
 or bifurcation position, a Newton step fails, its kinetostatic matrix is nearly
@@ -49,7 +53,7 @@ from ..dynamics.reactions import joint_reaction, reaction_frame
 from ..errors import Status
 from ..kernels import rows_numba, rows_numpy
 from ..kernels.rows_variants import (
-    body_loads_variants,
+    cycle_variants,
     inverse_variants,
     loads_variants,
     path_variants,
@@ -320,36 +324,49 @@ def _cycle(vs: Variants, analysis: KinetostaticExtremes, work: dict) -> list[Out
     at[keep] = np.arange(N)
     dQ, ddQ = np.zeros((M, n_d)), np.zeros((M, n_d))
     dQ[keep, 0] = analysis.speed
-    X, Xd, Xdd = (_scratch(work, k, (V, N, n_x)) for k in ("X", "Xd", "Xdd"))
-    J, LU = _scratch(work, "J", (V, N, n_x, n_x)), _scratch(work, "LU", (V, N, n_x, n_x))
-    piv, rc = _scratch(work, "piv", (V, N, n_x), np.int64), _scratch(work, "rc", (V, N))
+    rows = _reaction_rows(base, lay0, x_ref, n_rows)
+    if rows is None:
+        return [None] * V
+    joints, weight, group, cols, sign = rows
+    X, Xd, Xdd, Z = (_scratch(work, k, (V, N, n_x)) for k in ("X", "Xd", "Xdd", "Z"))
+    frame, Fj = _scratch(work, "frame", (V, N, 3)), _scratch(work, "Fj", (len(joints), V, N, 2))
+    rc = _scratch(work, "rc", (V, N))
     ok = np.ones(V, dtype=bool)
     fail = np.empty(V, dtype=np.int64)
-    path_variants(np.ascontiguousarray(vs.x_start), Q, dQ, ddQ, at, nb, ints, flts, n_rows,
-                  1e-12 * np.maximum(vs.length_scale, 1e-3), MAX_NEWTON, SHORT_STEP,
-                  MIN_PIVOT_RATIO, X, Xd, Xdd, J, LU, piv, rc, ok, fail)
-    live = np.flatnonzero(ok)
-    if not live.size:
-        return [None] * V
-    if live.size < V:
-        X, Xd, Xdd, J, LU, piv, rc = (a[live] for a in (X, Xd, Xdd, J, LU, piv, rc))
+    path = (np.ascontiguousarray(vs.x_start), Q, dQ, ddQ, at, nb, ints, flts, n_rows,
+            1e-12 * np.maximum(vs.length_scale, 1e-3), MAX_NEWTON, SHORT_STEP, MIN_PIVOT_RATIO)
+    loads = (weight, group, cols, sign)
     qd_dot = dQ[keep]
     t = (values - values[0]) / analysis.speed if analysis.speed != 0 else np.zeros(N)
-    # every coordinate is driven or held: q, qdot are the prescribed values
-    q = np.empty((live.size, N, base.n_q))
-    q[:] = q0[live, None, :]
-    q[..., didx[0]] = values
-    qdot = np.zeros_like(q)
-    qdot[..., didx] = qd_dot
-    rhs, F_ground = _rhs(vs.take(live), base, t, X, Xd, Xdd, q, qdot, didx)
-    Z = np.empty_like(X)
-    inverse_variants(LU, piv, rhs, n_rows, Z)
-    good = np.all(rc >= MIN_PIVOT_RATIO, axis=1) & np.all(np.isfinite(Z), axis=(1, 2))
-    loads = _reactions(base, lay0, X, J, Z, n_rows)
-    if loads is None:
+    if vs.models is None:  # the weights alone: the whole cycle compiled, variant by variant
+        cycle_variants(*path, np.ascontiguousarray(vs.mass), np.ascontiguousarray(vs.inertia),
+                       np.ascontiguousarray(vs.com), np.asarray(base.gravity, float), *loads,
+                       X, Xd, Xdd, Z, frame, Fj, rc, ok, fail)
+        live = np.flatnonzero(ok)
+        if live.size < V:
+            X, Xd, Xdd, Z, frame, rc = (a[live] for a in (X, Xd, Xdd, Z, frame, rc))
+            Fj = Fj[:, live]
+        q, qdot = _prescribed(q0[live], values, qd_dot, didx)
+    else:
+        J, LU = _scratch(work, "J", (V, N, n_x, n_x)), _scratch(work, "LU", (V, N, n_x, n_x))
+        piv = _scratch(work, "piv", (V, N, n_x), np.int64)
+        path_variants(*path, X, Xd, Xdd, J, LU, piv, rc, ok, fail)
+        live = np.flatnonzero(ok)
+        if live.size < V:
+            X, Xd, Xdd, J, LU, piv, rc, Z, frame = (
+                a[live] for a in (X, Xd, Xdd, J, LU, piv, rc, Z, frame))
+            Fj = Fj[:, live]
+        if not live.size:
+            return [None] * V
+        q, qdot = _prescribed(q0[live], values, qd_dot, didx)
+        rhs, F_ground = _rhs(vs.take(live), base, t, X, Xd, Xdd, q, qdot, didx)
+        inverse_variants(LU, piv, rhs, n_rows, Z)
+        loads_variants(X, J, Z, *loads, frame, Fj)
+        frame += F_ground  # the frame's share of the loads (point of the moments: the origin)
+    if not live.size:
         return [None] * V
-    reactions, frame = loads
-    frame += F_ground  # the frame's share of the loads (point of the moments: the origin)
+    good = np.all(rc >= MIN_PIVOT_RATIO, axis=1) & np.all(np.isfinite(Z), axis=(1, 2))
+    reactions = {name: Fj[g] for g, name in enumerate(joints)}
     names = base.coordinate_names
     driven = {names[k]: Z[..., n_rows + c] for c, k in enumerate(didx)}
     rec = Kinetostatics(
@@ -370,63 +387,67 @@ def _cycle(vs: Variants, analysis: KinetostaticExtremes, work: dict) -> list[Out
 
     figs = extremes(rec, rec.driving, rec.power, rec.reactions, rec.frame_force,
                     rec.frame_moment, rms)
+    keys = list(figs)
+    table = np.column_stack([np.broadcast_to(np.asarray(figs[k], float), live.shape)
+                             for k in keys])[good].tolist()  # Python floats, row by row
     out: list[Outcome | None] = [None] * V
-    for i, v in enumerate(live):
-        if good[i]:
-            out[v] = Outcome({k: float(a[i]) for k, a in figs.items()}, str(Status.SUCCESS))
+    status = str(Status.SUCCESS)
+    for v, row in zip(live[good].tolist(), table, strict=True):
+        out[v] = Outcome(dict(zip(keys, row, strict=True)), status)
     return out
+
+
+def _prescribed(q0, values, qd_dot, didx):
+    """q and qdot (V, N, n_q) at the positions: every coordinate is driven or held, so
+    they are the prescribed values (the held ones from each variant's start ``q0``)."""
+    q = np.empty((q0.shape[0], values.size, q0.shape[1]))
+    q[:] = q0[:, None, :]
+    q[..., didx[0]] = values
+    qdot = np.zeros_like(q)
+    qdot[..., didx] = qd_dot
+    return q, qdot
 
 
 def _rhs(vs: Variants, base, t, X, Xd, Xdd, q, qdot, didx):
     """Inertia forces minus applied forces, (V, N, n_x), and the loads on the frame
-    (V, N, 3): compiled when the weights are the only loads
-    (:func:`~mechdyn.kernels.rows_variants.body_loads_variants`), else the bodies of all
-    variants side by side as one model (:func:`~mechdyn.dynamics.inertia.inertia_forces`)
-    and each variant's loads (:func:`~mechdyn.dynamics.forces.applied_forces`)."""
+    (V, N, 3), of variants with loads besides the weights: the bodies of all variants
+    side by side as one model (:func:`~mechdyn.dynamics.inertia.inertia_forces`) and
+    each variant's loads (:func:`~mechdyn.dynamics.forces.applied_forces`)."""
     V, N, n_x = X.shape
 
     def side(a):  # (V, N, n_x) -> (N, V n_x)
         return np.ascontiguousarray(a.transpose(1, 0, 2)).reshape(N, V * n_x)
 
-    def back(a):
-        return a.reshape(N, V, n_x).transpose(1, 0, 2)
-
     F_ground = np.zeros((V, N, 3))
-    if vs.models is None:  # the weights alone: compiled
-        rhs = np.empty((V, N, n_x))
-        body_loads_variants(X, Xd, Xdd, np.ascontiguousarray(vs.mass),
-                            np.ascontiguousarray(vs.inertia), np.ascontiguousarray(vs.com),
-                            np.asarray(base.gravity, float), rhs)
-        return rhs, F_ground
-    rhs = back(inertia_forces(_SideBySide(vs, base.gravity), side(X), side(Xd), side(Xdd)))
+    rhs = inertia_forces(_SideBySide(vs, base.gravity), side(X), side(Xd), side(Xdd))
+    rhs = rhs.reshape(N, V, n_x).transpose(1, 0, 2)
     for i, m in enumerate(vs.models):
         F, F_ground[i], _ = applied_forces(m, t, X[i], Xd[i], q[i], qdot[i], skip_drives=didx)
         rhs[i] -= F
-    return rhs, F_ground
+    return np.ascontiguousarray(rhs), F_ground
 
 
-def _reactions(base, lay, X, J, Z, n_rows):
-    """The joint reactions {joint: (V, N, 2)} N (on the child from the parent, as
-    :func:`~mechdyn.dynamics.reactions.joint_reaction`), and what the frame receives
-    from the joints to the ground and from the drives' stators, (V, N, 3): Fx, Fy (N)
-    and the moment about the ground origin (N m) (as ``_inverse``'s frame loads; they
-    are linear in the forces on the bodies, so their sum is taken once); None when a
-    joint's reaction is not a column of its rows' force (left to the single-model
-    analysis).
+def _reaction_rows(base, lay, x, n_rows):
+    """What :func:`~mechdyn.kernels.rows_variants.loads_variants` needs to give the joint
+    reactions (on the child from the parent, as
+    :func:`~mechdyn.dynamics.reactions.joint_reaction`) and what the frame receives
+    from the joints to the ground and from the drives' stators (as ``_inverse``'s frame
+    loads; they are linear in the forces on the bodies, so their sum is taken once):
+    the joints, the rows' weights and groups, each joint's two columns and sign; None
+    when a joint's reaction is not two columns of its rows' force (the variants are then
+    left to the single-model analysis).
 
-    The sums over the rows are compiled
-    (:func:`~mechdyn.kernels.rows_variants.loads_variants`): a joint's force is two
-    columns of ``-Phi_e,x^T lambda_e`` with a sign, which :func:`joint_reaction` tells
-    by its answer to each unit column."""
-    V, N, n_x = X.shape
-    names = [n for n in base.joint_names if n in lay.rows]
+    A joint's force is two columns of ``-Phi_e,x^T lambda_e`` with a sign, which
+    :func:`joint_reaction` tells by its answer to each unit column at a pose ``x``."""
+    n_x = x.size
+    joints = [n for n in base.joint_names if n in lay.rows]
     group = np.full(n_x, -1, dtype=np.int64)
     weight = np.zeros(n_x)
     weight[n_rows:] = 1.0  # the drives' stators: the driving torques on the poses
-    cols = np.zeros((len(names), 2), dtype=np.int64)
-    sign = np.zeros(len(names))
-    probe = np.broadcast_to(X[0, 0], (n_x, n_x))
-    for g, name in enumerate(names):
+    cols = np.zeros((len(joints), 2), dtype=np.int64)
+    sign = np.zeros(len(joints))
+    probe = np.broadcast_to(x, (n_x, n_x))
+    for g, name in enumerate(joints):
         idx = np.asarray(lay.rows[name])
         group[idx] = g
         f = joint_reaction(base, name, probe, np.eye(n_x))[0]  # (n_x, 2): its columns
@@ -438,6 +459,4 @@ def _reactions(base, lay, X, J, Z, n_rows):
             return None
         if base.n_bodies in reaction_frame(base, name)[1:3]:
             weight[idx] = -1.0  # -Phi_e,x^T lambda_e: the joint's force on the bodies
-    frame, Fj = np.empty((V, N, 3)), np.empty((len(names), V, N, 2))
-    loads_variants(X, J, Z, weight, group, cols, sign, frame, Fj)
-    return {name: Fj[g] for g, name in enumerate(names)}, frame
+    return joints, weight, group, cols, sign
