@@ -105,7 +105,40 @@ def _numba_funcs(rows):
     return values, jacobian, quad
 
 
-@pytest.mark.parametrize("funcs", [_numpy_funcs, _numba_funcs], ids=["numpy", "numba"])
+def _numba_shared_rotations_funcs(rows):
+    """The compiled evaluators with the bodies' rotations computed once per pose."""
+    ints, flts = rows.packed()
+    n, nb = len(rows), rows.nb
+
+    def rotations(x):
+        cs = np.empty((nb + 1, 2))
+        RB.body_rotations(np.asarray(x, float), nb, cs)
+        return cs
+
+    def values(x):
+        out = np.empty(n)
+        RB.rows_values_cs(np.asarray(x, float), nb, ints, flts, rotations(x), out, 0)
+        return out
+
+    def jacobian(x):
+        J = np.zeros((n, rows.n_x))
+        RB.rows_jacobian_cs(np.asarray(x, float), nb, ints, flts, rotations(x), J, 0)
+        return J
+
+    def quad(x, xd):
+        out = np.empty(n)
+        RB.rows_quad_cs(np.asarray(x, float), np.asarray(xd, float), nb, ints, flts,
+                        rotations(x), out, 0)
+        return out
+
+    return values, jacobian, quad
+
+
+FUNCS = [_numpy_funcs, _numba_funcs, _numba_shared_rotations_funcs]
+IDS = ["numpy", "numba", "numba-shared-rotations"]
+
+
+@pytest.mark.parametrize("funcs", FUNCS, ids=IDS)
 def test_random_rows_match_central_differences(funcs):
     rng = np.random.default_rng(7)
     for nb in (1, 3, 5):
@@ -115,7 +148,7 @@ def test_random_rows_match_central_differences(funcs):
             _check(rows, x, xd, xdd, *funcs(rows))
 
 
-@pytest.mark.parametrize("funcs", [_numpy_funcs, _numba_funcs], ids=["numpy", "numba"])
+@pytest.mark.parametrize("funcs", FUNCS, ids=IDS)
 def test_every_bundled_example_matches_central_differences(funcs):
     rng = np.random.default_rng(3)
     for _name, rows in _example_rows():

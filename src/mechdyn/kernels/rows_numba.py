@@ -15,7 +15,8 @@ import numpy as np
 
 from . import cache_dir
 
-__all__ = ["rows_values", "rows_jacobian", "rows_quad", "body_pose", "njit", "NUMBA",
+__all__ = ["rows_values", "rows_jacobian", "rows_quad", "rows_values_cs",
+           "rows_jacobian_cs", "rows_quad_cs", "body_rotations", "body_pose", "njit", "NUMBA",
            "compiling", "ANNOUNCE_AFTER"]
 
 #: seconds after which a compilation is announced on stderr
@@ -65,14 +66,37 @@ def body_pose(x, nb, b):
 
 
 @njit
-def _row_parts(x, nb, ints, flts, k):
-    """th_b1, th_b2, rotated s1, rotated s2, w, separation d of row k."""
-    x1, y1, t1 = body_pose(x, nb, ints[k, 0])
-    x2, y2, t2 = body_pose(x, nb, ints[k, 1])
-    _, _, td = body_pose(x, nb, ints[k, 2])
-    c1, s1 = np.cos(t1), np.sin(t1)
-    c2, s2 = np.cos(t2), np.sin(t2)
-    cd, sd = np.cos(td), np.sin(td)
+def body_rotations(x, nb, cs):
+    """cos and sin of every body's angle in x into ``cs`` (nb + 1, 2), the ground's
+    (row nb) (1, 0): computed once per pose, shared by every row's terms (the ``*_cs``
+    evaluators)."""
+    for b in range(nb):
+        t = x[3 * b + 2]
+        cs[b, 0] = np.cos(t)
+        cs[b, 1] = np.sin(t)
+    cs[nb, 0] = 1.0
+    cs[nb, 1] = 0.0
+
+
+@njit
+def _rotations(x, nb):
+    """:func:`body_rotations` into a new array."""
+    cs = np.empty((nb + 1, 2))
+    body_rotations(x, nb, cs)
+    return cs
+
+
+@njit
+def _row_parts(x, nb, ints, flts, cs, k):
+    """Rotated s1, rotated s2, w and the separation d of row k (``cs``:
+    :func:`body_rotations` of x)."""
+    b1, b2, bd = ints[k, 0], ints[k, 1], ints[k, 2]
+    x1, y1, _ = body_pose(x, nb, b1)
+    x2, y2, _ = body_pose(x, nb, b2)
+    i1, i2, idd = min(b1, nb), min(b2, nb), min(bd, nb)
+    c1, s1 = cs[i1, 0], cs[i1, 1]
+    c2, s2 = cs[i2, 0], cs[i2, 1]
+    cd, sd = cs[idd, 0], cs[idd, 1]
     r1x = c1 * flts[k, 0] - s1 * flts[k, 1]
     r1y = s1 * flts[k, 0] + c1 * flts[k, 1]
     r2x = c2 * flts[k, 2] - s2 * flts[k, 3]
@@ -85,8 +109,14 @@ def _row_parts(x, nb, ints, flts, k):
 @njit
 def rows_values(x, nb, ints, flts, out, row0):
     """m(x) of every row into ``out[row0:row0 + n]``."""
+    rows_values_cs(x, nb, ints, flts, _rotations(x, nb), out, row0)
+
+
+@njit
+def rows_values_cs(x, nb, ints, flts, cs, out, row0):
+    """:func:`rows_values` with the rotations ``cs`` of x (:func:`body_rotations`)."""
     for k in range(ints.shape[0]):
-        r1x, r1y, r2x, r2y, wx, wy, dx, dy = _row_parts(x, nb, ints, flts, k)
+        r1x, r1y, r2x, r2y, wx, wy, dx, dy = _row_parts(x, nb, ints, flts, cs, k)
         v = wx * dx + wy * dy + flts[k, 8]
         a, bb = ints[k, 3], ints[k, 4]
         if a < nb:
@@ -99,8 +129,14 @@ def rows_values(x, nb, ints, flts, out, row0):
 @njit
 def rows_jacobian(x, nb, ints, flts, J, row0):
     """Add m_x of every row into ``J[row0:row0 + n, :]`` (J zeroed by the caller)."""
+    rows_jacobian_cs(x, nb, ints, flts, _rotations(x, nb), J, row0)
+
+
+@njit
+def rows_jacobian_cs(x, nb, ints, flts, cs, J, row0):
+    """:func:`rows_jacobian` with the rotations ``cs`` of x (:func:`body_rotations`)."""
     for k in range(ints.shape[0]):
-        r1x, r1y, r2x, r2y, wx, wy, dx, dy = _row_parts(x, nb, ints, flts, k)
+        r1x, r1y, r2x, r2y, wx, wy, dx, dy = _row_parts(x, nb, ints, flts, cs, k)
         r = row0 + k
         b1, b2, d, a, bb = ints[k, 0], ints[k, 1], ints[k, 2], ints[k, 3], ints[k, 4]
         if b1 < nb:
@@ -122,8 +158,14 @@ def rows_jacobian(x, nb, ints, flts, J, row0):
 @njit
 def rows_quad(x, v, nb, ints, flts, out, row0):
     """Velocity-quadratic part of d2m/dt2 of every row into ``out[row0:row0 + n]``."""
+    rows_quad_cs(x, v, nb, ints, flts, _rotations(x, nb), out, row0)
+
+
+@njit
+def rows_quad_cs(x, v, nb, ints, flts, cs, out, row0):
+    """:func:`rows_quad` with the rotations ``cs`` of x (:func:`body_rotations`)."""
     for k in range(ints.shape[0]):
-        r1x, r1y, r2x, r2y, wx, wy, dx, dy = _row_parts(x, nb, ints, flts, k)
+        r1x, r1y, r2x, r2y, wx, wy, dx, dy = _row_parts(x, nb, ints, flts, cs, k)
         if wx == 0.0 and wy == 0.0:
             out[row0 + k] = 0.0
             continue

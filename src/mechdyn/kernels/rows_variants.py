@@ -20,19 +20,21 @@ from __future__ import annotations
 import numpy as np
 
 from .linalg import lu_factor, lu_solve, lu_solve_transposed
-from .rows_numba import njit, rows_jacobian, rows_quad, rows_values
+from .rows_numba import body_rotations, njit, rows_jacobian_cs, rows_quad_cs, rows_values_cs
 
-__all__ = ["path_variants", "inverse_variants"]
+__all__ = ["path_variants", "inverse_variants", "loads_variants", "body_loads_variants",
+           "cycle_variants"]
 
 
 @njit
-def _system(x, q, nb, ints, flts, n_rows, F, J):
-    """F = [Phi; g_d - q] and J at one pose of one variant (in place)."""
-    rows_values(x, nb, ints, flts, F, 0)
+def _system(x, q, nb, ints, flts, n_rows, cs, F, J):
+    """F = [Phi; g_d - q] and J at one pose of one variant (in place; ``cs``: the
+    rotations of x, :func:`~mechdyn.kernels.rows_numba.body_rotations`)."""
+    rows_values_cs(x, nb, ints, flts, cs, F, 0)
     for k in range(q.shape[0]):
         F[n_rows + k] -= q[k]
     J[:, :] = 0.0
-    rows_jacobian(x, nb, ints, flts, J, 0)
+    rows_jacobian_cs(x, nb, ints, flts, cs, J, 0)
 
 
 @njit
@@ -50,25 +52,29 @@ def _det_sign(lu, piv, n):
 
 
 @njit
-def _at_solution(x, qdot, qddot, nb, ints, flts, n_rows, J, fresh, lu, piv, xd, xdd, b):
-    """J at a solved pose (evaluated into J unless ``fresh``: J holds it) and its factors;
-    the rates xd = J^-1 [0; qdot] and the accelerations xdd = J^-1 (gamma + [0; qddot])
-    (qdot, qddot of the driven rows).  Returns the pivot ratio (0: singular, rates not
-    set)."""
+def _at_solution(x, qdot, qddot, nb, ints, flts, n_rows, cs, J, fresh, lu, piv, T, xd, xdd,
+                 b):
+    """J at a solved pose x (``cs``: its rotations; J evaluated into J unless ``fresh``:
+    J holds it) and its factors; the tangents T = J^-1 [0; I] (n_x, n_d), the rates
+    xd = T qdot and the accelerations xdd = J^-1 (gamma + [0; qddot]) (qdot, qddot of
+    the driven rows).  Returns the pivot ratio (0: singular, T and the rates not set)."""
     n = x.shape[0]
     if not fresh:
         J[:, :] = 0.0
-        rows_jacobian(x, nb, ints, flts, J, 0)
+        rows_jacobian_cs(x, nb, ints, flts, cs, J, 0)
     lu[:, :] = J
     rc = lu_factor(lu, piv, n)
     if rc == 0.0:
         return rc
-    b[:] = 0.0
+    xd[:] = 0.0
     for c in range(qdot.shape[0]):
-        b[n_rows + c] = qdot[c]
-    lu_solve(lu, piv, b, n)
-    xd[:] = b
-    rows_quad(x, xd, nb, ints, flts, b, 0)
+        b[:] = 0.0
+        b[n_rows + c] = 1.0
+        lu_solve(lu, piv, b, n)
+        for i in range(n):
+            T[i, c] = b[i]
+            xd[i] += b[i] * qdot[c]
+    rows_quad_cs(x, xd, nb, ints, flts, cs, b, 0)
     for i in range(n):
         b[i] = -b[i]
     for c in range(qdot.shape[0]):
@@ -141,6 +147,7 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
     xdd = np.empty(n)
     T = np.empty((n, nd))
     Tp = np.empty(n)
+    cs = np.empty((nb + 1, 2))  # the rotations of x, once per pose
     for v in range(V):
         fail[v] = -1
         if not ok[v]:
@@ -165,11 +172,12 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
             done = False
             fresh = False  # Jw is J at x
             for it in range(max_iter + 1):
+                body_rotations(x, nb, cs)
                 if it == 0:
-                    _system(x, q, nb, ints, flts[v], n_rows, F, Jw)
+                    _system(x, q, nb, ints, flts[v], n_rows, cs, F, Jw)
                     fresh = True
                 else:
-                    rows_values(x, nb, ints, flts[v], F, 0)
+                    rows_values_cs(x, nb, ints, flts[v], cs, F, 0)
                     for c in range(nd):
                         F[n_rows + c] -= q[c]
                 err = 0.0
@@ -184,7 +192,7 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
                     break
                 if not fresh:
                     Jw[:, :] = 0.0
-                    rows_jacobian(x, nb, ints, flts[v], Jw, 0)
+                    rows_jacobian_cs(x, nb, ints, flts[v], cs, Jw, 0)
                 lu[:, :] = Jw
                 if lu_factor(lu, pv, n) == 0.0:
                     break
@@ -196,8 +204,9 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
                     step = max(step, abs(b[i]))
                 fresh = False
                 if it == 0 and step <= short * tol[v]:
+                    body_rotations(x, nb, cs)
                     J1[:, :] = 0.0
-                    rows_jacobian(x, nb, ints, flts[v], J1, 0)
+                    rows_jacobian_cs(x, nb, ints, flts[v], cs, J1, 0)
                     err = 0.0
                     for i in range(n):
                         r = 0.0
@@ -215,8 +224,10 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
                 break
             # at the solution: J, its factors, the branch sign, the rates; the tangent
             k = keep[m]
-            r = _at_solution(x, dQ[m], ddQ[m], nb, ints, flts[v], n_rows, Jw, fresh, lu, pv,
-                             xd, xdd, b)
+            for i in range(n):
+                Tp[i] = T[i, 0]
+            r = _at_solution(x, dQ[m], ddQ[m], nb, ints, flts[v], n_rows, cs, Jw, fresh, lu,
+                             pv, T, xd, xdd, b)
             s = _det_sign(lu, pv, n)
             if m == 0:
                 sign0 = s
@@ -224,14 +235,6 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
                 ok[v] = False
                 fail[v] = m
                 break
-            for i in range(n):
-                Tp[i] = T[i, 0]
-            for c in range(nd):
-                b[:] = 0.0
-                b[n_rows + c] = 1.0
-                lu_solve(lu, pv, b, n)
-                for i in range(n):
-                    T[i, c] = b[i]
             if k >= 0:
                 X[v, k, :] = x
                 Xd[v, k, :] = xd
@@ -266,3 +269,144 @@ def inverse_variants(LU, piv, rhs, n_rows, Z):
             lu_solve_transposed(LU[v, k], piv[v, k], b, n)
             for c in range(n):
                 Z[v, k, c] = -b[c] if c < n_rows else b[c]
+
+
+@njit
+def loads_variants(X, J, Z, weight, group, cols, sign, frame, Fj):
+    """Sums of the row forces ``Phi_x^T lambda`` (and ``g_d,x^T tau``) of every position
+    of every variant, from J = [Phi_x; g_d,x] and the solution z of
+    :func:`inverse_variants` (the multipliers with their sign turned, then the driving
+    torques/forces):
+
+    * ``frame[v, k]``: minus the net force and moment about the ground origin of the
+      rows' forces ``D = sum_r weight[r] z_r J_r`` on the bodies (for instance the
+      drives' stators and the joints to the frame), as
+      :func:`mechdyn.dynamics.reactions.net_on_ground`: (Fx, Fy) N and the moment, N m;
+    * ``Fj[g, v, k, c] = -sign[g] sum_{r: group[r] = g} z_r J[r, cols[g, c]]``: two
+      columns (c = 0, 1) of the constraint force of the rows of each group g (a joint's
+      force on one body, oriented by ``sign``).
+
+    Parameters
+    ----------
+    X : ndarray, shape (V, N, n_x)
+        Poses (m, rad).
+    J : ndarray, shape (V, N, n, n_x)
+    Z : ndarray, shape (V, N, n)
+    weight : ndarray, shape (n,)
+    group : ndarray of int, shape (n,)
+        The group of each row (-1: none).
+    cols : ndarray of int, shape (G, 2)
+    sign : ndarray, shape (G,)
+    frame : ndarray, shape (V, N, 3)
+        Output.
+    Fj : ndarray, shape (G, V, N, 2)
+        Output.
+    """
+    V, N, n, nx = J.shape
+    G = cols.shape[0]
+    D = np.empty(nx)
+    for v in range(V):
+        for k in range(N):
+            D[:] = 0.0
+            for g in range(G):
+                Fj[g, v, k, 0] = 0.0
+                Fj[g, v, k, 1] = 0.0
+            for r in range(n):
+                z = Z[v, k, r]
+                w = weight[r] * z
+                if w != 0.0:
+                    for i in range(nx):
+                        D[i] += w * J[v, k, r, i]
+                g = group[r]
+                if g >= 0:
+                    Fj[g, v, k, 0] -= z * J[v, k, r, cols[g, 0]]
+                    Fj[g, v, k, 1] -= z * J[v, k, r, cols[g, 1]]
+            for g in range(G):
+                Fj[g, v, k, 0] *= sign[g]
+                Fj[g, v, k, 1] *= sign[g]
+            fx = fy = mz = 0.0
+            for b in range(nx // 3):
+                fx += D[3 * b]
+                fy += D[3 * b + 1]
+                mz += D[3 * b + 2] + (X[v, k, 3 * b] * D[3 * b + 1]
+                                      - X[v, k, 3 * b + 1] * D[3 * b])
+            frame[v, k, 0] = -fx
+            frame[v, k, 1] = -fy
+            frame[v, k, 2] = -mz
+
+
+@njit
+def body_loads_variants(X, Xd, Xdd, mass, inertia, com, gravity, rhs):
+    """Inertia forces minus weights on the body poses, of every position of every
+    variant: the right-hand side of :func:`inverse_variants` when the bodies' weights
+    are the only applied loads.
+
+    Per body (as :func:`mechdyn.dynamics.inertia.inertia_forces` and the weights of
+    :class:`mechdyn.dynamics.forces.ForceModel`): ``m a_c - m g`` (N) and
+    ``J_c alpha + a x (m a_c - m g)`` (N m, about the frame origin), with the
+    centre-of-mass arm ``a = A(theta) c`` and ``a_c = rddot + alpha perp(a) - omega^2 a``.
+
+    Parameters
+    ----------
+    X, Xd, Xdd : ndarray, shape (V, N, n_x)
+        Poses (m, rad), rates and accelerations.
+    mass, inertia : ndarray, shape (V, n_b)
+        kg and kg m^2 (about the centre of mass).
+    com : ndarray, shape (V, n_b, 2)
+        Centres of mass in the body frames, m.
+    gravity : ndarray, shape (2,)
+        m/s^2.
+    rhs : ndarray, shape (V, N, n_x)
+        Output.
+    """
+    V, N, nx = X.shape
+    nb = mass.shape[1]
+    for v in range(V):
+        for b in range(nb):
+            m, Jc = mass[v, b], inertia[v, b]
+            cx, cy = com[v, b, 0], com[v, b, 1]
+            gx, gy = m * gravity[0], m * gravity[1]
+            for k in range(N):
+                th = X[v, k, 3 * b + 2]
+                c, s = np.cos(th), np.sin(th)
+                ax = c * cx - s * cy
+                ay = s * cx + c * cy
+                w2 = Xd[v, k, 3 * b + 2] ** 2
+                al = Xdd[v, k, 3 * b + 2]
+                fx = m * (Xdd[v, k, 3 * b] + al * -ay - w2 * ax)
+                fy = m * (Xdd[v, k, 3 * b + 1] + al * ax - w2 * ay)
+                rhs[v, k, 3 * b] = fx - gx
+                rhs[v, k, 3 * b + 1] = fy - gy
+                rhs[v, k, 3 * b + 2] = (Jc * al + (ax * fy - ay * fx)) - (ax * gy - ay * gx)
+
+
+@njit
+def cycle_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, short, min_rc,
+                   mass, inertia, com, gravity, weight, group, cols, sign, X, Xd, Xdd, Z, frame,
+                   Fj, rc, ok, fail):
+    """The whole kinetostatic cycle of every variant whose weights are its only loads,
+    variant by variant: :func:`path_variants`, :func:`body_loads_variants`,
+    :func:`inverse_variants` and :func:`loads_variants` of one variant in turn, its
+    Jacobians and factors kept in one variant's memory (in the processor's cache)
+    instead of the batch's.
+
+    The arguments are those of these functions (X0 ... min_rc and X, Xd, Xdd, rc, ok,
+    fail: :func:`path_variants`; mass, inertia, com, gravity:
+    :func:`body_loads_variants`; weight ... sign, frame, Fj: :func:`loads_variants`);
+    Z, shape (V, K, n): the solutions of :func:`inverse_variants`.  A variant that
+    leaves the continuation (``ok`` False) has no loads.
+    """
+    V, K, n = Z.shape
+    J = np.empty((1, K, n, n))
+    LU = np.empty((1, K, n, n))
+    piv = np.empty((1, K, n), np.int64)
+    rhs = np.empty((1, K, n))
+    for v in range(V):
+        w = slice(v, v + 1)
+        path_variants(X0[w], Q[w], dQ, ddQ, keep, nb, ints, flts[w], n_rows, tol[w], max_iter,
+                      short, min_rc, X[w], Xd[w], Xdd[w], J, LU, piv, rc[w], ok[w], fail[w])
+        if not ok[v]:
+            continue
+        body_loads_variants(X[w], Xd[w], Xdd[w], mass[w], inertia[w], com[w], gravity, rhs)
+        inverse_variants(LU, piv, rhs, n_rows, Z[w])
+        loads_variants(X[w], J, Z[w], weight, group, cols, sign, frame[w], Fj[:, w])

@@ -16,15 +16,21 @@ its own floats (:func:`mechdyn.kernels.rows_numpy.variant_rows`,
   position;
 * the inertia forces and weights are those of
   :func:`~mechdyn.dynamics.inertia.inertia_forces` and
-  :class:`~mechdyn.dynamics.forces.ForceModel`, called once with the bodies of all
-  variants side by side; other loads those of
+  :class:`~mechdyn.dynamics.forces.ForceModel`, compiled over the variant axis
+  (:func:`~mechdyn.kernels.rows_variants.body_loads_variants`); other loads those of
   :func:`~mechdyn.dynamics.forces.applied_forces`, one call per variant over its
-  positions; the joint reactions and frame loads those of
-  :mod:`mechdyn.dynamics.reactions` (:func:`~mechdyn.dynamics.reactions.joint_reaction`,
-  :func:`~mechdyn.dynamics.reactions.net_on_ground`), and the figures those of
+  positions (with the inertia forces of the bodies of all variants side by side); the
+  joint reactions and frame loads those of :mod:`mechdyn.dynamics.reactions`
+  (:func:`~mechdyn.dynamics.reactions.joint_reaction`,
+  :func:`~mechdyn.dynamics.reactions.net_on_ground`), compiled
+  (:func:`~mechdyn.kernels.rows_variants.loads_variants`), and the figures those of
   :func:`~mechdyn.study.analyses.extremes`, which
   :meth:`KinetostaticExtremes.figures <mechdyn.study.analyses.KinetostaticExtremes.figures>`
-  applies to one record.
+  applies to one record;
+* when the weights are the only loads, the continuation, the inertia forces, the solve
+  and the reactions of one variant after another are one compiled call
+  (:func:`~mechdyn.kernels.rows_variants.cycle_variants`): a variant's Jacobians and
+  factors stay in the processor's cache.
 
 A variant the batch cannot finish -- its sketch does not assemble, its path meets a dead
 or bifurcation position, a Newton step fails, its kinetostatic matrix is nearly
@@ -40,13 +46,18 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..dynamics.forces import ForceModel, applied_forces
+from ..dynamics.forces import applied_forces
 from ..dynamics.inertia import inertia_forces
 from ..dynamics.prescribed_motion import _independent_subset
-from ..dynamics.reactions import joint_reaction, net_on_ground, reaction_frame
+from ..dynamics.reactions import joint_reaction, reaction_frame
 from ..errors import Status
 from ..kernels import rows_numba, rows_numpy
-from ..kernels.rows_variants import inverse_variants, path_variants
+from ..kernels.rows_variants import (
+    cycle_variants,
+    inverse_variants,
+    loads_variants,
+    path_variants,
+)
 from ..kinematics.sweep import DEFAULT_MAX_STEP
 from ..model import Model
 from ..results.kinetostatics_record import Kinetostatics
@@ -313,33 +324,49 @@ def _cycle(vs: Variants, analysis: KinetostaticExtremes, work: dict) -> list[Out
     at[keep] = np.arange(N)
     dQ, ddQ = np.zeros((M, n_d)), np.zeros((M, n_d))
     dQ[keep, 0] = analysis.speed
-    X, Xd, Xdd = (_scratch(work, k, (V, N, n_x)) for k in ("X", "Xd", "Xdd"))
-    J, LU = _scratch(work, "J", (V, N, n_x, n_x)), _scratch(work, "LU", (V, N, n_x, n_x))
-    piv, rc = _scratch(work, "piv", (V, N, n_x), np.int64), _scratch(work, "rc", (V, N))
+    rows = _reaction_rows(base, lay0, x_ref, n_rows)
+    if rows is None:
+        return [None] * V
+    joints, weight, group, cols, sign = rows
+    X, Xd, Xdd, Z = (_scratch(work, k, (V, N, n_x)) for k in ("X", "Xd", "Xdd", "Z"))
+    frame, Fj = _scratch(work, "frame", (V, N, 3)), _scratch(work, "Fj", (len(joints), V, N, 2))
+    rc = _scratch(work, "rc", (V, N))
     ok = np.ones(V, dtype=bool)
     fail = np.empty(V, dtype=np.int64)
-    path_variants(np.ascontiguousarray(vs.x_start), Q, dQ, ddQ, at, nb, ints, flts, n_rows,
-                  1e-12 * np.maximum(vs.length_scale, 1e-3), MAX_NEWTON, SHORT_STEP,
-                  MIN_PIVOT_RATIO, X, Xd, Xdd, J, LU, piv, rc, ok, fail)
-    live = np.flatnonzero(ok)
-    if not live.size:
-        return [None] * V
-    if live.size < V:
-        X, Xd, Xdd, J, LU, piv, rc = (a[live] for a in (X, Xd, Xdd, J, LU, piv, rc))
+    path = (np.ascontiguousarray(vs.x_start), Q, dQ, ddQ, at, nb, ints, flts, n_rows,
+            1e-12 * np.maximum(vs.length_scale, 1e-3), MAX_NEWTON, SHORT_STEP, MIN_PIVOT_RATIO)
+    loads = (weight, group, cols, sign)
     qd_dot = dQ[keep]
     t = (values - values[0]) / analysis.speed if analysis.speed != 0 else np.zeros(N)
-    # every coordinate is driven or held: q, qdot are the prescribed values
-    q = np.empty((live.size, N, base.n_q))
-    q[:] = q0[live, None, :]
-    q[..., didx[0]] = values
-    qdot = np.zeros_like(q)
-    qdot[..., didx] = qd_dot
-    rhs, F_ground = _rhs(vs.take(live), base, t, X, Xd, Xdd, q, qdot, didx)
-    Z = np.empty_like(X)
-    inverse_variants(LU, piv, rhs, n_rows, Z)
+    if vs.models is None:  # the weights alone: the whole cycle compiled, variant by variant
+        cycle_variants(*path, np.ascontiguousarray(vs.mass), np.ascontiguousarray(vs.inertia),
+                       np.ascontiguousarray(vs.com), np.asarray(base.gravity, float), *loads,
+                       X, Xd, Xdd, Z, frame, Fj, rc, ok, fail)
+        live = np.flatnonzero(ok)
+        if live.size < V:
+            X, Xd, Xdd, Z, frame, rc = (a[live] for a in (X, Xd, Xdd, Z, frame, rc))
+            Fj = Fj[:, live]
+        q, qdot = _prescribed(q0[live], values, qd_dot, didx)
+    else:
+        J, LU = _scratch(work, "J", (V, N, n_x, n_x)), _scratch(work, "LU", (V, N, n_x, n_x))
+        piv = _scratch(work, "piv", (V, N, n_x), np.int64)
+        path_variants(*path, X, Xd, Xdd, J, LU, piv, rc, ok, fail)
+        live = np.flatnonzero(ok)
+        if live.size < V:
+            X, Xd, Xdd, J, LU, piv, rc, Z, frame = (
+                a[live] for a in (X, Xd, Xdd, J, LU, piv, rc, Z, frame))
+            Fj = Fj[:, live]
+        if not live.size:
+            return [None] * V
+        q, qdot = _prescribed(q0[live], values, qd_dot, didx)
+        rhs, F_ground = _rhs(vs.take(live), base, t, X, Xd, Xdd, q, qdot, didx)
+        inverse_variants(LU, piv, rhs, n_rows, Z)
+        loads_variants(X, J, Z, *loads, frame, Fj)
+        frame += F_ground  # the frame's share of the loads (point of the moments: the origin)
+    if not live.size:
+        return [None] * V
     good = np.all(rc >= MIN_PIVOT_RATIO, axis=1) & np.all(np.isfinite(Z), axis=(1, 2))
-    reactions, frame = _reactions(base, lay0, X, J, Z, n_rows)
-    frame += F_ground  # the frame's share of the loads (point of the moments: the origin)
+    reactions = {name: Fj[g] for g, name in enumerate(joints)}
     names = base.coordinate_names
     driven = {names[k]: Z[..., n_rows + c] for c, k in enumerate(didx)}
     rec = Kinetostatics(
@@ -360,56 +387,76 @@ def _cycle(vs: Variants, analysis: KinetostaticExtremes, work: dict) -> list[Out
 
     figs = extremes(rec, rec.driving, rec.power, rec.reactions, rec.frame_force,
                     rec.frame_moment, rms)
+    keys = list(figs)
+    table = np.column_stack([np.broadcast_to(np.asarray(figs[k], float), live.shape)
+                             for k in keys])[good].tolist()  # Python floats, row by row
     out: list[Outcome | None] = [None] * V
-    for i, v in enumerate(live):
-        if good[i]:
-            out[v] = Outcome({k: float(a[i]) for k, a in figs.items()}, str(Status.SUCCESS))
+    status = str(Status.SUCCESS)
+    for v, row in zip(live[good].tolist(), table, strict=True):
+        out[v] = Outcome(dict(zip(keys, row, strict=True)), status)
     return out
+
+
+def _prescribed(q0, values, qd_dot, didx):
+    """q and qdot (V, N, n_q) at the positions: every coordinate is driven or held, so
+    they are the prescribed values (the held ones from each variant's start ``q0``)."""
+    q = np.empty((q0.shape[0], values.size, q0.shape[1]))
+    q[:] = q0[:, None, :]
+    q[..., didx[0]] = values
+    qdot = np.zeros_like(q)
+    qdot[..., didx] = qd_dot
+    return q, qdot
 
 
 def _rhs(vs: Variants, base, t, X, Xd, Xdd, q, qdot, didx):
     """Inertia forces minus applied forces, (V, N, n_x), and the loads on the frame
-    (V, N, 3): the bodies of all variants side by side as one model
-    (:func:`~mechdyn.dynamics.inertia.inertia_forces`, and the weights of
-    :class:`~mechdyn.dynamics.forces.ForceModel`), or each variant's loads
-    (:func:`~mechdyn.dynamics.forces.applied_forces`) when it has more than gravity."""
+    (V, N, 3), of variants with loads besides the weights: the bodies of all variants
+    side by side as one model (:func:`~mechdyn.dynamics.inertia.inertia_forces`) and
+    each variant's loads (:func:`~mechdyn.dynamics.forces.applied_forces`)."""
     V, N, n_x = X.shape
 
     def side(a):  # (V, N, n_x) -> (N, V n_x)
         return np.ascontiguousarray(a.transpose(1, 0, 2)).reshape(N, V * n_x)
 
-    def back(a):
-        return a.reshape(N, V, n_x).transpose(1, 0, 2)
-
-    sbs = _SideBySide(vs, base.gravity)
-    rhs = back(inertia_forces(sbs, side(X), side(Xd), side(Xdd)))
     F_ground = np.zeros((V, N, 3))
-    if vs.models is None:
-        return rhs - back(ForceModel(sbs, [], [], [], [], []).conservative(side(X))), F_ground
+    rhs = inertia_forces(_SideBySide(vs, base.gravity), side(X), side(Xd), side(Xdd))
+    rhs = rhs.reshape(N, V, n_x).transpose(1, 0, 2)
     for i, m in enumerate(vs.models):
         F, F_ground[i], _ = applied_forces(m, t, X[i], Xd[i], q[i], qdot[i], skip_drives=didx)
         rhs[i] -= F
-    return rhs, F_ground
+    return np.ascontiguousarray(rhs), F_ground
 
 
-def _reactions(base, lay, X, J, Z, n_rows):
-    """The joint reactions {joint: (V, N, 2)} N (on the child from the parent, as
-    :func:`~mechdyn.dynamics.reactions.joint_reaction`), and what the frame receives
-    from the joints to the ground and from the drives' stators, (V, N, 3): Fx, Fy (N)
-    and the moment about the ground origin (N m) (as ``_inverse``'s frame loads; they
-    are linear in the forces on the bodies, so their sum is taken once)."""
-    V, N, n_x = X.shape
-    x, Jf, Zf = X.reshape(V * N, n_x), J.reshape(V * N, n_x, n_x), Z.reshape(V * N, n_x)
-    # the drives' stators: the driving torques on the poses, D = g_d,x^T tau
-    D = np.einsum("nd,ndx->nx", Zf[:, n_rows:], Jf[:, n_rows:, :])
-    reactions = {}
-    for name in (n for n in base.joint_names if n in lay.rows):
-        idx = lay.rows[name]
-        rows = slice(idx[0], idx[-1] + 1) if np.all(np.diff(idx) == 1) else idx
-        gen = -np.einsum("nr,nrx->nx", Zf[:, rows], Jf[:, rows, :])  # -Phi_e,x^T lambda_e
-        # the force does not depend on the joint point (the base's serves every variant)
-        f, _, _ = joint_reaction(base, name, x, gen)
-        reactions[name] = f.reshape(V, N, 2)
+def _reaction_rows(base, lay, x, n_rows):
+    """What :func:`~mechdyn.kernels.rows_variants.loads_variants` needs to give the joint
+    reactions (on the child from the parent, as
+    :func:`~mechdyn.dynamics.reactions.joint_reaction`) and what the frame receives
+    from the joints to the ground and from the drives' stators (as ``_inverse``'s frame
+    loads; they are linear in the forces on the bodies, so their sum is taken once):
+    the joints, the rows' weights and groups, each joint's two columns and sign; None
+    when a joint's reaction is not two columns of its rows' force (the variants are then
+    left to the single-model analysis).
+
+    A joint's force is two columns of ``-Phi_e,x^T lambda_e`` with a sign, which
+    :func:`joint_reaction` tells by its answer to each unit column at a pose ``x``."""
+    n_x = x.size
+    joints = [n for n in base.joint_names if n in lay.rows]
+    group = np.full(n_x, -1, dtype=np.int64)
+    weight = np.zeros(n_x)
+    weight[n_rows:] = 1.0  # the drives' stators: the driving torques on the poses
+    cols = np.zeros((len(joints), 2), dtype=np.int64)
+    sign = np.zeros(len(joints))
+    probe = np.broadcast_to(x, (n_x, n_x))
+    for g, name in enumerate(joints):
+        idx = np.asarray(lay.rows[name])
+        group[idx] = g
+        f = joint_reaction(base, name, probe, np.eye(n_x))[0]  # (n_x, 2): its columns
+        cols[g] = np.argmax(np.abs(f), axis=0)
+        sign[g] = f[cols[g, 0], 0]
+        select = np.zeros((n_x, 2))
+        select[cols[g], [0, 1]] = sign[g]
+        if abs(sign[g]) != 1.0 or not np.array_equal(f, select):
+            return None
         if base.n_bodies in reaction_frame(base, name)[1:3]:
-            D += gen
-    return reactions, net_on_ground(base, x, D, np.zeros(2)).reshape(V, N, 3)
+            weight[idx] = -1.0  # -Phi_e,x^T lambda_e: the joint's force on the bodies
+    return joints, weight, group, cols, sign
