@@ -271,11 +271,17 @@ def solve_supports(C, q, *, bilateral=None, equilibrium=None,
     if not (np.all(np.isfinite(q)) and np.all(np.isfinite(A)) and np.all(np.isfinite(f))):
         raise ModelError("q and the equilibrium equations must be finite")
     uni = ~bil
-    lam_scale = max(float(np.max(np.abs(f), initial=0.0)),
-                    float(np.max(np.abs(q), initial=0.0)) / max(
-                        float(np.max(np.abs(C), initial=0.0)), 1e-300), 1e-300)
-    gap_scale = max(float(np.max(np.abs(q), initial=0.0)),
-                    float(np.max(np.abs(C), initial=0.0)) * lam_scale, 1e-300)
+    f_scale = float(np.max(np.abs(f), initial=0.0))
+    q_scale = float(np.max(np.abs(q), initial=0.0))
+    C_scale = float(np.max(np.abs(C), initial=0.0))
+    A_scale = float(np.max(np.abs(A), initial=0.0))
+
+    def scales(lam, u):
+        """Force and gap scales of a candidate: its own forces, not q / C (which is
+        unbounded for rigid supports and would accept pulling ones)."""
+        ls = max(f_scale, float(np.max(np.abs(lam), initial=0.0)), 1e-300)
+        return ls, max(q_scale, C_scale * ls, A_scale * float(np.max(np.abs(u), initial=0.0)),
+                       1e-300)
     singular_ok = []  # solutions of sets whose KKT matrix is singular
 
     def attempt(closed):
@@ -294,19 +300,15 @@ def solve_supports(C, q, *, bilateral=None, equilibrium=None,
                 float(np.max(np.abs(K), initial=0.0)) * float(np.max(np.abs(z), initial=0.0)),
                 float(np.max(np.abs(rhs), initial=0.0)), 1e-300)
             # closed gaps are held by the solve (its residual), open ones checked here
-            gs = max(gap_scale, float(np.max(np.abs(A), initial=0.0)
-                                      * np.max(np.abs(z[ns:]), initial=0.0)))
-            if solved and _violation(lam, g, uni, lam_scale, gs) <= tol:
+            if solved and _violation(lam, g, uni, *scales(lam, z[ns:])) <= tol:
                 singular_ok.append(lam)
             return None
         lam, u, g = sol
-        gs = max(gap_scale, float(np.max(np.abs(A), initial=0.0)
-                                  * np.max(np.abs(u), initial=0.0)))
-        return lam, u, g, _violation(lam, g, uni, lam_scale, gs)
+        return lam, u, g, _violation(lam, g, uni, *scales(lam, u))
 
     def unique(sol):
         for other in singular_ok:
-            if np.max(np.abs(other - sol.forces)) > 1e-8 * lam_scale:
+            if np.max(np.abs(other - sol.forces)) > 1e-8 * scales(sol.forces, sol.motion)[0]:
                 raise ModelError(not_unique)
         return sol
 
