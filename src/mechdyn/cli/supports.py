@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import csv
-import re
 
 from ..errors import ModelError, UnitError
 from .options import quantity
@@ -51,18 +50,6 @@ def _list(text: str, kind: str, flag: str, n: int | None = None, rigid: bool = F
             for t in parts]
 
 
-def _bending_stiffness(text: str) -> float:
-    """EI in N m^2 from ``"2e6"``, ``"2e6 N*m^2"``, ``"2 kN*m^2"``."""
-    t = str(text).strip()
-    if re.fullmatch(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?", t):
-        return float(t)
-    try:  # N m^2 per metre is a moment: read it as one
-        return quantity(f"{t}/m", "torque", "--EI")
-    except UnitError:
-        raise UnitError(f"--EI {text!r}: expected a bending stiffness such as 2e6N*m^2 "
-                        "or 2MN*m^2") from None
-
-
 def run(args) -> int:
     import numpy as np
 
@@ -79,7 +66,7 @@ def run(args) -> int:
         if not sep:
             raise UnitError(f"--load {spec!r}: expected POSITION:FORCE, e.g. 2m:10kN")
         loads.append((quantity(where, "length", "--load"), quantity(force, "force", "--load")))
-    EI = _bending_stiffness(args.EI) if args.EI else np.inf
+    EI = quantity(args.EI, "bending_stiffness", "--EI") if args.EI else np.inf
     prob = beam_on_supports(x, stiff, EI=EI, loads=loads, gaps=gaps,
                             bilateral=[True] * k if args.bilateral else None)
     s = prob.solve()
