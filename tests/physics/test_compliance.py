@@ -152,6 +152,10 @@ def test_bad_problems_are_named():
         beam_on_supports([0.0, 1.0], [1e6, -1.0])
     with pytest.raises(ModelError, match="off the flexible beam"):
         beam_on_supports([0.0, 1.0], EI=1e5, loads=[(2.0, 1.0)])
+    with pytest.raises(ModelError, match=r"load 1: expected a pair \(x, P\)"):
+        beam_on_supports([0.0, 1.0], loads=[(0.5, 1.0), (0.5,)])
+    with pytest.raises(ModelError, match="load 0: x and P must be finite"):
+        beam_on_supports([0.0, 1.0], loads=[(0.5, np.nan)])
     # rigid beam on three rigid supports: nothing shares the load
     with pytest.raises(ModelError, match="not unique"):
         beam_on_supports(X, loads=[(2.0, P)]).solve()

@@ -172,3 +172,9 @@ def test_bad_friction_keywords_in_python_are_named_errors():
         m.add_revolute("O", "ground", "a", frction=0.1)
     m.add_revolute("O", "ground", "a", friction="0.1", pin_radius=0.01)
     assert any("friction must be a finite number >= 0, got '0.1'" in p for p in m.problems())
+
+
+def test_too_few_multipliers_name_the_joint():
+    fs = FrictionSet(_block())
+    with pytest.raises(ModelError, match=r"lam has 1 multiplier.*joint 'guide'"):
+        fs.generalized(np.zeros(3), np.zeros(3), np.zeros(1))

@@ -423,6 +423,18 @@ def simple_beam_influence(x, xi, a: float, b: float, EI: float) -> np.ndarray:
     return s * (ln - t) * (2 * ln * t - t * t - s * s) / (6 * ln * EI)
 
 
+def _load(i: int, load) -> tuple[float, float]:
+    """Load ``i`` of :func:`beam_on_supports` as finite floats (x m, P N)."""
+    try:
+        xl, p = (float(v) for v in load)
+    except (TypeError, ValueError):
+        raise ModelError(f"load {i}: expected a pair (x, P) of numbers (m, N), got "
+                         f"{load!r}") from None
+    if not (np.isfinite(xl) and np.isfinite(p)):
+        raise ModelError(f"load {i}: x and P must be finite, got ({xl!r}, {p!r})")
+    return xl, p
+
+
 def beam_on_supports(positions, stiffness=None, *, EI: float = np.inf, loads=(),
                      gaps=None, bilateral=None) -> SupportProblem:
     """C, q and the equilibrium equations of a beam on k supports.
@@ -458,7 +470,8 @@ def beam_on_supports(positions, stiffness=None, *, EI: float = np.inf, loads=(),
     Raises
     ------
     ModelError
-        Shapes, non-positive stiffness or EI, loads off a flexible beam.
+        Shapes, non-positive stiffness or EI, a load that is not a finite pair (x, P),
+        loads off a flexible beam.
 
     Examples
     --------
@@ -480,7 +493,7 @@ def beam_on_supports(positions, stiffness=None, *, EI: float = np.inf, loads=(),
                          f"got {[float(kk[i]) for i in bad]}")
     if not EI > 0:
         raise ModelError(f"EI must be > 0 N m^2 (np.inf for a rigid beam), got {EI!r}")
-    loads = [(float(xl), float(p)) for xl, p in loads]
+    loads = [_load(i, load) for i, load in enumerate(loads)]
     C = np.diag(1.0 / kk)
     q = np.zeros(k) if gaps is None else np.asarray(gaps, float).reshape(-1).copy()
     if q.size != k:

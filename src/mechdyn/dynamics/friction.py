@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ModelError
 from ..kernels import rows_numpy
 from ..kinematics.constraints import _perp, extend
 from ..model import Model
@@ -352,6 +353,11 @@ class FrictionSet:
             of every pair on the moving bodies.
         dF_dlam : ndarray, shape (..., n_x, n_rows)
             Its exact derivative (the zero subgradient where a pair's load vanishes).
+
+        Raises
+        ------
+        ModelError
+            ``lam`` has fewer multipliers than a pair's rows need (naming the joint).
         """
         return self.prepare(x, xdot, rows, signs).generalized(lam)
 
@@ -414,7 +420,12 @@ class PreparedFriction:
             K = self.owner.size
             E = np.zeros(self.batch + (K, n_rows))
             for p, A, a in zip(self.fs.pairs, self.maps, self.starts, strict=True):
-                E[..., a:a + A.shape[-2], np.asarray(self.rows[p.name], int)] = A
+                idx = np.asarray(self.rows[p.name], int)
+                if idx.size and idx.max() >= n_rows:
+                    raise ModelError(f"lam has {n_rows} multiplier(s) on its last axis, but "
+                                     f"joint {p.name!r} uses rows {idx.tolist()}: give the "
+                                     "multipliers of every constraint row")
+                E[..., a:a + A.shape[-2], idx] = A
             self._E[n_rows] = E
         return E
 
