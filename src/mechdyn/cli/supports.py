@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import csv
 
-from ..errors import ModelError, UnitError
+from ..errors import UnitError
+from ..results.table import written
 from .options import quantity
 
 __all__ = ["register", "run"]
@@ -82,12 +83,9 @@ def run(args) -> int:
     print(f"  beam: w0 = {1e3 * s.motion[0]:.6g} mm, phi = {s.motion[1]:.6g} rad "
           "(w = w0 + phi x, downwards)")
     if args.output:
-        try:
-            with open(args.output, "w", newline="", encoding="utf-8") as fh:
-                w = csv.writer(fh)
-                w.writerow(["support", "x_m", "force_N", "gap_mm", "closed"])
-                w.writerows(rows)
-        except IsADirectoryError as exc:
-            raise ModelError(f"-o {args.output}: is a folder") from exc
+        with written(args.output) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
+            w = csv.writer(fh)
+            w.writerow(["support", "x_m", "force_N", "gap_mm", "closed"])
+            w.writerows(rows)
         print(f"  table: {args.output}")
     return 0
