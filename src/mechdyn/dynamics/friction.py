@@ -81,7 +81,26 @@ class FrictionPair:
 
 def friction_joints(model: Model) -> tuple[str, ...]:
     """Names of the revolute and prismatic joints of a model that dissipate (a Coulomb
-    coefficient or a viscous term set), in the model's joint order."""
+    coefficient or a viscous term set), in the model's joint order.
+
+    Parameters
+    ----------
+    model : Model
+        A compiled model.
+
+    Returns
+    -------
+    tuple of str
+        The joint names (empty for a frictionless model).
+
+    Examples
+    --------
+    >>> from mechdyn import examples
+    >>> friction_joints(examples.load("toggle_press_friction").compile())
+    ('A', 'B', 'C', 'D', 'E', 'F', 'slide')
+    >>> friction_joints(examples.load("toggle_press").compile())
+    ()
+    """
     from ..mechanism.joint import has_friction
     joints = model.mechanism.joints
     return tuple(n for n in model.joint_names
