@@ -68,6 +68,14 @@ def run(args) -> int:
             raise UnitError(f"--load {spec!r}: expected POSITION:FORCE, e.g. 2m:10kN")
         loads.append((quantity(where, "length", "--load"), quantity(force, "force", "--load")))
     EI = quantity(args.EI, "bending_stiffness", "--EI") if args.EI else np.inf
+    # the checks of beam_on_supports, in the terms of this command (supports numbered
+    # from 1 as in the table, "rigid" rather than np.inf)
+    bad = [i + 1 for i, v in enumerate(stiff or ()) if not v > 0]
+    if bad:
+        raise UnitError(f"--stiffness {args.stiffness!r}: support(s) {bad} (numbered from 1) "
+                        "must be > 0 N/m, or 'rigid'")
+    if not EI > 0:
+        raise UnitError(f"--EI {args.EI!r}: must be > 0 (leave --EI out for a rigid beam)")
     prob = beam_on_supports(x, stiff, EI=EI, loads=loads, gaps=gaps,
                             bilateral=[True] * k if args.bilateral else None)
     s = prob.solve()
