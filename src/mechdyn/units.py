@@ -92,6 +92,8 @@ KINDS: dict[str, Kind] = {
     "stiffness": Kind("N/m", "stiffness (N/m)", '"4530 N/m" or "4.53 N/mm"'),
     "damping": Kind("N*s/m", "damping coefficient (N*s/m)", '"20 N*s/m"'),
     "compliance": Kind("m/N", "compliance (m/N)", '"2e-9 m/N" or "2 um/kN"'),
+    "bending_stiffness": Kind("N*m^2", "bending stiffness (N*m^2)",
+                              '"2e6 N*m^2" or "2 MN*m^2"'),
     "rotational_stiffness": Kind("N*m/rad", "rotational stiffness (N*m/rad)", '"12 N*m/rad"',
                                  None),
     "rotational_damping": Kind("N*m*s/rad", "rotational damping (N*m*s/rad)",

@@ -40,6 +40,9 @@ def test_held_down_supports_of_a_rigid_beam_on_springs(capsys):
     (["--at", "0m,1m", "--stiffness", "1e6N/m", "--load", "0.5m:1kN"], "expected 2 value"),
     (["--at", "0m,1m", "--EI", "3kg", "--load", "0.5m:1kN"], "bending stiffness"),
     (["--at", "0m,1m", "--load", "0.5m"], "POSITION:FORCE"),
+    (["--at", "0m,1m,2m", "--stiffness", "1e6,-5,rigid", "--load", "0.5m:1kN"],
+     "support(s) [2] (numbered from 1)"),
+    (["--at", "0m,1m", "--EI", "-3", "--load", "0.5m:1kN"], "leave --EI out"),
     (["--at", "0m,1m,2m", "--load", "0.5m:1kN"], "not unique"),
     (["--at", "0m,1m", "--stiffness", "1e6N/m,1e6N/m", "--load", "2m:1kN"], "tips over|holds"),
 ])

@@ -152,6 +152,10 @@ def test_bad_problems_are_named():
         beam_on_supports([0.0, 1.0], [1e6, -1.0])
     with pytest.raises(ModelError, match="off the flexible beam"):
         beam_on_supports([0.0, 1.0], EI=1e5, loads=[(2.0, 1.0)])
+    with pytest.raises(ModelError, match=r"load 1: expected a pair \(x, P\)"):
+        beam_on_supports([0.0, 1.0], loads=[(0.5, 1.0), (0.5,)])
+    with pytest.raises(ModelError, match="load 0: x and P must be finite"):
+        beam_on_supports([0.0, 1.0], loads=[(0.5, np.nan)])
     # rigid beam on three rigid supports: nothing shares the load
     with pytest.raises(ModelError, match="not unique"):
         beam_on_supports(X, loads=[(2.0, P)]).solve()
@@ -197,3 +201,16 @@ def test_random_problems_against_a_general_qp_solver_and_their_optimality_condit
         assert obj(s.forces) <= obj(ref.x) + 1e-12 * abs(obj(ref.x))
         np.testing.assert_allclose(s.forces, ref.x, atol=1e-4 * max(1, abs(s.forces).max()))
     assert methods == {"active-set", "enumeration"}  # both ways of finding the set run
+
+
+@pytest.mark.parametrize("stiffness", [None, [1e20] * 3])
+def test_a_support_standing_proud_of_rigid_supports_lifts_the_beam_off_the_far_one(stiffness):
+    # rigid beam, supports at 0, 1, 2 m, the middle one 1 mm higher (gap -1 mm), 1 kN at
+    # 0.5 m: the beam rests on the first two (statics of a beam on two supports: 500 N
+    # each) and clears the third by 2 mm (the line through w(0) = 0, w(1) = -1 mm); the
+    # supports only push, so the 1500 N / -500 N pair on the last two is not a solution
+    s = beam_on_supports([0.0, 1.0, 2.0], stiffness, loads=[(0.5, 1000.0)],
+                         gaps=[0.0, -1e-3, 0.0]).solve()
+    assert s.closed.tolist() == [True, True, False]
+    assert np.allclose(s.forces, [500.0, 500.0, 0.0], atol=1e-6)
+    assert np.isclose(s.gaps[2], 2e-3, atol=1e-9)

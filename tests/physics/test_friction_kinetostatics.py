@@ -293,3 +293,16 @@ def test_self_locking_toggle_position_driven_from_the_slider():
     k = int(np.flatnonzero(~locked)[-1]) + 1  # the first locked sample of the far end
     assert f"s = {s[k]:.6g} .. {s[-1]:.6g} m" in " ".join(res.warnings)
     np.testing.assert_allclose(res.x[:, 2] % (2 * np.pi), phi, atol=1e-9)
+
+
+def test_statics_with_friction_says_that_friction_is_left_out():
+    from mechdyn import examples
+
+    phi = np.linspace(0.5, 1.0, 3)
+    res = kinetostatics(examples.load("toggle_press_friction"), over="phi", speed=0.0,
+                        values=phi)
+    ideal = kinetostatics(examples.load("toggle_press"), over="phi", speed=0.0, values=phi)
+    assert any(w.startswith("statics (speed 0) of a model with friction in joint(s) 'A'")
+               and "'slide'" in w for w in res.warnings)
+    np.testing.assert_allclose(res.driving["phi"], ideal.driving["phi"], rtol=1e-12)
+    assert not any("friction" in w for w in ideal.warnings)

@@ -59,3 +59,13 @@ def test_reduce_command_shows_the_warning(tmp_path, capsys):
                    "-o", str(tmp_path / "red.csv")])
     assert rc == 0, capsys.readouterr().err
     assert len(_ignored(rec)) == 1
+
+
+def test_flywheel_command_warns_once_though_it_reduces_twice(capsys):
+    # no --speed: a first reduction finds the torque speed-independent, a second one at
+    # the model's speed makes the table; the user is told once
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        rc = main(["flywheel", "toggle_press_friction", "--delta", "0.05", "--steps", "37"])
+    assert rc == 0, capsys.readouterr().err
+    assert len(_ignored(rec)) == 1

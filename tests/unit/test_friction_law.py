@@ -161,3 +161,20 @@ def test_rows_of_a_layout_and_missing_rows():
     np.testing.assert_array_equal(dF, dF2)
     with pytest.raises(ValueError, match="'guide'"):
         fs.generalized(x, xdot, lam, {"O": [0, 1], "A": [2, 3], "B": [4, 5]})
+
+
+def test_bad_friction_keywords_in_python_are_named_errors():
+    m = Mechanism("m")
+    m.add_body("a")
+    with pytest.raises(ModelError, match=r"prismatic joint 'P'.*'compliance'.*'guide_length'"):
+        m.add_prismatic("P", "ground", "a", compliance=1e-9)
+    with pytest.raises(ModelError, match=r"revolute joint 'O'.*'frction'.*'friction'"):
+        m.add_revolute("O", "ground", "a", frction=0.1)
+    m.add_revolute("O", "ground", "a", friction="0.1", pin_radius=0.01)
+    assert any("friction must be a finite number >= 0, got '0.1'" in p for p in m.problems())
+
+
+def test_too_few_multipliers_name_the_joint():
+    fs = FrictionSet(_block())
+    with pytest.raises(ModelError, match=r"lam has 1 multiplier.*joint 'guide'"):
+        fs.generalized(np.zeros(3), np.zeros(3), np.zeros(1))

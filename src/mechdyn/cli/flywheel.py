@@ -18,7 +18,10 @@ Exit codes: 0 done; 1 the simulated delta misses the target by more than 5 %;
 
 from __future__ import annotations
 
+import warnings
+
 from ..dynamics.flywheel import FLYWHEEL_METHODS, size_flywheel
+from ..dynamics.friction_ignored import FrictionIgnoredWarning
 from ..dynamics.reduced_machine import ReducedMachine
 from ..dynamics.reduction import reduce_model
 from ..errors import ModelError
@@ -95,7 +98,9 @@ def run(args) -> int:
                                  f"steady speed is not determined by the machine, and {why}: "
                                  f"give the mean speed with --speed (e.g. --speed 43.5rad/s)")
             if not args.exact:  # the table's velocity-dependent loads at that speed
-                machine = reduce_model(model, steps=args.steps, omega=speed).machine(model)
+                with warnings.catch_warnings():  # the first reduction has said it
+                    warnings.simplefilter("ignore", FrictionIgnoredWarning)
+                    machine = reduce_model(model, steps=args.steps, omega=speed).machine(model)
         speed_kw = "omega_guess" if dependent else "omega_mean"  # a motor picks its own speed
         fs = size_flywheel(machine, delta, method=args.method, **{speed_kw: speed})
     print(f"{mech.name}: flywheel for delta = {delta:.4g} ({fs.method} method)")

@@ -118,7 +118,7 @@ def run(args) -> int:
                       f"{row['M_frame_Nm']:.6g}")
     if res.losses:
         e = res.energies()
-        print(f"  cycle efficiency {res.cycle_efficiency:.6g}; energy lost per pair: "
+        print("  energy lost per pair: "
               + ", ".join(f"{j} {e[f'loss_{j}']:.6g} J" for j in res.losses)
               + " (columns P_loss_<joint>_W, P_loss_W, P_out_W, efficiency in the table)")
     if args.output:

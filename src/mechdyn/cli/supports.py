@@ -4,9 +4,9 @@
 from __future__ import annotations
 
 import csv
-import re
 
-from ..errors import ModelError, UnitError
+from ..errors import UnitError
+from ..results.table import written
 from .options import quantity
 
 __all__ = ["register", "run"]
@@ -51,18 +51,6 @@ def _list(text: str, kind: str, flag: str, n: int | None = None, rigid: bool = F
             for t in parts]
 
 
-def _bending_stiffness(text: str) -> float:
-    """EI in N m^2 from ``"2e6"``, ``"2e6 N*m^2"``, ``"2 kN*m^2"``."""
-    t = str(text).strip()
-    if re.fullmatch(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?", t):
-        return float(t)
-    try:  # N m^2 per metre is a moment: read it as one
-        return quantity(f"{t}/m", "torque", "--EI")
-    except UnitError:
-        raise UnitError(f"--EI {text!r}: expected a bending stiffness such as 2e6N*m^2 "
-                        "or 2MN*m^2") from None
-
-
 def run(args) -> int:
     import numpy as np
 
@@ -79,7 +67,15 @@ def run(args) -> int:
         if not sep:
             raise UnitError(f"--load {spec!r}: expected POSITION:FORCE, e.g. 2m:10kN")
         loads.append((quantity(where, "length", "--load"), quantity(force, "force", "--load")))
-    EI = _bending_stiffness(args.EI) if args.EI else np.inf
+    EI = quantity(args.EI, "bending_stiffness", "--EI") if args.EI else np.inf
+    # the checks of beam_on_supports, in the terms of this command (supports numbered
+    # from 1 as in the table, "rigid" rather than np.inf)
+    bad = [i + 1 for i, v in enumerate(stiff or ()) if not v > 0]
+    if bad:
+        raise UnitError(f"--stiffness {args.stiffness!r}: support(s) {bad} (numbered from 1) "
+                        "must be > 0 N/m, or 'rigid'")
+    if not EI > 0:
+        raise UnitError(f"--EI {args.EI!r}: must be > 0 (leave --EI out for a rigid beam)")
     prob = beam_on_supports(x, stiff, EI=EI, loads=loads, gaps=gaps,
                             bilateral=[True] * k if args.bilateral else None)
     s = prob.solve()
@@ -95,12 +91,9 @@ def run(args) -> int:
     print(f"  beam: w0 = {1e3 * s.motion[0]:.6g} mm, phi = {s.motion[1]:.6g} rad "
           "(w = w0 + phi x, downwards)")
     if args.output:
-        try:
-            with open(args.output, "w", newline="", encoding="utf-8") as fh:
-                w = csv.writer(fh)
-                w.writerow(["support", "x_m", "force_N", "gap_mm", "closed"])
-                w.writerows(rows)
-        except IsADirectoryError as exc:
-            raise ModelError(f"-o {args.output}: is a folder") from exc
+        with written(args.output) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
+            w = csv.writer(fh)
+            w.writerow(["support", "x_m", "force_N", "gap_mm", "closed"])
+            w.writerows(rows)
         print(f"  table: {args.output}")
     return 0

@@ -163,6 +163,14 @@ class SupportSolution:
         ``"active-set"`` (primal-dual iteration) or ``"enumeration"``.
     residual : float
         Largest violation of the conditions, relative to the load and gap scales.
+
+    Examples
+    --------
+    A rigid beam on rigid supports at 0 and 2 m, 900 N at 1.5 m (statics: 225 N, 675 N):
+
+    >>> s = beam_on_supports([0.0, 2.0], loads=[(1.5, 900.0)]).solve()
+    >>> s.forces.tolist(), s.closed.tolist(), s.method
+    ([225.0, 675.0], [True, True], 'active-set')
     """
 
     forces: np.ndarray
@@ -271,11 +279,17 @@ def solve_supports(C, q, *, bilateral=None, equilibrium=None,
     if not (np.all(np.isfinite(q)) and np.all(np.isfinite(A)) and np.all(np.isfinite(f))):
         raise ModelError("q and the equilibrium equations must be finite")
     uni = ~bil
-    lam_scale = max(float(np.max(np.abs(f), initial=0.0)),
-                    float(np.max(np.abs(q), initial=0.0)) / max(
-                        float(np.max(np.abs(C), initial=0.0)), 1e-300), 1e-300)
-    gap_scale = max(float(np.max(np.abs(q), initial=0.0)),
-                    float(np.max(np.abs(C), initial=0.0)) * lam_scale, 1e-300)
+    f_scale = float(np.max(np.abs(f), initial=0.0))
+    q_scale = float(np.max(np.abs(q), initial=0.0))
+    C_scale = float(np.max(np.abs(C), initial=0.0))
+    A_scale = float(np.max(np.abs(A), initial=0.0))
+
+    def scales(lam, u):
+        """Force and gap scales of a candidate: its own forces, not q / C (which is
+        unbounded for rigid supports and would accept pulling ones)."""
+        ls = max(f_scale, float(np.max(np.abs(lam), initial=0.0)), 1e-300)
+        return ls, max(q_scale, C_scale * ls, A_scale * float(np.max(np.abs(u), initial=0.0)),
+                       1e-300)
     singular_ok = []  # solutions of sets whose KKT matrix is singular
 
     def attempt(closed):
@@ -294,19 +308,15 @@ def solve_supports(C, q, *, bilateral=None, equilibrium=None,
                 float(np.max(np.abs(K), initial=0.0)) * float(np.max(np.abs(z), initial=0.0)),
                 float(np.max(np.abs(rhs), initial=0.0)), 1e-300)
             # closed gaps are held by the solve (its residual), open ones checked here
-            gs = max(gap_scale, float(np.max(np.abs(A), initial=0.0)
-                                      * np.max(np.abs(z[ns:]), initial=0.0)))
-            if solved and _violation(lam, g, uni, lam_scale, gs) <= tol:
+            if solved and _violation(lam, g, uni, *scales(lam, z[ns:])) <= tol:
                 singular_ok.append(lam)
             return None
         lam, u, g = sol
-        gs = max(gap_scale, float(np.max(np.abs(A), initial=0.0)
-                                  * np.max(np.abs(u), initial=0.0)))
-        return lam, u, g, _violation(lam, g, uni, lam_scale, gs)
+        return lam, u, g, _violation(lam, g, uni, *scales(lam, u))
 
     def unique(sol):
         for other in singular_ok:
-            if np.max(np.abs(other - sol.forces)) > 1e-8 * lam_scale:
+            if np.max(np.abs(other - sol.forces)) > 1e-8 * scales(sol.forces, sol.motion)[0]:
                 raise ModelError(not_unique)
         return sol
 
@@ -358,7 +368,18 @@ class SupportProblem:
         m.
     A : ndarray, shape (k, m)
     f : ndarray, shape (m,)
+        N (and N m for a rotation).
     bilateral : ndarray of bool, shape (k,)
+
+    Examples
+    --------
+    Two springs of 1e-6 m/N under a block that can only translate (u: its sinking, m),
+    loaded by 1000 N: A = [[1], [1]], f = [1000].
+
+    >>> prob = SupportProblem(np.eye(2) * 1e-6, np.zeros(2), np.ones((2, 1)),
+    ...                       np.array([1000.0]), np.zeros(2, bool))
+    >>> prob.solve().forces.round(9).tolist()
+    [500.0, 500.0]
     """
 
     C: np.ndarray
@@ -421,6 +442,18 @@ def simple_beam_influence(x, xi, a: float, b: float, EI: float) -> np.ndarray:
     return s * (ln - t) * (2 * ln * t - t * t - s * s) / (6 * ln * EI)
 
 
+def _load(i: int, load) -> tuple[float, float]:
+    """Load ``i`` of :func:`beam_on_supports` as finite floats (x m, P N)."""
+    try:
+        xl, p = (float(v) for v in load)
+    except (TypeError, ValueError):
+        raise ModelError(f"load {i}: expected a pair (x, P) of numbers (m, N), got "
+                         f"{load!r}") from None
+    if not (np.isfinite(xl) and np.isfinite(p)):
+        raise ModelError(f"load {i}: x and P must be finite, got ({xl!r}, {p!r})")
+    return xl, p
+
+
 def beam_on_supports(positions, stiffness=None, *, EI: float = np.inf, loads=(),
                      gaps=None, bilateral=None) -> SupportProblem:
     """C, q and the equilibrium equations of a beam on k supports.
@@ -456,7 +489,8 @@ def beam_on_supports(positions, stiffness=None, *, EI: float = np.inf, loads=(),
     Raises
     ------
     ModelError
-        Shapes, non-positive stiffness or EI, loads off a flexible beam.
+        Shapes, non-positive stiffness or EI, a load that is not a finite pair (x, P),
+        loads off a flexible beam.
 
     Examples
     --------
@@ -478,7 +512,7 @@ def beam_on_supports(positions, stiffness=None, *, EI: float = np.inf, loads=(),
                          f"got {[float(kk[i]) for i in bad]}")
     if not EI > 0:
         raise ModelError(f"EI must be > 0 N m^2 (np.inf for a rigid beam), got {EI!r}")
-    loads = [(float(xl), float(p)) for xl, p in loads]
+    loads = [_load(i, load) for i, load in enumerate(loads)]
     C = np.diag(1.0 / kk)
     q = np.zeros(k) if gaps is None else np.asarray(gaps, float).reshape(-1).copy()
     if q.size != k:

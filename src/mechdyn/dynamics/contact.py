@@ -99,6 +99,14 @@ def solve_lcp(H, r, *, tol: float = 1e-9) -> LCPResult:
     ------
     ContactError
         No solution was found (e.g. the contact configuration is jammed).
+
+    Examples
+    --------
+    Two coupled contacts pressed together (by hand: 2 z1 + z2 = 1, z1 + 2 z2 = 1):
+
+    >>> res = solve_lcp([[2.0, 1.0], [1.0, 2.0]], [-1.0, -1.0])
+    >>> res.z.round(12).tolist(), res.w.round(12).tolist()
+    ([0.333333333333, 0.333333333333], [0.0, 0.0])
     """
     H = np.atleast_2d(np.asarray(H, float))
     r = np.asarray(r, float).reshape(-1)
@@ -216,6 +224,17 @@ def solve_frictional_impact(Z, p_minus, Cu, target, Ct, of_row, mu, vt_minus, *,
     ------
     ContactError
         Too many frictional rows, or no friction state is consistent.
+
+    Examples
+    --------
+    A unit point mass (q = x, y) hits the floor y = 0 at (1, -1) m/s, plastic (e = 0),
+    mu = 0.5: the normal impulse 1 N s stops the fall; sticking would need 1 N s > mu P_n,
+    so it slides on with 1 - mu P_n = 0.5 m/s.
+
+    >>> imp = solve_frictional_impact(np.eye(2), np.array([1.0, -1.0]), np.array([[0.0, 1.0]]),
+    ...                               np.zeros(1), np.array([[1.0, 0.0]]), [0], [0.5], [1.0])
+    >>> imp.normal.tolist(), imp.tangent.tolist(), imp.states, imp.qdot_plus.tolist()
+    ([1.0], [-0.5], ('slip+',), [0.5, 0.0])
     """
     m, mf = Cu.shape[0], Ct.shape[0]
     if mf > MAX_FRICTIONAL_ROWS:

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ModelError
 from ..kernels import rows_numpy
 from ..kinematics.constraints import _perp, extend
 from ..model import Model
@@ -80,7 +81,26 @@ class FrictionPair:
 
 def friction_joints(model: Model) -> tuple[str, ...]:
     """Names of the revolute and prismatic joints of a model that dissipate (a Coulomb
-    coefficient or a viscous term set), in the model's joint order."""
+    coefficient or a viscous term set), in the model's joint order.
+
+    Parameters
+    ----------
+    model : Model
+        A compiled model.
+
+    Returns
+    -------
+    tuple of str
+        The joint names (empty for a frictionless model).
+
+    Examples
+    --------
+    >>> from mechdyn import examples
+    >>> friction_joints(examples.load("toggle_press_friction").compile())
+    ('A', 'B', 'C', 'D', 'E', 'F', 'slide')
+    >>> friction_joints(examples.load("toggle_press").compile())
+    ()
+    """
     from ..mechanism.joint import has_friction
     joints = model.mechanism.joints
     return tuple(n for n in model.joint_names
@@ -352,6 +372,11 @@ class FrictionSet:
             of every pair on the moving bodies.
         dF_dlam : ndarray, shape (..., n_x, n_rows)
             Its exact derivative (the zero subgradient where a pair's load vanishes).
+
+        Raises
+        ------
+        ModelError
+            ``lam`` has fewer multipliers than a pair's rows need (naming the joint).
         """
         return self.prepare(x, xdot, rows, signs).generalized(lam)
 
@@ -414,7 +439,12 @@ class PreparedFriction:
             K = self.owner.size
             E = np.zeros(self.batch + (K, n_rows))
             for p, A, a in zip(self.fs.pairs, self.maps, self.starts, strict=True):
-                E[..., a:a + A.shape[-2], np.asarray(self.rows[p.name], int)] = A
+                idx = np.asarray(self.rows[p.name], int)
+                if idx.size and idx.max() >= n_rows:
+                    raise ModelError(f"lam has {n_rows} multiplier(s) on its last axis, but "
+                                     f"joint {p.name!r} uses rows {idx.tolist()}: give the "
+                                     "multipliers of every constraint row")
+                E[..., a:a + A.shape[-2], idx] = A
             self._E[n_rows] = E
         return E
 

@@ -16,6 +16,7 @@ from ..errors import ModelError, Status, did_you_mean
 from ..kinematics.constraints import coordinates, coordinates_gamma, coordinates_jacobian
 from ..results.kinetostatics_record import Kinetostatics
 from .forces import force_model
+from .joint_friction import friction_joints
 from .prescribed_motion import _independent_subset, _prescribed
 from .reactions import _inverse
 
@@ -155,6 +156,14 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
             qo_d, qo_dd = np.broadcast_to(w, qo.shape).copy(), np.zeros_like(qo)
             k0 = int(np.argmax(np.abs(w)))
             tt = ((qo[:, k0] - qo[0, k0]) / w[k0]) if w[k0] != 0 else np.zeros(qo.shape[0])
+            still = friction_joints(model) if w[k0] == 0 else ()
+            if still:
+                warn.append("statics (speed 0) of a model with friction in joint(s) "
+                            + ", ".join(repr(j) for j in still) + ": at rest the pairs do "
+                            "not slide and Coulomb friction is indeterminate, so the torques "
+                            "and reactions are those of the frictionless mechanism, the "
+                            "losses 0 and the efficiencies NaN; give a speed for the friction "
+                            "against the motion (docs/friction.md)")
         extra = didx[n_o:]
         q0 = coordinates(model, x_start)
         for nm, v in (hold or {}).items():

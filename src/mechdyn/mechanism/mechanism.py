@@ -124,12 +124,14 @@ class Mechanism:
         """Add a :class:`Revolute` joint (pin) between two bodies; ``friction``,
         ``pin_radius``, ``viscous``, ``smoothing`` and ``compliance`` as for
         ``Revolute``."""
+        _check_options("revolute", name, friction)
         return self.add(Revolute(name, parent, child, parent_point, child_point, **friction))
 
     def add_prismatic(self, name, parent, child, parent_point=(0.0, 0.0), axis=(1.0, 0.0),
                       child_point=(0.0, 0.0), angle=None, **friction) -> Prismatic:
         """Add a :class:`Prismatic` joint: ``child`` slides along a line of ``parent``;
         ``friction``, ``guide_length``, ``viscous`` and ``smoothing`` as for ``Prismatic``."""
+        _check_options("prismatic", name, friction)
         return self.add(Prismatic(name, parent, child, parent_point, tuple(axis),
                                   child_point, angle, **friction))
 
@@ -241,7 +243,9 @@ class Mechanism:
                 v = getattr(j, key)
                 if not (isinstance(v, int | float) and math.isfinite(v) and v >= 0):
                     out.append(f"{where}: {key} must be a finite number >= 0, got {v!r}")
-            if isinstance(j, Revolute) and j.friction > 0 and not j.pin_radius > 0:
+            if (isinstance(j, Revolute) and isinstance(j.friction, int | float)
+                    and j.friction > 0
+                    and not (isinstance(j.pin_radius, int | float) and j.pin_radius > 0)):
                 out.append(f"{where}: friction = {j.friction:g} needs the pin's radius "
                            "(pin_radius > 0, m)")
             if isinstance(j, Prismatic):
@@ -332,3 +336,13 @@ def reserved_names(bodies, coordinates, points) -> list[str]:
         if "com" in pts:
             out.append(f"body {b!r}: point 'com': the name is reserved for the centre of mass")
     return out
+
+
+def _check_options(jtype: str, name: str, options: dict) -> None:
+    """Raise a ModelError naming the joint for a keyword that is not one of its friction
+    or elastic fields (a typo, or compliance on a prismatic)."""
+    valid = [k for k, _ in (*FRICTION_FIELDS[jtype], *ELASTIC_FIELDS[jtype])]
+    for key in options:
+        if key not in valid:
+            raise ModelError(f"{jtype} joint {name!r}: "
+                             + did_you_mean(key, valid, "keyword argument"))
