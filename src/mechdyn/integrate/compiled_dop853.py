@@ -9,7 +9,7 @@ segment to the kernel's compiled loop (:mod:`mechdyn.kernels.dop853_numba`, driv
 the checks of the step run in machine code, and Python only records the output samples,
 looks at a flagged step (a coordinate rate changing sign, a nearly singular Jacobian)
 and reports a stop.  A segment with event functions (every mode of a variable-structure
-run, a caller's events) takes its steps from the same compiled loop, in batches, each
+run, a caller's events) takes its steps from the same compiled loop, each
 with its dense output of order 7 and under SciPy's step control (so that its events fall
 where ``"scipy-dop853"`` finds them): only the checks of each step, the event functions
 and their location on that dense output stay in Python.  Everywhere else -- the NumPy
