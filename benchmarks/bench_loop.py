@@ -18,6 +18,12 @@ loop of the releases before):
   against a run at rtol 1e-13 (digits in the coordinate and its rate) and the energy
   drift (J, conservative runs).
 
+A fifth case, the variable-structure press (``press_cycle`` over 0.4 s: stops, impacts,
+the lock; its segments have event functions) against the same press without switches
+(0.11 s, fixed structure; :mod:`benchmarks.bench_switching`), reports the wall time per
+simulated second of each on both integrators and the ratios switched / fixed (issue 9's
+figure, at most 3) and ``dop853`` / ``scipy-dop853``, all measured in one run.
+
 ``python -m benchmarks loop`` runs it (``python -m benchmarks.bench_loop`` prints one line
 per run).
 """
@@ -38,6 +44,7 @@ from mechdyn.model.workspace import Workspace
 from mechdyn.simulate import simulate
 
 from .bench_dynamics import _best_of
+from .bench_switching import T_END, T_FIXED, _models
 
 #: (name, model factory, t_end s, simulate keywords)
 CASES = (
@@ -117,6 +124,45 @@ def table(integrators=("dop853", "scipy-dop853"), repeat: int = 7) -> list[dict]
     return out
 
 
+def press_cycle_table(integrators=("dop853", "scipy-dop853"), repeat: int = 3) -> dict:
+    """Best wall time per simulated second (s/s) of the switched press (``T_END``) and the
+    fixed-structure press (``T_FIXED``) on each integrator, runs interleaved:
+    ``{(press, integrator): (s/s, trajectory)}``."""
+    switched, fixed = _models()
+    for m in (switched, fixed):
+        simulate(m, 1e-3, progress=False)  # compile / load the kernels first
+    out = {}
+    for _ in range(repeat):
+        for press, model, te in (("switched", switched, T_END), ("fixed", fixed, T_FIXED)):
+            for integ in integrators:
+                t0 = time.perf_counter()
+                tr = simulate(model, te, progress=False, integrator=integ)
+                wall = (time.perf_counter() - t0) / te
+                if wall < out.get((press, integ), (np.inf,))[0]:
+                    out[press, integ] = (wall, tr)
+    return out
+
+
+def press_cycle_rows(repeat: int = 3) -> list[dict]:
+    """The rows of :func:`press_cycle_table` with the ratios switched / fixed and
+    dop853 / scipy-dop853."""
+    res = press_cycle_table(repeat=repeat)
+    rows = []
+    for (press, integ), (wall, tr) in res.items():
+        rows.append({"name": f"press {press} {integ} wall per simulated s", "value": wall,
+                     "unit": "s/s", "note": f"{tr.status}, {len(tr.events)} events, "
+                     f"{tr.stats['steps']} steps, {tr.stats['evaluations']} evals"})
+    for integ in ("dop853", "scipy-dop853"):
+        rows.append({"name": f"press switched / fixed, {integ}",
+                     "value": res["switched", integ][0] / res["fixed", integ][0], "unit": "",
+                     "note": "issue 9: at most 3"})
+    for press in ("switched", "fixed"):
+        rows.append({"name": f"press {press}: dop853 / scipy-dop853",
+                     "value": res[press, "dop853"][0] / res[press, "scipy-dop853"][0],
+                     "unit": ""})
+    return rows
+
+
 def run(quick: bool = False) -> list[dict]:
     if not NUMBA:
         return [{"name": "compiled loop", "value": "skipped", "note": "numba not installed"}]
@@ -129,10 +175,12 @@ def run(quick: bool = False) -> list[dict]:
                              f"drift {r['drift']:.1e} J"})
         rows.append({"name": f"{head} kernel cost", "value": r["cost"] * 1e6, "unit": "us"})
         rows.append({"name": f"{head} wall/(evals x cost)", "value": r["ratio"], "unit": ""})
-    return rows
+    return rows + press_cycle_rows(repeat=1 if quick else 3)
 
 
 if __name__ == "__main__":
+    for r in press_cycle_rows():
+        print(f"{r['name']:44s} {r['value']:9.4g} {r['unit']:4s} {r.get('note', '')}")
     for r in table():
         print(f"{r['case']:38s} {r['integrator']:13s} wall {r['wall'] * 1e3:8.2f} ms  "
               f"evals {r['evals']:6d}  cost {r['cost'] * 1e6:6.2f} us  ratio {r['ratio']:5.2f}  "

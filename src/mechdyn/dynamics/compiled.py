@@ -36,7 +36,7 @@ from ..mechanism.mechanism import Mechanism
 from ..model import Model
 from ..model.rows import concat
 from ..model.variable import lower, parse
-from .compiled_loop import fast_forward, warm_up_loop
+from .compiled_loop import fast_forward, kept_steps, warm_up_loop
 from .forces import force_model
 
 __all__ = ["compile_mode_kernel", "CompiledKernel", "numba_available"]
@@ -154,6 +154,14 @@ class CompiledKernel:
         if len(ms.independent_rows) != ms.n_rows or y0.size != 2 * self.n_i + 1:
             return t, y0, callbacks["next_out"], False
         return fast_forward(self, integ, eqs, t, y0, t_end, **callbacks)
+
+    def kept_steps(self, integ, eqs, t, y0, t_end, stats):
+        """The steps of a segment with event functions from the compiled loop, or None
+        where it cannot run them (see :func:`mechdyn.dynamics.compiled_loop.kept_steps`)."""
+        ms = eqs.ms
+        if len(ms.independent_rows) != ms.n_rows or y0.size != 2 * self.n_i + 1:
+            return None
+        return kept_steps(self, integ, eqs, t, y0, t_end, stats)
 
     def first_order_function(self, on_failure):
         """A function ``fun(t, y) -> y'`` for y = (q_I, q_I', w) calling the kernel directly

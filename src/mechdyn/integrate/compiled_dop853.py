@@ -8,9 +8,13 @@ segment to the kernel's compiled loop (:mod:`mechdyn.kernels.dop853_numba`, driv
 :mod:`mechdyn.dynamics.compiled_loop`): every step, every stage, the position solves and
 the checks of the step run in machine code, and Python only records the output samples,
 looks at a flagged step (a coordinate rate changing sign, a nearly singular Jacobian)
-and reports a stop.  Everywhere else -- the NumPy path, variable-structure modes with
-their event functions, :func:`mechdyn.integrate.solve` -- it steps with SciPy's
-implementation of the same method (``"scipy-dop853"`` asks for that everywhere).
+and reports a stop.  A segment with event functions (every mode of a variable-structure
+run, a caller's events) takes its steps from the same compiled loop, each
+with its dense output of order 7 and under SciPy's step control (so that its events fall
+where ``"scipy-dop853"`` finds them): only the checks of each step, the event functions
+and their location on that dense output stay in Python.  Everywhere else -- the NumPy
+path, :func:`mechdyn.integrate.solve` -- it steps with SciPy's implementation of the
+same method (``"scipy-dop853"`` asks for that everywhere).
 
 Examples
 --------

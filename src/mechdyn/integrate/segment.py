@@ -182,6 +182,7 @@ def run_segment(integ, eqs, t: float, y0, t_end: float, efns: list[EventFunction
     n = (np.size(y0) - 1) // 2 if n is None else n
     y0 = np.asarray(y0, float)
     kernel = getattr(eqs, "kernel", None)
+    steps = None
     if getattr(integ, "compiled", False) and kernel is not None and not efns:
         # the compiled loop (mechdyn.dynamics.compiled_loop) as far as it can go
         t, y0, next_out, done = kernel.fast_forward(
@@ -189,8 +190,12 @@ def run_segment(integ, eqs, t: float, y0, t_end: float, efns: list[EventFunction
             next_out=next_out, every_step=every_step, stats=stats, bar=bar, deadline=deadline)
         if done:
             return None, next_out
-    steps = integ.integrate(eqs.rhs, t, y0[:n], y0[n:2 * n], t_end, w0=y0[2 * n:],
-                            first_order=eqs.first_order_function())
+    elif getattr(integ, "compiled", False) and kernel is not None:
+        # with event functions: the compiled loop's steps, each checked here
+        steps = kernel.kept_steps(integ, eqs, t, y0, t_end, stats)
+    if steps is None:
+        steps = integ.integrate(eqs.rhs, t, y0[:n], y0[n:2 * n], t_end, w0=y0[2 * n:],
+                                first_order=eqs.first_order_function())
     hit = None
     try:
         for step in steps:

@@ -38,6 +38,7 @@ __all__ = ["run", "evaluate_states", "dense_at", "DONE", "BATCH", "FLAGGED", "FA
            "P_HMAX", "P_STALL", "P_PIVOT", "P_WC0", "P_WC1", "P_LAST", "P_TOLD", "P_HOLD",
            "I_EVALS", "I_STEPS", "I_REJ", "I_NOUT", "I_NEXT", "I_FLAGS", "I_FSAL",
            "I_EVERY", "I_WATCH", "I_MAXSTEPS", "I_STATUS", "I_PREV", "I_WPEND", "P_WS",
+           "I_KEEP", "I_NKEPT", "I_CTRL",
            "N_PAR", "N_IPAR"]
 
 # return codes of run
@@ -52,10 +53,12 @@ P_T, P_TEND, P_H, P_RTOL, P_HMAX, P_STALL, P_PIVOT, P_WC0, P_WC1, P_LAST, P_TOLD
 N_PAR = 15
 # ipar: evaluations, accepted and rejected steps, samples in the buffers, next t_eval,
 # flags, f valid, every step sampled, watch on, steps per call, kernel status, history,
-# a watch due
+# a watch due, every step kept (with its dense output) in ``kept``, steps kept, SciPy's
+# step control (its starting step, step factors within [0.2, 10], a step accepted below an
+# error of 1, no stretch of the last step) instead of Hairer's
 I_EVALS, I_STEPS, I_REJ, I_NOUT, I_NEXT, I_FLAGS, I_FSAL, I_EVERY, I_WATCH, I_MAXSTEPS, \
-    I_STATUS, I_PREV, I_WPEND = range(13)
-N_IPAR = 13
+    I_STATUS, I_PREV, I_WPEND, I_KEEP, I_NKEPT, I_CTRL = range(16)
+N_IPAR = 16
 
 
 @njit
@@ -131,38 +134,91 @@ def _record(k, ts, y, ws, ext, nx, ni, o_t, o_y, o_x, o_xd, o_ext):
 
 
 @njit
-def _initial_guess(y, f, atol, rtol, hmax):
-    """Hairer's starting step for order 8, first part: ``(h, |f|^2)``."""
-    m = y.size
-    dnf = 0.0
+def _sizes2(y, f, atol, rtol):
+    """(|y|^2, |f|^2) in the error weights 1 / (atol_i + rtol |y_i|), for the starting
+    step."""
     dny = 0.0
-    for i in range(m):
+    dnf = 0.0
+    for i in range(y.size):
         sk = atol[i] + rtol * abs(y[i])
         dnf += (f[i] / sk) ** 2
         dny += (y[i] / sk) ** 2
+    return dny, dnf
+
+
+@njit
+def _initial_guess(y, f, atol, rtol, hmax):
+    """Hairer's starting step for order 8, first part: ``(h, |f|^2)``."""
+    dny, dnf = _sizes2(y, f, atol, rtol)
     h = 1e-6 if (dnf <= 1e-10 or dny <= 1e-10) else 0.01 * np.sqrt(dny / dnf)
     return min(h, hmax), dnf
 
 
 @njit
+def _change2(y, f, f1, atol, rtol):
+    """sum_i ((f1_i - f_i) / (atol_i + rtol |y_i|))^2, for the starting step."""
+    acc = 0.0
+    for i in range(y.size):
+        sk = atol[i] + rtol * abs(y[i])
+        acc += ((f1[i] - f[i]) / sk) ** 2
+    return acc
+
+
+@njit
 def _initial_step(y, f, f1, h, dnf, atol, rtol, hmax):
     """Hairer's starting step, second part, from f1 = f(t + h, y + h f)."""
-    m = y.size
-    der2 = 0.0
-    for i in range(m):
-        sk = atol[i] + rtol * abs(y[i])
-        der2 += ((f1[i] - f[i]) / sk) ** 2
-    der2 = np.sqrt(der2) / h
+    der2 = np.sqrt(_change2(y, f, f1, atol, rtol)) / h
     der12 = max(der2, np.sqrt(dnf))
     h1 = max(1e-6, h * 1e-3) if der12 <= 1e-15 else (0.01 / der12) ** (1.0 / 8.0)
     return min(100.0 * h, h1, hmax)
 
 
 @njit
+def _scipy_guess(y, f, atol, rtol, span):
+    """SciPy's starting step (``select_initial_step``), first part: ``(h0, d1)``, RMS
+    norms."""
+    d0, d1 = _sizes2(y, f, atol, rtol)
+    d0, d1 = np.sqrt(d0 / y.size), np.sqrt(d1 / y.size)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    return min(h0, span), d1
+
+
+@njit
+def _scipy_step(y, f, f1, h0, d1, atol, rtol, hmax, span):
+    """SciPy's starting step, second part, from f1 = f(t + h0, y + h0 f)."""
+    d2 = np.sqrt(_change2(y, f, f1, atol, rtol) / y.size) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    return min(100.0 * h0, h1, span, hmax)
+
+
+@njit
+def keep_step(row, t, h, t_new, y, ynew, fnew, dns):
+    """A step into a row of ``kept``: t, h, t_new, y, y_new, f_new (m each), the 7 m
+    coefficients of the dense output, then (written before the stages of the dense
+    output) the kernel's workspace after the evaluation at the step's end (pose,
+    analogs)."""
+    m = y.size
+    row[0], row[1], row[2] = t, h, t_new
+    row[3:3 + m] = y
+    row[3 + m:3 + 2 * m] = ynew
+    row[3 + 2 * m:3 + 3 * m] = fnew
+    o = 3 + 3 * m
+    for r in range(7):
+        row[o + r * m:o + (r + 1) * m] = dns[r]
+
+
+@njit
 def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_xd, o_ext,
-        ext, ext_end, x_end, ip, fp, ri, rf, dims, ws, sc, piv):
+        ext, ext_end, x_end, ip, fp, ri, rf, dims, ws, sc, piv, kept):
     """Integrate from ``par[P_T]`` (state ``y``, rates ``f`` when ``ipar[I_FSAL]``) towards
-    ``par[P_TEND]``; returns DONE, BATCH, FLAGGED or FAILED (see the module)."""
+    ``par[P_TEND]``; returns DONE, BATCH, FLAGGED or FAILED (see the module).
+
+    With ``ipar[I_KEEP]`` every accepted step is kept in row ``ipar[I_NKEPT]`` of ``kept``
+    (see :func:`keep_step`; at most ``ipar[I_MAXSTEPS]`` rows per call), with its dense
+    output, and no step is flagged for a rate changing sign (the caller checks each)."""
     ni = dims[D_NI]
     nx = x_end.size // 3
     m = y.size
@@ -180,12 +236,19 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
             return FAILED
         ipar[I_FSAL] = 1
     h = par[P_H]
+    scipy_ctrl = ipar[I_CTRL] != 0
     if not h > 0.0:
-        h, dnf = _initial_guess(y, f, atol, rtol, hmax)
+        if scipy_ctrl:
+            h, dnf = _scipy_guess(y, f, atol, rtol, t_end - t)
+        else:
+            h, dnf = _initial_guess(y, f, atol, rtol, hmax)
         for i in range(m):
             K[1, i] = y[i] + h * f[i]
         if _counted(t + h, K[1], K[2], ni, ip, fp, ri, rf, dims, ws, ext, off, sc, piv, ipar):
-            h = _initial_step(y, f, K[2], h, dnf, atol, rtol, hmax)
+            if scipy_ctrl:
+                h = _scipy_step(y, f, K[2], h, dnf, atol, rtol, hmax, t_end - t)
+            else:
+                h = _initial_step(y, f, K[2], h, dnf, atol, rtol, hmax)
     rejected = False
     steps = 0
     ipar[I_FLAGS] = 0
@@ -198,7 +261,7 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
             return BATCH
         hmin = 10.0 * abs(np.nextafter(t, np.inf) - t)
         h = min(max(h, hmin), hmax)
-        last = t + 1.01 * h >= t_end
+        last = t + (1.0 if scipy_ctrl else 1.01) * h >= t_end
         if last:
             h = t_end - t
         # room in the buffers for the samples this step can give
@@ -241,10 +304,13 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
         if not err == err:
             err = np.inf
         fac11 = err ** (0.125 - 0.2 * par[P_BETA])
-        if err > 1.0:  # rejected
+        if err > 1.0 or (scipy_ctrl and err == 1.0):  # rejected
             ipar[I_REJ] += 1
             rejected = True
-            h = h / min(3.0, fac11 / 0.9)
+            if scipy_ctrl:
+                h = h * max(0.2, 0.9 * err ** -0.125)
+            else:
+                h = h / min(3.0, fac11 / 0.9)
             if h < hmin:
                 par[P_T], par[P_H] = t, h
                 ipar[I_STATUS] = -1
@@ -269,12 +335,14 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
         par[P_ERROLD] = max(err, 1e-4)
         fac = max(1.0 / 6.0, min(3.0, fac / 0.9))
         h_next = h / fac
+        if scipy_ctrl:
+            h_next = h * (10.0 if err == 0.0 else min(10.0, 0.9 * err ** -0.125))
         if rejected:
             h_next = min(h_next, h)
         rejected = False
         # what Python must look at
         flags = 0
-        for c in range(ni):
+        for c in range(ni if ipar[I_KEEP] == 0 else 0):
             if (y[ni + c] > 0.0 and ynew[ni + c] < 0.0) or (y[ni + c] < 0.0
                                                            and ynew[ni + c] > 0.0):
                 flags |= F_TURN
@@ -296,7 +364,9 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
         hist[2, m + 1:] = fnew
         par[P_TOLD], par[P_HOLD] = t, h
         interior = ipar[I_NEXT] < n_te and t_eval[ipar[I_NEXT]] < t_new
-        if flags != 0 or interior:
+        if ipar[I_KEEP] != 0:
+            kept[ipar[I_NKEPT], kept.shape[1] - ws.size:] = ws
+        if flags != 0 or interior or ipar[I_KEEP] != 0:
             for s in range(N_STAGES + 1, N_STAGES + 4):  # the stages of the dense output
                 _stage(y, K, s, h, ys)
                 if not _counted(t + C[s] * h, ys, K[s], ni, ip, fp, ri, rf, dims, ws, ext, off,
@@ -304,6 +374,9 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
                     par[P_T], par[P_H] = t, h
                     return FAILED
             _dense(y, ynew, f, fnew, K, h, dns)
+        if ipar[I_KEEP] != 0:
+            keep_step(kept[ipar[I_NKEPT]], t, h, t_new, y, ynew, fnew, dns)
+            ipar[I_NKEPT] += 1
         if flags != 0:
             ipar[I_FLAGS] = flags
             for i in range(m):
