@@ -109,7 +109,9 @@ def test_the_kernel_cache_is_the_users_cache_folder_unless_set(tmp_path):
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           env={**env, "PYTHONPATH": SRC}, check=True, timeout=120)
-    expected = user_cache_dir("mechdyn", appauthor=False)
+    kernels = importlib.import_module("mechdyn.kernels")
+    expected = os.path.join(user_cache_dir("mechdyn", appauthor=False),
+                            f"kernels-{kernels.sources_digest()}")
     assert done.stdout.split() == [expected, expected]
     assert _python(code, NUMBA_CACHE_DIR=str(tmp_path)).split() == [str(tmp_path)] * 2
 

@@ -4,20 +4,42 @@ packed loads and the small dense linear algebra of the compiled kernels.
 The Numba kernels are compiled once per machine and kept in the user's cache folder
 (:func:`cache_dir`, ``platformdirs.user_cache_dir("mechdyn")``, e.g.
 ``~/.cache/mechdyn`` on Linux) rather than next to the installed sources, which may be
-read-only.  A ``NUMBA_CACHE_DIR`` the user has set is respected.
+read-only, in a subfolder named after a digest of the kernels' sources: Numba checks a
+cached function against its own file only, so a kernel that inlines a changed helper of
+another file (the linear algebra, the rows) would otherwise keep the old code.  A
+``NUMBA_CACHE_DIR`` the user has set is respected.
 """
 
 from __future__ import annotations
 
+import hashlib
 import os
 import sys
+from pathlib import Path
 
-__all__ = ["cache_dir"]
+__all__ = ["cache_dir", "sources_digest"]
+
+
+def sources_digest() -> str:
+    """A short digest (12 hex digits) of the sources of the kernels (this package's
+    ``*.py`` files): the name of the cache subfolder their compiled code is valid for.
+
+    Examples
+    --------
+    >>> d = sources_digest()
+    >>> len(d), d == sources_digest()
+    (12, True)
+    """
+    h = hashlib.sha1()
+    for f in sorted(Path(__file__).parent.glob("*.py")):
+        h.update(f.name.encode() + b"\0" + f.read_bytes())
+    return h.hexdigest()[:12]
 
 
 def cache_dir() -> str:
     """The folder the compiled kernels are cached in: ``NUMBA_CACHE_DIR`` when set (by
-    the user, or by this package on import), else the user's cache folder for mechdyn.
+    the user, or by this package on import), else ``kernels-<digest>`` in the user's cache
+    folder for mechdyn (:func:`sources_digest`).
 
     Examples
     --------
@@ -30,7 +52,8 @@ def cache_dir() -> str:
         return chosen
     from platformdirs import user_cache_dir
 
-    return user_cache_dir("mechdyn", appauthor=False)
+    return os.path.join(user_cache_dir("mechdyn", appauthor=False),
+                        f"kernels-{sources_digest()}")
 
 
 def _use_cache_dir() -> None:
