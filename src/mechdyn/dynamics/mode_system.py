@@ -144,10 +144,27 @@ class ModeSystem:
         self.element_rows = lay.element_rows
         self._slip = lay.friction if len(lay.slip_rows) else None
         self.x_ref = np.array(x, float)
-        Rs = _scaled(model, self.row_jacobian(self.x_ref), self.rowset.is_angle)
-        self.independent_rows = _independent_rows(Rs)
+        # the rows and coordinates chosen at a pose: a pure function of (mode, held values,
+        # pose, prefer, avoid), kept for the instant (an event builds the same mode at the
+        # same pose several times: impact, complementarity, the new segment), in model.memo
+        # (those of the last pose only)
+        held = held_key(self.targets)
+        key = None if held is None else (self.mode, held, tuple(prefer), tuple(avoid))
+        pose = self.x_ref.tobytes()
+        at = model.memo.get("mode coordinates")
+        if at is None or at[0] != pose:
+            at = model.memo["mode coordinates"] = (pose, {})
+        got = at[1].get(key) if key is not None else None
+        if got is None:
+            Rs = _scaled(model, self.row_jacobian(self.x_ref), self.rowset.is_angle)
+            self.independent_rows = _independent_rows(Rs)
+            self.dof = model.n_x - len(self.independent_rows)
+            got = (self.independent_rows,
+                   self._choose_coordinates(Rs[self.independent_rows], prefer, avoid))
+            if key is not None:
+                at[1][key] = got
+        self.independent_rows, self.coords = got[0].copy(), got[1].copy()
         self.dof = model.n_x - len(self.independent_rows)
-        self.coords = self._choose_coordinates(Rs[self.independent_rows], prefer, avoid)
         self.coord_names = tuple(model.coordinate_names[k] for k in self.coords)
         self.n_i = len(self.coords)
         # every row and every coordinate, evaluated at once; the position problem
