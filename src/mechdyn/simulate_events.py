@@ -397,8 +397,8 @@ def _budget(step, ev, ms, stats, span, min_step, max_steps, fixed_step) -> None:
         nearly singular position, ``"singular-position"``.
     """
     h = step.t - step.t_old
-    where = f"at t = {step.t:.9g} s"
     if not fixed_step and 0 < h < STALL * span:
+        where = f"at t = {step.t:.9g} s"
         rep = ms.singularity(ev.x)
         if rep["rcond"] < APPROACH_RCOND:
             raise Stop(Status.SINGULAR_POSITION, (
