@@ -219,6 +219,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
 
     qi, qdi = ms.independent(x, xd)
     just_fired: set = set()
+    after_event = False
     good = None  # (t, ModeEval) of the last accepted step: where a failed run was well
     next_out = 0
     fired_once: set = set()
@@ -256,9 +257,10 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             ev0 = evaluate(t, y0)
             # the start of the run is an output sample with every_step (else when it is
             # one of t_eval); each segment after an event starts with one
-            if (every_step or stats["segments"] > 1 or t >= t_end) and (
+            if after_event or (every_step or stats["segments"] > 1 or t >= t_end) and (
                     rec.last is None or rec.last[0] != t or rec.last[1].mode != ms.mode):
                 store(t, ms, ev0, w)
+            after_event = False
             good = (t, ev0, ms)
             if t >= t_end:
                 break
@@ -347,8 +349,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             ms = ms_new
             t = t_hit
             qi, qdi = ms.independent(x, xd)
-            ev_after = ms.evaluate_x(t, x, xd)
-            store(t, ms, ev_after, w)
+            after_event = True  # the state after it: the first sample of the next segment
         except Stop as exc:
             status, message = exc.status, exc.message
             break
@@ -365,6 +366,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
             break
         finally:
             stats["bifurcations"] += eqs.report()
+    if after_event:  # the run ended before the next segment stored the state after it
+        store(t, ms, ms.evaluate_x(t, x, xd), w)
     stats["backend"] = "numba" if backends == {"numba"} else (
         "numpy" if backends <= {"numpy"} else "numba+numpy")
     bar.close()
@@ -394,8 +397,8 @@ def _budget(step, ev, ms, stats, span, min_step, max_steps, fixed_step) -> None:
         nearly singular position, ``"singular-position"``.
     """
     h = step.t - step.t_old
-    where = f"at t = {step.t:.9g} s"
     if not fixed_step and 0 < h < STALL * span:
+        where = f"at t = {step.t:.9g} s"
         rep = ms.singularity(ev.x)
         if rep["rcond"] < APPROACH_RCOND:
             raise Stop(Status.SINGULAR_POSITION, (

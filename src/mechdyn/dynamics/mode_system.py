@@ -144,10 +144,28 @@ class ModeSystem:
         self.element_rows = lay.element_rows
         self._slip = lay.friction if len(lay.slip_rows) else None
         self.x_ref = np.array(x, float)
-        Rs = _scaled(model, self.row_jacobian(self.x_ref), self.rowset.is_angle)
-        self.independent_rows = _independent_rows(Rs)
+        # the rows and coordinates chosen at a pose: a pure function of (mode, held values,
+        # pose) and (prefer, avoid), kept for the instant (an event builds the same mode at
+        # the same pose several times: impact, complementarity, the new segment), in
+        # model.memo (those of the last pose only)
+        held = held_key(self.targets)
+        pose = self.x_ref.tobytes()
+        at = model.memo.get("mode coordinates")
+        if at is None or at[0] != pose:
+            at = model.memo["mode coordinates"] = (pose, {})
+        kept = at[1].get((self.mode, held)) if held is not None else None
+        if kept is None:
+            Rs = _scaled(model, self.row_jacobian(self.x_ref), self.rowset.is_angle)
+            rows_i = _independent_rows(Rs)
+            kept = {"rows": rows_i, "GN": self._coordinates_on_null_space(Rs[rows_i])}
+            if held is not None:
+                at[1][self.mode, held] = kept
+        self.independent_rows = kept["rows"].copy()
         self.dof = model.n_x - len(self.independent_rows)
-        self.coords = self._choose_coordinates(Rs[self.independent_rows], prefer, avoid)
+        choice = (tuple(prefer), tuple(avoid))
+        if choice not in kept:
+            kept[choice] = self._choose_coordinates(kept["GN"], prefer, avoid)
+        self.coords = kept[choice].copy()
         self.coord_names = tuple(model.coordinate_names[k] for k in self.coords)
         self.n_i = len(self.coords)
         # every row and every coordinate, evaluated at once; the position problem
@@ -162,15 +180,22 @@ class ModeSystem:
         #: the friction of the joints in this mode (None for a model without it)
         self.friction = JointFriction(self) if friction_joints(model) else None
 
-    def _choose_coordinates(self, Ri, prefer, avoid) -> np.ndarray:
-        """Pivots of G N (G the scaled coordinate Jacobian, N the null space of the
-        scaled independent rows ``Ri``), weighted by ``prefer`` and ``avoid``."""
+    def _coordinates_on_null_space(self, Ri) -> np.ndarray | None:
+        """G N (n_q, dof): G the scaled coordinate Jacobian, N the null space of the scaled
+        independent rows ``Ri`` (None without freedom)."""
+        model = self.model
+        if model.n_x == Ri.shape[0]:
+            return None
+        Gs = _scaled(model, self._coord_jac(self.x_ref), model.coord_is_angle)
+        N = np.linalg.svd(Ri)[2][Ri.shape[0]:].T if Ri.shape[0] else np.eye(model.n_x)
+        return Gs @ N
+
+    def _choose_coordinates(self, GN, prefer, avoid) -> np.ndarray:
+        """Pivots of G N (:meth:`_coordinates_on_null_space`), weighted by ``prefer`` and
+        ``avoid``."""
         model = self.model
         if self.dof == 0:
             return np.zeros(0, int)
-        Gs = _scaled(model, self._coord_jac(self.x_ref), model.coord_is_angle)
-        N = np.linalg.svd(Ri)[2][Ri.shape[0]:].T if Ri.shape[0] else np.eye(model.n_x)
-        GN = Gs @ N  # (n_q, dof)
         names = model.coordinate_names
         w = np.ones(model.n_q)
         for k, n in enumerate(names):

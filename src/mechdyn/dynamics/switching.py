@@ -19,11 +19,14 @@ import numpy as np
 from ..errors import AssemblyError
 from ..integrate.events import EventRecord
 from ..integrate.segment import EventFunction
+from ..kernels import rows_numpy
+from ..model.rows import concat
 from .contact import gap_measures, resolve_mode, touching
 from .impact import impact
 from .joint_friction import joint_states, resolve_joints, state_tokens, stick_slip_joints
 from .mode_system import held_key
 from .modes import (
+    Measure,
     ModeSystem,
     SwitchedModel,
     TimeMeasure,
@@ -42,6 +45,32 @@ def _value(meas, t, x, xd):
     return meas.value(x, xd)
 
 
+class _PoseValues:
+    """The values m(x) of the one-row measures a mode's event functions read (gaps, switch
+    variables of the pose), all rows evaluated together once per evaluation ``ev``: at a
+    step end every gap and switch function reads the same ``ev`` (m or rad)."""
+
+    def __init__(self, nb: int, measures):
+        self.index: dict[int, int] = {}
+        rows = []
+        for m in measures:
+            if type(m) is Measure and id(m) not in self.index:
+                self.index[id(m)] = len(rows)
+                rows.append(m.rows)
+        self.rows = concat(nb, *rows)
+        self._ev, self._vals = None, None
+
+    def value(self, m, ev) -> float:
+        """m(ev.x) of a measure of the batch (else from the measure itself)."""
+        k = self.index.get(id(m))
+        if k is None:
+            return m.value(ev.x)
+        if ev is not self._ev:
+            self._vals = rows_numpy.values(self.rows, ev.x)
+            self._ev = ev
+        return float(self._vals[k])
+
+
 def _row(ms: ModeSystem, element: str, kind: str) -> int:
     """Index into the mode's rowset of the row of ``kind`` of a contact."""
     return next(ms.n_base + k for k, r in enumerate(ms.rows)
@@ -52,6 +81,9 @@ def event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_scal
                      L) -> list[EventFunction]:
     out: list[EventFunction] = []
     locks = mode_locks(ms.mode)
+    gap_list = list(gap_measures(sm))
+    pv = _PoseValues(sm.nb, [m for _, m, _, _ in gap_list]
+                     + [m for _, m, _ in sm.switches if m is not None])
     for sw, meas, _guards in sm.switches:
         if sw.name in fired_once:
             continue
@@ -69,16 +101,18 @@ def event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_scal
         for d in ((1, -1) if sw.direction == 0 else (sw.direction,)):
             # rising (d > 0) fires when value - v crosses zero upwards: watched as v - value
             def fn(tt, ev, m=meas, v=sw.value, d=d):
+                if id(m) in pv.index:
+                    return d * (v - pv.value(m, ev))
                 return d * (v - _value(m, tt, ev.x, ev.xdot))
             out.append(EventFunction("switch", sw.name, fn, np.inf, (sw, d),
                                      arm=1e-11 * (abs(sw.value) + scale)))
     closed = set(mode_unilateral(ms.mode))
     # open stops and contacts: gaps
-    for tok, meas, sgn, lim in gap_measures(sm):
+    for tok, meas, sgn, lim in gap_list:
         if tok not in closed:
             tol = gap_tol / L if meas.is_angle else gap_tol
             out.append(EventFunction("gap", tok, lambda tt, ev, m=meas, lim=lim, s=sgn:
-                                     s * (m.value(ev.x) - lim), tol, arm=1e-3 * tol))
+                                     s * (pv.value(m, ev) - lim), tol, arm=1e-3 * tol))
     # closed ones: forces; the friction cone of sticking contacts, the slip of slipping ones
     for k, r in enumerate(ms.rows):
         if r.unilateral:
