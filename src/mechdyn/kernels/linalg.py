@@ -16,7 +16,7 @@ __all__ = ["lu_factor", "lu_factor_solve", "lu_solve", "lu_solve_transposed", "c
 @njit
 def lu_factor(a, piv, n):
     """In-place LU with partial pivoting; returns min|u_ii| / max|u_ii| (0 if singular)."""
-    return _factor(a, piv, n, None)
+    return _factor(a, piv, n, a[0], False)
 
 
 @njit
@@ -24,17 +24,16 @@ def lu_factor_solve(a, piv, b, n):
     """:func:`lu_factor` of a and, in the same pass, the solution of a y = b (b
     overwritten by y, unless singular: then b is left partly eliminated).  Returns the
     pivot ratio of :func:`lu_factor` (0 if singular); y equals :func:`lu_solve`'s."""
-    rc = _factor(a, piv, n, b)
+    rc = _factor(a, piv, n, b, True)
     if rc != 0.0:
         _back(a, b, n)
     return rc
 
 
 @njit
-def _factor(a, piv, n, b):
-    """The elimination of :func:`lu_factor`, applied to b as well unless b is None (its
-    swaps and forward substitution, in the order of :func:`lu_solve`; numba compiles
-    the None case without them)."""
+def _factor(a, piv, n, b, with_b):
+    """The elimination of :func:`lu_factor`, applied to b as well if ``with_b`` (its
+    swaps and forward substitution, in the order of :func:`lu_solve`)."""
     umin = np.inf
     umax = 0.0
     for k in range(n):
@@ -51,7 +50,7 @@ def _factor(a, piv, n, b):
                 tmp = a[k, c]
                 a[k, c] = a[p, c]
                 a[p, c] = tmp
-            if b is not None:
+            if with_b:
                 tmp = b[k]
                 b[k] = b[p]
                 b[p] = tmp
@@ -63,7 +62,7 @@ def _factor(a, piv, n, b):
         if d == 0.0:
             return 0.0
         inv = 1.0 / d
-        bk = b[k] if b is not None else 0.0
+        bk = b[k] if with_b else 0.0
         for r in range(k + 1, n):
             f = a[r, k] * inv
             a[r, k] = f
@@ -82,7 +81,7 @@ def _back(a, b, n):
     """Solve U y = b with the upper factor of :func:`lu_factor` (b overwritten), column
     by column: the updates of one column are independent (not one chain of sums)."""
     for c in range(n - 1, -1, -1):
-        bc = b[c] * (1.0 / a[c, c])
+        bc = b[c] / a[c, c]
         b[c] = bc
         if bc != 0.0:
             for r in range(c):
@@ -165,7 +164,7 @@ def lu_solve_transposed(a, piv, b, n):
     # P A = L U, so A^T = U^T L^T P: solve U^T y = b, L^T u = y, then z = P^T u; both by
     # columns of the transposes, i.e. along the rows of a (contiguous)
     for c in range(n):
-        bc = b[c] * (1.0 / a[c, c])
+        bc = b[c] / a[c, c]
         b[c] = bc
         if bc != 0.0:
             for r in range(c + 1, n):
