@@ -10,30 +10,12 @@ import numpy as np
 
 from .rows_numba import njit
 
-__all__ = ["lu_factor", "lu_factor_solve", "lu_solve", "lu_solve_transposed", "cholesky_solve"]
+__all__ = ["lu_factor", "lu_solve", "lu_solve_transposed", "cholesky_solve"]
 
 
 @njit
 def lu_factor(a, piv, n):
     """In-place LU with partial pivoting; returns min|u_ii| / max|u_ii| (0 if singular)."""
-    return _factor(a, piv, n, a[0], False)
-
-
-@njit
-def lu_factor_solve(a, piv, b, n):
-    """:func:`lu_factor` of a and, in the same pass, the solution of a y = b (b
-    overwritten by y, unless singular: then b is left partly eliminated).  Returns the
-    pivot ratio of :func:`lu_factor` (0 if singular); y equals :func:`lu_solve`'s."""
-    rc = _factor(a, piv, n, b, True)
-    if rc != 0.0:
-        _back(a, b, n)
-    return rc
-
-
-@njit
-def _factor(a, piv, n, b, with_b):
-    """The elimination of :func:`lu_factor`, applied to b as well if ``with_b`` (its
-    swaps and forward substitution, in the order of :func:`lu_solve`)."""
     umin = np.inf
     umax = 0.0
     for k in range(n):
@@ -50,10 +32,6 @@ def _factor(a, piv, n, b, with_b):
                 tmp = a[k, c]
                 a[k, c] = a[p, c]
                 a[p, c] = tmp
-            if with_b:
-                tmp = b[k]
-                b[k] = b[p]
-                b[p] = tmp
         d = a[k, k]
         if best < umin:
             umin = best
@@ -62,30 +40,15 @@ def _factor(a, piv, n, b, with_b):
         if d == 0.0:
             return 0.0
         inv = 1.0 / d
-        bk = b[k] if with_b else 0.0
         for r in range(k + 1, n):
             f = a[r, k] * inv
             a[r, k] = f
             if f != 0.0:
                 for c in range(k + 1, n):
                     a[r, c] -= f * a[k, c]
-                if bk != 0.0:
-                    b[r] -= f * bk
     if umax == 0.0:
         return 0.0
     return umin / umax
-
-
-@njit
-def _back(a, b, n):
-    """Solve U y = b with the upper factor of :func:`lu_factor` (b overwritten), column
-    by column: the updates of one column are independent (not one chain of sums)."""
-    for c in range(n - 1, -1, -1):
-        bc = b[c] / a[c, c]
-        b[c] = bc
-        if bc != 0.0:
-            for r in range(c):
-                b[r] -= a[r, c] * bc
 
 
 @njit
@@ -124,12 +87,8 @@ def _swap(b, piv, n, reverse):
 def lu_solve(a, piv, b, n):
     """Solve with the factors of ``lu_factor`` (b overwritten)."""
     _swap(b, piv, n, False)
-    for c in range(n - 1):  # L y = b, unit diagonal, column by column
-        bc = b[c]
-        if bc != 0.0:
-            for r in range(c + 1, n):
-                b[r] -= a[r, c] * bc
-    _back(a, b, n)
+    _forward(a, b, n, True)
+    _backward(a, b, n, False)
 
 
 @njit
@@ -161,17 +120,7 @@ def cholesky_solve(A, rhs, n):
 @njit
 def lu_solve_transposed(a, piv, b, n):
     """Solve A^T z = b with the factors of ``lu_factor`` of A (b overwritten by z)."""
-    # P A = L U, so A^T = U^T L^T P: solve U^T y = b, L^T u = y, then z = P^T u; both by
-    # columns of the transposes, i.e. along the rows of a (contiguous)
-    for c in range(n):
-        bc = b[c] / a[c, c]
-        b[c] = bc
-        if bc != 0.0:
-            for r in range(c + 1, n):
-                b[r] -= a[c, r] * bc
-    for c in range(n - 1, 0, -1):
-        bc = b[c]
-        if bc != 0.0:
-            for r in range(c):
-                b[r] -= a[c, r] * bc
+    # P A = L U, so A^T = U^T L^T P: solve U^T y = b, L^T u = y, then z = P^T u
+    _forward(a.T, b, n, False)
+    _backward(a.T, b, n, True)
     _swap(b, piv, n, True)

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .linalg import lu_factor_solve, lu_solve, lu_solve_transposed
+from .linalg import lu_factor, lu_solve, lu_solve_transposed
 from .rows_numba import body_rotations, njit, rows_jacobian_cs, rows_quad_cs, rows_values_cs
 
 __all__ = ["path_variants", "inverse_variants", "loads_variants", "body_loads_variants",
@@ -63,17 +63,14 @@ def _at_solution(x, qdot, qddot, nb, ints, flts, n_rows, cs, J, fresh, lu, piv, 
         J[:, :] = 0.0
         rows_jacobian_cs(x, nb, ints, flts, cs, J, 0)
     lu[:, :] = J
-    b[:] = 0.0
-    b[n_rows] = 1.0
-    rc = lu_factor_solve(lu, piv, b, n)  # the factors and the first tangent
+    rc = lu_factor(lu, piv, n)
     if rc == 0.0:
         return rc
     xd[:] = 0.0
     for c in range(qdot.shape[0]):
-        if c > 0:
-            b[:] = 0.0
-            b[n_rows + c] = 1.0
-            lu_solve(lu, piv, b, n)
+        b[:] = 0.0
+        b[n_rows + c] = 1.0
+        lu_solve(lu, piv, b, n)
         for i in range(n):
             T[i, c] = b[i]
             xd[i] += b[i] * qdot[c]
@@ -197,9 +194,10 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
                     Jw[:, :] = 0.0
                     rows_jacobian_cs(x, nb, ints, flts[v], cs, Jw, 0)
                 lu[:, :] = Jw
-                b[:] = F
-                if lu_factor_solve(lu, pv, b, n) == 0.0:
+                if lu_factor(lu, pv, n) == 0.0:
                     break
+                b[:] = F
+                lu_solve(lu, pv, b, n)
                 step = 0.0
                 for i in range(n):
                     x[i] -= b[i]
