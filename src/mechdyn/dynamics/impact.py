@@ -53,8 +53,8 @@ import numpy as np
 from ..kernels import rows_numpy
 from ..model.variable import parse_variable
 from .contact import constrained_inverse, row_terms, solve_frictional_impact, solve_lcp
+from .friction import friction_joints
 from .friction_ignored import FrictionIgnoredWarning
-from .joint_friction import friction_joints
 from .modes import ModeSystem, Row, SwitchedModel, mass_matrix_x
 from .reactions import element_forces, frame_forces
 

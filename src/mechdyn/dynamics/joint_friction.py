@@ -44,8 +44,9 @@ from ..errors import LockupError
 from ..kernels import rows_numpy as RN
 from ..model.state import Mode
 from ..model.variable import parse_variable
+from .friction import friction_joints
 
-__all__ = ["SelfLockingError", "friction_joints", "stick_slip_joints", "joint_states", "split_mode",
+__all__ = ["SelfLockingError", "stick_slip_joints", "joint_states", "split_mode",
            "stick_row", "capture_stick", "JointFriction", "STATES", "MAX_ITER",
            "state_tokens", "resolve_joints"]
 
@@ -59,16 +60,6 @@ class SelfLockingError(LockupError):
 STATES = ("stick", "slip+", "slip-")
 #: Newton iterations on the multipliers before the solve is declared failed
 MAX_ITER = 30
-
-
-def friction_joints(model) -> tuple:
-    """The revolute and prismatic joints of a model with friction (Coulomb or viscous),
-    memoized (:func:`mechdyn.dynamics.friction.friction_joints`)."""
-    memo = model.memo.get("friction_joints")
-    if memo is None:
-        from .friction import friction_joints as joints
-        memo = model.memo["friction_joints"] = joints(model)
-    return memo
 
 
 def stick_slip_joints(model) -> tuple:

@@ -59,6 +59,7 @@ from ..kernels.rows_variants import (
     path_variants,
 )
 from ..kinematics.sweep import DEFAULT_MAX_STEP
+from ..mechanism.joint import has_friction
 from ..model import Model
 from ..results.kinetostatics_record import Kinetostatics
 from .analyses import KinetostaticExtremes, Outcome, extremes
@@ -85,8 +86,7 @@ _WARM = {"done": False}
 
 def _friction(model) -> bool:
     """True if a joint of the model has friction (not in the batched solve)."""
-    return any(getattr(j, f, 0.0) for j in model.mechanism.joints.values()
-               for f in ("friction", "viscous"))
+    return any(map(has_friction, model.mechanism.joints.values()))
 
 
 def batched(analysis) -> bool:
