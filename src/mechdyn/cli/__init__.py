@@ -16,11 +16,13 @@ import os
 import re
 import signal
 import sys
+import warnings
 from pathlib import Path
 
 from .._version import __version__
 
-__all__ = ["main", "SUBCOMMANDS", "SUBCOMMAND_MODULES", "check_outputs", "PLOT_SUFFIXES"]
+__all__ = ["main", "SUBCOMMANDS", "SUBCOMMAND_MODULES", "check_outputs", "PLOT_SUFFIXES",
+           "warning_printer"]
 
 #: the subcommands, in the order of ``mechdyn --help``, each with the help line its module
 #: registers (a test keeps the two the same)
@@ -138,6 +140,54 @@ def check_outputs(args) -> None:
                              f"a read-only file system)")
 
 
+#: the folder of the mechdyn package: a warning raised from a file in it is mechdyn's
+_PACKAGE = str(Path(__file__).resolve().parent.parent)
+
+
+def warning_printer(command: str, fallback=None):
+    """A :func:`warnings.showwarning` that prints mechdyn's warnings as one line on stderr,
+    ``mechdyn COMMAND: warning: MESSAGE``, as the command line's other warnings.
+
+    Parameters
+    ----------
+    command : str
+        The subcommand, for the prefix.
+    fallback : callable, optional
+        Shows the warnings of other packages (NumPy, Matplotlib ...); default
+        :func:`warnings.showwarning` as it is when this is called.
+
+    Returns
+    -------
+    callable
+        ``show(message, category, filename, lineno, file=None, line=None)``: a mechdyn
+        warning (its class or the file that raised it in the package) goes to
+        ``file`` (default ``sys.stderr``) without Python's ``file:line: Category:``
+        prefix, on one line; any other to ``fallback``.
+
+    Examples
+    --------
+    >>> import io
+    >>> out = io.StringIO()
+    >>> show = warning_printer("reduce")
+    >>> show(UserWarning("joint 'A' has friction"), UserWarning,
+    ...      _PACKAGE + "/dynamics/x.py", 1, file=out)
+    >>> print(out.getvalue(), end="")
+    mechdyn reduce: warning: joint 'A' has friction
+    """
+    fallback = warnings.showwarning if fallback is None else fallback
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        ours = (getattr(category, "__module__", "").startswith("mechdyn")
+                or str(Path(filename).resolve()).startswith(_PACKAGE))
+        if not ours:
+            return fallback(message, category, filename, lineno, file, line)
+        text = " ".join(str(message).split())
+        print(f"mechdyn {command}: warning: {text}", file=sys.stderr if file is None else file)
+        return None
+
+    return show
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code (0 ok, 1 analysis stopped, 2 bad input,
     130 interrupted by Ctrl-C, 143 by SIGTERM; an interrupted run writes its data)."""
@@ -162,7 +212,9 @@ def main(argv: list[str] | None = None) -> int:
         previous = None
     try:
         check_outputs(args)
-        code = int(args.func(args) or 0)
+        with warnings.catch_warnings():  # mechdyn's warnings as the CLI's one-line form
+            warnings.showwarning = warning_printer(args.command)
+            code = int(args.func(args) or 0)
         return 143 if terminated and code == 130 else code
     except (MechdynError, FileNotFoundError, IsADirectoryError, PermissionError) as exc:
         print(f"mechdyn {args.command}: error: {exc}", file=sys.stderr)
