@@ -93,6 +93,17 @@ def batched(analysis) -> bool:
     """Whether a study analyses variants with this analysis as one batch (when they
     allow it: :func:`batch_reason`).
 
+    Parameters
+    ----------
+    analysis : object
+        A study analysis (:mod:`mechdyn.study.analyses`).
+
+    Returns
+    -------
+    bool
+        True for a :class:`~mechdyn.study.analyses.KinetostaticExtremes` (exactly that
+        type), the one analysis with a batched path.
+
     Examples
     --------
     >>> batched(KinetostaticExtremes("1000 rpm")), batched(len)
@@ -108,6 +119,18 @@ def batch_reason(analysis, models) -> str | None:
     variants with the bodies, joints, coordinates, loads and constraint rows of the
     first one, no switchable elements, no extension loads and no joint friction, and as
     many driven (or held) coordinates as coordinates.
+
+    Parameters
+    ----------
+    analysis : object
+        A study analysis (:func:`batched` decides first).
+    models : sequence of Model
+        The compiled variants.
+
+    Returns
+    -------
+    str or None
+        The first reason found, a sentence, or None when the batch can take them.
 
     Examples
     --------
@@ -171,6 +194,16 @@ class Variants:
     models : list of Model or None
         The compiled variants, whose loads are evaluated one by one; None: no loads but
         the weights under the base's gravity and the drives of the driven coordinates.
+
+    Examples
+    --------
+    Two copies of the bundled slider-crank (three moving bodies: crank, rod, slider):
+
+    >>> from mechdyn.study.parameters import BaseModel
+    >>> m = BaseModel("slider_crank").compile({})
+    >>> v = Variants.of_models([m, m])
+    >>> len(v), v.mass.shape, v.com.shape, len(v.take(slice(0, 1)))
+    (2, (2, 3), (2, 3, 2), 1)
     """
 
     base: Model

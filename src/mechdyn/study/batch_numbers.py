@@ -44,8 +44,23 @@ def affine_variants(task, values, attempt) -> Variants | None:
     loads besides gravity, a body without a sketch pose or assembly modes, or the
     reference variant (the one nearest the middle of the box) does not compile.
 
-    ``attempt(values)`` compiles one variant: its Model, or the (status, message) of its
-    failure (:func:`~mechdyn.study.evaluate.attempt`).
+    Parameters
+    ----------
+    task : Task
+        The study's task (:class:`~mechdyn.study.evaluate.Task`): its parameters and
+        analysis.
+    values : array_like, shape (V, d)
+        The parameter values of the V variants, SI (m, kg, kg m^2, rad ...).
+    attempt : callable
+        ``attempt(values)`` compiles one variant (values shape (d,)): its Model, or the
+        (status, message) of its failure (:func:`~mechdyn.study.evaluate.attempt`).
+
+    Returns
+    -------
+    Variants or None
+        The stacked numbers of the V variants, from 2 + d' probes (d' the parameters
+        that vary, at most :data:`MAX_CORNER_PARAMETERS`) plus the corners of the box,
+        not one compilation per variant; ``length_scale`` the smallest of the probes'.
 
     Examples
     --------
