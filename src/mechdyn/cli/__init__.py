@@ -22,7 +22,7 @@ from pathlib import Path
 from .._version import __version__
 
 __all__ = ["main", "SUBCOMMANDS", "SUBCOMMAND_MODULES", "check_outputs", "PLOT_SUFFIXES",
-           "warning_printer"]
+           "warning_format"]
 
 #: the subcommands, in the order of ``mechdyn --help``, each with the help line its module
 #: registers (a test keeps the two the same)
@@ -144,48 +144,45 @@ def check_outputs(args) -> None:
 _PACKAGE = str(Path(__file__).resolve().parent.parent)
 
 
-def warning_printer(command: str, fallback=None):
-    """A :func:`warnings.showwarning` that prints mechdyn's warnings as one line on stderr,
+def warning_format(command: str, fallback=None):
+    """A :func:`warnings.formatwarning` that writes mechdyn's warnings as one line,
     ``mechdyn COMMAND: warning: MESSAGE``, as the command line's other warnings.
+
+    Only the text changes: where the warnings go (stderr, or a log that records them)
+    stays Python's.
 
     Parameters
     ----------
     command : str
         The subcommand, for the prefix.
     fallback : callable, optional
-        Shows the warnings of other packages (NumPy, Matplotlib ...); default
-        :func:`warnings.showwarning` as it is when this is called.
+        Formats the warnings of other packages (NumPy, Matplotlib ...); default
+        :func:`warnings.formatwarning` as it is when this is called.
 
     Returns
     -------
     callable
-        ``show(message, category, filename, lineno, file=None, line=None)``: a mechdyn
-        warning (its class or the file that raised it in the package) goes to
-        ``file`` (default ``sys.stderr``) without Python's ``file:line: Category:``
-        prefix, on one line; any other to ``fallback``.
+        ``format(message, category, filename, lineno, line=None) -> str``: a mechdyn
+        warning (its class or the file that raised it in the package) on one line,
+        without Python's ``file:line: Category:`` prefix; any other by ``fallback``.
 
     Examples
     --------
-    >>> import io
-    >>> out = io.StringIO()
-    >>> show = warning_printer("reduce")
-    >>> show(UserWarning("joint 'A' has friction"), UserWarning,
-    ...      _PACKAGE + "/dynamics/x.py", 1, file=out)
-    >>> print(out.getvalue(), end="")
+    >>> fmt = warning_format("reduce")
+    >>> print(fmt(UserWarning("joint 'A' has friction"), UserWarning,
+    ...           _PACKAGE + "/dynamics/x.py", 1), end="")
     mechdyn reduce: warning: joint 'A' has friction
     """
-    fallback = warnings.showwarning if fallback is None else fallback
+    fallback = warnings.formatwarning if fallback is None else fallback
 
-    def show(message, category, filename, lineno, file=None, line=None):
+    def format_warning(message, category, filename, lineno, line=None):
         ours = (getattr(category, "__module__", "").startswith("mechdyn")
                 or str(Path(filename).resolve()).startswith(_PACKAGE))
         if not ours:
-            return fallback(message, category, filename, lineno, file, line)
-        text = " ".join(str(message).split())
-        print(f"mechdyn {command}: warning: {text}", file=sys.stderr if file is None else file)
-        return None
+            return fallback(message, category, filename, lineno, line)
+        return f"mechdyn {command}: warning: {' '.join(str(message).split())}\n"
 
-    return show
+    return format_warning
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -210,11 +207,11 @@ def main(argv: list[str] | None = None) -> int:
         previous = signal.signal(signal.SIGTERM, on_term)
     except ValueError:  # not the main thread: no handler
         previous = None
+    formatwarning = warnings.formatwarning  # mechdyn's warnings as the CLI's one-line form
+    warnings.formatwarning = warning_format(args.command)
     try:
         check_outputs(args)
-        with warnings.catch_warnings():  # mechdyn's warnings as the CLI's one-line form
-            warnings.showwarning = warning_printer(args.command)
-            code = int(args.func(args) or 0)
+        code = int(args.func(args) or 0)
         return 143 if terminated and code == 130 else code
     except (MechdynError, FileNotFoundError, IsADirectoryError, PermissionError) as exc:
         print(f"mechdyn {args.command}: error: {exc}", file=sys.stderr)
@@ -227,5 +224,6 @@ def main(argv: list[str] | None = None) -> int:
         print(f"mechdyn {args.command}: interrupted", file=sys.stderr)
         return 143 if terminated else 130
     finally:
+        warnings.formatwarning = formatwarning
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
