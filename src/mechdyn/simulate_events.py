@@ -37,8 +37,9 @@ import numpy as np
 
 from .dynamics.contact import gaps, touching
 from .dynamics.dead_position import diagnose, status_of, turning_point
+from .dynamics.friction import friction_joints
 from .dynamics.impact import frame_impulse_key
-from .dynamics.joint_friction import SelfLockingError, friction_joints, stick_slip_joints
+from .dynamics.joint_friction import SelfLockingError, stick_slip_joints
 from .dynamics.lagrange import kinetic_energy
 from .dynamics.mode_equations import ModeEquations
 from .dynamics.modes import ModeSystem, switched_model

@@ -16,11 +16,13 @@ import os
 import re
 import signal
 import sys
+import warnings
 from pathlib import Path
 
 from .._version import __version__
 
-__all__ = ["main", "SUBCOMMANDS", "SUBCOMMAND_MODULES", "check_outputs", "PLOT_SUFFIXES"]
+__all__ = ["main", "SUBCOMMANDS", "SUBCOMMAND_MODULES", "check_outputs", "PLOT_SUFFIXES",
+           "warning_format"]
 
 #: the subcommands, in the order of ``mechdyn --help``, each with the help line its module
 #: registers (a test keeps the two the same)
@@ -138,6 +140,51 @@ def check_outputs(args) -> None:
                              f"a read-only file system)")
 
 
+#: the folder of the mechdyn package: a warning raised from a file in it is mechdyn's
+_PACKAGE = str(Path(__file__).resolve().parent.parent)
+
+
+def warning_format(command: str, fallback=None):
+    """A :func:`warnings.formatwarning` that writes mechdyn's warnings as one line,
+    ``mechdyn COMMAND: warning: MESSAGE``, as the command line's other warnings.
+
+    Only the text changes: where the warnings go (stderr, or a log that records them)
+    stays Python's.
+
+    Parameters
+    ----------
+    command : str
+        The subcommand, for the prefix.
+    fallback : callable, optional
+        Formats the warnings of other packages (NumPy, Matplotlib ...); default
+        :func:`warnings.formatwarning` as it is when this is called.
+
+    Returns
+    -------
+    callable
+        ``format(message, category, filename, lineno, line=None) -> str``: a mechdyn
+        warning (its class or the file that raised it in the package) on one line,
+        without Python's ``file:line: Category:`` prefix; any other by ``fallback``.
+
+    Examples
+    --------
+    >>> fmt = warning_format("reduce")
+    >>> print(fmt(UserWarning("joint 'A' has friction"), UserWarning,
+    ...           _PACKAGE + "/dynamics/x.py", 1), end="")
+    mechdyn reduce: warning: joint 'A' has friction
+    """
+    fallback = warnings.formatwarning if fallback is None else fallback
+
+    def format_warning(message, category, filename, lineno, line=None):
+        ours = (getattr(category, "__module__", "").startswith("mechdyn")
+                or str(Path(filename).resolve()).startswith(_PACKAGE))
+        if not ours:
+            return fallback(message, category, filename, lineno, line)
+        return f"mechdyn {command}: warning: {' '.join(str(message).split())}\n"
+
+    return format_warning
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code (0 ok, 1 analysis stopped, 2 bad input,
     130 interrupted by Ctrl-C, 143 by SIGTERM; an interrupted run writes its data)."""
@@ -160,6 +207,8 @@ def main(argv: list[str] | None = None) -> int:
         previous = signal.signal(signal.SIGTERM, on_term)
     except ValueError:  # not the main thread: no handler
         previous = None
+    formatwarning = warnings.formatwarning  # mechdyn's warnings as the CLI's one-line form
+    warnings.formatwarning = warning_format(args.command)
     try:
         check_outputs(args)
         code = int(args.func(args) or 0)
@@ -175,5 +224,6 @@ def main(argv: list[str] | None = None) -> int:
         print(f"mechdyn {args.command}: interrupted", file=sys.stderr)
         return 143 if terminated else 130
     finally:
+        warnings.formatwarning = formatwarning
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)

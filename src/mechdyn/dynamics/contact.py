@@ -277,11 +277,56 @@ def solve_frictional_impact(Z, p_minus, Cu, target, Ct, of_row, mu, vt_minus, *,
                        "with Coulomb's law in this impact")
 
 
+def _drop(restitution: float = 0.5):
+    """The model of the Examples: a 1 kg ball (0.1 kg m^2) in a vertical prismatic guide
+    ``"guide"`` from the ground origin, its height the travel ``"s"`` (poses x = (x, y,
+    angle), so s = y), and a stop ``"floor"`` at s >= 0 with that restitution."""
+    from ..mechanism.contact import Stop
+    from ..mechanism.mechanism import Mechanism
+    m = Mechanism("drop")
+    m.add_body("ball", mass=1.0, inertia=0.1)
+    m.add_prismatic("guide", "ground", "ball", axis=(0.0, 1.0))
+    m.add_coordinate("s", kind="travel", joint="guide")
+    m.add(Stop("floor", "s", lower=0.0, restitution=restitution))
+    return m.compile()
+
+
 def constrained_inverse(A, C_eq):
     """Z = N (N^T A N)^-1 N^T with N a basis of the null space of ``C_eq``.
 
     With the equality rows C_eq qddot = 0 enforced, qddot = Z f solves
-    A qddot = f + C_eq^T mu.  Shape (n, n).
+    A qddot = f + C_eq^T mu.
+
+    Parameters
+    ----------
+    A : ndarray, shape (n, n)
+        Symmetric positive definite on the null space (a reduced mass matrix, kg and
+        kg m^2).
+    C_eq : ndarray, shape (m, n)
+        The equality rows (m may be 0); rows that depend on the others are allowed.
+
+    Returns
+    -------
+    Z : ndarray, shape (n, n)
+        Zero where ``C_eq`` leaves no freedom.
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        N^T A N is singular (A not definite on the free motions).
+
+    Examples
+    --------
+    Holding the first of two coordinates leaves the second, of inertia 1:
+
+    >>> import numpy as np
+    >>> A = np.diag([2.0, 1.0])
+    >>> constrained_inverse(A, np.array([[1.0, 0.0]])) + 0.0
+    array([[0., 0.],
+           [0., 1.]])
+    >>> constrained_inverse(A, np.zeros((0, 2)))  # no rows: A^-1
+    array([[0.5, 0. ],
+           [0. , 1. ]])
     """
     n = A.shape[0]
     if C_eq.shape[0] == 0:
@@ -297,9 +342,46 @@ def constrained_inverse(A, C_eq):
 
 
 def row_terms(ms: ModeSystem, rows: list[Row], x, xdot, B, b):
-    """For rows in a mode's coordinates: C (m, n_i) with rate = C qdot_I, the
-    acceleration offset d (m,) with accel = C qddot_I + d, and the force
-    directions W (m, n_i) including sliding friction."""
+    """A mode's view of some rows: their rates, force directions and acceleration
+    offsets in the mode's independent coordinates.
+
+    Parameters
+    ----------
+    ms : ModeSystem
+        The mode (:class:`~mechdyn.dynamics.mode_system.ModeSystem`).
+    rows : list of Row
+        Rows of the switched model (:meth:`SwitchedModel.rows`).
+    x, xdot : ndarray, shape (n_x,)
+        Body poses (m, rad) and rates (m/s, rad/s).
+    B : ndarray, shape (n_x, n_i)
+        xdot = B qdot_I (the mode's velocity analogs).
+    b : ndarray, shape (n_x,)
+        xddot = B qddot_I + b, m/s^2 and rad/s^2.
+
+    Returns
+    -------
+    C : ndarray, shape (m, n_i)
+        Rates: rate = C qdot_I.
+    W : ndarray, shape (m, n_i)
+        The force directions, C with the sliding friction of rows that slip.
+    d : ndarray, shape (m,)
+        Acceleration offsets: accel = C qddot_I + d.
+
+    Examples
+    --------
+    The floor stop's row is the ball's height s, the mode's one coordinate:
+
+    >>> import numpy as np
+    >>> from mechdyn.dynamics.modes import switched_model
+    >>> sm = switched_model(_drop())
+    >>> from mechdyn.dynamics.mode_system import ModeSystem
+    >>> x = np.zeros(3)
+    >>> ms = ModeSystem(sm, frozenset(), {}, x)
+    >>> B, _ = ms.velocity_analogs(x)
+    >>> rows = sm.rows(frozenset({"floor@lower"}), {})
+    >>> row_terms(ms, rows, x, np.array([0.0, -2.0, 0.0]), B, np.zeros(3))
+    (array([[1.]]), array([[1.]]), array([0.]))
+    """
     n = B.shape[1]
     if not rows:
         return np.zeros((0, n)), np.zeros((0, n)), np.zeros(0)
@@ -314,7 +396,27 @@ def row_terms(ms: ModeSystem, rows: list[Row], x, xdot, B, b):
 
 def gap_measures(sm: SwitchedModel):
     """``(token, measure, sign, limit)`` of every stop side and contact, its gap being
-    sign (measure - limit)."""
+    sign (measure - limit).
+
+    Parameters
+    ----------
+    sm : SwitchedModel
+        The switchable elements of a model.
+
+    Yields
+    ------
+    tuple
+        (``"stop@lower"`` | ``"stop@upper"`` | ``"contact@contact"``, Measure, +1.0 or
+        -1.0, limit in m or rad).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mechdyn.dynamics.modes import switched_model
+    >>> sm = switched_model(_drop())
+    >>> [(tok, sign, limit) for tok, _, sign, limit in gap_measures(sm)]
+    [('floor@lower', 1.0, 0.0)]
+    """
     for n, (st, meas) in sm.stops.items():
         for side in st.sides():
             yield f"{n}@{side}", meas, (1.0 if side == "lower" else -1.0), getattr(st, side)
@@ -323,14 +425,63 @@ def gap_measures(sm: SwitchedModel):
 
 
 def gaps(sm: SwitchedModel, x) -> dict:
-    """``{token: (gap, is_angle)}`` of every stop side and contact at poses x (..., n_x):
-    m, or rad for angle stops, negative where it penetrates."""
+    """The gap of every stop side and contact.
+
+    Parameters
+    ----------
+    sm : SwitchedModel
+        The switchable elements of a model.
+    x : ndarray, shape (..., n_x)
+        Body poses, m and rad.
+
+    Returns
+    -------
+    dict
+        {token: (gap (...), is_angle)}: m, or rad for angle stops, negative where it
+        penetrates.
+
+    Examples
+    --------
+    The ball 0.3 m above the floor:
+
+    >>> import numpy as np
+    >>> from mechdyn.dynamics.modes import switched_model
+    >>> sm = switched_model(_drop())
+    >>> g, is_angle = gaps(sm, np.array([0.0, 0.3, 0.0]))["floor@lower"]
+    >>> float(g), is_angle
+    (0.3, False)
+    """
     return {tok: (sign * (rows_numpy.values(m.rows, x)[..., 0] - lim), m.is_angle)
             for tok, m, sign, lim in gap_measures(sm)}
 
 
 def touching(sm: SwitchedModel, x, *, gap_tol: float) -> list[str]:
-    """Unilateral tokens whose gap is within ``gap_tol`` (m, or rad for angle stops)."""
+    """Unilateral tokens whose gap is within ``gap_tol``.
+
+    Parameters
+    ----------
+    sm : SwitchedModel
+        The switchable elements of a model.
+    x : ndarray, shape (n_x,)
+        Body poses, m and rad.
+    gap_tol : float
+        m, or rad for angle stops.
+
+    Returns
+    -------
+    list of str
+        The tokens (:func:`gaps`), in the model's order.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mechdyn.dynamics.modes import switched_model
+    >>> sm = switched_model(_drop())
+    >>> touching(sm, np.array([0.0, 1e-12, 0.0]), gap_tol=1e-9)
+    ['floor@lower']
+    >>> touching(sm, np.array([0.0, 0.3, 0.0]), gap_tol=1e-9)
+    []
+    """
     return [tok for tok, (g, _) in gaps(sm, x).items() if g <= gap_tol]
 
 

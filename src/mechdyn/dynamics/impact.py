@@ -53,8 +53,8 @@ import numpy as np
 from ..kernels import rows_numpy
 from ..model.variable import parse_variable
 from .contact import constrained_inverse, row_terms, solve_frictional_impact, solve_lcp
+from .friction import friction_joints
 from .friction_ignored import FrictionIgnoredWarning
-from .joint_friction import friction_joints
 from .modes import ModeSystem, Row, SwitchedModel, mass_matrix_x
 from .reactions import element_forces, frame_forces
 
@@ -165,10 +165,12 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     Parameters
     ----------
     sm : SwitchedModel
+        The switchable elements of the model (:func:`~mechdyn.dynamics.modes.
+        switched_model`).
     x : ndarray, shape (n_x,)
-        The pose at the switch (satisfies every row involved).
+        The pose at the switch (satisfies every row involved), m and rad.
     xdot_minus : ndarray, shape (n_x,)
-        Velocities before, consistent with ``locks_before``.
+        Velocities before (m/s, rad/s), consistent with ``locks_before``.
     locks_before : frozenset of str
         Locks engaged before (after the releases of the same instant).
     locks_after : frozenset of str
@@ -182,10 +184,43 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     small_velocity : float
         Approach speeds below it (m/s, or rad/s for angle stops) are treated as
         plastic (e = 0), which ends bouncing sequences in finite time.
+    t : float, optional
+        The time, s, for the warnings.
 
     Returns
     -------
     ImpactResult
+        The velocities after, the energies, and the impulses of every row and element.
+
+    Raises
+    ------
+    ContactError
+        No stick or slip state of the frictional stops and contacts is consistent with
+        Coulomb's law.
+    ModelError
+        An unknown lock, stop or contact token.
+
+    Warns
+    -----
+    FrictionIgnoredWarning
+        Joints with friction carry impulses (taken as frictionless in the impact).
+    UserWarning
+        A stop with friction stays closed after the impact (its friction acts in
+        impacts only).
+
+    Examples
+    --------
+    A 1 kg ball falling at 2 m/s onto a floor stop of restitution e = 0.5 leaves at
+    e * 2 = 1 m/s; the floor's impulse is m (1 + 2) = 3 N s and the energy lost
+    1/2 m (2^2 - 1^2) = 1.5 J:
+
+    >>> import numpy as np
+    >>> from mechdyn.dynamics.contact import _drop
+    >>> from mechdyn.dynamics.modes import switched_model
+    >>> r = impact(switched_model(_drop(0.5)), np.zeros(3), np.array([0.0, -2.0, 0.0]),
+    ...            frozenset(), frozenset(), {}, ["floor@lower"])
+    >>> r.xdot_plus + 0.0, r.impulses["floor@lower"], r.energy_lost
+    (array([0., 1., 0.]), 3.0, 1.5)
     """
     model = sm.model
     xdot_minus = np.asarray(xdot_minus, float)

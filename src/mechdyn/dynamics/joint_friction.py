@@ -44,36 +44,74 @@ from ..errors import LockupError
 from ..kernels import rows_numpy as RN
 from ..model.state import Mode
 from ..model.variable import parse_variable
+from .friction import friction_joints
 
-__all__ = ["SelfLockingError", "friction_joints", "stick_slip_joints", "joint_states", "split_mode",
-           "stick_row", "capture_stick", "JointFriction", "STATES", "MAX_ITER",
-           "state_tokens", "resolve_joints"]
+__all__ = ["SelfLockingError", "stick_slip_joints", "joint_states", "split_mode",
+           "stick_row", "capture_stick", "JointFriction", "state_tokens", "resolve_joints"]
 
 class SelfLockingError(LockupError):
     """Friction in the pairs admits no motion consistent with the law (self-locking, or a
     Painleve-type inconsistency of sliding friction): the friction solve has a singular
-    Newton matrix or does not converge.  A run stops with status ``"self-locking"``."""
+    Newton matrix or does not converge.  A run stops with status ``"self-locking"``.
+
+    Parameters
+    ----------
+    message : str
+        What locks, naming the joints and the mode.
+    t : float, optional
+        The time, s.
+    q : array_like, shape (n_q,), optional
+        The coordinates there, rad or m.
+
+    Examples
+    --------
+    >>> err = SelfLockingError("the friction of 'guide' locks the mechanism", t=0.5)
+    >>> str(err)
+    "the friction of 'guide' locks the mechanism (at t = 0.5 s)"
+    >>> from mechdyn.errors import LockupError
+    >>> isinstance(err, LockupError)
+    True
+    """
 
 
-#: the friction states of a stick-slip pair
-STATES = ("stick", "slip+", "slip-")
 #: Newton iterations on the multipliers before the solve is declared failed
-MAX_ITER = 30
+_MAX_ITER = 30
 
 
-def friction_joints(model) -> tuple:
-    """The revolute and prismatic joints of a model with friction (Coulomb or viscous),
-    memoized (:func:`mechdyn.dynamics.friction.friction_joints`)."""
-    memo = model.memo.get("friction_joints")
-    if memo is None:
-        from .friction import friction_joints as joints
-        memo = model.memo["friction_joints"] = joints(model)
-    return memo
+def _block(mu: float = 0.3):
+    """The model of the Examples: a 1 kg block (0.1 kg m^2) in a horizontal prismatic
+    guide ``"guide"`` along x from the ground origin, Coulomb friction ``mu``, gravity
+    9.81 m/s^2 down, the travel ``"s"`` its coordinate; poses x = (x, y, angle)."""
+    from ..mechanism.mechanism import Mechanism
+    m = Mechanism("block")
+    m.add_body("block", mass=1.0, inertia=0.1)
+    m.add_prismatic("guide", "ground", "block", friction=mu)
+    m.add_coordinate("s", kind="travel", joint="guide")
+    return m.compile()
 
 
 def stick_slip_joints(model) -> tuple:
     """The joints with true Coulomb friction (``friction > 0``, ``smoothing = 0``): the
-    pairs that stick and slip as modes."""
+    pairs that stick and slip as modes.
+
+    Parameters
+    ----------
+    model : Model
+        Compiled; its friction joints are
+        :func:`~mechdyn.dynamics.friction.friction_joints`.
+
+    Returns
+    -------
+    names : tuple of str
+        Those joints, in the model's joint order (empty without such pairs: joints
+        with viscous or smoothed friction only have no stick-slip states).
+
+    Examples
+    --------
+    >>> model = _block()
+    >>> stick_slip_joints(model)
+    ('guide',)
+    """
     joints = model.mechanism.joints
     return tuple(n for n in friction_joints(model)
                  if joints[n].friction > 0 and joints[n].smoothing == 0)
@@ -82,27 +120,53 @@ def stick_slip_joints(model) -> tuple:
 def joint_states(model, mode) -> dict:
     """{joint: 'stick' | 'slip+' | 'slip-'} of the stick-slip pairs in a mode.
 
+    Parameters
+    ----------
+    model : Model
+        A compiled model.
+    mode : iterable of str
+        The mode's tokens (locks, stops, contacts and friction states).
+
+    Returns
+    -------
+    dict
+        {joint: state} of the tokens ``"joint:state"`` whose joint is a stick-slip pair
+        (:func:`stick_slip_joints`); a contact's friction tokens are left out.
+
     Examples
     --------
-    >>> import mechdyn as md
-    >>> m = md.Mechanism("block")
-    >>> _ = m.add_body("block", mass=1.0, inertia=0.1)
-    >>> _ = m.add_prismatic("guide", "ground", "block", friction=0.3)
-    >>> _ = m.add_coordinate("s", kind="travel", joint="guide")
-    >>> model = m.compile()
-    >>> stick_slip_joints(model)
-    ('guide',)
+    >>> model = _block()
     >>> joint_states(model, {"guide:stick", "clutch"})
     {'guide': 'stick'}
-    >>> sorted(split_mode(model, {"guide:slip+", "clutch"})[0])
-    ['clutch']
     """
     ss = stick_slip_joints(model)
     return {k: v for k, v in Mode(mode).friction.items() if k in ss}
 
 
 def split_mode(model, mode) -> tuple[Mode, dict]:
-    """(the mode without the joints' friction tokens, :func:`joint_states`)."""
+    """Split a mode into its joints' friction states and the rest.
+
+    Parameters
+    ----------
+    model : Model
+        A compiled model.
+    mode : iterable of str
+        The mode's tokens.
+
+    Returns
+    -------
+    rest : Mode
+        The mode without the stick-slip pairs' tokens.
+    states : dict
+        {joint: state} (:func:`joint_states`).
+
+    Examples
+    --------
+    >>> model = _block()
+    >>> rest, states = split_mode(model, {"guide:slip+", "clutch"})
+    >>> sorted(rest), states
+    (['clutch'], {'guide': 'slip+'})
+    """
     st = joint_states(model, mode)
     return Mode(t for t in mode if t.split(":")[0] not in st or ":" not in t), st
 
@@ -117,7 +181,36 @@ def _measure(model, joint: str):
 
 
 def capture_stick(model, joint: str, x, targets: dict) -> None:
-    """Store in ``targets`` the travel or relative angle a pair sticks at, pose x (n_x,)."""
+    """Store in ``targets`` the travel or relative angle a pair sticks at.
+
+    Parameters
+    ----------
+    model : Model
+        A compiled model.
+    joint : str
+        A revolute or prismatic joint.
+    x : ndarray, shape (n_x,)
+        The body poses (x, y, angle per body; m and rad).
+    targets : dict
+        Updated in place: ``targets["joint:stick"]`` = the pair's travel (m) or
+        relative angle (rad) at ``x``.
+
+    Raises
+    ------
+    ModelError
+        ``joint`` is not a joint of the model (the message lists the valid ones).
+
+    Examples
+    --------
+    The block's travel in the guide along x is its x position:
+
+    >>> model = _block()
+    >>> import numpy as np
+    >>> targets = {}
+    >>> capture_stick(model, "guide", np.array([0.25, 0.0, 0.0]), targets)
+    >>> targets
+    {'guide:stick': 0.25}
+    """
     targets[f"{joint}:stick"] = _measure(model, joint).value(x)
 
 
@@ -147,7 +240,35 @@ class StickRow:
 
 
 def stick_row(model, joint: str, targets: dict) -> StickRow:
-    """The row holding a sticking pair at its captured value."""
+    """The row holding a sticking pair at its captured value.
+
+    Parameters
+    ----------
+    model : Model
+        A compiled model.
+    joint : str
+        The sticking pair.
+    targets : dict
+        Held values, with ``"joint:stick"`` (:func:`capture_stick`), m or rad.
+
+    Returns
+    -------
+    StickRow
+        Kind ``"stick"``, label ``"joint:stick"``: the pair's travel or relative angle
+        minus the target.
+
+    Raises
+    ------
+    KeyError
+        No value captured for the pair in ``targets``.
+
+    Examples
+    --------
+    >>> model = _block()
+    >>> row = stick_row(model, "guide", {"guide:stick": 0.25})
+    >>> row.kind, row.label, row.target
+    ('stick', 'guide:stick', 0.25)
+    """
     return StickRow(joint, f"{joint}:stick", _measure(model, joint),
                     float(targets[f"{joint}:stick"]))
 
@@ -169,6 +290,8 @@ class JointFriction:
     Parameters
     ----------
     ms : ModeSystem
+        The mode's equations (:class:`~mechdyn.dynamics.mode_system.ModeSystem`, whose
+        attribute ``friction`` this is when the model has friction joints).
 
     Attributes
     ----------
@@ -181,6 +304,25 @@ class JointFriction:
         {joint: +1 / -1}: sgn(v) of the slipping stick-slip pairs.
     stick_index : dict
         {joint: index into ``ms.rowset`` of its stick row}.
+
+    Examples
+    --------
+    The 1 kg block sliding at 1 m/s in its horizontal guide (mu = 0.3): the guide
+    carries the weight, 9.81 N, so its friction capacity is 0.3 * 9.81 = 2.943 N, and
+    friction decelerates the block at mu g:
+
+    >>> model = _block()
+    >>> import numpy as np
+    >>> from mechdyn.dynamics.modes import switched_model
+    >>> from mechdyn.dynamics.mode_system import ModeSystem
+    >>> ms = ModeSystem(switched_model(model), frozenset(), {}, np.zeros(3))
+    >>> jf = ms.friction
+    >>> jf.sliding
+    ['guide']
+    >>> x, xdot = np.zeros(3), np.array([1.0, 0.0, 0.0])
+    >>> ev = ms.evaluate_x(0.0, x, xdot)
+    >>> round(jf.capacity("guide", x, ev.lam), 6), round(float(ev.xddot[0]), 6)
+    (2.943, -2.943)
     """
 
     def __init__(self, ms):
@@ -303,7 +445,7 @@ class JointFriction:
         lam = sol[n_i:]
         prev = np.inf
         law = self.prepared(x, xdot)  # the per-pose part, once for the iteration
-        for it in range(MAX_ITER):
+        for it in range(_MAX_ITER):
             F, D = law.generalized(lam)
             sol = lin(rhs + F)
             r = lam - sol[n_i:]
@@ -320,7 +462,7 @@ class JointFriction:
                     "the Newton matrix of the friction solve is singular)"), t=t, q=q) from None
             lam, prev = lam - step, rn
         raise SelfLockingError(self._where(
-            f"the friction solve did not converge in {MAX_ITER} Newton iterations "
+            f"the friction solve did not converge in {_MAX_ITER} Newton iterations "
             f"(residual {rn:.3g} of {scale:.3g}); the friction of "
             + ", ".join(repr(j) for j in self.sliding) + " may lock the mechanism"), t=t, q=q)
 
@@ -329,7 +471,23 @@ class JointFriction:
 
 
 def state_tokens(states: dict) -> frozenset:
-    """The mode tokens of joint friction states: ``{"B:stick", "C:slip+"}``."""
+    """The mode tokens of joint friction states.
+
+    Parameters
+    ----------
+    states : dict
+        {joint: 'stick' | 'slip+' | 'slip-'}.
+
+    Returns
+    -------
+    frozenset of str
+        ``"joint:state"`` per pair.
+
+    Examples
+    --------
+    >>> sorted(state_tokens({"B": "stick", "C": "slip+"}))
+    ['B:stick', 'C:slip+']
+    """
     return frozenset(f"{j}:{s}" for j, s in states.items())
 
 
@@ -376,6 +534,31 @@ def resolve_joints(system, sm, t, x, xdot, mode, targets: dict, *, before: dict,
     -------
     dict
         {joint: 'stick' | 'slip+' | 'slip-'}.
+
+    Raises
+    ------
+    AssemblyError
+        A trial mode's rows cannot be assembled at ``x``.
+
+    Examples
+    --------
+    The block at rest in its horizontal guide needs no friction to stay (no force
+    along the guide), so it sticks where it is; moving at 1 m/s it slips forward:
+
+    >>> model = _block()
+    >>> import numpy as np
+    >>> from mechdyn.dynamics.modes import switched_model
+    >>> from mechdyn.dynamics.mode_system import ModeSystem
+    >>> sm, x, targets = switched_model(model), np.zeros(3), {}
+    >>> tols = {"velocity_tol": 1e-9, "force_tol": 1e-9}
+    >>> resolve_joints(ModeSystem, sm, 0.0, x, np.zeros(3), frozenset(), targets,
+    ...                before={}, forced_slip={}, forced_stick=(), **tols)
+    {'guide': 'stick'}
+    >>> targets
+    {'guide:stick': 0.0}
+    >>> resolve_joints(ModeSystem, sm, 0.0, x, np.array([1.0, 0.0, 0.0]), frozenset(), {},
+    ...                before={}, forced_slip={}, forced_stick=(), **tols)
+    {'guide': 'slip+'}
     """
     model = sm.model
     states: dict = {}

@@ -28,10 +28,10 @@ import numpy as np
 from ..kinematics.assembly import SINGULAR_RCOND
 from .friction import FrictionSet
 
-__all__ = ["friction_solve", "MAX_ITER"]
+__all__ = ["friction_solve", "locking_note"]
 
 #: Newton iterations per position before a position counts as self-locked
-MAX_ITER = 60
+_MAX_ITER = 60
 #: relative residual at which Newton stops
 RTOL = 1e-13
 
@@ -64,6 +64,7 @@ def friction_solve(fs: FrictionSet, rows, n_rows: int, As, bs, rs, cs, x, xdot, 
     Parameters
     ----------
     fs : FrictionSet
+        The friction law of the pairs (:class:`~mechdyn.dynamics.friction.FrictionSet`).
     rows : mapping
         {joint: indices of its rows among the multipliers}.
     n_rows : int
@@ -76,6 +77,7 @@ def friction_solve(fs: FrictionSet, rows, n_rows: int, As, bs, rs, cs, x, xdot, 
     cs : ndarray, shape (m,)
         The row and column scales; the first ``m - n_d`` columns are multipliers.
     x, xdot : ndarray, shape (n, n_x)
+        The body poses (m, rad) and their rates (m/s, rad/s) at the n positions.
     zs0 : ndarray, shape (n, m)
         The frictionless (scaled) solution: the start.
     signs : mapping, optional
@@ -93,6 +95,27 @@ def friction_solve(fs: FrictionSet, rows, n_rows: int, As, bs, rs, cs, x, xdot, 
     info : dict
         ``iterations`` (largest count), ``no_solution``, ``unbounded`` and ``jammed``
         (bool masks of the three symptoms).
+
+    Raises
+    ------
+    ValueError
+        Shapes that do not fit together (from NumPy).
+
+    Examples
+    --------
+    Without friction pairs the system is linear: a start that solves it, here z = b for
+    A = I, is the solution, after no iteration and not locked:
+
+    >>> import numpy as np
+    >>> from mechdyn.dynamics.friction import FrictionSet
+    >>> from mechdyn.dynamics.joint_friction import _block
+    >>> fs = FrictionSet(_block(), ())
+    >>> b = np.array([[2.0, -1.0, 0.5]])
+    >>> zs, Ff, locked, info = friction_solve(fs, {}, 2, np.eye(3)[None], b, np.ones(3),
+    ...                                       np.ones(3), np.zeros((1, 3)),
+    ...                                       np.zeros((1, 3)), b.copy())
+    >>> zs, Ff, locked, info["iterations"]
+    (array([[ 2. , -1. ,  0.5]]), array([[0., 0., 0.]]), array([False]), 0)
     """
     cs_l = cs[:n_rows]
     zs = zs0.copy()
@@ -106,7 +129,7 @@ def friction_solve(fs: FrictionSet, rows, n_rows: int, As, bs, rs, cs, x, xdot, 
 
     done = np.abs(r).max(axis=-1) <= RTOL * scale(zs, Ff)
     it = 0
-    while not done.all() and it < MAX_ITER:
+    while not done.all() and it < _MAX_ITER:
         it += 1
         a = ~done
         dz = _step(J[a], r[a])
@@ -148,7 +171,44 @@ def friction_solve(fs: FrictionSet, rows, n_rows: int, As, bs, rs, cs, x, xdot, 
 def locking_note(model, didx, t, q, locked, info) -> str:
     """The warning naming the self-locked positions: the runs of consecutive locked
     samples with the first driven coordinate's values (deg or m) and times, and the
-    symptoms."""
+    symptoms.
+
+    Parameters
+    ----------
+    model : Model
+        Its ``coordinate_names`` and ``coord_is_angle`` are used.
+    didx : sequence of int
+        The driven coordinates' indices (the first is named first; none: coordinate 0).
+    t : ndarray, shape (n,)
+        The samples' times, s.
+    q : ndarray, shape (n, n_q)
+        The coordinates at the samples, rad or m.
+    locked : ndarray of bool, shape (n,)
+        The self-locked samples (at least one).
+    info : dict
+        The masks ``no_solution``, ``unbounded`` and ``jammed``, shape (n,)
+        (:func:`friction_solve`).
+
+    Returns
+    -------
+    str
+        One sentence: the count, each run of locked samples (values, times, sample
+        indices) and the count of each symptom.
+
+    Examples
+    --------
+    Samples 1 and 2 of four, at 10 and 20 deg, have no solution:
+
+    >>> import numpy as np
+    >>> from types import SimpleNamespace
+    >>> model = SimpleNamespace(coordinate_names=("phi",), coord_is_angle=(True,))
+    >>> locked = np.array([False, True, True, False])
+    >>> none = np.zeros(4, dtype=bool)
+    >>> info = {"no_solution": locked, "unbounded": none, "jammed": none}
+    >>> q = np.deg2rad([[0.0], [10.0], [20.0], [30.0]])
+    >>> locking_note(model, [0], np.array([0.0, 0.1, 0.2, 0.3]), q, locked, info)
+    '2 self-locking position(s): ... at phi = 10 .. 20 deg (t = 0.1 s, samples 1..2) (2 ...'
+    """
     k0 = int(didx[0]) if len(didx) else 0
     names = model.coordinate_names
     # the driven coordinate first, then the others (a crank angle when a slider is driven)

@@ -16,7 +16,7 @@ from ..errors import ModelError, Status, did_you_mean
 from ..kinematics.constraints import coordinates, coordinates_gamma, coordinates_jacobian
 from ..results.kinetostatics_record import Kinetostatics
 from .forces import force_model
-from .joint_friction import friction_joints
+from .friction import friction_joints
 from .prescribed_motion import _independent_subset, _prescribed
 from .reactions import _inverse
 

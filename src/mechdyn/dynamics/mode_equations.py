@@ -49,7 +49,7 @@ from ..kinematics.constraints import extend
 from .compiled import compile_mode_kernel
 from .dead_position import _dependent, _where
 from .forces import com_arms
-from .joint_friction import friction_joints
+from .friction import friction_joints
 from .mode_system import solve_mass
 from .modes import ModeEval
 

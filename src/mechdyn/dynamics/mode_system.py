@@ -41,8 +41,9 @@ from ..kinematics.assembly import _position_tol, _scale, _scaled, _singular_repo
 from ..model import ConstraintLayout
 from ..model.state import Mode
 from ..model.workspace import Workspace
+from .friction import friction_joints
 from .inertia import mass_matrix_x
-from .joint_friction import JointFriction, friction_joints, split_mode, stick_row
+from .joint_friction import JointFriction, split_mode, stick_row
 from .reactions import ground_rows
 
 if TYPE_CHECKING:

@@ -17,8 +17,9 @@ from ..kinematics.constraints import _perp, coordinates_jacobian, extend
 from ..model import ConstraintLayout, Model
 from .compliance import share_by_compliance
 from .forces import applied_forces, cross, rotate
+from .friction import friction_joints
 from .inertia import inertia_forces
-from .joint_friction import friction_joints, friction_set, joint_states
+from .joint_friction import friction_set, joint_states
 from .kinetostatics_friction import friction_solve, locking_note
 
 __all__ = ["KinetostaticsWarning", "joint_reaction", "reaction_frame", "element_forces",

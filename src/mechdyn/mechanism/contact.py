@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ModelError
+
 __all__ = ["Stop", "Contact"]
 
 
@@ -48,6 +50,15 @@ class Stop:
         ``"body.point.x|y"``, whose tangent is the other ground axis.  It acts during
         impacts only: while the stop stays closed the point slides along it without
         friction (use a :class:`Contact` for lasting friction).
+
+    Raises
+    ------
+    ModelError
+        ``friction > 0`` on a variable that is not a point coordinate, naming the stop,
+        its variable and the valid forms.
+    ValueError
+        A restitution outside [0, 1], a negative friction, no limit, or limits in the
+        wrong order.
     """
 
     name: str
@@ -62,9 +73,11 @@ class Stop:
         _store_nonneg(self, f"stop {self.name!r}", "restitution", 1.0)
         _store_nonneg(self, f"stop {self.name!r}", "friction")
         if self.friction > 0 and self.tangent_variable() is None:
-            raise ValueError(f"stop {self.name!r}: friction needs a stop on a point "
+            raise ModelError(f"stop {self.name!r}: friction needs a stop on a point "
                              f"coordinate 'body.point.x' or 'body.point.y' (its tangent is "
-                             f"the other axis), got variable {self.variable!r}")
+                             f"the other axis), got variable {self.variable!r}; a stop on "
+                             f"a coordinate, 'joint:NAME' or 'angle:BODY' takes no friction "
+                             f"(use friction = 0, or a Contact)")
         for side in ("lower", "upper"):
             v = getattr(self, side)
             if v is not None:

@@ -59,39 +59,49 @@ from ..kernels.rows_variants import (
     path_variants,
 )
 from ..kinematics.sweep import DEFAULT_MAX_STEP
+from ..mechanism.joint import has_friction
 from ..model import Model
 from ..results.kinetostatics_record import Kinetostatics
 from .analyses import KinetostaticExtremes, Outcome, extremes
 
-__all__ = ["batched", "batch_reason", "kinetostatic_batch", "Variants", "MAX_NEWTON",
-           "MIN_PIVOT_RATIO", "SHORT_STEP", "SUB_BATCH", "SUB_BATCH_FLOATS"]
+__all__ = ["batched", "batch_reason", "kinetostatic_batch", "Variants"]
 
 #: Newton iterations per step of the batched continuation
-MAX_NEWTON = 12
-#: a first Newton step of at most SHORT_STEP x its tolerance (1e-5 of the length scale) is
+_MAX_NEWTON = 12
+#: a first Newton step of at most _SHORT_STEP x its tolerance (1e-5 of the length scale) is
 #: checked by the change of the Jacobian along it, without evaluating the residual
-SHORT_STEP = 1e7
+_SHORT_STEP = 1e7
 #: pivot ratio min|u_ii| / max|u_ii| of a Jacobian below which a variant leaves the batch
 #: (a dead, toggle or bifurcation position: the single-model analysis decides)
-MIN_PIVOT_RATIO = 1e-6
+_MIN_PIVOT_RATIO = 1e-6
 #: most variants whose cycle is solved in one call
-SUB_BATCH = 64
+_SUB_BATCH = 64
 #: floats of the Jacobians and their factors kept for one call (the call's variants x
 #: positions x n x n_x, twice): bounds its memory (32 MB)
-SUB_BATCH_FLOATS = 4_000_000
+_SUB_BATCH_FLOATS = 4_000_000
 #: the compiled kernels have been loaded (or compiled) in this process
 _WARM = {"done": False}
 
 
 def _friction(model) -> bool:
     """True if a joint of the model has friction (not in the batched solve)."""
-    return any(getattr(j, f, 0.0) for j in model.mechanism.joints.values()
-               for f in ("friction", "viscous"))
+    return any(map(has_friction, model.mechanism.joints.values()))
 
 
 def batched(analysis) -> bool:
     """Whether a study analyses variants with this analysis as one batch (when they
     allow it: :func:`batch_reason`).
+
+    Parameters
+    ----------
+    analysis : object
+        A study analysis (:mod:`mechdyn.study.analyses`).
+
+    Returns
+    -------
+    bool
+        True for a :class:`~mechdyn.study.analyses.KinetostaticExtremes` (exactly that
+        type), the one analysis with a batched path.
 
     Examples
     --------
@@ -108,6 +118,18 @@ def batch_reason(analysis, models) -> str | None:
     variants with the bodies, joints, coordinates, loads and constraint rows of the
     first one, no switchable elements, no extension loads and no joint friction, and as
     many driven (or held) coordinates as coordinates.
+
+    Parameters
+    ----------
+    analysis : object
+        A study analysis (:func:`batched` decides first).
+    models : sequence of Model
+        The compiled variants.
+
+    Returns
+    -------
+    str or None
+        The first reason found, a sentence, or None when the batch can take them.
 
     Examples
     --------
@@ -171,6 +193,16 @@ class Variants:
     models : list of Model or None
         The compiled variants, whose loads are evaluated one by one; None: no loads but
         the weights under the base's gravity and the drives of the driven coordinates.
+
+    Examples
+    --------
+    Two copies of the bundled slider-crank (three moving bodies: crank, rod, slider):
+
+    >>> from mechdyn.study.parameters import BaseModel
+    >>> m = BaseModel("slider_crank").compile({})
+    >>> v = Variants.of_models([m, m])
+    >>> len(v), v.mass.shape, v.com.shape, len(v.take(slice(0, 1)))
+    (2, (2, 3), (2, 3, 2), 1)
     """
 
     base: Model
@@ -276,7 +308,7 @@ def kinetostatic_batch(variants, analysis: KinetostaticExtremes) -> list[Outcome
     if not isinstance(variants, Variants):
         variants = Variants.of_models(variants)
     n = variants.base.n_x
-    size = max(1, min(SUB_BATCH, SUB_BATCH_FLOATS // (2 * analysis.steps * n * n)))
+    size = max(1, min(_SUB_BATCH, _SUB_BATCH_FLOATS // (2 * analysis.steps * n * n)))
     out: list[Outcome | None] = []
     work: dict = {}
     for k in range(0, len(variants), size):
@@ -334,7 +366,7 @@ def _cycle(vs: Variants, analysis: KinetostaticExtremes, work: dict) -> list[Out
     ok = np.ones(V, dtype=bool)
     fail = np.empty(V, dtype=np.int64)
     path = (np.ascontiguousarray(vs.x_start), Q, dQ, ddQ, at, nb, ints, flts, n_rows,
-            1e-12 * np.maximum(vs.length_scale, 1e-3), MAX_NEWTON, SHORT_STEP, MIN_PIVOT_RATIO)
+            1e-12 * np.maximum(vs.length_scale, 1e-3), _MAX_NEWTON, _SHORT_STEP, _MIN_PIVOT_RATIO)
     loads = (weight, group, cols, sign)
     qd_dot = dQ[keep]
     t = (values - values[0]) / analysis.speed if analysis.speed != 0 else np.zeros(N)
@@ -365,7 +397,7 @@ def _cycle(vs: Variants, analysis: KinetostaticExtremes, work: dict) -> list[Out
         frame += F_ground  # the frame's share of the loads (point of the moments: the origin)
     if not live.size:
         return [None] * V
-    good = np.all(rc >= MIN_PIVOT_RATIO, axis=1) & np.all(np.isfinite(Z), axis=(1, 2))
+    good = np.all(rc >= _MIN_PIVOT_RATIO, axis=1) & np.all(np.isfinite(Z), axis=(1, 2))
     reactions = {name: Fj[g] for g, name in enumerate(joints)}
     names = base.coordinate_names
     driven = {names[k]: Z[..., n_rows + c] for c, k in enumerate(didx)}

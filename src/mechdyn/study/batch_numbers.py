@@ -5,7 +5,7 @@ compiled probes give every variant's.
 
 The fit is checked, never assumed: compiled at a reference variant, at one step along
 each parameter and at one more point inside the batch's box, the probes' numbers must
-lie on one affine function (to :data:`FIT_RTOL`); and each corner of the box is
+lie on one affine function (to :data:`_FIT_RTOL`); and each corner of the box is
 compiled, so that the loader's value checks (a mass >= 0 ...), which hold on a box when
 they hold at its corners, hold for every variant.  A variant whose sketch does not
 assemble, or whose turn meets a dead position, leaves the batch at its first step
@@ -22,12 +22,12 @@ import numpy as np
 from ..errors import Status
 from .batch import Variants, batch_reason
 
-__all__ = ["affine_variants", "FIT_RTOL", "MAX_CORNER_PARAMETERS"]
+__all__ = ["affine_variants"]
 
 #: relative tolerance of the affine fit (of each array's largest entry)
-FIT_RTOL = 1e-12
+_FIT_RTOL = 1e-12
 #: the box's corners are compiled for up to this many varied parameters (beyond: no fit)
-MAX_CORNER_PARAMETERS = 4
+_MAX_CORNER_PARAMETERS = 4
 
 
 def _numbers(model) -> dict:
@@ -44,8 +44,23 @@ def affine_variants(task, values, attempt) -> Variants | None:
     loads besides gravity, a body without a sketch pose or assembly modes, or the
     reference variant (the one nearest the middle of the box) does not compile.
 
-    ``attempt(values)`` compiles one variant: its Model, or the (status, message) of its
-    failure (:func:`~mechdyn.study.evaluate.attempt`).
+    Parameters
+    ----------
+    task : Task
+        The study's task (:class:`~mechdyn.study.evaluate.Task`): its parameters and
+        analysis.
+    values : array_like, shape (V, d)
+        The parameter values of the V variants, SI (m, kg, kg m^2, rad ...).
+    attempt : callable
+        ``attempt(values)`` compiles one variant (values shape (d,)): its Model, or the
+        (status, message) of its failure (:func:`~mechdyn.study.evaluate.attempt`).
+
+    Returns
+    -------
+    Variants or None
+        The stacked numbers of the V variants, from 2 + d' probes (d' the parameters
+        that vary, at most 4) plus the corners of the box,
+        not one compilation per variant; ``length_scale`` the smallest of the probes'.
 
     Examples
     --------
@@ -72,7 +87,7 @@ def affine_variants(task, values, attempt) -> Variants | None:
     if ref.mechanism.loads or not ref.pose_given.all() or ref.assembly_modes:
         return None
     var = np.flatnonzero(hi > lo)
-    if var.size > MAX_CORNER_PARAMETERS:
+    if var.size > _MAX_CORNER_PARAMETERS:
         return None
     for corner in itertools.product(*[(lo[i], hi[i]) for i in var]):
         p = p0.copy()
@@ -100,7 +115,7 @@ def affine_variants(task, values, attempt) -> Variants | None:
         Y = np.stack([n[key].ravel() for n in nums])
         coef = np.linalg.lstsq(A[:-1], Y[:-1], rcond=None)[0]  # exact: square (1 + d)
         scale = max(float(np.abs(Y).max()), 1e-300)
-        if np.abs(A[-1] @ coef - Y[-1]).max() > FIT_RTOL * scale:
+        if np.abs(A[-1] @ coef - Y[-1]).max() > _FIT_RTOL * scale:
             return None  # not affine (a normalised axis, a derived offset ...)
         dv = values[:, var] - p0[var]
         fit[key] = (coef[0] + dv @ coef[1:]).reshape((len(values),) + nums[0][key].shape)
