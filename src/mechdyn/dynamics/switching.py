@@ -23,7 +23,7 @@ from ..kernels import rows_numpy
 from ..model.rows import concat
 from .contact import gap_measures, resolve_mode, touching
 from .impact import impact
-from .joint_friction import joint_states, resolve_joints, state_tokens, stick_slip_joints
+from .joint_friction import joint_states, stick_slip_joints
 from .mode_system import held_key
 from .modes import (
     Measure,
@@ -34,6 +34,7 @@ from .modes import (
     mode_locks,
     mode_unilateral,
 )
+from .stick_slip import resolve_joints, state_tokens
 
 __all__ = ["event_functions", "guard_holds", "apply_switch"]
 
