@@ -42,6 +42,22 @@ def test_pendulum_with_pin_friction_stopped_by_a_plastic_stop():
     assert "'O'" in notes[0] and "'rest@lower' closing" in notes[0] and "frictionless" in notes[0]
 
 
+def test_every_run_of_one_compiled_model_gives_its_own_warning():
+    """The 'once' of the warning is once per run: a second run of the same compiled model
+    (whose switchable elements are compiled once and kept with it) warns again."""
+    mech = pendulum(90.0, m=2.0, a=0.5, Jc=0.05, g=G)
+    pin = mech.joints["O"]
+    mech.joints["O"] = type(pin)(**{**pin.__dict__, "friction": 0.2, "pin_radius": 0.02})
+    add_element(mech, Stop("rest", "theta", lower=-1.0, restitution=0.0))
+    model = mech.compile()
+    for _ in range(2):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            tr = mechdyn.simulate(model, 0.8, q0=[0.0], qdot0=[0.0], progress=False)
+        assert tr.status == "success", tr.message
+        assert sum(issubclass(w.category, FrictionIgnoredWarning) for w in caught) == 1
+
+
 def test_no_warning_for_an_impact_of_frictionless_pairs():
     mech = pendulum(90.0)
     add_element(mech, Stop("rest", "theta", lower=-1.0, restitution=0.0))

@@ -159,7 +159,7 @@ def _momentum(x, Q):
 
 def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets: dict,
            unilateral=(), *, restitution: dict | None = None, small_velocity: float = 0.0,
-           t=None) -> ImpactResult:
+           t=None, warned: set | None = None) -> ImpactResult:
     """Velocities after locks engage and/or unilateral constraints close at pose ``x``.
 
     Parameters
@@ -186,6 +186,10 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
         plastic (e = 0), which ends bouncing sequences in finite time.
     t : float, optional
         The time, s, for the warnings.
+    warned : set, optional
+        The warnings already given in this run (the run's
+        :attr:`~mechdyn.model.workspace.Workspace.warned`), so that each is given once per
+        run; None: every call warns.
 
     Returns
     -------
@@ -264,7 +268,7 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
         P_u, P_t, qd_plus = imp.normal, imp.tangent, imp.qdot_plus
         t_labels = [f"{rows_u[k].element}.tangent" for k, _, _ in fric]
         states = dict(zip([rows_u[k].element for k, _, _ in fric], imp.states, strict=True))
-        _warn_closed_stops(sm, rows_u, fric, v_minus, Cu @ qd_plus, P_u)
+        _warn_closed_stops(sm, rows_u, fric, v_minus, Cu @ qd_plus, P_u, warned)
     else:
         P_u = solve_lcp(Hm, v0 - target).z
         qd_plus = Z @ (p_minus + Cu.T @ P_u)
@@ -287,7 +291,7 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     per_element = element_forces(after, x, Lam)
     _warn_pair_friction(sm, per_element, [*(f"lock {n!r} engaging" for n in sorted(new_locks)),
                                           *(f"{r.label!r} closing" for k, r in enumerate(rows_u)
-                                            if v_minus[k] < 0)], t)
+                                            if v_minus[k] < 0)], t, warned)
     per_element.update(zip(t_labels, map(float, P_t), strict=True))
     per_element[frame_impulse_key(sm)] = on_frame
     impulses = dict(zip(after.row_labels(), map(float, Lam), strict=True))
@@ -298,7 +302,8 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
                         states)
 
 
-def _warn_pair_friction(sm: SwitchedModel, per_element: dict, event: list, t) -> None:
+def _warn_pair_friction(sm: SwitchedModel, per_element: dict, event: list, t,
+                        warned: set | None) -> None:
     """Warn (once per event) that the pairs with friction carrying an impulse were taken
     as frictionless in the impact (``per_element``: the impulses of the mode's elements,
     :func:`element_forces`)."""
@@ -309,8 +314,8 @@ def _warn_pair_friction(sm: SwitchedModel, per_element: dict, event: list, t) ->
             if j in per_element}
     big = max(size.values(), default=0.0)
     pairs = [j for j, v in size.items() if v > 1e-9 * big]
-    told = sm.model.memo.setdefault("impact_pair_friction_warned", set())
-    key = tuple(event)
+    told = set() if warned is None else warned
+    key = ("impact pair friction", *event)
     if not pairs or key in told:
         return
     told.add(key)
@@ -323,16 +328,18 @@ def _warn_pair_friction(sm: SwitchedModel, per_element: dict, event: list, t) ->
         FrictionIgnoredWarning, stacklevel=4)
 
 
-def _warn_closed_stops(sm: SwitchedModel, rows_u, fric, v_minus, v_plus, P_n) -> None:
+def _warn_closed_stops(sm: SwitchedModel, rows_u, fric, v_minus, v_plus, P_n,
+                       warned: set | None) -> None:
     """Warn (once per stop) when a stop with friction stays closed after an impact: its
     friction acts in impacts only, not while it stays closed."""
     scale = max(float(np.max(np.abs(v_minus), initial=0.0)), 1e-300)
-    told = sm.model.memo.setdefault("stop_friction_warned", set())
+    told = set() if warned is None else warned
     for k, _, _ in fric:
         r = rows_u[k]
+        key = ("closed stop friction", r.element)
         if r.kind == "stop" and P_n[k] > 0 and abs(v_plus[k]) <= 1e-9 * scale \
-                and r.element not in told:
-            told.add(r.element)
+                and key not in told:
+            told.add(key)
             warnings.warn(f"stop {r.element!r} has friction = "
                           f"{sm.stops[r.element][0].friction:g}: it acts in its impacts only; "
                           "while the stop stays closed the point slides along it without "

@@ -224,7 +224,7 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
                                                                           x, xd)):
         imp = impact(sm, x, xd, locks_before, locks, targets, touch,
                      restitution={k: 0.0 for k in plastic},
-                     small_velocity=small_velocity, t=t)
+                     small_velocity=small_velocity, t=t, warned=ms.ws.warned)
         xd_plus = imp.xdot_plus
         lost = imp.energy_lost
     # candidates: touching and not separating

@@ -12,7 +12,7 @@ pose the previous one reached.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -33,6 +33,8 @@ class Workspace:
         The independent coordinates of ``x``.
     parts : tuple or None
         ``(x, Parts, values)`` of the rows at ``x`` (reused by the evaluation at x).
+    warned : set
+        Keys of the warnings already given in this run (each is given once per run).
 
     Examples
     --------
@@ -46,6 +48,7 @@ class Workspace:
     B: np.ndarray | None = None
     qi: np.ndarray | None = None
     parts: tuple | None = None
+    warned: set = field(default_factory=set)
 
     def reset(self, x) -> None:
         """Restart from the pose ``x`` (n_x,): no predictor, no cached parts."""
