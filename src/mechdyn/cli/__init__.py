@@ -36,7 +36,7 @@ SUBCOMMANDS = {
     "reduce": "reduced moment of inertia and reduced torque of a 1-DOF mechanism",
     "flywheel": "steady cycle, coefficient of speed fluctuation and flywheel sizing",
     "foundation": "loads on anchor bolts and isolators; natural frequencies of the mounted base",
-    "supports": "forces of a beam on elastic supports that may lift off (influence coefficients)",
+    "supports": "forces of elastic supports that may lift off (influence coefficients)",
     "study": "design study: many variants of a model, one table row each",
     "animate": "animated GIF of the motion (a sweep of one coordinate, or a simulation)",
     "report": "self-contained HTML report: model, kinematics, kinetostatics, loads on the "
