@@ -364,19 +364,66 @@ class JointFriction:
         return {j: F for j, (F, _) in fs.by_pair(x, xdot, lam, signs=self.signs).items()}
 
     def velocity(self, joint: str, x, xdot) -> float:
-        """The pair's sliding velocity (m/s) or relative angular velocity (rad/s)."""
+        """The pair's sliding velocity (m/s) or relative angular velocity (rad/s).
+
+        Parameters
+        ----------
+        joint : str
+            A friction joint of the model.
+        x, xdot : ndarray, shape (n_x,)
+            Body poses (m, rad) and their rates (m/s, rad/s).
+
+        Returns
+        -------
+        float
+        """
         return _measure(self.model, joint).rate(x, xdot)
 
     def capacity(self, joint: str, x, lam) -> float:
         """mu S of a pair (N; mu r |R|, N m, for a pin): the largest friction the pair
-        can give at the multipliers ``lam``."""
+        can give at the multipliers ``lam``.
+
+        Parameters
+        ----------
+        joint : str
+            A friction joint of the model.
+        x : ndarray, shape (n_x,)
+            Body poses (m, rad).
+        lam : ndarray, shape (n_rows,)
+            Multipliers of the mode's rows (N, N m).
+
+        Returns
+        -------
+        float
+            N for a guide, N m for a pin.
+        """
         fs = friction_set(self.model, (joint,))
         p = fs.pairs[0]
         load = fs.loads(x, np.asarray(lam, float))[joint][0]
         return float(p.mu * (p.length if p.kind == "revolute" else 1.0) * load)
 
     def margin(self, joint: str, x, lam) -> float:
-        """Capacity minus the friction needed to hold a sticking pair (< 0: it slips)."""
+        """Capacity minus the friction needed to hold a sticking pair (< 0: it slips).
+
+        Parameters
+        ----------
+        joint : str
+            A sticking pair of this mode (a key of :attr:`stick_index`).
+        x : ndarray, shape (n_x,)
+            Body poses (m, rad).
+        lam : ndarray, shape (n_rows,)
+            Multipliers of the mode's rows (N, N m), its stick row's the holding force.
+
+        Returns
+        -------
+        float
+            N (N m for a pin).
+
+        Raises
+        ------
+        KeyError
+            ``joint`` does not stick in this mode.
+        """
         return self.capacity(joint, x, lam) - abs(float(lam[self.stick_index[joint]]))
 
     def group(self, x) -> dict | None:
