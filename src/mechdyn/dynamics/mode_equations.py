@@ -41,7 +41,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ..errors import ModelError, SingularPositionError
+from ..errors import AssemblyError, ModelError, SingularPositionError
 from ..kinematics.analogs import default_displacement
 from ..kinematics.assembly import SINGULAR_RCOND, solve_position
 from ..kinematics.branch_chart import BranchChart, ChartBook, PathProblem
@@ -53,7 +53,7 @@ from .friction import friction_joints
 from .mode_system import solve_mass
 from .modes import ModeEval
 
-__all__ = ["ModeEquations", "BACKENDS", "FORMULATIONS", "PIVOT_CHECK"]
+__all__ = ["ModeEquations", "BACKENDS", "FORMULATIONS", "PIVOT_CHECK", "STAGE_FAILURES"]
 
 #: valid values of ``backend``
 BACKENDS = ("auto", "numpy", "numba")
@@ -61,6 +61,10 @@ BACKENDS = ("auto", "numpy", "numba")
 FORMULATIONS = ("exact", "analogs")
 #: compiled path: LU pivot ratio below which a position is checked for singularity by SVD
 PIVOT_CHECK = 1e-5
+#: failed position solves at the stages of a step that reject it (the step shrinks) before
+#: the failure ends the run (diagnosed from the last accepted state): a trial step far too
+#: long may leave the assembly region that the motion itself stays in
+STAGE_FAILURES = 8
 
 
 class ModeEquations:
@@ -111,6 +115,7 @@ class ModeEquations:
         self.sm, self.ms, self.formulation = sm, ms, formulation
         self.kernel, self.note, self.book = None, "", None
         self.watching, self._s_last = True, None
+        self._anchor, self._failures = None, 0  # see anchor
         self.d = default_displacement(model)
         if formulation == "analogs":
             if ms.friction is not None:
@@ -233,7 +238,7 @@ class ModeEquations:
             numpy_path)
         book = self.book
         if book is None:
-            return base
+            return self._anchored(base)
 
         def fun(t, y):
             if book.charts:
@@ -248,7 +253,51 @@ class ModeEquations:
             ch = self._watch(s)
             return out if ch is None else self._chart_first_order(ch, t, y)
 
-        return fun
+        return self._anchored(fun)
+
+    def _anchored(self, fun):
+        """``fun`` with its position solves started from the anchor, when one is set; a
+        failed position solve there rejects the trial step (NaN rates) up to
+        :data:`STAGE_FAILURES` times after the last accepted step, then raises."""
+
+        def anchored(t, y):
+            if self._anchor is None:
+                return fun(t, y)
+            if not np.all(np.isfinite(y)):  # a stage after a failed one: rejected anyway
+                return np.full(y.size, np.nan)
+            self._to_anchor()
+            try:
+                return fun(t, y)
+            except AssemblyError:
+                self._failures += 1
+                if self._failures > STAGE_FAILURES:
+                    raise
+                self._to_anchor()
+                return np.full(y.size, np.nan)
+
+        return anchored
+
+    def anchor(self) -> None:
+        """Start the position solves of the next step's stages from the pose solved last
+        (the end of the step just accepted), every stage of every attempt of the step.
+
+        The Newton solves otherwise go on from the last pose solved, and the stages of a
+        rejected trial step may have left the assembly branch (a step ten times too long
+        through the press's open chain); its retries, and the step accepted at last,
+        would then go on on the other branch.  The compiled loop does the same for its
+        steps (:mod:`mechdyn.kernels.dop853_numba`); set by
+        :func:`mechdyn.integrate.segment.run_segment` after every accepted step.
+        """
+        ws, k = self.ms.ws, self.kernel
+        self._failures = 0
+        self._anchor = (None if k is None else k.snapshot(), ws.x, ws.B, ws.qi, ws.parts)
+
+    def _to_anchor(self) -> None:
+        saved, *kept = self._anchor
+        ws = self.ms.ws
+        ws.x, ws.B, ws.qi, ws.parts = kept
+        if saved is not None:
+            self.kernel.restore(saved)
 
     # ------------------------------------------------------------------ branch charts
     def chart_at(self, qi) -> BranchChart | None:
