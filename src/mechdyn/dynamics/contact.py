@@ -36,6 +36,7 @@ import numpy as np
 from ..errors import MechdynError
 from ..kernels import rows_numpy
 from ..model.rows import concat
+from .mode_system import mode_system
 from .modes import ModeSystem, Row, SwitchedModel
 
 __all__ = ["ContactError", "solve_lcp", "LCPResult", "resolve_mode", "constrained_inverse",
@@ -487,7 +488,7 @@ def touching(sm: SwitchedModel, x, *, gap_tol: float) -> list[str]:
 
 def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates,
                  *, slip_velocity_tol: float, force_tol: float, forced_open=(),
-                 forced_slip: dict | None = None, forced_stick=()):
+                 forced_slip: dict | None = None, forced_stick=(), workspace=None):
     """Decide which touching constraints are closed, and stick or slip, at a state.
 
     Parameters
@@ -515,6 +516,8 @@ def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates
         just broke away from sticking).
     forced_stick : iterable of str
         Contacts whose slip velocity just vanished: they are tried sticking first.
+    workspace : Workspace, optional
+        The run's workspace (:func:`~mechdyn.dynamics.mode_system.mode_system`).
 
     Returns
     -------
@@ -532,7 +535,7 @@ def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates
         return locks, {}
     forced_open = set(forced_open)
     forced_slip = dict(forced_slip or {})
-    base = ModeSystem(sm, locks, targets, x)
+    base = mode_system(sm, locks, targets, x, workspace=workspace)
     terms = base.terms(t, x, xdot)
     B, b, A, f = terms["B"], terms["b"], terms["A"], terms["f"]
     # friction state of each candidate contact

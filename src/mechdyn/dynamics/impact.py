@@ -55,7 +55,8 @@ from ..model.variable import parse_variable
 from .contact import constrained_inverse, row_terms, solve_frictional_impact, solve_lcp
 from .friction import friction_joints
 from .friction_ignored import FrictionIgnoredWarning
-from .modes import ModeSystem, Row, SwitchedModel, mass_matrix_x
+from .mode_system import mode_system
+from .modes import Row, SwitchedModel, mass_matrix_x
 from .reactions import element_forces, frame_forces
 
 __all__ = ["ImpactResult", "impact", "element_forces", "frame_forces", "frame_impulse_key"]
@@ -159,7 +160,7 @@ def _momentum(x, Q):
 
 def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets: dict,
            unilateral=(), *, restitution: dict | None = None, small_velocity: float = 0.0,
-           t=None, warned: set | None = None) -> ImpactResult:
+           t=None, warned: set | None = None, workspace=None) -> ImpactResult:
     """Velocities after locks engage and/or unilateral constraints close at pose ``x``.
 
     Parameters
@@ -190,6 +191,9 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
         The warnings already given in this run (the run's
         :attr:`~mechdyn.model.workspace.Workspace.warned`), so that each is given once per
         run; None: every call warns.
+    workspace : Workspace, optional
+        The run's workspace: the mode systems built here are those the run builds at the
+        same pose (:func:`~mechdyn.dynamics.mode_system.mode_system`).
 
     Returns
     -------
@@ -228,7 +232,7 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     """
     model = sm.model
     xdot_minus = np.asarray(xdot_minus, float)
-    base = ModeSystem(sm, frozenset(locks_before), targets, x)
+    base = mode_system(sm, frozenset(locks_before), targets, x, workspace=workspace)
     B, _ = base.velocity_analogs(x)
     G_all = base._coord_jac(x)
     # bodies, plus the rotors and gears of the drives reduced to their coordinates
@@ -278,7 +282,8 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     T0 = 0.5 * float(xdot_minus @ M @ xdot_minus)
     T1 = 0.5 * float(xdot_plus @ M @ xdot_plus)
     # impulses of every row of the mode after the impact
-    after = ModeSystem(sm, frozenset(locks_after) | frozenset(uni_tokens), targets, x)
+    after = mode_system(sm, frozenset(locks_after) | frozenset(uni_tokens), targets, x,
+                        workspace=workspace)
     R = after.row_jacobian(x)
     Q_t = Tx.T @ P_t  # the friction impulses on the bodies
     dp = M @ (xdot_plus - xdot_minus) - Q_t

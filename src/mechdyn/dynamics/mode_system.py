@@ -49,7 +49,8 @@ from .reactions import ground_rows
 if TYPE_CHECKING:
     from .modes import SwitchedModel
 
-__all__ = ["ModeSystem", "ModeEval", "mass_matrix_x", "fmt_mode", "solve_mass", "held_key"]
+__all__ = ["ModeSystem", "ModeEval", "mass_matrix_x", "fmt_mode", "solve_mass", "held_key",
+           "mode_system"]
 
 
 def fmt_mode(mode) -> str:
@@ -145,22 +146,20 @@ class ModeSystem:
         self.element_rows = lay.element_rows
         self._slip = lay.friction if len(lay.slip_rows) else None
         self.x_ref = np.array(x, float)
+        self.ws = Workspace() if workspace is None else workspace
         # the rows and coordinates chosen at a pose: a pure function of (mode, held values,
         # pose) and (prefer, avoid), kept for the instant (an event builds the same mode at
-        # the same pose several times: impact, complementarity, the new segment), in
-        # model.memo (those of the last pose only)
+        # the same pose several times: impact, complementarity, the new segment) in the
+        # run's workspace (those of the last pose only)
         held = held_key(self.targets)
-        pose = self.x_ref.tobytes()
-        at = model.memo.get("mode coordinates")
-        if at is None or at[0] != pose:
-            at = model.memo["mode coordinates"] = (pose, {})
-        kept = at[1].get((self.mode, held)) if held is not None else None
+        at = _at_pose(self.ws, self.x_ref)
+        kept = at.get((self.mode, held)) if held is not None else None
         if kept is None:
             Rs = _scaled(model, self.row_jacobian(self.x_ref), self.rowset.is_angle)
             rows_i = _independent_rows(Rs)
             kept = {"rows": rows_i, "GN": self._coordinates_on_null_space(Rs[rows_i])}
             if held is not None:
-                at[1][self.mode, held] = kept
+                at[self.mode, held] = kept
         self.independent_rows = kept["rows"].copy()
         self.dof = model.n_x - len(self.independent_rows)
         choice = (tuple(prefer), tuple(avoid))
@@ -176,7 +175,6 @@ class ModeSystem:
         self._eye_i = np.zeros((model.n_x, self.n_i))
         self._eye_i[len(self.independent_rows):, :] = np.eye(self.n_i)
         self._rs = 1.0 / _scale(model)
-        self.ws = Workspace() if workspace is None else workspace
         self.ws.reset(self.x_ref)
         #: the friction of the joints in this mode (None for a model without it)
         self.friction = JointFriction(self) if friction_joints(model) else None
@@ -481,6 +479,49 @@ def held_key(targets: dict) -> tuple | None:
         return tuple(sorted((k, held(v)) for k, v in targets.items()))
     except (TypeError, ValueError):
         return None
+
+
+def _at_pose(ws: Workspace, x) -> dict:
+    """What the run (``ws``) keeps for the pose ``x``: the entries of the last pose only."""
+    pose = np.asarray(x, float).tobytes()
+    if ws.at_pose is None or ws.at_pose[0] != pose:
+        ws.at_pose = (pose, {})
+    return ws.at_pose[1]
+
+
+def mode_system(sm: SwitchedModel, mode, targets: dict, x, *, prefer=(), avoid=(),
+                workspace: Workspace | None = None) -> ModeSystem:
+    """The :class:`ModeSystem` of ``mode`` at the pose ``x``: the one the run built there
+    with the same held values and choices if it did (a switching instant builds the same
+    mode at its pose for the impact, the complementarity and the next segment), restarted
+    at ``x`` as a new one would be; else a new one (then kept for this pose).  Without a
+    ``workspace``, or with friction in the joints (whose mode systems carry the pairs'
+    states), always a new one.
+
+    Examples
+    --------
+    >>> import mechdyn
+    >>> from mechdyn.dynamics.modes import switched_model
+    >>> from mechdyn.model.workspace import Workspace
+    >>> sm = switched_model(mechdyn.examples.load("press_cycle").compile())
+    >>> ws, x = Workspace(), sm.model.x_sketch
+    >>> a = mode_system(sm, frozenset(), {}, x, workspace=ws)
+    >>> a is mode_system(sm, frozenset(), {}, x, workspace=ws), a.coord_names
+    (True, ('phi', 'psi', 'p'))
+    """
+    held = held_key(targets)
+    if workspace is None or held is None or friction_joints(sm.model):
+        return ModeSystem(sm, mode, targets, x, prefer=prefer, avoid=avoid,
+                          workspace=workspace)
+    key = ("system", Mode(mode), held, tuple(prefer), tuple(avoid))
+    at = _at_pose(workspace, x)
+    ms = at.get(key)
+    if ms is None or ms.x_ref.tobytes() != workspace.at_pose[0]:
+        ms = ModeSystem(sm, mode, targets, x, prefer=prefer, avoid=avoid, workspace=workspace)
+        _at_pose(workspace, x)[key] = ms
+    else:
+        ms.ws.reset(ms.x_ref)
+    return ms
 
 
 def _mode_rows(sm: SwitchedModel, mode: Mode, targets: dict):
