@@ -16,13 +16,13 @@ the new constraint rows are C = Phi_new,x B:
 * unilateral rows with Newton's restitution e: the impulses P >= 0 and the
   rows' velocities after the impact v+ >= e max(0, -v-) are complementary
   (v+ = -e v- on every row that receives an impulse), a velocity-level LCP
-  solved by :func:`mechdyn.dynamics.contact.solve_lcp`;
+  solved by :func:`mechdyn.dynamics.complementarity.solve_lcp`;
 * Coulomb friction in the impact, on contacts and on point stops with ``friction``
   mu > 0: a tangential impulse P_t along the contact line (the other ground axis for
   a stop on ``body.point.y|x``) with |P_t| <= mu P_n.  The contact sticks (its
   tangential velocity after the impact is zero) when the impulse that stops the
   sliding lies in the cone, and otherwise slides with P_t = -mu P_n sgn(v_t+)
-  (:func:`mechdyn.dynamics.contact.solve_frictional_impact`: Newton's restitution on
+  (:func:`mechdyn.dynamics.complementarity.solve_frictional_impact`: Newton's restitution on
   the normal velocity with Coulomb's law at the impulse level, the friction impulse
   opposing the sliding after the impact; when the sliding keeps its direction through
   the impact this is Routh's result, sgn(v_t+) = sgn(v_t-)).
@@ -52,7 +52,8 @@ import numpy as np
 
 from ..kernels import rows_numpy
 from ..model.variable import parse_variable
-from .contact import constrained_inverse, row_terms, solve_frictional_impact, solve_lcp
+from .complementarity import constrained_inverse, solve_frictional_impact, solve_lcp
+from .contact import row_terms
 from .friction import friction_joints
 from .friction_ignored import FrictionIgnoredWarning
 from .mode_system import mode_system
