@@ -267,7 +267,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
 
             def after_step(step, y, eqs=eqs, evaluate=evaluate, ms=ms):
                 nonlocal good
-                if not np.all(np.isfinite(y)):
+                if not np.isfinite(y).all():
                     raise Stop(Status.NON_FINITE, f"non-finite state at t = {step.t:.9g} s "
                                f"after t = {good[0]:.9g} s")
                 turn = turning_point(eqs, step, good[1].qdot[ms.coords], good[1].x)

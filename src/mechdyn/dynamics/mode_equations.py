@@ -158,6 +158,8 @@ class ModeEquations:
         # the kernel's multipliers are those of the independent rows: all of them unless
         # the mode has redundant rows (their share is chosen on the NumPy path)
         self._full = len(ms.independent_rows) == ms.n_rows
+        self._in_order = self._full and np.array_equal(ms.independent_rows,
+                                                       np.arange(ms.n_rows))
 
     # ------------------------------------------------------------------ evaluation
     def evaluate(self, t: float, qi, qdi) -> ModeEval:
@@ -176,6 +178,8 @@ class ModeEquations:
         if self.kernel is not None and self._full:
             k = self.kernel.evaluation(t, qi, qdi)
             if k is not None:
+                if self._in_order:  # the kernel's rows are the mode's, in order
+                    return ModeEval(*k)
                 lam = np.zeros(ms.n_rows)
                 lam[ms.independent_rows] = k[6]
                 return ModeEval(*k[:6], lam, k[7])
