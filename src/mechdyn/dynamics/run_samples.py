@@ -125,18 +125,20 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
     frame, res, p_f = np.zeros((n, 3)), np.zeros(n), np.zeros(n)
     forces: dict = {el: np.zeros((n, *shape)) for el, shape in (shapes or {}).items()}
     starts = [k for k in range(n) if k == 0 or rec[k][1] is not rec[k - 1][1]] + [n]
+    # the frame also carries the load elements anchored on it (spring ends, torque
+    # reactions) and the stators of the drives between it and the bodies: the loads do not
+    # depend on the mode, so they are evaluated over every sample at once
+    _, on_ground, Qd = sm.fm.loads(t, x, xd, q, qd)
+    on_ground[:, 2] -= point[0] * on_ground[:, 1] - point[1] * on_ground[:, 0]  # about P
+    drives = np.einsum("nqx,nq->nx", RN.jacobian(model.coordinate_rows, x), Qd)
+    stators = net_on_ground(model, x, drives, point)
     for a, b in zip(starts[:-1], starts[1:], strict=True):
         ms, sl = rec[a][1], slice(a, b)
         lam = np.array([r[2].lam for r in rec[a:b]], float).reshape(b - a, ms.n_rows)
         parts = RN.Parts(ms.rowset, x[sl])  # the rows' Jacobian and values share them
         R = RN.jacobian(ms.rowset, x[sl], parts)
-        # the frame also carries the load elements anchored on it (spring ends, torque
-        # reactions) and the stators of the drives between it and the bodies
-        _, on_ground, Qd = sm.fm.loads(t[sl], x[sl], xd[sl], q[sl], qd[sl])
-        on_ground[:, 2] -= point[0] * on_ground[:, 1] - point[1] * on_ground[:, 0]  # about P
-        drives = np.einsum("nqx,nq->nx", RN.jacobian(model.coordinate_rows, x[sl]), Qd)
-        frame[sl] = (frame_forces(ms, x[sl], lam, point=point, R=R)["total"] + on_ground
-                     + net_on_ground(model, x[sl], drives, point))
+        frame[sl] = (frame_forces(ms, x[sl], lam, point=point, R=R)["total"] + on_ground[sl]
+                     + stators[sl])
         pairs = None
         if ms.friction is not None:
             # the friction of the pairs: a pair between two bodies adds no net force or
