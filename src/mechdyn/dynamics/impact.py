@@ -56,6 +56,7 @@ from .complementarity import constrained_inverse, solve_frictional_impact, solve
 from .contact import row_terms
 from .friction import friction_joints
 from .friction_ignored import FrictionIgnoredWarning
+from .mode_rows import ModeRows
 from .mode_system import mode_system
 from .modes import Row, SwitchedModel, mass_matrix_x
 from .reactions import element_forces, frame_forces
@@ -282,9 +283,8 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     xdot_plus = B @ qd_plus
     T0 = 0.5 * float(xdot_minus @ M @ xdot_minus)
     T1 = 0.5 * float(xdot_plus @ M @ xdot_plus)
-    # impulses of every row of the mode after the impact
-    after = mode_system(sm, frozenset(locks_after) | frozenset(uni_tokens), targets, x,
-                        workspace=workspace)
+    # impulses of every row of the mode after the impact (its rows alone: no coordinates)
+    after = ModeRows(sm, frozenset(locks_after) | frozenset(uni_tokens), targets)
     R = after.row_jacobian(x)
     Q_t = Tx.T @ P_t  # the friction impulses on the bodies
     dp = M @ (xdot_plus - xdot_minus) - Q_t

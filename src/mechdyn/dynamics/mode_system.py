@@ -30,7 +30,6 @@ and locks follow from the multipliers in :mod:`mechdyn.dynamics.reactions`.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -38,13 +37,12 @@ import numpy as np
 from ..errors import AssemblyError, IntegrationError, LockupError
 from ..kernels import rows_numpy as RN
 from ..kinematics.assembly import _position_tol, _scale, _scaled, _singular_report, newton
-from ..model import ConstraintLayout
 from ..model.state import Mode
 from ..model.workspace import Workspace
 from .friction import friction_joints
 from .inertia import mass_matrix_x
-from .joint_friction import JointFriction, split_mode, stick_row
-from .reactions import ground_rows
+from .joint_friction import JointFriction
+from .mode_rows import ModeRows, held_key
 
 if TYPE_CHECKING:
     from .modes import SwitchedModel
@@ -93,7 +91,7 @@ class ModeEval:
     F_friction: np.ndarray | None = field(repr=False, default=None)
 
 
-class ModeSystem:
+class ModeSystem(ModeRows):
     """The constraint rows, independent coordinates and dynamics of one mode.
 
     Parameters
@@ -134,16 +132,8 @@ class ModeSystem:
 
     def __init__(self, sm: SwitchedModel, mode, targets: dict, x, *, prefer=(), avoid=(),
                  workspace: Workspace | None = None):
-        self.sm = sm
-        model = sm.model
-        self.model = model
-        self.mode = Mode(mode)
-        self.targets = dict(targets)
-        self.rows, self.layout = _mode_rows(sm, self.mode, self.targets)
-        lay = self.layout
-        self.rowset, self.n_rows, self.n_base = lay.rowset, lay.n_rows, lay.n_base
-        #: the rows of each element (joint, lock, stop, contact), indices into rowset
-        self.element_rows = lay.element_rows
+        super().__init__(sm, mode, targets)
+        model, lay = self.model, self.layout
         self._slip = lay.friction if len(lay.slip_rows) else None
         self.x_ref = np.array(x, float)
         self.ws = Workspace() if workspace is None else workspace
@@ -211,29 +201,6 @@ class ModeSystem:
                 f"mode {fmt_mode(self.mode)} leaves {self.dof} degree(s) of freedom that "
                 f"the declared coordinates ({', '.join(names)}) cannot describe")
         return chosen
-
-    # ------------------------------------------------------------------ rows
-    def row_values(self, x) -> np.ndarray:
-        """Residuals of every row of :attr:`rowset`, shape (n_rows,), m or rad."""
-        return RN.values(self.rowset, x)
-
-    def row_jacobian(self, x) -> np.ndarray:
-        """Jacobian of every row, shape (n_rows, n_x)."""
-        return RN.jacobian(self.rowset, x)
-
-    def row_labels(self) -> list[str]:
-        """A label per row (joint name + component, then the switchable rows)."""
-        return list(self.rowset.labels)
-
-    def row_elements(self) -> list[str]:
-        """The element (joint, lock, stop, contact) of each row."""
-        return list(self.rowset.elements)
-
-    @cached_property
-    def grounded(self) -> frozenset:
-        """The elements whose rows act between the frame and the moving bodies."""
-        on_ground = ground_rows(self.rowset)
-        return frozenset(el for el, idx in self.element_rows.items() if np.any(on_ground[idx]))
 
     def _coord_jac(self, x) -> np.ndarray:
         """Jacobian of all declared coordinates, shape (n_q, n_x)."""
@@ -457,30 +424,6 @@ def solve_mass(names, A, rhs, t, q) -> np.ndarray:
             f"no inertia", t=t, q=q) from None
 
 
-#: (mode, held values) kept per model with their rows and layout (bounded: locks that
-#: capture a new held value every cycle make a new entry each time)
-MODE_ROWS_KEPT = 64
-
-
-def held_key(targets: dict) -> tuple | None:
-    """The held values of the engaged locks and sticking contacts as a hashable key (their
-    names and bytes), equal for equal values; None for a held value that is not numbers.
-
-    Examples
-    --------
-    >>> held_key({"lock": 0.5}) == held_key({"lock": 0.5}), held_key({"lock": 0.5}) == ()
-    (True, False)
-    """
-    def held(value) -> bytes:
-        parts = value if isinstance(value, tuple) else (value,)
-        return np.concatenate([np.ravel(np.asarray(p, float)) for p in parts]).tobytes()
-
-    try:
-        return tuple(sorted((k, held(v)) for k, v in targets.items()))
-    except (TypeError, ValueError):
-        return None
-
-
 def _at_pose(ws: Workspace, x) -> dict:
     """What the run (``ws``) keeps for the pose ``x``: the entries of the last pose only."""
     pose = np.asarray(x, float).tobytes()
@@ -522,25 +465,6 @@ def mode_system(sm: SwitchedModel, mode, targets: dict, x, *, prefer=(), avoid=(
     else:
         ms.ws.reset(ms.x_ref)
     return ms
-
-
-def _mode_rows(sm: SwitchedModel, mode: Mode, targets: dict):
-    """(switchable rows, :class:`~mechdyn.model.ConstraintLayout`) of a mode with its held
-    values: pure data of the compiled model, kept in ``model.memo`` so that the runs of a
-    model build them once (the rows list is the caller's own copy)."""
-    model = sm.model
-    held = held_key(targets)
-    key = None if held is None else (mode, held)  # a held value that is not numbers: not kept
-    kept = model.memo.setdefault("mode rows", {})
-    got = kept.get(key) if key is not None else None
-    if got is None:
-        base, jstates = split_mode(model, mode)
-        rows = sm.rows(base, targets) + [stick_row(model, j, targets)
-                                         for j, s in sorted(jstates.items()) if s == "stick"]
-        got = (tuple(rows), ConstraintLayout(model, mode, rows))
-        if key is not None and len(kept) < MODE_ROWS_KEPT:
-            kept[key] = got
-    return list(got[0]), got[1]
 
 
 def _independent_rows(Rs, tol=1e-9) -> np.ndarray:
