@@ -115,7 +115,7 @@ class ModeEquations:
         self.sm, self.ms, self.formulation = sm, ms, formulation
         self.kernel, self.note, self.book = None, "", None
         self.watching, self._s_last = True, None
-        self._anchor, self._failures = None, 0  # see anchor
+        self._anchor, self._failures, self._rejects = None, 0, 0  # see anchor
         self.d = default_displacement(model)
         if formulation == "analogs":
             if ms.friction is not None:
@@ -274,16 +274,18 @@ class ModeEquations:
                 return fun(t, y)
             except AssemblyError:
                 self._failures += 1
-                if self._failures > STAGE_FAILURES:
+                if self._failures > self._rejects:
                     raise
                 self._to_anchor()
                 return np.full(y.size, np.nan)
 
         return anchored
 
-    def anchor(self) -> None:
+    def anchor(self, reject_failures: bool = True) -> None:
         """Start the position solves of the next step's stages from the pose solved last
-        (the end of the step just accepted), every stage of every attempt of the step.
+        (the end of the step just accepted), every stage of every attempt of the step;
+        with ``reject_failures``, a failed solve returns NaN rates (an integrator that
+        rejects such a step shrinks it) up to :data:`STAGE_FAILURES` times, else raises.
 
         The Newton solves otherwise go on from the last pose solved, and the stages of a
         rejected trial step may have left the assembly branch (a step ten times too long
@@ -293,7 +295,7 @@ class ModeEquations:
         :func:`mechdyn.integrate.segment.run_segment` after every accepted step.
         """
         ws, k = self.ms.ws, self.kernel
-        self._failures = 0
+        self._failures, self._rejects = 0, STAGE_FAILURES if reject_failures else 0
         self._anchor = (None if k is None else k.snapshot(), ws.x, ws.B, ws.qi, ws.parts)
 
     def _to_anchor(self) -> None:
