@@ -19,7 +19,9 @@ def rocker_driven():
 
 
 @pytest.mark.parametrize("integrator, opts", [("dop853", {}), ("rk4", {"steps": 1000}),
-                                              ("wilson", {"steps": 1000})])
+                                              ("wilson", {"steps": 1000}),
+                                              ("scipy-dop853", {}), ("rk45", {}), ("bdf", {}),
+                                              ("lsoda", {})])
 def test_runs_into_dead_position(integrator, opts):
     tr = simulate(rocker_driven(), 1.0, integrator=integrator, progress=False, **opts)
     assert tr.status == "singular-position"

@@ -71,6 +71,11 @@ class CompiledKernel:
         self.compile_time = compile_time
         self.status = 0
         self._st = np.zeros(1, dtype=np.int64)
+        # the parts of ``full``'s extended output: x'' | q | q' | q'' | lambda | F
+        nq, nc = int(dims[D_NQ]), int(dims[D_NC])
+        ends = np.cumsum([0, n_x, nq, nq, nq, nc, n_x]).tolist()
+        self._ext_size = ends[-1]
+        self._ext_parts = tuple(zip(ends[:-1], ends[1:], strict=True))
 
     @property
     def x(self) -> np.ndarray:
@@ -123,12 +128,11 @@ class CompiledKernel:
         xddot, q, qdot, qddot, lam, F)``, x and its rates (n_x,), every declared
         coordinate (n_q,), the multipliers (n_c,) of the constraint rows
         (M x'' + h - F = Phi_x^T lambda) and the applied forces with the drives (n_x,)."""
-        nx, nq, nc = self.n_x, int(self.dims[D_NQ]), int(self.dims[D_NC])
-        ext = np.empty(nx + 3 * nq + nc + nx)
+        ext = np.empty(self._ext_size)
         if not self._run(full, t, np.asarray(q, np.float64), np.asarray(qdot, np.float64),
                          *self._arrays, self.ws, np.empty(2 * self.n_i + 1), ext):
             return None
-        return (self.x.copy(), self.xdot.copy(), *np.split(ext, np.cumsum([nx, nq, nq, nq, nc])))
+        return (self.x.copy(), self.xdot.copy(), *(ext[a:b] for a, b in self._ext_parts))
 
     def snapshot(self) -> np.ndarray:
         """A copy of the workspace (last pose, analogs, flags), for :meth:`restore`."""

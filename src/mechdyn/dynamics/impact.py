@@ -16,13 +16,13 @@ the new constraint rows are C = Phi_new,x B:
 * unilateral rows with Newton's restitution e: the impulses P >= 0 and the
   rows' velocities after the impact v+ >= e max(0, -v-) are complementary
   (v+ = -e v- on every row that receives an impulse), a velocity-level LCP
-  solved by :func:`mechdyn.dynamics.contact.solve_lcp`;
+  solved by :func:`mechdyn.dynamics.complementarity.solve_lcp`;
 * Coulomb friction in the impact, on contacts and on point stops with ``friction``
   mu > 0: a tangential impulse P_t along the contact line (the other ground axis for
   a stop on ``body.point.y|x``) with |P_t| <= mu P_n.  The contact sticks (its
   tangential velocity after the impact is zero) when the impulse that stops the
   sliding lies in the cone, and otherwise slides with P_t = -mu P_n sgn(v_t+)
-  (:func:`mechdyn.dynamics.contact.solve_frictional_impact`: Newton's restitution on
+  (:func:`mechdyn.dynamics.complementarity.solve_frictional_impact`: Newton's restitution on
   the normal velocity with Coulomb's law at the impulse level, the friction impulse
   opposing the sliding after the impact; when the sliding keeps its direction through
   the impact this is Routh's result, sgn(v_t+) = sgn(v_t-)).
@@ -52,10 +52,13 @@ import numpy as np
 
 from ..kernels import rows_numpy
 from ..model.variable import parse_variable
-from .contact import constrained_inverse, row_terms, solve_frictional_impact, solve_lcp
+from .complementarity import constrained_inverse, solve_frictional_impact, solve_lcp
+from .contact import row_terms
 from .friction import friction_joints
 from .friction_ignored import FrictionIgnoredWarning
-from .modes import ModeSystem, Row, SwitchedModel, mass_matrix_x
+from .mode_rows import ModeRows
+from .mode_system import mode_system
+from .modes import Row, SwitchedModel, mass_matrix_x
 from .reactions import element_forces, frame_forces
 
 __all__ = ["ImpactResult", "impact", "element_forces", "frame_forces", "frame_impulse_key"]
@@ -159,7 +162,7 @@ def _momentum(x, Q):
 
 def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets: dict,
            unilateral=(), *, restitution: dict | None = None, small_velocity: float = 0.0,
-           t=None, warned: set | None = None) -> ImpactResult:
+           t=None, warned: set | None = None, workspace=None) -> ImpactResult:
     """Velocities after locks engage and/or unilateral constraints close at pose ``x``.
 
     Parameters
@@ -190,6 +193,9 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
         The warnings already given in this run (the run's
         :attr:`~mechdyn.model.workspace.Workspace.warned`), so that each is given once per
         run; None: every call warns.
+    workspace : Workspace, optional
+        The run's workspace: the mode systems built here are those the run builds at the
+        same pose (:func:`~mechdyn.dynamics.mode_system.mode_system`).
 
     Returns
     -------
@@ -228,7 +234,7 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     """
     model = sm.model
     xdot_minus = np.asarray(xdot_minus, float)
-    base = ModeSystem(sm, frozenset(locks_before), targets, x)
+    base = mode_system(sm, frozenset(locks_before), targets, x, workspace=workspace)
     B, _ = base.velocity_analogs(x)
     G_all = base._coord_jac(x)
     # bodies, plus the rotors and gears of the drives reduced to their coordinates
@@ -277,8 +283,8 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     xdot_plus = B @ qd_plus
     T0 = 0.5 * float(xdot_minus @ M @ xdot_minus)
     T1 = 0.5 * float(xdot_plus @ M @ xdot_plus)
-    # impulses of every row of the mode after the impact
-    after = ModeSystem(sm, frozenset(locks_after) | frozenset(uni_tokens), targets, x)
+    # impulses of every row of the mode after the impact (its rows alone: no coordinates)
+    after = ModeRows(sm, frozenset(locks_after) | frozenset(uni_tokens), targets)
     R = after.row_jacobian(x)
     Q_t = Tx.T @ P_t  # the friction impulses on the bodies
     dp = M @ (xdot_plus - xdot_minus) - Q_t

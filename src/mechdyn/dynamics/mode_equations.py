@@ -41,7 +41,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ..errors import ModelError, SingularPositionError
+from ..errors import AssemblyError, ModelError, SingularPositionError
 from ..kinematics.analogs import default_displacement
 from ..kinematics.assembly import SINGULAR_RCOND, solve_position
 from ..kinematics.branch_chart import BranchChart, ChartBook, PathProblem
@@ -53,7 +53,7 @@ from .friction import friction_joints
 from .mode_system import solve_mass
 from .modes import ModeEval
 
-__all__ = ["ModeEquations", "BACKENDS", "FORMULATIONS", "PIVOT_CHECK"]
+__all__ = ["ModeEquations", "BACKENDS", "FORMULATIONS", "PIVOT_CHECK", "STAGE_FAILURES"]
 
 #: valid values of ``backend``
 BACKENDS = ("auto", "numpy", "numba")
@@ -61,6 +61,10 @@ BACKENDS = ("auto", "numpy", "numba")
 FORMULATIONS = ("exact", "analogs")
 #: compiled path: LU pivot ratio below which a position is checked for singularity by SVD
 PIVOT_CHECK = 1e-5
+#: failed position solves at the stages of a step that reject it (the step shrinks) before
+#: the failure ends the run (diagnosed from the last accepted state): a trial step far too
+#: long may leave the assembly region that the motion itself stays in
+STAGE_FAILURES = 8
 
 
 class ModeEquations:
@@ -111,6 +115,7 @@ class ModeEquations:
         self.sm, self.ms, self.formulation = sm, ms, formulation
         self.kernel, self.note, self.book = None, "", None
         self.watching, self._s_last = True, None
+        self._anchor, self._failures, self._rejects = None, 0, 0  # see anchor
         self.d = default_displacement(model)
         if formulation == "analogs":
             if ms.friction is not None:
@@ -153,6 +158,8 @@ class ModeEquations:
         # the kernel's multipliers are those of the independent rows: all of them unless
         # the mode has redundant rows (their share is chosen on the NumPy path)
         self._full = len(ms.independent_rows) == ms.n_rows
+        self._in_order = self._full and np.array_equal(ms.independent_rows,
+                                                       np.arange(ms.n_rows))
 
     # ------------------------------------------------------------------ evaluation
     def evaluate(self, t: float, qi, qdi) -> ModeEval:
@@ -171,6 +178,8 @@ class ModeEquations:
         if self.kernel is not None and self._full:
             k = self.kernel.evaluation(t, qi, qdi)
             if k is not None:
+                if self._in_order:  # the kernel's rows are the mode's, in order
+                    return ModeEval(*k)
                 lam = np.zeros(ms.n_rows)
                 lam[ms.independent_rows] = k[6]
                 return ModeEval(*k[:6], lam, k[7])
@@ -233,7 +242,7 @@ class ModeEquations:
             numpy_path)
         book = self.book
         if book is None:
-            return base
+            return self._anchored(base)
 
         def fun(t, y):
             if book.charts:
@@ -248,7 +257,53 @@ class ModeEquations:
             ch = self._watch(s)
             return out if ch is None else self._chart_first_order(ch, t, y)
 
-        return fun
+        return self._anchored(fun)
+
+    def _anchored(self, fun):
+        """``fun`` with its position solves started from the anchor, when one is set; a
+        failed position solve there rejects the trial step (NaN rates) up to
+        :data:`STAGE_FAILURES` times after the last accepted step, then raises."""
+
+        def anchored(t, y):
+            if self._anchor is None:
+                return fun(t, y)
+            if not np.all(np.isfinite(y)):  # a stage after a failed one: rejected anyway
+                return np.full(y.size, np.nan)
+            self._to_anchor()
+            try:
+                return fun(t, y)
+            except AssemblyError:
+                self._failures += 1
+                if self._failures > self._rejects:
+                    raise
+                self._to_anchor()
+                return np.full(y.size, np.nan)
+
+        return anchored
+
+    def anchor(self, reject_failures: bool = True) -> None:
+        """Start the position solves of the next step's stages from the pose solved last
+        (the end of the step just accepted), every stage of every attempt of the step;
+        with ``reject_failures``, a failed solve returns NaN rates (an integrator that
+        rejects such a step shrinks it) up to :data:`STAGE_FAILURES` times, else raises.
+
+        The Newton solves otherwise go on from the last pose solved, and the stages of a
+        rejected trial step may have left the assembly branch (a step ten times too long
+        through the press's open chain); its retries, and the step accepted at last,
+        would then go on on the other branch.  The compiled loop does the same for its
+        steps (:mod:`mechdyn.kernels.dop853_numba`); set by
+        :func:`mechdyn.integrate.segment.run_segment` after every accepted step.
+        """
+        ws, k = self.ms.ws, self.kernel
+        self._failures, self._rejects = 0, STAGE_FAILURES if reject_failures else 0
+        self._anchor = (None if k is None else k.snapshot(), ws.x, ws.B, ws.qi, ws.parts)
+
+    def _to_anchor(self) -> None:
+        saved, *kept = self._anchor
+        ws = self.ms.ws
+        ws.x, ws.B, ws.qi, ws.parts = kept
+        if saved is not None:
+            self.kernel.restore(saved)
 
     # ------------------------------------------------------------------ branch charts
     def chart_at(self, qi) -> BranchChart | None:

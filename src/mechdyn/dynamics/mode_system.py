@@ -30,7 +30,6 @@ and locks follow from the multipliers in :mod:`mechdyn.dynamics.reactions`.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -38,18 +37,18 @@ import numpy as np
 from ..errors import AssemblyError, IntegrationError, LockupError
 from ..kernels import rows_numpy as RN
 from ..kinematics.assembly import _position_tol, _scale, _scaled, _singular_report, newton
-from ..model import ConstraintLayout
 from ..model.state import Mode
 from ..model.workspace import Workspace
 from .friction import friction_joints
 from .inertia import mass_matrix_x
-from .joint_friction import JointFriction, split_mode, stick_row
-from .reactions import ground_rows
+from .joint_friction import JointFriction
+from .mode_rows import ModeRows, held_key
 
 if TYPE_CHECKING:
     from .modes import SwitchedModel
 
-__all__ = ["ModeSystem", "ModeEval", "mass_matrix_x", "fmt_mode", "solve_mass", "held_key"]
+__all__ = ["ModeSystem", "ModeEval", "mass_matrix_x", "fmt_mode", "solve_mass", "held_key",
+           "mode_system"]
 
 
 def fmt_mode(mode) -> str:
@@ -92,7 +91,7 @@ class ModeEval:
     F_friction: np.ndarray | None = field(repr=False, default=None)
 
 
-class ModeSystem:
+class ModeSystem(ModeRows):
     """The constraint rows, independent coordinates and dynamics of one mode.
 
     Parameters
@@ -133,34 +132,24 @@ class ModeSystem:
 
     def __init__(self, sm: SwitchedModel, mode, targets: dict, x, *, prefer=(), avoid=(),
                  workspace: Workspace | None = None):
-        self.sm = sm
-        model = sm.model
-        self.model = model
-        self.mode = Mode(mode)
-        self.targets = dict(targets)
-        self.rows, self.layout = _mode_rows(sm, self.mode, self.targets)
-        lay = self.layout
-        self.rowset, self.n_rows, self.n_base = lay.rowset, lay.n_rows, lay.n_base
-        #: the rows of each element (joint, lock, stop, contact), indices into rowset
-        self.element_rows = lay.element_rows
+        super().__init__(sm, mode, targets)
+        model, lay = self.model, self.layout
         self._slip = lay.friction if len(lay.slip_rows) else None
         self.x_ref = np.array(x, float)
+        self.ws = Workspace() if workspace is None else workspace
         # the rows and coordinates chosen at a pose: a pure function of (mode, held values,
         # pose) and (prefer, avoid), kept for the instant (an event builds the same mode at
-        # the same pose several times: impact, complementarity, the new segment), in
-        # model.memo (those of the last pose only)
+        # the same pose several times: impact, complementarity, the new segment) in the
+        # run's workspace (those of the last pose only)
         held = held_key(self.targets)
-        pose = self.x_ref.tobytes()
-        at = model.memo.get("mode coordinates")
-        if at is None or at[0] != pose:
-            at = model.memo["mode coordinates"] = (pose, {})
-        kept = at[1].get((self.mode, held)) if held is not None else None
+        at = _at_pose(self.ws, self.x_ref)
+        kept = at.get((self.mode, held)) if held is not None else None
         if kept is None:
             Rs = _scaled(model, self.row_jacobian(self.x_ref), self.rowset.is_angle)
             rows_i = _independent_rows(Rs)
             kept = {"rows": rows_i, "GN": self._coordinates_on_null_space(Rs[rows_i])}
             if held is not None:
-                at[1][self.mode, held] = kept
+                at[self.mode, held] = kept
         self.independent_rows = kept["rows"].copy()
         self.dof = model.n_x - len(self.independent_rows)
         choice = (tuple(prefer), tuple(avoid))
@@ -176,7 +165,6 @@ class ModeSystem:
         self._eye_i = np.zeros((model.n_x, self.n_i))
         self._eye_i[len(self.independent_rows):, :] = np.eye(self.n_i)
         self._rs = 1.0 / _scale(model)
-        self.ws = Workspace() if workspace is None else workspace
         self.ws.reset(self.x_ref)
         #: the friction of the joints in this mode (None for a model without it)
         self.friction = JointFriction(self) if friction_joints(model) else None
@@ -213,29 +201,6 @@ class ModeSystem:
                 f"mode {fmt_mode(self.mode)} leaves {self.dof} degree(s) of freedom that "
                 f"the declared coordinates ({', '.join(names)}) cannot describe")
         return chosen
-
-    # ------------------------------------------------------------------ rows
-    def row_values(self, x) -> np.ndarray:
-        """Residuals of every row of :attr:`rowset`, shape (n_rows,), m or rad."""
-        return RN.values(self.rowset, x)
-
-    def row_jacobian(self, x) -> np.ndarray:
-        """Jacobian of every row, shape (n_rows, n_x)."""
-        return RN.jacobian(self.rowset, x)
-
-    def row_labels(self) -> list[str]:
-        """A label per row (joint name + component, then the switchable rows)."""
-        return list(self.rowset.labels)
-
-    def row_elements(self) -> list[str]:
-        """The element (joint, lock, stop, contact) of each row."""
-        return list(self.rowset.elements)
-
-    @cached_property
-    def grounded(self) -> frozenset:
-        """The elements whose rows act between the frame and the moving bodies."""
-        on_ground = ground_rows(self.rowset)
-        return frozenset(el for el, idx in self.element_rows.items() if np.any(on_ground[idx]))
 
     def _coord_jac(self, x) -> np.ndarray:
         """Jacobian of all declared coordinates, shape (n_q, n_x)."""
@@ -459,47 +424,47 @@ def solve_mass(names, A, rhs, t, q) -> np.ndarray:
             f"no inertia", t=t, q=q) from None
 
 
-#: (mode, held values) kept per model with their rows and layout (bounded: locks that
-#: capture a new held value every cycle make a new entry each time)
-MODE_ROWS_KEPT = 64
+def _at_pose(ws: Workspace, x) -> dict:
+    """What the run (``ws``) keeps for the pose ``x``: the entries of the last pose only."""
+    pose = np.asarray(x, float).tobytes()
+    if ws.at_pose is None or ws.at_pose[0] != pose:
+        ws.at_pose = (pose, {})
+    return ws.at_pose[1]
 
 
-def held_key(targets: dict) -> tuple | None:
-    """The held values of the engaged locks and sticking contacts as a hashable key (their
-    names and bytes), equal for equal values; None for a held value that is not numbers.
+def mode_system(sm: SwitchedModel, mode, targets: dict, x, *, prefer=(), avoid=(),
+                workspace: Workspace | None = None) -> ModeSystem:
+    """The :class:`ModeSystem` of ``mode`` at the pose ``x``: the one the run built there
+    with the same held values and choices if it did (a switching instant builds the same
+    mode at its pose for the impact, the complementarity and the next segment), restarted
+    at ``x`` as a new one would be; else a new one (then kept for this pose).  Without a
+    ``workspace``, or with friction in the joints (whose mode systems carry the pairs'
+    states), always a new one.
 
     Examples
     --------
-    >>> held_key({"lock": 0.5}) == held_key({"lock": 0.5}), held_key({"lock": 0.5}) == ()
-    (True, False)
+    >>> import mechdyn
+    >>> from mechdyn.dynamics.modes import switched_model
+    >>> from mechdyn.model.workspace import Workspace
+    >>> sm = switched_model(mechdyn.examples.load("press_cycle").compile())
+    >>> ws, x = Workspace(), sm.model.x_sketch
+    >>> a = mode_system(sm, frozenset(), {}, x, workspace=ws)
+    >>> a is mode_system(sm, frozenset(), {}, x, workspace=ws), a.coord_names
+    (True, ('phi', 'psi', 'p'))
     """
-    def held(value) -> bytes:
-        parts = value if isinstance(value, tuple) else (value,)
-        return np.concatenate([np.ravel(np.asarray(p, float)) for p in parts]).tobytes()
-
-    try:
-        return tuple(sorted((k, held(v)) for k, v in targets.items()))
-    except (TypeError, ValueError):
-        return None
-
-
-def _mode_rows(sm: SwitchedModel, mode: Mode, targets: dict):
-    """(switchable rows, :class:`~mechdyn.model.ConstraintLayout`) of a mode with its held
-    values: pure data of the compiled model, kept in ``model.memo`` so that the runs of a
-    model build them once (the rows list is the caller's own copy)."""
-    model = sm.model
     held = held_key(targets)
-    key = None if held is None else (mode, held)  # a held value that is not numbers: not kept
-    kept = model.memo.setdefault("mode rows", {})
-    got = kept.get(key) if key is not None else None
-    if got is None:
-        base, jstates = split_mode(model, mode)
-        rows = sm.rows(base, targets) + [stick_row(model, j, targets)
-                                         for j, s in sorted(jstates.items()) if s == "stick"]
-        got = (tuple(rows), ConstraintLayout(model, mode, rows))
-        if key is not None and len(kept) < MODE_ROWS_KEPT:
-            kept[key] = got
-    return list(got[0]), got[1]
+    if workspace is None or held is None or friction_joints(sm.model):
+        return ModeSystem(sm, mode, targets, x, prefer=prefer, avoid=avoid,
+                          workspace=workspace)
+    key = ("system", Mode(mode), held, tuple(prefer), tuple(avoid))
+    at = _at_pose(workspace, x)
+    ms = at.get(key)
+    if ms is None or ms.x_ref.tobytes() != workspace.at_pose[0]:
+        ms = ModeSystem(sm, mode, targets, x, prefer=prefer, avoid=avoid, workspace=workspace)
+        _at_pose(workspace, x)[key] = ms
+    else:
+        ms.ws.reset(ms.x_ref)
+    return ms
 
 
 def _independent_rows(Rs, tol=1e-9) -> np.ndarray:

@@ -196,9 +196,17 @@ def run_segment(integ, eqs, t: float, y0, t_end: float, efns: list[EventFunction
     if steps is None:
         steps = integ.integrate(eqs.rhs, t, y0[:n], y0[n:2 * n], t_end, w0=y0[2 * n:],
                                 first_order=eqs.first_order_function())
+    # the solves of every attempt of a step start from the state accepted last, and a failed
+    # solve rejects the attempt (see ModeEquations.anchor): adaptive integrators only, and
+    # not LSODA (its Fortran takes NaN rates into the state instead of rejecting the step)
+    reject = getattr(integ, "method", None) != "LSODA"
+    anchor = getattr(eqs, "anchor", None) if integ.adaptive else None
+    anchor = (lambda: None) if anchor is None else (lambda a=anchor: a(reject))
+    anchor()
     hit = None
     try:
         for step in steps:
+            anchor()
             stats["steps"] += 1
             t_old, t_new = step.t_old, step.t
             if bar is not None:

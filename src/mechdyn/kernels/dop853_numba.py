@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..integrate.dop853_tableau import E3, E5, N_STAGES, A, C, D
-from .lagrange_numba import D_NI, N_FLAGS, W_PIVOT, evaluate_into
+from .lagrange_numba import D_NI, N_FLAGS, W_COUNT, W_PIVOT, evaluate_into
 from .rows_numba import njit
 
 __all__ = ["run", "evaluate_states", "dense_at", "DONE", "BATCH", "FLAGGED", "FAILED", "WATCH",
@@ -71,6 +71,14 @@ def _counted(ts, ys, fout, ni, ip, fp, ri, rf, dims, ws, ext, full, sc, piv, ipa
                        sc, piv)
     ipar[I_STATUS] = st
     return st == 0
+
+
+@njit
+def _put_back(ws, ws0):
+    """The workspace saved at the start of a step put back (the evaluation count goes on)."""
+    cnt = ws[ws.size - N_FLAGS + W_COUNT]
+    ws[:] = ws0
+    ws[ws.size - N_FLAGS + W_COUNT] = cnt
 
 
 @njit
@@ -251,6 +259,7 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
                 h = _initial_step(y, f, K[2], h, dnf, atol, rtol, hmax)
     rejected = False
     steps = 0
+    ws0 = np.empty(ws.size)  # the Newton start of a step's stages, put back at a rejection
     ipar[I_FLAGS] = 0
     while True:
         if t >= t_end:
@@ -277,12 +286,15 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
             last = False
         t_new = t_end if last else t + h
         # the stages
+        if not rejected:
+            ws0[:] = ws
         for i in range(m):
             K[0, i] = f[i]
         for s in range(1, N_STAGES):
             _stage(y, K, s, h, ys)
             if not _counted(t + C[s] * h, ys, K[s], ni, ip, fp, ri, rf, dims, ws, ext, off,
                             sc, piv, ipar):
+                _put_back(ws, ws0)
                 par[P_T], par[P_H] = t, h
                 return FAILED
             _watch(ys[0], ws, nx, par, ipar, x_end)
@@ -307,6 +319,9 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
         if err > 1.0 or (scipy_ctrl and err == 1.0):  # rejected
             ipar[I_REJ] += 1
             rejected = True
+            # a retry starts its solves where the step started, not from the poses of the
+            # rejected stages (a long trial step may have jumped to another assembly branch)
+            _put_back(ws, ws0)
             if scipy_ctrl:
                 h = h * max(0.2, 0.9 * err ** -0.125)
             else:

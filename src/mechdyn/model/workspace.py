@@ -35,6 +35,10 @@ class Workspace:
         ``(x, Parts, values)`` of the rows at ``x`` (reused by the evaluation at x).
     warned : set
         Keys of the warnings already given in this run (each is given once per run).
+    at_pose : tuple or None
+        ``(pose bytes, {key: value})``: the mode systems and coordinate choices made at
+        the pose of the last switching instant (see
+        :func:`mechdyn.dynamics.mode_system.mode_system`).
 
     Examples
     --------
@@ -49,6 +53,7 @@ class Workspace:
     qi: np.ndarray | None = None
     parts: tuple | None = None
     warned: set = field(default_factory=set)
+    at_pose: tuple | None = None
 
     def reset(self, x) -> None:
         """Restart from the pose ``x`` (n_x,): no predictor, no cached parts."""

@@ -1,0 +1,66 @@
+"""The per-step and per-switch shortcuts of switched runs give what the full computation
+gives: the mode systems a run keeps for the pose of a switching instant, the compiled
+values of the event functions' measures, the compiled evaluation's parts."""
+
+import numpy as np
+import pytest
+
+import mechdyn
+from mechdyn.dynamics.compiled import numba_available
+from mechdyn.dynamics.contact import gap_measures
+from mechdyn.dynamics.mode_equations import ModeEquations
+from mechdyn.dynamics.mode_system import ModeSystem, mode_system
+from mechdyn.dynamics.modes import switched_model
+from mechdyn.dynamics.switching import _PoseValues
+from mechdyn.kernels import rows_numpy
+from mechdyn.model.workspace import Workspace
+
+
+@pytest.fixture(scope="module")
+def sm():
+    return switched_model(mechdyn.examples.load("press_cycle").compile())
+
+
+def test_a_run_builds_a_mode_once_per_pose(sm):
+    ws, x = Workspace(), sm.model.x_sketch
+    a = mode_system(sm, frozenset(), {}, x, workspace=ws)
+    ws.x = None  # used by a solve since: the one kept is restarted at its pose
+    assert mode_system(sm, frozenset(), {}, x.copy(), workspace=ws) is a
+    assert np.array_equal(ws.x, x)
+    # other choices, another run, no run: other mode systems, as a new one would be
+    b = mode_system(sm, frozenset(), {}, x, prefer=("phi",), workspace=ws)
+    assert b is not a
+    assert mode_system(sm, frozenset(), {}, x, workspace=Workspace()) is not a
+    c = mode_system(sm, frozenset(), {}, x)
+    assert c is not a and c.coords.tolist() == a.coords.tolist()
+    # a new pose forgets the last one
+    x2 = ModeSystem(sm, frozenset(), {}, x).solve_position(a.coordinates(x)[a.coords] + 0.01, x)
+    d = mode_system(sm, frozenset(), {}, x2, workspace=ws)
+    assert d is not a and np.array_equal(d.x_ref, x2)
+    assert mode_system(sm, frozenset(), {}, x, workspace=ws) is not a
+
+
+def test_pose_values_as_the_numpy_rows(sm):
+    measures = [m for _, m, _, _ in gap_measures(sm)]
+    pv = _PoseValues(sm.nb, measures)
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        x = sm.model.x_sketch + 0.01 * rng.normal(size=sm.model.n_x)
+        ev = type("Ev", (), {"x": x})()
+        want = rows_numpy.values(pv.rows, x)
+        got = [pv.value(m, ev) for m in measures]
+        np.testing.assert_allclose(got, want[[pv.index[id(m)] for m in measures]],
+                                   rtol=0, atol=1e-15)
+
+
+@pytest.mark.skipif(not numba_available(), reason="numba not installed")
+def test_compiled_evaluation_parts_as_the_numpy_evaluation(sm):
+    ms = ModeSystem(sm, frozenset(), {}, sm.model.x_sketch)
+    eqs = ModeEquations(sm, ms)
+    qi = ms.coordinates(sm.model.x_sketch)[ms.coords]
+    qd = np.array([43.5, 1.0, 0.1])[:ms.n_i]
+    got = eqs.evaluate(0.0, qi, qd)
+    ref = ms.evaluate(0.0, qi, qd)
+    for k in ("x", "xdot", "q", "qdot", "qddot", "lam", "F"):
+        np.testing.assert_allclose(getattr(got, k), getattr(ref, k), rtol=1e-9,
+                                   atol=1e-9, err_msg=k)
