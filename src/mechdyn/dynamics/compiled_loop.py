@@ -245,6 +245,7 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
         return t, y, next_out, False
     watch_window()
     mark = (t, y.copy(), next_out, list(counted), kernel.snapshot())  # the last checked state
+    checked_to = -np.inf  # the end of the last step checked
 
     def rewind():
         """Back to the last checked state: the generic loop takes the steps since then one
@@ -277,25 +278,29 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
         if code == L.WATCH:
             continue
         if code == L.FLAGGED:
-            if ipar[L.I_PREV] >= 2:  # the step before: the caller's last good state
-                ws_end = kernel.snapshot()
+            if ipar[L.I_PREV] >= 2 and b.hist[1, 0] > checked_to:
+                # the step before (unless checked already): the caller's last good state
+                ws_end = kernel.snapshot() if fixed else None
                 _, ok = checked(_step(b, 0, 1), b.hist[1, 1:m + 1].copy())
                 if not ok:
                     return rewind()
-                # the flagged step's end is evaluated from the pose the loop left there,
-                # as in the Python loop (whose check of the step before came first)
-                kernel.restore(ws_end)
+                if fixed:
+                    # the flagged step's end evaluated from the pose the loop left there, as
+                    # in the Python stepper (whose check of the step before came first): the
+                    # same numbers to round-off (DOP853's compiled runs stay as they were)
+                    kernel.restore(ws_end)
             hand()
             step = _step(b, 1, 2, None if fixed else (b.dns.copy(), float(par[L.P_TOLD]),
                                                       float(par[L.P_HOLD])))
             y_new = y.copy()
             ev = after_step(step, y_new)  # a stop here is the run's
             _samples_of(step, y_new, ev, sample, te, ipar, every_step, t_now)
-        elif ipar[L.I_STEPS]:
+        elif ipar[L.I_STEPS] and b.hist[2, 0] > checked_to:  # the batch's last step
             _, ok = checked(_step(b, 1, 2), y.copy())
             if not ok:
                 return rewind()
             hand()
+        checked_to = float(b.hist[2, 0]) if ipar[L.I_STEPS] else checked_to
         mark = (t_now, y.copy(), int(ipar[L.I_NEXT]), list(counted), kernel.snapshot())
         if bar is not None:
             bar.update(t_now)
