@@ -199,3 +199,4 @@ def test_fixed_step_orders_in_the_compiled_loop(integ, order, loop_calls):
     assert loop_calls == [True] * 4
     slope = np.polyfit(np.log(hs), np.log(errors), 1)[0]
     assert slope == pytest.approx(order, abs=0.15)
+

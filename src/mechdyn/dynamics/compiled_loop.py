@@ -32,7 +32,9 @@ import numpy as np
 
 from ..errors import Status
 from ..integrate.base import FixedStep, Step, hermite_dense
+from ..integrate.runge_kutta import RungeKutta4
 from ..integrate.segment import Stop
+from ..integrate.wilson import Wilson
 from ..kernels import dop853_numba as L
 from ..kernels import fixed_step_numba as F
 from ..kernels.lagrange_numba import D_NC, D_NQ, scratch_size
@@ -137,7 +139,7 @@ def _start(b, integ, t: float, t_end: float) -> np.ndarray:
     par[L.P_T], par[L.P_TEND] = t, t_end
     par[L.P_LAST] = -np.inf
     if isinstance(integ, FixedStep):
-        wilson = integ.name == "wilson"
+        wilson = _fixed_method(integ) == F.WILSON
         ipar[F.I_METHOD] = F.WILSON if wilson else F.RK4
         ipar[F.I_ITER] = integ.iterations if wilson else 0
         tol = integ.tol if wilson else None
@@ -149,6 +151,14 @@ def _start(b, integ, t: float, t_end: float) -> np.ndarray:
     par[L.P_HMAX] = integ.max_step or np.inf
     par[L.P_BETA], par[L.P_ERROLD] = BETA, 1e-4
     return np.broadcast_to(np.asarray(integ.atol, float), (b.dims[4],)).copy()
+
+
+def _fixed_method(integ) -> int | None:
+    """The fixed-step loop's method of ``integ`` (RK4 or Wilson's), or None (a subclass
+    that steps otherwise: its Python stepper)."""
+    step = type(integ)._advance
+    return F.RK4 if step is RungeKutta4._advance else (
+        F.WILSON if step is Wilson._advance else None)
 
 
 def _loop(kernel, b, integ, y, atol, te, t: float, t_end: float):
@@ -203,6 +213,8 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
     Stop
         From ``after_step`` (a dead position, the step budget) or the wall-time limit.
     """
+    if isinstance(integ, FixedStep) and _fixed_method(integ) is None:
+        return t, np.asarray(y0, float), next_out, False
     ms = eqs.ms
     b = buffers(kernel)
     _, ni, _, _, m = b.dims

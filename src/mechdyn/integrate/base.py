@@ -225,19 +225,21 @@ class FixedStep(Integrator):
     """Base class of the fixed-step integrators: ``steps`` equal steps over [t0, t_end]
     (default 100 when ``dt`` is not given), or steps of ``dt`` (s; the last one shortened
     to land on ``t_end``); ``compiled=False`` keeps the Python stepper where the compiled
-    loop could run (see :attr:`compiled`).  A subclass implements :meth:`_advance`; the
-    dense output over each step is :func:`hermite_dense`."""
+    loop could run (see :attr:`compiled`; None: the class's choice).  A subclass
+    implements :meth:`_advance`; the dense output over each step is
+    :func:`hermite_dense`."""
 
     adaptive = False
     #: segments on a compiled kernel run in the compiled fixed-step loop
-    #: (:mod:`mechdyn.kernels.fixed_step_numba`); False on an instance: the Python stepper
-    #: everywhere (for cross-checks)
-    compiled = True
+    #: (:mod:`mechdyn.kernels.fixed_step_numba`): True for the methods it has (RK4,
+    #: Wilson's); False on an instance: the Python stepper everywhere (for cross-checks)
+    compiled = False
 
     def __init__(self, steps: int | None = None, dt: float | None = None, *,
-                 compiled: bool = True):
+                 compiled: bool | None = None):
         super().__init__()
-        self.compiled = bool(compiled)
+        if compiled is not None:
+            self.compiled = bool(compiled)
         self.steps = check_positive("steps", steps, integer=True, allow_none=True)
         self.dt = check_positive("dt", dt, allow_none=True)
         if self.steps is not None and self.dt is not None:
