@@ -200,3 +200,28 @@ def test_fixed_step_orders_in_the_compiled_loop(integ, order, loop_calls):
     slope = np.polyfit(np.log(hs), np.log(errors), 1)[0]
     assert slope == pytest.approx(order, abs=0.15)
 
+
+
+@pytest.mark.parametrize("integ, opts", FIXED[:3])
+def test_switched_press_fixed_step_compiled_as_python(integ, opts, monkeypatch):
+    """A variable-structure run (the bundled press cycle: stops, impacts, the lock): its
+    segments with event functions take their steps from the compiled fixed-step loop,
+    one by one, each checked in Python; the events fall at the same times and the
+    samples agree with the Python stepper's to round-off."""
+    calls = []
+    real = compiled.kept_steps
+
+    def spy(*args, **kw):
+        out = real(*args, **kw)
+        calls.append(out is not None)
+        return out
+
+    monkeypatch.setattr(compiled, "kept_steps", spy)
+    model = examples.load("press_cycle").compile()
+    runs = [simulate(model, 0.1, integrator=_fixed(integ, c, dt=1e-4, **opts), progress=False)
+            for c in (True, False)]
+    assert calls and all(calls)
+    assert len(runs[0].events) >= 3
+    assert [(e.t, e.kind, e.element) for e in runs[0].events] == \
+        [(e.t, e.kind, e.element) for e in runs[1].events]
+    _agree(*runs)

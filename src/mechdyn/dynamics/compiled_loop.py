@@ -171,7 +171,7 @@ def _loop(kernel, b, integ, y, atol, te, t: float, t_end: float):
         b.ipar[F.I_GRID] = 0
         return (lambda: F.run(y, b.f, grid, b.par, b.ipar, b.K, b.ynew, b.ys, b.hist, te,
                               b.o_t, b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end,
-                              *kernel._arrays, kernel.ws, b.sc, b.piv)), True
+                              *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept)), True
     return (lambda: L.run(y, b.f, atol, b.par, b.ipar, b.K, b.ynew, b.ys, b.hist, b.dns, te,
                           b.o_t, b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end,
                           *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept)), False
@@ -337,10 +337,10 @@ def _samples_of(step, y_new, ev, sample, te, ipar, every_step, t_now):
 
 
 def kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
-    """The steps of a segment with event functions from the compiled DOP853 loop
-    (:func:`_kept_steps`), or None for a fixed-step integrator (its Python stepper takes
-    them)."""
-    if isinstance(integ, FixedStep):
+    """The steps of a segment with event functions from the compiled loop of the
+    integrator (:func:`_kept_steps`), or None for a fixed-step method the loop does not
+    have (its Python stepper takes them)."""
+    if isinstance(integ, FixedStep) and _fixed_method(integ) is None:
         return None
     return _kept_steps(kernel, integ, eqs, t, y0, t_end, stats)
 
@@ -359,7 +359,10 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
     evaluations of the checks start where they would after SciPy's step; a generator
     closed at an event drops the later steps of its batch.  Where the loop cannot go on
     (a kernel failure, a step too small, a branch chart built by the watch) the steps
-    go on with SciPy's DOP853 (``integ.integrate``) from the last step yielded.
+    go on with SciPy's DOP853 (``integ.integrate``) from the last step yielded.  A
+    fixed-step integrator's steps come from the fixed-step loop, each with the quintic
+    Hermite interpolant of its ends (as its Python stepper's), and its Python stepper
+    goes on where the loop cannot.
 
     Parameters
     ----------
@@ -404,11 +407,10 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
 
     watch_window()
     ipar[L.I_MAXSTEPS] = min(KEEP_STEPS, b.kept.shape[0])
+    call, fixed = _loop(kernel, b, integ, y, atol, te, t, t_end)
     while True:
         ipar[L.I_NKEPT] = 0
-        code = L.run(y, b.f, atol, par, ipar, b.K, b.ynew, b.ys, b.hist, b.dns, te, b.o_t,
-                     b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end, *kernel._arrays,
-                     kernel.ws, b.sc, b.piv, b.kept)
+        code = call()
         evals, rej = int(ipar[L.I_EVALS]), int(ipar[L.I_REJ])
         stats["evaluations"] += evals - counted[0]
         stats["rejected"] += rej - counted[1]
@@ -418,7 +420,7 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
         ws_end = kernel.snapshot()
         for row in rows:
             kernel.restore(row[o_ws:])
-            yield _kept_step(row, m, ni)
+            yield _kept_step(row, m, ni, fixed)
         kernel.restore(ws_end)
         if code == L.FAILED:  # SciPy's DOP853 goes on from the last step
             yield from scipy_from(float(par[L.P_T]), y.copy())
@@ -434,11 +436,18 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
             return
 
 
-def _kept_step(row, m: int, ni: int) -> Step:
-    """The :class:`Step` of a row of the loop's kept steps, with its dense output."""
+def _kept_step(row, m: int, ni: int, fixed: bool = False) -> Step:
+    """The :class:`Step` of a row of the loop's kept steps, with its dense output (a
+    fixed-step loop's: the Python stepper's quintic Hermite interpolant of its ends)."""
     t0, h, t1 = float(row[0]), float(row[1]), float(row[2])
     y0, y1, f1 = row[3:3 + m], row[3 + m:3 + 2 * m], row[3 + 2 * m:3 + 3 * m]
     dns = row[3 + 3 * m:3 + 10 * m].reshape(7, m)
+    if fixed:  # the rates at the step's start in the place of dns[0]
+        f0 = dns[0]
+        return Step(t0, t1, y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni], y1[2 * ni:],
+                    hermite_dense(t0, y0[:ni], y0[ni:2 * ni], f0[ni:2 * ni], y0[2 * ni:],
+                                  f0[2 * ni:], t1, y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni],
+                                  y1[2 * ni:], f1[2 * ni:]))
 
     def dense(s):
         out = np.empty(m)
@@ -470,4 +479,4 @@ def warm_up_loop(kernel) -> None:
         b.ipar[L.I_MAXSTEPS], b.ipar[F.I_METHOD], b.ipar[F.I_ITER] = 10, method, 2
         F.run(y, b.f, np.linspace(0.0, 1e-3, 3), b.par, b.ipar, b.K, b.ynew, b.ys, b.hist,
               np.zeros(0), b.o_t, b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end,
-              *kernel._arrays, kernel.ws, b.sc, b.piv)
+              *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept)

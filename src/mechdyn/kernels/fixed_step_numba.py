@@ -38,6 +38,7 @@ from .dop853_numba import (
     I_KEEP,
     I_MAXSTEPS,
     I_NEXT,
+    I_NKEPT,
     I_NOUT,
     I_STATUS,
     I_STEPS,
@@ -49,6 +50,7 @@ from .dop853_numba import (
     _counted,
     _watch,
     accept,
+    keep_step,
     samples,
     step_end,
 )
@@ -137,11 +139,14 @@ def _wilson(t, h, y, f, K, ynew, ys, ni, ip, fp, ri, rf, dims, ws, ext, off, sc,
 
 @njit
 def run(y, f, grid, par, ipar, K, ynew, ys, hist, t_eval, o_t, o_y, o_x, o_xd, o_ext, ext,
-        ext_end, x_end, ip, fp, ri, rf, dims, ws, sc, piv):
+        ext_end, x_end, ip, fp, ri, rf, dims, ws, sc, piv, kept):
     """Step from ``grid[ipar[I_GRID]]`` (state ``y``, rates ``f`` when ``ipar[I_FSAL]``)
     to the end of ``grid``; returns DONE, BATCH, FLAGGED, WATCH or FAILED, as
     :func:`mechdyn.kernels.dop853_numba.run` (the history rows, ``x_end``, the output
-    buffers and the flags F_TURN and F_PIVOT as there)."""
+    buffers and the flags F_TURN and F_PIVOT as there).  With ``ipar[I_KEEP]`` every step
+    is kept in row ``ipar[I_NKEPT]`` of ``kept`` as there
+    (:func:`mechdyn.kernels.dop853_numba.keep_step`), the rates at its start in the place
+    of the first coefficient of the dense output."""
     ni = dims[D_NI]
     nx = x_end.size // 3
     m = y.size
@@ -200,6 +205,12 @@ def run(y, f, grid, par, ipar, K, ynew, ys, hist, t_eval, o_t, o_y, o_x, o_xd, o
         ipar[I_STEPS] += 1
         flags = step_end(t, h, t_new, y, f, ynew, fnew, ws, x_end, hist, par, ni,
                          ipar[I_KEEP] == 0)
+        if ipar[I_KEEP] != 0:
+            row = kept[ipar[I_NKEPT]]
+            row[row.size - ws.size:] = ws
+            K[6, :] = f
+            keep_step(row, t, h, t_new, y, ynew, fnew, K[6:13])
+            ipar[I_NKEPT] += 1
         if flags != 0:
             ipar[I_FLAGS] = flags
             accept(y, f, ynew, fnew, ipar)
