@@ -18,6 +18,11 @@ loop of the releases before):
   against a run at rtol 1e-13 (digits in the coordinate and its rate) and the energy
   drift (J, conservative runs).
 
+The fixed-step integrators (RK4, Wilson's method: the paper's press with N = 40 and 320,
+the slider-crank spin-up with RK4) report their compiled loop against their Python
+stepper over the same kernel (:func:`fixed_step_table`): wall times, the speed-up, the
+ratio wall / (evaluations x cost) of the compiled run and how far apart the two runs are.
+
 A fifth case, the variable-structure press (``press_cycle`` over 0.4 s: stops, impacts,
 the lock; its segments have event functions) against the same press without switches
 (0.11 s, fixed structure; :mod:`benchmarks.bench_switching`), reports the wall time per
@@ -163,6 +168,59 @@ def press_cycle_rows(repeat: int = 3) -> list[dict]:
     return rows
 
 
+#: (name, model factory, t_end s, integrator, steps): the fixed-step runs compared
+FIXED_CASES = (
+    ("press 0.05 s wilson N = 40", lambda: press_idle(), 0.05, "wilson", 40),
+    ("press 0.05 s rk4 N = 320", lambda: press_idle(), 0.05, "rk4", 320),
+    ("slider-crank spin-up 2 s rk4 N = 20000", lambda: load("slider_crank"), 2.0, "rk4", 20000),
+)
+
+
+def fixed_step_table(repeat: int = 5) -> list[dict]:
+    """The compiled RK4 / Wilson loops against their Python steppers over the same kernel
+    (``RungeKutta4(compiled=False)``, ``Wilson(compiled=False)``), runs interleaved: the
+    best wall time of each, the speed-up, the compiled run's ratio wall / (evaluations x
+    kernel cost) and the largest difference of q and q' between the two (relative to
+    their largest values)."""
+    from mechdyn.integrate import RungeKutta4, Wilson
+
+    out = []
+    for name, build, t_end, integ, steps in FIXED_CASES:
+        model = build().compile()
+        cls = Wilson if integ == "wilson" else RungeKutta4
+        best, runs = {True: np.inf, False: np.inf}, {}
+        simulate(model, t_end, progress=False, integrator=cls(steps=steps))  # load kernels
+        for _ in range(repeat):
+            for compiled in (True, False):
+                wall, runs[compiled] = _best_of(
+                    lambda m=model, te=t_end, k=cls, n=steps, c=compiled: simulate(
+                        m, te, progress=False, integrator=k(steps=n, compiled=c)), 1)
+                best[compiled] = min(best[compiled], wall)
+        ours, ref = runs[True], runs[False]
+        assert ours.success and ref.success, (ours.message, ref.message)
+        diff = max(np.max(np.abs(ours.q - ref.q)) / np.max(np.abs(ref.q)),
+                   np.max(np.abs(ours.qdot - ref.qdot)) / np.max(np.abs(ref.qdot)))
+        cost = kernel_cost(model, ours)
+        out.append(dict(case=name, compiled=best[True], python=best[False],
+                        speedup=best[False] / best[True], evals=ours.stats["evaluations"],
+                        ratio=best[True] / (ours.stats["evaluations"] * cost), diff=diff))
+    return out
+
+
+def fixed_step_rows(repeat: int = 5) -> list[dict]:
+    """The rows of :func:`fixed_step_table`."""
+    rows = []
+    for r in fixed_step_table(repeat):
+        rows.append({"name": f"{r['case']} compiled wall", "value": r["compiled"] * 1e3,
+                     "unit": "ms", "note": f"{r['evals']} evals, wall/(evals x cost) "
+                     f"{r['ratio']:.2f}, differs from the Python stepper by {r['diff']:.1e}"})
+        rows.append({"name": f"{r['case']} Python stepper wall", "value": r["python"] * 1e3,
+                     "unit": "ms"})
+        rows.append({"name": f"{r['case']} Python / compiled", "value": r["speedup"],
+                     "unit": ""})
+    return rows
+
+
 def run(quick: bool = False) -> list[dict]:
     if not NUMBA:
         return [{"name": "compiled loop", "value": "skipped", "note": "numba not installed"}]
@@ -175,10 +233,15 @@ def run(quick: bool = False) -> list[dict]:
                              f"drift {r['drift']:.1e} J"})
         rows.append({"name": f"{head} kernel cost", "value": r["cost"] * 1e6, "unit": "us"})
         rows.append({"name": f"{head} wall/(evals x cost)", "value": r["ratio"], "unit": ""})
-    return rows + press_cycle_rows(repeat=1 if quick else 3)
+    return rows + fixed_step_rows(repeat=1 if quick else 5) + press_cycle_rows(
+        repeat=1 if quick else 3)
 
 
 if __name__ == "__main__":
+    for r in fixed_step_table():
+        print(f"{r['case']:40s} compiled {r['compiled'] * 1e3:8.2f} ms  Python "
+              f"{r['python'] * 1e3:8.2f} ms  x{r['speedup']:5.1f}  evals {r['evals']:6d}  "
+              f"ratio {r['ratio']:5.2f}  differs {r['diff']:.1e}")
     for r in press_cycle_rows():
         print(f"{r['name']:44s} {r['value']:9.4g} {r['unit']:4s} {r.get('note', '')}")
     for r in table():

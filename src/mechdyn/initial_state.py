@@ -83,8 +83,19 @@ def initial_state(model: Model, q0=None, qdot0=None, *, mode=None):
                          f"from the sketch to be reached by continuation (more than "
                          f"{MAX_WALK} steps of 0.05 rad or 0.05 length scale); give it "
                          "within a few turns of the sketch (angles modulo 360 deg)")
-    n = max(1, int(math.ceil(float(np.max(size, initial=0.0)))))
-    x = np.array(x_sk, float)
-    for k in range(1, n + 1):
-        x = solve_position(model, q_sk + dq * (k / n), x, layout=layout, check_singular=False)
-    return q, qd, x
+    # the pose is kept with the compiled model for the next run from the same state (the
+    # continuation is a function of the sketch, the mode and q alone)
+    key = ("initial pose", tuple(sorted(mode or ())), np.asarray(x_sk, float).tobytes(),
+           q.tobytes())
+    x = model.memo.get(key)
+    if x is None:
+        n = max(1, int(math.ceil(float(np.max(size, initial=0.0)))))
+        x = np.array(x_sk, float)
+        for k in range(1, n + 1):
+            x = solve_position(model, q_sk + dq * (k / n), x, layout=layout,
+                               check_singular=False)
+        kept = model.memo.setdefault("initial poses", [])
+        if len(kept) < 16:  # a bounded number (a study runs many initial states)
+            kept.append(key)
+            model.memo[key] = x
+    return q, qd, np.array(x, float)

@@ -73,7 +73,10 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
         method, for cross-checks); ``"rk45"``, ``"rk23"``, ``"radau"``, ``"bdf"``,
         ``"lsoda"`` (adaptive, SciPy); ``"rk4"`` or ``"wilson"`` (fixed step; the
         source paper's linear-acceleration method; they step on a grid of ``dt`` from
-        the start of every mode segment, its last step shortened to the event).
+        the start of every mode segment, its last step shortened to the event; in the
+        compiled fixed-step loop of :mod:`mechdyn.kernels.fixed_step_numba` on the
+        compiled kernel, with the numbers of their Python steppers, which run elsewhere
+        or with ``compiled=False`` on an instance).
     steps, dt
         Number of steps over [t0, t_end] (default 100) or step size (s) of the
         fixed-step integrators.

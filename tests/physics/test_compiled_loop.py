@@ -128,3 +128,100 @@ def test_bundled_fixed_structure_examples_agree_with_scipy(name, loop_calls):
     scale = np.where(model.coord_is_angle, 1.0, model.length_scale)
     assert np.max(np.abs(ours.q - ref.q) / scale) < 1e-9
     assert np.max(np.abs(ours.qdot - ref.qdot)) < 1e-8 * max(1.0, np.max(np.abs(ref.qdot)))
+
+
+# ---------------------------------------------------------------- the fixed-step loops
+def _fixed(name, compiled, **opts):
+    from mechdyn.integrate import RungeKutta4, Wilson
+
+    return (Wilson if name == "wilson" else RungeKutta4)(compiled=compiled, **opts)
+
+
+FIXED = [("rk4", {}), ("wilson", {}), ("wilson", {"theta": 1.4, "iterations": 3}),
+         ("wilson", {"tol": None, "iterations": 2})]
+
+
+def _agree(a, b, tol=1e-12, evaluations=True):
+    """Two runs agree sample by sample to ``tol`` (relative to each column's largest
+    value), with as many evaluations."""
+    assert a.status == b.status and np.array_equal(a.t, b.t)
+    assert a.stats["evaluations"] == b.stats["evaluations"] or not evaluations
+    for u, v in ((a.q, b.q), (a.qdot, b.qdot), (a.qddot, b.qddot), (a.x, b.x)):
+        assert np.max(np.abs(u - v)) <= tol * max(1.0, np.max(np.abs(v)))
+
+
+@pytest.mark.parametrize("name", [n for n in examples.names()
+                                  if not examples.load(n).compile().has_switching])
+@pytest.mark.parametrize("integ, opts", FIXED[:2])
+def test_bundled_examples_fixed_step_compiled_as_python(name, integ, opts, loop_calls):
+    """The compiled RK4 / Wilson loops and the Python steppers over the same kernel: the
+    same numbers (to 1e-12) on every bundled fixed-structure example, the output times
+    between the steps interpolated alike."""
+    model = examples.load(name).compile()
+    t_eval = np.linspace(0.0, 0.05, 13)  # not on the grid of 100 steps
+    ours, ref = (simulate(model, 0.05, integrator=_fixed(integ, c, **opts),
+                          t_eval=t_eval, progress=False) for c in (True, False))
+    if ours.stats["backend"] == "numba":
+        assert loop_calls == [True]
+    _agree(ours, ref)
+
+
+@pytest.mark.parametrize("integ, opts", FIXED)
+def test_fixed_step_loop_on_a_swinging_pendulum_as_python(integ, opts, loop_calls):
+    # rates changing sign (flagged steps), every step sampled, Wilson-theta, no early stop
+    runs = [simulate(pendulum(theta0_from_down_deg=60.0), 3.0,
+                     integrator=_fixed(integ, c, dt=1e-2, **opts), progress=False)
+            for c in (True, False)]
+    assert loop_calls == [True]
+    assert np.sum(np.diff(np.sign(runs[0].qdot[:, 0])) != 0) >= 3
+    _agree(*runs)
+    assert runs[0].stats["steps"] == 300
+
+
+def test_fixed_step_more_samples_in_a_step_than_the_buffers(loop_calls):
+    # 3000 output times in 2 steps: a step cannot be shortened, the Python stepper goes on
+    te = np.linspace(0.0, 0.2, 3000)
+    runs = [simulate(oscillator(), 0.2, integrator=_fixed("rk4", c, steps=2), t_eval=te,
+                     progress=False) for c in (True, False)]
+    assert loop_calls == [False]
+    _agree(*runs, evaluations=False)  # the loop's first evaluation is counted too
+
+
+@pytest.mark.parametrize("integ, order", [("rk4", 4), ("wilson", 2)])
+def test_fixed_step_orders_in_the_compiled_loop(integ, order, loop_calls):
+    """Measured orders against the closed form of the torsion oscillator."""
+    errors, hs = [], []
+    for n in (100, 200, 400, 800):  # omega h from 0.12 to 0.015
+        tr = simulate(oscillator(), 1.0, integrator=integ, steps=n, t_eval=[1.0],
+                      progress=False)
+        errors.append(abs(tr.q[-1, 0] - A0 * np.cos(OMEGA)))
+        hs.append(1.0 / n)
+    assert loop_calls == [True] * 4
+    slope = np.polyfit(np.log(hs), np.log(errors), 1)[0]
+    assert slope == pytest.approx(order, abs=0.15)
+
+
+
+@pytest.mark.parametrize("integ, opts", FIXED[:3])
+def test_switched_press_fixed_step_compiled_as_python(integ, opts, monkeypatch):
+    """A variable-structure run (the bundled press cycle: stops, impacts, the lock): its
+    segments with event functions take their steps from the compiled fixed-step loop,
+    one by one, each checked in Python; the events fall at the same times and the
+    samples agree with the Python stepper's to round-off."""
+    calls = []
+    real = compiled.kept_steps
+
+    def spy(*args, **kw):
+        out = real(*args, **kw)
+        calls.append(out is not None)
+        return out
+
+    monkeypatch.setattr(compiled, "kept_steps", spy)
+    model = examples.load("press_cycle").compile()
+    runs = [simulate(model, 0.1, integrator=_fixed(integ, c, dt=1e-4, **opts), progress=False)
+            for c in (True, False)]
+    assert calls and all(calls)
+    assert len(runs[0].events) >= 3
+    assert [(e.t, e.kind, e.element) for e in runs[0].events] == \
+        [(e.t, e.kind, e.element) for e in runs[1].events]
+    _agree(*runs)

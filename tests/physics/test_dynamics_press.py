@@ -87,3 +87,18 @@ def test_analogs_and_exact_give_the_same_motion(model):
     assert diffs[1, 0] < 1e-5  # rad
     assert diffs[1, 1] < 1e-3  # rad/s
     assert diffs[1, 2] < 0.1  # rad/s^2
+
+
+def test_wilson_40_steps_compiled_loop_gives_the_python_steppers_numbers(model):
+    """The paper's set-up on the compiled fixed-step loop and on the Python stepper over
+    the same kernel: the same samples, to round-off."""
+    from mechdyn.integrate import Wilson
+
+    fast = simulate(model, T_END, integrator="wilson", steps=WILSON_STEPS, progress=False)
+    ref = simulate(model, T_END, integrator=Wilson(steps=WILSON_STEPS, compiled=False),
+                   progress=False)
+    assert fast.success and ref.success
+    assert fast.stats["evaluations"] == ref.stats["evaluations"]
+    np.testing.assert_array_equal(fast.t, ref.t)
+    for a, b in ((fast.q, ref.q), (fast.qdot, ref.qdot), (fast.qddot, ref.qddot)):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-12 * np.max(np.abs(b)))

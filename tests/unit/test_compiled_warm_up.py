@@ -39,14 +39,15 @@ def test_warmup_compiles_the_types_the_study_and_the_loop_pass():
 
     if not NUMBA:
         pytest.skip("numba not installed")
-    from mechdyn.kernels import dop853_numba, rows_variants
+    from mechdyn.kernels import dop853_numba, fixed_step_numba, rows_variants
     from mechdyn.study.analyses import KinetostaticExtremes
     from mechdyn.study.batch import kinetostatic_batch
     from mechdyn.study.parameters import BaseModel
 
     times = warmup()
     assert {"dynamics", "integration loop", "kinematic sweep", "batched study"} <= set(times)
-    kernels = (rows_variants.path_variants, rows_variants.inverse_variants, dop853_numba.run)
+    kernels = (rows_variants.path_variants, rows_variants.inverse_variants, dop853_numba.run,
+               fixed_step_numba.run)
     before = [len(k.signatures) for k in kernels]
     base = BaseModel("slider_crank")
     p = base.parameter("bodies.rod.mass")
@@ -55,4 +56,6 @@ def test_warmup_compiles_the_types_the_study_and_the_loop_pass():
     assert all(o is not None for o in out)
     tr = simulate(_pendulum_with_spring(), 0.1, q0=[0.5], progress=False)
     assert tr.stats["backend"] == "numba"
+    for integ in ("rk4", "wilson"):
+        simulate(_pendulum_with_spring(), 0.1, q0=[0.5], integrator=integ, progress=False)
     assert [len(k.signatures) for k in kernels] == before

@@ -31,9 +31,12 @@ import time
 import numpy as np
 
 from ..errors import Status
-from ..integrate.base import Step, hermite_dense
+from ..integrate.base import FixedStep, Step, hermite_dense
+from ..integrate.runge_kutta import RungeKutta4
 from ..integrate.segment import Stop
+from ..integrate.wilson import Wilson
 from ..kernels import dop853_numba as L
+from ..kernels import fixed_step_numba as F
 from ..kernels.lagrange_numba import D_NC, D_NQ, scratch_size
 from .mode_system import ModeEval
 
@@ -77,8 +80,8 @@ class _Buffers:
         self.ext, self.ext_end, self.x_end = np.empty(n_ext), np.empty(n_ext), np.empty(3 * nx)
         self.sc = np.empty(scratch_size(nx, ni, nq, int(kernel.dims[3])))
         self.piv = np.empty(nx, dtype=np.int64)
-        self.par = np.zeros(L.N_PAR)
-        self.ipar = np.zeros(L.N_IPAR, dtype=np.int64)
+        self.par = np.zeros(F.N_PAR_FIXED)  # the DOP853 loop's scalars, then the fixed-step's
+        self.ipar = np.zeros(F.N_IPAR_FIXED, dtype=np.int64)
         self.kept = np.empty((KEEP_STEPS, 3 + 10 * m + kernel.ws.size))
 
 
@@ -134,25 +137,59 @@ def _start(b, integ, t: float, t_end: float) -> np.ndarray:
     par[:] = 0.0
     ipar[:] = 0
     par[L.P_T], par[L.P_TEND] = t, t_end
+    par[L.P_LAST] = -np.inf
+    if isinstance(integ, FixedStep):
+        wilson = _fixed_method(integ) == F.WILSON
+        ipar[F.I_METHOD] = F.WILSON if wilson else F.RK4
+        ipar[F.I_ITER] = integ.iterations if wilson else 0
+        tol = integ.tol if wilson else None
+        par[F.P_TOL] = -1.0 if tol is None else tol
+        par[F.P_THETA] = integ.theta if wilson else 1.0
+        return np.zeros(b.dims[4])
     par[L.P_H] = integ.first_step or 0.0
     par[L.P_RTOL] = integ.rtol
     par[L.P_HMAX] = integ.max_step or np.inf
-    par[L.P_LAST] = -np.inf
     par[L.P_BETA], par[L.P_ERROLD] = BETA, 1e-4
     return np.broadcast_to(np.asarray(integ.atol, float), (b.dims[4],)).copy()
+
+
+def _fixed_method(integ) -> int | None:
+    """The fixed-step loop's method of ``integ`` (RK4 or Wilson's), or None (a subclass
+    that steps otherwise: its Python stepper)."""
+    step = type(integ)._advance
+    return F.RK4 if step is RungeKutta4._advance else (
+        F.WILSON if step is Wilson._advance else None)
+
+
+def _loop(kernel, b, integ, y, atol, te, t: float, t_end: float):
+    """``(call, fixed)``: ``call()`` runs the compiled loop of ``integ`` once on the
+    buffers (DOP853's, or the fixed-step loop over ``integ``'s grid from ``t``); ``fixed``:
+    whether it is the fixed-step loop (its flagged steps interpolated as the Python
+    stepper's, :func:`~mechdyn.integrate.base.hermite_dense`)."""
+    if isinstance(integ, FixedStep):
+        grid = integ.grid(t, t_end)
+        b.ipar[F.I_GRID] = 0
+        return (lambda: F.run(y, b.f, grid, b.par, b.ipar, b.K, b.ynew, b.ys, b.hist, te,
+                              b.o_t, b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end,
+                              *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept)), True
+    return (lambda: L.run(y, b.f, atol, b.par, b.ipar, b.K, b.ynew, b.ys, b.hist, b.dns, te,
+                          b.o_t, b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end,
+                          *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept)), False
 
 
 def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, sample, t_eval,
                  next_out: int, every_step: bool, stats: dict, bar=None,
                  deadline: float | None = None):
-    """Integrate a segment on ``kernel`` in the compiled DOP853 loop, as far as it can.
+    """Integrate a segment on ``kernel`` in the compiled loop of its integrator (DOP853,
+    or RK4 and Wilson's method on their grid), as far as it can.
 
     Parameters
     ----------
     kernel : CompiledKernel
         The mode's kernel (``eqs.kernel``).
-    integ : ScipyIntegrator
-        Tolerances and step bounds (``rtol``, ``atol``, ``first_step``, ``max_step``).
+    integ : ScipyIntegrator or FixedStep
+        Tolerances and step bounds (``rtol``, ``atol``, ``first_step``, ``max_step``), or
+        the fixed-step integrator (its grid from ``t``, Wilson's settings).
     eqs : ModeEquations
         The mode's equations (its mode system and branch charts).
     t, y0, t_end
@@ -176,6 +213,8 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
     Stop
         From ``after_step`` (a dead position, the step budget) or the wall-time limit.
     """
+    if isinstance(integ, FixedStep) and _fixed_method(integ) is None:
+        return t, np.asarray(y0, float), next_out, False
     ms = eqs.ms
     b = buffers(kernel)
     _, ni, _, _, m = b.dims
@@ -183,13 +222,15 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
     book = eqs.book
     par, ipar = b.par, b.ipar
     atol = _start(b, integ, t, t_end)
-    par[L.P_STALL] = STALL_FLAG * (t_end - t)
+    if not isinstance(integ, FixedStep):  # the stall check is that of the adaptive runs
+        par[L.P_STALL] = STALL_FLAG * (t_end - t)
     par[L.P_PIVOT] = PIVOT_FLAG
     ipar[L.I_NEXT] = next_out
     ipar[L.I_EVERY] = int(every_step)
     ipar[L.I_MAXSTEPS] = BATCH_STEPS
     te = np.ascontiguousarray(t_eval, dtype=float)
     counted = [0, 0, 0]
+    call, fixed = _loop(kernel, b, integ, y, atol, te, t, t_end)
 
     def watch_window():
         w = None if book is None else book.watch_window()
@@ -216,6 +257,7 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
         return t, y, next_out, False
     watch_window()
     mark = (t, y.copy(), next_out, list(counted), kernel.snapshot())  # the last checked state
+    checked_to = -np.inf  # the end of the last step checked
 
     def rewind():
         """Back to the last checked state: the generic loop takes the steps since then one
@@ -234,12 +276,10 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
             return None, False
 
     while True:
-        code = L.run(y, b.f, atol, par, ipar, b.K, b.ynew, b.ys, b.hist, b.dns, te, b.o_t, b.o_y,
-                     b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end, *kernel._arrays,
-                     kernel.ws, b.sc, b.piv, b.kept)
+        code = call()
         account()
         t_now = float(par[L.P_T])
-        if code == L.FAILED:  # SciPy's DOP853 goes on from the last checked state
+        if code == L.FAILED:  # the Python stepper goes on from the last checked state
             return rewind()
         if ipar[L.I_WPEND]:  # the watch of the branch charts
             ipar[L.I_WPEND] = 0
@@ -250,20 +290,29 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
         if code == L.WATCH:
             continue
         if code == L.FLAGGED:
-            if ipar[L.I_PREV] >= 2:  # the step before: the caller's last good state
+            if ipar[L.I_PREV] >= 2 and b.hist[1, 0] > checked_to:
+                # the step before (unless checked already): the caller's last good state
+                ws_end = kernel.snapshot() if fixed else None
                 _, ok = checked(_step(b, 0, 1), b.hist[1, 1:m + 1].copy())
                 if not ok:
                     return rewind()
+                if fixed:
+                    # the flagged step's end evaluated from the pose the loop left there, as
+                    # in the Python stepper (whose check of the step before came first): the
+                    # same numbers to round-off (DOP853's compiled runs stay as they were)
+                    kernel.restore(ws_end)
             hand()
-            step = _step(b, 1, 2, (b.dns.copy(), float(par[L.P_TOLD]), float(par[L.P_HOLD])))
+            step = _step(b, 1, 2, None if fixed else (b.dns.copy(), float(par[L.P_TOLD]),
+                                                      float(par[L.P_HOLD])))
             y_new = y.copy()
             ev = after_step(step, y_new)  # a stop here is the run's
             _samples_of(step, y_new, ev, sample, te, ipar, every_step, t_now)
-        elif ipar[L.I_STEPS]:
+        elif ipar[L.I_STEPS] and b.hist[2, 0] > checked_to:  # the batch's last step
             _, ok = checked(_step(b, 1, 2), y.copy())
             if not ok:
                 return rewind()
             hand()
+        checked_to = float(b.hist[2, 0]) if ipar[L.I_STEPS] else checked_to
         mark = (t_now, y.copy(), int(ipar[L.I_NEXT]), list(counted), kernel.snapshot())
         if bar is not None:
             bar.update(t_now)
@@ -288,6 +337,15 @@ def _samples_of(step, y_new, ev, sample, te, ipar, every_step, t_now):
 
 
 def kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
+    """The steps of a segment with event functions from the compiled loop of the
+    integrator (:func:`_kept_steps`), or None for a fixed-step method the loop does not
+    have (its Python stepper takes them)."""
+    if isinstance(integ, FixedStep) and _fixed_method(integ) is None:
+        return None
+    return _kept_steps(kernel, integ, eqs, t, y0, t_end, stats)
+
+
+def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
     """The steps of a segment with event functions, taken in the compiled loop.
 
     The loop takes :data:`KEEP_STEPS` steps per call (those after an event are taken in
@@ -301,7 +359,10 @@ def kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
     evaluations of the checks start where they would after SciPy's step; a generator
     closed at an event drops the later steps of its batch.  Where the loop cannot go on
     (a kernel failure, a step too small, a branch chart built by the watch) the steps
-    go on with SciPy's DOP853 (``integ.integrate``) from the last step yielded.
+    go on with SciPy's DOP853 (``integ.integrate``) from the last step yielded.  A
+    fixed-step integrator's steps come from the fixed-step loop, each with the quintic
+    Hermite interpolant of its ends (as its Python stepper's), and its Python stepper
+    goes on where the loop cannot.
 
     Parameters
     ----------
@@ -346,11 +407,10 @@ def kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
 
     watch_window()
     ipar[L.I_MAXSTEPS] = min(KEEP_STEPS, b.kept.shape[0])
+    call, fixed = _loop(kernel, b, integ, y, atol, te, t, t_end)
     while True:
         ipar[L.I_NKEPT] = 0
-        code = L.run(y, b.f, atol, par, ipar, b.K, b.ynew, b.ys, b.hist, b.dns, te, b.o_t,
-                     b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end, *kernel._arrays,
-                     kernel.ws, b.sc, b.piv, b.kept)
+        code = call()
         evals, rej = int(ipar[L.I_EVALS]), int(ipar[L.I_REJ])
         stats["evaluations"] += evals - counted[0]
         stats["rejected"] += rej - counted[1]
@@ -360,7 +420,7 @@ def kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
         ws_end = kernel.snapshot()
         for row in rows:
             kernel.restore(row[o_ws:])
-            yield _kept_step(row, m, ni)
+            yield _kept_step(row, m, ni, fixed)
         kernel.restore(ws_end)
         if code == L.FAILED:  # SciPy's DOP853 goes on from the last step
             yield from scipy_from(float(par[L.P_T]), y.copy())
@@ -376,11 +436,18 @@ def kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
             return
 
 
-def _kept_step(row, m: int, ni: int) -> Step:
-    """The :class:`Step` of a row of the loop's kept steps, with its dense output."""
+def _kept_step(row, m: int, ni: int, fixed: bool = False) -> Step:
+    """The :class:`Step` of a row of the loop's kept steps, with its dense output (a
+    fixed-step loop's: the Python stepper's quintic Hermite interpolant of its ends)."""
     t0, h, t1 = float(row[0]), float(row[1]), float(row[2])
     y0, y1, f1 = row[3:3 + m], row[3 + m:3 + 2 * m], row[3 + 2 * m:3 + 3 * m]
     dns = row[3 + 3 * m:3 + 10 * m].reshape(7, m)
+    if fixed:  # the rates at the step's start in the place of dns[0]
+        f0 = dns[0]
+        return Step(t0, t1, y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni], y1[2 * ni:],
+                    hermite_dense(t0, y0[:ni], y0[ni:2 * ni], f0[ni:2 * ni], y0[2 * ni:],
+                                  f0[2 * ni:], t1, y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni],
+                                  y1[2 * ni:], f1[2 * ni:]))
 
     def dense(s):
         out = np.empty(m)
@@ -391,7 +458,8 @@ def _kept_step(row, m: int, ni: int) -> Step:
 
 
 def warm_up_loop(kernel) -> None:
-    """Compile (or load) the loop on a kernel: one short run without output."""
+    """Compile (or load) the loops on a kernel (DOP853, the fixed-step one): one short run
+    of each without output."""
     b = buffers(kernel)
     _, ni, _, _, m = b.dims
     y = np.zeros(m)
@@ -403,3 +471,12 @@ def warm_up_loop(kernel) -> None:
     L.run(y, b.f, np.full(m, 1e-9), b.par, b.ipar, b.K, b.ynew, b.ys, b.hist, b.dns,
           np.zeros(0), b.o_t, b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end,
           *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept)
+    for method in (F.RK4, F.WILSON):  # the fixed-step loop (one compilation for both)
+        y[:] = 0.0
+        y[:ni], y[ni:2 * ni] = 0.3, 1.0
+        b.par[:], b.ipar[:] = 0.0, 0
+        b.par[L.P_LAST], b.par[F.P_TOL], b.par[F.P_THETA] = -np.inf, 1e-12, 1.0
+        b.ipar[L.I_MAXSTEPS], b.ipar[F.I_METHOD], b.ipar[F.I_ITER] = 10, method, 2
+        F.run(y, b.f, np.linspace(0.0, 1e-3, 3), b.par, b.ipar, b.K, b.ynew, b.ys, b.hist,
+              np.zeros(0), b.o_t, b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end,
+              *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept)

@@ -160,7 +160,7 @@ def turning_point(eqs, step, qd_old, x_good) -> str | None:
     """
     turns = np.flatnonzero(np.sign(qd_old) * np.sign(step.qdot) < 0)
     if turns.size:
-        rigid = rigid_coordinates(eqs.ms, x_good)
+        rigid = _rigid_of(eqs.ms, x_good)
         turns = np.array([k for k in turns if k not in rigid], dtype=int)
     if not turns.size:
         return None
@@ -180,13 +180,15 @@ def turning_point(eqs, step, qd_old, x_good) -> str | None:
             qk = step.dense(tk)[0]
             if eqs.chart_at(qk) is not None:
                 continue  # a bifurcation: the branch goes on through it
+            xk = _compiled_pose(eqs, tk, qk, x_good)
+            if xk is not None and not _dead_at(ms, xk, k):
+                continue  # (the pose of the kernel's Newton: the same decision)
             try:
                 xk = ms.solve_position(qk, x_good)
             except AssemblyError:
                 xk = None
             rep = ms.singularity(x_good if xk is None else xk)
-            if xk is None or (rep["rcond"] < TURN_RCOND
-                              and ms.coord_names[k] in rep["coordinates"]):
+            if xk is None or _dead_at(ms, xk, k, rep):
                 q = ms.coordinates(x_good if xk is None else xk)
                 return (f"dead position reached near t = {tk:.9g} s at {_where(ms, q)}: "
                         f"{ms.coord_names[k]} turns back where the position Jacobian is "
@@ -197,6 +199,40 @@ def turning_point(eqs, step, qd_old, x_good) -> str | None:
         ws.x, ws.B, ws.qi = kept
         if saved is not None:
             kern.restore(saved)
+
+
+def _dead_at(ms, x, k: int, rep=None) -> bool:
+    """Whether coordinate ``k`` of the mode turning back at pose ``x`` is a dead position:
+    sigma_min / sigma_max below :data:`TURN_RCOND` with the coordinate carrying the null
+    vector (``rep``: the singularity report at x, made when not given)."""
+    rep = ms.singularity(x) if rep is None else rep
+    return bool(rep["rcond"] < TURN_RCOND and ms.coord_names[k] in rep["coordinates"])
+
+
+def _compiled_pose(eqs, t: float, qk, x_good):
+    """The pose at the mode's coordinates ``qk`` by the compiled kernel's Newton from
+    ``x_good`` (the start of :meth:`ModeSystem.solve_position`, a solve about a hundred
+    times cheaper), or None (no kernel, or its solve failed: the NumPy solve decides).
+    The caller puts the kernel's workspace back."""
+    kern = eqs.kernel
+    if kern is None or len(eqs.ms.independent_rows) != eqs.ms.n_rows:
+        return None
+    kern.reset(x_good)
+    if kern.rhs(t, qk, np.zeros_like(qk)) is None:
+        return None
+    return kern.x.copy()
+
+
+def _rigid_of(ms, x) -> frozenset:
+    """:func:`rigid_coordinates` of the mode, kept with the compiled model for the next
+    mode system of the same mode, coordinates and rows (every run builds its own)."""
+    memo = ms.model.memo
+    key = ("rigid coordinates", ms.mode, tuple(int(c) for c in ms.coords),
+           np.asarray(ms.independent_rows).tobytes())
+    found = memo.get(key)
+    if found is None:
+        found = memo[key] = rigid_coordinates(ms, x)
+    return found
 
 
 def diagnose(exc, good):

@@ -224,13 +224,22 @@ class Integrator(ABC):
 class FixedStep(Integrator):
     """Base class of the fixed-step integrators: ``steps`` equal steps over [t0, t_end]
     (default 100 when ``dt`` is not given), or steps of ``dt`` (s; the last one shortened
-    to land on ``t_end``).  A subclass implements :meth:`_advance`; the dense output over
-    each step is :func:`hermite_dense`."""
+    to land on ``t_end``); ``compiled=False`` keeps the Python stepper where the compiled
+    loop could run (see :attr:`compiled`; None: the class's choice).  A subclass
+    implements :meth:`_advance`; the dense output over each step is
+    :func:`hermite_dense`."""
 
     adaptive = False
+    #: segments on a compiled kernel run in the compiled fixed-step loop
+    #: (:mod:`mechdyn.kernels.fixed_step_numba`): True for the methods it has (RK4,
+    #: Wilson's); False on an instance: the Python stepper everywhere (for cross-checks)
+    compiled = False
 
-    def __init__(self, steps: int | None = None, dt: float | None = None):
+    def __init__(self, steps: int | None = None, dt: float | None = None, *,
+                 compiled: bool | None = None):
         super().__init__()
+        if compiled is not None:
+            self.compiled = bool(compiled)
         self.steps = check_positive("steps", steps, integer=True, allow_none=True)
         self.dt = check_positive("dt", dt, allow_none=True)
         if self.steps is not None and self.dt is not None:
@@ -244,15 +253,29 @@ class FixedStep(Integrator):
         """``(q, q', w, q'', p)`` at ``t1`` from the state and ``(a, p) = rhs(t, q, v)``
         at ``t``."""
 
-    def _steps(self, rhs, t0, q0, qdot0, w0, t_end, first_order=None) -> Iterator[Step]:
+    def grid(self, t0: float, t_end: float) -> np.ndarray:
+        """The step ends over [t0, t_end], ``t0`` first: ``steps`` equal steps, or steps
+        of ``dt`` with the last one shortened to land on ``t_end`` (s).
+
+        Examples
+        --------
+        >>> from mechdyn.integrate import RungeKutta4
+        >>> RungeKutta4(dt=0.4).grid(0.0, 1.0).tolist()
+        [0.0, 0.4, 0.8, 1.0]
+        >>> RungeKutta4(steps=2).grid(0.0, 1.0).tolist()
+        [0.0, 0.5, 1.0]
+        """
         if t_end == t0:
-            grid = np.array([t0])
-        elif self.dt is not None:
+            return np.array([t0])
+        if self.dt is not None:
             n = max(1, int(math.ceil((t_end - t0) / self.dt - 1e-9)))
             grid = t0 + self.dt * np.arange(n + 1)
             grid[-1] = t_end
-        else:
-            grid = np.linspace(t0, t_end, (100 if self.steps is None else self.steps) + 1)
+            return grid
+        return np.linspace(t0, t_end, (100 if self.steps is None else self.steps) + 1)
+
+    def _steps(self, rhs, t0, q0, qdot0, w0, t_end, first_order=None) -> Iterator[Step]:
+        grid = self.grid(t0, t_end)
         q, v, w = q0, qdot0, w0
         a, p = rhs(t0, q, v)
         t = t0

@@ -123,6 +123,7 @@ def segment_integrators(method, t0: float, t_end: float, *, rtol, atol, dt, step
         An unknown integrator or options that do not belong to it.
     """
     fixed = dict(dt=dt, steps=steps, iterations=iterations, tol=tol, theta=theta)
+    compiled = True
     name = method.lower() if isinstance(method, str) else method  # make_integrator checks it
     if isinstance(method, Integrator):
         make_integrator(method, **fixed)  # refuses options beside an instance
@@ -134,6 +135,7 @@ def segment_integrators(method, t0: float, t_end: float, *, rtol, atol, dt, step
         else:
             fixed.update(dt=method.dt, steps=method.steps,
                          **{k: getattr(method, k, None) for k in ("iterations", "tol", "theta")})
+            compiled = getattr(method, "compiled", True)
     if name in ("wilson", "rk4"):
         # the same validation as a fixed-structure run (first_step, max_step are refused)
         make_integrator(name, first_step=first_step, max_step=max_step, **fixed)
@@ -141,7 +143,9 @@ def segment_integrators(method, t0: float, t_end: float, *, rtol, atol, dt, step
         opts = {k: fixed[k] for k in ("iterations", "tol", "theta") if name == "wilson"}
 
         def factory(scale, first):
-            return make_integrator(name, dt=h, **opts)
+            integ = make_integrator(name, dt=h, **opts)
+            integ.compiled = compiled  # an instance's choice of the Python stepper is kept
+            return integ
 
         return factory, f"{name} (dt={h:.6g} s)"
     make_integrator(name, rtol=rtol, atol=atol, first_step=first_step, max_step=max_step,

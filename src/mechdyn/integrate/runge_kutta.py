@@ -21,10 +21,15 @@ class RungeKutta4(FixedStep):
         Number of equal steps over [t0, t_end] (default 100 when ``dt`` is not given).
     dt : float, optional
         Step size, s (the last step is shortened to land on ``t_end``).
+    compiled : bool, optional
+        Run segments on a compiled kernel in the compiled loop
+        (:mod:`mechdyn.kernels.fixed_step_numba`, default), or (False) always step in
+        Python.
     """
 
     name = "rk4"
     order = 4
+    compiled = True
 
     def _advance(self, rhs, t, t1, q, v, w, a, p):
         h = t1 - t

@@ -48,14 +48,20 @@ class Wilson(FixedStep):
         (1 + |(q, q')|) in the max norm; None always makes ``iterations`` passes.
     theta : float
         1 (the plain linear-acceleration method, default) or >= 1.37 (Wilson-theta).
+    compiled : bool, optional
+        Run segments on a compiled kernel in the compiled loop
+        (:mod:`mechdyn.kernels.fixed_step_numba`, default), or (False) always step in
+        Python.
     """
 
     name = "wilson"
     order = 2
+    compiled = True
 
     def __init__(self, steps: int | None = None, dt: float | None = None, *,
-                 iterations: int = 4, tol: float | None = 1e-12, theta: float = 1.0):
-        super().__init__(steps, dt)
+                 iterations: int = 4, tol: float | None = 1e-12, theta: float = 1.0,
+                 compiled: bool | None = None):
+        super().__init__(steps, dt, compiled=compiled)
         self.iterations = check_positive("iterations", iterations, integer=True)
         self.tol = check_positive("tol", tol, allow_none=True)
         theta = float(theta)

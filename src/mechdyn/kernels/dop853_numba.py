@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..integrate.dop853_tableau import E3, E5, N_STAGES, A, C, D
+from .hermite_numba import hermite_at
 from .lagrange_numba import D_NI, N_FLAGS, W_COUNT, W_PIVOT, evaluate_into
 from .rows_numba import njit
 
@@ -38,7 +39,7 @@ __all__ = ["run", "evaluate_states", "dense_at", "DONE", "BATCH", "FLAGGED", "FA
            "P_HMAX", "P_STALL", "P_PIVOT", "P_WC0", "P_WC1", "P_LAST", "P_TOLD", "P_HOLD",
            "I_EVALS", "I_STEPS", "I_REJ", "I_NOUT", "I_NEXT", "I_FLAGS", "I_FSAL",
            "I_EVERY", "I_WATCH", "I_MAXSTEPS", "I_STATUS", "I_PREV", "I_WPEND", "P_WS",
-           "I_KEEP", "I_NKEPT", "I_CTRL",
+           "I_KEEP", "I_NKEPT", "I_CTRL", "step_end", "accept", "samples",
            "N_PAR", "N_IPAR"]
 
 # return codes of run
@@ -219,6 +220,88 @@ def keep_step(row, t, h, t_new, y, ynew, fnew, dns):
 
 
 @njit
+def step_end(t, h, t_new, y, f, ynew, fnew, ws, x_end, hist, par, ni, turns):
+    """After the evaluation at an accepted step's end: the pose and its rates there into
+    ``x_end``, the step into the history rows (start of the previous step, start and end of
+    this one), its start and size into ``par``; returns its flags: F_TURN where a
+    coordinate rate changed sign (when ``turns``), F_PIVOT where the pivot ratio of the
+    position Jacobian fell below ``par[P_PIVOT]``."""
+    m = y.size
+    nx = x_end.size // 3
+    flags = 0
+    for c in range(ni if turns else 0):
+        if (y[ni + c] > 0.0 and ynew[ni + c] < 0.0) or (y[ni + c] < 0.0
+                                                       and ynew[ni + c] > 0.0):
+            flags |= F_TURN
+    if ws[ws.size - N_FLAGS + W_PIVOT] < par[P_PIVOT]:
+        flags |= F_PIVOT
+    o = nx + ni + nx * ni
+    for i in range(nx):
+        x_end[i] = ws[i]
+        x_end[nx + i] = ws[o + i]
+    hist[0, :] = hist[1, :]
+    hist[1, 0] = t
+    hist[1, 1:m + 1] = y
+    hist[1, m + 1:] = f
+    hist[2, 0] = t_new
+    hist[2, 1:m + 1] = ynew
+    hist[2, m + 1:] = fnew
+    par[P_TOLD], par[P_HOLD] = t, h
+    return flags
+
+
+@njit
+def accept(y, f, ynew, fnew, ipar):
+    """The step's end becomes the state (y, f) the next step starts from."""
+    for i in range(y.size):
+        y[i] = ynew[i]
+        f[i] = fnew[i]
+    ipar[I_PREV] += 1
+
+
+@njit
+def samples(hermite, t, h, t_new, y, f, ynew, fnew, dns, ys, fs, end_sample, t_eval, par,
+            ipar, ip, fp, ri, rf, dims, ws, ext, ext_end, x_end, on, sc, piv, o_t, o_y, o_x,
+            o_xd, o_ext):
+    """The output samples of an accepted step into the buffers: the times of ``t_eval``
+    inside it, on the step's dense output (``dns``, :func:`dense_at`) or, with
+    ``hermite``, on the quintic Hermite interpolant of its ends
+    (:func:`mechdyn.kernels.hermite_numba.hermite_at`), each evaluated in full (``on``: a
+    runtime True) and not counted as a step's evaluation; then its end where
+    ``end_sample`` (its evaluation in ``ext_end``, ``x_end``).  False where the kernel
+    failed at a sample."""
+    ni = dims[D_NI]
+    nx = x_end.size // 3
+    n_te = t_eval.size
+    while ipar[I_NEXT] < n_te and t_eval[ipar[I_NEXT]] <= t_new:
+        ts = t_eval[ipar[I_NEXT]]
+        ipar[I_NEXT] += 1
+        if ts <= par[P_LAST] or ts >= t_new:
+            continue
+        if hermite:
+            hermite_at(t, y, f, t_new, ynew, fnew, ni, ts, ys)
+        else:
+            dense_at(dns, y, t, h, ts, ys)
+        ok = _counted(ts, ys, fs, ni, ip, fp, ri, rf, dims, ws, ext, on, sc, piv, ipar)
+        ipar[I_EVALS] -= 1  # an output sample, not a step's evaluation
+        if not ok:
+            return False
+        _record(ipar[I_NOUT], ts, ys, ws, ext, nx, ni, o_t, o_y, o_x, o_xd, o_ext)
+        ipar[I_NOUT] += 1
+        par[P_LAST] = ts
+    if end_sample and t_new > par[P_LAST]:
+        k = ipar[I_NOUT]
+        o_t[k] = t_new
+        o_y[k, :] = ynew
+        o_x[k, :] = x_end[:nx]
+        o_xd[k, :] = x_end[nx:2 * nx]
+        o_ext[k, :] = ext_end
+        ipar[I_NOUT] += 1
+        par[P_LAST] = t_new
+    return True
+
+
+@njit
 def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_xd, o_ext,
         ext, ext_end, x_end, ip, fp, ri, rf, dims, ws, sc, piv, kept):
     """Integrate from ``par[P_T]`` (state ``y``, rates ``f`` when ``ipar[I_FSAL]``) towards
@@ -356,28 +439,10 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
             h_next = min(h_next, h)
         rejected = False
         # what Python must look at
-        flags = 0
-        for c in range(ni if ipar[I_KEEP] == 0 else 0):
-            if (y[ni + c] > 0.0 and ynew[ni + c] < 0.0) or (y[ni + c] < 0.0
-                                                           and ynew[ni + c] > 0.0):
-                flags |= F_TURN
-        if ws[ws.size - N_FLAGS + W_PIVOT] < par[P_PIVOT]:
-            flags |= F_PIVOT
+        flags = step_end(t, h, t_new, y, f, ynew, fnew, ws, x_end, hist, par, ni,
+                         ipar[I_KEEP] == 0)
         if h < par[P_STALL]:
             flags |= F_STALL
-        o = nx + ni + nx * ni
-        for i in range(nx):
-            x_end[i] = ws[i]
-            x_end[nx + i] = ws[o + i]
-        # history: start of the previous step, start and end of this one
-        hist[0, :] = hist[1, :]
-        hist[1, 0] = t
-        hist[1, 1:m + 1] = y
-        hist[1, m + 1:] = f
-        hist[2, 0] = t_new
-        hist[2, 1:m + 1] = ynew
-        hist[2, m + 1:] = fnew
-        par[P_TOLD], par[P_HOLD] = t, h
         interior = ipar[I_NEXT] < n_te and t_eval[ipar[I_NEXT]] < t_new
         if ipar[I_KEEP] != 0:
             kept[ipar[I_NKEPT], kept.shape[1] - ws.size:] = ws
@@ -394,40 +459,15 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
             ipar[I_NKEPT] += 1
         if flags != 0:
             ipar[I_FLAGS] = flags
-            for i in range(m):
-                y[i] = ynew[i]
-                f[i] = fnew[i]
-            ipar[I_PREV] += 1
+            accept(y, f, ynew, fnew, ipar)
             par[P_T], par[P_H] = t_new, h_next
             return FLAGGED
         # the samples of the step: t_eval inside it (dense output), then its end
-        while ipar[I_NEXT] < n_te and t_eval[ipar[I_NEXT]] <= t_new:
-            ts = t_eval[ipar[I_NEXT]]
-            ipar[I_NEXT] += 1
-            if ts <= par[P_LAST] or ts >= t_new:
-                continue
-            dense_at(dns, y, t, h, ts, ys)
-            if not _counted(ts, ys, K[N_STAGES + 1], ni, ip, fp, ri, rf, dims, ws, ext, on,
-                            sc, piv, ipar):
-                ipar[I_EVALS] -= 1  # an output sample, not a step's evaluation
-                return FAILED
-            ipar[I_EVALS] -= 1
-            _record(ipar[I_NOUT], ts, ys, ws, ext, nx, ni, o_t, o_y, o_x, o_xd, o_ext)
-            ipar[I_NOUT] += 1
-            par[P_LAST] = ts
-        if end_sample and t_new > par[P_LAST]:
-            k = ipar[I_NOUT]
-            o_t[k] = t_new
-            o_y[k, :] = ynew
-            o_x[k, :] = x_end[:nx]
-            o_xd[k, :] = x_end[nx:2 * nx]
-            o_ext[k, :] = ext_end
-            ipar[I_NOUT] += 1
-            par[P_LAST] = t_new
-        for i in range(m):
-            y[i] = ynew[i]
-            f[i] = fnew[i]
-        ipar[I_PREV] += 1
+        if not samples(off, t, h, t_new, y, f, ynew, fnew, dns, ys, K[N_STAGES + 1],
+                       end_sample, t_eval, par, ipar, ip, fp, ri, rf, dims, ws, ext, ext_end,
+                       x_end, on, sc, piv, o_t, o_y, o_x, o_xd, o_ext):
+            return FAILED
+        accept(y, f, ynew, fnew, ipar)
         t = t_new
         h = h_next
         if ipar[I_WPEND] != 0:
