@@ -220,5 +220,5 @@ def _warm_up_study(model: Model) -> None:
     path_variants(np.ascontiguousarray(model.x0[None]), Q, dQ, ddQ, np.arange(m), model.n_bodies,
                   ints, flts, lay.n_rows, np.full(1, 1e-12), 12, 1e7, 1e-9, X, Xd, Xdd, J, LU,
                   piv, rc, ok, fail)
-    rhs = np.zeros((1, m, 2 * n))[..., :n]  # the study's right-hand sides are strided views
-    inverse_variants(LU, piv, rhs, lay.n_rows, np.empty((1, m, n)))
+    # the study passes its right-hand sides C-contiguous (one specialization)
+    inverse_variants(LU, piv, np.zeros((1, m, n)), lay.n_rows, np.empty((1, m, n)))

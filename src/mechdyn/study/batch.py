@@ -392,7 +392,9 @@ def _cycle(vs: Variants, analysis: KinetostaticExtremes, work: dict) -> list[Out
             return [None] * V
         q, qdot = _prescribed(q0[live], values, qd_dot, didx)
         rhs, F_ground = _rhs(vs.take(live), base, t, X, Xd, Xdd, q, qdot, didx)
-        inverse_variants(LU, piv, rhs, n_rows, Z)
+        # C-contiguous whatever _rhs returns (a strided view or not): one specialization
+        # of the kernel, the one mechdyn.warmup compiles
+        inverse_variants(LU, piv, np.ascontiguousarray(rhs), n_rows, Z)
         loads_variants(X, J, Z, *loads, frame, Fj)
         frame += F_ground  # the frame's share of the loads (point of the moments: the origin)
     if not live.size:
