@@ -441,6 +441,32 @@ def mode_system(sm: SwitchedModel, mode, targets: dict, x, *, prefer=(), avoid=(
     ``workspace``, or with friction in the joints (whose mode systems carry the pairs'
     states), always a new one.
 
+    Parameters
+    ----------
+    sm : SwitchedModel
+    mode : frozenset of str
+    targets : dict
+        Held values of the engaged locks and sticking contacts; part of the key (equal
+        values by :func:`held_key`; a held value that is not numbers: never kept).
+    x : ndarray, shape (n_x,)
+        The pose (m, rad); part of the key, byte for byte (only the last pose is kept).
+    prefer, avoid : sequence of str
+        As in :class:`ModeSystem`; part of the key.
+    workspace : Workspace, optional
+        The run's workspace, where the mode systems of the pose are kept
+        (:attr:`~mechdyn.model.workspace.Workspace.at_pose`); None: a new mode system
+        with a workspace of its own.
+
+    Returns
+    -------
+    ModeSystem
+        Its workspace restarted at ``x`` (``workspace.reset``).
+
+    Raises
+    ------
+    LockupError
+        As :class:`ModeSystem` (a new one only).
+
     Examples
     --------
     >>> import mechdyn
