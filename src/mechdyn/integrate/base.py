@@ -257,6 +257,16 @@ class FixedStep(Integrator):
         """The step ends over [t0, t_end], ``t0`` first: ``steps`` equal steps, or steps
         of ``dt`` with the last one shortened to land on ``t_end`` (s).
 
+        Parameters
+        ----------
+        t0, t_end : float
+            The interval, s (``t_end`` >= ``t0``; equal: the grid is ``[t0]``).
+
+        Returns
+        -------
+        ndarray, shape (n + 1,)
+            The step ends, s: ``t0`` first, ``t_end`` last (exactly).
+
         Examples
         --------
         >>> from mechdyn.integrate import RungeKutta4
