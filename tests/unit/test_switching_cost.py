@@ -40,6 +40,24 @@ def test_a_run_builds_a_mode_once_per_pose(sm):
     assert mode_system(sm, frozenset(), {}, x, workspace=ws) is not a
 
 
+def test_a_kept_mode_system_is_keyed_on_the_mode_and_its_held_values(sm):
+    # the same pose and workspace: a lock held at another value, or another mode, is
+    # another mode system (its lock row holds its own value: residual -0.01 rad at x)
+    ws, x = Workspace(), sm.model.x_sketch
+    lock = sm.lock_names[0]
+    held = {}
+    sm.capture_target(lock, x, held)
+    a = mode_system(sm, frozenset({lock}), held, x, workspace=ws)
+    moved = {lock: held[lock] + 0.01}
+    b = mode_system(sm, frozenset({lock}), moved, x, workspace=ws)
+    assert b is not a
+    assert a.row_values(x)[-1] == pytest.approx(0.0, abs=1e-15)
+    assert b.row_values(x)[-1] == pytest.approx(-0.01, abs=1e-12)
+    assert mode_system(sm, frozenset({lock}), dict(held), x, workspace=ws) is a
+    free = mode_system(sm, frozenset(), held, x, workspace=ws)
+    assert free is not a and free.n_rows == a.n_rows - 1
+
+
 def test_pose_values_as_the_numpy_rows(sm):
     measures = [m for _, m, _, _ in gap_measures(sm)]
     pv = _PoseValues(sm.nb, measures)
