@@ -35,16 +35,15 @@ import time
 
 import numpy as np
 
-from .dynamics.contact import gaps, touching
 from .dynamics.dead_position import diagnose, status_of, turning_point
 from .dynamics.friction import friction_joints
-from .dynamics.joint_friction import SelfLockingError, stick_slip_joints
+from .dynamics.joint_friction import SelfLockingError
 from .dynamics.mode_equations import ModeEquations
-from .dynamics.modes import ModeSystem, switched_model
+from .dynamics.modes import switched_model
 from .dynamics.run_samples import Samples, finish
+from .dynamics.run_start import start_state
 from .dynamics.switching import apply_switch, event_functions
 from .errors import (
-    LockupError,
     MechdynError,
     ModelError,
     Status,
@@ -164,7 +163,6 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
 
     # ---------------------------------------------------------------- initial state
     status, message = Status.SUCCESS, ""
-    targets: dict = {}
     locks = sm.initial_locks() if mode is None else frozenset(mode)
     unknown = [n for n in locks if n not in sm.lock_names]
     if unknown:
@@ -178,38 +176,9 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     w = np.zeros(2 if friction_joints(model) else 1)
     ws = Workspace()  # the run's caches, shared by the mode systems of the run
     try:
-        x = x_guess
-        if locks:
-            try:  # the pose at which undeclared locks capture what they hold
-                free = ModeSystem(sm, frozenset(), targets, x_guess, workspace=ws)
-                x = free.solve_position(q_init[free.coords], x_guess, t=t)
-            except LockupError:  # the coordinates need the locks: the welded pose
-                pass
-        for n in locks:
-            sm.capture_target(n, x, targets)
-        ms = ModeSystem(sm, locks, targets, x, workspace=ws)
-        x = ms.solve_position(q_init[ms.coords], x, t=t)
-        # rates: given for the independent coordinates of the mode with every
-        # touching stop and contact closed (the rest are dependent there)
-        touch0 = touching(sm, x, gap_tol=gap_tol)
-        ms_t = ModeSystem(sm, locks | frozenset(touch0), targets, x, workspace=ws) \
-            if touch0 else ms
-        B, _ = ms_t.velocity_analogs(x)
-        xd = B @ qd_init[ms_t.coords]
-        for tok, (g, is_angle) in gaps(sm, x).items():
-            n, side = tok.split("@")
-            if g >= -(gap_tol / L if is_angle else gap_tol):
-                continue
-            if side == "contact":
-                raise ModelError(f"contact {n!r}: the initial state penetrates by {-g:.3g} m")
-            st, meas = sm.stops[n]
-            raise ModelError(f"stop {n!r}: the initial state violates its limits ({meas.label} "
-                             f"= {meas.value(x):.9g}, lower {st.lower}, upper {st.upper})")
-        if sm.has_switching or stick_slip_joints(model):
-            # the mode the state is in: touching stops and contacts, sticking pairs
-            ms, x, xd, _ = apply_switch(sm, t, ms, x, xd, targets, events, fired=[],
-                                        small_velocity=small_velocity, gap_tol=gap_tol,
-                                        force_scale=force_scale, initial=True)
+        ms, x, xd, targets = start_state(sm, t, locks, q_init, qd_init, x_guess, ws, events,
+                                         gap_tol=gap_tol, small_velocity=small_velocity,
+                                         force_scale=force_scale)
     except (MechdynError, np.linalg.LinAlgError) as exc:
         if isinstance(exc, ModelError):
             raise
