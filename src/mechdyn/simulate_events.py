@@ -176,15 +176,14 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     w = np.zeros(2 if friction_joints(model) else 1)
     ws = Workspace()  # the run's caches, shared by the mode systems of the run
     try:
-        ms, x, xd, targets = start_state(sm, t, locks, q_init, qd_init, x_guess, ws, events,
-                                         gap_tol=gap_tol, small_velocity=small_velocity,
-                                         force_scale=force_scale)
+        ms, x, xd, targets, qi, qdi = start_state(
+            sm, t, locks, q_init, qd_init, x_guess, ws, events, gap_tol=gap_tol,
+            small_velocity=small_velocity, force_scale=force_scale)
     except (MechdynError, np.linalg.LinAlgError) as exc:
         if isinstance(exc, ModelError):
             raise
         return finish(model, rec, events, stats, wall0, *_status(exc, None), sm, point)
 
-    qi, qdi = ms.independent(x, xd)
     just_fired: set = set()
     after_event = False
     good = None  # (t, ModeEval) of the last accepted step: where a failed run was well

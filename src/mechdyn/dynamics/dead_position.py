@@ -204,9 +204,35 @@ def turning_point(eqs, step, qd_old, x_good) -> str | None:
 def _dead_at(ms, x, k: int, rep=None) -> bool:
     """Whether coordinate ``k`` of the mode turning back at pose ``x`` is a dead position:
     sigma_min / sigma_max below :data:`TURN_RCOND` with the coordinate carrying the null
-    vector (``rep``: the singularity report at x, made when not given)."""
-    rep = ms.singularity(x) if rep is None else rep
-    return bool(rep["rcond"] < TURN_RCOND and ms.coord_names[k] in rep["coordinates"])
+    vector (its share of the left singular vector of sigma_min above 1e-3; ``rep``: the
+    singularity report at x, else the decision of that report made from the singular
+    values and vectors alone)."""
+    if rep is not None:
+        return bool(rep["rcond"] < TURN_RCOND and ms.coord_names[k] in rep["coordinates"])
+    sel, row_scale, col_scale = _scaling(ms)
+    if not sel.size:
+        return False  # no freedom: rcond 1
+    # the scaled position Jacobian [rows_I; g_I] of ModeSystem.singularity, the same numbers
+    J = RN.jacobian(ms.layout.position_rows, x)[sel]
+    u, s, _ = np.linalg.svd(J * row_scale * col_scale)
+    rcond = float(s[-1] / s[0]) if s[0] > 0 else 0.0
+    return bool(rcond < TURN_RCOND and u[len(ms.independent_rows) + k, -1] ** 2 > 1e-3)
+
+
+def _scaling(ms) -> tuple:
+    """(the indices of [rows_I; g_I] among the mode's position rows, the row scale (n, 1)
+    and the column scale (n_x,) that make their Jacobian dimensionless as
+    :func:`mechdyn.kinematics.assembly._scaled` does), kept with the compiled model."""
+    model = ms.model
+    sel = np.concatenate([ms.independent_rows, ms.n_rows + np.asarray(ms.coords, int)])
+    key = ("turn scaling", ms.mode, sel.tobytes())
+    found = model.memo.get(key)
+    if found is None:
+        L = model.length_scale
+        is_angle = ms.layout.position_rows.is_angle[sel]
+        found = model.memo[key] = (sel, np.where(is_angle, 1.0, 1.0 / L)[:, None],
+                                   np.tile([L, L, 1.0], model.n_bodies))
+    return found
 
 
 def _compiled_pose(eqs, t: float, qk, x_good):

@@ -62,6 +62,8 @@ def start_state(sm, t: float, locks: frozenset, q_init, qd_init, x_guess, ws: Wo
     x, xd : ndarray, shape (n_x,)
     targets : dict
         The held values of the engaged locks (and sticking contacts).
+    qi, qdi : ndarray, shape (n_i,)
+        The mode's independent coordinates and their rates.
 
     Raises
     ------
@@ -81,13 +83,14 @@ def start_state(sm, t: float, locks: frozenset, q_init, qd_init, x_guess, ws: Wo
     ms, x, xd, targets, touch0 = _start(sm, t, locks, q_init, qd_init, x_guess, ws, events,
                                         gap_tol=gap_tol, small_velocity=small_velocity,
                                         force_scale=force_scale)
+    qi, qdi = ms.independent(x, xd)
     starts = model.memo.setdefault("run starts", [])
     if (not touch0 and len(events) == n_events and not ws.warned and ms.friction is None
             and not friction_joints(model) and not stick_slip_joints(model)
             and held_key(targets) is not None and len(starts) < STARTS_KEPT):
         starts.append(key)
-        model.memo[key] = _kept(ms, x, xd, targets, ws)
-    return ms, x, xd, targets
+        model.memo[key] = _kept(ms, x, xd, targets, ws, qi, qdi)
+    return ms, x, xd, targets, qi, qdi
 
 
 def _start(sm, t, locks, q_init, qd_init, x_guess, ws, events, *, gap_tol, small_velocity,
@@ -131,7 +134,7 @@ def _start(sm, t, locks, q_init, qd_init, x_guess, ws, events, *, gap_tol, small
     return ms, x, xd, targets, touch0
 
 
-def _kept(ms, x, xd, targets, ws) -> tuple:
+def _kept(ms, x, xd, targets, ws, qi, qdi) -> tuple:
     """What :func:`_restart` needs: the mode system (a copy, so that the run that made it
     changes nothing of it), the state, the held values and the workspace's solve state
     (its arrays marked where they are ``x`` itself)."""
@@ -143,13 +146,14 @@ def _kept(ms, x, xd, targets, ws) -> tuple:
     ms0.x_ref = np.array(ms.x_ref, float)
     ms0.ws = None
     return (ms0, np.array(x, float), np.array(xd, float), dict(targets),
-            (own(ws.x), own(ws.B), own(ws.qi), parts))
+            (own(ws.x), own(ws.B), own(ws.qi), parts), np.array(qi, float),
+            np.array(qdi, float))
 
 
 def _restart(kept, ws):
     """The start of a kept run for a new run: a copy of the mode system in the run's
     workspace, set as the start's last solve left it."""
-    ms0, x0, xd0, targets, (wx, wB, wqi, parts) = kept
+    ms0, x0, xd0, targets, (wx, wB, wqi, parts), qi, qdi = kept
     x = x0.copy()
 
     def own(a):
@@ -160,4 +164,4 @@ def _restart(kept, ws):
     ms.ws = ws
     ws.x, ws.B, ws.qi = own(wx), own(wB), own(wqi)
     ws.parts = None if parts is None else (own(parts[0]), *parts[1:])
-    return ms, x, xd0.copy(), dict(targets)
+    return ms, x, xd0.copy(), dict(targets), qi.copy(), qdi.copy()
