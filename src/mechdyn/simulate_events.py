@@ -69,6 +69,9 @@ from .results.trajectory import Trajectory
 __all__ = ["simulate_events", "SwitchEvent", "format_events", "needs_event_loop"]
 
 
+#: the default point of the frame moment: the ground origin, m
+ORIGIN = (0.0, 0.0)
+
 #: a switching instant is an :class:`~mechdyn.integrate.events.EventRecord`, the one record
 #: of events in the package (kind ``"engage"``, ``"release"``, ``"impact"`` ...)
 SwitchEvent = EventRecord
@@ -88,7 +91,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                     small_velocity: float | None = None, gap_tol: float | None = None,
                     zeno_time: float | None = None,
                     max_wall_time: float | None = None, max_steps: int | None = None,
-                    min_step: float | None = None, point=(0.0, 0.0),
+                    min_step: float | None = None, point=ORIGIN,
                     progress: bool | None = None, dt: float | None = None,
                     steps: int | None = None, iterations: int | None = None,
                     tol: float | None = None, theta: float | None = None,
@@ -109,7 +112,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     model = mech_or_model if isinstance(mech_or_model, Model) else mech_or_model.compile()
     sm = switched_model(model)
     L = model.length_scale
-    scale = np.where(model.coord_is_angle, 1.0, L)  # of the coordinates' tolerances
+    scale, force_scale = _constants(model)
     t_end = float(t_end)
     t0 = float(t0)
     if not t_end >= t0:
@@ -123,7 +126,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     span = t_end - t0
     if zeno_time is None:
         zeno_time = 1e-4 * span
-    if np.shape(point) != (2,) or not np.all(np.isfinite(np.asarray(point, float))):
+    if point is not ORIGIN and (np.shape(point) != (2,)
+                                or not np.all(np.isfinite(np.asarray(point, float)))):
         raise ModelError(f"point must be a finite (x, y) in m, got {point!r}")
     if min_step is None:
         min_step = 1e-13 * span
@@ -139,7 +143,6 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         if t_eval[-1] < t_end - 1e-12 * max(1.0, abs(t_end)):
             t_eval = np.append(t_eval, t_end)
     t_eval = np.asarray(t_eval, float)
-    force_scale = max(float(np.sum(model.mass) * max(np.hypot(*model.gravity), 1.0)), 1.0)
     segment_integrator, method_name = segment_integrators(
         method, t0, t_end, rtol=rtol, atol=atol, dt=dt, steps=steps, iterations=iterations,
         tol=tol, theta=theta, first_step=first_step, max_step=max_step)
@@ -338,6 +341,18 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         "numpy" if backends <= {"numpy"} else "numba+numpy")
     bar.close()
     return finish(model, rec, events, stats, wall0, status, message, sm, point)
+
+
+def _constants(model) -> tuple:
+    """The scale of the coordinates' tolerances (1 for angles, the length scale for
+    travels), shape (n_q,), and the force scale of the model (its weight, at least 1 N),
+    kept with the compiled model."""
+    got = model.memo.get("run constants")
+    if got is None:
+        got = model.memo["run constants"] = (
+            np.where(model.coord_is_angle, 1.0, model.length_scale),
+            max(float(np.sum(model.mass) * max(np.hypot(*model.gravity), 1.0)), 1.0))
+    return got
 
 
 def _status(exc, good):
