@@ -42,7 +42,7 @@ def test_dead_decision_is_that_of_the_singularity_report():
         qi0 = ms.coordinates(ms.model.x_sketch)[ms.coords]
         for k, sign in ((k, s) for k in range(ms.n_i) for s in (1.0, -1.0)):
             x = ms.model.x_sketch
-            for dq in sign * np.linspace(0.0, 6.3, 316):  # by continuation to a fold, if any
+            for dq in sign * np.linspace(0.0, 6.3, 631):  # by continuation to a fold, if any
                 qi = qi0.copy()
                 qi[k] += dq
                 try:
