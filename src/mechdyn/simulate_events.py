@@ -41,7 +41,7 @@ from .dynamics.joint_friction import SelfLockingError
 from .dynamics.mode_equations import ModeEquations
 from .dynamics.modes import switched_model
 from .dynamics.run_samples import Samples, finish
-from .dynamics.run_start import start_state
+from .dynamics.run_start import give_back, start_equations, start_state
 from .dynamics.switching import apply_switch, event_functions
 from .errors import (
     MechdynError,
@@ -179,7 +179,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     w = np.zeros(2 if friction_joints(model) else 1)
     ws = Workspace()  # the run's caches, shared by the mode systems of the run
     try:
-        ms, x, xd, targets, qi, qdi = start_state(
+        ms, x, xd, targets, qi, qdi, start = start_state(
             sm, t, locks, q_init, qd_init, x_guess, ws, events, gap_tol=gap_tol,
             small_velocity=small_velocity, force_scale=force_scale)
     except (MechdynError, np.linalg.LinAlgError) as exc:
@@ -195,9 +195,14 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     n_events = 0
     last_event_t, repeat = None, 0
     bar = Progress(progress, t0, t_end)
+    first_eqs = kept_eqs = None
     while t < t_end or not stats["segments"]:
         stats["segments"] += 1
-        eqs = ModeEquations(sm, ms, backend, formulation, d)
+        if stats["segments"] == 1:  # kept with the run's start, if it was kept
+            eqs, kept_eqs = start_equations(sm, ms, backend, formulation, d, start)
+            first_eqs = eqs
+        else:
+            eqs = ModeEquations(sm, ms, backend, formulation, d)
         backends.add(eqs.backend)
         if eqs.note:
             stats["backend_note"] = eqs.note
@@ -340,6 +345,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     stats["backend"] = "numba" if backends == {"numba"} else (
         "numpy" if backends <= {"numpy"} else "numba+numpy")
     bar.close()
+    give_back(sm, first_eqs, kept_eqs)  # for the next run from the same start
     return finish(model, rec, events, stats, wall0, status, message, sm, point)
 
 

@@ -56,3 +56,41 @@ def test_a_bounded_number_of_starts_is_kept():
     for k in range(STARTS_KEPT + 3):
         mechdyn.simulate(model, 1e-3, progress=False, qdot0={"phi": 1.0 + k})
     assert len(_kept(model)) == STARTS_KEPT
+
+
+def _pool(model):
+    return [v for k, v in model.memo.items() if isinstance(k, tuple) and k[0] == "run equations"]
+
+
+def test_the_equations_of_a_kept_start_serve_the_next_run():
+    model = press_idle().compile()
+    first = mechdyn.simulate(model, 0.05, progress=False, rtol=1e-9)
+    (pool,) = _pool(model)
+    assert len(pool) == 1
+    eqs = pool[0][0]
+    for kw in ({"integrator": "rk4", "steps": 40}, {"rtol": 1e-9}):
+        tr = mechdyn.simulate(model, 0.05, progress=False, **kw)
+        assert len(pool) == 1 and pool[0][0] is eqs  # taken, restarted, given back
+    _same(first, tr)
+    assert tr.stats["compile_time_s"] == 0.0
+
+
+def test_a_run_within_a_run_has_its_own_equations():
+    """An event function that runs the same model from the same state: the inner run does
+    not share the outer run's equations (nor its kernel's workspace)."""
+    model = press_idle().compile()
+    ref = mechdyn.simulate(model, 0.02, progress=False, rtol=1e-9)
+    inner = []
+
+    def g(t, q, qdot):
+        if not inner:
+            inner.append(mechdyn.simulate(model, 0.02, progress=False, rtol=1e-9))
+        return 1.0
+
+    outer = mechdyn.simulate(model, 0.02, progress=False, rtol=1e-9,
+                             events=[mechdyn.integrate.Event(g, "inner run")])
+    _same(ref, inner[0])
+    plain = mechdyn.simulate(model, 0.02, progress=False, rtol=1e-9,
+                             events=[mechdyn.integrate.Event(lambda t, q, qd: 1.0, "none")])
+    _same(plain, outer)
+    assert len(_pool(model)[0]) == 2

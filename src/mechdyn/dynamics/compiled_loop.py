@@ -85,6 +85,13 @@ class _Buffers:
         self.ipar = np.zeros(F.N_IPAR_FIXED, dtype=np.int64)
         self.kept = np.empty((KEEP_STEPS, 3 + 10 * m + kernel.ws.size))
 
+    def restart(self) -> None:
+        """Clear what a new set of buffers has cleared (for a kernel used again)."""
+        self.hist[:] = 0.0
+        self.dns[:] = 0.0
+        self.par[:] = 0.0
+        self.ipar[:] = 0
+
 
 def buffers(kernel) -> _Buffers:
     """The loop's arrays of ``kernel`` (made on first use)."""

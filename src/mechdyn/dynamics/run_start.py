@@ -10,6 +10,15 @@ alone, and costs about as much as a short run itself: where it records nothing b
 the state (no event, no warning, no friction in the pairs, nothing touching), it is
 kept with the compiled model, and the next run from the same state starts from a copy
 of the mode system with its own workspace, as the last solve left it.
+
+The equations of the first segment of such a run (:class:`ModeEquations` on the mode's
+compiled kernel: the kernel's packed rows and loads, the compiled loop's buffers) are
+kept too, in a small pool: :func:`start_equations` takes the ones a finished run from
+the same start gave back (:func:`give_back`) and restarts them as new ones start (the
+kernel's workspace as it was when they were made, the loop's buffers cleared), else it
+makes new ones.  A run in progress owns its equations (a run started meanwhile from
+the same state makes its own), and equations with more state than is restarted here
+(a branch-chart book, attributes this module does not know) are not kept.
 """
 
 from __future__ import annotations
@@ -23,11 +32,12 @@ from ..model.workspace import Workspace
 from .contact import gaps, touching
 from .friction import friction_joints
 from .joint_friction import stick_slip_joints
+from .mode_equations import ModeEquations
 from .mode_rows import held_key
 from .modes import ModeSystem
 from .switching import apply_switch
 
-__all__ = ["start_state", "STARTS_KEPT"]
+__all__ = ["start_state", "start_equations", "give_back", "STARTS_KEPT"]
 
 #: run starts kept per compiled model (a study runs many initial states)
 STARTS_KEPT = 16
@@ -64,6 +74,8 @@ def start_state(sm, t: float, locks: frozenset, q_init, qd_init, x_guess, ws: Wo
         The held values of the engaged locks (and sticking contacts).
     qi, qdi : ndarray, shape (n_i,)
         The mode's independent coordinates and their rates.
+    key : tuple or None
+        The key of the start kept with the model (None: not kept).
 
     Raises
     ------
@@ -78,7 +90,7 @@ def start_state(sm, t: float, locks: frozenset, q_init, qd_init, x_guess, ws: Wo
            float(gap_tol), float(small_velocity), float(force_scale))
     kept = model.memo.get(key)
     if kept is not None:
-        return _restart(kept, ws)
+        return (*_restart(kept, ws), key)
     n_events = len(events)
     ms, x, xd, targets, touch0 = _start(sm, t, locks, q_init, qd_init, x_guess, ws, events,
                                         gap_tol=gap_tol, small_velocity=small_velocity,
@@ -90,7 +102,9 @@ def start_state(sm, t: float, locks: frozenset, q_init, qd_init, x_guess, ws: Wo
             and held_key(targets) is not None and len(starts) < STARTS_KEPT):
         starts.append(key)
         model.memo[key] = _kept(ms, x, xd, targets, ws, qi, qdi)
-    return ms, x, xd, targets, qi, qdi
+    else:
+        key = None
+    return ms, x, xd, targets, qi, qdi, key
 
 
 def _start(sm, t, locks, q_init, qd_init, x_guess, ws, events, *, gap_tol, small_velocity,
@@ -165,3 +179,70 @@ def _restart(kept, ws):
     ws.x, ws.B, ws.qi = own(wx), own(wB), own(wqi)
     ws.parts = None if parts is None else (own(parts[0]), *parts[1:])
     return ms, x, xd0.copy(), dict(targets), qi.copy(), qdi.copy()
+
+
+#: the attributes of :class:`ModeEquations` and of its compiled kernel that
+#: :func:`_restart_equations` knows (equations with others are not kept)
+_EQUATIONS_STATE = frozenset({
+    "sm", "ms", "formulation", "kernel", "note", "book", "watching", "_s_last", "_anchor",
+    "_failures", "_rejects", "d", "backend", "_full", "_in_order", "_first_order"})
+_KERNEL_STATE = frozenset({
+    "ip", "fp", "ri", "rf", "dims", "_arrays", "n_x", "n_i", "ws", "compile_time", "status",
+    "_st", "_ext_size", "_ext_parts", "_out", "_loop_buffers"})
+#: equations kept per start, backend and formulation
+EQUATIONS_KEPT = 2
+
+
+def start_equations(sm, ms, backend: str, formulation: str, d, key):
+    """The equations of the first segment of a run from the start ``key``
+    (:func:`start_state`): kept ones restarted, else new ones.
+
+    Returns
+    -------
+    eqs : ModeEquations
+    kept : tuple or None
+        What :func:`give_back` needs to keep them for the next run (None: not kept).
+    """
+    pool_key = None if key is None or d is not None else ("run equations", key, backend,
+                                                          formulation)
+    pool = None if pool_key is None else sm.model.memo.get(pool_key)
+    while pool:
+        eqs, fresh = pool.pop()
+        if eqs.sm is sm and _restartable(eqs):
+            _restart_equations(eqs, ms, fresh)
+            return eqs, (pool_key, fresh)
+    eqs = ModeEquations(sm, ms, backend, formulation, d)
+    if pool_key is None or eqs.kernel is None or not _restartable(eqs):
+        return eqs, None
+    return eqs, (pool_key, eqs.kernel.ws.copy())
+
+
+def give_back(sm, eqs, kept) -> None:
+    """Keep the equations of a finished run for the next run from its start."""
+    if kept is None or not _restartable(eqs):
+        return
+    pool_key, fresh = kept
+    pool = sm.model.memo.setdefault(pool_key, [])
+    if len(pool) < EQUATIONS_KEPT and all(e is not eqs for e, _ in pool):
+        pool.append((eqs, fresh))
+
+
+def _restartable(eqs) -> bool:
+    k = eqs.kernel
+    return (k is not None and eqs.book is None and set(vars(eqs)) <= _EQUATIONS_STATE
+            and set(vars(k)) <= _KERNEL_STATE)
+
+
+def _restart_equations(eqs, ms, fresh) -> None:
+    """Equations kept from a run as :class:`ModeEquations` makes them for ``ms``: the
+    run's mode system, no anchor, the kernel's workspace as it was made (``fresh``), the
+    compiled loop's scalars and history cleared."""
+    eqs.ms = ms
+    eqs.watching, eqs._s_last = True, None
+    eqs._anchor, eqs._failures, eqs._rejects = None, 0, 0
+    k = eqs.kernel
+    k.ws[:] = fresh
+    k.status, k._st[0], k.compile_time = 0, 0, 0.0
+    b = getattr(k, "_loop_buffers", None)
+    if b is not None:
+        b.restart()
