@@ -92,10 +92,10 @@ def test_lazy_dict_fills_once_on_any_use():
     for use in (len, list, repr, bool, dict, lambda d: d.get("a"), lambda d: "a" in d,
                 lambda d: d == {"a": 1, "b": 2}, lambda d: d | {"c": 3}):
         calls.clear()
-        d = LazyDict(fill)
+        d = LazyDict.lazy(fill)
         use(d)
         use(d)
         assert calls == [1]
-    d = LazyDict(fill)
+    d = LazyDict.lazy(fill)
     d["c"] = 3
     assert dict(d) == {"a": 1, "b": 2, "c": 3}

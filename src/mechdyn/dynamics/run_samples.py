@@ -292,7 +292,7 @@ def _lazy_trajectory(model, sm, rec, point, modes, events, stats, status, messag
         table.frame_and_forces, mode=[r[1].mode for r in rec], modes=list(modes),
         mode_index=mode_index, impact_losses=lost, penetration=pen)
     return Trajectory(t, q, qd, qdd, x, xd, status=status, message=message,
-                      events=list(events), stats=stats, energy=LazyDict(table.energy),
+                      events=list(events), stats=stats, energy=LazyDict.lazy(table.energy),
                       coordinate_names=model.coordinate_names, body_names=model.body_names,
                       coordinate_is_angle=tuple(bool(v) for v in model.coord_is_angle),
                       model=model)

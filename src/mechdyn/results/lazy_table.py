@@ -18,18 +18,14 @@ __all__ = ["LazyDict"]
 
 
 class LazyDict(dict):
-    """A dict whose items are computed on first use: any read or write first adds the
-    items ``fill()`` returns (once; an error of ``fill`` is raised again by the next use).
-
-    Parameters
-    ----------
-    fill : callable
-        ``fill() -> mapping`` of the items.
+    """A dict whose items are computed on first use (:meth:`lazy`): any read or write
+    first adds the items ``fill()`` returns (once; an error of ``fill`` is raised again by
+    the next use).  Made as a dict is (``LazyDict(mapping, **items)``), it is one.
 
     Examples
     --------
     >>> calls = []
-    >>> d = LazyDict(lambda: calls.append(1) or {"a": 1.0, "b": 2.0})
+    >>> d = LazyDict.lazy(lambda: calls.append(1) or {"a": 1.0, "b": 2.0})
     >>> calls
     []
     >>> d["a"], sorted(d), dict(d) == {"a": 1.0, "b": 2.0}, len(calls)
@@ -38,9 +34,16 @@ class LazyDict(dict):
 
     __slots__ = ("_fill",)
 
-    def __init__(self, fill: Callable):
-        super().__init__()
-        self._fill = fill
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._fill = None
+
+    @classmethod
+    def lazy(cls, fill: Callable) -> LazyDict:
+        """The dict of the items ``fill() -> mapping`` returns, computed on first use."""
+        d = cls()
+        d._fill = fill
+        return d
 
     def _filled(self) -> LazyDict:
         fill = self._fill
