@@ -68,6 +68,8 @@ def test_the_equations_of_a_kept_start_serve_the_next_run():
     (pool,) = _pool(model)
     assert len(pool) == 1
     eqs = pool[0][0]
+    # kept without the run: no mode system, workspace or anchor of it
+    assert eqs.ms is None and eqs._anchor is None
     for kw in ({"integrator": "rk4", "steps": 40}, {"rtol": 1e-9}):
         tr = mechdyn.simulate(model, 0.05, progress=False, **kw)
         assert len(pool) == 1 and pool[0][0] is eqs  # taken, restarted, given back

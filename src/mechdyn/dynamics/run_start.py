@@ -13,12 +13,14 @@ of the mode system with its own workspace, as the last solve left it.
 
 The equations of the first segment of such a run (:class:`ModeEquations` on the mode's
 compiled kernel: the kernel's packed rows and loads, the compiled loop's buffers) are
-kept too, in a small pool: :func:`start_equations` takes the ones a finished run from
-the same start gave back (:func:`give_back`) and restarts them as new ones start (the
-kernel's workspace as it was when they were made, the loop's buffers cleared), else it
-makes new ones.  A run in progress owns its equations (a run started meanwhile from
-the same state makes its own), and equations with more state than is restarted here
-(a branch-chart book, attributes this module does not know) are not kept.
+kept too, in a small pool: a finished run gives them back (:func:`give_back`) cleared of
+the run -- no mode system or workspace of it, the kernel's workspace as it was when they
+were made, the loop's buffers cleared -- and :func:`start_equations` gives them to the
+next run from the same start with its mode system, else it makes new ones.  A run in
+progress owns its equations (a run started meanwhile from the same state makes its
+own), and equations with more state than is cleared here (a branch-chart book,
+attributes this module does not know) are not kept.  No workspace of a run is kept with
+the model: the start's mode system is kept without one, the equations without theirs.
 """
 
 from __future__ import annotations
@@ -181,8 +183,8 @@ def _restart(kept, ws):
     return ms, x, xd0.copy(), dict(targets), qi.copy(), qdi.copy()
 
 
-#: the attributes of :class:`ModeEquations` and of its compiled kernel that
-#: :func:`_restart_equations` knows (equations with others are not kept)
+#: the attributes of :class:`ModeEquations` and of its compiled kernel that :func:`_clear`
+#: knows (equations with others are not kept)
 _EQUATIONS_STATE = frozenset({
     "sm", "ms", "formulation", "kernel", "note", "book", "watching", "_s_last", "_anchor",
     "_failures", "_rejects", "d", "backend", "_full", "_in_order", "_first_order"})
@@ -209,7 +211,7 @@ def start_equations(sm, ms, backend: str, formulation: str, d, key):
     while pool:
         eqs, fresh = pool.pop()
         if eqs.sm is sm and _restartable(eqs):
-            _restart_equations(eqs, ms, fresh)
+            eqs.ms = ms
             return eqs, (pool_key, fresh)
     eqs = ModeEquations(sm, ms, backend, formulation, d)
     if pool_key is None or eqs.kernel is None or not _restartable(eqs):
@@ -218,12 +220,14 @@ def start_equations(sm, ms, backend: str, formulation: str, d, key):
 
 
 def give_back(sm, eqs, kept) -> None:
-    """Keep the equations of a finished run for the next run from its start."""
+    """Keep the equations of a finished run for the next run from its start, cleared of
+    the run (no mode system, workspace or anchor of it; the kernel as it was made)."""
     if kept is None or not _restartable(eqs):
         return
     pool_key, fresh = kept
     pool = sm.model.memo.setdefault(pool_key, [])
     if len(pool) < EQUATIONS_KEPT and all(e is not eqs for e, _ in pool):
+        _clear(eqs, fresh)
         pool.append((eqs, fresh))
 
 
@@ -233,11 +237,11 @@ def _restartable(eqs) -> bool:
             and set(vars(k)) <= _KERNEL_STATE)
 
 
-def _restart_equations(eqs, ms, fresh) -> None:
-    """Equations kept from a run as :class:`ModeEquations` makes them for ``ms``: the
-    run's mode system, no anchor, the kernel's workspace as it was made (``fresh``), the
-    compiled loop's scalars and history cleared."""
-    eqs.ms = ms
+def _clear(eqs, fresh) -> None:
+    """Equations of a run as :class:`ModeEquations` made them, without a mode system: no
+    anchor, the kernel's workspace as it was made (``fresh``), the compiled loop's
+    scalars and history cleared."""
+    eqs.ms = None
     eqs.watching, eqs._s_last = True, None
     eqs._anchor, eqs._failures, eqs._rejects = None, 0, 0
     k = eqs.kernel
