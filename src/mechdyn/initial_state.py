@@ -62,16 +62,41 @@ def initial_state(model: Model, q0=None, qdot0=None, *, mode=None):
     x_sk = getattr(model, "x0", None)
     if x_sk is None:
         x_sk = assemble(model, layout=layout)
-    q_sk = coordinates(model, x_sk)
+    sketch = np.asarray(x_sk, float).tobytes()
+    q_sk = _sketch_coordinates(model, x_sk, sketch)
     init = model.mechanism.extras.get("initial") or {}
     q = _values(model, init.get("q"), q_sk, "initial q")
     qd = _values(model, init.get("qdot"), np.zeros(model.n_q), "initial qdot")
     q = _values(model, q0, q, "q0")
     qd = _values(model, qdot0, qd, "qdot0")
-    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd))):
+    if not (np.isfinite(q).all() and np.isfinite(qd).all()):
         raise ModelError(f"the initial state must be finite, got q = {q}, qdot = {qd}")
-    # Newton continuation from the sketch (keeps its branch), in steps of 0.05 rad or 0.05
-    # length scale
+    # the pose is kept with the compiled model for the next run from the same state (the
+    # continuation is a function of the sketch, the mode and q alone)
+    key = ("initial pose", tuple(sorted(mode or ())), sketch, q.tobytes())
+    x = model.memo.get(key)
+    if x is None:
+        x = _walk(model, layout, q, q_sk, x_sk)
+        kept = model.memo.setdefault("initial poses", [])
+        if len(kept) < 16:  # a bounded number (a study runs many initial states)
+            kept.append(key)
+            model.memo[key] = x
+    return q, qd, np.array(x, float)
+
+
+def _sketch_coordinates(model: Model, x_sk, sketch: bytes) -> np.ndarray:
+    """The coordinates of the sketch pose (bytes ``sketch``), kept with the compiled
+    model."""
+    key = ("sketch coordinates", sketch)
+    q_sk = model.memo.get(key)
+    if q_sk is None:
+        q_sk = model.memo[key] = coordinates(model, x_sk)
+    return q_sk
+
+
+def _walk(model: Model, layout, q, q_sk, x_sk) -> np.ndarray:
+    """The pose at ``q`` by Newton continuation from the sketch (keeps its branch), in
+    steps of 0.05 rad or 0.05 length scale."""
     dq = q - q_sk
     size = np.where(model.coord_is_angle, np.abs(dq) / 0.05,
                     np.abs(dq) / (0.05 * model.length_scale))
@@ -83,19 +108,8 @@ def initial_state(model: Model, q0=None, qdot0=None, *, mode=None):
                          f"from the sketch to be reached by continuation (more than "
                          f"{MAX_WALK} steps of 0.05 rad or 0.05 length scale); give it "
                          "within a few turns of the sketch (angles modulo 360 deg)")
-    # the pose is kept with the compiled model for the next run from the same state (the
-    # continuation is a function of the sketch, the mode and q alone)
-    key = ("initial pose", tuple(sorted(mode or ())), np.asarray(x_sk, float).tobytes(),
-           q.tobytes())
-    x = model.memo.get(key)
-    if x is None:
-        n = max(1, int(math.ceil(float(np.max(size, initial=0.0)))))
-        x = np.array(x_sk, float)
-        for k in range(1, n + 1):
-            x = solve_position(model, q_sk + dq * (k / n), x, layout=layout,
-                               check_singular=False)
-        kept = model.memo.setdefault("initial poses", [])
-        if len(kept) < 16:  # a bounded number (a study runs many initial states)
-            kept.append(key)
-            model.memo[key] = x
-    return q, qd, np.array(x, float)
+    n = max(1, int(math.ceil(float(np.max(size, initial=0.0)))))
+    x = np.array(x_sk, float)
+    for k in range(1, n + 1):
+        x = solve_position(model, q_sk + dq * (k / n), x, layout=layout, check_singular=False)
+    return x

@@ -35,16 +35,15 @@ import time
 
 import numpy as np
 
-from .dynamics.contact import gaps, touching
 from .dynamics.dead_position import diagnose, status_of, turning_point
 from .dynamics.friction import friction_joints
-from .dynamics.joint_friction import SelfLockingError, stick_slip_joints
+from .dynamics.joint_friction import SelfLockingError
 from .dynamics.mode_equations import ModeEquations
-from .dynamics.modes import ModeSystem, switched_model
+from .dynamics.modes import switched_model
 from .dynamics.run_samples import Samples, finish
+from .dynamics.run_start import give_back, start_equations, start_state
 from .dynamics.switching import apply_switch, event_functions
 from .errors import (
-    LockupError,
     MechdynError,
     ModelError,
     Status,
@@ -70,6 +69,9 @@ from .results.trajectory import Trajectory
 __all__ = ["simulate_events", "SwitchEvent", "format_events", "needs_event_loop"]
 
 
+#: the default point of the frame moment: the ground origin, m
+ORIGIN = (0.0, 0.0)
+
 #: a switching instant is an :class:`~mechdyn.integrate.events.EventRecord`, the one record
 #: of events in the package (kind ``"engage"``, ``"release"``, ``"impact"`` ...)
 SwitchEvent = EventRecord
@@ -89,7 +91,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                     small_velocity: float | None = None, gap_tol: float | None = None,
                     zeno_time: float | None = None,
                     max_wall_time: float | None = None, max_steps: int | None = None,
-                    min_step: float | None = None, point=(0.0, 0.0),
+                    min_step: float | None = None, point=ORIGIN,
                     progress: bool | None = None, dt: float | None = None,
                     steps: int | None = None, iterations: int | None = None,
                     tol: float | None = None, theta: float | None = None,
@@ -110,7 +112,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     model = mech_or_model if isinstance(mech_or_model, Model) else mech_or_model.compile()
     sm = switched_model(model)
     L = model.length_scale
-    scale = np.where(model.coord_is_angle, 1.0, L)  # of the coordinates' tolerances
+    scale, force_scale = _constants(model)
     t_end = float(t_end)
     t0 = float(t0)
     if not t_end >= t0:
@@ -124,7 +126,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     span = t_end - t0
     if zeno_time is None:
         zeno_time = 1e-4 * span
-    if np.shape(point) != (2,) or not np.all(np.isfinite(np.asarray(point, float))):
+    if point is not ORIGIN and (np.shape(point) != (2,)
+                                or not np.all(np.isfinite(np.asarray(point, float)))):
         raise ModelError(f"point must be a finite (x, y) in m, got {point!r}")
     if min_step is None:
         min_step = 1e-13 * span
@@ -140,7 +143,6 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         if t_eval[-1] < t_end - 1e-12 * max(1.0, abs(t_end)):
             t_eval = np.append(t_eval, t_end)
     t_eval = np.asarray(t_eval, float)
-    force_scale = max(float(np.sum(model.mass) * max(np.hypot(*model.gravity), 1.0)), 1.0)
     segment_integrator, method_name = segment_integrators(
         method, t0, t_end, rtol=rtol, atol=atol, dt=dt, steps=steps, iterations=iterations,
         tol=tol, theta=theta, first_step=first_step, max_step=max_step)
@@ -164,7 +166,6 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
 
     # ---------------------------------------------------------------- initial state
     status, message = Status.SUCCESS, ""
-    targets: dict = {}
     locks = sm.initial_locks() if mode is None else frozenset(mode)
     unknown = [n for n in locks if n not in sm.lock_names]
     if unknown:
@@ -178,44 +179,14 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     w = np.zeros(2 if friction_joints(model) else 1)
     ws = Workspace()  # the run's caches, shared by the mode systems of the run
     try:
-        x = x_guess
-        if locks:
-            try:  # the pose at which undeclared locks capture what they hold
-                free = ModeSystem(sm, frozenset(), targets, x_guess, workspace=ws)
-                x = free.solve_position(q_init[free.coords], x_guess, t=t)
-            except LockupError:  # the coordinates need the locks: the welded pose
-                pass
-        for n in locks:
-            sm.capture_target(n, x, targets)
-        ms = ModeSystem(sm, locks, targets, x, workspace=ws)
-        x = ms.solve_position(q_init[ms.coords], x, t=t)
-        # rates: given for the independent coordinates of the mode with every
-        # touching stop and contact closed (the rest are dependent there)
-        touch0 = touching(sm, x, gap_tol=gap_tol)
-        ms_t = ModeSystem(sm, locks | frozenset(touch0), targets, x, workspace=ws) \
-            if touch0 else ms
-        B, _ = ms_t.velocity_analogs(x)
-        xd = B @ qd_init[ms_t.coords]
-        for tok, (g, is_angle) in gaps(sm, x).items():
-            n, side = tok.split("@")
-            if g >= -(gap_tol / L if is_angle else gap_tol):
-                continue
-            if side == "contact":
-                raise ModelError(f"contact {n!r}: the initial state penetrates by {-g:.3g} m")
-            st, meas = sm.stops[n]
-            raise ModelError(f"stop {n!r}: the initial state violates its limits ({meas.label} "
-                             f"= {meas.value(x):.9g}, lower {st.lower}, upper {st.upper})")
-        if sm.has_switching or stick_slip_joints(model):
-            # the mode the state is in: touching stops and contacts, sticking pairs
-            ms, x, xd, _ = apply_switch(sm, t, ms, x, xd, targets, events, fired=[],
-                                        small_velocity=small_velocity, gap_tol=gap_tol,
-                                        force_scale=force_scale, initial=True)
+        ms, x, xd, targets, qi, qdi, start = start_state(
+            sm, t, locks, q_init, qd_init, x_guess, ws, events, gap_tol=gap_tol,
+            small_velocity=small_velocity, force_scale=force_scale)
     except (MechdynError, np.linalg.LinAlgError) as exc:
         if isinstance(exc, ModelError):
             raise
         return finish(model, rec, events, stats, wall0, *_status(exc, None), sm, point)
 
-    qi, qdi = ms.independent(x, xd)
     just_fired: set = set()
     after_event = False
     good = None  # (t, ModeEval) of the last accepted step: where a failed run was well
@@ -224,9 +195,14 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     n_events = 0
     last_event_t, repeat = None, 0
     bar = Progress(progress, t0, t_end)
+    first_eqs = kept_eqs = None
     while t < t_end or not stats["segments"]:
         stats["segments"] += 1
-        eqs = ModeEquations(sm, ms, backend, formulation, d)
+        if stats["segments"] == 1:  # kept with the run's start, if it was kept
+            eqs, kept_eqs = start_equations(sm, ms, backend, formulation, d, start)
+            first_eqs = eqs
+        else:
+            eqs = ModeEquations(sm, ms, backend, formulation, d)
         backends.add(eqs.backend)
         if eqs.note:
             stats["backend_note"] = eqs.note
@@ -369,7 +345,20 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     stats["backend"] = "numba" if backends == {"numba"} else (
         "numpy" if backends <= {"numpy"} else "numba+numpy")
     bar.close()
+    give_back(sm, first_eqs, kept_eqs)  # for the next run from the same start
     return finish(model, rec, events, stats, wall0, status, message, sm, point)
+
+
+def _constants(model) -> tuple:
+    """The scale of the coordinates' tolerances (1 for angles, the length scale for
+    travels), shape (n_q,), and the force scale of the model (its weight, at least 1 N),
+    kept with the compiled model."""
+    got = model.memo.get("run constants")
+    if got is None:
+        got = model.memo["run constants"] = (
+            np.where(model.coord_is_angle, 1.0, model.length_scale),
+            max(float(np.sum(model.mass) * max(np.hypot(*model.gravity), 1.0)), 1.0))
+    return got
 
 
 def _status(exc, good):

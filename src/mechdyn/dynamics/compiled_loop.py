@@ -38,6 +38,7 @@ from ..integrate.wilson import Wilson
 from ..kernels import dop853_numba as L
 from ..kernels import fixed_step_numba as F
 from ..kernels.lagrange_numba import D_NC, D_NQ, scratch_size
+from ..kernels.rows_numba import rows_jacobian
 from .mode_system import ModeEval
 
 __all__ = ["fast_forward", "kept_steps", "warm_up_loop", "KEEP_STEPS", "PIVOT_FLAG",
@@ -84,6 +85,13 @@ class _Buffers:
         self.ipar = np.zeros(F.N_IPAR_FIXED, dtype=np.int64)
         self.kept = np.empty((KEEP_STEPS, 3 + 10 * m + kernel.ws.size))
 
+    def restart(self) -> None:
+        """Clear what a new set of buffers has cleared (for a kernel used again)."""
+        self.hist[:] = 0.0
+        self.dns[:] = 0.0
+        self.par[:] = 0.0
+        self.ipar[:] = 0
+
 
 def buffers(kernel) -> _Buffers:
     """The loop's arrays of ``kernel`` (made on first use)."""
@@ -99,7 +107,7 @@ def _evals(b, ms, n) -> list:
     nx, _, nq, nc, _ = b.dims
     X, XD, E = b.o_x[:n].copy(), b.o_xd[:n].copy(), b.o_ext[:n].copy()
     rows = ms.independent_rows
-    if np.array_equal(rows, np.arange(ms.n_rows)):
+    if rows.tolist() == list(range(ms.n_rows)):
         LAM = E[:, nx + 3 * nq:nx + 3 * nq + nc]
     else:
         LAM = np.zeros((n, ms.n_rows))
@@ -116,9 +124,16 @@ def _step(b, i0, i1, dense=None) -> Step:
     _, ni, _, _, m = b.dims
     h0, h1 = b.hist[i0].copy(), b.hist[i1].copy()
     y0, f0, y1, f1 = h0[1:m + 1], h0[m + 1:], h1[1:m + 1], h1[m + 1:]
-    if dense is None:
-        d = hermite_dense(h0[0], y0[:ni], y0[ni:2 * ni], f0[ni:2 * ni], y0[2 * ni:], f0[2 * ni:],
-                          h1[0], y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni], y1[2 * ni:], f1[2 * ni:])
+    if dense is None:  # made on first use (a check that needs no dense output is common)
+        made = []
+
+        def d(s):
+            if not made:
+                made.append(hermite_dense(h0[0], y0[:ni], y0[ni:2 * ni], f0[ni:2 * ni],
+                                          y0[2 * ni:], f0[2 * ni:], h1[0], y1[:ni],
+                                          y1[ni:2 * ni], f1[ni:2 * ni], y1[2 * ni:],
+                                          f1[2 * ni:]))
+            return made[0](s)
     else:
         dns, t_old, h = dense
 
@@ -150,7 +165,9 @@ def _start(b, integ, t: float, t_end: float) -> np.ndarray:
     par[L.P_RTOL] = integ.rtol
     par[L.P_HMAX] = integ.max_step or np.inf
     par[L.P_BETA], par[L.P_ERROLD] = BETA, 1e-4
-    return np.broadcast_to(np.asarray(integ.atol, float), (b.dims[4],)).copy()
+    atol = np.empty(b.dims[4])
+    atol[:] = integ.atol  # a scalar or one value per state
+    return atol
 
 
 def _fixed_method(integ) -> int | None:
@@ -459,7 +476,11 @@ def _kept_step(row, m: int, ni: int, fixed: bool = False) -> Step:
 
 def warm_up_loop(kernel) -> None:
     """Compile (or load) the loops on a kernel (DOP853, the fixed-step one): one short run
-    of each without output."""
+    of each without output; and the compiled rows' Jacobian as the turning-point check
+    calls it (:func:`mechdyn.dynamics.dead_position.turning_point`)."""
+    _, _, ri, rf, _ = kernel._arrays
+    rows_jacobian(np.zeros(kernel.n_x), kernel.n_x // 3, ri, rf,
+                  np.zeros((len(ri), kernel.n_x)), 0)
     b = buffers(kernel)
     _, ni, _, _, m = b.dims
     y = np.zeros(m)

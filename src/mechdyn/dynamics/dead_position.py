@@ -24,9 +24,11 @@ from ..errors import (
     Status,
 )
 from ..kernels import rows_numpy as RN
+from ..kernels.rows_numba import NUMBA, rows_jacobian
 from ..kinematics.assembly import DEAD_RCOND
 from ..mechanism.coordinate import BODY_KINDS
 from .contact import ContactError
+from .mode_rows import held_key
 
 __all__ = ["turning_point", "rigid_coordinates", "diagnose", "status_of", "TURN_RCOND"]
 
@@ -204,9 +206,50 @@ def turning_point(eqs, step, qd_old, x_good) -> str | None:
 def _dead_at(ms, x, k: int, rep=None) -> bool:
     """Whether coordinate ``k`` of the mode turning back at pose ``x`` is a dead position:
     sigma_min / sigma_max below :data:`TURN_RCOND` with the coordinate carrying the null
-    vector (``rep``: the singularity report at x, made when not given)."""
-    rep = ms.singularity(x) if rep is None else rep
-    return bool(rep["rcond"] < TURN_RCOND and ms.coord_names[k] in rep["coordinates"])
+    vector (its share of the left singular vector of sigma_min above 1e-3; ``rep``: the
+    singularity report at x, else the decision of that report made from the singular
+    values and vectors alone)."""
+    if rep is not None:
+        return bool(rep["rcond"] < TURN_RCOND and ms.coord_names[k] in rep["coordinates"])
+    sel, row_scale, col_scale, packed = _scaling(ms)
+    if not sel.size:
+        return False  # no freedom: rcond 1
+    # the scaled position Jacobian [rows_I; g_I] of ModeSystem.singularity, the same numbers
+    # (the compiled rows give the NumPy rows' Jacobian bit for bit: the same operations in
+    # the same order; a test keeps them so)
+    if packed is None:
+        J = RN.jacobian(ms.layout.position_rows, x)
+    else:
+        nb, ints, flts = packed
+        J = np.zeros((len(ints), len(x)))
+        rows_jacobian(np.asarray(x, float), nb, ints, flts, J, 0)
+    u, s, _ = np.linalg.svd(J[sel] * row_scale * col_scale)
+    rcond = float(s[-1] / s[0]) if s[0] > 0 else 0.0
+    return bool(rcond < TURN_RCOND and u[len(ms.independent_rows) + k, -1] ** 2 > 1e-3)
+
+
+def _scaling(ms) -> tuple:
+    """(the indices of [rows_I; g_I] among the mode's position rows, the row scale (n, 1)
+    and the column scale (n_x,) that make their Jacobian dimensionless as
+    :func:`mechdyn.kinematics.assembly._scaled` does, and ``(nb, ints, flts)``, the packed
+    position rows for the compiled Jacobian, or None), kept with the compiled model for
+    the mode's rows and held values (made anew for held values that are not numbers)."""
+    model = ms.model
+    held = held_key(ms.targets)
+    sel = np.concatenate([ms.independent_rows, ms.n_rows + np.asarray(ms.coords, int)])
+    key = None if held is None else ("turn scaling", ms.mode, held, sel.tobytes())
+    found = None if key is None else model.memo.get(key)
+    if found is None:
+        L = model.length_scale
+        rows = ms.layout.position_rows
+        found = (sel, np.where(rows.is_angle[sel], 1.0, 1.0 / L)[:, None],
+                 np.tile([L, L, 1.0], model.n_bodies),
+                 (rows.nb, *rows.packed()) if NUMBA else None)
+        kept = model.memo.setdefault("turn scalings", [])
+        if key is not None and len(kept) < 64:  # a bounded number (held values change)
+            kept.append(key)
+            model.memo[key] = found
+    return found
 
 
 def _compiled_pose(eqs, t: float, qk, x_good):

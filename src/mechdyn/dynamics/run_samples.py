@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import ModelError, Status
 from ..kernels import rows_numpy as RN
+from ..results.lazy_table import LazyDict
 from ..results.trajectory import SwitchedSamples, Trajectory
 from .contact import gaps
 from .friction import friction_joints
@@ -114,14 +115,8 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
     """Forces, frame loads and energies of samples ``rec``, batched over each mode's
     samples; ``modes`` (the run's modes so far) is extended by the new ones; ``shapes``
     (element -> trailing shape) makes a force entry of every element listed."""
-    n_q, n_x, n = model.n_q, model.n_x, len(rec)
-    t = np.array([r[0] for r in rec], float)
-    W = np.array([r[3][0] for r in rec], float)
-    W_f = np.array([r[3][1] if len(r[3]) > 1 else 0.0 for r in rec], float)
-    lost = np.array([r[4] for r in rec], float)
-    x, xd, q, qd, qdd = (np.array([getattr(r[2], k) for r in rec], float).reshape(n, w)
-                         for k, w in (("x", n_x), ("xdot", n_x), ("q", n_q), ("qdot", n_q),
-                                      ("qddot", n_q)))
+    n = len(rec)
+    t, W, W_f, lost, x, xd, q, qd, qdd = _motion(model, rec)
     frame, res, p_f = np.zeros((n, 3)), np.zeros(n), np.zeros(n)
     forces: dict = {el: np.zeros((n, *shape)) for el, shape in (shapes or {}).items()}
     starts = [k for k in range(n) if k == 0 or rec[k][1] is not rec[k - 1][1]] + [n]
@@ -144,7 +139,7 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
             # the friction of the pairs: a pair between two bodies adds no net force or
             # moment to them, so the net of the friction on the bodies is that of the
             # pairs with the frame, whose opposite the frame receives
-            Ff = np.array([r[2].F_friction for r in rec[a:b]], float).reshape(b - a, n_x)
+            Ff = np.array([r[2].F_friction for r in rec[a:b]], float).reshape(b - a, model.n_x)
             frame[sl] += net_on_ground(model, x[sl], Ff, point)
             p_f[sl] = -np.einsum("nx,nx->n", Ff, xd[sl])  # the power friction dissipates
             pairs = ms.friction.by_pair(x[sl], xd[sl], lam)  # part of their reactions
@@ -152,20 +147,44 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
             forces.setdefault(el, np.zeros((n,) + np.shape(v)[1:]))[sl] = v
         if ms.n_rows:
             res[sl] = np.max(np.abs(RN.values(ms.rowset, x[sl], parts)), axis=-1)
-    for r in rec:
-        if r[1].mode not in modes:
-            modes.append(r[1].mode)
+    mode_index = _modes(rec, modes)
     # the bodies, plus the rotors and gears of the drives reduced to their coordinates
     T = kinetic_energy(model, x, xd) + 0.5 * (qd**2) @ sm.drive_inertia
     U = sm.fm.potential_energy(x)
-    # the largest penetration of a stop (lengths only) or contact, m
-    pen = [float(np.max(-g)) for g, angle in gaps(sm, x).values() if not angle] if n else []
     return dict(t=t, q=q, qdot=qd, qddot=qdd, x=x, xdot=xd, frame=frame, forces=forces,
-                mode=[r[1].mode for r in rec],
-                mode_index=np.array([modes.index(r[1].mode) for r in rec], int),
+                mode=[r[1].mode for r in rec], mode_index=mode_index,
                 kinetic=T, potential=U, work_nc=W, work_friction=W_f, power_friction=p_f,
                 balance=T + U - W + lost, residual=res,
-                impact_losses=lost, penetration=max([0.0, *pen]))
+                impact_losses=lost, penetration=_penetration(sm, x))
+
+
+def _motion(model, rec) -> tuple:
+    """The columns of samples ``rec`` that they hold: t, W_nc, W_f, the impact losses, x,
+    x', q, q', q''."""
+    n_q, n_x, n = model.n_q, model.n_x, len(rec)
+    t = np.array([r[0] for r in rec], float)
+    W = np.array([r[3][0] for r in rec], float)
+    W_f = np.array([r[3][1] if len(r[3]) > 1 else 0.0 for r in rec], float)
+    lost = np.array([r[4] for r in rec], float)
+    x, xd, q, qd, qdd = (np.array([getattr(r[2], k) for r in rec], float).reshape(n, w)
+                         for k, w in (("x", n_x), ("xdot", n_x), ("q", n_q), ("qdot", n_q),
+                                      ("qddot", n_q)))
+    return t, W, W_f, lost, x, xd, q, qd, qdd
+
+
+def _modes(rec, modes: list) -> np.ndarray:
+    """The index of each sample's mode in ``modes``, extended by the new ones."""
+    for r in rec:
+        if r[1].mode not in modes:
+            modes.append(r[1].mode)
+    return np.array([modes.index(r[1].mode) for r in rec], int)
+
+
+def _penetration(sm, x) -> float:
+    """The largest penetration of a stop (lengths only) or contact at the poses x, m."""
+    pen = [float(np.max(-g)) for g, angle in gaps(sm, x).values() if not angle] if len(x) \
+        else []
+    return max([0.0, *pen])
 
 
 def _joined(blocks: list) -> dict:
@@ -190,13 +209,10 @@ def _trajectory(model, block, modes, events, stats, status, message) -> Trajecto
         mode=b["mode"], modes=list(modes), mode_index=b["mode_index"],
         frame_force=b["frame"][:, :2], frame_moment=b["frame"][:, 2], forces=b["forces"],
         impact_losses=b["impact_losses"], penetration=b["penetration"])
-    energy = {k: b[k] for k in ("kinetic", "potential", "work_nc", "balance", "residual")}
-    if friction_joints(model):
-        energy.update(work_friction=b["work_friction"], power_friction=b["power_friction"])
     return Trajectory(b["t"], b["q"], b["qdot"], b["qddot"], b["x"], b["xdot"],
                       status=status, message=message, events=list(events), stats=stats,
-                      energy=energy, coordinate_names=model.coordinate_names,
-                      body_names=model.body_names,
+                      energy=_energy(bool(friction_joints(model)), b),
+                      coordinate_names=model.coordinate_names, body_names=model.body_names,
                       coordinate_is_angle=tuple(bool(v) for v in model.coord_is_angle),
                       model=model)
 
@@ -213,18 +229,70 @@ def finish(model, rec: Samples, events, stats, wall0, status, message, sm,
         blocks = rec.blocks
         if rec.streamed and not rec.keep:
             stats["streamed"] = dict(rec.streamed)
-    else:
-        blocks = [_block(model, sm, rec.state[1], point, rec.modes)]
-    if not blocks:  # nothing recorded
-        blocks = [_block(model, sm, [], point, rec.modes)]
     key = frame_impulse_key(sm)
     for ev in events:  # the frame's impulse of an impact: its angular part about the point
         if key in ev.impulses:
             f = np.array(ev.impulses[key], float)
             f[2] -= point[0] * f[1] - point[1] * f[0]
             ev.impulses[key] = f
+    if rec.sink is None:  # forces, frame loads and energies: evaluated on first use
+        stats["wall_time_s"] = time.perf_counter() - wall0
+        return _lazy_trajectory(model, sm, rec.state[1], point, rec.modes, events, stats,
+                                status, message)
+    if not blocks:  # nothing recorded
+        blocks = [_block(model, sm, [], point, rec.modes)]
     block = _joined(blocks)
     if rec.sink is not None:
         block["penetration"] = max(rec.penetration, block["penetration"])
     stats["wall_time_s"] = time.perf_counter() - wall0
     return _trajectory(model, block, rec.modes, events, stats, status, message)
+
+
+class _Table:
+    """The evaluation of samples ``rec`` (:func:`_block`), made on first use and kept (an
+    error is raised again at the next use)."""
+
+    def __init__(self, model, sm, rec, point, modes):
+        self._args, self._block = (model, sm, rec, point, list(modes)), None
+        self.friction = bool(friction_joints(model))
+
+    def block(self) -> dict:
+        if self._block is None:
+            model, sm, rec, point, modes = self._args
+            self._block = _block(model, sm, rec, point, modes)
+            self._args = None  # the samples: no longer needed
+        return self._block
+
+    def energy(self) -> dict:
+        return _energy(self.friction, self.block())
+
+    def frame_and_forces(self) -> dict:
+        b = self.block()
+        return dict(frame_force=b["frame"][:, :2], frame_moment=b["frame"][:, 2],
+                    forces=b["forces"])
+
+
+def _energy(friction: bool, b: dict) -> dict:
+    """The energy columns of a block."""
+    energy = {k: b[k] for k in ("kinetic", "potential", "work_nc", "balance", "residual")}
+    if friction:
+        energy.update(work_friction=b["work_friction"], power_friction=b["power_friction"])
+    return energy
+
+
+def _lazy_trajectory(model, sm, rec, point, modes, events, stats, status, message):
+    """The Trajectory of samples ``rec`` with its forces, frame loads and energies
+    evaluated on first use (the numbers of :func:`_block`): the motion and the modes
+    now."""
+    t, _, _, lost, x, xd, q, qd, qdd = _motion(model, rec)
+    mode_index = _modes(rec, modes)
+    table = _Table(model, sm, rec, point, modes)
+    stats["penetration"] = pen = _penetration(sm, x)
+    stats["variable_structure"] = SwitchedSamples.lazy(
+        table.frame_and_forces, mode=[r[1].mode for r in rec], modes=list(modes),
+        mode_index=mode_index, impact_losses=lost, penetration=pen)
+    return Trajectory(t, q, qd, qdd, x, xd, status=status, message=message,
+                      events=list(events), stats=stats, energy=LazyDict.lazy(table.energy),
+                      coordinate_names=model.coordinate_names, body_names=model.body_names,
+                      coordinate_is_angle=tuple(bool(v) for v in model.coord_is_angle),
+                      model=model)

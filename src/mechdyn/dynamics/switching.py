@@ -61,7 +61,7 @@ class _PoseValues:
             if type(m) is Measure and id(m) not in self.index:
                 self.index[id(m)] = len(rows)
                 rows.append(m.rows)
-        self.rows = concat(nb, *rows)
+        self.rows = concat(nb, *rows) if rows else None  # None: no measure to evaluate
         self._packed = (nb, *self.rows.packed()) if NUMBA and rows else None
         self._ev, self._vals = None, np.zeros(len(rows))
 

@@ -16,6 +16,9 @@ __all__ = ["Trajectory", "SwitchedSamples"]
 
 #: statuses of a run that reached its end (or a terminal event)
 SUCCESS_STATUSES = ("success", "event")
+#: the fields of a :class:`SwitchedSamples` that :meth:`SwitchedSamples.lazy` evaluates on
+#: first use
+_LAZY_FIELDS = frozenset({"frame_force", "frame_moment", "forces"})
 
 
 @dataclass(frozen=True)
@@ -53,6 +56,31 @@ class SwitchedSamples(Mapping):
     impact_losses: np.ndarray
     penetration: float = 0.0
     frame_moment: np.ndarray | None = None
+
+    @classmethod
+    def lazy(cls, fill, **fields) -> SwitchedSamples:
+        """The record with ``frame_force``, ``frame_moment`` and ``forces`` evaluated on
+        first use: ``fill()`` returns them (a mapping; an error of ``fill`` is raised
+        again by the next use); ``fields`` are the others."""
+        obj = object.__new__(cls)
+        for k, v in fields.items():
+            object.__setattr__(obj, k, v)
+        object.__setattr__(obj, "_fill", fill)
+        return obj
+
+    def __getattribute__(self, name):
+        if name in _LAZY_FIELDS:
+            d = object.__getattribute__(self, "__dict__")
+            fill = d.get("_fill")
+            if fill is not None:
+                for k, v in fill().items():
+                    object.__setattr__(self, k, v)
+                del d["_fill"]
+        return object.__getattribute__(self, name)
+
+    def __getstate__(self) -> dict:  # pickled and copied with every field evaluated
+        self.frame_force  # noqa: B018 - evaluates the lazy fields
+        return dict(self.__dict__)
 
     def __getitem__(self, key):
         if key not in self.__dataclass_fields__:
