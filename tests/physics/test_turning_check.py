@@ -27,7 +27,7 @@ def test_compiled_rows_jacobian_is_the_numpy_one_bit_for_bit():
     rng = np.random.default_rng(3)
     for ms in _systems():
         rows = ms.layout.position_rows
-        nb, ints, flts = D._scaling(ms)[3]
+        nb, ints, flts = D._packed_rows(ms)
         for k in range(200):
             x = ms.model.x_sketch + rng.normal(size=ms.model.n_x) * (3.0 if k % 2 else 0.05)
             J = np.zeros((len(rows), ms.model.n_x))

@@ -12,8 +12,6 @@ which bisects for the edge of the assembly region).
 
 from __future__ import annotations
 
-import weakref
-
 import numpy as np
 
 from ..errors import (
@@ -27,7 +25,7 @@ from ..kernels import rows_numpy as RN
 from ..kernels.rows_numba import NUMBA, rows_jacobian
 from ..kinematics.assembly import DEAD_RCOND
 from ..mechanism.coordinate import BODY_KINDS
-from .contact import ContactError
+from .complementarity import ContactError
 from .mode_rows import held_key
 
 __all__ = ["turning_point", "rigid_coordinates", "diagnose", "status_of", "TURN_RCOND"]
@@ -50,8 +48,6 @@ def _dependent(rep) -> str:
 TURN_RCOND = 1e-2
 
 
-#: mode system -> the indices of :func:`rigid_coordinates` (found once per mode system)
-_RIGID: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def _assembly(rows, b: int) -> set[int]:
@@ -103,10 +99,15 @@ def rigid_coordinates(ms, x) -> frozenset:
     Returns
     -------
     frozenset of int
+        Kept with the compiled model for the mode, its coordinates and rows (a property
+        of the assembly, the same at every pose of the mode).
     """
-    if ms in _RIGID:
-        return _RIGID[ms]
     model = ms.model
+    key = ("rigid coordinates", ms.mode, tuple(int(c) for c in ms.coords),
+           np.asarray(ms.independent_rows).tobytes())
+    found = model.memo.get(key)
+    if found is not None:
+        return found
     coords = list(model.mechanism.coordinates.values())
     rows = ms.layout.position_rows
     n_ind = len(ms.independent_rows)
@@ -133,8 +134,8 @@ def rigid_coordinates(ms, x) -> frozenset:
         Jw = J @ w
         if np.abs(Jw - e).max() <= 1e-9 * max(1.0, np.abs(J).max() * np.abs(w).max()):
             out.add(k)
-    _RIGID[ms] = frozenset(out)
-    return _RIGID[ms]
+    found = model.memo[key] = frozenset(out)
+    return found
 
 
 def turning_point(eqs, step, qd_old, x_good) -> str | None:
@@ -162,7 +163,7 @@ def turning_point(eqs, step, qd_old, x_good) -> str | None:
     """
     turns = np.flatnonzero(np.sign(qd_old) * np.sign(step.qdot) < 0)
     if turns.size:
-        rigid = _rigid_of(eqs.ms, x_good)
+        rigid = rigid_coordinates(eqs.ms, x_good)
         turns = np.array([k for k in turns if k not in rigid], dtype=int)
     if not turns.size:
         return None
@@ -206,46 +207,33 @@ def turning_point(eqs, step, qd_old, x_good) -> str | None:
 def _dead_at(ms, x, k: int, rep=None) -> bool:
     """Whether coordinate ``k`` of the mode turning back at pose ``x`` is a dead position:
     sigma_min / sigma_max below :data:`TURN_RCOND` with the coordinate carrying the null
-    vector (its share of the left singular vector of sigma_min above 1e-3; ``rep``: the
-    singularity report at x, else the decision of that report made from the singular
-    values and vectors alone)."""
-    if rep is not None:
-        return bool(rep["rcond"] < TURN_RCOND and ms.coord_names[k] in rep["coordinates"])
-    sel, row_scale, col_scale, packed = _scaling(ms)
-    if not sel.size:
-        return False  # no freedom: rcond 1
-    # the scaled position Jacobian [rows_I; g_I] of ModeSystem.singularity, the same numbers
-    # (the compiled rows give the NumPy rows' Jacobian bit for bit: the same operations in
-    # the same order; a test keeps them so)
-    if packed is None:
-        J = RN.jacobian(ms.layout.position_rows, x)
-    else:
-        nb, ints, flts = packed
-        J = np.zeros((len(ints), len(x)))
-        rows_jacobian(np.asarray(x, float), nb, ints, flts, J, 0)
-    u, s, _ = np.linalg.svd(J[sel] * row_scale * col_scale)
-    rcond = float(s[-1] / s[0]) if s[0] > 0 else 0.0
-    return bool(rcond < TURN_RCOND and u[len(ms.independent_rows) + k, -1] ** 2 > 1e-3)
+    vector (``rep``: the singularity report at x, else made here on the position rows'
+    Jacobian from the compiled rows, bit for bit the NumPy rows' one and ~20x cheaper)."""
+    if rep is None:
+        packed = _packed_rows(ms)
+        J = None
+        if packed is not None:
+            nb, ints, flts = packed
+            J = np.zeros((len(ints), len(x)))
+            rows_jacobian(np.asarray(x, float), nb, ints, flts, J, 0)
+        rep = ms.singularity(x, jacobian=J)
+    return bool(rep["rcond"] < TURN_RCOND and ms.coord_names[k] in rep["coordinates"])
 
 
-def _scaling(ms) -> tuple:
-    """(the indices of [rows_I; g_I] among the mode's position rows, the row scale (n, 1)
-    and the column scale (n_x,) that make their Jacobian dimensionless as
-    :func:`mechdyn.kinematics.assembly._scaled` does, and ``(nb, ints, flts)``, the packed
-    position rows for the compiled Jacobian, or None), kept with the compiled model for
-    the mode's rows and held values (made anew for held values that are not numbers)."""
+def _packed_rows(ms):
+    """``(nb, ints, flts)``: the mode's position rows packed for the compiled Jacobian (None
+    without Numba), kept with the compiled model for the mode's rows and held values (made
+    anew for held values that are not numbers)."""
+    if not NUMBA:
+        return None
     model = ms.model
     held = held_key(ms.targets)
-    sel = np.concatenate([ms.independent_rows, ms.n_rows + np.asarray(ms.coords, int)])
-    key = None if held is None else ("turn scaling", ms.mode, held, sel.tobytes())
+    key = None if held is None else ("turn rows", ms.mode, held)
     found = None if key is None else model.memo.get(key)
     if found is None:
-        L = model.length_scale
         rows = ms.layout.position_rows
-        found = (sel, np.where(rows.is_angle[sel], 1.0, 1.0 / L)[:, None],
-                 np.tile([L, L, 1.0], model.n_bodies),
-                 (rows.nb, *rows.packed()) if NUMBA else None)
-        kept = model.memo.setdefault("turn scalings", [])
+        found = (rows.nb, *rows.packed())
+        kept = model.memo.setdefault("turn rows kept", [])
         if key is not None and len(kept) < 64:  # a bounded number (held values change)
             kept.append(key)
             model.memo[key] = found
@@ -264,18 +252,6 @@ def _compiled_pose(eqs, t: float, qk, x_good):
     if kern.rhs(t, qk, np.zeros_like(qk)) is None:
         return None
     return kern.x.copy()
-
-
-def _rigid_of(ms, x) -> frozenset:
-    """:func:`rigid_coordinates` of the mode, kept with the compiled model for the next
-    mode system of the same mode, coordinates and rows (every run builds its own)."""
-    memo = ms.model.memo
-    key = ("rigid coordinates", ms.mode, tuple(int(c) for c in ms.coords),
-           np.asarray(ms.independent_rows).tobytes())
-    found = memo.get(key)
-    if found is None:
-        found = memo[key] = rigid_coordinates(ms, x)
-    return found
 
 
 def diagnose(exc, good):

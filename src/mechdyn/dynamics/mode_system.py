@@ -250,12 +250,13 @@ class ModeSystem(ModeRows):
         x, lengths and angles on one scale (1 where the mode has no freedom)."""
         return self.singularity(x)["rcond"]
 
-    def singularity(self, x) -> dict:
+    def singularity(self, x, jacobian=None) -> dict:
         """Singular-value report of the scaled position Jacobian [rows_I; g_I] at x:
         ``rcond`` (sigma_min / sigma_max), ``coordinates`` (those whose equations carry
         the left null vector: they lose control) and ``joints`` (the elements whose rows
-        become dependent)."""
-        J = RN.jacobian(self._all, x)[self._sel]
+        become dependent).  ``jacobian``: the Jacobian of all the mode's position rows at
+        x (n_rows + n_q, n_x), where the caller has it, else evaluated here."""
+        J = (RN.jacobian(self._all, x) if jacobian is None else jacobian)[self._sel]
         rows = [self.rowset.elements[r] for r in self.independent_rows]
         return _singular_report(_scaled(self.model, J, self._all.is_angle[self._sel]), rows,
                                 self.coord_names)
