@@ -30,7 +30,7 @@ from ..kernels.lagrange_numba import (
     full,
     work_size,
 )
-from ..kernels.loads_numba import LoadPacker, Unsupported
+from ..kernels.loads_numba import H_NTAB, LoadPacker, Unsupported
 from ..kernels.rows_numba import NUMBA, compiling
 from ..mechanism.mechanism import Mechanism
 from ..model import Model
@@ -67,7 +67,7 @@ class CompiledKernel:
         self.ip, self.fp, self.ri, self.rf, self.dims = ip, fp, ri, rf, dims
         self._arrays = (ip, fp, ri, rf, dims)
         self.n_x, self.n_i = n_x, int(dims[D_NI])
-        self.ws = np.zeros(work_size(n_x, self.n_i))
+        self.ws = np.zeros(work_size(n_x, self.n_i, int(ip[H_NTAB])))
         self.compile_time = compile_time
         self.status = 0
         self._st = np.zeros(1, dtype=np.int64)

@@ -38,6 +38,7 @@ from ..integrate.wilson import Wilson
 from ..kernels import dop853_numba as L
 from ..kernels import fixed_step_numba as F
 from ..kernels.lagrange_numba import D_NC, D_NQ, scratch_size
+from ..kernels.loads_numba import H_NTAB
 from ..kernels.rows_numba import rows_jacobian
 from .mode_system import ModeEval
 
@@ -84,6 +85,7 @@ class _Buffers:
         self.par = np.zeros(F.N_PAR_FIXED)  # the DOP853 loop's scalars, then the fixed-step's
         self.ipar = np.zeros(F.N_IPAR_FIXED, dtype=np.int64)
         self.kept = np.empty((KEEP_STEPS, 3 + 10 * m + kernel.ws.size))
+        self.kv = np.zeros(4 * int(kernel._arrays[0][H_NTAB]))  # held table pieces
 
     def restart(self) -> None:
         """Clear what a new set of buffers has cleared (for a kernel used again)."""
@@ -191,7 +193,7 @@ def _loop(kernel, b, integ, y, atol, te, t: float, t_end: float):
                               *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept)), True
     return (lambda: L.run(y, b.f, atol, b.par, b.ipar, b.K, b.ynew, b.ys, b.hist, b.dns, te,
                           b.o_t, b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end,
-                          *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept)), False
+                          *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept, b.kv)), False
 
 
 def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, sample, t_eval,
@@ -491,7 +493,7 @@ def warm_up_loop(kernel) -> None:
     b.ipar[L.I_MAXSTEPS] = 10
     L.run(y, b.f, np.full(m, 1e-9), b.par, b.ipar, b.K, b.ynew, b.ys, b.hist, b.dns,
           np.zeros(0), b.o_t, b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end,
-          *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept)
+          *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept, b.kv)
     for method in (F.RK4, F.WILSON):  # the fixed-step loop (one compilation for both)
         y[:] = 0.0
         y[:ni], y[ni:2 * ni] = 0.3, 1.0

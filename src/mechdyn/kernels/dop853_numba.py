@@ -30,9 +30,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..integrate.dop853_tableau import E3, E5, N_STAGES, A, C, D
+from .held_tables import hold, left, table_vars
 from .hermite_numba import hermite_at
-from .lagrange_numba import D_NI, N_FLAGS, W_COUNT, W_PIVOT, evaluate_into
+from .lagrange_numba import D_NI, N_FLAGS, W_COUNT, W_PIVOT, evaluate_into, held_pieces
+from .loads_numba import H_NB, H_NTAB
 from .rows_numba import njit
+from .table_regions import ETA
 
 __all__ = ["run", "evaluate_states", "dense_at", "DONE", "BATCH", "FLAGGED", "FAILED", "WATCH",
            "F_TURN", "F_PIVOT", "F_STALL", "P_T", "P_TEND", "P_H", "P_RTOL",
@@ -72,6 +75,25 @@ def _counted(ts, ys, fout, ni, ip, fp, ri, rf, dims, ws, ext, full, sc, piv, ipa
                        sc, piv)
     ipar[I_STATUS] = st
     return st == 0
+
+
+@njit
+def _switch(switch, t_new, ynew, fnew, s_old, s_new, ni, ip, fp, ri, rf, dims, ws, ext_end,
+            full, sc, piv, ipar, locks):
+    """At the end of an accepted step (after its dense output and samples, made on the
+    pieces it was taken on): with ``switch``, hold the next pieces of the tables that have
+    left theirs and evaluate the rates there again on them; the table variables there
+    become the step's start values."""
+    nt = ip[H_NTAB]
+    if nt == 0:
+        return True
+    if switch:
+        hold(ip, fp, s_new, s_new + (s_new - s_old), locks, True)
+        if not _counted(t_new, ynew, fnew, ni, ip, fp, ri, rf, dims, ws, ext_end, full, sc,
+                        piv, ipar):
+            return False
+    s_old[:] = s_new
+    return True
 
 
 @njit
@@ -303,13 +325,34 @@ def samples(hermite, t, h, t_new, y, f, ynew, fnew, dns, ys, fs, end_sample, t_e
 
 @njit
 def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_xd, o_ext,
-        ext, ext_end, x_end, ip, fp, ri, rf, dims, ws, sc, piv, kept):
+        ext, ext_end, x_end, ip, fp, ri, rf, dims, ws, sc, piv, kept, kv):
+    """:func:`_run`, with the held table pieces (:mod:`mechdyn.kernels.table_regions`)
+    kept in ``kv`` between calls (``kv``: 4 values per held table) and released in the
+    work array when it returns (every evaluation outside the loop sees the tables)."""
+    code = _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_xd,
+                o_ext, ext, ext_end, x_end, ip, fp, ri, rf, dims, ws, sc, piv, kept, kv)
+    nt = ip[H_NTAB]
+    if nt > 0:
+        locks = held_pieces(ws, 3 * ip[H_NB], dims[D_NI])
+        kv[2 * nt:4 * nt] = locks
+        locks[:] = 0.0
+    return code
+
+
+@njit
+def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_xd, o_ext,
+         ext, ext_end, x_end, ip, fp, ri, rf, dims, ws, sc, piv, kept, kv):
     """Integrate from ``par[P_T]`` (state ``y``, rates ``f`` when ``ipar[I_FSAL]``) towards
     ``par[P_TEND]``; returns DONE, BATCH, FLAGGED or FAILED (see the module).
 
     With ``ipar[I_KEEP]`` every accepted step is kept in row ``ipar[I_NKEPT]`` of ``kept``
     (see :func:`keep_step`; at most ``ipar[I_MAXSTEPS]`` rows per call), with its dense
-    output, and no step is flagged for a rate changing sign (the caller checks each)."""
+    output, and no step is flagged for a rate changing sign (the caller checks each).
+
+    Each table with sharp points has its piece held through a step; a step at whose end
+    a table variable has left its piece is taken again up to the piece's end (within
+    ``ETA`` of the step), and the next piece is held from there (``kv``: the variables at
+    the last accepted point | at the step's end | the pieces held between calls)."""
     ni = dims[D_NI]
     nx = x_end.size // 3
     m = y.size
@@ -322,10 +365,20 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
     every = ipar[I_EVERY] != 0
     off = ipar[I_FSAL] < 0  # False and True at run time (see _counted)
     on = not off
+    nt = ip[H_NTAB]
+    locks = held_pieces(ws, nx, ni)
+    s_old, s_new = kv[:nt], kv[nt:2 * nt]
     if ipar[I_FSAL] == 0:
+        locks[:] = 0.0
         if not _counted(t, y, f, ni, ip, fp, ri, rf, dims, ws, ext, off, sc, piv, ipar):
             return FAILED
+        table_vars(t, ip, fp, dims, sc, s_old)
+        for j in range(nt):
+            s_new[j] = s_old[j] + 1.0  # (at a point exactly: the piece above it)
+        hold(ip, fp, s_old, s_new, locks, False)
         ipar[I_FSAL] = 1
+    else:
+        locks[:] = kv[2 * nt:4 * nt]
     h = par[P_H]
     scipy_ctrl = ipar[I_CTRL] != 0
     if not h > 0.0:
@@ -341,6 +394,10 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
             else:
                 h = _initial_step(y, f, K[2], h, dnf, atol, rtol, hmax)
     rejected = False
+    retried = 0  # attempts of this step taken again up to a table's point
+    h_full = 0.0  # the step before the first of them
+    j_last, c_last = -1, 0.0  # the table and the point a step was taken again up to
+    switch = False  # the next pieces are held from the end of the step
     steps = 0
     ws0 = np.empty(ws.size)  # the Newton start of a step's stages, put back at a rejection
     ipar[I_FLAGS] = 0
@@ -369,7 +426,7 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
             last = False
         t_new = t_end if last else t + h
         # the stages
-        if not rejected:
+        if not rejected and retried == 0:
             ws0[:] = ws
         for i in range(m):
             K[0, i] = f[i]
@@ -402,6 +459,8 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
         if err > 1.0 or (scipy_ctrl and err == 1.0):  # rejected
             ipar[I_REJ] += 1
             rejected = True
+            retried = 0
+            h_full = 0.0
             # a retry starts its solves where the step started, not from the poses of the
             # rejected stages (a long trial step may have jumped to another assembly branch)
             _put_back(ws, ws0)
@@ -426,6 +485,35 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
                         sc, piv, ipar):
             par[P_T], par[P_H] = t, h
             return FAILED
+        if nt > 0:  # has a table variable left its piece?
+            table_vars(t_new, ip, fp, dims, sc, s_new)
+            th, jt, ct = left(ip, fp, s_old, s_new, locks)
+            if th <= 1.0 and retried < 8:
+                if th <= ETA or th * h <= hmin:  # at the point already: the next piece
+                    ipar[I_REJ] += 1
+                    _put_back(ws, ws0)
+                    hold(ip, fp, s_old, s_new, locks, True, jt)
+                    if not _counted(t, y, f, ni, ip, fp, ri, rf, dims, ws, ext, off, sc, piv,
+                                    ipar):
+                        par[P_T], par[P_H] = t, h
+                        return FAILED
+                    ws0[:] = ws
+                    retried += 1
+                    continue
+                if th < 1.0 - ETA:  # again, up to the point (just past it)
+                    ipar[I_REJ] += 1
+                    _put_back(ws, ws0)
+                    if retried == 0:
+                        h_full = h
+                    j_last, c_last = jt, ct
+                    retried += 1
+                    h = th * h * (1.0 + 0.5 * ETA)
+                    continue
+            switch = th <= 1.0  # past the point by at most ETA of the step: next piece
+            if not switch and retried > 0 and abs(s_new[j_last] - c_last) <= \
+                    ETA * abs(s_new[j_last] - s_old[j_last]):  # just short of it: as well
+                switch = True
+                s_new[j_last] = c_last + (c_last - s_old[j_last]) * ETA  # (past it)
         _watch(ynew[0], ws, nx, par, ipar, x_end)
         steps += 1
         ipar[I_STEPS] += 1
@@ -437,15 +525,22 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
             h_next = h * (10.0 if err == 0.0 else min(10.0, 0.9 * err ** -0.125))
         if rejected:
             h_next = min(h_next, h)
+        elif h_full > 0.0:  # taken again up to a point: on with the step chosen before
+            h_next = max(h_next, h_full)
         rejected = False
+        aimed = retried > 0  # (a step shortened to a table's point: no stall)
+        retried = 0
+        h_full = 0.0
         # what Python must look at
         flags = step_end(t, h, t_new, y, f, ynew, fnew, ws, x_end, hist, par, ni,
                          ipar[I_KEEP] == 0)
-        if h < par[P_STALL]:
+        if h < par[P_STALL] and not aimed:
             flags |= F_STALL
         interior = ipar[I_NEXT] < n_te and t_eval[ipar[I_NEXT]] < t_new
         if ipar[I_KEEP] != 0:
             kept[ipar[I_NKEPT], kept.shape[1] - ws.size:] = ws
+            o = kept.shape[1] - ws.size + nx + ni + nx * ni + nx  # no held pieces there
+            kept[ipar[I_NKEPT], o:o + 2 * nt] = 0.0
         if flags != 0 or interior or ipar[I_KEEP] != 0:
             for s in range(N_STAGES + 1, N_STAGES + 4):  # the stages of the dense output
                 _stage(y, K, s, h, ys)
@@ -459,6 +554,10 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
             ipar[I_NKEPT] += 1
         if flags != 0:
             ipar[I_FLAGS] = flags
+            if not _switch(switch, t_new, ynew, fnew, s_old, s_new, ni, ip, fp, ri, rf, dims,
+                           ws, ext_end, end_sample, sc, piv, ipar, locks):
+                par[P_T], par[P_H] = t, h
+                return FAILED
             accept(y, f, ynew, fnew, ipar)
             par[P_T], par[P_H] = t_new, h_next
             return FLAGGED
@@ -466,6 +565,10 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
         if not samples(off, t, h, t_new, y, f, ynew, fnew, dns, ys, K[N_STAGES + 1],
                        end_sample, t_eval, par, ipar, ip, fp, ri, rf, dims, ws, ext, ext_end,
                        x_end, on, sc, piv, o_t, o_y, o_x, o_xd, o_ext):
+            return FAILED
+        if not _switch(switch, t_new, ynew, fnew, s_old, s_new, ni, ip, fp, ri, rf, dims, ws,
+                       ext_end, end_sample, sc, piv, ipar, locks):
+            par[P_T], par[P_H] = t, h
             return FAILED
         accept(y, f, ynew, fnew, ipar)
         t = t_new

@@ -40,6 +40,7 @@ from .loads_numba import (
 from .rows_numba import njit, rows_jacobian, rows_quad, rows_values
 
 __all__ = ["evaluate", "evaluate_into", "scratch_size", "first_order", "full", "work_size",
+           "held_pieces", "table_inputs",
            "D_NC", "D_NI", "D_NQ", "D_NV", "W_VALID", "W_PIVOT", "W_COUNT", "N_FLAGS"]
 
 # dims: n_c (constraint rows), n_i (independent coordinates), n_q (declared coordinates),
@@ -54,9 +55,18 @@ W_COUNT = 4  # evaluations of the equations
 N_FLAGS = 5
 
 
-def work_size(n_x: int, n_i: int) -> int:
-    """Work array: x | q_last (n_i) | B_last (n_x n_i) | xdot | x_good | flags."""
-    return n_x + n_i + n_x * n_i + 2 * n_x + N_FLAGS
+def work_size(n_x: int, n_i: int, n_t: int = 0) -> int:
+    """Work array: x | q_last (n_i) | B_last (n_x n_i) | xdot | held table pieces (2 n_t,
+    see :func:`held_pieces`) | x_good | flags."""
+    return n_x + n_i + n_x * n_i + 2 * n_x + 2 * n_t + N_FLAGS
+
+
+@njit
+def held_pieces(ws, nx, ni):
+    """The block of the work array with the table pieces that the loads evaluate on
+    (:mod:`mechdyn.kernels.table_regions`; all zero outside the DOP853 loop: none)."""
+    o = nx + ni + nx * ni + nx
+    return ws[o:ws.size - N_FLAGS - nx]
 
 
 @njit
@@ -144,6 +154,16 @@ def scratch_size(n_x, n_i, n_q, n_v):
 
 
 @njit
+def table_inputs(sc, nx, ni, nq, nv):
+    """Views into the scratch of :func:`evaluate_into` of the declared coordinates, their
+    rates and the measured table variables of its last evaluation: ``(q, qdot, varv)``."""
+    o = nx * nx + 6 * nx
+    q, qdot = sc[o:o + nq], sc[o + nq:o + 2 * nq]
+    o += 4 * nq + nq * nx + nq * ni + ni * ni + 4 * ni
+    return q, qdot, sc[o:o + nv]
+
+
+@njit
 def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
     """q_I'' and P_nc at (t, q_I, q_I'); out = [q_I' | q_I'' | P_nc].  Status: 0 ok,
     1 position solve failed, 2 mass matrix not positive definite, 3 non-finite.
@@ -174,8 +194,8 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
     F, col, bb = sc[o:o + nx], sc[o + nx:o + 2 * nx], sc[o + 2 * nx:o + 3 * nx]
     Fa, Fnc, z = sc[o + 3 * nx:o + 4 * nx], sc[o + 4 * nx:o + 5 * nx], sc[o + 5 * nx:o + 6 * nx]
     o += 6 * nx
-    q, qdot, Gb, Qd = sc[o:o + nq], sc[o + nq:o + 2 * nq], sc[o + 2 * nq:o + 3 * nq], \
-        sc[o + 3 * nq:o + 4 * nq]
+    q, qdot, varv = table_inputs(sc, nx, ni, nq, nv)
+    Gb, Qd = sc[o + 2 * nq:o + 3 * nq], sc[o + 3 * nq:o + 4 * nq]
     o += 4 * nq
     G = sc[o:o + nq * nx].reshape((nq, nx))
     o += nq * nx
@@ -185,7 +205,6 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
     o += ni * ni
     cc, bcx, bcy, rhs = sc[o:o + ni], sc[o + ni:o + 2 * ni], sc[o + 2 * ni:o + 3 * ni], \
         sc[o + 3 * ni:o + 4 * ni]
-    varv = sc[o + 4 * ni:o + 4 * ni + nv]
     ws[ws.size - N_FLAGS + W_COUNT] += 1.0
     st = _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb)
     if st != 0:
@@ -265,7 +284,7 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
                     A[i, j] += je * GB[c, i] * GB[c, j]
     # forces
     rows_values(x, nb, ri[nc + ni + nq:], rf[nc + ni + nq:], varv, 0)
-    forces(t, q, qdot, x, v, ip, fp, Fa, Fnc, Qd, varv)
+    forces(t, q, qdot, x, v, ip, fp, Fa, Fnc, Qd, varv, held_pieces(ws, nx, ni))
     P = 0.0
     for r in range(nx):
         P += Fnc[r] * v[r]

@@ -17,24 +17,30 @@ import numpy as np
 from ..mechanism.drive import TorqueSpeedCurve
 from ..mechanism.load import Force, RotarySpring, Spring, Table, Torque
 from .rows_numba import body_pose, njit
+from .table_regions import region_value, sharp_breakpoints
 
 __all__ = ["LoadPacker", "Unsupported", "forces", "body_inertia", "load_value", "interp",
            "H_NB", "H_NQ", "H_NDRV", "H_IOFF", "H_FOFF", "S_BODY", "S_DRV", "FR_BODY", "IR_DRV",
-           "FR_DRV", "IR_VAL"]
+           "FR_DRV", "IR_VAL", "H_NTAB", "S_LOCK", "IR_LOCK"]
 
 # header of the int array: counts, then section offsets
-H_NB, H_NQ, H_NSPR, H_NROT, H_NFOR, H_NTOR, H_NDRV = range(7)
+H_NB, H_NQ, H_NSPR, H_NROT, H_NFOR, H_NTOR, H_NDRV, H_NTAB = range(8)
 H_IOFF = 16  # int offsets of sections start here
 H_FOFF = 32  # float offsets of sections start here
 HEADER = 48
 # sections (same index in the int and the float offset tables)
-S_BODY, S_SPR, S_ROT, S_FOR, S_TOR, S_DRV, S_TAB = range(7)
-N_SECTIONS = 7
+# (S_LOCK: a record per table whose piece the DOP853 loop holds through a step,
+# :mod:`mechdyn.kernels.table_regions`: variable kind, variable index, table offset,
+# points, flags)
+S_BODY, S_SPR, S_ROT, S_FOR, S_TOR, S_DRV, S_TAB, S_LOCK = range(8)
+N_SECTIONS = 8
+IR_LOCK = 5
 IR_SPR, FR_SPR = 2, 8
 IR_ROT, FR_ROT = 2, 4
 # value records (forces, torques, drives): mode, tab_off, tab_len, var_kind, var_index,
-# table flags (T_OUTSIDE | T_PERIODIC), then a target part; a table is stored in the
-# table section as xs (tab_len), ys (tab_len) and, if periodic, its period
+# table flags (T_OUTSIDE | T_PERIODIC | its hold slot << 2), then a target part; a table is
+# stored in the table section as xs (tab_len), ys (tab_len) and, if periodic, its period;
+# a table with sharp points has a hold slot (1, 2, ...: see S_LOCK), others 0
 IR_VAL = 6
 IR_FOR, FR_FOR = IR_VAL + 2, 5 + 1  # body, frame | sx, sy, dx, dy, value, outside
 IR_TOR, FR_TOR = IR_VAL + 2, 2  # body, reaction | value, outside
@@ -76,6 +82,7 @@ class LoadPacker:
         self.variable_rows: list = []
         self._var_index: dict[str, int] = {}
         self.tabs: list[float] = []
+        self.held: list[list[int]] = []  # the value records of the tables with a hold slot
         self.ints: dict[int, list[int]] = {s: [] for s in range(N_SECTIONS)}
         self.flts: dict[int, list[float]] = {s: [] for s in range(N_SECTIONS)}
 
@@ -113,8 +120,11 @@ class LoadPacker:
         if period is not None:
             self.tabs.append(float(period))
             flags |= T_PERIODIC
-        return ([V_TABLE, off, len(xs), kind, idx, flags], 0.0,
-                0.0 if outside is None else float(outside))
+        rec = [V_TABLE, off, len(xs), kind, idx, flags]
+        if sharp_breakpoints(xs, ys, outside, period).size:
+            self.held.append(rec)
+            rec[5] |= len(self.held) << 2
+        return rec, 0.0, 0.0 if outside is None else float(outside)
 
     def pack(self):
         m, fm = self.model, self.fm
@@ -157,11 +167,14 @@ class LoadPacker:
             raise Unsupported(f"load {getattr(extra[0], 'name', '?')!r} "
                                f"({type(extra[0]).__name__}) is evaluated on the NumPy path")
         self.flts[S_TAB] = self.tabs
+        for rec in self.held:  # variable kind and index as patched above
+            self.ints[S_LOCK] += [rec[3], rec[4], rec[1], rec[2], rec[5]]
 
         head = np.zeros(HEADER, dtype=np.int64)
         head[H_NB], head[H_NQ] = nb, m.n_q
         head[H_NSPR], head[H_NROT] = len(fm.springs), len(fm.rotary)
         head[H_NFOR], head[H_NTOR], head[H_NDRV] = len(fm.forces), len(fm.torques), len(fm.drives)
+        head[H_NTAB] = len(self.held)
         ip_parts, fp_parts = [head], [np.array([*m.gravity, m.length_scale,
                                                 1e-13 * max(m.length_scale, 1e-3)])]
         ioff, foff = HEADER, F_GLOBAL
@@ -198,7 +211,7 @@ def interp(xs, ys, n, s, has_out, outside):
 
 
 @njit
-def load_value(ip, fp, irec, fval, t, q, qdot, varv):
+def load_value(ip, fp, irec, fval, t, q, qdot, varv, locks):
     if ip[irec] == 0:
         return fp[fval]
     tab0 = ip[H_FOFF + S_TAB] + ip[irec + 1]
@@ -214,6 +227,12 @@ def load_value(ip, fp, irec, fval, t, q, qdot, varv):
     else:
         s = varv[idx]
     flags = ip[irec + 5]
+    slot = flags >> 2
+    if slot > 0 and 2 * slot <= locks.size and locks[2 * slot - 2] > 0.0:  # a held piece
+        per = fp[tab0 + 2 * n] if flags & 2 else 0.0
+        return region_value(fp[tab0:tab0 + n], fp[tab0 + n:tab0 + 2 * n], n, per,
+                            int(locks[2 * slot - 2]) - 1, locks[2 * slot - 1], s,
+                            (flags & 1) == 1, fp[fval + 1])
     if flags & 2:  # T_PERIODIC: wrap into [x0, x0 + period), as Table.wrap
         x0 = fp[tab0]
         per = fp[tab0 + 2 * n]
@@ -246,8 +265,10 @@ def _apply(F, b, nb, armx, army, fx, fy):
 
 
 @njit
-def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv):
-    """Applied forces F (all) and Fnc (non-conservative part) on the poses, drives Qd."""
+def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv, locks):
+    """Applied forces F (all) and Fnc (non-conservative part) on the poses, drives Qd.
+    ``locks``: the held table pieces, ``[region + 1, period count]`` per hold slot (0:
+    none; an empty array holds none)."""
     nb = ip[H_NB]
     nq = ip[H_NQ]
     gx, gy = fp[0], fp[1]
@@ -307,7 +328,7 @@ def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv):
     for k in range(ip[H_NFOR]):
         i0 = oi + IR_FOR * k
         f0 = of + FR_FOR * k
-        mag = load_value(ip, fp, i0, f0 + 4, t, q, qdot, varv)
+        mag = load_value(ip, fp, i0, f0 + 4, t, q, qdot, varv, locks)
         b = ip[i0 + IR_VAL]
         frame = ip[i0 + IR_VAL + 1]
         th = x[3 * b + 2] if b < nb else 0.0
@@ -322,7 +343,7 @@ def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv):
     for k in range(ip[H_NTOR]):
         i0 = oi + IR_TOR * k
         f0 = of + FR_TOR * k
-        tq = load_value(ip, fp, i0, f0, t, q, qdot, varv)
+        tq = load_value(ip, fp, i0, f0, t, q, qdot, varv, locks)
         b = ip[i0 + IR_VAL]
         r = ip[i0 + IR_VAL + 1]
         if b < nb:
@@ -335,4 +356,4 @@ def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv):
     for k in range(ip[H_NDRV]):
         i0 = oi + IR_DRV * k
         f0 = of + FR_DRV * k
-        Qd[ip[i0 + IR_VAL]] += load_value(ip, fp, i0, f0, t, q, qdot, varv)
+        Qd[ip[i0 + IR_VAL]] += load_value(ip, fp, i0, f0, t, q, qdot, varv, locks)

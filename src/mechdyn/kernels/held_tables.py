@@ -1,0 +1,99 @@
+"""The loop's side of the held table pieces (:mod:`mechdyn.kernels.table_regions`): the
+table variables of an evaluation, the pieces held, and where a step leaves them.
+
+Used by :func:`mechdyn.kernels.dop853_numba.run`; every function reads the held tables'
+records (section ``S_LOCK`` of the packed loads, :mod:`mechdyn.kernels.loads_numba`) and
+the pieces held (``[region + 1, period count]`` per table, in the work array,
+:func:`mechdyn.kernels.lagrange_numba.held_pieces`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .lagrange_numba import D_NI, D_NQ, D_NV, table_inputs
+from .loads_numba import H_FOFF, H_IOFF, H_NB, H_NTAB, IR_LOCK, S_LOCK, S_TAB
+from .rows_numba import njit
+from .table_regions import region_bounds, region_of
+
+__all__ = ["table_vars", "hold", "left"]
+
+
+@njit
+def _table(ip, fp, j):
+    """``(xs, n, period)`` of held table ``j`` (period 0: not periodic)."""
+    o = ip[H_IOFF + S_LOCK] + IR_LOCK * j
+    tab0 = ip[H_FOFF + S_TAB] + ip[o + 2]
+    n = ip[o + 3]
+    per = fp[tab0 + 2 * n] if ip[o + 4] & 2 else 0.0
+    return fp[tab0:tab0 + n], n, per
+
+
+@njit
+def table_vars(t, ip, fp, dims, sc, out):
+    """The variables of the held tables at the last evaluation, into ``out``."""
+    q, qdot, varv = table_inputs(sc, 3 * ip[H_NB], dims[D_NI], dims[D_NQ], dims[D_NV])
+    o = ip[H_IOFF + S_LOCK]
+    for j in range(ip[H_NTAB]):
+        kind, idx = ip[o + IR_LOCK * j], ip[o + IR_LOCK * j + 1]
+        out[j] = t if kind == 0 else (q[idx] if kind == 1 else (
+            qdot[idx] if kind == 2 else varv[idx]))
+
+
+@njit
+def _slack(xs, n, per, c):
+    """How far past an end ``c`` of its piece a variable may lie and still count as on it
+    (round-off: a ram held at a stop that is also a table's point must not flip between
+    the two pieces there)."""
+    return 1e-12 * (abs(c) + xs[n - 1] - xs[0] + per) if abs(c) < np.inf else 0.0
+
+
+@njit
+def hold(ip, fp, s, towards, locks, only_left, only=-1):
+    """Hold the piece of each table at its variable ``s`` (at a point: the piece on the
+    side of ``towards``); with ``only_left``, hold instead the piece next to the one held
+    now, past the end that the variable has crossed on its way to ``towards``, of each
+    table whose variable there has left the piece held now (of table ``only`` alone
+    where it is not -1)."""
+    for j in range(ip[H_NTAB]):
+        if only >= 0 and j != only:
+            continue
+        xs, n, per = _table(ip, fp, j)
+        if not only_left:
+            g, kp = region_of(xs, n, per, s[j], towards[j] - s[j])
+        else:
+            g, kp = int(locks[2 * j]) - 1, locks[2 * j + 1]
+            lo, hi = region_bounds(xs, n, per, g, kp)
+            if towards[j] > hi + _slack(xs, n, per, hi):
+                g += 1
+                if g > n:  # (periodic: on into the next period; else held above)
+                    g, kp = (1, kp + 1.0) if per > 0.0 else (n, kp)
+            elif towards[j] < lo - _slack(xs, n, per, lo):
+                g -= 1
+                if g < 1 and per > 0.0:
+                    g, kp = n, kp - 1.0
+                g = max(g, 0)
+        locks[2 * j], locks[2 * j + 1] = g + 1.0, kp
+
+
+@njit
+def left(ip, fp, old, new, locks):
+    """``(theta, j, c)``: the smallest fraction ``theta`` of a step (in [0, 1], linear in
+    the variable between its ends ``old`` and ``new``) at which a table variable leaves
+    its held piece, the table ``j`` and the end ``c`` of its piece; theta 2.0 where none
+    does."""
+    best, jb, cb = 2.0, -1, 0.0
+    for j in range(ip[H_NTAB]):
+        xs, n, per = _table(ip, fp, j)
+        lo, hi = region_bounds(xs, n, per, int(locks[2 * j]) - 1, locks[2 * j + 1])
+        a, b = old[j], new[j]
+        if b > hi + _slack(xs, n, per, hi):
+            c = hi
+        elif b < lo - _slack(xs, n, per, lo):
+            c = lo
+        else:
+            continue
+        th = min(max((c - a) / (b - a), 0.0), 1.0) if b != a else 0.0
+        if th < best:
+            best, jb, cb = th, j, c
+    return best, jb, cb
