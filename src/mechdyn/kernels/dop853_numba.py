@@ -400,6 +400,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
     switch = False  # the next pieces are held from the end of the step
     steps = 0
     ws0 = np.empty(ws.size)  # the Newton start of a step's stages, put back at a rejection
+    wp0 = 0
     ipar[I_FLAGS] = 0
     while True:
         if t >= t_end:
@@ -428,6 +429,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
         # the stages
         if not rejected and retried == 0:
             ws0[:] = ws
+            wp0 = ipar[I_WPEND]  # a watch armed by an attempt that is not kept is dropped
         for i in range(m):
             K[0, i] = f[i]
         for s in range(1, N_STAGES):
@@ -461,6 +463,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
             rejected = True
             retried = 0
             h_full = 0.0
+            ipar[I_WPEND] = wp0
             # a retry starts its solves where the step started, not from the poses of the
             # rejected stages (a long trial step may have jumped to another assembly branch)
             _put_back(ws, ws0)
@@ -492,6 +495,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
                 if th <= ETA or th * h <= hmin:  # at the point already: the next piece
                     ipar[I_REJ] += 1
                     _put_back(ws, ws0)
+                    ipar[I_WPEND] = wp0
                     hold(ip, fp, s_old, s_new, locks, True, jt)
                     if not _counted(t, y, f, ni, ip, fp, ri, rf, dims, ws, ext, off, sc, piv,
                                     ipar):
@@ -503,6 +507,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
                 if th < 1.0 - ETA:  # again, up to the point (just past it)
                     ipar[I_REJ] += 1
                     _put_back(ws, ws0)
+                    ipar[I_WPEND] = wp0
                     if retried == 0:
                         h_full = h
                     j_last, c_last = jt, ct

@@ -27,6 +27,8 @@ samples than the buffers hold ends the call with ``FAILED`` and ``ipar[I_STATUS]
 
 from __future__ import annotations
 
+import numpy as np
+
 from .dop853_numba import (
     BATCH,
     DONE,
@@ -48,6 +50,7 @@ from .dop853_numba import (
     P_T,
     WATCH,
     _counted,
+    _put_back,
     _watch,
     accept,
     keep_step,
@@ -163,6 +166,7 @@ def run(y, f, grid, par, ipar, K, ynew, ys, hist, t_eval, o_t, o_y, o_x, o_xd, o
         ipar[I_FSAL] = 1
     wilson = ipar[I_METHOD] == WILSON
     steps = 0
+    ws0 = np.empty(ws.size)  # the Newton start of a step, put back where a stage fails
     ipar[I_FLAGS] = 0
     while True:
         par[P_T] = t
@@ -185,17 +189,17 @@ def run(y, f, grid, par, ipar, K, ynew, ys, hist, t_eval, o_t, o_y, o_x, o_xd, o
                 return BATCH
             ipar[I_STATUS] = -2
             return FAILED
+        ws0[:] = ws
         if wilson:
             ok = _wilson(t, h, y, f, K, ynew, ys, ni, ip, fp, ri, rf, dims, ws, ext, off, sc,
                          piv, par, ipar, nx, x_end)
         else:
             ok = _rk4(t, t_new, h, y, f, K, ynew, ys, ni, ip, fp, ri, rf, dims, ws, ext, off,
                       sc, piv, par, ipar, nx, x_end)
-        if not ok:
-            return FAILED
         fnew = K[4]
-        if not _counted(t_new, ynew, fnew, ni, ip, fp, ri, rf, dims, ws, ext_end, end_sample,
-                        sc, piv, ipar):
+        if not (ok and _counted(t_new, ynew, fnew, ni, ip, fp, ri, rf, dims, ws, ext_end,
+                                end_sample, sc, piv, ipar)):
+            _put_back(ws, ws0)  # (the caller goes on from the step's start)
             return FAILED
         _watch(ynew[0], ws, nx, par, ipar, x_end)
         if wilson:  # w by the trapezoidal rule
