@@ -156,3 +156,28 @@ def test_press_cycle_events_converge_with_rtol():
         [(e.kind, e.element) for e in fine.events]
     np.testing.assert_allclose([e.t for e in coarse.events], [e.t for e in fine.events],
                                rtol=0, atol=2e-10)
+
+
+@needs_numba
+def test_a_variable_held_at_a_point_stays_on_its_piece():
+    # the ram of the press sits at its upper stop, 28 mm, which is also the last point of
+    # its spring table: round-off around the point must not flip the held piece
+    from mechdyn.dynamics.mode_equations import ModeEquations
+    from mechdyn.dynamics.mode_system import ModeSystem
+    from mechdyn.dynamics.modes import switched_model
+    from mechdyn.kernels.held_tables import hold, left
+    from mechdyn.model.workspace import Workspace
+
+    model = _slider(Table([0.02, 0.022, 0.028], [0.0, 68.8e3, 70e3], "s")).compile()
+    sm = switched_model(model)
+    ms = ModeSystem(sm, frozenset(), {}, np.zeros(model.n_x), workspace=Workspace())
+    ip, fp = ModeEquations(sm, ms, "numba").kernel._arrays[:2]
+    locks = np.array([4.0, 0.0])  # above the last point (region 3 + 1)
+    at = np.array([0.028])
+    assert left(ip, fp, at, at - 4e-18, locks)[0] == 2.0  # still on it
+    th, j, c = left(ip, fp, at, np.array([0.0279]), locks)  # down into the table
+    assert (th, j, c) == (0.0, 0, 0.028)
+    hold(ip, fp, at, np.array([0.0279]), locks, True, 0)
+    assert locks.tolist() == [3.0, 0.0]  # the piece from 22 to 28 mm
+    th, j, c = left(ip, fp, np.array([0.0279]), np.array([0.0215]), locks)
+    assert j == 0 and c == 0.022 and th == pytest.approx(0.0059 / 0.0064)
