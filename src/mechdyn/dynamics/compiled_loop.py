@@ -85,7 +85,7 @@ class _Buffers:
         self.par = np.zeros(F.N_PAR_FIXED)  # the DOP853 loop's scalars, then the fixed-step's
         self.ipar = np.zeros(F.N_IPAR_FIXED, dtype=np.int64)
         self.kept = np.empty((KEEP_STEPS, 3 + 10 * m + kernel.ws.size))
-        self.kv = np.zeros(4 * int(kernel._arrays[0][H_NTAB]))  # held table pieces
+        self.kv = np.zeros(4 * int(kernel.ip[H_NTAB]))  # held table pieces
 
     def restart(self) -> None:
         """Clear what a new set of buffers has cleared (for a kernel used again)."""

@@ -81,9 +81,9 @@ def _counted(ts, ys, fout, ni, ip, fp, ri, rf, dims, ws, ext, full, sc, piv, ipa
 def _switch(switch, t_new, ynew, fnew, s_old, s_new, ni, ip, fp, ri, rf, dims, ws, ext_end,
             full, sc, piv, ipar, locks):
     """At the end of an accepted step (after its dense output and samples, made on the
-    pieces it was taken on): with ``switch``, hold the next pieces of the tables that have
-    left theirs and evaluate the rates there again on them; the table variables there
-    become the step's start values."""
+    pieces it was taken on): with ``switch``, hold the next pieces of the tables whose
+    variable in ``s_new`` has left its piece and evaluate the rates there again on them; the
+    table variables there (as evaluated) become the step's start values."""
     nt = ip[H_NTAB]
     if nt == 0:
         return True
@@ -92,6 +92,7 @@ def _switch(switch, t_new, ynew, fnew, s_old, s_new, ni, ip, fp, ri, rf, dims, w
         if not _counted(t_new, ynew, fnew, ni, ip, fp, ri, rf, dims, ws, ext_end, full, sc,
                         piv, ipar):
             return False
+        table_vars(t_new, ip, fp, dims, sc, s_new)
     s_old[:] = s_new
     return True
 
@@ -399,8 +400,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
     j_last, c_last = -1, 0.0  # the table and the point a step was taken again up to
     switch = False  # the next pieces are held from the end of the step
     steps = 0
-    ws0 = np.empty(ws.size)  # the Newton start of a step's stages, put back at a rejection
-    wp0 = 0
+    ws0, wp0 = np.empty(ws.size), 0  # the workspace and watch at a step's start (put back)
     ipar[I_FLAGS] = 0
     while True:
         if t >= t_end:
@@ -518,7 +518,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
             if not switch and retried > 0 and abs(s_new[j_last] - c_last) <= \
                     ETA * abs(s_new[j_last] - s_old[j_last]):  # just short of it: as well
                 switch = True
-                s_new[j_last] = c_last + (c_last - s_old[j_last]) * ETA  # (past it)
+                s_new[j_last] = c_last + (c_last - s_old[j_last]) * ETA  # (for hold: past it)
         _watch(ynew[0], ws, nx, par, ipar, x_end)
         steps += 1
         ipar[I_STEPS] += 1
@@ -543,9 +543,9 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
             flags |= F_STALL
         interior = ipar[I_NEXT] < n_te and t_eval[ipar[I_NEXT]] < t_new
         if ipar[I_KEEP] != 0:
-            kept[ipar[I_NKEPT], kept.shape[1] - ws.size:] = ws
-            o = kept.shape[1] - ws.size + nx + ni + nx * ni + nx  # no held pieces there
-            kept[ipar[I_NKEPT], o:o + 2 * nt] = 0.0
+            row_ws = kept[ipar[I_NKEPT], kept.shape[1] - ws.size:]
+            row_ws[:] = ws
+            held_pieces(row_ws, nx, ni)[:] = 0.0  # (a kept workspace holds no pieces)
         if flags != 0 or interior or ipar[I_KEEP] != 0:
             for s in range(N_STAGES + 1, N_STAGES + 4):  # the stages of the dense output
                 _stage(y, K, s, h, ys)
