@@ -18,6 +18,7 @@ import time
 
 import numpy as np
 
+from ..kernels.block_lu import block_order
 from ..kernels.lagrange_numba import (
     D_NC,
     D_NI,
@@ -273,8 +274,10 @@ def compile_mode_kernel(model, force_model, constraint_rows, independent):
             var = concat(model.n_bodies, *packer.variable_rows)
             ri, rf = concat(model.n_bodies, constraint_rows, crd.take(independent), crd,
                             var).packed()
-            dims = np.array([len(constraint_rows), independent.size, model.n_q, len(var)],
-                            dtype=np.int64)
+            n_sq = len(constraint_rows) + independent.size  # the square block
+            order = block_order(ri[:n_sq], rf[:n_sq], model.n_bodies)
+            dims = np.concatenate([[len(constraint_rows), independent.size, model.n_q,
+                                    len(var)], order]).astype(np.int64)
             packed = (ip, fp, ri, rf, dims)
         kept = model.memo.setdefault("kernels", [])
         if len(kept) < 64:  # a bounded number (locks capture new targets every cycle)

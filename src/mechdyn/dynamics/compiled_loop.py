@@ -81,7 +81,7 @@ class _Buffers:
             np.empty((cap, n_ext))
         self.ext, self.ext_end, self.x_end = np.empty(n_ext), np.empty(n_ext), np.empty(3 * nx)
         self.sc = np.empty(scratch_size(nx, ni, nq, int(kernel.dims[3])))
-        self.piv = np.empty(nx, dtype=np.int64)
+        self.piv = np.empty(nx + 1, dtype=np.int64)
         self.par = np.zeros(F.N_PAR_FIXED)  # the DOP853 loop's scalars, then the fixed-step's
         self.ipar = np.zeros(F.N_IPAR_FIXED, dtype=np.int64)
         self.kept = np.empty((KEEP_STEPS, 3 + 10 * m + kernel.ws.size))

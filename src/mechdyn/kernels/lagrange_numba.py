@@ -9,7 +9,9 @@ A = B^T M_x B + sum_drives J_e (G_k B)^T (G_k B) (motor rotor and gear inertia
 J_e reduced to the driven coordinate k, whether it is independent or not), the
 bias c, the applied forces and Q = B^T (F + G^T Q_drive), the Cholesky solve for
 q_I'' and the power of the non-conservative forces; with ``full``, also the
-multipliers of the rows from the transposed LU of the same position Jacobian.
+multipliers of the rows from the transposed solve with the same factors.  The
+position Jacobian is factored in its block triangular form
+(:mod:`mechdyn.kernels.block_lu`: the order kept at the end of ``dims``).
 
 The arrays: ``ip``, ``fp`` the packed loads (:mod:`mechdyn.kernels.loads_numba`);
 ``ri``, ``rf`` the packed rows (:meth:`mechdyn.model.rows.Rows.packed`) in four
@@ -23,7 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .linalg import cholesky_solve, lu_factor, lu_solve, lu_solve_transposed
+from .block_lu import fac_size, factor, solve, solve_transposed
+from .linalg import cholesky_solve
 from .loads_numba import (
     FR_DRV,
     H_FOFF,
@@ -84,17 +87,26 @@ def _system(x, qi, ri, rf, dims, nb, F, J):
 
 
 @njit
-def _solve_scaled(J, piv, col, nx, nb, ls):
-    """Solve with the LU of the Jacobian with scaled rotation columns (col overwritten)."""
-    lu_solve(J, piv, col, nx)
+def _fac(sc, nx):
+    """The factors' scratch (:func:`mechdyn.kernels.block_lu.fac_size`) at the end of
+    the scratch of :func:`evaluate_into`."""
+    return sc[sc.size - fac_size(nx):]
+
+
+@njit
+def _solve_scaled(J, fac, piv, dims, col, nx, nb, ls):
+    """Solve with the factors of the Jacobian with scaled rotation columns (col
+    overwritten)."""
+    solve(J, fac, piv, dims, col, nx)
     for b in range(nb):
         col[3 * b + 2] *= ls
 
 
 @njit
-def _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb):
-    """Solve the positions at q_I from the pose in ws; leaves the LU of the scaled
-    Jacobian at the solution in (J, piv).  Returns 0 or 1 (no convergence)."""
+def _newton(qi, fp, ri, rf, dims, ws, J, fac, piv, F, nb):
+    """Solve the positions at q_I from the pose in ws; leaves the factors of the scaled
+    Jacobian at the solution in (J, fac, piv) (:mod:`mechdyn.kernels.block_lu`).
+    Returns 0 or 1 (no convergence)."""
     nx = 3 * nb
     ni = dims[D_NI]
     ls = fp[2]
@@ -124,7 +136,7 @@ def _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb):
         for r in range(nx):  # rotation columns scaled by the length scale
             for b in range(nb):
                 J[r, 3 * b + 2] *= ls
-        flags[W_PIVOT] = lu_factor(J, piv, nx)
+        flags[W_PIVOT] = factor(J, fac, piv, dims, nx)
         flags[W_ITER] = it
         flags[W_ERR] = err
         if err <= tol or (err >= 0.5 * prev and err <= 1e3 * tol):
@@ -133,7 +145,7 @@ def _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb):
         if not err < np.inf or flags[W_PIVOT] == 0.0:
             break
         prev = err
-        _solve_scaled(J, piv, F, nx, nb, ls)
+        _solve_scaled(J, fac, piv, dims, F, nx, nb, ls)
         for r in range(nx):
             x[r] -= F[r]
     if status == 0:
@@ -150,7 +162,8 @@ def _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb):
 def scratch_size(n_x, n_i, n_q, n_v):
     """Length of the scratch array of :func:`evaluate_into` (every intermediate of one
     evaluation, so that a compiled loop evaluates without allocating)."""
-    return n_x * n_x + 6 * n_x + 4 * n_q + n_q * n_x + n_q * n_i + n_i * n_i + 4 * n_i + n_v
+    return n_x * n_x + 6 * n_x + 4 * n_q + n_q * n_x + n_q * n_i + n_i * n_i + 4 * n_i + n_v \
+        + fac_size(n_x)
 
 
 @njit
@@ -177,14 +190,14 @@ def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
     # would compile this and evaluate_into once more for each -- seconds of first use)
     nx = 3 * ip[H_NB]
     sc = np.empty(scratch_size(nx, dims[D_NI], dims[D_NQ], dims[D_NV]))
-    piv = np.empty(nx, dtype=np.int64)
+    piv = np.empty(nx + 1, dtype=np.int64)
     return evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
 
 
 @njit
 def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv):
     """:func:`evaluate` with the caller's scratch arrays: ``sc`` (float,
-    :func:`scratch_size`) and ``piv`` (int64, n_x)."""
+    :func:`scratch_size`) and ``piv`` (int64, n_x + 1)."""
     nb = ip[H_NB]
     nx = 3 * nb
     nc, ni, nq, nv = dims[D_NC], dims[D_NI], dims[D_NQ], dims[D_NV]
@@ -206,7 +219,8 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
     cc, bcx, bcy, rhs = sc[o:o + ni], sc[o + ni:o + 2 * ni], sc[o + 2 * ni:o + 3 * ni], \
         sc[o + 3 * ni:o + 4 * ni]
     ws[ws.size - N_FLAGS + W_COUNT] += 1.0
-    st = _newton(qi, fp, ri, rf, dims, ws, J, piv, F, nb)
+    fac = _fac(sc, nx)
+    st = _newton(qi, fp, ri, rf, dims, ws, J, fac, piv, F, nb)
     if st != 0:
         return st
     x = ws[:nx]
@@ -218,7 +232,7 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
         for r in range(nx):
             col[r] = 0.0
         col[nc + c] = 1.0
-        _solve_scaled(J, piv, col, nx, nb, ls)
+        _solve_scaled(J, fac, piv, dims, col, nx, nb, ls)
         for r in range(nx):
             Bl[r * ni + c] = col[r]
     flags[W_VALID] = 1.0
@@ -231,7 +245,7 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
     rows_quad(x, v, nb, ri[:nc + ni], rf[:nc + ni], bb, 0)
     for r in range(nx):
         bb[r] = -bb[r]
-    _solve_scaled(J, piv, bb, nx, nb, ls)
+    _solve_scaled(J, fac, piv, dims, bb, nx, nb, ls)
     # declared coordinates, their rates, analogs G B and bias G b + quad_g
     gi, gf = ri[nc + ni:nc + ni + nq], rf[nc + ni:nc + ni + nq]
     for k in range(nq):
@@ -300,8 +314,8 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
     if not cholesky_solve(A, rhs, ni):
         return 2
     if full:
-        _reactions(x, v, bb, rhs, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, ni, nq,
-                   ext, z)
+        _reactions(x, v, bb, rhs, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, fac, piv, dims, ip, fp, nb,
+                   nc, ni, nq, ext, z)
     ok = P == P
     for c in range(ni):
         out[c] = qdi[c]
@@ -314,8 +328,8 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
 
 
 @njit
-def _reactions(x, v, bb, qdd, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb, nc, ni, nq,
-               ext, z):
+def _reactions(x, v, bb, qdd, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, fac, piv, dims, ip, fp, nb, nc,
+               ni, nq, ext, z):
     """Fill ``ext`` (see :func:`evaluate`) after the solve for q_I''."""
     nx = 3 * nb
     ls = fp[2]
@@ -361,7 +375,7 @@ def _reactions(x, v, bb, qdd, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, piv, ip, fp, nb
     # Phi_x^T lambda = z with J = [Phi_x; g_I,x] factored with scaled rotation columns
     for b in range(nb):
         z[3 * b + 2] *= ls
-    lu_solve_transposed(J, piv, z, nx)
+    solve_transposed(J, fac, piv, dims, z, nx)
     for r in range(nc):
         ext[o + 3 * nq + r] = z[r]
 
