@@ -15,7 +15,15 @@ import pytest
 from mechdyn import examples
 from mechdyn.dynamics.compiled import numba_available
 from mechdyn.foundation import FloorFrameWarning, mounted
-from mechdyn.kernels.block_lu import D_NS, block_order, fac_size, factor, solve, solve_transposed
+from mechdyn.kernels.block_lu import (
+    D_NS,
+    block_order,
+    fac_size,
+    factor,
+    solve,
+    solve_transposed,
+    solve_unit,
+)
 from mechdyn.kernels.rows_numba import rows_jacobian
 from mechdyn.model.rows import concat
 
@@ -81,6 +89,11 @@ def test_solves_as_lapack_at_random_poses(name):
         solve_transposed(Jk, fac, piv, dims, z, n)
         want = np.linalg.solve(J.T, b)
         np.testing.assert_allclose(z, want, rtol=0, atol=1e-12 * np.max(np.abs(want)))
+        first = n - 2 if n > 2 else 0  # the analogs' right-hand sides: unit columns
+        Y = np.empty((n, n - first))
+        solve_unit(Jk, fac, piv, dims, first, Y, n, n - first)
+        want = np.linalg.solve(J, np.eye(n)[:, first:])
+        np.testing.assert_allclose(Y, want, rtol=0, atol=1e-12 * np.max(np.abs(want)))
 
 
 def test_mounted_press_has_blocks_beyond_single_entries():
@@ -130,3 +143,6 @@ def test_singular_and_unordered_matrices():
     z = b.copy()
     solve_transposed(Af, fac, piv, dims, z, n)
     np.testing.assert_allclose(A.T @ z, b, rtol=1e-14)
+    Y = np.empty((n, 2))
+    solve_unit(Af, fac, piv, dims, 1, Y, n, 2)
+    np.testing.assert_allclose(A @ Y, np.eye(n)[:, 1:], atol=1e-15)

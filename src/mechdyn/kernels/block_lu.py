@@ -38,7 +38,8 @@ from scipy.sparse.csgraph import connected_components, maximum_bipartite_matchin
 from .linalg import lu_factor, lu_solve, lu_solve_transposed
 from .rows_numba import njit, rows_jacobian
 
-__all__ = ["block_order", "factor", "solve", "solve_transposed", "fac_size", "D_NS"]
+__all__ = ["block_order", "factor", "solve", "solve_unit", "solve_transposed", "fac_size",
+           "D_NS"]
 
 #: index in ``dims`` of the number of diagonal blocks (the form follows it)
 D_NS = 4
@@ -212,6 +213,52 @@ def solve(J, fac, piv, dims, b, n):
         off += s * s
     for i in range(n):
         b[i] = y[i]
+
+
+@njit
+def solve_unit(J, fac, piv, dims, first, Y, n, m):
+    """Solve J Y = E for the m unit columns E[:, c] = e_(first + c) (by rows of J) with
+    the factors of :func:`factor`, Y (n, m) overwritten (by columns of J): the velocity
+    analogs, each row's substitution shared among the m right-hand sides."""
+    y, w = _vectors(fac, n)
+    if piv[n] == 1:
+        for c in range(m):
+            for i in range(n):
+                y[i] = 0.0
+            y[first + c] = 1.0
+            lu_solve(J, piv, y, n)
+            for i in range(n):
+                Y[i, c] = y[i]
+        return
+    nblk, st, rp, cp, pp, ix = _layout(dims, n)
+    off = 0
+    for j in range(nblk):
+        a0, a1 = dims[st + j], dims[st + j + 1]
+        s = a1 - a0
+        for a in range(s):  # row a's right-hand sides, kept in its column's place
+            p = a0 + a
+            r = dims[rp + p]
+            ca = dims[cp + p]
+            for c in range(m):
+                Y[ca, c] = 1.0 if r == first + c else 0.0
+            for e in range(dims[pp + p], dims[pp + p + 1]):
+                k = dims[ix + e]
+                g = J[r, k]
+                for c in range(m):
+                    Y[ca, c] -= g * Y[k, c]
+        if s == 1:
+            ca = dims[cp + a0]
+            for c in range(m):
+                Y[ca, c] = Y[ca, c] / fac[off]
+        else:
+            B = fac[off:off + s * s].reshape((s, s))
+            for c in range(m):
+                for a in range(s):
+                    w[a] = Y[dims[cp + a0 + a], c]
+                lu_solve(B, piv[a0:a1], w[:s], s)
+                for a in range(s):
+                    Y[dims[cp + a0 + a], c] = w[a]
+        off += s * s
 
 
 @njit

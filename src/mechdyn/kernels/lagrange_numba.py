@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .block_lu import fac_size, factor, solve, solve_transposed
+from .block_lu import fac_size, factor, solve, solve_transposed, solve_unit
 from .linalg import cholesky_solve
 from .loads_numba import (
     FR_DRV,
@@ -204,7 +204,7 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
     ls = fp[2]
     o = nx * nx
     J = sc[:o].reshape((nx, nx))
-    F, col, bb = sc[o:o + nx], sc[o + nx:o + 2 * nx], sc[o + 2 * nx:o + 3 * nx]
+    F, bb = sc[o:o + nx], sc[o + 2 * nx:o + 3 * nx]
     Fa, Fnc, z = sc[o + 3 * nx:o + 4 * nx], sc[o + 4 * nx:o + 5 * nx], sc[o + 5 * nx:o + 6 * nx]
     o += 6 * nx
     q, qdot, varv = table_inputs(sc, nx, ni, nq, nv)
@@ -227,14 +227,11 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
     Bl = ws[nx + ni:nx + ni + nx * ni]
     v = ws[nx + ni + nx * ni:nx + ni + nx * ni + nx]
     flags = ws[ws.size - N_FLAGS:]
-    # velocity analogs B (row r, column c stored at r * ni + c)
-    for c in range(ni):
-        for r in range(nx):
-            col[r] = 0.0
-        col[nc + c] = 1.0
-        _solve_scaled(J, fac, piv, dims, col, nx, nb, ls)
-        for r in range(nx):
-            Bl[r * ni + c] = col[r]
+    # velocity analogs B (row r, column c stored at r * ni + c): J B = [0; I]
+    solve_unit(J, fac, piv, dims, nc, Bl.reshape((nx, ni)), nx, ni)
+    for b in range(nb):
+        for c in range(ni):
+            Bl[(3 * b + 2) * ni + c] *= ls
     flags[W_VALID] = 1.0
     for r in range(nx):
         s = 0.0
