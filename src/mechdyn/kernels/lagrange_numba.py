@@ -40,7 +40,13 @@ from .loads_numba import (
     body_inertia,
     forces,
 )
-from .rows_numba import njit, rows_jacobian, rows_quad, rows_values
+from .rows_numba import (
+    body_rotations,
+    njit,
+    rows_jacobian_cs,
+    rows_quad_cs,
+    rows_values_cs,
+)
 
 __all__ = ["evaluate", "evaluate_into", "scratch_size", "first_order", "full", "work_size",
            "held_pieces", "table_inputs",
@@ -73,15 +79,17 @@ def held_pieces(ws, nx, ni):
 
 
 @njit
-def _system(x, qi, ri, rf, dims, nb, F, J):
-    """Residual [Phi; g_I - q_I] (F) and Jacobian (J) at pose x."""
+def _system(x, qi, ri, rf, dims, nb, F, J, cs):
+    """Residual [Phi; g_I - q_I] (F) and Jacobian (J) at pose x; ``cs`` receives the
+    bodies' rotations there (:func:`~mechdyn.kernels.rows_numba.body_rotations`)."""
     nc, ni = dims[D_NC], dims[D_NI]
     nx = 3 * nb
     for r in range(nx):
         for c in range(nx):
             J[r, c] = 0.0
-    rows_values(x, nb, ri[:nc + ni], rf[:nc + ni], F, 0)
-    rows_jacobian(x, nb, ri[:nc + ni], rf[:nc + ni], J, 0)
+    body_rotations(x, nb, cs)
+    rows_values_cs(x, nb, ri[:nc + ni], rf[:nc + ni], cs, F, 0)
+    rows_jacobian_cs(x, nb, ri[:nc + ni], rf[:nc + ni], cs, J, 0)
     for c in range(ni):
         F[nc + c] -= qi[c]
 
@@ -94,6 +102,14 @@ def _fac(sc, nx):
 
 
 @njit
+def _rot(sc, nx):
+    """The bodies' rotations (nb + 1, 2) in the scratch of :func:`evaluate_into`, just
+    before the factors."""
+    o = sc.size - fac_size(nx)
+    return sc[o - 2 * (nx // 3 + 1):o].reshape((nx // 3 + 1, 2))
+
+
+@njit
 def _solve_scaled(J, fac, piv, dims, col, nx, nb, ls):
     """Solve with the factors of the Jacobian with scaled rotation columns (col
     overwritten)."""
@@ -103,7 +119,7 @@ def _solve_scaled(J, fac, piv, dims, col, nx, nb, ls):
 
 
 @njit
-def _newton(qi, fp, ri, rf, dims, ws, J, fac, piv, F, nb):
+def _newton(qi, fp, ri, rf, dims, ws, J, fac, piv, F, nb, cs):
     """Solve the positions at q_I from the pose in ws; leaves the factors of the scaled
     Jacobian at the solution in (J, fac, piv) (:mod:`mechdyn.kernels.block_lu`).
     Returns 0 or 1 (no convergence)."""
@@ -127,7 +143,7 @@ def _newton(qi, fp, ri, rf, dims, ws, J, fac, piv, F, nb):
     prev = np.inf
     status = 1
     for it in range(40):
-        _system(x, qi, ri, rf, dims, nb, F, J)
+        _system(x, qi, ri, rf, dims, nb, F, J, cs)
         err = 0.0
         for r in range(nx):
             a = abs(F[r])
@@ -163,7 +179,7 @@ def scratch_size(n_x, n_i, n_q, n_v):
     """Length of the scratch array of :func:`evaluate_into` (every intermediate of one
     evaluation, so that a compiled loop evaluates without allocating)."""
     return n_x * n_x + 6 * n_x + 4 * n_q + n_q * n_x + n_q * n_i + n_i * n_i + 4 * n_i + n_v \
-        + fac_size(n_x)
+        + 2 * (n_x // 3 + 1) + fac_size(n_x)
 
 
 @njit
@@ -220,7 +236,8 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
         sc[o + 3 * ni:o + 4 * ni]
     ws[ws.size - N_FLAGS + W_COUNT] += 1.0
     fac = _fac(sc, nx)
-    st = _newton(qi, fp, ri, rf, dims, ws, J, fac, piv, F, nb)
+    cs = _rot(sc, nx)  # of the pose Newton ends at
+    st = _newton(qi, fp, ri, rf, dims, ws, J, fac, piv, F, nb, cs)
     if st != 0:
         return st
     x = ws[:nx]
@@ -239,7 +256,7 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
             s += Bl[r * ni + c] * qdi[c]
         v[r] = s
     # acceleration bias: J b = -quad
-    rows_quad(x, v, nb, ri[:nc + ni], rf[:nc + ni], bb, 0)
+    rows_quad_cs(x, v, nb, ri[:nc + ni], rf[:nc + ni], cs, bb, 0)
     for r in range(nx):
         bb[r] = -bb[r]
     _solve_scaled(J, fac, piv, dims, bb, nx, nb, ls)
@@ -251,9 +268,9 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
             G[k, r] = 0.0
         for c in range(ni):
             GB[k, c] = 0.0
-    rows_values(x, nb, gi, gf, q, 0)
-    rows_jacobian(x, nb, gi, gf, G, 0)
-    rows_quad(x, v, nb, gi, gf, Gb, 0)
+    rows_values_cs(x, nb, gi, gf, cs, q, 0)
+    rows_jacobian_cs(x, nb, gi, gf, cs, G, 0)
+    rows_quad_cs(x, v, nb, gi, gf, cs, Gb, 0)
     for k in range(nq):
         for r in range(nx):
             g = G[k, r]
@@ -269,7 +286,7 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
             A[i, j] = 0.0
     ob = ip[H_FOFF + S_BODY]
     for b in range(nb):
-        m, Jc, ax, ay = body_inertia(fp, ob, b, x)
+        m, Jc, ax, ay = body_inertia(fp, ob, b, cs)
         w = v[3 * b + 2]
         for i in range(ni):
             bcx[i] = Bl[(3 * b) * ni + i] - ay * Bl[(3 * b + 2) * ni + i]
@@ -294,8 +311,8 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
                 for j in range(i, ni):
                     A[i, j] += je * GB[c, i] * GB[c, j]
     # forces
-    rows_values(x, nb, ri[nc + ni + nq:], rf[nc + ni + nq:], varv, 0)
-    forces(t, q, qdot, x, v, ip, fp, Fa, Fnc, Qd, varv, held_pieces(ws, nx, ni))
+    rows_values_cs(x, nb, ri[nc + ni + nq:], rf[nc + ni + nq:], cs, varv, 0)
+    forces(t, q, qdot, x, v, ip, fp, Fa, Fnc, Qd, varv, held_pieces(ws, nx, ni), cs)
     P = 0.0
     for r in range(nx):
         P += Fnc[r] * v[r]
@@ -312,7 +329,7 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
         return 2
     if full:
         _reactions(x, v, bb, rhs, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, fac, piv, dims, ip, fp, nb,
-                   nc, ni, nq, ext, z)
+                   nc, ni, nq, ext, z, cs)
     ok = P == P
     for c in range(ni):
         out[c] = qdi[c]
@@ -326,7 +343,7 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
 
 @njit
 def _reactions(x, v, bb, qdd, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, fac, piv, dims, ip, fp, nb, nc,
-               ni, nq, ext, z):
+               ni, nq, ext, z, cs):
     """Fill ``ext`` (see :func:`evaluate`) after the solve for q_I''."""
     nx = 3 * nb
     ls = fp[2]
@@ -354,7 +371,7 @@ def _reactions(x, v, bb, qdd, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, fac, piv, dims,
             s += G[k, r] * Qd[k]
         Ftot[r] = s
     for b in range(nb):
-        m, Jc, ax, ay = body_inertia(fp, ob, b, x)
+        m, Jc, ax, ay = body_inertia(fp, ob, b, cs)
         w = v[3 * b + 2]
         al = xdd[3 * b + 2]
         acx = xdd[3 * b] - al * ay - w * w * ax

@@ -245,14 +245,14 @@ def load_value(ip, fp, irec, fval, t, q, qdot, varv, locks):
 
 
 @njit
-def body_inertia(fp, ob, b, x):
+def body_inertia(fp, ob, b, cs):
     """Mass, inertia about the centre of mass and the centre-of-mass arm A(theta) c
-    (ground frame) of body b at pose x."""
+    (ground frame) of body b; ``cs`` the bodies' rotations at the pose
+    (:func:`~mechdyn.kernels.rows_numba.body_rotations`)."""
     m = fp[ob + FR_BODY * b]
     Jc = fp[ob + FR_BODY * b + 1]
     cx, cy = fp[ob + FR_BODY * b + 2], fp[ob + FR_BODY * b + 3]
-    th = x[3 * b + 2]
-    co, si = np.cos(th), np.sin(th)
+    co, si = cs[b, 0], cs[b, 1]
     return m, Jc, co * cx - si * cy, si * cx + co * cy
 
 
@@ -265,10 +265,11 @@ def _apply(F, b, nb, armx, army, fx, fy):
 
 
 @njit
-def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv, locks):
+def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv, locks, cs):
     """Applied forces F (all) and Fnc (non-conservative part) on the poses, drives Qd.
     ``locks``: the held table pieces, ``[region + 1, period count]`` per hold slot (0:
-    none; an empty array holds none)."""
+    none; an empty array holds none); ``cs`` the bodies' rotations at x
+    (:func:`~mechdyn.kernels.rows_numba.body_rotations`, the ground's in row nb)."""
     nb = ip[H_NB]
     nq = ip[H_NQ]
     gx, gy = fp[0], fp[1]
@@ -279,19 +280,19 @@ def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv, locks):
     for c in range(nq):
         Qd[c] = 0.0
     for b in range(nb):
-        m, _, ax, ay = body_inertia(fp, ob, b, x)
+        m, _, ax, ay = body_inertia(fp, ob, b, cs)
         _apply(F, b, nb, ax, ay, m * gx, m * gy)
     oi, of = ip[H_IOFF + S_SPR], ip[H_FOFF + S_SPR]
     for k in range(ip[H_NSPR]):
         i = ip[oi + IR_SPR * k]
         j = ip[oi + IR_SPR * k + 1]
         f0 = of + FR_SPR * k
-        xi, yi, ti = body_pose(x, nb, i)
+        xi, yi, _ = body_pose(x, nb, i)
         vxi, vyi, wi = body_pose(v, nb, i)
-        xj, yj, tj = body_pose(x, nb, j)
+        xj, yj, _ = body_pose(x, nb, j)
         vxj, vyj, wj = body_pose(v, nb, j)
-        ci, si = np.cos(ti), np.sin(ti)
-        cj, sj = np.cos(tj), np.sin(tj)
+        ci, si = cs[min(i, nb), 0], cs[min(i, nb), 1]
+        cj, sj = cs[min(j, nb), 0], cs[min(j, nb), 1]
         aix, aiy = ci * fp[f0] - si * fp[f0 + 1], si * fp[f0] + ci * fp[f0 + 1]
         ajx, ajy = cj * fp[f0 + 2] - sj * fp[f0 + 3], sj * fp[f0 + 2] + cj * fp[f0 + 3]
         dx = xj + ajx - xi - aix
@@ -331,8 +332,7 @@ def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv, locks):
         mag = load_value(ip, fp, i0, f0 + 4, t, q, qdot, varv, locks)
         b = ip[i0 + IR_VAL]
         frame = ip[i0 + IR_VAL + 1]
-        th = x[3 * b + 2] if b < nb else 0.0
-        c, s = np.cos(th), np.sin(th)
+        c, s = cs[min(b, nb), 0], cs[min(b, nb), 1]
         dx, dy = fp[f0 + 2], fp[f0 + 3]
         if frame == 1:
             dx, dy = c * dx - s * dy, s * dx + c * dy
