@@ -37,6 +37,7 @@ from ..integrate.segment import Stop
 from ..integrate.wilson import Wilson
 from ..kernels import dop853_numba as L
 from ..kernels import fixed_step_numba as F
+from ..kernels.dense_stages import dense_output
 from ..kernels.lagrange_numba import D_NC, D_NQ, scratch_size
 from ..kernels.loads_numba import H_NTAB
 from ..kernels.rows_numba import rows_jacobian
@@ -84,7 +85,8 @@ class _Buffers:
         self.piv = np.empty(nx + 1, dtype=np.int64)
         self.par = np.zeros(F.N_PAR_FIXED)  # the DOP853 loop's scalars, then the fixed-step's
         self.ipar = np.zeros(F.N_IPAR_FIXED, dtype=np.int64)
-        self.kept = np.empty((KEEP_STEPS, 3 + 10 * m + kernel.ws.size))
+        # t, h, t_new | y, y_new, f_new | dense output (7 m) | stages (13 m) | made | ws
+        self.kept = np.empty((KEEP_STEPS, 4 + 23 * m + kernel.ws.size))
         self.kv = np.zeros(4 * int(kernel.ip[H_NTAB]))  # held table pieces
 
     def restart(self) -> None:
@@ -368,8 +370,10 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
     """The steps of a segment with event functions, taken in the compiled loop.
 
     The loop takes :data:`KEEP_STEPS` steps per call (those after an event are taken in
-    vain) and keeps each one with its
-    dense output of order 7 (:func:`mechdyn.kernels.dop853_numba.keep_step`); they are
+    vain) and keeps each one with the stages of its dense output of order 7
+    (:func:`mechdyn.kernels.dop853_numba.keep_step`), made on first use (the steps in
+    which an event function changes sign or a rate turns: 3 evaluations each, where
+    every step's would add 15 % to the press cycle's); they are
     yielded one by one as :class:`~mechdyn.integrate.base.Step` records for
     :func:`mechdyn.integrate.segment.run_segment` to check (the caller's checks, the
     event functions and their location on that dense output, the output samples), as
@@ -439,7 +443,7 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
         ws_end = kernel.snapshot()
         for row in rows:
             kernel.restore(row[o_ws:])
-            yield _kept_step(row, m, ni, fixed)
+            yield _kept_step(row, m, ni, fixed, kernel, stats)
         kernel.restore(ws_end)
         if code == L.FAILED:  # SciPy's DOP853 goes on from the last step
             yield from scipy_from(float(par[L.P_T]), y.copy())
@@ -455,12 +459,18 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
             return
 
 
-def _kept_step(row, m: int, ni: int, fixed: bool = False) -> Step:
+def _kept_step(row, m: int, ni: int, fixed: bool = False, kernel=None,
+               stats: dict | None = None) -> Step:
     """The :class:`Step` of a row of the loop's kept steps, with its dense output (a
-    fixed-step loop's: the Python stepper's quintic Hermite interpolant of its ends)."""
+    fixed-step loop's: the Python stepper's quintic Hermite interpolant of its ends).  A
+    DOP853 step whose dense output the loop did not make gets it on first use
+    (:func:`mechdyn.kernels.dense_stages.dense_output`: three evaluations of ``kernel``
+    from the workspace of the step's end, counted in ``stats``; the workspace is put
+    back after them)."""
     t0, h, t1 = float(row[0]), float(row[1]), float(row[2])
     y0, y1, f1 = row[3:3 + m], row[3 + m:3 + 2 * m], row[3 + 2 * m:3 + 3 * m]
     dns = row[3 + 3 * m:3 + 10 * m].reshape(7, m)
+    made = fixed or row[3 + 23 * m] != 0.0
     if fixed:  # the rates at the step's start in the place of dns[0]
         f0 = dns[0]
         return Step(t0, t1, y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni], y1[2 * ni:],
@@ -468,12 +478,44 @@ def _kept_step(row, m: int, ni: int, fixed: bool = False) -> Step:
                                   f0[2 * ni:], t1, y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni],
                                   y1[2 * ni:], f1[2 * ni:]))
 
+    coeffs = [dns] if made else []
+    fallback = []
+
     def dense(s):
+        if not coeffs and not fallback:
+            _finish(kernel, row, m, t0, h, coeffs, fallback, stats)
+        if fallback:
+            return fallback[0](s)
         out = np.empty(m)
-        L.dense_at(dns, y0, t0, h, s, out)
+        L.dense_at(coeffs[0], y0, t0, h, s, out)
         return out[:ni], out[ni:2 * ni], out[2 * ni:]
 
     return Step(t0, t1, y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni], y1[2 * ni:], dense)
+
+
+def _finish(kernel, row, m: int, t0: float, h: float, coeffs: list, fallback: list,
+            stats) -> None:
+    """The dense output of a kept step that the loop did not make (into ``coeffs``), or,
+    where an evaluation fails, the quintic Hermite interpolant of its ends (into
+    ``fallback``)."""
+    ni = kernel.n_i
+    y0, y1, f1 = row[3:3 + m], row[3 + m:3 + 2 * m], row[3 + 2 * m:3 + 3 * m]
+    stages = row[3 + 10 * m:3 + 23 * m].reshape(13, m)
+    b = buffers(kernel)
+    saved = kernel.snapshot()
+    kernel.restore(row[row.size - kernel.ws.size:])
+    dns = np.empty((7, m))
+    st = dense_output(y0, y1, stages, t0, h, *kernel._arrays, kernel.ws, b.sc, b.piv, dns)
+    kernel.restore(saved)
+    if stats is not None:
+        stats["evaluations"] += 3
+    if st == 0:
+        coeffs.append(dns)
+        return
+    f0 = stages[0]
+    fallback.append(hermite_dense(t0, y0[:ni], y0[ni:2 * ni], f0[ni:2 * ni], y0[2 * ni:],
+                                  f0[2 * ni:], t0 + h, y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni],
+                                  y1[2 * ni:], f1[2 * ni:]))
 
 
 def warm_up_loop(kernel) -> None:

@@ -227,11 +227,12 @@ def _scipy_step(y, f, f1, h0, d1, atol, rtol, hmax, span):
 
 
 @njit
-def keep_step(row, t, h, t_new, y, ynew, fnew, dns):
+def keep_step(row, t, h, t_new, y, ynew, fnew, dns, K, made):
     """A step into a row of ``kept``: t, h, t_new, y, y_new, f_new (m each), the 7 m
-    coefficients of the dense output, then (written before the stages of the dense
-    output) the kernel's workspace after the evaluation at the step's end (pose,
-    analogs)."""
+    coefficients of the dense output (where ``made``, else its first N_STAGES + 1 stages,
+    K, for :func:`mechdyn.kernels.dense_stages.dense_output` to finish when the dense
+    output is wanted), ``made``, then (written before the stages of the dense output) the
+    kernel's workspace after the evaluation at the step's end (pose, analogs)."""
     m = y.size
     row[0], row[1], row[2] = t, h, t_new
     row[3:3 + m] = y
@@ -240,6 +241,11 @@ def keep_step(row, t, h, t_new, y, ynew, fnew, dns):
     o = 3 + 3 * m
     for r in range(7):
         row[o + r * m:o + (r + 1) * m] = dns[r]
+    o += 7 * m
+    if not made:
+        for r in range(N_STAGES + 1):
+            row[o + r * m:o + (r + 1) * m] = K[r]
+    row[o + (N_STAGES + 1) * m] = 1.0 if made else 0.0
 
 
 @njit
@@ -546,7 +552,8 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
             row_ws = kept[ipar[I_NKEPT], kept.shape[1] - ws.size:]
             row_ws[:] = ws
             held_pieces(row_ws, nx, ni)[:] = 0.0  # (a kept workspace holds no pieces)
-        if flags != 0 or interior or ipar[I_KEEP] != 0:
+        made = flags != 0 or interior  # a kept step's is made when it is wanted
+        if made:
             for s in range(N_STAGES + 1, N_STAGES + 4):  # the stages of the dense output
                 _stage(y, K, s, h, ys)
                 if not _counted(t + C[s] * h, ys, K[s], ni, ip, fp, ri, rf, dims, ws, ext, off,
@@ -555,7 +562,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
                     return FAILED
             _dense(y, ynew, f, fnew, K, h, dns)
         if ipar[I_KEEP] != 0:
-            keep_step(kept[ipar[I_NKEPT]], t, h, t_new, y, ynew, fnew, dns)
+            keep_step(kept[ipar[I_NKEPT]], t, h, t_new, y, ynew, fnew, dns, K, made)
             ipar[I_NKEPT] += 1
         if flags != 0:
             ipar[I_FLAGS] = flags

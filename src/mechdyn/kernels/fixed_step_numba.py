@@ -213,7 +213,7 @@ def run(y, f, grid, par, ipar, K, ynew, ys, hist, t_eval, o_t, o_y, o_x, o_xd, o
             row = kept[ipar[I_NKEPT]]
             row[row.size - ws.size:] = ws
             K[6, :] = f
-            keep_step(row, t, h, t_new, y, ynew, fnew, K[6:13])
+            keep_step(row, t, h, t_new, y, ynew, fnew, K[6:13], K, True)
             ipar[I_NKEPT] += 1
         if flags != 0:
             ipar[I_FLAGS] = flags
