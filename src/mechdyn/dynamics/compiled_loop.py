@@ -37,7 +37,7 @@ from ..integrate.segment import Stop
 from ..integrate.wilson import Wilson
 from ..kernels import dop853_numba as L
 from ..kernels import fixed_step_numba as F
-from ..kernels.dense_stages import dense_output
+from ..kernels.dop853_dense import dense_at, dense_output, kept_offsets, kept_parts
 from ..kernels.lagrange_numba import D_NC, D_NQ, scratch_size
 from ..kernels.loads_numba import H_NTAB
 from ..kernels.rows_numba import rows_jacobian
@@ -85,8 +85,7 @@ class _Buffers:
         self.piv = np.empty(nx + 1, dtype=np.int64)
         self.par = np.zeros(F.N_PAR_FIXED)  # the DOP853 loop's scalars, then the fixed-step's
         self.ipar = np.zeros(F.N_IPAR_FIXED, dtype=np.int64)
-        # t, h, t_new | y, y_new, f_new | dense output (7 m) | stages (13 m) | made | ws
-        self.kept = np.empty((KEEP_STEPS, 4 + 23 * m + kernel.ws.size))
+        self.kept = np.empty((KEEP_STEPS, kept_offsets(m)[-1] + kernel.ws.size))
         self.kv = np.zeros(4 * int(kernel.ip[H_NTAB]))  # held table pieces
 
     def restart(self) -> None:
@@ -133,20 +132,24 @@ def _step(b, i0, i1, dense=None) -> Step:
 
         def d(s):
             if not made:
-                made.append(hermite_dense(h0[0], y0[:ni], y0[ni:2 * ni], f0[ni:2 * ni],
-                                          y0[2 * ni:], f0[2 * ni:], h1[0], y1[:ni],
-                                          y1[ni:2 * ni], f1[ni:2 * ni], y1[2 * ni:],
-                                          f1[2 * ni:]))
+                made.append(_hermite(h0[0], y0, f0, h1[0], y1, f1, ni))
             return made[0](s)
     else:
         dns, t_old, h = dense
 
         def d(s):
             out = np.empty(m)
-            L.dense_at(dns, y0, t_old, h, s, out)
+            dense_at(dns, y0, t_old, h, s, out)
             return out[:ni], out[ni:2 * ni], out[2 * ni:]
     return Step(float(h0[0]), float(h1[0]), y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni], y1[2 * ni:],
                 d)
+
+
+def _hermite(t0, y0, f0, t1, y1, f1, ni: int):
+    """The quintic Hermite interpolant (:func:`~mechdyn.integrate.base.hermite_dense`) of
+    a step's ends, states y = (q_I, q_I', w) and rates f = (q_I', q_I'', P)."""
+    return hermite_dense(t0, y0[:ni], y0[ni:2 * ni], f0[ni:2 * ni], y0[2 * ni:], f0[2 * ni:],
+                         t1, y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni], y1[2 * ni:], f1[2 * ni:])
 
 
 def _start(b, integ, t: float, t_end: float) -> np.ndarray:
@@ -371,7 +374,7 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
 
     The loop takes :data:`KEEP_STEPS` steps per call (those after an event are taken in
     vain) and keeps each one with the stages of its dense output of order 7
-    (:func:`mechdyn.kernels.dop853_numba.keep_step`), made on first use (the steps in
+    (:func:`mechdyn.kernels.dop853_dense.keep_step`), made on first use (the steps in
     which an event function changes sign or a rate turns: 3 evaluations each, where
     every step's would add 15 % to the press cycle's); they are
     yielded one by one as :class:`~mechdyn.integrate.base.Step` records for
@@ -464,58 +467,38 @@ def _kept_step(row, m: int, ni: int, fixed: bool = False, kernel=None,
     """The :class:`Step` of a row of the loop's kept steps, with its dense output (a
     fixed-step loop's: the Python stepper's quintic Hermite interpolant of its ends).  A
     DOP853 step whose dense output the loop did not make gets it on first use
-    (:func:`mechdyn.kernels.dense_stages.dense_output`: three evaluations of ``kernel``
+    (:func:`mechdyn.kernels.dop853_dense.dense_output`: three evaluations of ``kernel``
     from the workspace of the step's end, counted in ``stats``; the workspace is put
     back after them)."""
-    t0, h, t1 = float(row[0]), float(row[1]), float(row[2])
-    y0, y1, f1 = row[3:3 + m], row[3 + m:3 + 2 * m], row[3 + 2 * m:3 + 3 * m]
-    dns = row[3 + 3 * m:3 + 10 * m].reshape(7, m)
-    made = fixed or row[3 + 23 * m] != 0.0
+    t0, h, t1, y0, y1, f1, dns, stages, made, ws = kept_parts(row, m)
     if fixed:  # the rates at the step's start in the place of dns[0]
-        f0 = dns[0]
         return Step(t0, t1, y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni], y1[2 * ni:],
-                    hermite_dense(t0, y0[:ni], y0[ni:2 * ni], f0[ni:2 * ni], y0[2 * ni:],
-                                  f0[2 * ni:], t1, y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni],
-                                  y1[2 * ni:], f1[2 * ni:]))
-
+                    _hermite(t0, y0, dns[0], t1, y1, f1, ni))
     coeffs = [dns] if made else []
     fallback = []
 
     def dense(s):
-        if not coeffs and not fallback:
-            _finish(kernel, row, m, t0, h, coeffs, fallback, stats)
+        if not coeffs and not fallback:  # the dense output, or where an evaluation fails,
+            saved = kernel.snapshot()   # the quintic Hermite interpolant of the ends
+            kernel.restore(ws)
+            b = buffers(kernel)
+            d = np.empty((7, m))
+            st = dense_output(y0, y1, stages, t0, h, *kernel._arrays, kernel.ws, b.sc,
+                              b.piv, d)
+            kernel.restore(saved)
+            if stats is not None:
+                stats["evaluations"] += 3
+            if st == 0:
+                coeffs.append(d)
+            else:
+                fallback.append(_hermite(t0, y0, stages[0], t1, y1, f1, ni))
         if fallback:
             return fallback[0](s)
         out = np.empty(m)
-        L.dense_at(coeffs[0], y0, t0, h, s, out)
+        dense_at(coeffs[0], y0, t0, h, s, out)
         return out[:ni], out[ni:2 * ni], out[2 * ni:]
 
     return Step(t0, t1, y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni], y1[2 * ni:], dense)
-
-
-def _finish(kernel, row, m: int, t0: float, h: float, coeffs: list, fallback: list,
-            stats) -> None:
-    """The dense output of a kept step that the loop did not make (into ``coeffs``), or,
-    where an evaluation fails, the quintic Hermite interpolant of its ends (into
-    ``fallback``)."""
-    ni = kernel.n_i
-    y0, y1, f1 = row[3:3 + m], row[3 + m:3 + 2 * m], row[3 + 2 * m:3 + 3 * m]
-    stages = row[3 + 10 * m:3 + 23 * m].reshape(13, m)
-    b = buffers(kernel)
-    saved = kernel.snapshot()
-    kernel.restore(row[row.size - kernel.ws.size:])
-    dns = np.empty((7, m))
-    st = dense_output(y0, y1, stages, t0, h, *kernel._arrays, kernel.ws, b.sc, b.piv, dns)
-    kernel.restore(saved)
-    if stats is not None:
-        stats["evaluations"] += 3
-    if st == 0:
-        coeffs.append(dns)
-        return
-    f0 = stages[0]
-    fallback.append(hermite_dense(t0, y0[:ni], y0[ni:2 * ni], f0[ni:2 * ni], y0[2 * ni:],
-                                  f0[2 * ni:], t0 + h, y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni],
-                                  y1[2 * ni:], f1[2 * ni:]))
 
 
 def warm_up_loop(kernel) -> None:

@@ -29,7 +29,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..integrate.dop853_tableau import E3, E5, N_STAGES, A, C, D
+from ..integrate.dop853_tableau import E3, E5, N_STAGES, C
+from .dop853_dense import dense_at, dense_coefficients, keep_step, stage
 from .held_tables import hold, left, table_vars
 from .hermite_numba import hermite_at
 from .lagrange_numba import D_NI, N_FLAGS, W_COUNT, W_PIVOT, evaluate_into, held_pieces
@@ -37,7 +38,7 @@ from .loads_numba import H_NB, H_NTAB
 from .rows_numba import njit
 from .table_regions import ETA
 
-__all__ = ["run", "evaluate_states", "dense_at", "DONE", "BATCH", "FLAGGED", "FAILED", "WATCH",
+__all__ = ["run", "evaluate_states", "DONE", "BATCH", "FLAGGED", "FAILED", "WATCH",
            "F_TURN", "F_PIVOT", "F_STALL", "P_T", "P_TEND", "P_H", "P_RTOL",
            "P_HMAX", "P_STALL", "P_PIVOT", "P_WC0", "P_WC1", "P_LAST", "P_TOLD", "P_HOLD",
            "I_EVALS", "I_STEPS", "I_REJ", "I_NOUT", "I_NEXT", "I_FLAGS", "I_FSAL",
@@ -103,45 +104,6 @@ def _put_back(ws, ws0):
     cnt = ws[ws.size - N_FLAGS + W_COUNT]
     ws[:] = ws0
     ws[ws.size - N_FLAGS + W_COUNT] = cnt
-
-
-@njit
-def _stage(y, K, s, h, ys):
-    """ys = y + h sum_j a_sj K_j."""
-    m = y.size
-    for i in range(m):
-        acc = 0.0
-        for j in range(s):
-            a = A[s, j]
-            if a != 0.0:
-                acc += a * K[j, i]
-        ys[i] = y[i] + h * acc
-
-
-@njit
-def dense_at(dns, y_old, t_old, h, ts, out):
-    """The dense output of order 7 of a step at ``ts`` into ``out``."""
-    s = (ts - t_old) / h
-    s1 = 1.0 - s
-    for i in range(y_old.size):
-        out[i] = y_old[i] + s * (dns[0, i] + s1 * (dns[1, i] + s * (dns[2, i] + s1 * (
-            dns[3, i] + s * (dns[4, i] + s1 * (dns[5, i] + s * dns[6, i]))))))
-
-
-@njit
-def _dense(y, ynew, f, fnew, K, h, dns):
-    """The coefficients of the dense output, the three extra stages in K."""
-    m = y.size
-    for i in range(m):
-        dy = ynew[i] - y[i]
-        dns[0, i] = dy
-        dns[1, i] = h * f[i] - dy
-        dns[2, i] = 2.0 * dy - h * (f[i] + fnew[i])
-        for k in range(4):
-            acc = 0.0
-            for j in range(N_STAGES + 4):
-                acc += D[k, j] * K[j, i]
-            dns[3 + k, i] = h * acc
 
 
 @njit
@@ -227,28 +189,6 @@ def _scipy_step(y, f, f1, h0, d1, atol, rtol, hmax, span):
 
 
 @njit
-def keep_step(row, t, h, t_new, y, ynew, fnew, dns, K, made):
-    """A step into a row of ``kept``: t, h, t_new, y, y_new, f_new (m each), the 7 m
-    coefficients of the dense output (where ``made``, else its first N_STAGES + 1 stages,
-    K, for :func:`mechdyn.kernels.dense_stages.dense_output` to finish when the dense
-    output is wanted), ``made``, then (written before the stages of the dense output) the
-    kernel's workspace after the evaluation at the step's end (pose, analogs)."""
-    m = y.size
-    row[0], row[1], row[2] = t, h, t_new
-    row[3:3 + m] = y
-    row[3 + m:3 + 2 * m] = ynew
-    row[3 + 2 * m:3 + 3 * m] = fnew
-    o = 3 + 3 * m
-    for r in range(7):
-        row[o + r * m:o + (r + 1) * m] = dns[r]
-    o += 7 * m
-    if not made:
-        for r in range(N_STAGES + 1):
-            row[o + r * m:o + (r + 1) * m] = K[r]
-    row[o + (N_STAGES + 1) * m] = 1.0 if made else 0.0
-
-
-@njit
 def step_end(t, h, t_new, y, f, ynew, fnew, ws, x_end, hist, par, ni, turns):
     """After the evaluation at an accepted step's end: the pose and its rates there into
     ``x_end``, the step into the history rows (start of the previous step, start and end of
@@ -293,7 +233,8 @@ def samples(hermite, t, h, t_new, y, f, ynew, fnew, dns, ys, fs, end_sample, t_e
             ipar, ip, fp, ri, rf, dims, ws, ext, ext_end, x_end, on, sc, piv, o_t, o_y, o_x,
             o_xd, o_ext):
     """The output samples of an accepted step into the buffers: the times of ``t_eval``
-    inside it, on the step's dense output (``dns``, :func:`dense_at`) or, with
+    inside it, on the step's dense output (``dns``,
+    :func:`~mechdyn.kernels.dop853_dense.dense_at`) or, with
     ``hermite``, on the quintic Hermite interpolant of its ends
     (:func:`mechdyn.kernels.hermite_numba.hermite_at`), each evaluated in full (``on``: a
     runtime True) and not counted as a step's evaluation; then its end where
@@ -353,8 +294,9 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
     ``par[P_TEND]``; returns DONE, BATCH, FLAGGED or FAILED (see the module).
 
     With ``ipar[I_KEEP]`` every accepted step is kept in row ``ipar[I_NKEPT]`` of ``kept``
-    (see :func:`keep_step`; at most ``ipar[I_MAXSTEPS]`` rows per call), with its dense
-    output, and no step is flagged for a rate changing sign (the caller checks each).
+    (see :func:`~mechdyn.kernels.dop853_dense.keep_step`; at most ``ipar[I_MAXSTEPS]`` rows
+    per call), with its dense output (or the stages to make it), and no step is flagged
+    for a rate changing sign (the caller checks each).
 
     Each table with sharp points has its piece held through a step; a step at whose end
     a table variable has left its piece is taken again up to the piece's end (within
@@ -439,14 +381,14 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
         for i in range(m):
             K[0, i] = f[i]
         for s in range(1, N_STAGES):
-            _stage(y, K, s, h, ys)
+            stage(y, K, s, h, ys)
             if not _counted(t + C[s] * h, ys, K[s], ni, ip, fp, ri, rf, dims, ws, ext, off,
                             sc, piv, ipar):
                 _put_back(ws, ws0)
                 par[P_T], par[P_H] = t, h
                 return FAILED
             _watch(ys[0], ws, nx, par, ipar, x_end)
-        _stage(y, K, N_STAGES, h, ynew)
+        stage(y, K, N_STAGES, h, ynew)
         # the error estimate (orders 5 and 3)
         e5n = 0.0
         e3n = 0.0
@@ -555,12 +497,12 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
         made = flags != 0 or interior  # a kept step's is made when it is wanted
         if made:
             for s in range(N_STAGES + 1, N_STAGES + 4):  # the stages of the dense output
-                _stage(y, K, s, h, ys)
+                stage(y, K, s, h, ys)
                 if not _counted(t + C[s] * h, ys, K[s], ni, ip, fp, ri, rf, dims, ws, ext, off,
                                 sc, piv, ipar):
                     par[P_T], par[P_H] = t, h
                     return FAILED
-            _dense(y, ynew, f, fnew, K, h, dns)
+            dense_coefficients(y, ynew, f, fnew, K, h, dns)
         if ipar[I_KEEP] != 0:
             keep_step(kept[ipar[I_NKEPT]], t, h, t_new, y, ynew, fnew, dns, K, made)
             ipar[I_NKEPT] += 1

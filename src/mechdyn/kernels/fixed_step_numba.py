@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .dop853_dense import keep_step
 from .dop853_numba import (
     BATCH,
     DONE,
@@ -53,7 +54,6 @@ from .dop853_numba import (
     _put_back,
     _watch,
     accept,
-    keep_step,
     samples,
     step_end,
 )
@@ -148,7 +148,7 @@ def run(y, f, grid, par, ipar, K, ynew, ys, hist, t_eval, o_t, o_y, o_x, o_xd, o
     :func:`mechdyn.kernels.dop853_numba.run` (the history rows, ``x_end``, the output
     buffers and the flags F_TURN and F_PIVOT as there).  With ``ipar[I_KEEP]`` every step
     is kept in row ``ipar[I_NKEPT]`` of ``kept`` as there
-    (:func:`mechdyn.kernels.dop853_numba.keep_step`), the rates at its start in the place
+    (:func:`mechdyn.kernels.dop853_dense.keep_step`), the rates at its start in the place
     of the first coefficient of the dense output."""
     ni = dims[D_NI]
     nx = x_end.size // 3
