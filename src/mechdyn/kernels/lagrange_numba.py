@@ -65,17 +65,25 @@ N_FLAGS = 5
 
 
 def work_size(n_x: int, n_i: int, n_t: int = 0) -> int:
-    """Work array: x | q_last (n_i) | B_last (n_x n_i) | xdot | held table pieces (2 n_t,
-    see :func:`held_pieces`) | x_good | flags."""
-    return n_x + n_i + n_x * n_i + 2 * n_x + 2 * n_t + N_FLAGS
+    """Work array: x | q_last (n_i) | B_last (n_x n_i) | xdot | b_last (n_x) | q_I'_last
+    (n_i) | held table pieces (2 n_t, see :func:`held_pieces`) | x_good | flags."""
+    return 2 * n_i + n_x * n_i + 4 * n_x + 2 * n_t + N_FLAGS
 
 
 @njit
 def held_pieces(ws, nx, ni):
     """The block of the work array with the table pieces that the loads evaluate on
     (:mod:`mechdyn.kernels.table_regions`; all zero outside the DOP853 loop: none)."""
-    o = nx + ni + nx * ni + nx
+    o = 2 * nx + 2 * ni + nx * ni + nx
     return ws[o:ws.size - N_FLAGS - nx]
+
+
+@njit
+def _last_bias(ws, nx, ni):
+    """The acceleration bias b (n_x) and the rates q_I' (n_i) of the last evaluation in
+    the work array: the pose's second derivative along q_I' is b (J b = -quad)."""
+    o = nx + ni + nx * ni + nx
+    return ws[o:o + nx], ws[o + nx:o + nx + ni]
 
 
 @njit
@@ -135,11 +143,29 @@ def _newton(qi, fp, ri, rf, dims, ws, J, fac, piv, F, nb, cs):
     for r in range(nx):
         xg[r] = x[r]
     if flags[W_VALID] == 1.0:
+        # predictor of second order: x_l + B dq + b tau^2 / 2, tau the time at the last
+        # rates q_I' that covers the part of dq along them (b: the path's curvature there;
+        # the rest of dq comes from the accelerations, an order higher), the second-order
+        # term only where it is smaller than the first
+        bl, qdl = _last_bias(ws, nx, ni)
+        dd = 0.0
+        tau = 0.0
+        for c in range(ni):
+            dd += qdl[c] * qdl[c]
+            tau += qdl[c] * (qi[c] - ql[c])
+        h2 = 0.5 * (tau / dd) ** 2 if dd > 0.0 else 0.0
+        d1 = 0.0
+        d2 = 0.0
         for r in range(nx):
             s = 0.0
             for c in range(ni):
                 s += Bl[r * ni + c] * (qi[c] - ql[c])
             x[r] += s
+            d1 = max(d1, abs(s))
+            d2 = max(d2, abs(h2 * bl[r]))
+        if d2 <= 0.5 * d1:  # (not NaN)
+            for r in range(nx):
+                x[r] += h2 * bl[r]
     prev = np.inf
     status = 1
     for it in range(40):
@@ -260,6 +286,11 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
     for r in range(nx):
         bb[r] = -bb[r]
     _solve_scaled(J, fac, piv, dims, bb, nx, nb, ls)
+    bl, qdl = _last_bias(ws, nx, ni)  # for the predictor of the next solve
+    for r in range(nx):
+        bl[r] = bb[r]
+    for c in range(ni):
+        qdl[c] = qdi[c]
     # declared coordinates, their rates, analogs G B and bias G b + quad_g
     gi, gf = ri[nc + ni:nc + ni + nq], rf[nc + ni:nc + ni + nq]
     for k in range(nq):
