@@ -83,10 +83,11 @@ class LoadContext:
         Body poses and their rates.
     """
 
-    __slots__ = ("model", "t", "q", "qdot", "x", "xdot")
+    __slots__ = ("model", "t", "q", "qdot", "x", "xdot", "_read")
 
     def __init__(self, model: Model, t, q, qdot, x, xdot):
         self.model, self.t, self.q, self.qdot, self.x, self.xdot = model, t, q, qdot, x, xdot
+        self._read = {}  # the variables read so far (several tables read the same one)
 
     @property
     def shape(self) -> tuple:
@@ -120,7 +121,10 @@ class LoadContext:
         """A named variable (:mod:`mechdyn.model.variable`): ``'t'``, a coordinate,
         ``'<coordinate>_dot'``, ``'joint:NAME'``, ``'angle:BODY'``, ``'body.point.x|y'``
         or ``'dist(body.point, body.point)'``; s, rad, m or their rates."""
-        return _scalar_or_array(_variable_reader(self.model, name)(self))
+        v = self._read.get(name)
+        if v is None:
+            v = self._read[name] = _scalar_or_array(_variable_reader(self.model, name)(self))
+        return v
 
 
 def _variable_reader(model: Model, name: str):
@@ -207,11 +211,67 @@ def _apply(F, b, arm, f):
     F[..., b, 2] += cross(arm, f)
 
 
-def _spring_geometry(X, i, si, j, sj):
-    """Arms of the two spring ends, the vector P1 -> P2 and its length."""
-    ai, aj = rotate(X[..., i, 2], si), rotate(X[..., j, 2], sj)
-    d = X[..., j, :2] + aj - X[..., i, :2] - ai
-    return ai, aj, d, np.hypot(d[..., 0], d[..., 1])
+class _SpringSet:
+    """The springs of a force model as arrays, evaluated together (one NumPy operation
+    for all of them, not one per spring: a mounted machine has eight).
+
+    Rows s of the tuples ``(name, i, si, j, sj, k, L0, c, pre)`` of
+    :class:`ForceModel`: end 1 at ``si`` on body slot ``i``, end 2 at ``sj`` on slot
+    ``j`` (the ground the last slot, nb)."""
+
+    def __init__(self, springs, nb: int):
+        self.names = [sp[0] for sp in springs]
+        self.i = np.array([sp[1] for sp in springs], dtype=int)
+        self.j = np.array([sp[3] for sp in springs], dtype=int)
+        self.si = np.array([sp[2] for sp in springs], dtype=float).reshape(-1, 2)
+        self.sj = np.array([sp[4] for sp in springs], dtype=float).reshape(-1, 2)
+        self.k, self.L0, self.c, self.pre = (np.array([sp[n] for sp in springs], dtype=float)
+                                             for n in (5, 6, 7, 8))
+        self.damped = bool(np.any(self.c != 0.0))
+        n = len(springs)
+        #: slot incidence: +1 at end 1's slot, -1 at end 2's (forces), and each end's alone
+        self.p1, self.p2 = np.zeros((n, nb + 1)), np.zeros((n, nb + 1))
+        self.p1[np.arange(n), self.i] = 1.0
+        self.p2[np.arange(n), self.j] = 1.0
+
+    def geometry(self, X):
+        """Arms of both ends (..., n, 2), the vectors P1 -> P2 (..., n, 2) and their
+        lengths (..., n), for the slot poses X (..., nb + 1, 3)."""
+        ai, aj = _rotate_each(X[..., self.i, 2], self.si), _rotate_each(X[..., self.j, 2], self.sj)
+        d = X[..., self.j, :2] + aj - X[..., self.i, :2] - ai
+        return ai, aj, d, np.hypot(d[..., 0], d[..., 1])
+
+    def apply(self, F, X, V):
+        """Add the spring forces (stiffness, preload, and damping unless V is None) at
+        the slot poses X and rates V to F (..., nb + 1, 3)."""
+        ai, aj, d, L = self.geometry(X)
+        short = L < 1e-300
+        if short.any():
+            name = self.names[int(np.argmax(short.reshape(-1, len(self.names)).any(axis=0)))]
+            raise ModelError(f"spring {name!r}: its two points coincide; direction undefined")
+        e = d / L[..., None]
+        f = self.k * (L - self.L0)
+        if V is not None and self.damped:
+            vd = (V[..., self.j, :2] + V[..., self.j, 2, None] * _perp(aj)
+                  - V[..., self.i, :2] - V[..., self.i, 2, None] * _perp(ai))
+            f = f + self.c * np.sum(e * vd, axis=-1)
+        f = (f + self.pre)[..., None] * e  # on end 1, towards end 2
+        F[..., :2] += np.swapaxes(np.swapaxes(f, -1, -2) @ (self.p1 - self.p2), -1, -2)
+        F[..., 2] += cross(ai, f) @ self.p1 - cross(aj, f) @ self.p2
+
+    def energy(self, X):
+        """Stored energy of stiffness and preload (...), J."""
+        L = self.geometry(X)[3]
+        return np.sum(0.5 * self.k * (L - self.L0) ** 2 + self.pre * L, axis=-1)
+
+
+def _rotate_each(th, s) -> np.ndarray:
+    """A(th_n) s_n for angles th (..., n) and body-frame vectors s (n, 2) -> (..., n, 2)."""
+    c, sn = np.cos(th), np.sin(th)
+    out = np.empty(np.shape(th) + (2,))
+    out[..., 0] = c * s[:, 0] - sn * s[:, 1]
+    out[..., 1] = sn * s[:, 0] + c * s[:, 1]
+    return out
 
 
 @dataclass
@@ -232,6 +292,7 @@ class ForceModel:
         self._weights = m.mass[:, None] * m.gravity if has else None
         self._damped = any(sp[7] != 0.0 for sp in self.springs) or any(
             r[5] != 0.0 for r in self.rotary)
+        self._springs = _SpringSet(self.springs, m.n_bodies) if self.springs else None
 
     # ----------------------------------------------------------------- forces
     def loads(self, t, x, xdot, q, qdot, *, skip_drives: Sequence[int] = (),
@@ -279,19 +340,8 @@ class ForceModel:
             F[..., :nb, :2] += self._weights
             F[..., :nb, 2] += cross(com_arms(m, x), self._weights)
         V = None if conservative else extend(m, xdot)
-        for (name, i, si, j, sj, k, L0, c, pre) in self.springs:
-            ai, aj, d, L = _spring_geometry(X, i, si, j, sj)
-            if (L < 1e-300).any():
-                raise ModelError(f"spring {name!r}: its two points coincide; direction undefined")
-            e = d / L[..., None]
-            f = k * (L - L0)
-            if V is not None and c != 0.0:
-                vd = (V[..., j, :2] + V[..., j, 2, None] * _perp(aj)
-                      - V[..., i, :2] - V[..., i, 2, None] * _perp(ai))
-                f = f + c * np.sum(e * vd, axis=-1)
-            f = (f + pre)[..., None] * e
-            _apply(F, i, ai, f)
-            _apply(F, j, aj, -f)
+        if self._springs is not None:
+            self._springs.apply(F, X, V)
         for (_name, i, j, k, a0, c, pre) in self.rotary:
             tq = k * (X[..., j, 2] - X[..., i, 2] - a0)
             if V is not None and c != 0.0:
@@ -361,9 +411,8 @@ class ForceModel:
         X = extend(m, x)
         rc = X[..., :-1, :2] + com_arms(m, x)
         U = -np.sum(m.mass * (rc @ m.gravity), axis=-1)
-        for (_, i, si, j, sj, k, L0, _c, pre) in self.springs:
-            L = _spring_geometry(X, i, si, j, sj)[3]
-            U = U + 0.5 * k * (L - L0) ** 2 + pre * L
+        if self._springs is not None:
+            U = U + self._springs.energy(X)
         for (_, i, j, k, a0, _c, pre) in self.rotary:
             rel = X[..., j, 2] - X[..., i, 2]
             U = U + 0.5 * k * (rel - a0) ** 2 + pre * rel
