@@ -4,9 +4,10 @@ Oracle: the order of the prediction, seen in the Newton corrections it leaves. F
 converged pose, a change of q_I by q_I' d (d small) is predicted by the analogs alone
 with an error of order d^2 and with the curvature term to order d^3: for a turn of the
 slider-crank's crank by 1e-5 rad the first (about 1e-11 m) is above the solve's
-tolerance (1e-13 of the length scale, 2e-14 m) and the second (about 1e-15 m) below it, so the solve must end without a correction. From a pose
-solved at rest the curvature along the rates is unknown: the same change then needs a
-correction. The poses are checked against the NumPy path's position solve.
+tolerance (1e-13 of the length scale, 2e-14 m) and the second (under 1e-15 m) below
+it, so the solve must end without a correction. From a pose solved at rest the
+curvature along the rates is unknown: the same change then needs a correction. The
+poses are checked against the NumPy path's position solve.
 """
 
 import numpy as np
