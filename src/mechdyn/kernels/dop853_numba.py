@@ -476,10 +476,13 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
         h_next = h / fac
         if scipy_ctrl:
             h_next = h * (10.0 if err == 0.0 else min(10.0, 0.9 * err ** -0.125))
-        if rejected:
+        if h_full > 0.0:  # taken again up to a point: on with the step chosen before
+            # (after a rejection that step alone: the short step's error says nothing of
+            # it, and a short step kept as the next one can land short of the point again
+            # and again, each time shorter, down to the smallest step)
+            h_next = h_full if rejected else max(h_next, h_full)
+        elif rejected:
             h_next = min(h_next, h)
-        elif h_full > 0.0:  # taken again up to a point: on with the step chosen before
-            h_next = max(h_next, h_full)
         rejected = False
         aimed = retried > 0  # (a step shortened to a table's point: no stall)
         retried = 0
