@@ -35,7 +35,14 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components, maximum_bipartite_matching
 
-from .linalg import lu_factor, lu_solve, lu_solve_transposed
+from .linalg import (
+    lu_factor,
+    lu_factor_packed,
+    lu_solve,
+    lu_solve_packed,
+    lu_solve_transposed,
+    lu_solve_transposed_packed,
+)
 from .rows_numba import njit, rows_jacobian
 
 __all__ = ["block_order", "factor", "solve", "solve_unit", "solve_transposed", "fac_size",
@@ -143,87 +150,6 @@ def _vectors(fac, n):
 
 
 @njit
-def _lu(fac, off, s, piv, a0):
-    """LU with partial pivoting, in place, of the s x s block kept row by row at
-    ``fac[off:]`` (its pivots in ``piv[a0:a0 + s]``), as
-    :func:`~mechdyn.kernels.linalg.lu_factor` (indices, not views: the blocks are small
-    and many); returns the smallest |u_kk| (0 if singular) and the largest."""
-    umin = np.inf
-    umax = 0.0
-    for k in range(s):
-        p = k
-        best = abs(fac[off + k * s + k])
-        for r in range(k + 1, s):
-            v = abs(fac[off + r * s + k])
-            if v > best:
-                best = v
-                p = r
-        piv[a0 + k] = p
-        if p != k:
-            for c in range(s):
-                tmp = fac[off + k * s + c]
-                fac[off + k * s + c] = fac[off + p * s + c]
-                fac[off + p * s + c] = tmp
-        d = fac[off + k * s + k]
-        umin = min(umin, best)
-        umax = max(umax, best)
-        if d == 0.0:
-            return 0.0, umax
-        inv = 1.0 / d
-        for r in range(k + 1, s):
-            f = fac[off + r * s + k] * inv
-            fac[off + r * s + k] = f
-            if f != 0.0:
-                for c in range(k + 1, s):
-                    fac[off + r * s + c] -= f * fac[off + k * s + c]
-    return umin, umax
-
-
-@njit
-def _lu_solve(fac, off, s, piv, a0, w):
-    """Solve with the block's factors of :func:`_lu` (w[:s] overwritten)."""
-    for k in range(s):
-        p = piv[a0 + k]
-        if p != k:
-            tmp = w[k]
-            w[k] = w[p]
-            w[p] = tmp
-    for r in range(s):
-        acc = w[r]
-        for c in range(r):
-            acc -= fac[off + r * s + c] * w[c]
-        w[r] = acc
-    for r in range(s - 1, -1, -1):
-        acc = w[r]
-        for c in range(r + 1, s):
-            acc -= fac[off + r * s + c] * w[c]
-        w[r] = acc / fac[off + r * s + r]
-
-
-@njit
-def _lu_solve_transposed(fac, off, s, piv, a0, w):
-    """Solve the transposed block with the factors of :func:`_lu` (w[:s] overwritten):
-    P B = L U, so B^T = U^T L^T P."""
-    for r in range(s):
-        acc = w[r]
-        for c in range(r):
-            acc -= fac[off + c * s + r] * w[c]
-        w[r] = acc / fac[off + r * s + r]
-    for r in range(s - 1, -1, -1):
-        acc = w[r]
-        for c in range(r + 1, s):
-            acc -= fac[off + c * s + r] * w[c]
-        w[r] = acc
-    for j in range(s):
-        k = s - 1 - j
-        p = piv[a0 + k]
-        if p != k:
-            tmp = w[k]
-            w[k] = w[p]
-            w[p] = tmp
-
-
-@njit
 def factor(J, fac, piv, dims, n):
     """Factor J (n, n) for :func:`solve`: the diagonal blocks' LU into ``fac`` and
     ``piv`` (J kept), or -- without a form in ``dims`` -- J's LU in place (``piv[n]`` =
@@ -253,7 +179,7 @@ def factor(J, fac, piv, dims, n):
             r = dims[rp + a0 + a]
             for b in range(s):
                 fac[off + a * s + b] = J[r, dims[cp + a0 + b]]
-        lo, hi = _lu(fac, off, s, piv, a0)
+        lo, hi = lu_factor_packed(fac, off, s, piv, a0)
         if lo == 0.0:
             return 0.0
         umin = min(umin, lo)
@@ -286,7 +212,7 @@ def solve(J, fac, piv, dims, b, n):
         if s == 1:
             y[dims[cp + a0]] = w[0] / fac[off]
         else:
-            _lu_solve(fac, off, s, piv, a0, w)
+            lu_solve_packed(fac, off, s, piv, a0, w)
             for a in range(s):
                 y[dims[cp + a0 + a]] = w[a]
         off += s * s
@@ -333,7 +259,7 @@ def solve_unit(J, fac, piv, dims, first, Y, n, m):
             for c in range(m):
                 for a in range(s):
                     w[a] = Y[dims[cp + a0 + a], c]
-                _lu_solve(fac, off, s, piv, a0, w)
+                lu_solve_packed(fac, off, s, piv, a0, w)
                 for a in range(s):
                     Y[dims[cp + a0 + a], c] = w[a]
         off += s * s
@@ -362,7 +288,7 @@ def solve_transposed(J, fac, piv, dims, b, n):
         if s == 1:
             b[0] /= fac[off]
         else:
-            _lu_solve_transposed(fac, off, s, piv, a0, b)
+            lu_solve_transposed_packed(fac, off, s, piv, a0, b)
         for a in range(s):  # the block's rows, and their share of the earlier columns
             p = a0 + a
             r = dims[rp + p]

@@ -10,45 +10,117 @@ import numpy as np
 
 from .rows_numba import njit
 
-__all__ = ["lu_factor", "lu_solve", "lu_solve_transposed", "cholesky_solve"]
+__all__ = ["lu_factor", "lu_solve", "lu_solve_transposed", "lu_factor_packed",
+           "lu_solve_packed", "lu_solve_transposed_packed", "cholesky_solve"]
+
+
+@njit
+def lu_factor_packed(fac, off, s, piv, a0):
+    """LU with partial pivoting, in place, of the s x s matrix kept row by row at
+    ``fac[off:]`` (its pivots in ``piv[a0:a0 + s]``); returns the smallest |u_kk| (0 if
+    singular) and the largest.  By index into one array, not through views: the
+    diagonal blocks of :mod:`mechdyn.kernels.block_lu` are small and many."""
+    umin = np.inf
+    umax = 0.0
+    for k in range(s):
+        p = k
+        best = abs(fac[off + k * s + k])
+        for r in range(k + 1, s):
+            v = abs(fac[off + r * s + k])
+            if v > best:
+                best = v
+                p = r
+        piv[a0 + k] = p
+        if p != k:
+            for c in range(s):
+                tmp = fac[off + k * s + c]
+                fac[off + k * s + c] = fac[off + p * s + c]
+                fac[off + p * s + c] = tmp
+        d = fac[off + k * s + k]
+        umin = min(umin, best)
+        umax = max(umax, best)
+        if d == 0.0:
+            return 0.0, umax
+        inv = 1.0 / d
+        for r in range(k + 1, s):
+            f = fac[off + r * s + k] * inv
+            fac[off + r * s + k] = f
+            if f != 0.0:
+                for c in range(k + 1, s):
+                    fac[off + r * s + c] -= f * fac[off + k * s + c]
+    return umin, umax
+
+
+@njit
+def lu_solve_packed(fac, off, s, piv, a0, w):
+    """Solve with the block's factors of :func:`lu_factor_packed` (w[:s] overwritten)."""
+    for k in range(s):
+        p = piv[a0 + k]
+        if p != k:
+            tmp = w[k]
+            w[k] = w[p]
+            w[p] = tmp
+    for r in range(s):
+        acc = w[r]
+        for c in range(r):
+            acc -= fac[off + r * s + c] * w[c]
+        w[r] = acc
+    for r in range(s - 1, -1, -1):
+        acc = w[r]
+        for c in range(r + 1, s):
+            acc -= fac[off + r * s + c] * w[c]
+        w[r] = acc / fac[off + r * s + r]
+
+
+@njit
+def lu_solve_transposed_packed(fac, off, s, piv, a0, w):
+    """Solve the transposed block with the factors of :func:`lu_factor_packed` (w[:s] overwritten):
+    P B = L U, so B^T = U^T L^T P."""
+    for r in range(s):
+        acc = w[r]
+        for c in range(r):
+            acc -= fac[off + c * s + r] * w[c]
+        w[r] = acc / fac[off + r * s + r]
+    for r in range(s - 1, -1, -1):
+        acc = w[r]
+        for c in range(r + 1, s):
+            acc -= fac[off + c * s + r] * w[c]
+        w[r] = acc
+    for j in range(s):
+        k = s - 1 - j
+        p = piv[a0 + k]
+        if p != k:
+            tmp = w[k]
+            w[k] = w[p]
+            w[p] = tmp
+
+
+@njit
+def _flat(a, n):
+    """The n x n matrix ``a`` (C order) as one array, for the packed routines."""
+    if a.shape[0] != n or a.shape[1] != n:
+        raise ValueError("linalg: an n x n matrix is expected")
+    return a.reshape(n * n)
 
 
 @njit
 def lu_factor(a, piv, n):
-    """In-place LU with partial pivoting; returns min|u_ii| / max|u_ii| (0 if singular)."""
-    umin = np.inf
-    umax = 0.0
-    for k in range(n):
-        p = k
-        best = abs(a[k, k])
-        for r in range(k + 1, n):
-            v = abs(a[r, k])
-            if v > best:
-                best = v
-                p = r
-        piv[k] = p
-        if p != k:
-            for c in range(n):
-                tmp = a[k, c]
-                a[k, c] = a[p, c]
-                a[p, c] = tmp
-        d = a[k, k]
-        if best < umin:
-            umin = best
-        if best > umax:
-            umax = best
-        if d == 0.0:
-            return 0.0
-        inv = 1.0 / d
-        for r in range(k + 1, n):
-            f = a[r, k] * inv
-            a[r, k] = f
-            if f != 0.0:
-                for c in range(k + 1, n):
-                    a[r, c] -= f * a[k, c]
-    if umax == 0.0:
-        return 0.0
-    return umin / umax
+    """In-place LU with partial pivoting of ``a`` (n, n), pivots in ``piv``; returns
+    min|u_ii| / max|u_ii| (0 if singular)."""
+    umin, umax = lu_factor_packed(_flat(a, n), 0, n, piv, 0)
+    return umin / umax if umax > 0.0 else 0.0
+
+
+@njit
+def lu_solve(a, piv, b, n):
+    """Solve with the factors of ``lu_factor`` (b overwritten)."""
+    lu_solve_packed(_flat(a, n), 0, n, piv, 0, b)
+
+
+@njit
+def lu_solve_transposed(a, piv, b, n):
+    """Solve A^T z = b with the factors of ``lu_factor`` of A (b overwritten by z)."""
+    lu_solve_transposed_packed(_flat(a, n), 0, n, piv, 0, b)
 
 
 @njit
@@ -69,26 +141,6 @@ def _backward(U, b, n, unit):
         for c in range(r + 1, n):
             s -= U[r, c] * b[c]
         b[r] = s if unit else s / U[r, r]
-
-
-@njit
-def _swap(b, piv, n, reverse):
-    """Apply the row swaps of ``lu_factor`` to b (undo them with ``reverse``)."""
-    for j in range(n):
-        k = n - 1 - j if reverse else j
-        p = piv[k]
-        if p != k:
-            tmp = b[k]
-            b[k] = b[p]
-            b[p] = tmp
-
-
-@njit
-def lu_solve(a, piv, b, n):
-    """Solve with the factors of ``lu_factor`` (b overwritten)."""
-    _swap(b, piv, n, False)
-    _forward(a, b, n, True)
-    _backward(a, b, n, False)
 
 
 @njit
@@ -117,10 +169,3 @@ def cholesky_solve(A, rhs, n):
     return True
 
 
-@njit
-def lu_solve_transposed(a, piv, b, n):
-    """Solve A^T z = b with the factors of ``lu_factor`` of A (b overwritten by z)."""
-    # P A = L U, so A^T = U^T L^T P: solve U^T y = b, L^T u = y, then z = P^T u
-    _forward(a.T, b, n, False)
-    _backward(a.T, b, n, True)
-    _swap(b, piv, n, True)
