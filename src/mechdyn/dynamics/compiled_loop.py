@@ -422,8 +422,7 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
     ipar[L.I_CTRL] = 1  # SciPy's step control: the events where scipy-dop853 finds them
     te = np.zeros(0)
     counted = [0, 0]
-    nws = kernel.ws.size
-    o_ws = b.kept.shape[1] - nws
+    o_ws = kept_offsets(m)[-1]  # the workspace at the row's end
 
     def watch_window():
         w = None if book is None else book.watch_window()

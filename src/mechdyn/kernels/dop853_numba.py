@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..integrate.dop853_tableau import E3, E5, N_STAGES, C
-from .dop853_dense import dense_at, dense_coefficients, keep_step, stage
+from .dop853_dense import dense_at, dense_coefficients, keep_step, kept_offsets, stage
 from .held_tables import hold, left, table_vars
 from .hermite_numba import hermite_at
 from .lagrange_numba import D_NI, N_FLAGS, W_COUNT, W_PIVOT, evaluate_into, held_pieces
@@ -494,7 +494,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
             flags |= F_STALL
         interior = ipar[I_NEXT] < n_te and t_eval[ipar[I_NEXT]] < t_new
         if ipar[I_KEEP] != 0:
-            row_ws = kept[ipar[I_NKEPT], kept.shape[1] - ws.size:]
+            row_ws = kept[ipar[I_NKEPT], kept_offsets(m)[-1]:]
             row_ws[:] = ws
             held_pieces(row_ws, nx, ni)[:] = 0.0  # (a kept workspace holds no pieces)
         made = flags != 0 or interior  # a kept step's is made when it is wanted
