@@ -37,11 +37,13 @@ __all__ = ["LoadContext", "ForceModel", "force_model", "evaluate", "applied_forc
 
 # ====================================================================== geometry
 def rotate(th, s) -> np.ndarray:
-    """A(th) s for angles th, shape (...,), and one body-frame vector s (2,) -> (..., 2)."""
+    """A(th) s for angles th, shape (...,), and body-frame vectors s, shape (2,) (one for
+    every angle) or (..., 2) (broadcast against th: one per angle) -> (..., 2)."""
+    s = np.asarray(s, dtype=float)
     c, sn = np.cos(th), np.sin(th)
-    out = np.empty(np.shape(th) + (2,))
-    out[..., 0] = c * s[0] - sn * s[1]
-    out[..., 1] = sn * s[0] + c * s[1]
+    out = np.empty(np.broadcast_shapes(np.shape(th), s.shape[:-1]) + (2,))
+    out[..., 0] = c * s[..., 0] - sn * s[..., 1]
+    out[..., 1] = sn * s[..., 0] + c * s[..., 1]
     return out
 
 
@@ -237,7 +239,7 @@ class _SpringSet:
     def geometry(self, X):
         """Arms of both ends (..., n, 2), the vectors P1 -> P2 (..., n, 2) and their
         lengths (..., n), for the slot poses X (..., nb + 1, 3)."""
-        ai, aj = _rotate_each(X[..., self.i, 2], self.si), _rotate_each(X[..., self.j, 2], self.sj)
+        ai, aj = rotate(X[..., self.i, 2], self.si), rotate(X[..., self.j, 2], self.sj)
         d = X[..., self.j, :2] + aj - X[..., self.i, :2] - ai
         return ai, aj, d, np.hypot(d[..., 0], d[..., 1])
 
@@ -263,15 +265,6 @@ class _SpringSet:
         """Stored energy of stiffness and preload (...), J."""
         L = self.geometry(X)[3]
         return np.sum(0.5 * self.k * (L - self.L0) ** 2 + self.pre * L, axis=-1)
-
-
-def _rotate_each(th, s) -> np.ndarray:
-    """A(th_n) s_n for angles th (..., n) and body-frame vectors s (n, 2) -> (..., n, 2)."""
-    c, sn = np.cos(th), np.sin(th)
-    out = np.empty(np.shape(th) + (2,))
-    out[..., 0] = c * s[:, 0] - sn * s[:, 1]
-    out[..., 1] = sn * s[:, 0] + c * s[:, 1]
-    return out
 
 
 @dataclass

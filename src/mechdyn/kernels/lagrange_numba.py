@@ -74,15 +74,21 @@ def work_size(n_x: int, n_i: int, n_t: int = 0) -> int:
 def held_pieces(ws, nx, ni):
     """The block of the work array with the table pieces that the loads evaluate on
     (:mod:`mechdyn.kernels.table_regions`; all zero outside the DOP853 loop: none)."""
-    o = 2 * nx + 2 * ni + nx * ni + nx
+    o = _bias_offset(nx, ni) + nx + ni
     return ws[o:ws.size - N_FLAGS - nx]
+
+
+@njit
+def _bias_offset(nx, ni):
+    """Where b_last begins in the work array (after x, q_last, B_last and xdot)."""
+    return nx + ni + nx * ni + nx
 
 
 @njit
 def _last_bias(ws, nx, ni):
     """The acceleration bias b (n_x) and the rates q_I' (n_i) of the last evaluation in
     the work array: the pose's second derivative along q_I' is b (J b = -quad)."""
-    o = nx + ni + nx * ni + nx
+    o = _bias_offset(nx, ni)
     return ws[o:o + nx], ws[o + nx:o + nx + ni]
 
 

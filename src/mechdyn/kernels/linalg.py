@@ -124,23 +124,23 @@ def lu_solve_transposed(a, piv, b, n):
 
 
 @njit
-def _forward(L, b, n, unit):
-    """Solve L y = b for lower-triangular L (unit diagonal if ``unit``), b overwritten."""
+def _forward(L, b, n):
+    """Solve L y = b for lower-triangular L, b overwritten."""
     for r in range(n):
         s = b[r]
         for c in range(r):
             s -= L[r, c] * b[c]
-        b[r] = s if unit else s / L[r, r]
+        b[r] = s / L[r, r]
 
 
 @njit
-def _backward(U, b, n, unit):
-    """Solve U y = b for upper-triangular U (unit diagonal if ``unit``), b overwritten."""
+def _backward(U, b, n):
+    """Solve U y = b for upper-triangular U, b overwritten."""
     for r in range(n - 1, -1, -1):
         s = b[r]
         for c in range(r + 1, n):
             s -= U[r, c] * b[c]
-        b[r] = s if unit else s / U[r, r]
+        b[r] = s / U[r, r]
 
 
 @njit
@@ -164,8 +164,6 @@ def cholesky_solve(A, rhs, n):
             for k in range(j):
                 s2 -= A[i, k] * A[j, k]
             A[i, j] = s2 / d
-    _forward(A, rhs, n, False)
-    _backward(A.T, rhs, n, False)
+    _forward(A, rhs, n)
+    _backward(A.T, rhs, n)
     return True
-
-
