@@ -30,9 +30,9 @@ _WHERE: dict[str, str | None] = {
                     ".foundation"),
     **dict.fromkeys(("KinematicPoint", "KinematicSweep", "SweepSummary", "analyze", "sweep"),
                     ".kinematics.sweep"),
-    **dict.fromkeys(("Body", "Coordinate", "Drive", "Force", "Ground", "Lock", "Mechanism",
-                     "Prismatic", "Revolute", "RotarySpring", "Spring", "Table", "Torque",
-                     "TorqueSpeedCurve", "pulse"), ".mechanism"),
+    **dict.fromkeys(("Body", "Bushing", "Coordinate", "Drive", "Force", "Ground", "Lock",
+                     "Mechanism", "Prismatic", "Revolute", "RotarySpring", "Spring", "Table",
+                     "Torque", "TorqueSpeedCurve", "pulse"), ".mechanism"),
     "AssemblyMode": ".mechanism.assembly_mode",
     "Contact": ".mechanism.contact", "Stop": ".mechanism.contact",
     **dict.fromkeys(("ConstantSpeedDrive", "DCMotor", "GearStage", "InductionMotor"),
@@ -49,7 +49,7 @@ _WHERE: dict[str, str | None] = {
 __all__ = [
     # description
     "Mechanism", "Body", "Ground", "Revolute", "Prismatic", "Lock", "Coordinate", "Spring",
-    "RotarySpring", "Force", "Torque", "Table", "pulse", "Drive", "TorqueSpeedCurve",
+    "Bushing", "RotarySpring", "Force", "Torque", "Table", "pulse", "Drive", "TorqueSpeedCurve",
     "InductionMotor", "DCMotor", "ConstantSpeedDrive", "GearStage", "Model", "Mode", "State",
     "AssemblyMode", "CoordinateLock", "Switch", "Stop", "Contact",
     "load", "loads", "examples", "units",

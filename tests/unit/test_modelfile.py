@@ -6,6 +6,7 @@ import pytest
 
 from mechdyn.errors import ModelError, UnitError
 from mechdyn.mechanism import (
+    Bushing,
     Drive,
     Force,
     Prismatic,
@@ -478,3 +479,32 @@ def test_periodic_tables_and_pulses():
                                          r"period of the pulse over 't' \('10 ms'\) must be "
                                          r"longer than its duration"):
         bad('duration = "20 ms" }', 'duration = "20 ms", period = "10 ms" }')
+
+
+def test_bushing_is_read_in_si_units_and_checked():
+    text = SLIDER_CRANK.replace('''[[loads]]
+type = "rotary_damper"''', '''[[loads]]
+type = "bushing"
+name = "mount"
+body1 = "ground"
+point1 = "O"
+body2 = "crank"
+point2 = [0, 0]
+kx = "2 N/mm"
+ky = "3 kN/m"
+cy = "5 N*s/mm"
+
+[[loads]]
+type = "rotary_damper"''', 1)
+    m = loads(text, name="slider_crank.toml")
+    mount = next(ld for ld in m.loads if ld.name == "mount")
+    assert isinstance(mount, Bushing)
+    assert (mount.body1, mount.point1, mount.body2) == ("ground", "O", "crank")
+    assert (mount.kx, mount.ky, mount.cx, mount.cy) == pytest.approx((2e3, 3e3, 0.0, 5e3))
+    with pytest.raises(ModelError) as err:
+        loads(text.replace('kx = "2 N/mm"', 'kx = "-2 N/mm"').replace('body1 = "ground"\n'
+              'point1 = "O"\nbody2 = "crank"', 'body1 = "crank"\npoint1 = [0, 0]\n'
+              'body2 = "crank"'), name="slider_crank.toml")
+    msg = str(err.value)
+    assert "'mount' kx: '-2 N/mm': kx must be >= 0 N/m" in msg
+    assert "body1 and body2 are the same body 'crank'" in msg

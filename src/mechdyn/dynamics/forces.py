@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -27,7 +27,7 @@ from ..kinematics.constraints import (
     point_velocity,
 )
 from ..mechanism.drive import Drive
-from ..mechanism.load import Force, RotarySpring, Spring, Table, Torque
+from ..mechanism.load import Bushing, Force, RotarySpring, Spring, Table, Torque
 from ..model import Model
 from ..model.variable import lower, parse
 
@@ -213,40 +213,51 @@ def _apply(F, b, arm, f):
     F[..., b, 2] += cross(arm, f)
 
 
-class _SpringSet:
-    """The springs of a force model as arrays, evaluated together (one NumPy operation
-    for all of them, not one per spring: a mounted machine has eight).
+class _Pairs:
+    """Load elements between two body points, as arrays: rows ``(name, i, si, j, sj, ...)``
+    with end 1 at ``si`` on body slot ``i``, end 2 at ``sj`` on slot ``j`` (the ground the
+    last slot, nb), and the incidence matrices that scatter their forces onto the slots."""
 
-    Rows s of the tuples ``(name, i, si, j, sj, k, L0, c, pre)`` of
-    :class:`ForceModel`: end 1 at ``si`` on body slot ``i``, end 2 at ``sj`` on slot
-    ``j`` (the ground the last slot, nb)."""
-
-    def __init__(self, springs, nb: int):
-        self.names = [sp[0] for sp in springs]
-        self.i = np.array([sp[1] for sp in springs], dtype=int)
-        self.j = np.array([sp[3] for sp in springs], dtype=int)
-        self.si = np.array([sp[2] for sp in springs], dtype=float).reshape(-1, 2)
-        self.sj = np.array([sp[4] for sp in springs], dtype=float).reshape(-1, 2)
-        self.k, self.L0, self.c, self.pre = (np.array([sp[n] for sp in springs], dtype=float)
-                                             for n in (5, 6, 7, 8))
-        self.damped = bool(np.any(self.c != 0.0))
-        n = len(springs)
-        #: slot incidence: +1 at end 1's slot, -1 at end 2's (forces), and each end's alone
+    def __init__(self, rows, nb: int):
+        self.names = [r[0] for r in rows]
+        self.i = np.array([r[1] for r in rows], dtype=int)
+        self.j = np.array([r[3] for r in rows], dtype=int)
+        self.si = np.array([r[2] for r in rows], dtype=float).reshape(-1, 2)
+        self.sj = np.array([r[4] for r in rows], dtype=float).reshape(-1, 2)
+        n = len(rows)
+        #: slot incidence of end 1 and of end 2
         self.p1, self.p2 = np.zeros((n, nb + 1)), np.zeros((n, nb + 1))
         self.p1[np.arange(n), self.i] = 1.0
         self.p2[np.arange(n), self.j] = 1.0
 
     def geometry(self, X):
-        """Arms of both ends (..., n, 2), the vectors P1 -> P2 (..., n, 2) and their
-        lengths (..., n), for the slot poses X (..., nb + 1, 3)."""
+        """Arms of both ends (..., n, 2) and the vectors P1 -> P2 (..., n, 2) for the slot
+        poses X (..., nb + 1, 3)."""
         ai, aj = rotate(X[..., self.i, 2], self.si), rotate(X[..., self.j, 2], self.sj)
-        d = X[..., self.j, :2] + aj - X[..., self.i, :2] - ai
-        return ai, aj, d, np.hypot(d[..., 0], d[..., 1])
+        return ai, aj, X[..., self.j, :2] + aj - X[..., self.i, :2] - ai
+
+    def scatter(self, F, f, a1, a2):
+        """Add force f (..., n, 2) on end 1 at arm a1 from its slot's origin, and -f on end 2
+        at arm a2, to F (..., nb + 1, 3)."""
+        F[..., :2] += np.swapaxes(np.swapaxes(f, -1, -2) @ (self.p1 - self.p2), -1, -2)
+        F[..., 2] += cross(a1, f) @ self.p1 - cross(a2, f) @ self.p2
+
+
+class _SpringSet(_Pairs):
+    """The springs of a force model, evaluated together (one NumPy operation for all of
+    them, not one per spring): rows ``(name, i, si, j, sj, k, L0, c, pre)``."""
+
+    def __init__(self, springs, nb: int):
+        super().__init__(springs, nb)
+        self.k, self.L0, self.c, self.pre = (np.array([sp[n] for sp in springs], dtype=float)
+                                             for n in (5, 6, 7, 8))
+        self.damped = bool(np.any(self.c != 0.0))
 
     def apply(self, F, X, V):
         """Add the spring forces (stiffness, preload, and damping unless V is None) at
         the slot poses X and rates V to F (..., nb + 1, 3)."""
-        ai, aj, d, L = self.geometry(X)
+        ai, aj, d = self.geometry(X)
+        L = np.hypot(d[..., 0], d[..., 1])
         short = L < 1e-300
         if short.any():
             name = self.names[int(np.argmax(short.reshape(-1, len(self.names)).any(axis=0)))]
@@ -257,14 +268,52 @@ class _SpringSet:
             vd = (V[..., self.j, :2] + V[..., self.j, 2, None] * _perp(aj)
                   - V[..., self.i, :2] - V[..., self.i, 2, None] * _perp(ai))
             f = f + self.c * np.sum(e * vd, axis=-1)
-        f = (f + self.pre)[..., None] * e  # on end 1, towards end 2
-        F[..., :2] += np.swapaxes(np.swapaxes(f, -1, -2) @ (self.p1 - self.p2), -1, -2)
-        F[..., 2] += cross(ai, f) @ self.p1 - cross(aj, f) @ self.p2
+        self.scatter(F, (f + self.pre)[..., None] * e, ai, aj)  # on end 1, towards end 2
 
     def energy(self, X):
         """Stored energy of stiffness and preload (...), J."""
-        L = self.geometry(X)[3]
+        d = self.geometry(X)[2]
+        L = np.hypot(d[..., 0], d[..., 1])
         return np.sum(0.5 * self.k * (L - self.L0) ** 2 + self.pre * L, axis=-1)
+
+
+class _BushingSet(_Pairs):
+    """The bushings of a force model (:class:`~mechdyn.mechanism.load.Bushing`), evaluated
+    together: rows ``(name, i, si, j, sj, kx, ky, cx, cy)``.
+
+    The offset of end 2 from end 1 in the axes of body i, d = A_i^T (r_j - r_i), loads
+    end 2 with -A_i (K d + C d') and body i with the opposite at the same place, so the
+    pair has no moment and does the work -(K d + C d) . d' (d' the rate of d: end 2's
+    velocity less that of the point of body i under it)."""
+
+    def __init__(self, rows, nb: int):
+        super().__init__(rows, nb)
+        self.k = np.array([r[5:7] for r in rows], dtype=float).reshape(-1, 2)
+        self.c = np.array([r[7:9] for r in rows], dtype=float).reshape(-1, 2)
+        self.damped = bool(np.any(self.c != 0.0))
+
+    def offsets(self, X):
+        """Arms of both ends, d in body i's axes (..., n, 2) and body i's angle (..., n)."""
+        ai, aj, delta = self.geometry(X)
+        th = X[..., self.i, 2]
+        return ai, aj, delta, rotate(-th, delta), th
+
+    def apply(self, F, X, V):
+        """Add the bushing forces (stiffness, and damping unless V is None) at the slot
+        poses X and rates V to F (..., nb + 1, 3)."""
+        ai, aj, delta, d, th = self.offsets(X)
+        f = self.k * d
+        a1 = ai + delta  # body i takes its force where end 2 is
+        if V is not None and self.damped:
+            vd = (V[..., self.j, :2] + V[..., self.j, 2, None] * _perp(aj)
+                  - V[..., self.i, :2] - V[..., self.i, 2, None] * _perp(a1))
+            f = f + self.c * rotate(-th, vd)
+        self.scatter(F, rotate(th, f), a1, aj)
+
+    def energy(self, X):
+        """Stored energy (...), J."""
+        d = self.offsets(X)[3]
+        return np.sum(0.5 * np.sum(self.k * d * d, axis=-1), axis=-1)
 
 
 @dataclass
@@ -277,15 +326,17 @@ class ForceModel:
     forces: list
     torques: list
     drives: list
+    bushings: list = field(default_factory=list)
 
     def __post_init__(self):
         m = self.model
         has = bool(np.any(m.gravity)) and bool(np.any(m.mass))
         #: the weights (n_bodies, 2), N, or None without gravity
         self._weights = m.mass[:, None] * m.gravity if has else None
-        self._damped = any(sp[7] != 0.0 for sp in self.springs) or any(
-            r[5] != 0.0 for r in self.rotary)
         self._springs = _SpringSet(self.springs, m.n_bodies) if self.springs else None
+        self._bushings = _BushingSet(self.bushings, m.n_bodies) if self.bushings else None
+        self._damped = any(r[5] != 0.0 for r in self.rotary) or any(
+            p is not None and p.damped for p in (self._springs, self._bushings))
 
     # ----------------------------------------------------------------- forces
     def loads(self, t, x, xdot, q, qdot, *, skip_drives: Sequence[int] = (),
@@ -333,8 +384,9 @@ class ForceModel:
             F[..., :nb, :2] += self._weights
             F[..., :nb, 2] += cross(com_arms(m, x), self._weights)
         V = None if conservative else extend(m, xdot)
-        if self._springs is not None:
-            self._springs.apply(F, X, V)
+        for pairs in (self._springs, self._bushings):
+            if pairs is not None:
+                pairs.apply(F, X, V)
         for (_name, i, j, k, a0, c, pre) in self.rotary:
             tq = k * (X[..., j, 2] - X[..., i, 2] - a0)
             if V is not None and c != 0.0:
@@ -404,8 +456,9 @@ class ForceModel:
         X = extend(m, x)
         rc = X[..., :-1, :2] + com_arms(m, x)
         U = -np.sum(m.mass * (rc @ m.gravity), axis=-1)
-        if self._springs is not None:
-            U = U + self._springs.energy(X)
+        for pairs in (self._springs, self._bushings):
+            if pairs is not None:
+                U = U + pairs.energy(X)
         for (_, i, j, k, a0, _c, pre) in self.rotary:
             rel = X[..., j, 2] - X[..., i, 2]
             U = U + 0.5 * k * (rel - a0) ** 2 + pre * rel
@@ -470,7 +523,7 @@ def force_model(model: Model) -> ForceModel:
     if cached is not None:
         return cached
     probs: list[str] = []
-    springs, rotary, forces, torques, drives = [], [], [], [], []
+    springs, rotary, forces, torques, drives, bushings = [], [], [], [], [], []
 
     def body(name, where):
         try:
@@ -497,6 +550,19 @@ def force_model(model: Model) -> ForceModel:
             if a1 and a2:
                 springs.append((ld.name, *a1, *a2, float(ld.stiffness), float(ld.free_length),
                                 float(ld.damping), float(ld.preload)))
+        elif isinstance(ld, Bushing):
+            a1, a2 = anchor(ld.body1, ld.point1, where), anchor(ld.body2, ld.point2, where)
+            for fld in ("kx", "ky", "cx", "cy"):
+                v = getattr(ld, fld)
+                if not (isinstance(v, int | float | np.integer | np.floating)
+                        and math.isfinite(v) and v >= 0):
+                    probs.append(f"{where}: {fld} must be a finite number >= 0, got {v!r}")
+            if a1 and a2 and a1[0] == a2[0]:
+                probs.append(f"{where}: body1 and body2 are the same body "
+                             f"{ld.body1!r}")
+            elif a1 and a2:
+                bushings.append((ld.name, *a1, *a2, *(float(getattr(ld, f))
+                                                      for f in ("kx", "ky", "cx", "cy"))))
         elif isinstance(ld, RotarySpring):
             if ld.joint not in mech.joints or model.joint_kind(ld.joint) != "revolute":
                 probs.append(f"{where}: joint: " + did_you_mean(ld.joint, model.rev.names,
@@ -518,8 +584,8 @@ def force_model(model: Model) -> ForceModel:
         elif hasattr(ld, "generalized"):  # extension loads (process loads, contacts ...)
             continue
         else:
-            probs.append(f"{where}: not a load mechdyn knows (Spring, RotarySpring, Force, "
-                         f"Torque)")
+            probs.append(f"{where}: not a load mechdyn knows (Spring, Bushing, RotarySpring, "
+                         "Force, Torque)")
     for ld in [*mech.loads, *mech.drives]:  # table variables: resolved once, here
         for fld in ("magnitude", "torque"):
             tab = getattr(ld, fld, None)
@@ -537,6 +603,6 @@ def force_model(model: Model) -> ForceModel:
         drives.append((dr, model.coordinate_index(dr.coordinate)))
     if probs:
         raise ModelError(probs)
-    fm = ForceModel(model, springs, rotary, forces, torques, drives)
+    fm = ForceModel(model, springs, rotary, forces, torques, drives, bushings)
     model.memo["force_model"] = fm
     return fm

@@ -18,17 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from ..kinematics.constraints import _turn
 from ..mechanism import Mechanism
 from .frame_loads import frame_loads
-from .mounting import (
-    ARM,
-    _foundation,
-    _spring_forces,
-    base_coordinates,
-    isolator_geometry,
-    mounted,
-    to_centre_of_mass,
-)
+from .mounting import _foundation, base_coordinates, isolator_forces, mounted, to_centre_of_mass
 from .response import MountedResponse, mounted_response
 from .supports import Foundation, shift_moment
 
@@ -36,21 +29,16 @@ __all__ = ["floor_forces", "MountingComparison", "compare_mounting"]
 
 
 def floor_forces(trajectory, foundation: Foundation, base: str = "base",
-                 gravity=(0.0, -9.81), arm: float = ARM,
                  point=(0.0, 0.0)) -> MountedResponse:
     """The isolators' forces on the floor over a run of a :func:`mounted` machine, from the
-    base's coordinates and the isolator springs' exact geometry.
+    base's coordinates (:func:`~mechdyn.foundation.mounting.isolator_forces`).
 
     Parameters
     ----------
     trajectory : Trajectory
-        A run of ``mounted(mechanism, foundation, base, arm)``.
+        A run of ``mounted(mechanism, foundation, base)``.
     foundation : Foundation
     base : str
-    gravity : (float, float)
-        The mechanism's gravity, m/s^2 (it placed the springs' anchors).
-    arm : float
-        As given to :func:`mounted`, m.
     point : (float, float)
         Point of the moment, m.
 
@@ -74,11 +62,11 @@ def floor_forces(trajectory, foundation: Foundation, base: str = "base",
                          f"{', '.join(names)})")
     idx = [names.index(c) for c in base_coordinates(base)]
     u, v = trajectory.q[:, idx], trajectory.qdot[:, idx]
-    geo = isolator_geometry(foundation, gravity, arm)
-    F = _spring_forces(foundation, geo, u, v)  # (n, iso, spring, 2) on the anchors
-    per = F.sum(axis=2)
-    anchors = geo[:, :, 1, :] - np.asarray(point, float)  # lines of action through them
-    m = np.sum(anchors[..., 0] * F[..., 1] - anchors[..., 1] * F[..., 0], axis=(1, 2))
+    per = isolator_forces(foundation, u, v)  # (n, iso, 2) on the floor
+    s = np.array([(p.x, p.y) for p in foundation.supports], float)
+    # where the base points are: the floor takes the forces there
+    at = _turn(u[:, 2, None], s) + u[:, None, :2] - np.asarray(point, float)
+    m = np.sum(at[..., 0] * per[..., 1] - at[..., 1] * per[..., 0], axis=1)
     floor = np.column_stack([per.sum(axis=1), m])
     u, v = to_centre_of_mass(foundation, u, v)
     return MountedResponse(t=np.asarray(trajectory.t, float), u=u, v=v, floor=floor,
@@ -198,7 +186,7 @@ def _on(t, ts, values):
 
 def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
                      t_end: float = 1.0, *, samples: int = 2001, base: str = "base",
-                     arm: float = ARM, reacting: Sequence[str] = (),
+                     reacting: Sequence[str] = (),
                      rigid_run=None, **simulate_kw) -> MountingComparison:
     """Run the machine on a rigid frame and coupled on its isolators, and compare.
 
@@ -212,7 +200,7 @@ def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
         End of both runs, s.
     samples : int
         Points of the common time grid (both runs are sampled on it).
-    base, arm, reacting
+    base, reacting
         As for :func:`~mechdyn.foundation.mounting.mounted`; the reactions of the
         ``reacting`` forces are also added to the rigid run's frame loads.
     rigid_run : Trajectory, optional
@@ -263,12 +251,12 @@ def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
     if reacting:
         machine = machine + _reaction_loads(rigid_run, reacting, loads.t)
     start = shift_moment(machine[0], point, f.com)
-    mm = mounted(mechanism, f, base=base, arm=arm, load=start, reacting=reacting)
+    mm = mounted(mechanism, f, base=base, load=start, reacting=reacting)
     coupled_run = simulate(mm, t_end, **simulate_kw)
     weight = shift_moment([*(f.mass * np.asarray(mechanism.gravity, float)), 0.0], f.com, point)
     rigid = _on(t, loads.t, machine) + weight
     one_way = mounted_response(f, t, rigid[:, 0], rigid[:, 1], rigid[:, 2], point=point)
-    ff = floor_forces(coupled_run, f, base, mechanism.gravity, arm, point)
+    ff = floor_forces(coupled_run, f, base, point)
     good = np.isfinite(ff.t)
     ts = ff.t[good]
     coupled = MountedResponse(t=t, u=_on(t, ts, ff.u[good]), v=_on(t, ts, ff.v[good]),

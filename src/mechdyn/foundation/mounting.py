@@ -14,19 +14,16 @@ base frame's origin, which in the sketch is the ground origin, so they are its
 displacement, m) and ``<base>_theta`` (kind ``"angle"``, its absolute angle, rad).  No
 joint holds it to the floor: it is held by the isolators alone.
 
-Each isolator is two linear spring-dampers of :class:`~mechdyn.mechanism.load.Spring`
-from the isolator's point on the base to an anchor on the floor ``arm`` (default 100 m)
-away: one along x (kx, cx), one along y (ky, cy), at their free length in the sketch.
-A spring of tension T and length L also resists a sideways displacement with T / L:
-the isolators' x, y stiffness is kx, ky to first order, with an error of about
-|T| / (L k) (the static load of the isolator over arm times stiffness; 1.5e-5 for a
-15 kN share on 1e7 N/m and a 100 m arm), and the damping exact to first order.  The
-anchors lie on the side opposite to gravity, so that the springs carrying the weight
-are in tension (a stabilising, not destabilising, error).
+Each isolator is a linear :class:`~mechdyn.mechanism.load.Bushing` ``<base>_<isolator>``
+from the isolator's point on the floor to the same point on the base, stiffness kx, ky
+and damping cx, cy along the floor's axes: the isolator model of
+:class:`~mechdyn.foundation.supports.Foundation` exactly, its force computed from the
+point's small displacement itself (no long lever whose direction must barely turn, no
+cancellation).  The floor takes each isolator's force where the base point is.
 
 The initial base coordinates are the static equilibrium under the weights of the base
-and of the machine's bodies in their initial (or sketch) pose, solved on the exact spring
-geometry: the base sags by about weight / (sum of ky).  A machine that starts moving
+and of the machine's bodies in their initial (or sketch) pose, solved with the base's
+rotation exact: the base sags by weight / (sum of ky).  A machine that starts moving
 then sets the base vibrating about it.
 
 What cannot follow the base
@@ -62,6 +59,7 @@ from ..mechanism import (
     GROUND,
     AssemblyMode,
     Body,
+    Bushing,
     Coordinate,
     Force,
     Ground,
@@ -74,11 +72,7 @@ from ..mechanism import (
 )
 from .supports import Foundation
 
-__all__ = ["mounted", "base_coordinates", "isolator_geometry", "FloorFrameWarning",
-           "ARM"]
-
-#: default distance from an isolator's point to its springs' floor anchors, m
-ARM = 100.0
+__all__ = ["mounted", "base_coordinates", "isolator_forces", "FloorFrameWarning"]
 
 #: the extras kinds that :func:`mounted` knows how to carry over
 _EXTRAS = ("assembly", "stops", "contacts", "coordinate_locks", "switches", "initial")
@@ -115,31 +109,6 @@ def _foundation(mechanism: Mechanism, foundation: Foundation | None) -> Foundati
                          f"{', '.join(map(repr, bolts))} are anchor bolts (use Isolator(name, "
                          "x, y, kx, ky, cx, cy), or the rigid analysis for bolts)")
     return f
-
-
-def isolator_geometry(foundation: Foundation, gravity=(0.0, -9.81),
-                      arm: float = ARM) -> np.ndarray:
-    """Points of the isolators' springs, shape (n, 2, 2, 2): [isolator, direction (x, y),
-    (point on the base, anchor on the floor), (x, y)] in the sketch, m.
-
-    The x spring's anchor lies ``arm`` to the side opposite to gravity's x component, the
-    y spring's opposite to its y component (+x, +y without one).
-
-    Examples
-    --------
-    >>> from mechdyn.foundation import Isolator
-    >>> f = Foundation([Isolator("L", -0.5, 0.0, 1e5, 1e5), Isolator("R", 0.5, 0.0, 1e5, 1e5)])
-    >>> isolator_geometry(f, arm=10.0)[0].tolist()
-    [[[-0.5, 0.0], [9.5, 0.0]], [[-0.5, 0.0], [-0.5, 10.0]]]
-    """
-    g = np.asarray(gravity, float)
-    side = np.where(g > 0, -1.0, 1.0)
-    out = np.zeros((len(foundation.supports), 2, 2, 2))
-    for i, s in enumerate(foundation.supports):
-        for d in range(2):
-            out[i, d, 0] = out[i, d, 1] = (s.x, s.y)
-            out[i, d, 1, d] += side[d] * arm
-    return out
 
 
 def sketch_poses(mech: Mechanism) -> dict:
@@ -283,7 +252,7 @@ def _angle_used(mech: Mechanism, joint: str) -> bool:
 
 
 def _load(ld, base: str):
-    if isinstance(ld, Spring):
+    if isinstance(ld, Spring | Bushing):
         return dataclasses.replace(ld, body1=_replace_ground(ld.body1, base),
                                    body2=_replace_ground(ld.body2, base))
     if isinstance(ld, Torque):
@@ -293,8 +262,8 @@ def _load(ld, base: str):
     if isinstance(ld, Force | RotarySpring):  # on a moving body / in a joint: unchanged
         return ld
     raise ModelError(f"load {getattr(ld, 'name', ld)!r}: a {type(ld).__name__} cannot be "
-                     "carried onto a mounted base; known loads: Spring, RotarySpring, Force, "
-                     "Torque")
+                     "carried onto a mounted base; known loads: Spring, Bushing, RotarySpring, "
+                     "Force, Torque")
 
 
 def _extras(mech: Mechanism, base: str) -> dict:
@@ -320,8 +289,7 @@ def _extras(mech: Mechanism, base: str) -> dict:
 
 
 def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: str = "base",
-            arm: float = ARM, equilibrium: bool = True, load=None,
-            reacting: Sequence[str] = ()) -> Mechanism:
+            equilibrium: bool = True, load=None, reacting: Sequence[str] = ()) -> Mechanism:
     """The machine on its frame mounted on isolators: one mechanism, the floor its ground.
 
     Parameters
@@ -333,9 +301,6 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
         mechanism's own ``foundation``).
     base : str
         Name of the new body (its coordinates: :func:`base_coordinates`).
-    arm : float
-        Distance of the isolator springs' floor anchors, m (the relative stiffness error
-        is about the static isolator load / (arm k)).
     equilibrium : bool
         Start the base at its static equilibrium under the weights (default); False
         starts it at the sketch position, the isolators unloaded.
@@ -359,7 +324,7 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
     Mechanism
         A new mechanism: ``base`` with the ground's points (the floor keeps them too, for
         variables such as ``"dist(ground.P, ram.Q)"``), every element once attached
-        to the ground on it, the isolator springs ``<base>_<isolator>_x`` / ``_y`` and
+        to the ground on it, the isolator bushings ``<base>_<isolator>`` and
         the base's coordinates ``<base>_x``, ``<base>_y`` (kinds ``"x"``, ``"y"``: its
         origin's displacement from the sketch, m) and ``<base>_theta`` (rad).
 
@@ -393,8 +358,6 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
     -5.0031
     """
     f = _foundation(mechanism, foundation)
-    if not (np.isfinite(arm) and arm > 0):
-        raise ModelError(f"mounted: arm must be a finite length > 0 m, got {arm!r}")
     names = [base, *base_coordinates(base)]
     taken = [n for n in names if n in mechanism.bodies or n in mechanism.joints
              or n in mechanism.coordinates]
@@ -436,44 +399,44 @@ def mounted(mechanism: Mechanism, foundation: Foundation | None = None, base: st
     out.add(Coordinate(cx, "x", body=base))
     out.add(Coordinate(cy, "y", body=base))
     out.add(Coordinate(cth, "angle", body=base))
-    geo = isolator_geometry(f, mechanism.gravity, arm)
-    for s, g, k, c in zip(f.supports, geo, f.stiffnesses(), f.dampings(), strict=True):
-        for d, axis in enumerate("xy"):
-            out.add(Spring(f"{base}_{s.name}_{axis}", GROUND, tuple(g[d, 1]), base,
-                           tuple(g[d, 0]), stiffness=float(k[d]), free_length=float(arm),
-                           damping=float(c[d])))
+    for s, k, c in zip(f.supports, f.stiffnesses(), f.dampings(), strict=True):
+        at = (float(s.x), float(s.y))
+        out.add(Bushing(f"{base}_{s.name}", GROUND, at, base, at, kx=float(k[0]),
+                        ky=float(k[1]), cx=float(c[0]), cy=float(c[1])))
     out.foundation = f
     if equilibrium:
-        u0 = static_equilibrium(mechanism, f, arm, load)
+        u0 = static_equilibrium(mechanism, f, load)
         init = out.extras.setdefault("initial", {})
         q = init.setdefault("q", {})
         q.update({cx: float(u0[0]), cy: float(u0[1]), cth: float(u0[2])})
     return out
 
 
-def _spring_forces(f: Foundation, geo, u, v=None, pivot=(0.0, 0.0)) -> np.ndarray:
-    """Forces of the isolator springs on the floor anchors, shape (..., n, 2 springs, 2),
-    for the base displacement ``u`` (..., 3) of its ``pivot`` (and its rate ``v``)."""
+def isolator_forces(foundation: Foundation, u, v=None, pivot=(0.0, 0.0)) -> np.ndarray:
+    """Forces of the isolators of a :func:`mounted` base on the floor, shape (..., n, 2), N,
+    for the displacement ``u`` (..., 3) of the base's ``pivot`` from the sketch (m, m,
+    rad) and its rate ``v`` (without it, the elastic part alone): K delta + C delta' of
+    each isolator point's displacement delta, acting where the base point is.
+
+    Examples
+    --------
+    >>> from mechdyn.foundation import Isolator
+    >>> f = Foundation([Isolator("L", -0.5, 0.0, 1e5, 2e5), Isolator("R", 0.5, 0.0, 1e5, 2e5)])
+    >>> isolator_forces(f, [0.0, -1e-3, 0.0]).tolist()
+    [[0.0, -200.0], [0.0, -200.0]]
+    """
     u = np.asarray(u, float)
     pivot = np.asarray(pivot, float)
-    shape = u.shape[:-1] + (1, 1)
-    rr = _turn(u[..., 2].reshape(shape), geo[:, :, 0, :] - pivot)  # (..., n, 2, 2)
-    d = rr + pivot + u[..., None, None, :2] - geo[:, :, 1, :]
-    L = np.linalg.norm(d, axis=-1)
-    e = d / L[..., None]
-    k, damp = f.stiffnesses(), f.dampings()
-    T = k * (L - geo_arm(geo))
+    shape = u.shape[:-1] + (1,)
+    s = np.array([(p.x, p.y) for p in foundation.supports], float) - pivot  # (n, 2)
+    rr = _turn(u[..., 2].reshape(shape), s)  # (..., n, 2)
+    F = foundation.stiffnesses() * (rr - s + u[..., None, :2])
     if v is not None:
         v = np.asarray(v, float)
         w = v[..., 2].reshape(shape)
-        vp = v[..., None, None, :2] + np.stack([-w * rr[..., 1], w * rr[..., 0]], axis=-1)
-        T = T + damp * np.sum(e * vp, axis=-1)
-    return T[..., None] * e  # a tension pulls the anchor towards the base
-
-
-def geo_arm(geo) -> np.ndarray:
-    """The springs' free lengths (their sketch lengths), shape (n, 2)."""
-    return np.linalg.norm(geo[:, :, 0, :] - geo[:, :, 1, :], axis=-1)
+        vp = v[..., None, :2] + np.stack([-w * rr[..., 1], w * rr[..., 0]], axis=-1)
+        F = F + foundation.dampings() * vp
+    return F
 
 
 def to_centre_of_mass(foundation: Foundation, u, v=None, pivot=(0.0, 0.0)):
@@ -493,11 +456,11 @@ def to_centre_of_mass(foundation: Foundation, u, v=None, pivot=(0.0, 0.0)):
     return uc, vc
 
 
-def static_equilibrium(mechanism: Mechanism, foundation: Foundation, arm: float = ARM,
+def static_equilibrium(mechanism: Mechanism, foundation: Foundation,
                        weights: Sequence | None = None, pivot=(0.0, 0.0)) -> np.ndarray:
     """Displacement (x, y, theta) of the base's ``pivot`` (m, m, rad) at rest on its
     isolators under the weights of the base and of the machine's bodies (in their sketch
-    pose, turning with the base), on the exact spring geometry of :func:`mounted`.
+    pose, turning with the base), the base's rotation exact as in :func:`mounted`.
 
     ``weights`` (Fx, Fy, M about the base's centre of mass), N, N, N m, replaces the
     machine's part of the load.
@@ -528,16 +491,15 @@ def static_equilibrium(mechanism: Mechanism, foundation: Foundation, arm: float 
             points.append(np.asarray(pose[:2]) + _turn(pose[2], np.asarray(b.com)))
             forces.append(b.mass * g)
     r0, F0 = np.array(points) - pivot, np.array(forces)
-    geo = isolator_geometry(foundation, mechanism.gravity, arm)
-    r_iso = geo[:, :, 0, :] - pivot
+    r_iso = np.array([(s.x, s.y) for s in foundation.supports], float) - pivot
 
     def residual(u):
-        F = _spring_forces(foundation, geo, u, pivot=pivot)  # what the base pushes
+        F = isolator_forces(foundation, u, pivot=pivot)  # what the base pushes
         a = _turn(u[2], r_iso)
         r = _turn(u[2], r0)
-        m = np.sum(a[..., 0] * F[..., 1] - a[..., 1] * F[..., 0])
+        m = np.sum(a[:, 0] * F[:, 1] - a[:, 1] * F[:, 0])
         m_load = np.sum(r[:, 0] * F0[:, 1] - r[:, 1] * F0[:, 0]) + moment
-        return np.array([*(F.sum(axis=(0, 1)) - F0.sum(axis=0)), m - m_load])
+        return np.array([*(F.sum(axis=0) - F0.sum(axis=0)), m - m_load])
 
     K = foundation.stiffness_matrix(pivot)
     u = np.linalg.solve(K, -residual(np.zeros(3)))

@@ -1,6 +1,6 @@
 """The compiled (Numba) twin of the load evaluation of :mod:`mechdyn.dynamics.forces`.
 
-Gravity, springs and dampers, rotary springs, forces and torques of constant or
+Gravity, springs and dampers, bushings, rotary springs, forces and torques of constant or
 tabulated magnitude, and drives (constant, tabulated, torque-speed curves) are
 packed by :class:`LoadPacker` into one integer and one float array; the
 function :func:`forces` returns the applied forces on the body poses, their
@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..mechanism.drive import TorqueSpeedCurve
-from ..mechanism.load import Force, RotarySpring, Spring, Table, Torque
+from ..mechanism.load import Bushing, Force, RotarySpring, Spring, Table, Torque
 from .rows_numba import body_pose, njit
 from .table_regions import region_value, sharp_breakpoints
 
@@ -24,7 +24,7 @@ __all__ = ["LoadPacker", "Unsupported", "forces", "body_inertia", "load_value", 
            "FR_DRV", "IR_VAL", "H_NTAB", "S_LOCK", "IR_LOCK"]
 
 # header of the int array: counts, then section offsets
-H_NB, H_NQ, H_NSPR, H_NROT, H_NFOR, H_NTOR, H_NDRV, H_NTAB = range(8)
+H_NB, H_NQ, H_NSPR, H_NROT, H_NFOR, H_NTOR, H_NDRV, H_NTAB, H_NBUS = range(9)
 H_IOFF = 16  # int offsets of sections start here
 H_FOFF = 32  # float offsets of sections start here
 HEADER = 48
@@ -32,11 +32,12 @@ HEADER = 48
 # (S_LOCK: a record per table whose piece the DOP853 loop holds through a step,
 # :mod:`mechdyn.kernels.table_regions`: variable kind, variable index, table offset,
 # points, flags)
-S_BODY, S_SPR, S_ROT, S_FOR, S_TOR, S_DRV, S_TAB, S_LOCK = range(8)
-N_SECTIONS = 8
+S_BODY, S_SPR, S_ROT, S_FOR, S_TOR, S_DRV, S_TAB, S_LOCK, S_BUS = range(9)
+N_SECTIONS = 9
 IR_LOCK = 5
 IR_SPR, FR_SPR = 2, 8
 IR_ROT, FR_ROT = 2, 4
+IR_BUS, FR_BUS = 2, 8  # body1, body2 | s1x, s1y, s2x, s2y, kx, ky, cx, cy
 # value records (forces, torques, drives): mode, tab_off, tab_len, var_kind, var_index,
 # table flags (T_OUTSIDE | T_PERIODIC | its hold slot << 2), then a target part; a table is
 # stored in the table section as xs (tab_len), ys (tab_len) and, if periodic, its period;
@@ -134,6 +135,9 @@ class LoadPacker:
         for (_, i, si, j, sj, k, L0, c, pre) in fm.springs:
             self.ints[S_SPR] += [int(i), int(j)]
             self.flts[S_SPR] += [*si, *sj, k, L0, c, pre]
+        for (_, i, si, j, sj, kx, ky, cx, cy) in fm.bushings:
+            self.ints[S_BUS] += [int(i), int(j)]
+            self.flts[S_BUS] += [*si, *sj, kx, ky, cx, cy]
         for (_, i, j, k, a0, c, pre) in fm.rotary:
             self.ints[S_ROT] += [int(i), int(j)]
             self.flts[S_ROT] += [k, a0, c, pre]
@@ -162,7 +166,7 @@ class LoadPacker:
             j_extra = getattr(tq, "extra_inertia", None)
             self.flts[S_DRV] += [val, out, float(j_extra()) if j_extra is not None else 0.0]
         extra = [ld for ld in m.mechanism.loads
-                 if not isinstance(ld, Spring | RotarySpring | Force | Torque)]
+                 if not isinstance(ld, Spring | Bushing | RotarySpring | Force | Torque)]
         if extra:
             raise Unsupported(f"load {getattr(extra[0], 'name', '?')!r} "
                                f"({type(extra[0]).__name__}) is evaluated on the NumPy path")
@@ -175,6 +179,7 @@ class LoadPacker:
         head[H_NSPR], head[H_NROT] = len(fm.springs), len(fm.rotary)
         head[H_NFOR], head[H_NTOR], head[H_NDRV] = len(fm.forces), len(fm.torques), len(fm.drives)
         head[H_NTAB] = len(self.held)
+        head[H_NBUS] = len(fm.bushings)
         ip_parts, fp_parts = [head], [np.array([*m.gravity, m.length_scale,
                                                 1e-13 * max(m.length_scale, 1e-3)])]
         ioff, foff = HEADER, F_GLOBAL
@@ -265,6 +270,23 @@ def _apply(F, b, nb, armx, army, fx, fy):
 
 
 @njit
+def _ends(x, v, nb, cs, fp, f0, i, j):
+    """The two ends of a spring or bushing, at ``fp[f0:f0 + 4]`` on bodies i and j (nb:
+    the ground): their arms (aix, aiy, ajx, ajy), the vector from end i to end j, the
+    velocity of end j less that of end i, and body i's angular velocity."""
+    xi, yi, _ = body_pose(x, nb, i)
+    vxi, vyi, wi = body_pose(v, nb, i)
+    xj, yj, _ = body_pose(x, nb, j)
+    vxj, vyj, wj = body_pose(v, nb, j)
+    ci, si = cs[min(i, nb), 0], cs[min(i, nb), 1]
+    cj, sj = cs[min(j, nb), 0], cs[min(j, nb), 1]
+    aix, aiy = ci * fp[f0] - si * fp[f0 + 1], si * fp[f0] + ci * fp[f0 + 1]
+    ajx, ajy = cj * fp[f0 + 2] - sj * fp[f0 + 3], sj * fp[f0 + 2] + cj * fp[f0 + 3]
+    return (aix, aiy, ajx, ajy, xj + ajx - xi - aix, yj + ajy - yi - aiy,
+            vxj - wj * ajy - vxi + wi * aiy, vyj + wj * ajx - vyi - wi * aix, wi)
+
+
+@njit
 def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv, locks, cs):
     """Applied forces F (all) and Fnc (non-conservative part) on the poses, drives Qd.
     ``locks``: the held table pieces, ``[region + 1, period count]`` per hold slot (0:
@@ -287,20 +309,9 @@ def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv, locks, cs):
         i = ip[oi + IR_SPR * k]
         j = ip[oi + IR_SPR * k + 1]
         f0 = of + FR_SPR * k
-        xi, yi, _ = body_pose(x, nb, i)
-        vxi, vyi, wi = body_pose(v, nb, i)
-        xj, yj, _ = body_pose(x, nb, j)
-        vxj, vyj, wj = body_pose(v, nb, j)
-        ci, si = cs[min(i, nb), 0], cs[min(i, nb), 1]
-        cj, sj = cs[min(j, nb), 0], cs[min(j, nb), 1]
-        aix, aiy = ci * fp[f0] - si * fp[f0 + 1], si * fp[f0] + ci * fp[f0 + 1]
-        ajx, ajy = cj * fp[f0 + 2] - sj * fp[f0 + 3], sj * fp[f0 + 2] + cj * fp[f0 + 3]
-        dx = xj + ajx - xi - aix
-        dy = yj + ajy - yi - aiy
+        aix, aiy, ajx, ajy, dx, dy, vdx, vdy, _ = _ends(x, v, nb, cs, fp, f0, i, j)
         L = np.sqrt(dx * dx + dy * dy)
         ex, ey = dx / L, dy / L
-        vdx = vxj - wj * ajy - vxi + wi * aiy
-        vdy = vyj + wj * ajx - vyi - wi * aix
         fc = fp[f0 + 4] * (L - fp[f0 + 5]) + fp[f0 + 7]
         fd = fp[f0 + 6] * (ex * vdx + ey * vdy)
         f = fc + fd
@@ -308,6 +319,27 @@ def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv, locks, cs):
         _apply(F, j, nb, ajx, ajy, -f * ex, -f * ey)
         _apply(Fnc, i, nb, aix, aiy, fd * ex, fd * ey)
         _apply(Fnc, j, nb, ajx, ajy, -fd * ex, -fd * ey)
+    oi, of = ip[H_IOFF + S_BUS], ip[H_FOFF + S_BUS]
+    for k in range(ip[H_NBUS]):
+        # d = A_i^T (r_j - r_i) in body i's axes; -A_i (K d + C d') on j, the opposite on
+        # i where end j is (the twin of forces._BushingSet)
+        i = ip[oi + IR_BUS * k]
+        j = ip[oi + IR_BUS * k + 1]
+        f0 = of + FR_BUS * k
+        aix, aiy, ajx, ajy, ddx, ddy, vdx, vdy, wi = _ends(x, v, nb, cs, fp, f0, i, j)
+        aix, aiy = aix + ddx, aiy + ddy  # body i's arm to end j, and its point's velocity
+        vdx, vdy = vdx + wi * ddy, vdy - wi * ddx
+        ci, si = cs[min(i, nb), 0], cs[min(i, nb), 1]
+        fcx = fp[f0 + 4] * (ci * ddx + si * ddy)
+        fcy = fp[f0 + 5] * (ci * ddy - si * ddx)
+        fdx = fp[f0 + 6] * (ci * vdx + si * vdy)
+        fdy = fp[f0 + 7] * (ci * vdy - si * vdx)
+        fx, fy = ci * (fcx + fdx) - si * (fcy + fdy), si * (fcx + fdx) + ci * (fcy + fdy)
+        _apply(F, i, nb, aix, aiy, fx, fy)
+        _apply(F, j, nb, ajx, ajy, -fx, -fy)
+        fx, fy = ci * fdx - si * fdy, si * fdx + ci * fdy
+        _apply(Fnc, i, nb, aix, aiy, fx, fy)
+        _apply(Fnc, j, nb, ajx, ajy, -fx, -fy)
     oi, of = ip[H_IOFF + S_ROT], ip[H_FOFF + S_ROT]
     for k in range(ip[H_NROT]):
         i = ip[oi + IR_ROT * k]

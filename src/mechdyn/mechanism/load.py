@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Table", "Spring", "RotarySpring", "Force", "Torque", "Value", "pulse"]
+__all__ = ["Table", "Spring", "Bushing", "RotarySpring", "Force", "Torque", "Value", "pulse"]
 
 
 @dataclass(frozen=True)
@@ -177,6 +177,45 @@ class Spring:
     free_length: float = 0.0
     damping: float = 0.0
     preload: float = 0.0
+
+
+@dataclass(frozen=True)
+class Bushing:
+    """Linear bushing: a point of ``body2`` held elastically to a point of ``body1`` along
+    the two axes of ``body1``'s frame (the ground's for a mount on the floor).
+
+    With d = A1^T (r2 - r1) the offset of point2 from point1 in body1's axes (m) and
+    d' its rate, the force on ``body2`` at point2 is -A1 (kx dx + cx dx', ky dy + cy dy')
+    and its opposite acts on ``body1`` at the same place (so the pair has no moment:
+    a stiff housing of body1 around point2).  Unloaded where the two points coincide;
+    it stores 0.5 (kx dx^2 + ky dy^2).  Unlike a :class:`Spring` it has no direction to
+    turn with the deflection, so an isolator under a static load keeps its stiffness
+    exactly and its small deflection is computed without cancellation.
+
+    Parameters
+    ----------
+    name : str
+    body1, point1, body2, point2 : str and point (name or (x, y) in the body frame, m)
+    kx, ky : float
+        Stiffness along body1's x and y axes, N/m (>= 0).
+    cx, cy : float
+        Damping along them, N s/m (>= 0).
+
+    Examples
+    --------
+    >>> Bushing("mount", "ground", (0.5, 0.0), "base", (0.5, 0.0), kx=1e6, ky=2e6).ky
+    2000000.0
+    """
+
+    name: str
+    body1: str
+    point1: object
+    body2: str
+    point2: object
+    kx: float = 0.0
+    ky: float = 0.0
+    cx: float = 0.0
+    cy: float = 0.0
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,7 @@ from ..errors import did_you_mean
 from ..mechanism import GROUND
 from ..mechanism.coordinate import LENGTH_KINDS
 from ..mechanism.drive import Drive, TorqueSpeedCurve
-from ..mechanism.load import Force, RotarySpring, Spring, Table, Torque, pulse
+from ..mechanism.load import Bushing, Force, RotarySpring, Spring, Table, Torque, pulse
 from .drives import drive_from_table
 from .reader import _Failed, _Reader
 
@@ -125,6 +125,16 @@ class _LoadsDrives(_Reader):
                 self.failed = True
             self.check()
             return Spring(name, b1, p1, b2, p2, stiff, free, damp, pre)
+        if typ == "bushing":
+            b1, p1 = body_point("body1", "point1")
+            b2, p2 = body_point("body2", "point2")
+            kx, ky = (q(k, "stiffness", nonneg=True) for k in ("kx", "ky"))
+            cx, cy = (q(k, "damping", nonneg=True) for k in ("cx", "cy"))
+            if b1 is not None and b1 == b2:
+                self.problem(f"{self.where(*P)}: body1 and body2 are the same body {b1!r}")
+                self.failed = True
+            self.check()
+            return Bushing(name, b1, p1, b2, p2, kx, ky, cx, cy)
         if typ in ("rotary_spring", "rotary_damper"):
             joint = spec["joint"]
             if self.joint_types.get(joint) != "revolute":
