@@ -172,6 +172,7 @@ def _start(b, integ, t: float, t_end: float) -> np.ndarray:
     par[L.P_RTOL] = integ.rtol
     par[L.P_HMAX] = integ.max_step or np.inf
     par[L.P_BETA], par[L.P_ERROLD] = BETA, 1e-4
+    par[L.P_BRACKET] = np.inf  # no table point aimed at
     atol = np.empty(b.dims[4])
     atol[:] = integ.atol  # a scalar or one value per state
     return atol

@@ -123,7 +123,12 @@ def locate(cands, t_old: float, t_new: float, dense: Callable, evaluate: Callabl
                 if gfun(s_, e) > 0:
                     t_a, a_val = s_, 1.0
                     break
-        if a_val > 0:
+        if a_val > 0 and gfun(t_new, e) > 0:
+            # the step's end has crossed by its own evaluation, not by the dense output's
+            # (the two differ by round-off where the end lies on the crossing, as a step
+            # ended at a table point that is also a stop): the event at the end
+            ts = t_new
+        elif a_val > 0:
             ts = brentq(gfun, t_a, t_new, args=(e,), xtol=1e-15,
                         rtol=4 * np.finfo(float).eps, maxiter=200)
             if gfun(ts, e) > 0:  # take the side where the event has happened

@@ -43,7 +43,7 @@ __all__ = ["run", "evaluate_states", "DONE", "BATCH", "FLAGGED", "FAILED", "WATC
            "P_HMAX", "P_STALL", "P_PIVOT", "P_WC0", "P_WC1", "P_LAST", "P_TOLD", "P_HOLD",
            "I_EVALS", "I_STEPS", "I_REJ", "I_NOUT", "I_NEXT", "I_FLAGS", "I_FSAL",
            "I_EVERY", "I_WATCH", "I_MAXSTEPS", "I_STATUS", "I_PREV", "I_WPEND", "P_WS",
-           "I_KEEP", "I_NKEPT", "I_CTRL", "step_end", "accept", "samples",
+           "I_KEEP", "I_NKEPT", "I_CTRL", "P_BRACKET", "step_end", "accept", "samples",
            "N_PAR", "N_IPAR"]
 
 # return codes of run
@@ -52,10 +52,11 @@ DONE, BATCH, FLAGGED, FAILED, WATCH = 0, 1, 2, 3, 4
 F_TURN, F_PIVOT, F_STALL = 1, 2, 8
 # par: time, end, step, rtol, largest step, stall step, pivot ratio to check, watch window
 # (centre, half width), last sample time, start and size of the last step, coordinate of a
-# watch due
+# watch due, step control (beta, last error), and from P_BRACKET six values: the bracket of
+# the time of a table point a step was taken again up to (inf: none; see _run)
 P_T, P_TEND, P_H, P_RTOL, P_HMAX, P_STALL, P_PIVOT, P_WC0, P_WC1, P_LAST, P_TOLD, P_HOLD, \
-    P_WS, P_BETA, P_ERROLD = range(15)
-N_PAR = 15
+    P_WS, P_BETA, P_ERROLD, P_BRACKET = range(16)
+N_PAR = P_BRACKET + 6
 # ipar: evaluations, accepted and rejected steps, samples in the buffers, next t_eval,
 # flags, f valid, every step sampled, watch on, steps per call, kernel status, history,
 # a watch due, every step kept (with its dense output) in ``kept``, steps kept, SciPy's
@@ -79,8 +80,8 @@ def _counted(ts, ys, fout, ni, ip, fp, ri, rf, dims, ws, ext, full, sc, piv, ipa
 
 
 @njit
-def _switch(switch, t_new, ynew, fnew, s_old, s_new, ni, ip, fp, ri, rf, dims, ws, ext_end,
-            full, sc, piv, ipar, locks):
+def _switch(switch, ahead, t_new, ynew, fnew, s_old, s_new, ni, ip, fp, ri, rf, dims, ws,
+            ext_end, full, sc, piv, ipar, locks):
     """At the end of an accepted step (after its dense output and samples, made on the
     pieces it was taken on): with ``switch``, hold the next pieces of the tables whose
     variable in ``s_new`` has left its piece and evaluate the rates there again on them; the
@@ -89,7 +90,11 @@ def _switch(switch, t_new, ynew, fnew, s_old, s_new, ni, ip, fp, ri, rf, dims, w
     if nt == 0:
         return True
     if switch:
-        hold(ip, fp, s_new, s_new + (s_new - s_old), locks, True)
+        # the variables a little further on, the way they went (the part ``ahead`` of the
+        # step's travel): every table whose point lies within it gets its next piece
+        # (tables that share a point switch together; extrapolated by a whole step, a
+        # variable near a point of its own would be moved onto the next piece too early)
+        hold(ip, fp, s_new, s_new + ahead * (s_new - s_old), locks, True)
         if not _counted(t_new, ynew, fnew, ni, ip, fp, ri, rf, dims, ws, ext_end, full, sc,
                         piv, ipar):
             return False
@@ -301,7 +306,9 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
     Each table with sharp points has its piece held through a step; a step at whose end
     a table variable has left its piece is taken again up to the piece's end (within
     ``ETA`` of the step), and the next piece is held from there (``kv``: the variables at
-    the last accepted point | at the step's end | the pieces held between calls)."""
+    the last accepted point | at the step's end | the pieces held between calls).  Where
+    that step lands short of the point, the next ones aim at it by regula falsi over the
+    bracket of its time (Illinois' rule; the bracket in ``par[P_BRACKET:]``)."""
     ni = dims[D_NI]
     nx = x_end.size // 3
     m = y.size
@@ -345,8 +352,13 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
     rejected = False
     retried = 0  # attempts of this step taken again up to a table's point
     h_full = 0.0  # the step before the first of them
-    j_last, c_last = -1, 0.0  # the table and the point a step was taken again up to
+    # a table point a step was taken again up to, kept between calls: the bracket of its
+    # time (the end of the last attempt past it: time, variable), how often a step has
+    # since landed short of it (Illinois' rule), the variable's travel in the first step
+    # past it, the point and its table (see P_BRACKET)
+    br = par[P_BRACKET:P_BRACKET + 6]
     switch = False  # the next pieces are held from the end of the step
+    ahead = 2.0 * ETA  # (the part of its travel past its end at which a table switches)
     steps = 0
     ws0, wp0 = np.empty(ws.size), 0  # the workspace and watch at a step's start (put back)
     ipar[I_FLAGS] = 0
@@ -439,8 +451,13 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
         if nt > 0:  # has a table variable left its piece?
             table_vars(t_new, ip, fp, dims, sc, s_new)
             th, jt, ct = left(ip, fp, s_old, s_new, locks)
+            # (a bracket of this point's time: the criteria relative to the first step
+            # past it, not to the short steps that aim at it)
+            aiming = br[0] < np.inf and jt == int(br[5]) and ct == br[4]
             if th <= 1.0 and retried < 8:
-                if th <= ETA or th * h <= hmin:  # at the point already: the next piece
+                if th <= ETA or th * h <= hmin or (
+                        aiming and abs(s_old[jt] - ct) <= ETA * br[3]):  # at the point already
+                    br[0] = np.inf  # (the next piece)
                     ipar[I_REJ] += 1
                     _put_back(ws, ws0)
                     ipar[I_WPEND] = wp0
@@ -458,15 +475,25 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
                     ipar[I_WPEND] = wp0
                     if retried == 0:
                         h_full = h
-                    j_last, c_last = jt, ct
+                    if not aiming:
+                        br[3] = abs(s_new[jt] - s_old[jt])
+                    if not aiming or t_new < br[0]:
+                        br[0], br[1], br[2] = t_new, s_new[jt], 0.0
+                    br[4], br[5] = ct, jt
                     retried += 1
                     h = th * h * (1.0 + 0.5 * ETA)
                     continue
             switch = th <= 1.0  # past the point by at most ETA of the step: next piece
-            if not switch and retried > 0 and abs(s_new[j_last] - c_last) <= \
-                    ETA * abs(s_new[j_last] - s_old[j_last]):  # just short of it: as well
-                switch = True
-                s_new[j_last] = c_last + (c_last - s_old[j_last]) * ETA  # (for hold: past it)
+            ahead = 2.0 * ETA
+            if switch and aiming:
+                br[0] = np.inf
+            jl = int(br[5])
+            if not switch and br[0] < np.inf and abs(s_new[jl] - br[4]) <= ETA * br[3]:
+                switch = True  # just short of it (by ETA of the first step past it): as well
+                ahead = min(1.0, max(ahead, 2.0 * ETA * br[3] / max(abs(s_new[jl] - s_old[jl]),
+                                                                   1e-300)))
+                s_new[jl] = br[4] + (br[1] - br[4]) * ETA  # (for hold: past it)
+                br[0] = np.inf
         _watch(ynew[0], ws, nx, par, ipar, x_end)
         steps += 1
         ipar[I_STEPS] += 1
@@ -483,6 +510,20 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
             h_next = h_full if rejected else max(h_next, h_full)
         elif rejected:
             h_next = min(h_next, h)
+        if t_new >= br[0]:
+            br[0] = np.inf
+        elif br[0] < np.inf:
+            # landed short of the point (the variable's path curves, as a ram slowing down
+            # towards its stop): the next step aims at it by the secant through the ends of
+            # the bracket, the far end's distance halved each time it is kept (Illinois),
+            # not again from a step past it, which would land short by the same part
+            c = br[4]
+            far = c + (br[1] - c) * 0.5 ** br[2]
+            lo = s_new[int(br[5])]
+            if (far - c) * (c - lo) > 0.0:
+                aim = (br[0] - t_new) * (c - lo) / (far - lo) * (1.0 + 0.5 * ETA)
+                h_next = min(h_next, max(aim, hmin))
+            br[2] += 1.0
         rejected = False
         aimed = retried > 0  # (a step shortened to a table's point: no stall)
         retried = 0
@@ -511,7 +552,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
             ipar[I_NKEPT] += 1
         if flags != 0:
             ipar[I_FLAGS] = flags
-            if not _switch(switch, t_new, ynew, fnew, s_old, s_new, ni, ip, fp, ri, rf, dims,
+            if not _switch(switch, ahead, t_new, ynew, fnew, s_old, s_new, ni, ip, fp, ri, rf, dims,
                            ws, ext_end, end_sample, sc, piv, ipar, locks):
                 par[P_T], par[P_H] = t, h
                 return FAILED
@@ -523,7 +564,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
                        end_sample, t_eval, par, ipar, ip, fp, ri, rf, dims, ws, ext, ext_end,
                        x_end, on, sc, piv, o_t, o_y, o_x, o_xd, o_ext):
             return FAILED
-        if not _switch(switch, t_new, ynew, fnew, s_old, s_new, ni, ip, fp, ri, rf, dims, ws,
+        if not _switch(switch, ahead, t_new, ynew, fnew, s_old, s_new, ni, ip, fp, ri, rf, dims, ws,
                        ext_end, end_sample, sc, piv, ipar, locks):
             par[P_T], par[P_H] = t, h
             return FAILED

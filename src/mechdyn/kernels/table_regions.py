@@ -16,7 +16,10 @@ function), and looks at the table variables at the end of each accepted step: wh
 has left its piece, the step is taken again, shortened to end where the variable meets
 the piece's end (linear in the variable between the step's ends; again until the point
 lies within :data:`ETA` of the step's end), and the next piece is held from there.  The
-error of the part past the point then falls with the square of its length.
+error of the part past the point then falls with the square of its length.  A shortened
+step that lands short of the point (by more than ETA of the first step's travel past it)
+is followed by steps that aim at it by regula falsi with Illinois' rule over the bracket
+of its time, not from past it again.
 
 A *region* of a table of n points is ``g`` in 0..n: 0 below the first point, g between
 points g - 1 and g, n above the last point; a periodic table also has its period count
