@@ -5,7 +5,7 @@ Run ``python -m benchmarks foundation`` or ``python benchmarks/bench_foundation.
 The bundled press cycle (``mechdyn.examples.load("press_cycle")``, the isolators of its
 ``[foundation]`` table) is simulated over the same interval on its fixed frame and
 ``mechdyn.foundation.mounted`` on its isolators (one more body, the base, free with
-three more coordinates, and four isolator springs): as it stands (``external``: the
+three more coordinates, and two isolator bushings): as it stands (``external``: the
 cylinder, spring and punch forces push the whole mounted machine) and with the frame
 carrying their reactions (``bed``: ``reacting=BED``, the press as built; ``mechdyn foundation
 press_cycle --coupled --bed ...``).  After a short warm-up run of each (kernels
