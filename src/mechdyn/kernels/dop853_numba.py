@@ -306,9 +306,12 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
     Each table with sharp points has its piece held through a step; a step at whose end
     a table variable has left its piece is taken again up to the piece's end (within
     ``ETA`` of the step), and the next piece is held from there (``kv``: the variables at
-    the last accepted point | at the step's end | the pieces held between calls).  Where
-    that step lands short of the point, the next ones aim at it by regula falsi over the
-    bracket of its time (Illinois' rule; the bracket in ``par[P_BRACKET:]``)."""
+    the last accepted point | at the step's end | the pieces held between calls).  The
+    cuts are regula falsi with Illinois' rule on both sides of the point: where an attempt
+    lands past it again, the start's distance is halved; where the step lands short, the
+    next ones aim at it over the bracket of its time (``par[P_BRACKET:]``).  A variable
+    that leaves its piece at a stage and is back on it at the end has the step cut back to
+    that stage."""
     ni = dims[D_NI]
     nx = x_end.size // 3
     m = y.size
@@ -324,6 +327,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
     nt = ip[H_NTAB]
     locks = held_pieces(ws, nx, ni)
     s_old, s_new = kv[:nt], kv[nt:2 * nt]
+    s_st = np.empty(nt)  # the table variables at a stage
     if ipar[I_FSAL] == 0:
         locks[:] = 0.0
         if not _counted(t, y, f, ni, ip, fp, ri, rf, dims, ws, ext, off, sc, piv, ipar):
@@ -351,6 +355,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
                 h = _initial_step(y, f, K[2], h, dnf, atol, rtol, hmax)
     rejected = False
     retried = 0  # attempts of this step taken again up to a table's point
+    over = 0  # of them, those past the same point in a row
     h_full = 0.0  # the step before the first of them
     # a table point a step was taken again up to, kept between calls: the bracket of its
     # time (the end of the last attempt past it: time, variable), how often a step has
@@ -392,6 +397,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
             wp0 = ipar[I_WPEND]  # a watch armed by an attempt that is not kept is dropped
         for i in range(m):
             K[0, i] = f[i]
+        first = 2.0  # the earliest part of the step at which a stage has left a piece
         for s in range(1, N_STAGES):
             stage(y, K, s, h, ys)
             if not _counted(t + C[s] * h, ys, K[s], ni, ip, fp, ri, rf, dims, ws, ext, off,
@@ -400,6 +406,11 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
                 par[P_T], par[P_H] = t, h
                 return FAILED
             _watch(ys[0], ws, nx, par, ipar, x_end)
+            if nt > 0:
+                table_vars(t + C[s] * h, ip, fp, dims, sc, s_st)
+                th_s = left(ip, fp, s_old, s_st, locks)[0]
+                if th_s <= 1.0:
+                    first = min(first, th_s * C[s])
         stage(y, K, N_STAGES, h, ynew)
         # the error estimate (orders 5 and 3)
         e5n = 0.0
@@ -422,6 +433,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
             ipar[I_REJ] += 1
             rejected = True
             retried = 0
+            over = 0
             h_full = 0.0
             ipar[I_WPEND] = wp0
             # a retry starts its solves where the step started, not from the poses of the
@@ -454,6 +466,18 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
             # (a bracket of this point's time: the criteria relative to the first step
             # past it, not to the short steps that aim at it)
             aiming = br[0] < np.inf and jt == int(br[5]) and ct == br[4]
+            if th > 1.0 and ETA < first < 1.0 - ETA and retried < 8:
+                # a variable that left its piece and came back within the step (a ram
+                # that, on the piece past its stop, would turn round there): the step
+                # again, up to where the first stage past the point puts it
+                ipar[I_REJ] += 1
+                _put_back(ws, ws0)
+                ipar[I_WPEND] = wp0
+                if retried == 0:
+                    h_full = h
+                retried += 1
+                h = max(first * h * (1.0 + 0.5 * ETA), hmin)
+                continue
             if th <= 1.0 and retried < 8:
                 if th <= ETA or th * h <= hmin or (
                         aiming and abs(s_old[jt] - ct) <= ETA * br[3]):  # at the point already
@@ -479,6 +503,13 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
                         br[3] = abs(s_new[jt] - s_old[jt])
                     if not aiming or t_new < br[0]:
                         br[0], br[1], br[2] = t_new, s_new[jt], 0.0
+                    # the secant from the step's start, whose distance to the point is
+                    # halved each time the attempt lands past it again (Illinois' rule:
+                    # a path that curves towards the point would otherwise be closed in
+                    # on by a few per cent an attempt, and the attempts run out past it)
+                    over = over + 1 if aiming else 1
+                    a = ct + (s_old[jt] - ct) * 0.5 ** (over - 1)
+                    th = (ct - a) / (s_new[jt] - a)
                     br[4], br[5] = ct, jt
                     retried += 1
                     h = th * h * (1.0 + 0.5 * ETA)
@@ -527,6 +558,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
         rejected = False
         aimed = retried > 0  # (a step shortened to a table's point: no stall)
         retried = 0
+        over = 0
         h_full = 0.0
         # what Python must look at
         flags = step_end(t, h, t_new, y, f, ynew, fnew, ws, x_end, hist, par, ni,
