@@ -34,7 +34,7 @@ from ..errors import ModelError
 from ..kernels import rows_numpy
 from ..kinematics.constraints import _perp, extend
 from ..model import Model
-from .forces import cross, rotate
+from .pair_loads import cross, rotate
 
 __all__ = ["FrictionPair", "FrictionSet", "PreparedFriction", "friction_joints"]
 

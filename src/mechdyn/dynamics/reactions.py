@@ -16,11 +16,12 @@ from ..kinematics.assembly import SINGULAR_RCOND, _redundant_rows, _scale
 from ..kinematics.constraints import _perp, coordinates_jacobian, extend
 from ..model import ConstraintLayout, Model
 from .compliance import share_by_compliance
-from .forces import applied_forces, cross, rotate
+from .forces import applied_forces
 from .friction import friction_joints
 from .inertia import inertia_forces
 from .joint_friction import friction_set, joint_states
 from .kinetostatics_friction import friction_solve, locking_note
+from .pair_loads import cross, rotate
 
 __all__ = ["KinetostaticsWarning", "joint_reaction", "reaction_frame", "element_forces",
            "element_width", "frame_forces", "touches_ground", "ground_rows"]

@@ -63,9 +63,8 @@ def floor_forces(trajectory, foundation: Foundation, base: str = "base",
     idx = [names.index(c) for c in base_coordinates(base)]
     u, v = trajectory.q[:, idx], trajectory.qdot[:, idx]
     per = isolator_forces(foundation, u, v)  # (n, iso, 2) on the floor
-    s = np.array([(p.x, p.y) for p in foundation.supports], float)
     # where the base points are: the floor takes the forces there
-    at = _turn(u[:, 2, None], s) + u[:, None, :2] - np.asarray(point, float)
+    at = _turn(u[:, 2, None], foundation.positions()) + u[:, None, :2] - np.asarray(point, float)
     m = np.sum(at[..., 0] * per[..., 1] - at[..., 1] * per[..., 0], axis=1)
     floor = np.column_stack([per.sum(axis=1), m])
     u, v = to_centre_of_mass(foundation, u, v)

@@ -428,7 +428,7 @@ def isolator_forces(foundation: Foundation, u, v=None, pivot=(0.0, 0.0)) -> np.n
     u = np.asarray(u, float)
     pivot = np.asarray(pivot, float)
     shape = u.shape[:-1] + (1,)
-    s = np.array([(p.x, p.y) for p in foundation.supports], float) - pivot  # (n, 2)
+    s = foundation.positions() - pivot
     rr = _turn(u[..., 2].reshape(shape), s)  # (..., n, 2)
     F = foundation.stiffnesses() * (rr - s + u[..., None, :2])
     if v is not None:
@@ -491,7 +491,7 @@ def static_equilibrium(mechanism: Mechanism, foundation: Foundation,
             points.append(np.asarray(pose[:2]) + _turn(pose[2], np.asarray(b.com)))
             forces.append(b.mass * g)
     r0, F0 = np.array(points) - pivot, np.array(forces)
-    r_iso = np.array([(s.x, s.y) for s in foundation.supports], float) - pivot
+    r_iso = foundation.positions() - pivot
 
     def residual(u):
         F = isolator_forces(foundation, u, pivot=pivot)  # what the base pushes

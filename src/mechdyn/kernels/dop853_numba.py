@@ -31,7 +31,7 @@ import numpy as np
 
 from ..integrate.dop853_tableau import E3, E5, N_STAGES, C
 from .dop853_dense import dense_at, dense_coefficients, keep_step, kept_offsets, stage
-from .held_tables import hold, left, table_vars
+from .held_tables import aim, cut_back, hold, left, table_vars
 from .hermite_numba import hermite_at
 from .lagrange_numba import D_NI, N_FLAGS, W_COUNT, W_PIVOT, evaluate_into, held_pieces
 from .loads_numba import H_NB, H_NTAB
@@ -101,6 +101,15 @@ def _switch(switch, ahead, t_new, ynew, fnew, s_old, s_new, ni, ip, fp, ri, rf, 
         table_vars(t_new, ip, fp, dims, sc, s_new)
     s_old[:] = s_new
     return True
+
+
+@njit
+def _again(ws, ws0, ipar, wp0):
+    """An attempt that is not kept: counted as rejected, its workspace and watch put back
+    to those of the step's start."""
+    ipar[I_REJ] += 1
+    ipar[I_WPEND] = wp0
+    _put_back(ws, ws0)
 
 
 @njit
@@ -430,15 +439,13 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
             err = np.inf
         fac11 = err ** (0.125 - 0.2 * par[P_BETA])
         if err > 1.0 or (scipy_ctrl and err == 1.0):  # rejected
-            ipar[I_REJ] += 1
             rejected = True
             retried = 0
             over = 0
             h_full = 0.0
-            ipar[I_WPEND] = wp0
             # a retry starts its solves where the step started, not from the poses of the
             # rejected stages (a long trial step may have jumped to another assembly branch)
-            _put_back(ws, ws0)
+            _again(ws, ws0, ipar, wp0)
             if scipy_ctrl:
                 h = h * max(0.2, 0.9 * err ** -0.125)
             else:
@@ -470,9 +477,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
                 # a variable that left its piece and came back within the step (a ram
                 # that, on the piece past its stop, would turn round there): the step
                 # again, up to where the first stage past the point puts it
-                ipar[I_REJ] += 1
-                _put_back(ws, ws0)
-                ipar[I_WPEND] = wp0
+                _again(ws, ws0, ipar, wp0)
                 if retried == 0:
                     h_full = h
                 retried += 1
@@ -482,9 +487,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
                 if th <= ETA or th * h <= hmin or (
                         aiming and abs(s_old[jt] - ct) <= ETA * br[3]):  # at the point already
                     br[0] = np.inf  # (the next piece)
-                    ipar[I_REJ] += 1
-                    _put_back(ws, ws0)
-                    ipar[I_WPEND] = wp0
+                    _again(ws, ws0, ipar, wp0)
                     hold(ip, fp, s_old, s_new, locks, True, jt)
                     if not _counted(t, y, f, ni, ip, fp, ri, rf, dims, ws, ext, off, sc, piv,
                                     ipar):
@@ -494,25 +497,17 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
                     retried += 1
                     continue
                 if th < 1.0 - ETA:  # again, up to the point (just past it)
-                    ipar[I_REJ] += 1
-                    _put_back(ws, ws0)
-                    ipar[I_WPEND] = wp0
+                    _again(ws, ws0, ipar, wp0)
                     if retried == 0:
                         h_full = h
                     if not aiming:
                         br[3] = abs(s_new[jt] - s_old[jt])
                     if not aiming or t_new < br[0]:
                         br[0], br[1], br[2] = t_new, s_new[jt], 0.0
-                    # the secant from the step's start, whose distance to the point is
-                    # halved each time the attempt lands past it again (Illinois' rule:
-                    # a path that curves towards the point would otherwise be closed in
-                    # on by a few per cent an attempt, and the attempts run out past it)
                     over = over + 1 if aiming else 1
-                    a = ct + (s_old[jt] - ct) * 0.5 ** (over - 1)
-                    th = (ct - a) / (s_new[jt] - a)
                     br[4], br[5] = ct, jt
                     retried += 1
-                    h = th * h * (1.0 + 0.5 * ETA)
+                    h = cut_back(s_old[jt], s_new[jt], ct, over) * h * (1.0 + 0.5 * ETA)
                     continue
             switch = th <= 1.0  # past the point by at most ETA of the step: next piece
             ahead = 2.0 * ETA
@@ -543,18 +538,8 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
             h_next = min(h_next, h)
         if t_new >= br[0]:
             br[0] = np.inf
-        elif br[0] < np.inf:
-            # landed short of the point (the variable's path curves, as a ram slowing down
-            # towards its stop): the next step aims at it by the secant through the ends of
-            # the bracket, the far end's distance halved each time it is kept (Illinois),
-            # not again from a step past it, which would land short by the same part
-            c = br[4]
-            far = c + (br[1] - c) * 0.5 ** br[2]
-            lo = s_new[int(br[5])]
-            if (far - c) * (c - lo) > 0.0:
-                aim = (br[0] - t_new) * (c - lo) / (far - lo) * (1.0 + 0.5 * ETA)
-                h_next = min(h_next, max(aim, hmin))
-            br[2] += 1.0
+        elif br[0] < np.inf:  # landed short of the point: the next step aims at it
+            h_next = min(h_next, max(aim(br, t_new, s_new[int(br[5])], ETA), hmin))
         rejected = False
         aimed = retried > 0  # (a step shortened to a table's point: no stall)
         retried = 0

@@ -16,7 +16,7 @@ from .loads_numba import H_FOFF, H_IOFF, H_NB, H_NTAB, IR_LOCK, S_LOCK, S_TAB
 from .rows_numba import njit
 from .table_regions import region_bounds, region_of
 
-__all__ = ["table_vars", "hold", "left"]
+__all__ = ["table_vars", "hold", "left", "cut_back", "aim"]
 
 
 @njit
@@ -97,3 +97,44 @@ def left(ip, fp, old, new, locks):
         if th < best:
             best, jb, cb = th, j, c
     return best, jb, cb
+
+
+@njit
+def cut_back(a, b, c, over):
+    """The part of a step whose variable went from ``a`` to ``b`` past the point ``c`` at
+    which to end it again: the secant from the start, whose distance to the point is
+    halved for each earlier attempt past it in a row (``over`` - 1 of them; Illinois'
+    rule: a path that curves towards the point would otherwise be closed in on by a few
+    per cent an attempt, and the attempts would run out past it).
+
+    Examples
+    --------
+    >>> cut_back(0.0, 2.0, 1.0, 1), cut_back(0.0, 2.0, 1.0, 2)
+    (0.5, 0.3333333333333333)
+    """
+    a = c + (a - c) * 0.5 ** (over - 1)
+    return (c - a) / (b - a)
+
+
+@njit
+def aim(br, t, s, eta):
+    """The step from ``t``, where a step ended short of the point of the bracket ``br``
+    (its table's variable there ``s``), that aims at the point: the secant through the
+    bracket's ends, the far end's distance to the point halved each time it is kept
+    (Illinois' rule, ``br[2]`` counts them), just past it by ``eta``; inf where ``s`` is
+    not short of the point.  ``br``: time and variable of the far end, the count, the
+    first step's travel, the point, the table (``P_BRACKET`` of the DOP853 loop).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> br = np.array([1.0, 2.0, 0.0, 1.0, 1.0, 0.0])
+    >>> aim(br, 0.0, 0.0, 0.0), aim(br, 0.5, 0.75, 0.0), float(br[2])
+    (0.5, 0.16666666666666666, 2.0)
+    """
+    c = br[4]
+    far = c + (br[1] - c) * 0.5 ** br[2]
+    br[2] += 1.0
+    if (far - c) * (c - s) > 0.0:
+        return (br[0] - t) * (c - s) / (far - s) * (1.0 + 0.5 * eta)
+    return np.inf

@@ -322,7 +322,7 @@ def forces(t, q, qdot, x, v, ip, fp, F, Fnc, Qd, varv, locks, cs):
     oi, of = ip[H_IOFF + S_BUS], ip[H_FOFF + S_BUS]
     for k in range(ip[H_NBUS]):
         # d = A_i^T (r_j - r_i) in body i's axes; -A_i (K d + C d') on j, the opposite on
-        # i where end j is (the twin of forces._BushingSet)
+        # i where end j is (the twin of pair_loads.BushingSet)
         i = ip[oi + IR_BUS * k]
         j = ip[oi + IR_BUS * k + 1]
         f0 = of + FR_BUS * k

@@ -289,6 +289,10 @@ class Foundation:
         """True for each support that is an anchor bolt."""
         return tuple(isinstance(s, AnchorBolt) for s in self.supports)
 
+    def positions(self) -> np.ndarray:
+        """(x, y) of every support, shape (n, 2), m."""
+        return np.array([(s.x, s.y) for s in self.supports], float)
+
     def stiffnesses(self) -> np.ndarray:
         """(kx, ky) of every support, shape (n, 2), N/m."""
         return np.array([s.stiffness for s in self.supports], float)
