@@ -29,6 +29,7 @@ from .dynamics.forces import force_model
 from .dynamics.modes import switched_model
 from .errors import MechdynError, ModelError
 from .kinematics.assembly import assemble, rank_report
+from .kinematics.constraints import coordinates
 from .model import Model
 
 __all__ = ["compile_mechanism", "check_rank", "check_loads", "warmup"]
@@ -79,7 +80,8 @@ def compile_mechanism(mechanism) -> Model:
 def check_rank(model: Model, gruebler_message: str | None = None) -> None:
     """Assemble the sketch and check the coordinates and constraints by rank.
 
-    Sets ``model.x0`` (the assembled sketch) and ``model.redundant``.
+    Sets ``model.x0`` (the assembled sketch), ``model.q_sketch`` (its coordinates) and
+    ``model.redundant``.
 
     Raises
     ------
@@ -96,6 +98,7 @@ def check_rank(model: Model, gruebler_message: str | None = None) -> None:
             probs.insert(0, gruebler_message)
         raise ModelError(probs) from exc
     model.x0 = x0
+    model.q_sketch = coordinates(model, x0)
     rep = rank_report(model, x0)
     model.redundant = rep["redundant_joints"]
     problems = []
@@ -124,7 +127,8 @@ def check_loads(model: Model) -> Model:
     Returns
     -------
     Model
-        ``model`` itself.
+        ``model`` itself, with ``forces`` (the loads and drives resolved) and
+        ``switchable`` (the switchable elements) set.
 
     Raises
     ------
@@ -132,9 +136,9 @@ def check_loads(model: Model) -> Model:
         Listing every problem found.
     """
     probs: list[str] = []
-    for check in (force_model, switched_model):
+    for attr, build in (("forces", force_model), ("switchable", switched_model)):
         try:
-            check(model)
+            setattr(model, attr, build(model))
         except ModelError as exc:
             probs.extend(p for p in exc.problems if p not in probs)
     if probs:

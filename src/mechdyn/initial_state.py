@@ -43,7 +43,7 @@ def _values(model: Model, given, base: np.ndarray, what: str) -> np.ndarray:
 MAX_WALK = 2000
 
 
-def initial_state(model: Model, q0=None, qdot0=None, *, mode=None):
+def initial_state(model: Model, q0=None, qdot0=None, *, mode=None, workspace=None):
     """Initial (q, qdot, x): arguments, else ``mechanism.extras["initial"]``, else the sketch.
 
     Parameters
@@ -51,6 +51,10 @@ def initial_state(model: Model, q0=None, qdot0=None, *, mode=None):
     q0, qdot0 : array_like (n_q,) or mapping {coordinate name: value}, optional
         Values given override those of the model file; missing ones come from the
         model file's ``initial`` table, then from the sketch (rates: zero).
+    mode : sequence of str, optional
+        The engaged locks (default: the initial mode).
+    workspace : Workspace, optional
+        Keeps the pose for the next run given the same workspace.
 
     Returns
     -------
@@ -62,8 +66,9 @@ def initial_state(model: Model, q0=None, qdot0=None, *, mode=None):
     x_sk = getattr(model, "x0", None)
     if x_sk is None:
         x_sk = assemble(model, layout=layout)
-    sketch = np.asarray(x_sk, float).tobytes()
-    q_sk = _sketch_coordinates(model, x_sk, sketch)
+    q_sk = getattr(model, "q_sketch", None)
+    if q_sk is None:
+        q_sk = coordinates(model, x_sk)
     init = model.mechanism.extras.get("initial") or {}
     q = _values(model, init.get("q"), q_sk, "initial q")
     qd = _values(model, init.get("qdot"), np.zeros(model.n_q), "initial qdot")
@@ -71,27 +76,15 @@ def initial_state(model: Model, q0=None, qdot0=None, *, mode=None):
     qd = _values(model, qdot0, qd, "qdot0")
     if not (np.isfinite(q).all() and np.isfinite(qd).all()):
         raise ModelError(f"the initial state must be finite, got q = {q}, qdot = {qd}")
-    # the pose is kept with the compiled model for the next run from the same state (the
-    # continuation is a function of the sketch, the mode and q alone)
-    key = ("initial pose", tuple(sorted(mode or ())), sketch, q.tobytes())
-    x = model.memo.get(key)
+    # the continuation is a function of the sketch, the mode and q alone: a caller that
+    # passes the same workspace to many runs from one state walks once
+    key = (tuple(sorted(mode or ())), np.asarray(x_sk, float).tobytes(), q.tobytes())
+    x = None if workspace is None else workspace.poses.get(key)
     if x is None:
         x = _walk(model, layout, q, q_sk, x_sk)
-        kept = model.memo.setdefault("initial poses", [])
-        if len(kept) < 16:  # a bounded number (a study runs many initial states)
-            kept.append(key)
-            model.memo[key] = x
+        if workspace is not None:
+            workspace.keep(workspace.poses, key, x)
     return q, qd, np.array(x, float)
-
-
-def _sketch_coordinates(model: Model, x_sk, sketch: bytes) -> np.ndarray:
-    """The coordinates of the sketch pose (bytes ``sketch``), kept with the compiled
-    model."""
-    key = ("sketch coordinates", sketch)
-    q_sk = model.memo.get(key)
-    if q_sk is None:
-        q_sk = model.memo[key] = coordinates(model, x_sk)
-    return q_sk
 
 
 def _walk(model: Model, layout, q, q_sk, x_sk) -> np.ndarray:

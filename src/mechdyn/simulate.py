@@ -50,7 +50,7 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
              iterations: int | None = None, tol: float | None = None,
              theta: float | None = None, first_step: float | None = None,
              max_step: float | None = None, sink=None, chunk: int = 2000, keep: bool = True,
-             **switching) -> Trajectory:
+             workspace=None, **switching) -> Trajectory:
     """Simulate the motion of a mechanism under its loads and drives, through every
     switch, impact and contact of a variable-structure mechanism.
 
@@ -145,6 +145,12 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
         ``False`` keeps only the last chunk, so memory does not grow with the run, and
         ``stats["streamed"]`` gives the run's ``rows``, ``t_first``, ``energy_drift``
         and largest constraint ``residual``.
+    workspace : Workspace, optional
+        The caches of the run (:class:`~mechdyn.model.workspace.Workspace`): pass the
+        same one to many runs of one model from one initial state (a study, an
+        optimiser) and they pay the start of the run -- the assembly, the first mode
+        system, the equations of the first segment -- once.  By default each run makes
+        its own; the Model keeps nothing of a run.
 
     Returns
     -------
@@ -210,4 +216,4 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
                            progress=progress, dt=dt, steps=steps, iterations=iterations,
                            tol=tol, theta=theta, events=events, backend=backend,
                            formulation=formulation, d=d, sink=sink, chunk=chunk, keep=keep,
-                           **switching)
+                           workspace=workspace, **switching)

@@ -97,11 +97,13 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
                     tol: float | None = None, theta: float | None = None,
                     first_step: float | None = None, events=None,
                     backend: str = "auto", formulation: str = "exact",
-                    d=None, sink=None, chunk: int = 2000, keep: bool = True) -> Trajectory:
+                    d=None, sink=None, chunk: int = 2000, keep: bool = True,
+                    workspace: Workspace | None = None) -> Trajectory:
     """The segment loop that runs every simulation: the keywords of
     :func:`mechdyn.simulate` (``method`` is its ``integrator``) and its ``**switching``
     options, without the checks of the keywords that :func:`mechdyn.simulate` makes.
-    ``sink``, ``chunk`` and ``keep``: see :class:`~mechdyn.dynamics.run_samples.Samples`.
+    ``sink``, ``chunk`` and ``keep``: see :class:`~mechdyn.dynamics.run_samples.Samples`;
+    ``workspace``: see :func:`mechdyn.simulate`.
 
     Returns
     -------
@@ -112,7 +114,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     model = mech_or_model if isinstance(mech_or_model, Model) else mech_or_model.compile()
     sm = switched_model(model)
     L = model.length_scale
-    scale, force_scale = _constants(model)
+    scale, force_scale = model.tolerance_scale, model.force_scale
     t_end = float(t_end)
     t0 = float(t0)
     if not t_end >= t0:
@@ -172,12 +174,13 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         raise ModelError("mode: " + did_you_mean(unknown[0], sm.lock_names, "lock"))
     stats["mode"] = sorted(locks)  # the engaged locks at the start
     welds = sorted(locks & set(sm.welds))
-    q_init, qd_init, x_guess = initial_state(model, q0, qdot0, mode=welds)
+    # the run's caches, shared by the mode systems of the run (the caller's, if given)
+    ws = (Workspace() if workspace is None else workspace).begin()
+    q_init, qd_init, x_guess = initial_state(model, q0, qdot0, mode=welds, workspace=ws)
     t = t0
     # the integrated work: W_nc (every non-conservative force, friction included) and,
     # with friction in the joints, the work W_f lost to it (>= 0)
     w = np.zeros(2 if friction_joints(model) else 1)
-    ws = Workspace()  # the run's caches, shared by the mode systems of the run
     try:
         ms, x, xd, targets, qi, qdi, start = start_state(
             sm, t, locks, q_init, qd_init, x_guess, ws, events, gap_tol=gap_tol,
@@ -345,20 +348,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     stats["backend"] = "numba" if backends == {"numba"} else (
         "numpy" if backends <= {"numpy"} else "numba+numpy")
     bar.close()
-    give_back(sm, first_eqs, kept_eqs)  # for the next run from the same start
+    give_back(ws, first_eqs, kept_eqs)  # for the next run from the same start
     return finish(model, rec, events, stats, wall0, status, message, sm, point)
-
-
-def _constants(model) -> tuple:
-    """The scale of the coordinates' tolerances (1 for angles, the length scale for
-    travels), shape (n_q,), and the force scale of the model (its weight, at least 1 N),
-    kept with the compiled model."""
-    got = model.memo.get("run constants")
-    if got is None:
-        got = model.memo["run constants"] = (
-            np.where(model.coord_is_angle, 1.0, model.length_scale),
-            max(float(np.sum(model.mass) * max(np.hypot(*model.gravity), 1.0)), 1.0))
-    return got
 
 
 def _status(exc, good):

@@ -1,11 +1,12 @@
-"""The fixed cost of a run: what a mode system keeps on the model and its shortcuts give
-what the full computation gives."""
+"""The fixed cost of a run: what a mode system keeps in the run's workspace and its
+shortcuts give what the full computation gives."""
 
 import numpy as np
 
 from mechdyn.dynamics import mode_system as MS
 from mechdyn.dynamics.modes import ModeSystem, switched_model
 from mechdyn.examples.paper_case import press_idle
+from mechdyn.model.workspace import Workspace
 
 
 def _greedy(Rs):
@@ -31,12 +32,13 @@ def test_independent_rows_shortcut_agrees_with_gram_schmidt():
         assert MS._independent_rows(C).tolist() == _greedy(C)
 
 
-def test_mode_rows_kept_on_the_model_give_the_same_mode_system():
+def test_mode_rows_kept_in_a_workspace_give_the_same_mode_system():
     model = press_idle().compile()
     sm = switched_model(model)
-    a = ModeSystem(sm, frozenset(), {}, model.x0)
-    b = ModeSystem(sm, frozenset(), {}, model.x0)
-    assert b.layout is a.layout  # built once, kept in model.memo
+    ws = Workspace()
+    a = ModeSystem(sm, frozenset(), {}, model.x0, workspace=ws)
+    b = ModeSystem(sm, frozenset(), {}, model.x0, workspace=ws)
+    assert b.layout is a.layout  # built once, kept in the run's workspace
     assert b.rows is not a.rows  # each mode system has its own list
     assert a.coords.tolist() == b.coords.tolist()
     assert a.independent_rows.tolist() == b.independent_rows.tolist()

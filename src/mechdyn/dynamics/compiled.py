@@ -37,6 +37,7 @@ from ..mechanism.mechanism import Mechanism
 from ..model import Model
 from ..model.rows import concat
 from ..model.variable import lower, parse
+from ..model.workspace import Workspace
 from .compiled_loop import fast_forward, kept_steps, warm_up_loop
 from .forces import force_model
 
@@ -230,7 +231,7 @@ def _warm_up() -> float:
     return _COMPILED["time"]
 
 
-def compile_mode_kernel(model, force_model, constraint_rows, independent):
+def compile_mode_kernel(model, force_model, constraint_rows, independent, *, kept=None):
     """The compiled kernel of a mode, or ``(None, reason)``.
 
     Parameters
@@ -244,6 +245,9 @@ def compile_mode_kernel(model, force_model, constraint_rows, independent):
     independent : sequence of int
         Indices of the declared coordinates that are independent in the mode
         (n_i of them, n_c + n_i = n_x).
+    kept : dict, optional
+        Where the packed arrays of the modes of a run are kept
+        (:attr:`Workspace.kernels <mechdyn.model.workspace.Workspace>`).
 
     Returns
     -------
@@ -258,11 +262,12 @@ def compile_mode_kernel(model, force_model, constraint_rows, independent):
         return None, "nothing to compile"
     if len(constraint_rows) + independent.size != model.n_x:
         return None, "redundant constraints (non-square position Jacobian)"
-    # the packed arrays of a mode are kept with the model: a run, or the next run, that
-    # meets the same rows again (the same targets) only allocates a new workspace
+    # the packed arrays of a mode are kept in ``kept``: a run (or the next run given the
+    # same workspace) that meets the same rows again (the same targets) only allocates a
+    # new kernel workspace
     ints, flts = constraint_rows.packed()
-    key = ("kernel", independent.tobytes(), ints.tobytes(), flts.tobytes())
-    packed = model.memo.get(key)
+    key = None if kept is None else (independent.tobytes(), ints.tobytes(), flts.tobytes())
+    packed = None if key is None else kept.get(key)
     if packed is None:
         packer = LoadPacker(model, force_model, variable=lambda name: _variable(model, name))
         try:
@@ -279,10 +284,8 @@ def compile_mode_kernel(model, force_model, constraint_rows, independent):
             dims = np.concatenate([[len(constraint_rows), independent.size, model.n_q,
                                     len(var)], order]).astype(np.int64)
             packed = (ip, fp, ri, rf, dims)
-        kept = model.memo.setdefault("kernels", [])
-        if len(kept) < 64:  # a bounded number (locks capture new targets every cycle)
-            kept.append(key)
-            model.memo[key] = packed
+        if kept is not None:
+            Workspace.keep(kept, key, packed)
     if isinstance(packed, str):
         return None, packed
     return CompiledKernel(*packed, model.n_x, _warm_up()), ""

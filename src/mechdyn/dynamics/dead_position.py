@@ -99,13 +99,13 @@ def rigid_coordinates(ms, x) -> frozenset:
     Returns
     -------
     frozenset of int
-        Kept with the compiled model for the mode, its coordinates and rows (a property
+        Kept in the run's workspace for the mode, its coordinates and rows (a property
         of the assembly, the same at every pose of the mode).
     """
     model = ms.model
-    key = ("rigid coordinates", ms.mode, tuple(int(c) for c in ms.coords),
+    key = (ms.mode, tuple(int(c) for c in ms.coords),
            np.asarray(ms.independent_rows).tobytes())
-    found = model.memo.get(key)
+    found = ms.ws.rigid.get(key)
     if found is not None:
         return found
     coords = list(model.mechanism.coordinates.values())
@@ -134,8 +134,7 @@ def rigid_coordinates(ms, x) -> frozenset:
         Jw = J @ w
         if np.abs(Jw - e).max() <= 1e-9 * max(1.0, np.abs(J).max() * np.abs(w).max()):
             out.add(k)
-    found = model.memo[key] = frozenset(out)
-    return found
+    return ms.ws.keep(ms.ws.rigid, key, frozenset(out))
 
 
 def turning_point(eqs, step, qd_old, x_good) -> str | None:
@@ -222,21 +221,16 @@ def _dead_at(ms, x, k: int, rep=None) -> bool:
 
 def _packed_rows(ms):
     """``(nb, ints, flts)``: the mode's position rows packed for the compiled Jacobian (None
-    without Numba), kept with the compiled model for the mode's rows and held values (made
+    without Numba), kept in the run's workspace for the mode's rows and held values (made
     anew for held values that are not numbers)."""
     if not NUMBA:
         return None
-    model = ms.model
     held = held_key(ms.targets)
-    key = None if held is None else ("turn rows", ms.mode, held)
-    found = None if key is None else model.memo.get(key)
+    key = None if held is None else (ms.mode, held)
+    found = None if key is None else ms.ws.turn_rows.get(key)
     if found is None:
         rows = ms.layout.position_rows
-        found = (rows.nb, *rows.packed())
-        kept = model.memo.setdefault("turn rows kept", [])
-        if key is not None and len(kept) < 64:  # a bounded number (held values change)
-            kept.append(key)
-            model.memo[key] = found
+        found = ms.ws.keep(ms.ws.turn_rows, key, (rows.nb, *rows.packed()))
     return found
 
 

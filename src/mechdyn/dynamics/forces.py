@@ -109,13 +109,17 @@ class LoadContext:
         or ``'dist(body.point, body.point)'``; s, rad, m or their rates."""
         v = self._read.get(name)
         if v is None:
-            v = self._read[name] = _scalar_or_array(_variable_reader(self.model, name)(self))
+            fm = self.model.forces
+            fn = fm.readers.get(name) if fm is not None else None
+            if fn is None:  # a variable of no table (read by a callable load)
+                fn = _variable_reader(self.model, name)
+            v = self._read[name] = _scalar_or_array(fn(self))
         return v
 
 
 def _variable_reader(model: Model, name: str):
-    """A function of a :class:`LoadContext` giving variable ``name`` (array or float),
-    resolved once per model and name (cached on the model).
+    """A function of a :class:`LoadContext` giving variable ``name`` (array or float);
+    those of the load tables are resolved once, by :func:`force_model`.
 
     Raises
     ------
@@ -123,10 +127,6 @@ def _variable_reader(model: Model, name: str):
         Unknown variable, coordinate, joint, body or point; the message lists the
         valid forms or names.
     """
-    cache = model.memo.setdefault("load_variables", {})
-    fn = cache.get(name)
-    if fn is not None:
-        return fn
     var = parse(name, model.coordinate_names)
     if var.kind == "time":
         def fn(ctx):
@@ -151,7 +151,6 @@ def _variable_reader(model: Model, name: str):
         else:
             def fn(ctx, rows=rows):
                 return rows_numpy.values(rows, ctx.x)[..., 0]
-    cache[name] = fn
     return fn
 
 
@@ -208,6 +207,8 @@ class ForceModel:
     torques: list
     drives: list
     bushings: list = field(default_factory=list)
+    #: {variable name: its reader, a function of a LoadContext} of the load tables
+    readers: dict = field(default_factory=dict)
 
     def __post_init__(self):
         m = self.model
@@ -400,11 +401,11 @@ def applied_forces(model: Model, t, x, xdot, q, qdot, *, skip_drives: Sequence[i
 def force_model(model: Model) -> ForceModel:
     """Resolve the loads and drives of ``model.mechanism`` to indices; all problems at once."""
     mech = model.mechanism
-    cached = model.memo.get("force_model")
-    if cached is not None:
-        return cached
+    if model.forces is not None:  # built when the model was compiled
+        return model.forces
     probs: list[str] = []
     springs, rotary, forces, torques, drives, bushings = [], [], [], [], [], []
+    readers: dict = {}  # the table variables, each resolved once
 
     def body(name, where):
         try:
@@ -472,7 +473,7 @@ def force_model(model: Model) -> ForceModel:
             tab = getattr(ld, fld, None)
             if isinstance(tab, Table):
                 try:
-                    _variable_reader(model, tab.variable)
+                    readers[tab.variable] = _variable_reader(model, tab.variable)
                 except ModelError as exc:
                     probs.append(f"{type(ld).__name__.lower()} {getattr(ld, 'name', '?')!r}: "
                                  f"{fld}: table variable: {exc}")
@@ -484,6 +485,4 @@ def force_model(model: Model) -> ForceModel:
         drives.append((dr, model.coordinate_index(dr.coordinate)))
     if probs:
         raise ModelError(probs)
-    fm = ForceModel(model, springs, rotary, forces, torques, drives, bushings)
-    model.memo["force_model"] = fm
-    return fm
+    return ForceModel(model, springs, rotary, forces, torques, drives, bushings, readers)

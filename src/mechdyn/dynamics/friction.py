@@ -81,8 +81,8 @@ class FrictionPair:
 
 def friction_joints(model: Model) -> tuple[str, ...]:
     """Names of the revolute and prismatic joints of a model that dissipate (a Coulomb
-    coefficient or a viscous term set), in the model's joint order; memoized in
-    ``model.memo``.
+    coefficient or a viscous term set), in the model's joint order
+    (:attr:`Model.friction_joints <mechdyn.model.Model>`, found when it was compiled).
 
     Parameters
     ----------
@@ -102,14 +102,7 @@ def friction_joints(model: Model) -> tuple[str, ...]:
     >>> friction_joints(examples.load("toggle_press").compile())
     ()
     """
-    names = model.memo.get("friction_joints")
-    if names is None:
-        from ..mechanism.joint import has_friction
-        joints = model.mechanism.joints
-        names = model.memo["friction_joints"] = tuple(
-            n for n in model.joint_names
-            if model.joint_kind(n) in ("revolute", "prismatic") and has_friction(joints[n]))
-    return names
+    return model.friction_joints
 
 
 def _sign(v, smoothing: float):

@@ -146,10 +146,10 @@ def _tangent(sm: SwitchedModel, r: Row):
     st = sm.stops[r.element][0]
     if not st.friction > 0:
         return None
-    cache = sm.model.memo.setdefault("stop_tangents", {})
-    if r.element not in cache:
-        cache[r.element] = parse_variable(sm.model, st.tangent_variable())
-    return st.friction, cache[r.element]
+    tangent = sm.stop_tangents.get(r.element)
+    if tangent is None:  # not resolved by the compiler: its error, here
+        tangent = parse_variable(sm.model, st.tangent_variable())
+    return st.friction, tangent
 
 
 def _momentum(x, Q):

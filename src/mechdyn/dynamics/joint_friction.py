@@ -173,12 +173,11 @@ def split_mode(model, mode) -> tuple[Mode, dict]:
 
 
 def _measure(model, joint: str):
-    """The pair's travel (m) or relative angle (rad), a Measure (memoized)."""
-    key = ("joint_measure", joint)
-    meas = model.memo.get(key)
-    if meas is None:
-        meas = model.memo[key] = parse_variable(model, f"joint:{joint}")
-    return meas
+    """The pair's travel (m) or relative angle (rad), a Measure (resolved by the
+    compiler for the joints with friction)."""
+    sm = model.switchable
+    meas = None if sm is None else sm.joint_measures.get(joint)
+    return parse_variable(model, f"joint:{joint}") if meas is None else meas
 
 
 def capture_stick(model, joint: str, x, targets: dict) -> None:
@@ -276,13 +275,9 @@ def stick_row(model, joint: str, targets: dict) -> StickRow:
 
 def friction_set(model, joints):
     """The friction law (:class:`~mechdyn.dynamics.friction.FrictionSet`) of some joints of
-    a model, built once per set."""
-    key = ("friction_set", tuple(joints))
-    fs = model.memo.get(key)
-    if fs is None:
-        from .friction import FrictionSet
-        fs = model.memo[key] = FrictionSet(model, joints)
-    return fs
+    a model (a mode's :class:`JointFriction` keeps those of its sliding pairs)."""
+    from .friction import FrictionSet
+    return FrictionSet(model, joints)
 
 
 class JointFriction:
@@ -336,6 +331,9 @@ class JointFriction:
                       if s != "stick"}
         self.stick_index = {r.element: ms.n_base + k for k, r in enumerate(ms.rows)
                             if r.kind == "stick" and r.element in self.states}
+        #: the law of the sliding pairs
+        self.law = friction_set(model, tuple(self.sliding))
+        self._single: dict = {}  # the law of each pair alone, as asked for
 
     # ------------------------------------------------------------------ the law
     def forces(self, x, xdot, lam):
@@ -354,13 +352,13 @@ class JointFriction:
         """The law of the sliding pairs at a pose and its rates, for any multipliers
         (:class:`~mechdyn.dynamics.friction.PreparedFriction`), with the mode's slip
         directions."""
-        return friction_set(self.model, tuple(self.sliding)).prepare(x, xdot, signs=self.signs)
+        return self.law.prepare(x, xdot, signs=self.signs)
 
     def by_pair(self, x, xdot, lam) -> dict:
         """{joint: generalized force (..., n_x) of its friction on the poses, N and N m} of
         the sliding pairs, batched over samples x, xdot (..., n_x), lam (..., n_rows): the
         forces of :meth:`forces`, pair by pair (the friction part of their reactions)."""
-        fs = friction_set(self.model, tuple(self.sliding))
+        fs = self.law
         return {j: F for j, (F, _) in fs.by_pair(x, xdot, lam, signs=self.signs).items()}
 
     def velocity(self, joint: str, x, xdot) -> float:
@@ -397,7 +395,9 @@ class JointFriction:
         float
             N for a guide, N m for a pin.
         """
-        fs = friction_set(self.model, (joint,))
+        fs = self._single.get(joint)
+        if fs is None:
+            fs = self._single[joint] = friction_set(self.model, (joint,))
         p = fs.pairs[0]
         load = fs.loads(x, np.asarray(lam, float))[joint][0]
         return float(p.mu * (p.length if p.kind == "revolute" else 1.0) * load)

@@ -143,7 +143,8 @@ class ModeEquations:
                     "path (Newton on the multipliers per evaluation)")
             else:
                 self.kernel, self.note = compile_mode_kernel(
-                    model, sm.fm, ms.rowset.take(ms.independent_rows), ms.coords)
+                    model, sm.fm, ms.rowset.take(ms.independent_rows), ms.coords,
+                    kept=ms.ws.kernels)
             if self.kernel is None and backend == "numba":
                 raise ModelError(f"the compiled (numba) backend is not available: {self.note}")
         if self.kernel is not None:

@@ -18,13 +18,14 @@ import numpy as np
 from ..kernels import rows_numpy as RN
 from ..model import ConstraintLayout
 from ..model.state import Mode
+from ..model.workspace import Workspace
 from .joint_friction import split_mode, stick_row
 from .reactions import ground_rows
 
 if TYPE_CHECKING:
     from .modes import SwitchedModel
 
-__all__ = ["ModeRows", "held_key", "MODE_ROWS_KEPT"]
+__all__ = ["ModeRows", "held_key"]
 
 
 class ModeRows:
@@ -36,6 +37,8 @@ class ModeRows:
     mode : frozenset of str
     targets : dict
         Held values of the engaged locks and sticking contacts.
+    workspace : Workspace, optional
+        The run's workspace, which keeps the rows of the modes the run meets.
 
     Attributes
     ----------
@@ -57,12 +60,13 @@ class ModeRows:
     (1, 'ram_stop@upper')
     """
 
-    def __init__(self, sm: SwitchedModel, mode, targets: dict):
+    def __init__(self, sm: SwitchedModel, mode, targets: dict, workspace=None):
         self.sm = sm
         self.model = sm.model
         self.mode = Mode(mode)
         self.targets = dict(targets)
-        self.rows, self.layout = _mode_rows(sm, self.mode, self.targets)
+        kept = None if workspace is None else workspace.mode_rows
+        self.rows, self.layout = _mode_rows(sm, self.mode, self.targets, kept)
         lay = self.layout
         self.rowset, self.n_rows, self.n_base = lay.rowset, lay.n_rows, lay.n_base
         self.element_rows = lay.element_rows
@@ -90,11 +94,6 @@ class ModeRows:
         return frozenset(el for el, idx in self.element_rows.items() if np.any(on_ground[idx]))
 
 
-#: (mode, held values) kept per model with their rows and layout (bounded: locks that
-#: capture a new held value every cycle make a new entry each time)
-MODE_ROWS_KEPT = 64
-
-
 def held_key(targets: dict) -> tuple | None:
     """The held values of the engaged locks and sticking contacts as a hashable key (their
     names and bytes), equal for equal values; None for a held value that is not numbers.
@@ -114,20 +113,20 @@ def held_key(targets: dict) -> tuple | None:
         return None
 
 
-def _mode_rows(sm: SwitchedModel, mode: Mode, targets: dict):
+def _mode_rows(sm: SwitchedModel, mode: Mode, targets: dict, kept: dict | None):
     """(switchable rows, :class:`~mechdyn.model.ConstraintLayout`) of a mode with its held
-    values: pure data of the compiled model, kept in ``model.memo`` so that the runs of a
-    model build them once (the rows list is the caller's own copy)."""
+    values, kept in ``kept`` (a run's :attr:`Workspace.mode_rows
+    <mechdyn.model.workspace.Workspace>`, or None) so that a run builds those of each
+    mode it meets again once (the rows list is the caller's own copy)."""
     model = sm.model
     held = held_key(targets)
-    key = None if held is None else (mode, held)  # a held value that is not numbers: not kept
-    kept = model.memo.setdefault("mode rows", {})
-    got = kept.get(key) if key is not None else None
+    key = None if held is None or kept is None else (mode, held)  # not numbers: not kept
+    got = None if key is None else kept.get(key)
     if got is None:
         base, jstates = split_mode(model, mode)
         rows = sm.rows(base, targets) + [stick_row(model, j, targets)
                                          for j, s in sorted(jstates.items()) if s == "stick"]
         got = (tuple(rows), ConstraintLayout(model, mode, rows))
-        if key is not None and len(kept) < MODE_ROWS_KEPT:
-            kept[key] = got
+        if kept is not None:
+            Workspace.keep(kept, key, got)
     return list(got[0]), got[1]

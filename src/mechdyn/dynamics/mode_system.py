@@ -132,11 +132,11 @@ class ModeSystem(ModeRows):
 
     def __init__(self, sm: SwitchedModel, mode, targets: dict, x, *, prefer=(), avoid=(),
                  workspace: Workspace | None = None):
-        super().__init__(sm, mode, targets)
+        self.ws = Workspace() if workspace is None else workspace
+        super().__init__(sm, mode, targets, self.ws)
         model, lay = self.model, self.layout
         self._slip = lay.friction if len(lay.slip_rows) else None
         self.x_ref = np.array(x, float)
-        self.ws = Workspace() if workspace is None else workspace
         # the rows and coordinates chosen at a pose: a pure function of (mode, held values,
         # pose) and (prefer, avoid), kept for the instant (an event builds the same mode at
         # the same pose several times: impact, complementarity, the new segment) in the

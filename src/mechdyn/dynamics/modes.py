@@ -202,6 +202,14 @@ class SwitchedModel:
                       for var, op, val in sw.guard]
             probs.extend(p)
             self.switches.append((sw, meas, guards))
+        #: the Measure along the face of each stop with friction (its tangent variable)
+        self.stop_tangents = {
+            n: meas for n, (st, _) in self.stops.items()
+            if st.friction > 0 and st.tangent_variable() is not None
+            and (meas := measure(f"stop {n!r}: tangent", st.tangent_variable())) is not None}
+        #: the travel or relative angle of each joint with friction (a Measure)
+        self.joint_measures = {j: parse_variable(model, f"joint:{j}")
+                               for j in model.friction_joints}
         if probs:
             raise ModelError(probs)
         self.lock_names = tuple(sorted(lock_names))
@@ -308,15 +316,14 @@ class SwitchedModel:
 
 
 def switched_model(model: Model) -> SwitchedModel:
-    """The switchable elements of a compiled model, compiled once (validated by the
-    compiler) and kept with the model.
+    """The switchable elements of a compiled model (:attr:`Model.switchable
+    <mechdyn.model.Model>`, built and validated by the compiler).
 
     Raises
     ------
     ModelError
         Every problem of the switchable elements, at once.
     """
-    sm = model.memo.get("switched_model")
-    if sm is None:
-        sm = model.memo["switched_model"] = SwitchedModel(model)
-    return sm
+    if model.switchable is not None:  # built when the model was compiled
+        return model.switchable
+    return SwitchedModel(model)

@@ -8,19 +8,18 @@ variable-structure model, decides the mode the state is in
 sticking pairs).  That is a function of the compiled model and the initial state
 alone, and costs about as much as a short run itself: where it records nothing but
 the state (no event, no warning, no friction in the pairs, nothing touching), it is
-kept with the compiled model, and the next run from the same state starts from a copy
-of the mode system with its own workspace, as the last solve left it.
+kept in the run's :class:`~mechdyn.model.workspace.Workspace`, and the next run given
+the same workspace from the same state starts from a copy of the mode system, as the
+last solve left it.  The Model itself keeps nothing of a run.
 
 The equations of the first segment of such a run (:class:`ModeEquations` on the mode's
 compiled kernel: the kernel's packed rows and loads, the compiled loop's buffers) are
-kept too, in a small pool: a finished run gives them back (:func:`give_back`) cleared of
-the run -- no mode system or workspace of it, the kernel's workspace as it was when they
-were made, the loop's buffers cleared -- and :func:`start_equations` gives them to the
-next run from the same start with its mode system, else it makes new ones.  A run in
-progress owns its equations (a run started meanwhile from the same state makes its
-own), and equations with more state than is cleared here (a branch-chart book,
-attributes this module does not know) are not kept.  No workspace of a run is kept with
-the model: the start's mode system is kept without one, the equations without theirs.
+kept too, in a small pool of the workspace: a finished run gives them back
+(:func:`give_back`) cleared of the run -- no mode system of it, the kernel's workspace
+as it was when they were made, the loop's buffers cleared -- and
+:func:`start_equations` gives them to the next run from the same start with its mode
+system, else it makes new ones.  Equations with more state than is cleared here (a
+branch-chart book, attributes this module does not know) are not kept.
 """
 
 from __future__ import annotations
@@ -30,7 +29,7 @@ import copy
 import numpy as np
 
 from ..errors import LockupError, ModelError
-from ..model.workspace import Workspace
+from ..model.workspace import KEPT, Workspace
 from .contact import gaps, touching
 from .friction import friction_joints
 from .joint_friction import stick_slip_joints
@@ -39,10 +38,7 @@ from .mode_rows import held_key
 from .modes import ModeSystem
 from .switching import apply_switch
 
-__all__ = ["start_state", "start_equations", "give_back", "STARTS_KEPT"]
-
-#: run starts kept per compiled model (a study runs many initial states)
-STARTS_KEPT = 16
+__all__ = ["start_state", "start_equations", "give_back"]
 
 
 def start_state(sm, t: float, locks: frozenset, q_init, qd_init, x_guess, ws: Workspace,
@@ -77,7 +73,7 @@ def start_state(sm, t: float, locks: frozenset, q_init, qd_init, x_guess, ws: Wo
     qi, qdi : ndarray, shape (n_i,)
         The mode's independent coordinates and their rates.
     key : tuple or None
-        The key of the start kept with the model (None: not kept).
+        The key of the start kept in the workspace (None: not kept).
 
     Raises
     ------
@@ -87,10 +83,10 @@ def start_state(sm, t: float, locks: frozenset, q_init, qd_init, x_guess, ws: Wo
         The state cannot be assembled or has no consistent mode.
     """
     model = sm.model
-    key = ("run start", float(t), tuple(sorted(locks)), np.asarray(q_init, float).tobytes(),
+    key = (float(t), tuple(sorted(locks)), np.asarray(q_init, float).tobytes(),
            np.asarray(qd_init, float).tobytes(), np.asarray(x_guess, float).tobytes(),
            float(gap_tol), float(small_velocity), float(force_scale))
-    kept = model.memo.get(key)
+    kept = ws.starts.get(key)
     if kept is not None:
         return (*_restart(kept, ws), key)
     n_events = len(events)
@@ -98,12 +94,10 @@ def start_state(sm, t: float, locks: frozenset, q_init, qd_init, x_guess, ws: Wo
                                         gap_tol=gap_tol, small_velocity=small_velocity,
                                         force_scale=force_scale)
     qi, qdi = ms.independent(x, xd)
-    starts = model.memo.setdefault("run starts", [])
     if (not touch0 and len(events) == n_events and not ws.warned and ms.friction is None
             and not friction_joints(model) and not stick_slip_joints(model)
-            and held_key(targets) is not None and len(starts) < STARTS_KEPT):
-        starts.append(key)
-        model.memo[key] = _kept(ms, x, xd, targets, ws, qi, qdi)
+            and held_key(targets) is not None and len(ws.starts) < KEPT):
+        ws.starts[key] = _kept(ms, x, xd, targets, ws, qi, qdi)
     else:
         key = None
     return ms, x, xd, targets, qi, qdi, key
@@ -205,9 +199,8 @@ def start_equations(sm, ms, backend: str, formulation: str, d, key):
     kept : tuple or None
         What :func:`give_back` needs to keep them for the next run (None: not kept).
     """
-    pool_key = None if key is None or d is not None else ("run equations", key, backend,
-                                                          formulation)
-    pool = None if pool_key is None else sm.model.memo.get(pool_key)
+    pool_key = None if key is None or d is not None else (key, backend, formulation)
+    pool = None if pool_key is None else ms.ws.equations.get(pool_key)
     while pool:
         eqs, fresh = pool.pop()
         if eqs.sm is sm and _restartable(eqs):
@@ -219,13 +212,16 @@ def start_equations(sm, ms, backend: str, formulation: str, d, key):
     return eqs, (pool_key, eqs.kernel.ws.copy())
 
 
-def give_back(sm, eqs, kept) -> None:
-    """Keep the equations of a finished run for the next run from its start, cleared of
-    the run (no mode system, workspace or anchor of it; the kernel as it was made)."""
+def give_back(ws, eqs, kept) -> None:
+    """Keep the equations of a finished run in its workspace ``ws`` for the next run from
+    its start, cleared of the run (no mode system or anchor of it; the kernel as it was
+    made)."""
     if kept is None or not _restartable(eqs):
         return
     pool_key, fresh = kept
-    pool = sm.model.memo.setdefault(pool_key, [])
+    if pool_key not in ws.equations and len(ws.equations) >= KEPT:
+        return
+    pool = ws.equations.setdefault(pool_key, [])
     if len(pool) < EQUATIONS_KEPT and all(e is not eqs for e, _ in pool):
         _clear(eqs, fresh)
         pool.append((eqs, fresh))

@@ -334,11 +334,7 @@ def _anchor_indices(values, max_step) -> np.ndarray:
 
 def _kernel(model: Model, layout, idx=None) -> Kernel:
     """The evaluation kernel of a model in a mode (for the coordinates ``idx``, default
-    all), cached on the model itself (so that it goes away with the model)."""
+    all), made for the analysis that asks (packing the rows costs microseconds)."""
     if idx is not None and np.array_equal(idx, np.arange(model.n_q)):
         idx = None
-    key = (layout.mode, None if idx is None else tuple(int(i) for i in idx))
-    per = model.memo.setdefault("sweep_kernels", {})
-    if key not in per or per[key].lay is not layout:
-        per[key] = Kernel(model, layout, idx)
-    return per[key]
+    return Kernel(model, layout, idx)

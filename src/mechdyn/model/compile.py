@@ -9,19 +9,22 @@ ground is not part of ``x``; in the index arrays below it has index
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
 from ..mechanism.body import GROUND
-from ..mechanism.joint import Lock, Prismatic, Revolute
+from ..mechanism.joint import Lock, Prismatic, Revolute, has_friction
 from ..mechanism.placement import start_poses
 from . import rows as R
 
 __all__ = ["Model", "RevoluteRows", "PrismaticRows", "LockRows", "as_model"]
 
 COORD_ANGLE, COORD_RELATIVE, COORD_TRAVEL, COORD_X, COORD_Y = 0, 1, 2, 3, 4
+#: the most lock modes whose layouts a model builds when it is compiled
+LAYOUTS_KEPT = 64
 _KIND_CODE = {"angle": COORD_ANGLE, "relative_angle": COORD_RELATIVE, "travel": COORD_TRAVEL,
               "x": COORD_X, "y": COORD_Y}
 
@@ -88,7 +91,22 @@ class Model:
         A characteristic length (m) used to scale tolerances and rotations.
     x0 : ndarray, shape (n_x,)
         The assembled sketch; set when the model is compiled
-        (:func:`mechdyn.compiler.check_rank`, which also sets ``redundant``).
+        (:func:`mechdyn.compiler.check_rank`, which also sets ``q_sketch``, its
+        coordinates, and ``redundant``).
+    tolerance_scale : ndarray, shape (n_q,)
+        1 for angles, ``length_scale`` for travels and positions.
+    force_scale : float
+        The model's weight, at least 1 N.
+    friction_joints : tuple of str
+        The revolute and prismatic joints with friction, in joint order.
+    forces, switchable
+        The loads and drives resolved (:class:`~mechdyn.dynamics.forces.ForceModel`)
+        and the switchable elements (:class:`~mechdyn.dynamics.modes.SwitchedModel`),
+        set by the compiler (:func:`mechdyn.compiler.check_loads`).
+
+    A compiled model is constant: the compiler builds everything above, then freezes
+    it, and no analysis writes to it (a run keeps its own caches in a
+    :class:`~mechdyn.model.workspace.Workspace`).
     """
 
     def __init__(self, mechanism):
@@ -163,11 +181,25 @@ class Model:
         #: locks): its runs go mode by mode
         self.has_switching = any(ex.get(k) for k in ("switches", "stops", "contacts",
                                                      "coordinate_locks"))
-        self._layouts: dict = {}
-        #: memoized data derived from the model by the analyses (the parsed loads, the
-        #: sweep kernels ...): constants of the model computed on first use, never
-        #: the state of a run
-        self.memo: dict = {}
+        #: the layouts of the lock modes, built here for every subset of the locks when
+        #: there are at most LAYOUTS_KEPT of them (else for the initial mode and none)
+        self._layouts = self._lock_layouts(lk.names)
+        #: the scale of each coordinate's tolerances: 1 for angles, the length scale for
+        #: travels and positions, shape (n_q,)
+        self.tolerance_scale = np.where(self.coord_is_angle, 1.0, self.length_scale)
+        #: the model's weight (at least 1 N): the scale of its forces, N
+        self.force_scale = max(float(np.sum(self.mass)
+                                     * max(np.hypot(*self.gravity), 1.0)), 1.0)
+        #: the revolute and prismatic joints that dissipate (a Coulomb coefficient or a
+        #: viscous term set), in joint order
+        self.friction_joints = tuple(
+            n for n, j in mechanism.joints.items()
+            if isinstance(j, Revolute | Prismatic) and has_friction(j))
+        #: the loads and drives resolved to indices (:class:`~mechdyn.dynamics.forces.
+        #: ForceModel`) and the switchable elements (:class:`~mechdyn.dynamics.modes.
+        #: SwitchedModel`): set by the compiler (:func:`mechdyn.compiler.check_loads`)
+        self.forces = None
+        self.switchable = None
 
     def _coordinate_row(self, c) -> R.Rows:
         """The row of one coordinate (:mod:`mechdyn.model.rows`, lowering rules)."""
@@ -271,13 +303,31 @@ class Model:
 
     # ------------------------------------------------------------------ modes
     def layout(self, mode=None) -> ConstraintLayout:
-        """Row layout of the constraint equations in a mode (cached)."""
+        """Row layout of the constraint equations in a mode of engaged locks (the initial
+        mode by default); built with the model (see :attr:`LAYOUTS_KEPT`).
+
+        Raises
+        ------
+        ModelError
+            A name in ``mode`` that is not a lock (the message lists the locks).
+        """
         mode = self.initial_mode if mode is None else frozenset(mode)
-        if mode not in self._layouts:
-            if unknown := set(mode) - set(self.lock.names):
-                raise ModelError(did_you_mean(sorted(unknown)[0], self.lock.names, "lock"))
-            self._layouts[mode] = ConstraintLayout(self, mode)
-        return self._layouts[mode]
+        got = self._layouts.get(mode)
+        if got is not None:
+            return got
+        if unknown := set(mode) - set(self.lock.names):
+            raise ModelError(did_you_mean(sorted(unknown)[0], self.lock.names, "lock"))
+        return ConstraintLayout(self, mode)
+
+    def _lock_layouts(self, locks) -> dict:
+        """{mode: ConstraintLayout} of every subset of ``locks`` (at most
+        :data:`LAYOUTS_KEPT` of them; else of the initial mode and of no lock)."""
+        if 2 ** len(locks) > LAYOUTS_KEPT:
+            modes = [self.initial_mode, frozenset()]
+        else:
+            modes = [frozenset(c) for r in range(len(locks) + 1)
+                     for c in itertools.combinations(locks, r)]
+        return {m: ConstraintLayout(self, m) for m in modes}
 
 
 class ConstraintLayout:
