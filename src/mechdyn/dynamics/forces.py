@@ -399,90 +399,133 @@ def applied_forces(model: Model, t, x, xdot, q, qdot, *, skip_drives: Sequence[i
 
 
 def force_model(model: Model) -> ForceModel:
-    """Resolve the loads and drives of ``model.mechanism`` to indices; all problems at once."""
-    mech = model.mechanism
+    """Resolve the loads and drives of ``model.mechanism`` to indices; all problems at once
+    (the compiler builds it once: :attr:`Model.forces <mechdyn.model.Model>`).
+
+    Raises
+    ------
+    ModelError
+        Every problem found: unknown bodies, points, joints and coordinates (with the
+        valid names), negative or non-finite parameters, unknown table variables.
+    """
     if model.forces is not None:  # built when the model was compiled
         return model.forces
-    probs: list[str] = []
-    springs, rotary, forces, torques, drives, bushings = [], [], [], [], [], []
-    readers: dict = {}  # the table variables, each resolved once
+    r = _Resolver(model)
+    for ld in model.mechanism.loads:
+        r.load(ld)
+    r.tables()
+    r.drives()
+    if r.probs:
+        raise ModelError(r.probs)
+    return ForceModel(model, r.springs, r.rotary, r.forces, r.torques, r.drives_, r.bushings,
+                      r.readers)
 
-    def body(name, where):
+
+class _Resolver:
+    """The loads and drives of a model resolved one by one, their problems collected."""
+
+    def __init__(self, model: Model):
+        self.model, self.mech = model, model.mechanism
+        self.probs: list[str] = []
+        self.springs, self.rotary, self.forces, self.torques = [], [], [], []
+        self.drives_, self.bushings = [], []
+        self.readers: dict = {}  # the table variables, each resolved once
+
+    def body(self, name, where):
+        """The body index, or None with the problem noted."""
+        model = self.model
         try:
             return model.body_index(name)
         except ModelError:
-            probs.append(f"{where}: " + did_you_mean(name, [*model.body_names, "ground"], "body"))
+            self.probs.append(f"{where}: " + did_you_mean(name, [*model.body_names, "ground"],
+                                                         "body"))
             return None
 
-    def anchor(b, p, where):
+    def anchor(self, b, p, where):
         """(body index, point in the body frame), or None with the problem noted."""
-        i = body(b, where)
+        i = self.body(b, where)
         try:
-            return None if i is None else (i, model.point_local(b, p))
+            return None if i is None else (i, self.model.point_local(b, p))
         except ModelError as exc:
-            probs.append(f"{where}: {exc}")
+            self.probs.append(f"{where}: {exc}")
 
-    for ld in mech.loads:
+    def load(self, ld) -> None:
+        """Resolve one load by its type."""
         where = f"{type(ld).__name__.lower()} {getattr(ld, 'name', '?')!r}"
-        if isinstance(ld, Spring):
-            a1, a2 = anchor(ld.body1, ld.point1, where), anchor(ld.body2, ld.point2, where)
-            for fld in ("stiffness", "free_length", "damping"):
-                if getattr(ld, fld) < 0:
-                    probs.append(f"{where}: {fld} must be >= 0, got {getattr(ld, fld)!r}")
-            if a1 and a2:
-                springs.append((ld.name, *a1, *a2, float(ld.stiffness), float(ld.free_length),
-                                float(ld.damping), float(ld.preload)))
-        elif isinstance(ld, Bushing):
-            a1, a2 = anchor(ld.body1, ld.point1, where), anchor(ld.body2, ld.point2, where)
-            for fld in ("kx", "ky", "cx", "cy"):
-                v = getattr(ld, fld)
-                if not (isinstance(v, int | float | np.integer | np.floating)
-                        and math.isfinite(v) and v >= 0):
-                    probs.append(f"{where}: {fld} must be a finite number >= 0, got {v!r}")
-            if a1 and a2 and a1[0] == a2[0]:
-                probs.append(f"{where}: body1 and body2 are the same body "
-                             f"{ld.body1!r}")
-            elif a1 and a2:
-                bushings.append((ld.name, *a1, *a2, *(float(getattr(ld, f))
-                                                      for f in ("kx", "ky", "cx", "cy"))))
-        elif isinstance(ld, RotarySpring):
-            if ld.joint not in mech.joints or model.joint_kind(ld.joint) != "revolute":
-                probs.append(f"{where}: joint: " + did_you_mean(ld.joint, model.rev.names,
-                                                                 "revolute joint"))
+        for kind, resolve in ((Spring, self.spring), (Bushing, self.bushing),
+                              (RotarySpring, self.rotary_spring), (Force, self.force),
+                              (Torque, self.torque)):
+            if isinstance(ld, kind):
+                resolve(ld, where)
+                return
+        if not hasattr(ld, "generalized"):  # extension loads (process loads, contacts ...)
+            self.probs.append(f"{where}: not a load mechdyn knows (Spring, Bushing, "
+                              "RotarySpring, Force, Torque)")
+
+    def spring(self, ld, where) -> None:
+        a1, a2 = self.anchor(ld.body1, ld.point1, where), self.anchor(ld.body2, ld.point2, where)
+        for fld in ("stiffness", "free_length", "damping"):
+            if getattr(ld, fld) < 0:
+                self.probs.append(f"{where}: {fld} must be >= 0, got {getattr(ld, fld)!r}")
+        if a1 and a2:
+            self.springs.append((ld.name, *a1, *a2, float(ld.stiffness),
+                                 float(ld.free_length), float(ld.damping), float(ld.preload)))
+
+    def bushing(self, ld, where) -> None:
+        a1, a2 = self.anchor(ld.body1, ld.point1, where), self.anchor(ld.body2, ld.point2, where)
+        for fld in ("kx", "ky", "cx", "cy"):
+            v = getattr(ld, fld)
+            if not (isinstance(v, int | float | np.integer | np.floating)
+                    and math.isfinite(v) and v >= 0):
+                self.probs.append(f"{where}: {fld} must be a finite number >= 0, got {v!r}")
+        if a1 and a2 and a1[0] == a2[0]:
+            self.probs.append(f"{where}: body1 and body2 are the same body {ld.body1!r}")
+        elif a1 and a2:
+            self.bushings.append((ld.name, *a1, *a2, *(float(getattr(ld, f))
+                                                       for f in ("kx", "ky", "cx", "cy"))))
+
+    def rotary_spring(self, ld, where) -> None:
+        model = self.model
+        if ld.joint not in self.mech.joints or model.joint_kind(ld.joint) != "revolute":
+            self.probs.append(f"{where}: joint: " + did_you_mean(ld.joint, model.rev.names,
+                                                                  "revolute joint"))
+            return
+        jj = model.rev.names.index(ld.joint)
+        self.rotary.append((ld.name, int(model.rev.i[jj]), int(model.rev.j[jj]),
+                            float(ld.stiffness), float(ld.free_angle), float(ld.damping),
+                            float(ld.preload)))
+
+    def force(self, ld, where) -> None:
+        a = self.anchor(ld.body, ld.point, where)
+        if a:
+            self.forces.append((ld, *a))
+
+    def torque(self, ld, where) -> None:
+        b = self.body(ld.body, where)
+        r = self.body(ld.reaction_body, where) if ld.reaction_body is not None else None
+        if b is not None:
+            self.torques.append((ld, b, r))
+
+    def tables(self) -> None:
+        """The variables of the load and drive tables, each resolved once."""
+        for ld in [*self.mech.loads, *self.mech.drives]:
+            for fld in ("magnitude", "torque"):
+                tab = getattr(ld, fld, None)
+                if isinstance(tab, Table):
+                    try:
+                        self.readers[tab.variable] = _variable_reader(self.model, tab.variable)
+                    except ModelError as exc:
+                        self.probs.append(f"{type(ld).__name__.lower()} "
+                                          f"{getattr(ld, 'name', '?')!r}: {fld}: table "
+                                          f"variable: {exc}")
+
+    def drives(self) -> None:
+        """Each drive's coordinate index."""
+        model = self.model
+        for dr in self.mech.drives:
+            if dr.coordinate not in model.coordinate_names:
+                self.probs.append(f"drive {dr.name!r}: coordinate: "
+                                  + did_you_mean(dr.coordinate, model.coordinate_names,
+                                                 "coordinate"))
                 continue
-            jj = model.rev.names.index(ld.joint)
-            rotary.append((ld.name, int(model.rev.i[jj]), int(model.rev.j[jj]),
-                           float(ld.stiffness), float(ld.free_angle), float(ld.damping),
-                           float(ld.preload)))
-        elif isinstance(ld, Force):
-            a = anchor(ld.body, ld.point, where)
-            if a:
-                forces.append((ld, *a))
-        elif isinstance(ld, Torque):
-            b = body(ld.body, where)
-            r = body(ld.reaction_body, where) if ld.reaction_body is not None else None
-            if b is not None:
-                torques.append((ld, b, r))
-        elif hasattr(ld, "generalized"):  # extension loads (process loads, contacts ...)
-            continue
-        else:
-            probs.append(f"{where}: not a load mechdyn knows (Spring, Bushing, RotarySpring, "
-                         "Force, Torque)")
-    for ld in [*mech.loads, *mech.drives]:  # table variables: resolved once, here
-        for fld in ("magnitude", "torque"):
-            tab = getattr(ld, fld, None)
-            if isinstance(tab, Table):
-                try:
-                    readers[tab.variable] = _variable_reader(model, tab.variable)
-                except ModelError as exc:
-                    probs.append(f"{type(ld).__name__.lower()} {getattr(ld, 'name', '?')!r}: "
-                                 f"{fld}: table variable: {exc}")
-    for dr in mech.drives:
-        if dr.coordinate not in model.coordinate_names:
-            probs.append(f"drive {dr.name!r}: coordinate: "
-                         + did_you_mean(dr.coordinate, model.coordinate_names, "coordinate"))
-            continue
-        drives.append((dr, model.coordinate_index(dr.coordinate)))
-    if probs:
-        raise ModelError(probs)
-    return ForceModel(model, springs, rotary, forces, torques, drives, bushings, readers)
+            self.drives_.append((dr, model.coordinate_index(dr.coordinate)))

@@ -13,6 +13,7 @@ and an :class:`~mechdyn.integrate.events.EventRecord` per thing that happened.
 from __future__ import annotations
 
 import operator
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -179,90 +180,81 @@ def guard_holds(sm, guards, t, x, xd) -> bool:
     return all(_OPS[op](_value(meas, t, x, xd), val) for meas, op, val in guards)
 
 
-def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *, fired,
-            small_velocity, gap_tol, force_scale, initial=False, plastic=()):
-    """Apply the fired events at (t, x, xd); returns (new ModeSystem, x, xdot, energy lost)."""
-    mode_before = ms.mode
-    q_b = ms.coordinates(x)
-    qd_b = ms._coord_jac(x) @ xd
-    locks = set(mode_locks(mode_before))
-    engage, release = [], []
-    forced_open, forced_slip, forced_stick = set(), {}, set()
-    notes = []
+@dataclass
+class _Requests:
+    """What the fired events ask of a switching instant."""
+
+    engage: list = field(default_factory=list)  # (lock, switch name)
+    release: list = field(default_factory=list)  # (lock, switch name)
+    forced_open: set = field(default_factory=set)  # closed rows whose force fell to zero
+    forced_slip: dict = field(default_factory=dict)  # {contact: slip direction}
+    forced_stick: set = field(default_factory=set)  # slipping rows that came to rest
+    notes: list = field(default_factory=list)  # (kind, element, message) of ignored ones
+
+
+def _requests(sm: SwitchedModel, ms: ModeSystem, t, x, xd, fired, locks) -> _Requests:
+    """Sort the fired events into engagements, releases and forced friction states
+    (a switch whose guard fails, or whose lock is already so, is a note)."""
+    req = _Requests()
     for e in fired:
         if e.kind in ("switch", "time"):
             sw = e.data[0]
             guards = [g for s_, _m, g in sm.switches if s_ is sw][0]
             if not guard_holds(sm, guards, t, x, xd):
-                notes.append(("ignored", sw.name, "guard not met"))
+                req.notes.append(("ignored", sw.name, "guard not met"))
                 continue
             act = sw.action
             if act == "toggle":
                 act = "release" if sw.target in locks else "engage"
             if act == "engage" and sw.target not in locks:
-                engage.append((sw.target, sw.name))
+                req.engage.append((sw.target, sw.name))
             elif act == "release" and sw.target in locks:
-                release.append((sw.target, sw.name))
+                req.release.append((sw.target, sw.name))
             else:
-                notes.append(("ignored", sw.name, f"{sw.target} already {act}d"))
+                req.notes.append(("ignored", sw.name, f"{sw.target} already {act}d"))
         elif e.kind == "force":
-            forced_open.add(e.key)
+            req.forced_open.add(e.key)
         elif e.kind == "cone":
             ev = ms.evaluate_x(t, x, xd)
-            forced_slip[e.key] = -1 if ev.lam[_row(ms, e.key, "stick")] > 0 else 1
+            req.forced_slip[e.key] = -1 if ev.lam[_row(ms, e.key, "stick")] > 0 else 1
         elif e.kind == "slip":
-            forced_stick.add(e.key)
-    for n, _ in release:
-        locks.discard(n)
-        targets.pop(n, None)
-    locks_before = frozenset(locks)
-    for n, _ in engage:
-        sm.capture_target(n, x, targets)
-        locks.add(n)
-    frees = [f for n, _ in engage for f in sm.lock_frees(n)]
-    locks = frozenset(locks)
-    # touching unilateral constraints (closed ones have zero gap by construction)
-    touch = set(touching(sm, x, gap_tol=gap_tol)) | set(mode_unilateral(mode_before))
-    lost = 0.0
-    imp = None
-    xd_plus = xd
-    # an engaging lock, or a touching constraint approaching
-    if set(locks) - set(locks_before) or any(v < 0.0 for _, v in _rates(sm, touch, targets,
-                                                                          x, xd)):
-        imp = impact(sm, x, xd, locks_before, locks, targets, touch,
-                     restitution={k: 0.0 for k in plastic},
-                     small_velocity=small_velocity, t=t, warned=ms.ws.warned, workspace=ms.ws)
-        xd_plus = imp.xdot_plus
-        lost = imp.energy_lost
-    # candidates: touching and not separating
+            req.forced_stick.add(e.key)
+    return req
+
+
+def _mode_after(sm, t, ms, x, xd_plus, locks, targets, touch, req: _Requests, *,
+                small_velocity, force_scale):
+    """The mode after the instant: unilateral rows by complementarity, then the
+    friction state of the stick-slip pairs."""
     vmax = float(np.max(np.abs(xd_plus), initial=0.0))
+    # candidates: touching and not separating
     cand = [tok for tok, v in _rates(sm, touch, targets, x, xd_plus)
             if v <= max(small_velocity * 1e-3, 1e-9 * vmax)]
     ss = stick_slip_joints(sm.model)
     vtol = 1e-9 * max(vmax, small_velocity) + 1e-12
     mode_after, _ = resolve_mode(
         sm, t, x, xd_plus, locks, targets, cand,
-        slip_velocity_tol=vtol, force_tol=1e-10 * force_scale, forced_open=forced_open,
-        forced_slip={k: v for k, v in forced_slip.items() if k not in ss},
-        forced_stick=forced_stick - set(ss), workspace=ms.ws)
+        slip_velocity_tol=vtol, force_tol=1e-10 * force_scale, forced_open=req.forced_open,
+        forced_slip={k: v for k, v in req.forced_slip.items() if k not in ss},
+        forced_stick=req.forced_stick - set(ss), workspace=ms.ws)
     if ss:  # the friction state of the stick-slip pairs
         mode_after = frozenset(mode_after) | state_tokens(resolve_joints(
             ModeSystem, sm, t, x, xd_plus, mode_after, targets,
-            before=joint_states(sm.model, mode_before),
-            forced_slip={k: v for k, v in forced_slip.items() if k in ss},
-            forced_stick=forced_stick & set(ss), velocity_tol=vtol,
+            before=joint_states(sm.model, ms.mode),
+            forced_slip={k: v for k, v in req.forced_slip.items() if k in ss},
+            forced_stick=req.forced_stick & set(ss), velocity_tol=vtol,
             force_tol=1e-10 * force_scale, workspace=ms.ws))
-    if (initial and mode_after == ms.mode and not engage
-            and held_key(targets) == held_key(ms.targets) is not None):
-        # the mode the run starts in, built a moment ago: the same rows and coordinates,
-        # restarted at this pose as a new one would be (a second build costs ~1 ms a run)
-        ms_new = ms
-        ms_new.x_ref = np.array(x, float)
-        ms_new.ws.reset(ms_new.x_ref)
-    else:
-        ms_new = mode_system(sm, mode_after, targets, x, prefer=ms.coord_names, avoid=frees,
-                             workspace=ms.ws)
-    # an engaging lock must hold the pose it engages at (no position jump)
+    return mode_after
+
+
+def _no_jump(sm, ms_new: ModeSystem, x, engage, t, q_b) -> None:
+    """An engaging lock must hold the pose it engages at (no position jump).
+
+    Raises
+    ------
+    AssemblyError
+        Naming the locks and the rows that are off, with their residuals.
+    """
     tol_pos = 1e-8 * sm.model.length_scale
     bad = {lab: float(v) for lab, v, el in zip(ms_new.row_labels(), ms_new.row_values(x),
                                                ms_new.row_elements(), strict=True)
@@ -273,6 +265,56 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
             "jump: the held value differs from the pose at the switch ("
             + ", ".join(f"{k} off by {v:.3g}" for k, v in bad.items()) + ")",
             t=t, q=q_b, residuals=bad)
+
+
+def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *, fired,
+                 small_velocity, gap_tol, force_scale, initial=False, plastic=()):
+    """Apply the fired events at (t, x, xd); returns (new ModeSystem, x, xdot, energy lost).
+
+    In order: the switches release and engage their locks (:func:`_requests`); an
+    engaging lock or a touching row that closes makes an impact
+    (:func:`~mechdyn.dynamics.impact.impact`); the mode after is found by
+    complementarity (:func:`_mode_after`); its mode system is built and the state
+    projected onto its constraints; the events of the instant are recorded
+    (:func:`_record`)."""
+    mode_before = ms.mode
+    q_b = ms.coordinates(x)
+    qd_b = ms._coord_jac(x) @ xd
+    locks = set(mode_locks(mode_before))
+    req = _requests(sm, ms, t, x, xd, fired, locks)
+    for n, _ in req.release:
+        locks.discard(n)
+        targets.pop(n, None)
+    locks_before = frozenset(locks)
+    for n, _ in req.engage:
+        sm.capture_target(n, x, targets)
+        locks.add(n)
+    frees = [f for n, _ in req.engage for f in sm.lock_frees(n)]
+    locks = frozenset(locks)
+    # touching unilateral constraints (closed ones have zero gap by construction)
+    touch = set(touching(sm, x, gap_tol=gap_tol)) | set(mode_unilateral(mode_before))
+    lost, imp, xd_plus = 0.0, None, xd
+    # an engaging lock, or a touching constraint approaching
+    if set(locks) - set(locks_before) or any(v < 0.0 for _, v in _rates(sm, touch, targets,
+                                                                          x, xd)):
+        imp = impact(sm, x, xd, locks_before, locks, targets, touch,
+                     restitution={k: 0.0 for k in plastic},
+                     small_velocity=small_velocity, t=t, warned=ms.ws.warned, workspace=ms.ws)
+        xd_plus = imp.xdot_plus
+        lost = imp.energy_lost
+    mode_after = _mode_after(sm, t, ms, x, xd_plus, locks, targets, touch, req,
+                             small_velocity=small_velocity, force_scale=force_scale)
+    if (initial and mode_after == ms.mode and not req.engage
+            and held_key(targets) == held_key(ms.targets) is not None):
+        # the mode the run starts in, built a moment ago: the same rows and coordinates,
+        # restarted at this pose as a new one would be (a second build costs ~1 ms a run)
+        ms_new = ms
+        ms_new.x_ref = np.array(x, float)
+        ms_new.ws.reset(ms_new.x_ref)
+    else:
+        ms_new = mode_system(sm, mode_after, targets, x, prefer=ms.coord_names, avoid=frees,
+                             workspace=ms.ws)
+    _no_jump(sm, ms_new, x, req.engage, t, q_b)
     # project onto the new mode's constraints (removes round-off of the located crossing)
     qi = ms_new.coordinates(x)[ms_new.coords]
     x_new = ms_new.solve_position(qi, x, t=t)
@@ -280,15 +322,27 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
     G = ms_new._coord_jac(x_new)
     xd_new = B @ (G[ms_new.coords] @ xd_plus)
     q_a, qd_a = ms_new.coordinates(x_new), G @ xd_new
-    if initial and mode_after == mode_before and not engage:
+    if initial and mode_after == mode_before and not req.engage:
         return ms_new, x_new, xd_new, lost
 
     def add(kind, element, msg="", lost_=0.0, impulses=None):
         events.append(EventRecord(t, kind, element, mode_before, frozenset(mode_after),
                                   q_b, qd_b, q_a, qd_a, lost_, dict(impulses or {}), msg))
 
+    _record(add, sm, mode_before, mode_after, req, imp, touch, lost)
+    if len(events) == 0 or events[-1].t != t:
+        if mode_after != mode_before:
+            add("switch", ",".join(sorted(set(mode_after) ^ set(mode_before))))
+    return ms_new, x_new, xd_new, lost
+
+
+def _record(add, sm, mode_before, mode_after, req: _Requests, imp, touch, lost) -> None:
+    """The events of a switching instant, through ``add(kind, element, message, energy
+    lost, impulses)``: releases, engagements, rows closing, opening or bouncing, friction
+    states changing, and the notes of ignored switches."""
+    engage = req.engage
     impulses = imp.element_impulses if imp is not None else {}
-    for n, swn in release:
+    for n, swn in req.release:
         add("release", n, f"switch {swn!r} released lock {n!r}")
     for n, swn in engage:
         add("engage", n, f"switch {swn!r} engaged lock {n!r}", lost, impulses)
@@ -303,7 +357,7 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
             "rebound" if bounced else "force fell to zero", lost if bounced and not engage
             else 0.0, impulses if bounced else None)
     for tok in sorted(touch - closed_before - closed_after):
-        if imp is not None and not engage and tok not in forced_open:
+        if imp is not None and not engage and tok not in req.forced_open:
             add("impact", tok, "rebound", lost, impulses)
     fb, fa = mode_friction(mode_before), mode_friction(mode_after)
     for c in sorted(set(fb) | set(fa)):
@@ -313,12 +367,8 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
     for j in sorted(ja):
         if jb.get(j) != ja[j]:
             add("stick" if ja[j] == "stick" else "slip", j, ja[j])
-    for kind, name, msg in notes:
+    for kind, name, msg in req.notes:
         add(kind, name, msg)
-    if len(events) == 0 or events[-1].t != t:
-        if mode_after != mode_before:
-            add("switch", ",".join(sorted(set(mode_after) ^ set(mode_before))))
-    return ms_new, x_new, xd_new, lost
 
 
 def _rates(sm, tokens, targets, x, xd) -> list:
