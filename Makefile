@@ -21,8 +21,9 @@ demo: $(STAMP)
 	@echo "the command line: $(BIN)/mechdyn (or: source $(BIN)/activate; mechdyn --help)"
 
 test: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks tools
 	$(BIN)/lint-imports
+	$(BIN)/python tools/private_imports.py
 	$(BIN)/python -m pytest -q
 
 test-fast: $(STAMP)
@@ -32,8 +33,9 @@ bench: $(STAMP)
 	$(BIN)/python -m benchmarks
 
 lint: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks tools
 	$(BIN)/lint-imports
+	$(BIN)/python tools/private_imports.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info src/*.egg-info .pytest_cache .import_linter_cache mechdyn-demo

@@ -177,7 +177,7 @@ def warmup() -> dict[str, float]:
     """
     import time
 
-    from .dynamics.compiled import _COMPILED, _warm_up, numba_available
+    from .dynamics.compiled import numba_available, warm_up_groups
     from .kernels.rows_numba import compiling
     from .kinematics.continuation import Kernel
     from .mechanism import Mechanism
@@ -185,10 +185,8 @@ def warmup() -> dict[str, float]:
     if not numba_available():
         return {}
     t0 = time.perf_counter()
-    fresh = not _COMPILED["done"]
-    _warm_up()
+    times = warm_up_groups()
     t1 = time.perf_counter()
-    times = dict(_COMPILED["groups"]) if fresh else {"dynamics": 0.0, "integration loop": 0.0}
     mech = Mechanism("warm-up pendulum")
     mech.add_body("bar", mass=1.0, inertia=0.1, com=(0.5, 0.0))
     mech.add_revolute("O", "ground", "bar")

@@ -60,10 +60,10 @@ def test_dead_decision_is_that_of_the_singularity_report():
 
 @pytest.mark.skipif(not numba_available(), reason="numba not installed")
 def test_the_warm_up_compiles_the_jacobian_the_check_calls():
-    from mechdyn.dynamics.compiled import _warm_up
+    from mechdyn.dynamics.compiled import warm_up_groups
     from mechdyn.kernels.rows_numba import rows_jacobian
 
-    _warm_up()
+    warm_up_groups()
     before = len(rows_jacobian.signatures)
     tr = mechdyn.simulate(press_idle().compile(), 0.05, progress=False, rtol=1e-9)
     assert tr.success and len(rows_jacobian.signatures) == before

@@ -16,7 +16,7 @@ import time
 
 from ..kinematics.sweep import sweep
 from ..progress import stage
-from ..results.animate import _trace_spec, animate, check_animation_path, snapshot
+from ..results.animate import animate, check_animation_path, snapshot, trace_spec
 from ..results.frame_geometry import MAX_FRAMES
 from .options import add_motion_arguments, finish, open_model, simulate_from_args, sweep_values
 
@@ -53,7 +53,7 @@ def run(args) -> int:
     t0 = time.perf_counter()  # the stage running once the run has taken 2 s is named
     check_animation_path(args.output)  # before any computing
     mech, model = open_model(args)
-    _trace_spec(model, args.trace)
+    trace_spec(model, args.trace)
     if args.simulate:
         n = args.frames if args.frames is not None else MAX_FRAMES
         record = simulate_from_args(model, args, max(int(n), 2))

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from ..kinematics.sweep import sweep
 from ..progress import stage
-from ..results.frame_geometry import _trace_spec
+from ..results.frame_geometry import trace_spec
 from ..results.plot import plot_kinematic_sweep
 from ..results.table import deg_or_mm
 from .options import (
@@ -65,7 +65,7 @@ def run(args) -> int:
     """Run ``mechdyn kinematics``; returns the exit code."""
     check_plot_columns(args)
     mech, model = open_model(args)
-    _trace_spec(model, args.trace)
+    trace_spec(model, args.trace)
     over, values, _ = sweep_values(model, args, only=True)
     speed, why = speed_from_args(model, over, args)
     with stage(f"kinematics: sweeping {over} over {values.size} positions", args.progress):

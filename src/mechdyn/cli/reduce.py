@@ -20,7 +20,7 @@ from ..dynamics.reduction import reduce_model
 from ..errors import ModelError
 from ..kinematics.sweep import initial_coordinates
 from ..progress import stage
-from ..results.frame_geometry import _trace_spec
+from ..results.frame_geometry import trace_spec
 from ..results.plot_reduction import plot_reduction
 from .options import (
     add_files,
@@ -71,7 +71,7 @@ def run(args) -> int:
     mech, model = prepare_model(args)
     if args.steps < 2:
         raise ModelError(f"--steps must be at least 2, got {args.steps}")
-    point = _trace_spec(model, args.mass_at, "--mass-at")
+    point = trace_spec(model, args.mass_at, "--mass-at")
     coordinate = model.coordinate_names[0] if model.n_q == 1 else None
     if coordinate is None:  # reduce_model names the coordinates
         speed, why, start = 1.0, "", 0.0

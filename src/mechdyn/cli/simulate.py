@@ -25,7 +25,7 @@ from ..errors import ModelError, Status, did_you_mean
 from ..mechanism import Drive
 from ..results import spectrum
 from ..results.events import events_table
-from ..results.frame_geometry import _trace_spec
+from ..results.frame_geometry import trace_spec
 from ..results.plot_dynamics import plot_trajectory
 from ..results.plot_spectrum import plot_spectrum
 from ..results.table import CsvStream, deg_or_mm, written
@@ -140,7 +140,7 @@ def run(args) -> int:
     d = quantity(args.d, "angle", "--d") if args.d is not None else None
     model = mech.compile()
     for point in args.points or ():  # unknown names before the run
-        _trace_spec(model, point, "--points")
+        trace_spec(model, point, "--points")
     t_eval = None
     fixed = args.integrator.lower() in ("wilson", "rk4")
     if args.samples is None and not (fixed or args.every_step):

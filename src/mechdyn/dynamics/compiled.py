@@ -231,6 +231,23 @@ def _warm_up() -> float:
     return _COMPILED["time"]
 
 
+def warm_up_groups() -> dict[str, float]:
+    """Compile (or load) the kernels of the dynamics now (:func:`_warm_up`); returns the
+    wall time of each group, s: ``"dynamics"`` and ``"integration loop"`` (0 for groups
+    compiled earlier in this process).
+
+    Examples
+    --------
+    >>> sorted(warm_up_groups()) if numba_available() else ["dynamics", "integration loop"]
+    ['dynamics', 'integration loop']
+    """
+    fresh = not _COMPILED["done"]
+    _warm_up()
+    if fresh:
+        return dict(_COMPILED["groups"])
+    return {"dynamics": 0.0, "integration loop": 0.0}
+
+
 def compile_mode_kernel(model, force_model, constraint_rows, independent, *, kept=None):
     """The compiled kernel of a mode, or ``(None, reason)``.
 

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..errors import ModelError, did_you_mean
 from ..kernels import rows_numpy
+from ..kernels.planar import cross, rotate
 from ..kinematics.constraints import (
     coordinates_jacobian,
     extend,
@@ -29,7 +30,7 @@ from ..mechanism.drive import Drive
 from ..mechanism.load import Bushing, Force, RotarySpring, Spring, Table, Torque
 from ..model import Model
 from ..model.variable import lower, parse
-from .pair_loads import BushingSet, SpringSet, cross, rotate
+from .pair_loads import BushingSet, SpringSet
 
 __all__ = ["LoadContext", "ForceModel", "force_model", "evaluate", "applied_forces",
            "com_arms"]

@@ -32,9 +32,9 @@ import numpy as np
 
 from ..errors import ModelError
 from ..kernels import rows_numpy
-from ..kinematics.constraints import _perp, extend
+from ..kernels.planar import cross, perp, rotate
+from ..kinematics.constraints import extend
 from ..model import Model
-from .pair_loads import cross, rotate
 
 __all__ = ["FrictionPair", "FrictionSet", "PreparedFriction", "friction_joints"]
 
@@ -210,8 +210,8 @@ class FrictionSet:
                 out[p.name] = V[..., p.child, 2] - V[..., p.parent, 2]
                 continue
             P, u = self._point_axis(X, p)
-            vc = V[..., p.child, :2] + V[..., p.child, 2, None] * _perp(P - X[..., p.child, :2])
-            vp = V[..., p.parent, :2] + V[..., p.parent, 2, None] * _perp(
+            vc = V[..., p.child, :2] + V[..., p.child, 2, None] * perp(P - X[..., p.child, :2])
+            vp = V[..., p.parent, :2] + V[..., p.parent, 2, None] * perp(
                 P - X[..., p.parent, :2])
             out[p.name] = np.sum((vc - vp) * u, axis=-1)
         return out
@@ -255,7 +255,7 @@ class FrictionSet:
                 out[p.name] = Af
                 continue
             P, u = self._point_axis(X, p)
-            aN = np.einsum("...k,...ke->...e", _perp(u), Af)
+            aN = np.einsum("...k,...ke->...e", perp(u), Af)
             if p.length > 0:
                 aM = sgn * (Je[..., 3 * b + 2] - cross(P[..., None, :] - X[..., None, b, :2],
                                                        Je[..., 3 * b:3 * b + 2]))

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kinematics.constraints import _perp
+from ..kernels.planar import cross, perp
 from ..model import Model
-from .forces import com_arms, cross
+from .forces import com_arms
 
 __all__ = ["frame_mass_matrix", "inertia_forces", "mass_matrix_x", "drive_inertia"]
 
@@ -54,7 +54,7 @@ def inertia_forces(model: Model, x, xdot, xddot) -> np.ndarray:
     V = np.asarray(xdot, dtype=float).reshape(batch + (nb, 3))
     W = np.asarray(xddot, dtype=float).reshape(batch + (nb, 3))
     a = com_arms(model, x)
-    ac = W[..., :2] + W[..., 2, None] * _perp(a) - (V[..., 2] ** 2)[..., None] * a
+    ac = W[..., :2] + W[..., 2, None] * perp(a) - (V[..., 2] ** 2)[..., None] * a
     f = model.mass[:, None] * ac
     mom = model.inertia * W[..., 2] + cross(a, f)
     return np.concatenate([f, mom[..., None]], axis=-1).reshape(batch + (model.n_x,))

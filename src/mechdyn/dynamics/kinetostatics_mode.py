@@ -17,7 +17,7 @@ from ..kinematics.constraints import coordinates, coordinates_gamma, coordinates
 from ..results.kinetostatics_record import Kinetostatics
 from .forces import force_model
 from .friction import friction_joints
-from .prescribed_motion import _independent_subset, _prescribed
+from .prescribed_motion import _prescribed, independent_subset
 from .reactions import _inverse
 
 __all__ = ["_kinetostatics", "MESSAGES"]
@@ -115,7 +115,7 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
     # ---------------------------------------------------------- the motion
     over = [over] if isinstance(over, str) else list(over or [])
     over_idx = [model.coordinate_index(c) for c in over]
-    didx = _independent_subset(model, lay, x_start, over_idx, candidates)
+    didx = independent_subset(model, lay, x_start, over_idx, candidates)
     if trajectory is not None:
         tt = np.asarray(trajectory.t, dtype=float).reshape(-1)
         qd, qd_dot, qd_ddot = (np.asarray(getattr(trajectory, a), dtype=float)

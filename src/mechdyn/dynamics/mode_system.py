@@ -36,7 +36,13 @@ import numpy as np
 
 from ..errors import AssemblyError, IntegrationError, LockupError
 from ..kernels import rows_numpy as RN
-from ..kinematics.assembly import _position_tol, _scale, _scaled, _singular_report, newton
+from ..kinematics.assembly import (
+    column_scale,
+    newton,
+    position_tol,
+    scaled_by_columns,
+    singular_report,
+)
 from ..model.state import Mode
 from ..model.workspace import Workspace
 from .friction import friction_joints
@@ -145,7 +151,7 @@ class ModeSystem(ModeRows):
         at = _at_pose(self.ws, self.x_ref)
         kept = at.get((self.mode, held)) if held is not None else None
         if kept is None:
-            Rs = _scaled(model, self.row_jacobian(self.x_ref), self.rowset.is_angle)
+            Rs = scaled_by_columns(model, self.row_jacobian(self.x_ref), self.rowset.is_angle)
             rows_i = _independent_rows(Rs)
             kept = {"rows": rows_i, "GN": self._coordinates_on_null_space(Rs[rows_i])}
             if held is not None:
@@ -164,7 +170,7 @@ class ModeSystem(ModeRows):
         self._sel = np.concatenate([self.independent_rows, self.n_rows + self.coords])
         self._eye_i = np.zeros((model.n_x, self.n_i))
         self._eye_i[len(self.independent_rows):, :] = np.eye(self.n_i)
-        self._rs = 1.0 / _scale(model)
+        self._rs = 1.0 / column_scale(model)
         self.ws.reset(self.x_ref)
         #: the friction of the joints in this mode (None for a model without it)
         self.friction = JointFriction(self) if friction_joints(model) else None
@@ -175,7 +181,7 @@ class ModeSystem(ModeRows):
         model = self.model
         if model.n_x == Ri.shape[0]:
             return None
-        Gs = _scaled(model, self._coord_jac(self.x_ref), model.coord_is_angle)
+        Gs = scaled_by_columns(model, self._coord_jac(self.x_ref), model.coord_is_angle)
         N = np.linalg.svd(Ri)[2][Ri.shape[0]:].T if Ri.shape[0] else np.eye(model.n_x)
         return Gs @ N
 
@@ -225,7 +231,7 @@ class ModeSystem(ModeRows):
         qi = np.asarray(qi, float)
         x = self.ws.predict(qi) if x_guess is None else np.array(x_guess, float)
         n_r = len(self.independent_rows)
-        tol = _position_tol(self.model)
+        tol = position_tol(self.model)
         x, done = newton(self._all, x, np.concatenate([np.zeros(n_r), qi]), sel=self._sel,
                          tol=tol)
         if not done:
@@ -258,8 +264,8 @@ class ModeSystem(ModeRows):
         x (n_rows + n_q, n_x), where the caller has it, else evaluated here."""
         J = (RN.jacobian(self._all, x) if jacobian is None else jacobian)[self._sel]
         rows = [self.rowset.elements[r] for r in self.independent_rows]
-        return _singular_report(_scaled(self.model, J, self._all.is_angle[self._sel]), rows,
-                                self.coord_names)
+        Js = scaled_by_columns(self.model, J, self._all.is_angle[self._sel])
+        return singular_report(Js, rows, self.coord_names)
 
     def state(self, qi, qdoti, x_guess=None, t=None):
         """(x, xdot, B) at independent coordinates and rates."""

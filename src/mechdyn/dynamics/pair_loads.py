@@ -14,25 +14,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
-from ..kinematics.constraints import _perp
+from ..kernels.planar import cross, perp, rotate
 
-__all__ = ["rotate", "cross", "SpringSet", "BushingSet"]
-
-
-def rotate(th, s) -> np.ndarray:
-    """A(th) s for angles th, shape (...,), and body-frame vectors s, shape (2,) (one for
-    every angle) or (..., 2) (broadcast against th: one per angle) -> (..., 2)."""
-    s = np.asarray(s, dtype=float)
-    c, sn = np.cos(th), np.sin(th)
-    out = np.empty(np.broadcast_shapes(np.shape(th), s.shape[:-1]) + (2,))
-    out[..., 0] = c * s[..., 0] - sn * s[..., 1]
-    out[..., 1] = sn * s[..., 0] + c * s[..., 1]
-    return out
-
-
-def cross(a, b) -> np.ndarray:
-    """z component of a x b for planar vectors (..., 2) -> (...)."""
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+__all__ = ["SpringSet", "BushingSet"]
 
 
 class _Pairs:
@@ -87,8 +71,8 @@ class SpringSet(_Pairs):
         e = d / L[..., None]
         f = self.k * (L - self.L0)
         if V is not None and self.damped:
-            vd = (V[..., self.j, :2] + V[..., self.j, 2, None] * _perp(aj)
-                  - V[..., self.i, :2] - V[..., self.i, 2, None] * _perp(ai))
+            vd = (V[..., self.j, :2] + V[..., self.j, 2, None] * perp(aj)
+                  - V[..., self.i, :2] - V[..., self.i, 2, None] * perp(ai))
             f = f + self.c * np.sum(e * vd, axis=-1)
         self.scatter(F, (f + self.pre)[..., None] * e, ai, aj)  # on end 1, towards end 2
 
@@ -127,8 +111,8 @@ class BushingSet(_Pairs):
         f = self.k * d
         a1 = ai + delta  # body i takes its force where end 2 is
         if V is not None and self.damped:
-            vd = (V[..., self.j, :2] + V[..., self.j, 2, None] * _perp(aj)
-                  - V[..., self.i, :2] - V[..., self.i, 2, None] * _perp(a1))
+            vd = (V[..., self.j, :2] + V[..., self.j, 2, None] * perp(aj)
+                  - V[..., self.i, :2] - V[..., self.i, 2, None] * perp(a1))
             f = f + self.c * rotate(-th, vd)
         self.scatter(F, rotate(th, f), a1, aj)
 

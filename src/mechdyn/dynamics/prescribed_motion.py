@@ -17,18 +17,18 @@ import numpy as np
 
 from ..errors import AssemblyError, ModelError, SingularPositionError
 from ..kernels import rows_numpy
-from ..kinematics.assembly import _scale, joint_residuals
+from ..kinematics.assembly import column_scale, joint_residuals
 from ..kinematics.branch_chart import ChartBook, PathProblem
-from ..kinematics.constraints import _point_kinematics, coordinates, coordinates_jacobian
-from ..kinematics.continuation import Kernel, _kernel, _march, _newton, _node
-from ..kinematics.records import _refine_root
+from ..kinematics.constraints import coordinates, coordinates_jacobian, point_kinematics
+from ..kinematics.continuation import Kernel, march_path, path_newton, path_node, sweep_kernel
+from ..kinematics.records import refine_root
 from ..kinematics.sweep import (
     DEFAULT_MAX_STEP,
     DEFAULT_MIN_STEP,
-    _motion,
-    _path,
-    _solve_at,
+    path_of,
+    solve_at,
     sweep,
+    sweep_motion,
 )
 from ..model import Model, as_model
 from .mode_system import _independent_rows
@@ -49,7 +49,7 @@ def _move(kern: Kernel, node, q, cs, tol: float, counter: dict):
     book); raises where it stalls."""
     for c in cs:
         if node.q[c] != q[c]:
-            nodes, stop = _march(kern, _node(kern, node.x, node.q, c), c, [q[c]],
+            nodes, stop = march_path(kern, path_node(kern, node.x, node.q, c), c, [q[c]],
                                  **_steps(kern, c, tol, counter))
             if stop is not None:
                 raise _error(kern, stop.q_try, stop.node.x)
@@ -60,17 +60,17 @@ def _move(kern: Kernel, node, q, cs, tol: float, counter: dict):
 def _start(kern: Kernel, q0, x_start, j: int, tol: float, counter: dict):
     """The node at the held coordinates of q0 (coordinate j as at x_start), by
     continuation from the pose x_start when it is assembled, else at q0 by the sweep's
-    Newton-else-fit (:func:`~mechdyn.kinematics.sweep._solve_at`)."""
+    Newton-else-fit (:func:`~mechdyn.kinematics.sweep.solve_at`)."""
     q_s = coordinates(kern.model, x_start)[kern.idx]
-    x, ok, _, J = _newton(kern, x_start, q_s, tol, max_iter=60)
+    x, ok, _, J = path_newton(kern, x_start, q_s, tol, max_iter=60)
     if ok:
         try:
-            return _move(kern, _node(kern, x, q_s, j, J), q0,
+            return _move(kern, path_node(kern, x, q_s, j, J), q0,
                          [c for c in range(len(q0)) if c != j], tol, counter)
         except (AssemblyError, SingularPositionError):
             pass
-    x, _, J = _solve_at(kern, x_start, q0, tol, max_iter=60, error=lambda xx: _error(kern, q0, xx))
-    return _node(kern, x, q0, j, J)
+    x, _, J = solve_at(kern, x_start, q0, tol, max_iter=60, error=lambda xx: _error(kern, q0, xx))
+    return path_node(kern, x, q0, j, J)
 
 
 def _error(kern: Kernel, qd, x):
@@ -102,7 +102,7 @@ def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=N
     (through bifurcation positions with a chart book), or through anchors when several
     driven coordinates vary.  Also returns the charted samples (mask (n,), x', x'') or
     None and the stats ``position_solves`` and ``bifurcations``."""
-    kern = Kernel(model, lay, didx) if lay.extra else _kernel(model, lay, didx)
+    kern = Kernel(model, lay, didx) if lay.extra else sweep_kernel(model, lay, didx)
     tol, n = 1e-12 * max(model.length_scale, 1e-3), len(qd)
     counter = {"coarse_steps": 0}
     var = np.flatnonzero(np.ptp(qd, axis=0) > 0) if n > 1 else []
@@ -112,7 +112,7 @@ def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=N
         book = ChartBook(PathProblem(model, lay, didx, qd[0], j))
     ok = guessed = False
     if x_guess is not None:
-        x, ok, F, J = _newton(kern, x_guess, qd, tol, max_iter=30)
+        x, ok, F, J = path_newton(kern, x_guess, qd, tol, max_iter=30)
     if np.all(ok):
         guessed = True
         system = (F, J, kern.factor(J))
@@ -123,7 +123,7 @@ def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=N
         node = _start(kern, qd[0], np.asarray(x_start if x_guess is None else x_guess[0],
                                               dtype=float), j, tol, counter)
         if len(var) <= 1:
-            x, stop, system = _path(kern, node, j, qd[:, j], book=book,
+            x, stop, system = path_of(kern, node, j, qd[:, j], book=book,
                                     **_steps(kern, j, tol, counter))
             if stop is not None:
                 raise _error(kern, stop.q_try, stop.node.x)
@@ -135,13 +135,13 @@ def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=N
                 nodes.append(node)
             a = [nodes[i] for i in np.searchsorted(anchors, np.arange(n), "right") - 1]
             pred = np.array([nd.x + nd.B @ (qk - nd.q) for nd, qk in zip(a, qd, strict=True)])
-            x, ok, F, J = _newton(kern, pred, qd, tol, max_iter=30)
+            x, ok, F, J = path_newton(kern, pred, qd, tol, max_iter=30)
             fac = kern.factor(J)
             system = (F, J, fac)
             ok &= fac[2] == np.array([nd.sign for nd in a])  # on the anchor's branch
             for k in np.flatnonzero(~ok):  # by continuation from the anchor
                 x[k], system = _move(kern, a[k], qd[k], var, tol, counter).x, None
-    x, _, xdot, xddot, charted = _motion(kern, x, qd, qd_dot, qd_ddot, book, j, system,
+    x, _, xdot, xddot, charted = sweep_motion(kern, x, qd, qd_dot, qd_ddot, book, j, system,
                                          correct=False)
     # Newton solves: the continuation's steps and the batched solves
     stats = {"position_solves": counter["coarse_steps"] + (x_guess is not None) + (not guessed),
@@ -149,13 +149,13 @@ def _prescribed(model: Model, lay, didx, qd, qd_dot, qd_ddot, x_start, x_guess=N
     return x, xdot, xddot, charted, stats
 
 
-def _independent_subset(model, lay, x0, first: list[int], candidates=None) -> list[int]:
+def independent_subset(model, lay, x0, first: list[int], candidates=None) -> list[int]:
     """Extend ``first`` with coordinates that add rank, up to the DOF of the layout
     (``candidates``: the order in which the others are tried; default declared order)."""
     order = first + [k for k in (range(model.n_q) if candidates is None else candidates)
                      if k not in first]
     A = np.concatenate([rows_numpy.jacobian(lay.rowset, x0),
-                        coordinates_jacobian(model, x0)[order]]) * _scale(model)
+                        coordinates_jacobian(model, x0)[order]]) * column_scale(model)
     keep = _independent_rows(A)
     dof = model.n_x - int(np.sum(keep < lay.n_rows))
     picked = [i - lay.n_rows for i in keep if i >= lay.n_rows]  # positions in order
@@ -195,13 +195,13 @@ def dead_centres(mech_or_model, body: str, point, *, coordinate: str = "y",
     model = as_model(mech_or_model)
     x_start = getattr(model, "x0", model.x_sketch)
     over_idx = [model.coordinate_index(over)] if over else []
-    k = _independent_subset(model, model.layout(mode), x_start, over_idx)[0]
+    k = independent_subset(model, model.layout(mode), x_start, over_idx)[0]
     sw = sweep(model, model.coordinate_names[k], np.linspace(0.0, 2 * np.pi, n + 1),
                x_start=x_start, mode=mode).raise_for_status()
     c = 0 if coordinate == "x" else 1
 
     def quantity(x, xs, xss):  # the point's coordinate and its derivatives along the crank
-        return [v[..., c] for v in _point_kinematics(model, x, xs, xss, body, point)]
+        return [v[..., c] for v in point_kinematics(model, x, xs, xss, body, point)]
 
     y, dy, _ = quantity(sw.x, sw.B[..., k], sw.x * 0.0)
     out = {}
@@ -210,6 +210,6 @@ def dead_centres(mech_or_model, body: str, point, *, coordinate: str = "y",
         j = i if i == 0 or np.sign(dy[i - 1]) == np.sign(dy[i]) else i - 1
         if i == 0 and np.sign(dy[0]) == np.sign(dy[1]):
             j = n - 1
-        a, v = _refine_root(sw, j, quantity)
+        a, v = refine_root(sw, j, quantity)
         out[key] = (float(np.mod(a, 2 * np.pi)), v)
     return out

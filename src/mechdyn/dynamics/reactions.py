@@ -12,8 +12,9 @@ import numpy as np
 
 from ..errors import ModelError, Status
 from ..kernels import rows_numpy
-from ..kinematics.assembly import SINGULAR_RCOND, _redundant_rows, _scale
-from ..kinematics.constraints import _perp, coordinates_jacobian, extend
+from ..kernels.planar import cross, perp, rotate
+from ..kinematics.assembly import SINGULAR_RCOND, column_scale, redundant_rows
+from ..kinematics.constraints import coordinates_jacobian, extend
 from ..model import ConstraintLayout, Model
 from .compliance import share_by_compliance
 from .forces import applied_forces
@@ -21,7 +22,6 @@ from .friction import friction_joints
 from .inertia import inertia_forces
 from .joint_friction import friction_set, joint_states
 from .kinetostatics_friction import friction_solve, locking_note
-from .pair_loads import cross, rotate
 
 __all__ = ["KinetostaticsWarning", "joint_reaction", "reaction_frame", "element_forces",
            "element_width", "frame_forces", "touches_ground", "ground_rows"]
@@ -42,7 +42,7 @@ def _redundancy(model, lay, x) -> tuple[int, list[str], list[str]]:
     row labels."""
     if x.shape[0] > 64:  # redundancy is structural: a sample of the positions suffices
         x = x[np.unique(np.linspace(0, x.shape[0] - 1, 64).astype(int))]
-    rank, rows = _redundant_rows(rows_numpy.jacobian(lay.rowset, x) * _scale(model),
+    rank, rows = redundant_rows(rows_numpy.jacobian(lay.rowset, x) * column_scale(model),
                                  REDUNDANT_RCOND)
     n_red = lay.n_rows - rank
     if n_red == 0:
@@ -299,7 +299,7 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
     A = np.concatenate([-P, Gd], axis=1).transpose(0, 2, 1)  # (n, n_x, rows + n_d)
     rhs = Ix - F
     # balance units: moment equations / L; moment-like unknowns scaled by L
-    rs = 1.0 / _scale(model)
+    rs = 1.0 / column_scale(model)
     cs = np.where(np.concatenate([lay.rowset.is_angle, model.coord_is_angle[didx]]), L, 1.0)
     As = A * rs[:, None] * cs[None, :]
     bs = rhs * rs
@@ -402,7 +402,7 @@ def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qd
         # prismatic: along and normal to the axis; else along the parent's x and y axes
         u = rotate(X[:, i, 2], model.pri.ui[model.pri.names.index(name)]
                    if kind == "prismatic" else (1.0, 0.0))
-        jframe[name] = np.stack([np.sum(f * u, -1), np.sum(f * _perp(u), -1)], axis=-1)
+        jframe[name] = np.stack([np.sum(f * u, -1), np.sum(f * perp(u), -1)], axis=-1)
         if model.n_bodies in (i, j):  # attached to the ground
             frame_loads[name] = net_on_ground(model, x, gen, point)
 

@@ -16,8 +16,9 @@ import math
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
+from ..kernels.planar import perp
 from ..kinematics.analogs import acceleration_bias, velocity_analogs
-from ..kinematics.constraints import _perp, full_jacobian
+from ..kinematics.constraints import full_jacobian
 from ..kinematics.sweep import analyze, sweep
 from ..model import Model, as_model
 from .forces import com_arms, force_model
@@ -63,8 +64,8 @@ def reduced_kinematics(model: Model, x, layout=None) -> dict:
     V = B.reshape(B.shape[:-1] + (-1, 3))
     A = b.reshape(V.shape)
     w, al = V[..., 2], A[..., 2]
-    vc = V[..., :2] + w[..., None] * _perp(arm)
-    ac = A[..., :2] + al[..., None] * _perp(arm) - (w**2)[..., None] * arm
+    vc = V[..., :2] + w[..., None] * perp(arm)
+    ac = A[..., :2] + al[..., None] * perp(arm) - (w**2)[..., None] * arm
     J, dJ = _inertia(model, x, B, b)
     return {"B": B, "b": b, "vc": vc, "ac": ac, "w": w, "al": al, "J": J, "dJ": dJ, "Jf": Jf}
 

@@ -54,7 +54,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
-from ..kinematics.constraints import _turn
+from ..kernels.planar import rotate
 from ..mechanism import (
     GROUND,
     AssemblyMode,
@@ -234,7 +234,7 @@ def _reactions(mech: Mechanism, names: Sequence[str], base: str) -> list:
         b = mech.body(ld.body)
         p = b.point(ld.point) if isinstance(ld.point, str) else tuple(ld.point)
         pose = poses[ld.body]
-        at = np.asarray(pose[:2]) + _turn(pose[2], np.asarray(p, float))
+        at = np.asarray(pose[:2]) + rotate(pose[2], np.asarray(p, float))
         out.append(Force(f"{name}_reaction", base, tuple(float(v) for v in at), ld.magnitude,
                          tuple(-v for v in ld.direction), "ground"))
     return out
@@ -429,7 +429,7 @@ def isolator_forces(foundation: Foundation, u, v=None, pivot=(0.0, 0.0)) -> np.n
     pivot = np.asarray(pivot, float)
     shape = u.shape[:-1] + (1,)
     s = foundation.positions() - pivot
-    rr = _turn(u[..., 2].reshape(shape), s)  # (..., n, 2)
+    rr = rotate(u[..., 2].reshape(shape), s)  # (..., n, 2)
     F = foundation.stiffnesses() * (rr - s + u[..., None, :2])
     if v is not None:
         v = np.asarray(v, float)
@@ -444,7 +444,7 @@ def to_centre_of_mass(foundation: Foundation, u, v=None, pivot=(0.0, 0.0)):
     its ``pivot`` (the base coordinates of :func:`mounted`)."""
     u = np.asarray(u, float)
     r = np.asarray(foundation.com, float) - np.asarray(pivot, float)
-    rr = _turn(u[..., 2], r)
+    rr = rotate(u[..., 2], r)
     uc = np.array(u)
     uc[..., :2] += rr - r
     if v is None:
@@ -488,15 +488,15 @@ def static_equilibrium(mechanism: Mechanism, foundation: Foundation,
         poses = sketch_poses(mechanism)
         for b in mechanism.bodies.values():
             pose = poses[b.name]
-            points.append(np.asarray(pose[:2]) + _turn(pose[2], np.asarray(b.com)))
+            points.append(np.asarray(pose[:2]) + rotate(pose[2], np.asarray(b.com)))
             forces.append(b.mass * g)
     r0, F0 = np.array(points) - pivot, np.array(forces)
     r_iso = foundation.positions() - pivot
 
     def residual(u):
         F = isolator_forces(foundation, u, pivot=pivot)  # what the base pushes
-        a = _turn(u[2], r_iso)
-        r = _turn(u[2], r0)
+        a = rotate(u[2], r_iso)
+        r = rotate(u[2], r0)
         m = np.sum(a[:, 0] * F[:, 1] - a[:, 1] * F[:, 0])
         m_load = np.sum(r[:, 0] * F0[:, 1] - r[:, 1] * F0[:, 0]) + moment
         return np.array([*(F.sum(axis=0) - F0.sum(axis=0)), m - m_load])

@@ -13,10 +13,11 @@ import numpy as np
 
 from ..errors import AssemblyError, SingularPositionError
 from ..kernels import rows_numpy
+from ..kernels.planar import rotate
 from ..mechanism.placement import describe_poses, initial_values, suggest_assembly_mode
 from ..model import ConstraintLayout, Model
 from ..model.rows import Rows
-from .constraints import _turn, coordinates, extend, full_jacobian, residual, system
+from .constraints import coordinates, extend, full_jacobian, residual, system
 
 __all__ = ["newton", "solve_position", "assemble", "find_poses", "start_coordinates",
            "joint_residuals", "singularity", "rank_report",
@@ -29,12 +30,12 @@ SINGULAR_RCOND = 1e-9
 DEAD_RCOND = 1e-4
 
 
-def _scale(model: Model) -> np.ndarray:
+def column_scale(model: Model) -> np.ndarray:
     """Column scaling: lengths as they are, rotations times the length scale."""
     return np.tile([1.0, 1.0, model.length_scale], model.n_bodies)
 
 
-def _position_tol(model: Model) -> float:
+def position_tol(model: Model) -> float:
     """Default residual tolerance of the position solve: 1e-13 x the length scale, m."""
     return 1e-13 * max(model.length_scale, 1e-3)
 
@@ -154,7 +155,7 @@ def solve_position(model: Model, q, x_guess, *, layout: ConstraintLayout | None 
     lay = layout or model.layout()
     q = np.asarray(q, dtype=float)
     if tol is None:
-        tol = _position_tol(model)
+        tol = position_tol(model)
     zeros = np.zeros(q.shape[:-1] + (len(lay.rowset),))
     x, done = newton(lay.position_rows, x_guess, np.concatenate([zeros, q], axis=-1), tol=tol,
                      max_iter=max_iter)
@@ -211,18 +212,18 @@ def singularity(model: Model, x, layout: ConstraintLayout | None = None) -> dict
     and ``joints`` (joints whose equations become dependent).
     """
     lay = layout or model.layout()
-    Js = _scaled(model, full_jacobian(model, x, lay), lay.position_rows.is_angle)
-    return _singular_report(Js, lay.row_joint, model.coordinate_names)
+    Js = scaled_by_columns(model, full_jacobian(model, x, lay), lay.position_rows.is_angle)
+    return singular_report(Js, lay.row_joint, model.coordinate_names)
 
 
-def _scaled(model: Model, J, is_angle) -> np.ndarray:
+def scaled_by_columns(model: Model, J, is_angle) -> np.ndarray:
     """J (..., n_r, n_x) made dimensionless: rows in m divided by the length scale L (rows
     in rad as they are), the x and y columns times L."""
     L = model.length_scale
     return J * np.where(is_angle, 1.0, 1.0 / L)[:, None] * np.tile([L, L, 1.0], model.n_bodies)
 
 
-def _singular_report(Js, rows, coords) -> dict:
+def singular_report(Js, rows, coords) -> dict:
     """The report of :func:`singularity` from a scaled Jacobian ``Js`` whose rows are the
     constraint rows (their elements ``rows``), then the coordinates ``coords``."""
     if not Js.size:
@@ -238,12 +239,12 @@ def _singular_report(Js, rows, coords) -> dict:
 def _check_singular(model, x, q, lay, t):
     if model.n_x == 0 or lay.n_rows + model.n_q != model.n_x:
         return
-    Js = _scaled(model, full_jacobian(model, x, lay), lay.position_rows.is_angle)
+    Js = scaled_by_columns(model, full_jacobian(model, x, lay), lay.position_rows.is_angle)
     s = np.linalg.svd(Js, compute_uv=False)
     rc = s[..., -1] / s[..., 0]
     if np.any(rc < SINGULAR_RCOND):
         k = np.unravel_index(np.argmin(rc), rc.shape)
-        rep = _singular_report(Js[k], lay.row_joint, model.coordinate_names)
+        rep = singular_report(Js[k], lay.row_joint, model.coordinate_names)
         raise SingularPositionError(
             f"dead or toggle position: the constraint Jacobian is singular "
             f"(sigma_min/sigma_max = {rep['rcond']:.2e}); coordinate(s) "
@@ -259,12 +260,12 @@ def branch_sign(model: Model, x, layout: ConstraintLayout | None = None) -> np.n
     J = full_jacobian(model, x, layout)
     if J.shape[-1] != J.shape[-2]:
         return np.ones(np.shape(x)[:-1])
-    return np.sign(np.linalg.det(J * _scale(model)))
+    return np.sign(np.linalg.det(J * column_scale(model)))
 
 
 def _world(X, b, s):
     """Ground-frame position of the point(s) s (..., 2) of body b, poses X (..., nb + 1, 3)."""
-    return X[..., b, :2] + _turn(X[..., b, 2], s)
+    return X[..., b, :2] + rotate(X[..., b, 2], s)
 
 
 def turn_signs(model: Model, x) -> dict:
@@ -315,7 +316,7 @@ def _mirror_guess(model: Model, x, pts) -> np.ndarray:
         # rigid fit (rotation only): angle from the centred cross-covariance
         lc, mc = local - local.mean(0), mirrored - mirrored.mean(0)
         th = np.angle(np.vdot(lc @ [1, 1j], mc @ [1, 1j]))
-        origin = mirrored.mean(0) - _turn(th, local.mean(0))
+        origin = mirrored.mean(0) - rotate(th, local.mean(0))
         # keep the angle on the branch of the sketch angle (no 2 pi jumps)
         th = xg[3 * k + 2] + np.angle(np.exp(1j * (th - xg[3 * k + 2])))
         xg[3 * k:3 * k + 3] = (origin[0], origin[1], th)
@@ -456,12 +457,12 @@ def _pick_branch(model: Model, sols: list, q, lay, t) -> np.ndarray:
     """The one branch of ``sols`` (see :func:`find_poses`), or an AssemblyError."""
     if len(sols) == 1:
         return sols[0]
-    J = full_jacobian(model, sols[0], lay) * _scale(model)
+    J = full_jacobian(model, sols[0], lay) * column_scale(model)
     if _rank(J) < model.n_x:  # not a set of branches: the coordinates do not fix the
         return sols[0]        # pose (the rank check of the compiler reports it)
     given = np.repeat(np.asarray(model.pose_given, bool), 3)
     if given.any():
-        d = np.array([np.linalg.norm(((x - model.x_sketch) / _scale(model))[given])
+        d = np.array([np.linalg.norm(((x - model.x_sketch) / column_scale(model))[given])
                       for x in sols])
         order = np.argsort(d)
         if d[order[1]] > 2.0 * d[order[0]] + 1e-6:
@@ -511,7 +512,7 @@ def _assemble_near(model: Model, q, *, x_guess=None, layout=None, t=None) -> np.
     except AssemblyError:
         pass
     x = _least_squares(lambda xx: system(model, xx, q, lay), x, method="trf", max_nfev=2000,
-                       x_scale=_scale(model) / model.length_scale)
+                       x_scale=column_scale(model) / model.length_scale)
     return solve_position(model, q, x, layout=lay, t=t, check_singular=False)
 
 
@@ -526,9 +527,9 @@ def _least_squares(fun, x, w=1.0, **options) -> np.ndarray:
 def rank_report(model: Model, x, layout=None) -> dict:
     """Ranks at a pose: constraint rank, redundant joints, dependent coordinates."""
     lay = layout or model.layout()
-    J = full_jacobian(model, x, lay) * _scale(model)
+    J = full_jacobian(model, x, lay) * column_scale(model)
     P, Gq = J[:lay.n_rows], J[lay.n_rows:]
-    rank_phi, redundant = _redundant_rows(P)
+    rank_phi, redundant = redundant_rows(P)
     rank_full = _rank(J)
     dep = []
     if model.n_q and rank_full < rank_phi + model.n_q:
@@ -544,7 +545,7 @@ def _rank(A, rtol=1e-9):
     return np.linalg.matrix_rank(A, rtol=rtol)
 
 
-def _redundant_rows(P, rtol=1e-9):
+def redundant_rows(P, rtol=1e-9):
     """(rank, dependent rows) of a scaled constraint Jacobian P (n_rows, n_x), or of the one
     of least rank of a batch (..., n_rows, n_x): the dependent rows are linear combinations
     of the others (they carry the left null space)."""

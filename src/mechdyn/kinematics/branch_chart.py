@@ -41,8 +41,8 @@ import numpy as np
 from numpy.polynomial import chebyshev as cheb
 
 from ..model import ConstraintLayout, Model
-from .assembly import _scale
-from .continuation import _hermite5, _kernel, _march, _newton, _Node, _node
+from .assembly import column_scale
+from .continuation import _hermite5, _Node, march_path, path_newton, path_node, sweep_kernel
 
 __all__ = ["PathProblem", "BranchChart", "ChartBook", "bridge", "ZONE", "WINDOW", "REACH"]
 
@@ -92,7 +92,7 @@ class PathProblem:
     >>> _ = m.add_coordinate("phi", kind="angle", body="crank")
     >>> path = PathProblem(m.compile(), m.compile().layout(), [0], [0.0], 0)
     >>> node = path.solve(0.3, np.zeros(3))
-    >>> round(float(node.x[2]), 12), float(node.xs[2])
+    >>> round(float(node.x[2]), 9), round(float(node.xs[2]), 9)   # crank angle, its analog
     (0.3, 1.0)
     """
 
@@ -105,12 +105,12 @@ class PathProblem:
             raise ValueError("a branch chart needs a square position system "
                              f"({layout.n_rows} joint rows + {self.idx.size} coordinates "
                              f"for {model.n_x} pose components)")
-        self.scale = _scale(model)
+        self.scale = column_scale(model)
         #: unit of the path coordinate for the zone sizes: 1 rad, or the length scale
         self.unit = 1.0 if model.coord_is_angle[self.idx[self.k]] else float(model.length_scale)
         self.tol = 1e-14 * max(model.length_scale, 1e-3)
         #: the equations [Phi; g_idx - q] (the compiled kernel of the sweep)
-        self.kernel = _kernel(model, layout, self.idx)
+        self.kernel = sweep_kernel(model, layout, self.idx)
 
     # ------------------------------------------------------------------ equations
     def _q(self, s) -> np.ndarray:
@@ -124,11 +124,11 @@ class PathProblem:
 
     def node(self, s, x, J=None) -> _Node:
         """The solved pose x at s with x' = dx/ds (``xs``), x'' (``xss``) and the branch sign."""
-        return _node(self.kernel, np.asarray(x, dtype=float), self._q(s), self.k, J)
+        return path_node(self.kernel, np.asarray(x, dtype=float), self._q(s), self.k, J)
 
     def solve(self, s, x_guess) -> _Node | None:
         """The node at s by Newton from ``x_guess`` (None if it does not converge)."""
-        x, ok, _, J = _newton(self.kernel, np.asarray(x_guess, dtype=float), self._q(s),
+        x, ok, _, J = path_newton(self.kernel, np.asarray(x_guess, dtype=float), self._q(s),
                               self.tol, max_iter=12)
         return self.node(s, x, J) if ok else None
 
@@ -162,7 +162,7 @@ class PathProblem:
         """Continuation from ``node`` to s_to (the sweep's march, without charts); returns
         (node reached, ok).  A change of the branch sign is refused, so the march stops
         in front of a singular position."""
-        out, stop = _march(self.kernel, node, self.k, [s_to], max_step=_STEP * self.unit,
+        out, stop = march_path(self.kernel, node, self.k, [s_to], max_step=_STEP * self.unit,
                            min_step=1e-9 * self.unit, tol=self.tol, counter={})
         return (stop.node if stop is not None else out[-1]), stop is None
 
@@ -292,8 +292,8 @@ def bridge(path: PathProblem, start: _Node, s_star: float, *, zone: float = ZONE
     >>> path = PathProblem(model, model.layout(), [0], [0.5], 0)
     >>> chart = bridge(path, path.node(0.5, model.x0), 0.0)
     >>> x, _, _ = chart.evaluate(-0.1)
-    >>> round(float(x[2]), 12), round(float(x[5]), 12)   # crank angle, coupler angle
-    (-0.1, 0.0)
+    >>> round(float(x[2]), 9), abs(float(x[5])) < 1e-9   # crank angle; coupler level?
+    (-0.1, True)
     """
     r1, R = zone * path.unit, window * path.unit
     ts = r1 + (R - r1) * (1.0 - np.cos(np.array([0.0, 0.25, 0.5]) * np.pi))  # r1 .. R
@@ -397,8 +397,8 @@ class ChartBook:
     >>> chart.kind, abs(chart.centre) < 1e-3     # centre: an estimate of the crossing
     ('bifurcation', True)
     >>> x, xs, _ = chart.evaluate(0.0)
-    >>> round(float(x[8]), 12), round(float(xs[8]), 12)  # rocker angle, its analog
-    (0.0, 1.0)
+    >>> abs(float(x[8])) < 1e-9, round(float(xs[8]), 9)  # rocker angle zero?; its analog
+    (True, 1.0)
     """
 
     def __init__(self, path: PathProblem, *, zone: float = ZONE, window: float = WINDOW,

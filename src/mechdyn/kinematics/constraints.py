@@ -13,6 +13,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..kernels import rows_numpy
+from ..kernels.planar import perp, rotate
 from ..model import ConstraintLayout, Model
 from ..model import rows as R
 
@@ -27,17 +28,6 @@ def extend(model: Model, x: np.ndarray) -> np.ndarray:
     X = x.reshape(x.shape[:-1] + (model.n_bodies, 3))
     pad = np.zeros(x.shape[:-1] + (1, 3))
     return np.concatenate([X, pad], axis=-2)
-
-
-def _turn(th, s):
-    """A(theta) s: vectors s (..., 2) turned by the angles th (...), shape (..., 2)."""
-    c, sn = np.cos(th), np.sin(th)
-    return np.stack([c * s[..., 0] - sn * s[..., 1], sn * s[..., 0] + c * s[..., 1]], axis=-1)
-
-
-def _perp(v):
-    """Rotate vectors (..., 2) by +90 deg."""
-    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
 
 
 def residual(model: Model, x, layout: ConstraintLayout | None = None) -> np.ndarray:
@@ -112,7 +102,7 @@ def _arm(model: Model, x, body: str, point):
     """Body index k, poses with the ground X and the arm A(theta_k) s of a body point."""
     k = model.body_index(body)
     X = extend(model, x)
-    return k, X, _turn(X[..., k, 2], model.point_local(body, point))
+    return k, X, rotate(X[..., k, 2], model.point_local(body, point))
 
 
 def point_position(model: Model, x, body: str, point) -> np.ndarray:
@@ -125,17 +115,17 @@ def point_velocity(model: Model, x, xdot, body: str, point) -> np.ndarray:
     """Velocity of a body point, shape (..., 2), m/s."""
     k, _, a = _arm(model, x, body, point)
     V = extend(model, xdot)
-    return V[..., k, :2] + V[..., k, 2][..., None] * _perp(a)
+    return V[..., k, :2] + V[..., k, 2][..., None] * perp(a)
 
 
 def point_acceleration(model: Model, x, xdot, xddot, body: str, point) -> np.ndarray:
     """Acceleration of a body point, shape (..., 2), m/s^2."""
     k, _, a = _arm(model, x, body, point)
     V, W = extend(model, xdot), extend(model, xddot)
-    return W[..., k, :2] + W[..., k, 2][..., None] * _perp(a) - (V[..., k, 2] ** 2)[..., None] * a
+    return W[..., k, :2] + W[..., k, 2][..., None] * perp(a) - (V[..., k, 2] ** 2)[..., None] * a
 
 
-def _point_kinematics(model: Model, x, xdot, xddot, body: str, point):
+def point_kinematics(model: Model, x, xdot, xddot, body: str, point):
     """Position (m), velocity (m/s) and acceleration (m/s^2) of a body point, (..., 2) each."""
     return (point_position(model, x, body, point),
             point_velocity(model, x, xdot, body, point),

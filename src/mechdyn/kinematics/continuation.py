@@ -20,7 +20,7 @@ import numpy as np
 from ..kernels import rows_numpy
 from ..model import ConstraintLayout, Model
 from ..model.rows import concat
-from .assembly import _dense_solve, _scale, newton
+from .assembly import _dense_solve, column_scale, newton
 
 #: Newton iterations allowed per step of the continuation
 _MAX_NEWTON = 10
@@ -66,7 +66,7 @@ class Kernel:
         self.n_eq = len(self.rows)
         self.n_q = self.n_eq - self.n_rows
         self.square = self.n_eq == self.n_x
-        self.col_scale = _scale(model)
+        self.col_scale = column_scale(model)
         self._ints, self._flts = self.rows.packed()
         from ..kernels import rows_numba, rows_sweep  # numba is imported only here
 
@@ -157,7 +157,7 @@ class _Node:
     xss = property(lambda self: self.H)
 
 
-def _newton(kern: Kernel, x, q, tol, max_iter=_MAX_NEWTON):
+def path_newton(kern: Kernel, x, q, tol, max_iter=_MAX_NEWTON):
     """The one position Newton (:func:`~mechdyn.kinematics.assembly.newton`) on the
     kernel's equations [Phi; g - q] = 0, from poses x (N, n_x) or one pose (1-D x, q);
     returns x, converged, and the residual F and the Jacobian J at x."""
@@ -175,7 +175,7 @@ def _newton(kern: Kernel, x, q, tol, max_iter=_MAX_NEWTON):
     return x, ok, at[0], at[1]
 
 
-def _node(kern: Kernel, x, q, k: int, J=None) -> _Node:
+def path_node(kern: Kernel, x, q, k: int, J=None) -> _Node:
     """Analogs, second derivative along coordinate ``k`` and branch sign at a solved pose."""
     if J is None:
         J = kern.system(x, q)[1]
@@ -217,7 +217,7 @@ def _chart_node(kern: Kernel, chart, q, k: int) -> _Node:
     return _Node(np.array(q, dtype=float), x, B, xss, chart.side_sign(q[k]), k)
 
 
-def _march(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, tol,
+def march_path(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, tol,
            counter: dict, prev: _Node | None = None, book=None):
     """Sequential continuation through ``targets`` (values of coordinate k).
 
@@ -250,10 +250,10 @@ def _march(kern: Kernel, start: _Node, k: int, targets, *, max_step, min_step, t
                 continue
             win = (book.window_chart(qn[k]) or book.window_chart(node.q[k])) if book else None
             xp = win.evaluate(qn[k])[0] if win is not None else _predict(prev, node, k, h)
-            x, ok, _, J = _newton(kern, xp, qn, tol)
+            x, ok, _, J = path_newton(kern, xp, qn, tol)
             reason = "Newton's method does not converge"  # None: the step is accepted
             if ok:
-                nn = _node(kern, x, qn, k, J=J)
+                nn = path_node(kern, x, qn, k, J=J)
                 step = np.max(np.abs((nn.x - node.x) * kern.col_scale))
                 corr = np.max(np.abs((nn.x - xp) * kern.col_scale))
                 expected = win.side_sign(qn[k]) if win is not None else node.sign
@@ -332,7 +332,7 @@ def _anchor_indices(values, max_step) -> np.ndarray:
     return np.array(anchors, dtype=int)
 
 
-def _kernel(model: Model, layout, idx=None) -> Kernel:
+def sweep_kernel(model: Model, layout, idx=None) -> Kernel:
     """The evaluation kernel of a model in a mode (for the coordinates ``idx``, default
     all), made for the analysis that asks (packing the rows costs microseconds)."""
     if idx is not None and np.array_equal(idx, np.arange(model.n_q)):

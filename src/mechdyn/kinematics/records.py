@@ -17,9 +17,9 @@ import numpy as np
 from ..kernels import rows_numpy
 from ..mechanism.joint import Revolute
 from ..model import Model
-from .assembly import _position_tol
-from .constraints import _point_kinematics, point_position, point_velocity, travel_rows
-from .continuation import _kernel, _newton, _node
+from .assembly import position_tol
+from .constraints import point_kinematics, point_position, point_velocity, travel_rows
+from .continuation import path_newton, path_node, sweep_kernel
 
 __all__ = ["KinematicSweep", "KinematicPoint", "SweepSummary", "DeadCentre", "TransmissionAngle",
            "PointExtremes", "FourBarLoop", "four_bar_loops"]
@@ -56,7 +56,7 @@ class KinematicPoint:
 
     def point(self, body: str, name) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position (m), velocity (m/s) and acceleration (m/s^2) of a body point, each (2,)."""
-        return _point_kinematics(self.model, self.x, self.xdot, self.xddot, body, name)
+        return point_kinematics(self.model, self.x, self.xdot, self.xddot, body, name)
 
     def angular(self, body: str) -> tuple[float, float, float]:
         """Angle (rad), angular velocity (rad/s) and acceleration (rad/s^2) of a body."""
@@ -146,7 +146,7 @@ class KinematicSweep:
         -------
         r, v, a : ndarray, shape (n, 2) each
         """
-        return _point_kinematics(self.model, self.x, self.xdot, self.xddot, body, name)
+        return point_kinematics(self.model, self.x, self.xdot, self.xddot, body, name)
 
     def point_analogs(self, body: str, name) -> np.ndarray:
         """Velocity analogs dr/dq of a body point, shape (n, 2, n_q) (m/rad or m/m)."""
@@ -403,7 +403,7 @@ def _summarize(sw: KinematicSweep) -> SweepSummary:
         for i in np.flatnonzero(np.sign(ds[:-1]) * np.sign(ds[1:]) < 0):
             # a maximum where the travel rate goes from + to - along the sweep direction
             is_max = (ds[i] > 0) == (sw.values[i + 1] > sw.values[i])
-            found.append((*_refine_root(sw, i, partial(_travel, m, jname)), is_max))
+            found.append((*refine_root(sw, i, partial(_travel, m, jname)), is_max))
         for i in np.flatnonzero(ds == 0.0):  # exactly on a sample: keep it if an extremum
             j0, j1 = max(i - 1, 0), min(i + 1, n - 1)
             hi, lo = s[i] >= max(s[j0], s[j1]), s[i] <= min(s[j0], s[j1])
@@ -429,23 +429,23 @@ def _summarize(sw: KinematicSweep) -> SweepSummary:
     return SweepSummary(sw.over, sw.over_is_angle, strokes, dcs, trans, ext)
 
 
-def _refine_root(sw: KinematicSweep, i: int, quantity) -> tuple[float, float]:
+def refine_root(sw: KinematicSweep, i: int, quantity) -> tuple[float, float]:
     """Root of the exact rate of a quantity along the swept coordinate between positions
     i and i+1 (Brent's method, each position solved from the last): ``quantity(x, x', x'')``
     gives the value and its first derivative (a travel, a point coordinate); returns
     (q there, value there)."""
     m, k = sw.model, sw.over_index
-    kern = _kernel(m, m.layout(sw.stats.get("mode")))
-    tol = _position_tol(m)
+    kern = sweep_kernel(m, m.layout(sw.stats.get("mode")))
+    tol = position_tol(m)
     last = {"x": sw.x[i], "s": np.nan}
 
     def rate(q_over):
         q = sw.q[0].copy()
         q[k] = q_over
-        x, ok, _, J = _newton(kern, np.array(last["x"], dtype=float), q, tol)
+        x, ok, _, J = path_newton(kern, np.array(last["x"], dtype=float), q, tol)
         if not ok:
             raise ArithmeticError(f"no position at {sw.over} = {q_over!r}")
-        node = _node(kern, x, q, k, J=J)
+        node = path_node(kern, x, q, k, J=J)
         last["x"] = x
         s, ds = quantity(x, node.B[:, k], node.H)[:2]
         last["s"] = float(s)

@@ -38,7 +38,7 @@ constraint and coordinate rows (:mod:`mechdyn.model.rows`), the equations of
 (compiled when numba is installed) that also factors the Jacobians (sparse LU,
 which gives the branch sign too).
 
-Steps 1-2 are :func:`_path`, step 3 :func:`_motion` (kinetostatics uses both); the
+Steps 1-2 are :func:`path_of`, step 3 :func:`sweep_motion` (kinetostatics uses both); the
 building blocks are in :mod:`mechdyn.kinematics.continuation`, the records (public
 names importable from here) in :mod:`mechdyn.kinematics.records`.
 """
@@ -53,18 +53,18 @@ import numpy as np
 
 from ..errors import ModelError, SingularPositionError, Status, did_you_mean
 from ..model import Model, as_model
-from .assembly import _least_squares, _position_tol, assemble, singularity
+from .assembly import _least_squares, assemble, position_tol, singularity
 from .branch_chart import ChartBook, PathProblem
 from .constraints import coordinates
 from .continuation import (
     _MAX_NEWTON,
     _anchor_indices,
     _hermite5,
-    _kernel,
-    _march,
-    _newton,
-    _node,
     _Stop,
+    march_path,
+    path_newton,
+    path_node,
+    sweep_kernel,
 )
 from .records import (
     DeadCentre,
@@ -115,13 +115,13 @@ def _start_pose(model: Model, lay=None, fresh: bool = False) -> np.ndarray:
     return assemble(model, layout=lay) if x0 is None or fresh else x0
 
 
-def _solve_at(kern, x_guess, q, tol, max_iter=_MAX_NEWTON, error=None):
+def solve_at(kern, x_guess, q, tol, max_iter=_MAX_NEWTON, error=None):
     """Pose at q by Newton from ``x_guess``, else assembled from it, with F and J there:
     by :func:`assemble` (in the declared assembly modes) or, given ``error`` (a kernel of
     some coordinates or of a switched mode's rows), by a least-squares fit of the kernel's
     equations and Newton, raising ``error(x)`` where that fails."""
     x_guess = np.asarray(x_guess, float)
-    x, ok, F, J = _newton(kern, x_guess, q, tol, max_iter)
+    x, ok, F, J = path_newton(kern, x_guess, q, tol, max_iter)
     if ok:
         return x, F, J
     if error is None:
@@ -129,7 +129,7 @@ def _solve_at(kern, x_guess, q, tol, max_iter=_MAX_NEWTON, error=None):
         return x, *kern.system(x, q)
     x = _least_squares(lambda xx: kern.system(xx, q), x_guess, method="trf", max_nfev=2000,
                        x_scale=kern.col_scale / kern.model.length_scale)
-    x, ok, F, J = _newton(kern, x, q, tol, max_iter=30)
+    x, ok, F, J = path_newton(kern, x, q, tol, max_iter=30)
     if not ok:
         raise error(x)
     return x, F, J
@@ -206,10 +206,10 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
     k = model.coordinate_index(over)
     is_angle = bool(model.coord_is_angle[k])
     lay = model.layout(mode)
-    kern = _kernel(model, lay)
+    kern = sweep_kernel(model, lay)
     L = model.length_scale
     if tol is None:
-        tol = _position_tol(model)
+        tol = position_tol(model)
     if max_step is None:
         max_step = DEFAULT_MAX_STEP if is_angle else 0.05 * L
     if min_step is None:
@@ -222,8 +222,8 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
     else:
         x0 = np.asarray(x_start, float).reshape(model.n_x)
         q_init = coordinates(model, x0)
-    x_init, _, J0 = _solve_at(kern, x0, q_init, tol)
-    start = _node(kern, x_init, q_init, k, J=J0)
+    x_init, _, J0 = solve_at(kern, x0, q_init, tol)
+    start = path_node(kern, x_init, q_init, k, J=J0)
     # bifurcation positions on the way are gone through on the branch (branch charts)
     book = ChartBook(PathProblem(model, lay, np.arange(model.n_q), q_init, k)) \
         if kern.square else None
@@ -239,13 +239,13 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
     qdot_c = _rates(model, k, speed)
 
     counter: dict = {}
-    X, stop, system = _path(kern, start, k, values, max_step=max_step, min_step=min_step,
+    X, stop, system = path_of(kern, start, k, values, max_step=max_step, min_step=min_step,
                             tol=tol, book=book, counter=counter)
     N = len(X)
     Q = _coords(q_init, k, values[:N])
     qdot = np.broadcast_to(qdot_c, (N, model.n_q)).copy()
     qddot = np.zeros((N, model.n_q))
-    X, B, xdot, xddot, _ = _motion(kern, X, Q, qdot, qddot, book, k, system)
+    X, B, xdot, xddot, _ = sweep_motion(kern, X, Q, qdot, qddot, book, k, system)
 
     error, events = None, ()
     if stop is not None:
@@ -267,7 +267,7 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
         message="" if error is None else str(error), error=error, model=model)
 
 
-def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter):
+def path_of(kern, start, k: int, values, *, max_step, min_step, tol, book, counter):
     """The continuation of the sweep from the node ``start`` through ``values`` of
     coordinate k (the kernel's other coordinates held at ``start.q``): steps 1 and 2 of
     the module docstring.  Returns the poses reached (n_ok, n_x), the :class:`_Stop` or
@@ -277,7 +277,7 @@ def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter
     t_coarse = time.perf_counter()
     # ---- 1. coarse continuation through the anchors
     anchors = _anchor_indices(values, max_step)
-    march = partial(_march, kern, k=k, max_step=max_step, min_step=min_step, tol=tol,
+    march = partial(march_path, kern, k=k, max_step=max_step, min_step=min_step, tol=tol,
                     counter=counter, book=book)
     anodes, stop = march(start, targets=values[anchors])
     n_anch = len(anodes)
@@ -299,7 +299,7 @@ def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter
         with np.errstate(invalid="ignore", divide="ignore"):
             t = np.where(h != 0, (values[:n_ok, None] - qa[seg, None]) / h, 0.0)
         xp = _hermite5(t, h, xa[seg], da[seg], aa[seg], xa[seg + 1], da[seg + 1], aa[seg + 1])
-        X, ok_f, F, J = _newton(kern, xp, _coords(start.q, k, values[:n_ok]), tol, max_iter=5)
+        X, ok_f, F, J = path_newton(kern, xp, _coords(start.q, k, values[:n_ok]), tol, max_iter=5)
         fac = kern.factor(J)
         near = np.max(np.abs((X - xp) * kern.col_scale), axis=1) <= 1e-3 * model.length_scale
         ok_f &= (fac[2] == sg[seg]) & near
@@ -333,7 +333,7 @@ def _path(kern, start, k: int, values, *, max_step, min_step, tol, book, counter
     return X, stop, system
 
 
-def _motion(kern, X, Q, qdot, qddot, book, k: int, system=None, correct=True):
+def sweep_motion(kern, X, Q, qdot, qddot, book, k: int, system=None, correct=True):
     """Step 3 of the module docstring: a last Newton correction of the poses X (N, n_x)
     at the coordinates Q (with ``correct``), the analogs B and the velocities and
     accelerations for the rates qdot, qddot (N, n_q), from the charts in the bifurcation
@@ -424,13 +424,13 @@ def analyze(mech_or_model, q, qdot, qddot=None, x_guess=None, *, mode=None) -> K
     """
     model = as_model(mech_or_model)
     lay = model.layout(mode)
-    kern = _kernel(model, lay)
+    kern = sweep_kernel(model, lay)
     q, qdot, qddot = (np.array(v, float).reshape(model.n_q)
                       for v in (q, qdot, np.zeros(model.n_q) if qddot is None else qddot))
-    x, F, J = _solve_at(kern, _start_pose(model, lay) if x_guess is None else x_guess, q,
-                        _position_tol(model))
+    x, F, J = solve_at(kern, _start_pose(model, lay) if x_guess is None else x_guess, q,
+                        position_tol(model))
     system = (F[None], J[None], kern.factor(J[None]))
-    x, B, xdot, xddot, _ = _motion(kern, x[None], q[None], qdot[None], qddot[None], None, 0,
+    x, B, xdot, xddot, _ = sweep_motion(kern, x[None], q[None], qdot[None], qddot[None], None, 0,
                                    system, correct=False)
     return KinematicPoint(q=_ro(q), qdot=_ro(qdot), qddot=_ro(qddot),
                           x=_ro(x[0]), xdot=_ro(xdot[0]), xddot=_ro(xddot[0]), B=_ro(B[0]),

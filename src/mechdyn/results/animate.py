@@ -28,10 +28,10 @@ from .frame_geometry import (
     MechanismDrawing,
     _labels,
     _record_parts,
-    _trace_spec,
     _zigzag,
     frame_geometry,
     frame_indices,
+    trace_spec,
 )
 from .table import output_path, written
 
@@ -51,7 +51,7 @@ class _Scene:
         from matplotlib.patches import FancyArrowPatch, Polygon
 
         model, _ = _record_parts(record)
-        self.trace = _trace_spec(model, trace)
+        self.trace = trace_spec(model, trace)
         self.g = g = frame_geometry(record, trace=self.trace)  # every frame, drawn by update()
         (x0, x1), (y0, y1) = g["limits"]
         # the figure's shape follows the drawing's (room for title and labels added)

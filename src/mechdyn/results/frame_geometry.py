@@ -11,7 +11,8 @@ import numpy as np
 
 from ..errors import ModelError
 from ..kernels import rows_numpy
-from ..kinematics.constraints import _turn, extend, point_position, travel_rows
+from ..kernels.planar import rotate
+from ..kinematics.constraints import extend, point_position, travel_rows
 from ..mechanism.load import Force, Spring
 from ..model.variable import parse as parse_variable
 from .table import deg_or_mm
@@ -92,7 +93,7 @@ def _drawing(model, x: np.ndarray) -> MechanismDrawing:
             k = model.pri.names.index(name)
             u = model.pri.ui[k]
             if j.child != ground:  # the guide's direction in the child frame
-                guided[j.child] = _turn(-model.pri.angle[k], u)
+                guided[j.child] = rotate(-model.pri.angle[k], u)
             guides[name] = (j.parent, pp, u, j.child)
 
     # the symbols' size follows the region swept by all points and body origins
@@ -211,10 +212,10 @@ def _arm(model, bodies, body, pivot_local) -> np.ndarray:
 def _world(model, x: np.ndarray, body: str, local: np.ndarray) -> np.ndarray:
     """Ground-frame positions (n, k, 2) of body-frame points ``local`` (k, 2) over ``x``."""
     pose = extend(model, x)[:, model.body_index(body)]
-    return pose[:, None, :2] + _turn(pose[:, 2, None], local)
+    return pose[:, None, :2] + rotate(pose[:, 2, None], local)
 
 
-def _trace_spec(model, trace, what: str = "trace") -> tuple[str, object] | None:
+def trace_spec(model, trace, what: str = "trace") -> tuple[str, object] | None:
     """(body, point) of ``"BODY.POINT"`` or a pair, checked against the model; None for None."""
     if trace is None:
         return None
@@ -312,7 +313,7 @@ def frame_geometry(record, index=None, *, trace=None) -> dict:
         (ymin, ymax)) over the whole motion; ``size``: symbol size; all in m.
     """
     model, x = _record_parts(record)
-    drawing, spec = _drawing(model, x), _trace_spec(model, trace)
+    drawing, spec = _drawing(model, x), trace_spec(model, trace)
     g = _geometry(model, x, drawing, index, spec)
     every = g if index is None else _geometry(model, x, drawing, None, spec)  # all frames
     s = g["size"]
@@ -376,7 +377,7 @@ def _geometry(model, x, drawing: MechanismDrawing, index, trace) -> dict:
     for name, (b, p, d, turns) in drawing.loads.items():
         tail = point_position(model, xs, b, p)
         if turns:
-            d = _turn(extend(model, xs)[:, model.body_index(b), 2], d)
+            d = rotate(extend(model, xs)[:, model.body_index(b), 2], d)
         g["loads"][name] = np.stack([tail, tail + 4.0 * drawing.size * np.broadcast_to(
             d, tail.shape)], axis=1)
     if trace is not None:

@@ -10,7 +10,7 @@ import numpy as np
 from ..kinematics.records import four_bar_loops
 from .figure import mosaic as _mosaic
 from .figure import save as _save
-from .frame_geometry import _trace_spec
+from .frame_geometry import trace_spec
 from .plot_axes import model_name, speed_text, x_axis
 from .table import deg_or_mm
 
@@ -71,9 +71,9 @@ def plot_kinematic_sweep(sweep, path=None, points: Iterable | None = None, *,
                if j.child != "ground"] or [
             (body, p, _label(body, p)) for p in list(mech.bodies[body].points) or ["com"]]
     else:
-        pts = [(b, n, _label(b, n)) for b, n in (_trace_spec(model, p, "point") for p in points)]
+        pts = [(b, n, _label(b, n)) for b, n in (trace_spec(model, p, "point") for p in points)]
     spec = (_default_trace(model) if trace is None else
-            None if trace is False else _trace_spec(model, trace, "trace"))
+            None if trace is False else trace_spec(model, trace, "trace"))
     turning = [b for b in model.body_names
                if len(sweep) and np.ptp(sweep.angular(b)[0]) > 1e-9]
     layout = [["position", "angle"], ["velocity", "omega"], ["acceleration", "alpha"]]

@@ -206,9 +206,9 @@ def default_points(model, trace=None) -> list:
         pts = [(body, p, _point_label(body, p)) for p in list(mech.bodies[body].points)
                or ["com"]]
     if trace is not None:
-        from .frame_geometry import _trace_spec
+        from .frame_geometry import trace_spec
 
-        body, name = _trace_spec(model, trace)
+        body, name = trace_spec(model, trace)
         if not any(b == body and isinstance(n, str) and n == name for b, n, _ in pts):
             pts.append((body, name, _point_label(body, name)))
     return pts

@@ -48,7 +48,7 @@ import numpy as np
 
 from ..dynamics.forces import applied_forces
 from ..dynamics.inertia import inertia_forces
-from ..dynamics.prescribed_motion import _independent_subset
+from ..dynamics.prescribed_motion import independent_subset
 from ..dynamics.reactions import joint_reaction, reaction_frame
 from ..errors import Status
 from ..kernels import rows_numba, rows_numpy
@@ -339,7 +339,7 @@ def _cycle(vs: Variants, analysis: KinetostaticExtremes, work: dict) -> list[Out
     over, values = analysis.values(base)
     lay0 = base.layout()
     x_ref = base.x0 if getattr(base, "x0", None) is not None else base.x_sketch
-    didx = np.asarray(_independent_subset(base, lay0, x_ref, [base.coordinate_index(over)]),
+    didx = np.asarray(independent_subset(base, lay0, x_ref, [base.coordinate_index(over)]),
                       dtype=int)
     n_rows, n_d = lay0.n_rows, len(didx)
     if n_rows + n_d != n_x or n_d != base.n_q:
