@@ -16,6 +16,7 @@ import numpy as np
 
 from ..kernels import rows_numpy
 from ..model.rows import concat
+from ..model.state import contact_of, contact_token, friction_token, side_token, stick_key
 from .complementarity import (
     MAX_FRICTIONAL_ROWS,
     ContactError,
@@ -127,9 +128,9 @@ def gap_measures(sm: SwitchedModel):
     """
     for n, (st, meas) in sm.stops.items():
         for side in st.sides():
-            yield f"{n}@{side}", meas, (1.0 if side == "lower" else -1.0), getattr(st, side)
+            yield side_token(n, side), meas, (1.0 if side == "lower" else -1.0), getattr(st, side)
     for n, (_ct, gap, _) in sm.contacts.items():
-        yield f"{n}@contact", gap, 1.0, 0.0
+        yield contact_token(n), gap, 1.0, 0.0
 
 
 def gaps(sm: SwitchedModel, x) -> dict:
@@ -248,7 +249,7 @@ def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates
     # friction state of each candidate contact
     fric = {}
     for tok in cand:
-        c = tok[:-8] if tok.endswith("@contact") else None
+        c = contact_of(tok)
         if c is not None and sm.contacts[c][0].friction > 0:
             if c in forced_slip:
                 fric[c] = "slip+" if forced_slip[c] > 0 else "slip-"
@@ -260,12 +261,12 @@ def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates
                 fric[c] = "slip+" if vt > 0 else "slip-"
     active = [c for c in cand if c not in forced_open]
     for _ in range(4 * len(cand) + 4):
-        toks = frozenset(active) | frozenset(f"{c}:{s}" for c, s in fric.items()
-                                             if f"{c}@contact" in active)
+        toks = frozenset(active) | frozenset(friction_token(c, s) for c, s in fric.items()
+                                             if contact_token(c) in active)
         stick_targets = dict(targets)
-        for c in [a[:-8] for a in active if a.endswith("@contact")]:
+        for c in [a for a in map(contact_of, active) if a is not None]:
             if fric.get(c) == "stick":
-                stick_targets[f"{c}:stick"] = sm.contacts[c][2].value(x)
+                stick_targets[stick_key(c)] = sm.contacts[c][2].value(x)
         rows = sm.rows(toks, stick_targets)
         eq = [r for r in rows if r.kind == "stick"]
         uni = [r for r in rows if r.unilateral]
@@ -293,7 +294,7 @@ def resolve_mode(sm: SwitchedModel, t, x, xdot, locks, targets: dict, candidates
         for r_, m_ in zip(eq, mu_e, strict=True):
             c = r_.element
             mu = sm.contacts[c][0].friction
-            if f"{c}@contact" in active and \
+            if contact_token(c) in active and \
                     abs(m_) > mu * lam_n.get(c, 0.0) * (1 + 1e-12) + force_tol:
                 fric[c] = "slip-" if m_ > 0 else "slip+"
                 changed = True

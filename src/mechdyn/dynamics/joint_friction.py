@@ -43,7 +43,7 @@ import numpy as np
 
 from ..errors import LockupError
 from ..kernels import rows_numpy as RN
-from ..model.state import Mode
+from ..model.state import Mode, friction_of, stick_key
 from ..model.variable import parse_variable
 from .friction import friction_joints
 
@@ -169,7 +169,7 @@ def split_mode(model, mode) -> tuple[Mode, dict]:
     (['clutch'], {'guide': 'slip+'})
     """
     st = joint_states(model, mode)
-    return Mode(t for t in mode if t.split(":")[0] not in st or ":" not in t), st
+    return Mode(t for t in mode if (friction_of(t) or (None,))[0] not in st), st
 
 
 def _measure(model, joint: str):
@@ -211,7 +211,7 @@ def capture_stick(model, joint: str, x, targets: dict) -> None:
     >>> targets
     {'guide:stick': 0.25}
     """
-    targets[f"{joint}:stick"] = _measure(model, joint).value(x)
+    targets[stick_key(joint)] = _measure(model, joint).value(x)
 
 
 @dataclass(frozen=True)
@@ -269,8 +269,8 @@ def stick_row(model, joint: str, targets: dict) -> StickRow:
     >>> row.kind, row.label, row.target
     ('stick', 'guide:stick', 0.25)
     """
-    return StickRow(joint, f"{joint}:stick", _measure(model, joint),
-                    float(targets[f"{joint}:stick"]))
+    return StickRow(joint, stick_key(joint), _measure(model, joint),
+                    float(targets[stick_key(joint)]))
 
 
 def friction_set(model, joints):

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..errors import MechdynError, Status
 from ..model import ConstraintLayout, Model
+from ..model.state import stick_key
 from ..results.kinetostatics_record import Kinetostatics
 from .forces import force_model
 from .joint_friction import capture_stick, split_mode, stick_row
@@ -36,7 +37,7 @@ def _mode_rows(model: Model, sm: SwitchedModel, mode: frozenset, x0, first):
     as driven (``first``, the others, and last those the mode's locks free)."""
     targets: dict = {}
     base, jstates = split_mode(model, mode)  # the joints' stick-slip states apart
-    sticks = [f"{c}:stick" for c, s in mode_friction(base).items() if s == "stick"]
+    sticks = [stick_key(c) for c, s in mode_friction(base).items() if s == "stick"]
     for n in [*mode_locks(base), *sticks]:
         sm.capture_target(n, x0, targets)
     held = sorted(j for j, s in jstates.items() if s == "stick")

@@ -32,7 +32,7 @@ from ..kinematics.constraints import extend
 from ..model import Model
 from ..model import rows as R
 from ..model.rows import Rows
-from ..model.state import Mode
+from ..model.state import Mode, friction_of, side_of, stick_key
 from ..model.variable import Measure, TimeMeasure, parse_variable
 from .forces import force_model
 from .inertia import drive_inertia
@@ -263,8 +263,8 @@ class SwitchedModel:
         elif name in self.coord_locks:
             cl, meas = self.coord_locks[name]
             targets[name] = cl.value if cl.value is not None else meas.value(x)
-        elif ":" in name:
-            targets[name] = self.contacts[name.split(":")[0]][2].value(x)
+        elif (fr := friction_of(name)) is not None:
+            targets[name] = self.contacts[fr[0]][2].value(x)
 
     def weld_rows(self, name: str, targets: dict) -> Rows:
         """The three rows of weld lock ``name`` holding its target (or the model's offset)."""
@@ -292,7 +292,7 @@ class SwitchedModel:
             else:
                 raise ModelError(did_you_mean(n, self.lock_names, "lock"))
         for tok in sorted(mode_unilateral(mode)):
-            n, side = tok.split("@")
+            n, side = side_of(tok)
             if side == "contact":
                 if n not in self.contacts:
                     raise ModelError(did_you_mean(n, self.contacts, "contact"))
@@ -311,7 +311,7 @@ class SwitchedModel:
         for c, s in sorted(fr.items()):
             if s == "stick":
                 slip = self.contacts[c][2]
-                out.append(Row(c, f"{c}.tangent", "stick", slip, float(targets[f"{c}:stick"])))
+                out.append(Row(c, f"{c}.tangent", "stick", slip, float(targets[stick_key(c)])))
         return out
 
 

@@ -29,6 +29,7 @@ import copy
 import numpy as np
 
 from ..errors import LockupError, ModelError
+from ..model.state import side_of
 from ..model.workspace import KEPT, Workspace
 from .contact import gaps, touching
 from .friction import friction_joints
@@ -128,7 +129,7 @@ def _start(sm, t, locks, q_init, qd_init, x_guess, ws, events, *, gap_tol, small
     B, _ = ms_t.velocity_analogs(x)
     xd = B @ qd_init[ms_t.coords]
     for tok, (g, is_angle) in gaps(sm, x).items():
-        n, side = tok.split("@")
+        n, side = side_of(tok)
         if g >= -(gap_tol / L if is_angle else gap_tol):
             continue
         if side == "contact":

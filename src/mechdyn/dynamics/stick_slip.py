@@ -9,6 +9,7 @@ instant the segment loop decides the states again here (:func:`resolve_joints`).
 from __future__ import annotations
 
 from ..kernels import rows_numpy as RN
+from ..model.state import friction_token, stick_key
 from .joint_friction import _measure, capture_stick, stick_slip_joints
 
 __all__ = ["state_tokens", "resolve_joints"]
@@ -32,7 +33,7 @@ def state_tokens(states: dict) -> frozenset:
     >>> sorted(state_tokens({"B": "stick", "C": "slip+"}))
     ['B:stick', 'C:slip+']
     """
-    return frozenset(f"{j}:{s}" for j, s in states.items())
+    return frozenset(friction_token(j, s) for j, s in states.items())
 
 
 def resolve_joints(system, sm, t, x, xdot, mode, targets: dict, *, before: dict,
@@ -111,7 +112,7 @@ def resolve_joints(system, sm, t, x, xdot, mode, targets: dict, *, before: dict,
     for j in stick_slip_joints(model):
         if j in forced_slip:
             states[j] = "slip+" if forced_slip[j] > 0 else "slip-"
-            if before.get(j) == "stick" and f"{j}:stick" in targets:
+            if before.get(j) == "stick" and stick_key(j) in targets:
                 states[j] = "stick"
                 pending.add(j)
             continue
@@ -119,7 +120,7 @@ def resolve_joints(system, sm, t, x, xdot, mode, targets: dict, *, before: dict,
         if j not in forced_stick and abs(v) > velocity_tol:
             states[j] = "slip+" if v > 0 else "slip-"
             continue
-        if before.get(j) != "stick" or f"{j}:stick" not in targets:
+        if before.get(j) != "stick" or stick_key(j) not in targets:
             capture_stick(model, j, x, targets)
         states[j] = "stick"
     L = model.length_scale
@@ -163,7 +164,7 @@ def resolve_joints(system, sm, t, x, xdot, mode, targets: dict, *, before: dict,
         states[worst] = "slip-" if lam[jf.stick_index[worst]] > 0 else "slip+"
     for j, s in states.items():
         if s != "stick":
-            targets.pop(f"{j}:stick", None)
+            targets.pop(stick_key(j), None)
     return states
 
 

@@ -23,6 +23,7 @@ from ..integrate.segment import EventFunction
 from ..kernels import rows_numpy
 from ..kernels.rows_numba import NUMBA, rows_values
 from ..model.rows import concat
+from ..model.state import contact_token
 from .contact import gap_measures, resolve_mode, touching
 from .impact import impact
 from .joint_friction import joint_states, stick_slip_joints
@@ -361,7 +362,7 @@ def _record(add, sm, mode_before, mode_after, req: _Requests, imp, touch, lost) 
             add("impact", tok, "rebound", lost, impulses)
     fb, fa = mode_friction(mode_before), mode_friction(mode_after)
     for c in sorted(set(fb) | set(fa)):
-        if fb.get(c) != fa.get(c) and c in fa and f"{c}@contact" in closed_before:
+        if fb.get(c) != fa.get(c) and c in fa and contact_token(c) in closed_before:
             add("stick" if fa[c] == "stick" else "slip", c, fa[c])
     jb, ja = joint_states(sm.model, mode_before), joint_states(sm.model, mode_after)
     for j in sorted(ja):

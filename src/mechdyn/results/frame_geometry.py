@@ -14,6 +14,7 @@ from ..kernels import rows_numpy
 from ..kernels.planar import rotate
 from ..kinematics.constraints import extend, point_position, travel_rows
 from ..mechanism.load import Force, Spring
+from ..model.state import side_token
 from ..model.variable import parse as parse_variable
 from .table import deg_or_mm
 
@@ -163,7 +164,7 @@ def _stops(model, bodies: dict, size: float) -> dict:
             limit = getattr(stop, side) - offset
             seg = _limit_mark(model, bodies, size, joint, body, limit)
             if seg is not None:
-                out[f"{stop.name}@{side}"] = seg
+                out[side_token(stop.name, side)] = seg
     return out
 
 
