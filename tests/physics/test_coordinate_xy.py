@@ -132,12 +132,16 @@ def test_python_errors_name_the_coordinate():
 
 def test_a_stop_on_a_body_position_is_not_drawn_as_an_angle():
     """A pendulum whose coordinate is the x of its origin (0.5 m from the pin): a stop on
-    it is not drawn as a ray (that of a stop on an angle); one on the pin's angle is."""
+    it is not drawn as a ray (that of a stop on an angle); one on the pin's angle is.
+
+    The pin P is at the bar's far end and the centre of mass at its origin, 0.5 m from
+    the pin, so the mass matrix in X is well away from zero (a centre of mass on the pin
+    would leave X massless and the run creeping)."""
     from mechdyn.mechanism.contact import Stop
     from mechdyn.results.animate import frame_geometry
 
     m = Mechanism("pendulum")
-    m.add_body("bar", mass=1.0, com=(0.5, 0.0), points={"P": (0.5, 0.0)},
+    m.add_body("bar", mass=1.0, com=(0.0, 0.0), points={"P": (0.5, 0.0)},
                pose=(-0.5 * np.cos(1.2), -0.5 * np.sin(1.2), 1.2))
     m.add_revolute("O", "ground", "bar", (0.0, 0.0), "P")
     m.add_coordinate("X", kind="x", body="bar")

@@ -57,6 +57,15 @@ def njit(fn):
     return fn
 
 
+def njit_inline(fn):
+    """:func:`njit`, and inlined into its callers by Numba (``inline="always"``): a step
+    of a loop split into functions without the cost of a call per step; ``fn`` itself
+    without Numba."""
+    if NUMBA:
+        return numba.njit(cache=True, fastmath=False, nogil=True, inline="always")(fn)
+    return fn
+
+
 @njit
 def body_pose(x, nb, b):
     """(x, y, theta) of body b in x (or its rates in xdot); the ground (b >= nb) is zero."""

@@ -20,7 +20,14 @@ from __future__ import annotations
 import numpy as np
 
 from .linalg import lu_factor, lu_solve, lu_solve_transposed
-from .rows_numba import body_rotations, njit, rows_jacobian_cs, rows_quad_cs, rows_values_cs
+from .rows_numba import (
+    body_rotations,
+    njit,
+    njit_inline,
+    rows_jacobian_cs,
+    rows_quad_cs,
+    rows_values_cs,
+)
 
 __all__ = ["path_variants", "inverse_variants", "loads_variants", "body_loads_variants",
            "cycle_variants"]
@@ -158,66 +165,9 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
         for m in range(M):
             q = Q[v, m]
             if m > 0:
-                h = q[0] - Q[v, m - 1, 0]
-                curved = m > 1 and hp != 0.0
-                for i in range(n):
-                    for c in range(nd):
-                        x[i] += T[i, c] * (q[c] - Q[v, m - 1, c])
-                    if curved:  # the second derivative along q_0 from the last two tangents
-                        x[i] += 0.5 * (T[i, 0] - Tp[i]) / hp * h * h
-                hp = h
-            # Newton (at least one step).  After a first step dx from x0 to x1 the residual
-            # is F(x1) = -(J(x1) - J(x0)) dx / 2 + O(|dx|^3) (trapezoid rule along the
-            # step): a short step is checked with J(x1), which the solution needs anyway
-            done = False
-            fresh = False  # Jw is J at x
-            for it in range(max_iter + 1):
-                body_rotations(x, nb, cs)
-                if it == 0:
-                    _system(x, q, nb, ints, flts[v], n_rows, cs, F, Jw)
-                    fresh = True
-                else:
-                    rows_values_cs(x, nb, ints, flts[v], cs, F, 0)
-                    for c in range(nd):
-                        F[n_rows + c] -= q[c]
-                err = 0.0
-                for i in range(n):
-                    err = max(err, abs(F[i]))
-                if not np.isfinite(err):
-                    break
-                if err <= tol[v] and it > 0:
-                    done = True
-                    break
-                if it == max_iter:
-                    break
-                if not fresh:
-                    Jw[:, :] = 0.0
-                    rows_jacobian_cs(x, nb, ints, flts[v], cs, Jw, 0)
-                lu[:, :] = Jw
-                if lu_factor(lu, pv, n) == 0.0:
-                    break
-                b[:] = F
-                lu_solve(lu, pv, b, n)
-                step = 0.0
-                for i in range(n):
-                    x[i] -= b[i]
-                    step = max(step, abs(b[i]))
-                fresh = False
-                if it == 0 and step <= short * tol[v]:
-                    body_rotations(x, nb, cs)
-                    J1[:, :] = 0.0
-                    rows_jacobian_cs(x, nb, ints, flts[v], cs, J1, 0)
-                    err = 0.0
-                    for i in range(n):
-                        r = 0.0
-                        for j in range(n):
-                            r += (J1[i, j] - Jw[i, j]) * b[j]
-                        err = max(err, abs(0.5 * r))
-                    Jw[:, :] = J1
-                    fresh = True
-                    if err <= tol[v]:
-                        done = True
-                        break
+                hp = _predict(x, q, Q[v, m - 1], T, Tp, hp, m > 1 and hp != 0.0)
+            done, fresh = _newton(x, q, nb, ints, flts[v], n_rows, tol[v], max_iter, short,
+                                  cs, F, Jw, J1, lu, pv, b)
             if not done:
                 ok[v] = False
                 fail[v] = m
@@ -243,6 +193,91 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
                 LU[v, k] = lu
                 piv[v, k] = pv
                 rc[v, k] = r
+
+
+@njit_inline
+def _predict(x, q, q_prev, T, Tp, hp, curved):
+    """Move x (in place) from the pose at ``q_prev`` to the predictor at ``q``: the
+    tangent T times the change of the driven coordinates, plus, where ``curved``, the
+    second derivative along q_0 from T and the previous tangent Tp (``hp``: the previous
+    step of q_0).  Returns this step of q_0."""
+    n, nd = T.shape
+    h = q[0] - q_prev[0]
+    for i in range(n):
+        for c in range(nd):
+            x[i] += T[i, c] * (q[c] - q_prev[c])
+        if curved:  # the second derivative along q_0 from the last two tangents
+            x[i] += 0.5 * (T[i, 0] - Tp[i]) / hp * h * h
+    return h
+
+
+@njit_inline
+def _short_step_error(x, b, nb, ints, flts, cs, Jw, J1):
+    """The residual after a short first Newton step b (x already moved), estimated as
+    |(J(x1) - J(x0)) b / 2| without evaluating F: J(x1) is evaluated (into J1, then Jw,
+    with the rotations ``cs`` of x1) and Jw = J(x0) on entry."""
+    n = x.shape[0]
+    body_rotations(x, nb, cs)
+    J1[:, :] = 0.0
+    rows_jacobian_cs(x, nb, ints, flts, cs, J1, 0)
+    err = 0.0
+    for i in range(n):
+        r = 0.0
+        for j in range(n):
+            r += (J1[i, j] - Jw[i, j]) * b[j]
+        err = max(err, abs(0.5 * r))
+    Jw[:, :] = J1
+    return err
+
+
+@njit_inline
+def _newton(x, q, nb, ints, flts, n_rows, tol, max_iter, short, cs, F, Jw, J1, lu, pv, b):
+    """Newton's method (at least one step) on F(x) = [Phi(x); g_d(x) - q] = 0 of one
+    variant, in place from the predictor x; arguments as for :func:`path_variants`, the
+    others work arrays.  Returns (done, fresh): converged, and whether Jw holds J at x
+    (with ``cs`` its rotations).
+
+    After a first step dx from x0 to x1 the residual is F(x1) = -(J(x1) - J(x0)) dx / 2
+    + O(|dx|^3) (trapezoid rule along the step): a short step is checked with J(x1),
+    which the solution needs anyway."""
+    n, nd = x.shape[0], q.shape[0]
+    fresh = False  # Jw is J at x
+    for it in range(max_iter + 1):
+        body_rotations(x, nb, cs)
+        if it == 0:
+            _system(x, q, nb, ints, flts, n_rows, cs, F, Jw)
+            fresh = True
+        else:
+            rows_values_cs(x, nb, ints, flts, cs, F, 0)
+            for c in range(nd):
+                F[n_rows + c] -= q[c]
+        err = 0.0
+        for i in range(n):
+            err = max(err, abs(F[i]))
+        if not np.isfinite(err):
+            return False, fresh
+        if err <= tol and it > 0:
+            return True, fresh
+        if it == max_iter:
+            return False, fresh
+        if not fresh:
+            Jw[:, :] = 0.0
+            rows_jacobian_cs(x, nb, ints, flts, cs, Jw, 0)
+        lu[:, :] = Jw
+        if lu_factor(lu, pv, n) == 0.0:
+            return False, fresh
+        b[:] = F
+        lu_solve(lu, pv, b, n)
+        step = 0.0
+        for i in range(n):
+            x[i] -= b[i]
+            step = max(step, abs(b[i]))
+        fresh = False
+        if it == 0 and step <= short * tol:
+            fresh = True
+            if _short_step_error(x, b, nb, ints, flts, cs, Jw, J1) <= tol:
+                return True, fresh
+    return False, fresh
 
 
 @njit

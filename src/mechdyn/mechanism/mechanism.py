@@ -207,67 +207,61 @@ class Mechanism:
     def problems(self) -> list[str]:
         """Every problem of the description that can be found without solving."""
         out: list[str] = []
-        names = [GROUND, *self.bodies]
-
-        def point_problem(bname, ref, where_body, where_point):
-            """Record an unknown body ``bname`` or an unknown point ``ref`` of it."""
-            if bname not in names:
-                out.append(f"{where_body}: " + did_you_mean(bname, names, "body"))
-            elif isinstance(ref, str) and ref not in self.body(bname).point_names():
-                out.append(f"{where_point}: "
-                           + unknown_point(ref, bname, self.body(bname).point_names()))
-
         for b in self.bodies.values():
-            if not np.isfinite(b.mass) or b.mass < 0:
-                out.append(f"body {b.name!r}: mass must be >= 0 kg, got {b.mass!r}")
-            if not np.isfinite(b.inertia) or b.inertia < 0:
-                out.append(f"body {b.name!r}: inertia must be >= 0 kg*m^2, got {b.inertia!r}")
-            if b.pose is not None and not np.all(np.isfinite(b.pose)):
-                out.append(f"body {b.name!r}: pose must be finite (x, y, theta), got {b.pose!r}")
-            for k, v in [("com", b.com), *b.points.items()]:
-                if not np.all(np.isfinite(v)):
-                    out.append(f"body {b.name!r}: point {k!r} is not finite: {v!r}")
+            out += _body_problems(b)
         g = np.asarray(self.gravity, dtype=float)
         if g.shape != (2,) or not np.all(np.isfinite(g)):
             out.append(f"gravity must be a finite vector (gx, gy) in m/s^2, got {self.gravity!r}")
-
         for j in self.joints.values():
-            where = f"{type(j).__name__.lower()} joint {j.name!r}"
-            for role in ("parent", "child"):
-                point_problem(getattr(j, role), getattr(j, f"{role}_point", None),
-                              f"{where}: {role}", f"{where}: {role}_point")
-            if j.parent == j.child:
-                out.append(f"{where}: parent and child are the same body {j.parent!r}")
-            jtype = type(j).__name__.lower()
-            for key, _ in (*FRICTION_FIELDS.get(jtype, ()), *ELASTIC_FIELDS.get(jtype, ())):
-                v = getattr(j, key)
-                if not (isinstance(v, int | float) and math.isfinite(v) and v >= 0):
-                    out.append(f"{where}: {key} must be a finite number >= 0, got {v!r}")
-            if (isinstance(j, Revolute) and isinstance(j.friction, int | float)
-                    and j.friction > 0
-                    and not (isinstance(j.pin_radius, int | float) and j.pin_radius > 0)):
-                out.append(f"{where}: friction = {j.friction:g} needs the pin's radius "
-                           "(pin_radius > 0, m)")
-            if isinstance(j, Prismatic):
-                ax = np.asarray(j.axis, dtype=float)
-                if ax.shape != (2,) or not np.all(np.isfinite(ax)) or np.hypot(*ax) == 0:
-                    out.append(f"{where}: axis must be a non-zero direction (x, y), "
-                               f"got {j.axis!r}")
-
+            out += self._joint_problems(j)
         out += reserved_names(self.bodies, self.coordinates,
                               {b.name: list(b.points) for b in self.bodies.values()})
+        out += self._coordinate_problems()
+        for am in self.extras.get("assembly", []):
+            for role, (bname, ref) in zip("PQR", am.points, strict=True):
+                where = f"assembly mode {am.name!r}: point {role}"
+                out += self._point_problems(bname, ref, where, where)
+        if self.foundation is not None and not isinstance(self.foundation, Foundation):
+            out.append(f"foundation: expected a Foundation (supports, mass, inertia, com), "
+                       f"got {type(self.foundation).__name__}")
+        out += self._count_problems()
+        return out
+
+    def _point_problems(self, bname, ref, where_body, where_point) -> list[str]:
+        """An unknown body ``bname``, or an unknown point ``ref`` of it (a name; a
+        coordinate pair is not checked here)."""
+        names = [GROUND, *self.bodies]
+        if bname not in names:
+            return [f"{where_body}: " + did_you_mean(bname, names, "body")]
+        if isinstance(ref, str) and ref not in self.body(bname).point_names():
+            return [f"{where_point}: " + unknown_point(ref, bname, self.body(bname).point_names())]
+        return []
+
+    def _joint_problems(self, j: Joint) -> list[str]:
+        """The problems of one joint: its bodies and points, and its own values."""
+        out: list[str] = []
+        where = f"{type(j).__name__.lower()} joint {j.name!r}"
+        for role in ("parent", "child"):
+            out += self._point_problems(getattr(j, role), getattr(j, f"{role}_point", None),
+                                        f"{where}: {role}", f"{where}: {role}_point")
+        if j.parent == j.child:
+            out.append(f"{where}: parent and child are the same body {j.parent!r}")
+        return out + _joint_value_problems(j, where)
+
+    def _coordinate_problems(self) -> list[str]:
+        """The problems of the declared coordinates (kind, body or joint)."""
         joint_types = {n: type(j).__name__.lower() for n, j in self.joints.items()}
+        out: list[str] = []
         for c in self.coordinates.values():
             for key, msg in coordinate_problems(c.kind, c.body, c.joint, self.bodies,
                                                 joint_types):
                 out.append(f"coordinate {c.name!r}: " + (f"{key}: " if key else "") + msg)
-        for am in self.extras.get("assembly", []):
-            for role, (bname, ref) in zip("PQR", am.points, strict=True):
-                where = f"assembly mode {am.name!r}: point {role}"
-                point_problem(bname, ref, where, where)
-        if self.foundation is not None and not isinstance(self.foundation, Foundation):
-            out.append(f"foundation: expected a Foundation (supports, mass, inertia, com), "
-                       f"got {type(self.foundation).__name__}")
+        return out
+
+    def _count_problems(self) -> list[str]:
+        """No moving bodies, no coordinates, or a coordinate count that differs from
+        Gruebler's count of the degrees of freedom."""
+        out: list[str] = []
         if not self.bodies:
             out.append("the mechanism has no moving bodies")
         if not self.coordinates:
@@ -302,6 +296,43 @@ class Mechanism:
     def __repr__(self) -> str:
         return (f"Mechanism({self.name!r}: {len(self.bodies)} bodies, {len(self.joints)} joints, "
                 f"coordinates {list(self.coordinates)})")
+
+
+def _body_problems(b: Body) -> list[str]:
+    """The problems of one body's numbers: mass, inertia, pose and points."""
+    out: list[str] = []
+    if not np.isfinite(b.mass) or b.mass < 0:
+        out.append(f"body {b.name!r}: mass must be >= 0 kg, got {b.mass!r}")
+    if not np.isfinite(b.inertia) or b.inertia < 0:
+        out.append(f"body {b.name!r}: inertia must be >= 0 kg*m^2, got {b.inertia!r}")
+    if b.pose is not None and not np.all(np.isfinite(b.pose)):
+        out.append(f"body {b.name!r}: pose must be finite (x, y, theta), got {b.pose!r}")
+    for k, v in [("com", b.com), *b.points.items()]:
+        if not np.all(np.isfinite(v)):
+            out.append(f"body {b.name!r}: point {k!r} is not finite: {v!r}")
+    return out
+
+
+def _joint_value_problems(j: Joint, where: str) -> list[str]:
+    """The problems of one joint's own values (``where`` names it): its friction and
+    elastic fields, a pin's friction without a radius, a slider's axis."""
+    out: list[str] = []
+    jtype = type(j).__name__.lower()
+    for key, _ in (*FRICTION_FIELDS.get(jtype, ()), *ELASTIC_FIELDS.get(jtype, ())):
+        v = getattr(j, key)
+        if not (isinstance(v, int | float) and math.isfinite(v) and v >= 0):
+            out.append(f"{where}: {key} must be a finite number >= 0, got {v!r}")
+    if (isinstance(j, Revolute) and isinstance(j.friction, int | float)
+            and j.friction > 0
+            and not (isinstance(j.pin_radius, int | float) and j.pin_radius > 0)):
+        out.append(f"{where}: friction = {j.friction:g} needs the pin's radius "
+                   "(pin_radius > 0, m)")
+    if isinstance(j, Prismatic):
+        ax = np.asarray(j.axis, dtype=float)
+        if ax.shape != (2,) or not np.all(np.isfinite(ax)) or np.hypot(*ax) == 0:
+            out.append(f"{where}: axis must be a non-zero direction (x, y), "
+                       f"got {j.axis!r}")
+    return out
 
 
 #: names the variable grammar gives a meaning (time; the centre of mass of a body)
