@@ -207,8 +207,9 @@ def _trajectory(model, block, modes, events, stats, status, message) -> Trajecto
     stats["penetration"] = b["penetration"]
     stats["variable_structure"] = SwitchedSamples(
         mode=b["mode"], modes=list(modes), mode_index=b["mode_index"],
-        frame_force=b["frame"][:, :2], frame_moment=b["frame"][:, 2], forces=b["forces"],
-        impact_losses=b["impact_losses"], penetration=b["penetration"])
+        impact_losses=b["impact_losses"], penetration=b["penetration"],
+        loads=dict(frame_force=b["frame"][:, :2], frame_moment=b["frame"][:, 2],
+                   forces=b["forces"]))
     return Trajectory(b["t"], b["q"], b["qdot"], b["qddot"], b["x"], b["xdot"],
                       status=status, message=message, events=list(events), stats=stats,
                       energy=_energy(bool(friction_joints(model)), b),

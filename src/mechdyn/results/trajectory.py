@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -16,15 +17,20 @@ __all__ = ["Trajectory", "SwitchedSamples"]
 
 #: statuses of a run that reached its end (or a terminal event)
 SUCCESS_STATUSES = ("success", "event")
-#: the fields of a :class:`SwitchedSamples` that :meth:`SwitchedSamples.lazy` evaluates on
-#: first use
-_LAZY_FIELDS = frozenset({"frame_force", "frame_moment", "forces"})
+#: the keys of a :class:`SwitchedSamples` read as a mapping, in order
+SWITCHED_KEYS = ("mode", "modes", "mode_index", "frame_force", "forces", "impact_losses",
+                 "penetration", "frame_moment")
 
 
 @dataclass(frozen=True)
 class SwitchedSamples(Mapping):
     """What a variable-structure run records per sample beyond the motion (typed; it also
     reads as the mapping ``trajectory.stats["variable_structure"]`` it used to be).
+
+    The loads on the frame and in every element (``frame_force``, ``frame_moment``,
+    ``forces``) are computed from the run's samples when first read: ``loads`` is the
+    mapping of them or the function that computes it (an error of the function is raised
+    again by the next read).
 
     Attributes
     ----------
@@ -34,6 +40,10 @@ class SwitchedSamples(Mapping):
         The distinct modes in the order they appeared.
     mode_index : ndarray of int, shape (n,)
         Index of each sample's mode in ``modes``.
+    impact_losses : ndarray, shape (n,)
+        Kinetic energy lost in impacts up to each sample, J.
+    penetration : float
+        Largest penetration of a stop or contact seen, m.
     frame_force : ndarray, shape (n, 2)
         Force the frame receives (reactions and the ground ends of springs), N.
     frame_moment : ndarray, shape (n,)
@@ -42,56 +52,63 @@ class SwitchedSamples(Mapping):
         Per joint, lock, stop and contact: its reaction per sample ((n, 2) or (n, 3):
         force on the child from the parent at the joint point, N, and moment, N m;
         (n,) normal force of a stop or contact, N).
-    impact_losses : ndarray, shape (n,)
-        Kinetic energy lost in impacts up to each sample, J.
-    penetration : float
-        Largest penetration of a stop or contact seen, m.
+
+    Examples
+    --------
+    >>> s = SwitchedSamples([frozenset()], [frozenset()], np.zeros(1, int), np.zeros(1),
+    ...                     loads=lambda: {"frame_force": np.ones((1, 2)), "forces": {}})
+    >>> s["frame_force"].tolist(), s.frame_moment is None, len(s)
+    ([[1.0, 1.0]], True, 8)
     """
 
     mode: list
     modes: list
     mode_index: np.ndarray
-    frame_force: np.ndarray
-    forces: dict
     impact_losses: np.ndarray
     penetration: float = 0.0
-    frame_moment: np.ndarray | None = None
+    loads: Callable[[], Mapping] | Mapping = field(default_factory=dict, repr=False,
+                                                   compare=False)
 
     @classmethod
     def lazy(cls, fill, **fields) -> SwitchedSamples:
-        """The record with ``frame_force``, ``frame_moment`` and ``forces`` evaluated on
-        first use: ``fill()`` returns them (a mapping; an error of ``fill`` is raised
-        again by the next use); ``fields`` are the others."""
-        obj = object.__new__(cls)
-        for k, v in fields.items():
-            object.__setattr__(obj, k, v)
-        object.__setattr__(obj, "_fill", fill)
-        return obj
+        """The record with its loads computed by ``fill()`` on first read."""
+        return cls(**fields, loads=fill)
 
-    def __getattribute__(self, name):
-        if name in _LAZY_FIELDS:
-            d = object.__getattribute__(self, "__dict__")
-            fill = d.get("_fill")
-            if fill is not None:
-                for k, v in fill().items():
-                    object.__setattr__(self, k, v)
-                del d["_fill"]
-        return object.__getattribute__(self, name)
+    @cached_property
+    def _loads(self) -> dict:
+        """The loads, computed once (see the class's text)."""
+        return dict(self.loads() if callable(self.loads) else self.loads)
 
-    def __getstate__(self) -> dict:  # pickled and copied with every field evaluated
-        self.frame_force  # noqa: B018 - evaluates the lazy fields
-        return dict(self.__dict__)
+    @property
+    def frame_force(self) -> np.ndarray:
+        """Force the frame receives, N, shape (n, 2)."""
+        return self._loads.get("frame_force")
+
+    @property
+    def frame_moment(self) -> np.ndarray | None:
+        """Moment the frame receives about the ground origin, N m, shape (n,)."""
+        return self._loads.get("frame_moment")
+
+    @property
+    def forces(self) -> dict:
+        """The reaction of every joint, lock, stop and contact per sample, N (N m)."""
+        return self._loads.get("forces", {})
+
+    def __getstate__(self) -> dict:  # pickled and copied with the loads computed
+        state = {k: v for k, v in self.__dict__.items() if k != "_loads"}
+        state["loads"] = self._loads
+        return state
 
     def __getitem__(self, key):
-        if key not in self.__dataclass_fields__:
+        if key not in SWITCHED_KEYS:
             raise KeyError(key)
         return getattr(self, key)
 
     def __iter__(self):
-        return iter(self.__dataclass_fields__)
+        return iter(SWITCHED_KEYS)
 
     def __len__(self) -> int:
-        return len(self.__dataclass_fields__)
+        return len(SWITCHED_KEYS)
 
 
 @dataclass(frozen=True)
