@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from mechdyn.dynamics.impact import impact
-from mechdyn.dynamics.modes import ModeSystem, switched_model
+from mechdyn.dynamics.mode_system import ModeSystem
+from mechdyn.dynamics.modes import switched_model
 from mechdyn.mechanism import Mechanism
 from mechdyn.mechanism.contact import Contact, Stop
 from mechdyn.mechanism.switch import add_element

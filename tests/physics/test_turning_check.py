@@ -9,7 +9,8 @@ from dynamics_models import four_bar
 import mechdyn
 from mechdyn.dynamics import dead_position as D
 from mechdyn.dynamics.compiled import numba_available
-from mechdyn.dynamics.modes import ModeSystem, switched_model
+from mechdyn.dynamics.mode_system import ModeSystem
+from mechdyn.dynamics.modes import switched_model
 from mechdyn.examples.paper_case import press_idle
 from mechdyn.kernels import rows_numpy as RN
 

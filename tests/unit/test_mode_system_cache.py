@@ -4,7 +4,8 @@ shortcuts give what the full computation gives."""
 import numpy as np
 
 from mechdyn.dynamics import mode_system as MS
-from mechdyn.dynamics.modes import ModeSystem, switched_model
+from mechdyn.dynamics.mode_system import ModeSystem
+from mechdyn.dynamics.modes import switched_model
 from mechdyn.examples.paper_case import press_idle
 from mechdyn.model.workspace import Workspace
 

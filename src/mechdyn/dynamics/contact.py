@@ -26,8 +26,8 @@ from .complementarity import (
     solve_frictional_impact,
     solve_lcp,
 )
-from .mode_system import mode_system
-from .modes import ModeSystem, Row, SwitchedModel
+from .mode_system import ModeSystem, mode_system
+from .modes import Row, SwitchedModel
 
 __all__ = ["ContactError", "solve_lcp", "LCPResult", "resolve_mode", "constrained_inverse",
            "row_terms", "FrictionalImpulse", "solve_frictional_impact", "MAX_FRICTIONAL_ROWS",

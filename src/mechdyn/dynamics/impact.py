@@ -57,8 +57,8 @@ from .contact import row_terms
 from .friction import friction_joints
 from .friction_ignored import FrictionIgnoredWarning
 from .mode_rows import ModeRows
-from .mode_system import mode_system
-from .modes import Row, SwitchedModel, mass_matrix_x
+from .mode_system import mass_matrix_x, mode_system
+from .modes import Row, SwitchedModel
 from .reactions import element_forces, frame_forces
 
 __all__ = ["ImpactResult", "impact", "element_forces", "frame_forces", "frame_impulse_key"]

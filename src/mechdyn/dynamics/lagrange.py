@@ -36,7 +36,8 @@ from ..model import Model
 from .forces import com_arms, force_model
 from .inertia import drive_inertia, frame_mass_matrix
 from .mode_equations import FORMULATIONS, PIVOT_CHECK, ModeEquations
-from .modes import ModeSystem, switched_model
+from .mode_system import ModeSystem
+from .modes import switched_model
 
 __all__ = ["EquationsOfMotion", "BranchEquations", "Terms", "FORMULATIONS", "PIVOT_CHECK",
            "equations_of_motion", "drive_inertia", "kinetic_energy", "potential_energy",

@@ -1,7 +1,7 @@
 """The equations of motion of one mode, as the integrators see them.
 
 Lagrange II in the independent coordinates q_I of the mode (a subset of the
-declared coordinates, chosen by :class:`~mechdyn.dynamics.modes.ModeSystem`):
+declared coordinates, chosen by :class:`~mechdyn.dynamics.mode_system.ModeSystem`):
 A(q) q_I'' = Q - c, with the rows of every active element (joints, engaged
 locks, closed stops and contacts, sticking contacts) and the rotor and gear
 inertia of the drives reduced to their coordinates.  A fixed-structure run is a
@@ -50,8 +50,7 @@ from .compiled import compile_mode_kernel
 from .dead_position import _dependent, _where
 from .forces import com_arms
 from .friction import friction_joints
-from .mode_system import solve_mass
-from .modes import ModeEval
+from .mode_system import ModeEval, solve_mass
 
 __all__ = ["ModeEquations", "BACKENDS", "FORMULATIONS", "PIVOT_CHECK", "STAGE_FAILURES"]
 

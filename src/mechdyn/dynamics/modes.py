@@ -17,7 +17,7 @@ a weld lock three of them (ground x and y of r_child - (r_parent + A_parent c),
 then theta_child - theta_parent - angle: the lowering rule
 :func:`mechdyn.model.rows.weld`, as the model's own ``weld_rows``).  The
 kinematics and dynamics in a mode are :class:`~mechdyn.dynamics.mode_system.ModeSystem`
-(imported here too).
+(:mod:`mechdyn.dynamics.mode_system`).
 """
 
 from __future__ import annotations
@@ -36,11 +36,10 @@ from ..model.state import Mode, friction_of, side_of, stick_key
 from ..model.variable import Measure, TimeMeasure, parse_variable
 from .forces import force_model
 from .inertia import drive_inertia
-from .mode_system import ModeEval, ModeSystem, mass_matrix_x
 
 __all__ = ["Row", "SwitchedModel", "switched_model", "mode_locks", "mode_unilateral",
            "mode_friction",
-           "ModeSystem", "ModeEval", "mass_matrix_x", "Measure", "TimeMeasure",
+           "Measure", "TimeMeasure",
            "parse_variable"]
 
 

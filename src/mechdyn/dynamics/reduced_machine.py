@@ -19,7 +19,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, fields
 from types import SimpleNamespace
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
@@ -30,8 +30,16 @@ from ..model import Model, as_model
 from .inertia import drive_inertia
 from .reduced_kinematics import _ModelEvaluator
 
-if TYPE_CHECKING:
-    from .reduction import Reduction
+
+class ReductionTable(Protocol):
+    """What :meth:`ReducedMachine.from_reduction` reads of a
+    :class:`~mechdyn.dynamics.reduction.Reduction` (which imports this module)."""
+
+    link: str | None
+    coordinate: str
+    phi: np.ndarray
+    J_red: np.ndarray
+    M_forces: np.ndarray
 
 __all__ = ["ReducedMachine", "Member", "MemberLoad"]
 
@@ -294,7 +302,7 @@ class ReducedMachine:
                    coordinate=ev.coordinate)
 
     @classmethod
-    def from_reduction(cls, red: Reduction, model: Model | None = None, *,
+    def from_reduction(cls, red: ReductionTable, model: Model | None = None, *,
                        extra_inertia: float | None = None, drive=None) -> ReducedMachine:
         """A fast machine interpolating a one-cycle
         :class:`~mechdyn.dynamics.reduction.Reduction` table.

@@ -36,7 +36,7 @@ from .friction import friction_joints
 from .joint_friction import stick_slip_joints
 from .mode_equations import ModeEquations
 from .mode_rows import held_key
-from .modes import ModeSystem
+from .mode_system import ModeSystem
 from .switching import apply_switch
 
 __all__ = ["start_state", "start_equations", "give_back"]

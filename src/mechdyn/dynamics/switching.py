@@ -27,10 +27,9 @@ from ..model.state import contact_token
 from .contact import gap_measures, resolve_mode, touching
 from .impact import impact
 from .joint_friction import joint_states, stick_slip_joints
-from .mode_system import held_key, mode_system
+from .mode_system import ModeSystem, held_key, mode_system
 from .modes import (
     Measure,
-    ModeSystem,
     SwitchedModel,
     TimeMeasure,
     mode_friction,

@@ -16,15 +16,38 @@ same arrays.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
-if TYPE_CHECKING:  # the row data is lowered by mechdyn.model, which imports these kernels
-    from ..model.rows import Rows
-
 __all__ = ["Parts", "parts", "values", "jacobian", "quad", "evaluate", "VariantRows",
            "variant_rows"]
+
+
+class Rows(Protocol):
+    """What the evaluator reads of a set of rows (:class:`mechdyn.model.rows.Rows`, which
+    the model lowers and which imports these kernels): the body indices and arrays of
+    every row, ``nb`` bodies, ``n_x`` = 3 nb, the contiguous columns and the Jacobian's
+    scatter indices."""
+
+    nb: int
+    b1: np.ndarray
+    b2: np.ndarray
+    d: np.ndarray
+    a: np.ndarray
+    bb: np.ndarray
+    ka: np.ndarray
+    kb: np.ndarray
+    c: np.ndarray
+
+    @property
+    def n_x(self) -> int: ...
+
+    @property
+    def columns(self) -> tuple: ...
+
+    @property
+    def scatter(self) -> np.ndarray: ...
 
 
 class Parts:
