@@ -28,6 +28,7 @@ from functools import cached_property
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
+from ..kernels.planar import rotate_back
 from ..kinematics.constraints import extend
 from ..model import Model
 from ..model import rows as R
@@ -255,10 +256,7 @@ class SwitchedModel:
                 return
             X = extend(self.model, x)
             pi, pj = X[w["i"]], X[w["j"]]
-            c, s = np.cos(pi[2]), np.sin(pi[2])
-            d = pj[:2] - pi[:2]
-            targets[name] = (np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1]]),
-                             float(pj[2] - pi[2]))
+            targets[name] = (rotate_back(pi[2], pj[:2] - pi[:2]), float(pj[2] - pi[2]))
         elif name in self.coord_locks:
             cl, meas = self.coord_locks[name]
             targets[name] = cl.value if cl.value is not None else meas.value(x)

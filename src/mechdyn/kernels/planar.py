@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["rotate", "perp", "cross"]
+__all__ = ["rotate", "rotate_back", "perp", "cross"]
 
 
 def rotate(th, s) -> np.ndarray:
@@ -43,6 +43,29 @@ def rotate(th, s) -> np.ndarray:
     out[..., 0] = c * s[..., 0] - sn * s[..., 1]
     out[..., 1] = sn * s[..., 0] + c * s[..., 1]
     return out
+
+
+def rotate_back(th, v) -> np.ndarray:
+    """A(th)^T v: ground-frame vectors v expressed in a frame turned by th (the inverse
+    of :func:`rotate`).
+
+    Parameters
+    ----------
+    th : float or array_like, shape (...)
+        Angles of the frames, rad.
+    v : array_like, shape (2,) or (..., 2)
+        Vectors in the ground frame.
+
+    Returns
+    -------
+    ndarray, shape (..., 2)
+
+    Examples
+    --------
+    >>> rotate_back(np.pi / 2, [0.0, 1.0]).round(12) + 0.0
+    array([1., 0.])
+    """
+    return rotate(-np.asarray(th, dtype=float), v)
 
 
 def perp(v) -> np.ndarray:

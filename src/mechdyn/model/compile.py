@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
+from ..kernels.planar import rotate_back
 from ..mechanism.body import GROUND
 from ..mechanism.joint import Lock, Prismatic, Revolute, has_friction
 from ..mechanism.placement import start_poses
@@ -262,9 +263,7 @@ class Model:
     def _sketch_offset(self, j):
         pi = np.asarray(self._start[j.parent])
         pj = np.asarray(self._start[j.child])
-        c, s = np.cos(pi[2]), np.sin(pi[2])
-        d = pj[:2] - pi[:2]
-        return (c * d[0] + s * d[1], -s * d[0] + c * d[1], pj[2] - pi[2])
+        return (*rotate_back(pi[2], pj[:2] - pi[:2]), pj[2] - pi[2])
 
     def body_index(self, name: str) -> int:
         """Index of a moving body in ``x`` (ground: ``n_bodies``); clear error if unknown."""
