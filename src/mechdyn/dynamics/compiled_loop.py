@@ -242,7 +242,6 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
         return t, np.asarray(y0, float), next_out, False
     ms = eqs.ms
     b = buffers(kernel)
-    _, ni, _, _, m = b.dims
     y = np.array(y0, float)
     book = eqs.book
     par, ipar = b.par, b.ipar
@@ -256,87 +255,24 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
     te = np.ascontiguousarray(t_eval, dtype=float)
     counted = [0, 0, 0]
     call, fixed = _loop(kernel, b, integ, y, atol, te, t, t_end)
-
-    def watch_window():
-        w = None if book is None else book.watch_window()
-        ipar[L.I_WATCH] = w is not None
-        if w is not None:
-            par[L.P_WC0], par[L.P_WC1] = w
-
-    def account():
-        steps, evals, rej = (int(ipar[i]) for i in (L.I_STEPS, L.I_EVALS, L.I_REJ))
-        stats["steps"] += steps - counted[0]
-        stats["evaluations"] += evals - counted[1]
-        stats["rejected"] += rej - counted[2]
-        counted[:] = steps, evals, rej
-
-    def hand():
-        n = int(ipar[L.I_NOUT])
-        if n:
-            T, Y = b.o_t[:n].tolist(), b.o_y[:n].copy()
-            for j, ev in enumerate(_evals(b, ms, n)):
-                sample(T[j], Y[j], None, ev)
-        ipar[L.I_NOUT] = 0
-
     if book is not None and book.charts:
         return t, y, next_out, False
-    watch_window()
+    _watch_window(book, par, ipar)
     mark = (t, y.copy(), next_out, list(counted), kernel.snapshot())  # the last checked state
     checked_to = -np.inf  # the end of the last step checked
-
-    def rewind():
-        """Back to the last checked state: the generic loop takes the steps since then one
-        by one, with the caller's checks after each (the exact step budget ...)."""
-        t0_, y0_, next0, (st, _, rej), ws0 = mark
-        stats["steps"] -= counted[0] - st
-        stats["rejected"] -= counted[2] - rej
-        kernel.restore(ws0)
-        ipar[L.I_NOUT] = 0
-        return t0_, y0_, next0, False
-
-    def checked(step, y_):
-        try:
-            return after_step(step, y_), True
-        except Stop:
-            return None, False
-
     while True:
         code = call()
-        account()
+        _account(ipar, stats, counted)
         t_now = float(par[L.P_T])
-        if code == L.FAILED:  # the Python stepper goes on from the last checked state
-            return rewind()
-        if ipar[L.I_WPEND]:  # the watch of the branch charts
-            ipar[L.I_WPEND] = 0
-            if eqs.watching and book.watch(float(par[L.P_WS]), b.x_end[2 * b.dims[0]:].copy()) \
-                    is not None or book.charts:
-                return rewind()  # bifurcation zones are evaluated in Python
-            watch_window()
+        # a kernel failure, or a branch chart built by the watch (bifurcation zones are
+        # evaluated in Python): the Python stepper goes on from the last checked state
+        if code == L.FAILED or not _watched(eqs, b):
+            return _rewind(mark, counted, stats, kernel, ipar)
         if code == L.WATCH:
             continue
-        if code == L.FLAGGED:
-            if ipar[L.I_PREV] >= 2 and b.hist[1, 0] > checked_to:
-                # the step before (unless checked already): the caller's last good state
-                ws_end = kernel.snapshot() if fixed else None
-                _, ok = checked(_step(b, 0, 1), b.hist[1, 1:m + 1].copy())
-                if not ok:
-                    return rewind()
-                if fixed:
-                    # the flagged step's end evaluated from the pose the loop left there, as
-                    # in the Python stepper (whose check of the step before came first): the
-                    # same numbers to round-off (DOP853's compiled runs stay as they were)
-                    kernel.restore(ws_end)
-            hand()
-            step = _step(b, 1, 2, None if fixed else (b.dns.copy(), float(par[L.P_TOLD]),
-                                                      float(par[L.P_HOLD])))
-            y_new = y.copy()
-            ev = after_step(step, y_new)  # a stop here is the run's
-            _samples_of(step, y_new, ev, sample, te, ipar, every_step, t_now)
-        elif ipar[L.I_STEPS] and b.hist[2, 0] > checked_to:  # the batch's last step
-            _, ok = checked(_step(b, 1, 2), y.copy())
-            if not ok:
-                return rewind()
-            hand()
+        if not _check(code, kernel, b, ms, fixed, checked_to, y, t_now, after_step=after_step,
+                      sample=sample, te=te, every_step=every_step):
+            return _rewind(mark, counted, stats, kernel, ipar)
         checked_to = float(b.hist[2, 0]) if ipar[L.I_STEPS] else checked_to
         mark = (t_now, y.copy(), int(ipar[L.I_NEXT]), list(counted), kernel.snapshot())
         if bar is not None:
@@ -345,6 +281,114 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
             return t_now, y.copy(), int(ipar[L.I_NEXT]), True
         if deadline is not None and time.perf_counter() > deadline:
             raise Stop(Status.TIMEOUT, f"stopped on the wall-time limit at t = {t_now:.9g} s")
+
+
+def _watch_window(book, par, ipar) -> None:
+    """The loop's watch of the branch charts set to the window of ``book`` (off where it
+    has none)."""
+    w = None if book is None else book.watch_window()
+    ipar[L.I_WATCH] = w is not None
+    if w is not None:
+        par[L.P_WC0], par[L.P_WC1] = w
+
+
+def _watched(eqs, b) -> bool:
+    """The watch of the branch charts where the loop found it due (at ``par[P_WS]``, the
+    pose in ``x_end``), its window set again; False where it built a chart (the loop
+    cannot go on)."""
+    par, ipar, book = b.par, b.ipar, eqs.book
+    if not ipar[L.I_WPEND]:
+        return True
+    ipar[L.I_WPEND] = 0
+    if eqs.watching and book.watch(float(par[L.P_WS]), b.x_end[2 * b.dims[0]:].copy()) \
+            is not None or book.charts:
+        return False
+    _watch_window(book, par, ipar)
+    return True
+
+
+def _account(ipar, stats, counted: list) -> None:
+    """The loop's steps, evaluations and rejected steps since they were last ``counted``
+    added to the run's ``stats``."""
+    steps, evals, rej = (int(ipar[i]) for i in (L.I_STEPS, L.I_EVALS, L.I_REJ))
+    stats["steps"] += steps - counted[0]
+    stats["evaluations"] += evals - counted[1]
+    stats["rejected"] += rej - counted[2]
+    counted[:] = steps, evals, rej
+
+
+def _rewind(mark, counted: list, stats, kernel, ipar):
+    """Back to the last checked state ``mark``: the generic loop takes the steps since then
+    one by one, with the caller's checks after each (the exact step budget ...); returns
+    what :func:`fast_forward` does."""
+    t0_, y0_, next0, (st, _, rej), ws0 = mark
+    stats["steps"] -= counted[0] - st
+    stats["rejected"] -= counted[2] - rej
+    kernel.restore(ws0)
+    ipar[L.I_NOUT] = 0
+    return t0_, y0_, next0, False
+
+
+def _hand(b, ms, sample) -> None:
+    """The output samples in the buffers handed to ``sample`` (and the buffers emptied)."""
+    n = int(b.ipar[L.I_NOUT])
+    if n:
+        T, Y = b.o_t[:n].tolist(), b.o_y[:n].copy()
+        for j, ev in enumerate(_evals(b, ms, n)):
+            sample(T[j], Y[j], None, ev)
+    b.ipar[L.I_NOUT] = 0
+
+
+def _checked(after_step, step, y_) -> tuple:
+    """``(after_step(step, y_), True)``, or ``(None, False)`` where it stops the run."""
+    try:
+        return after_step(step, y_), True
+    except Stop:
+        return None, False
+
+
+def _check(code, kernel, b, ms, fixed: bool, checked_to: float, y, t_now: float, *,
+           after_step, sample, te, every_step) -> bool:
+    """The caller's checks after a call of the loop that returned ``code``, and the
+    samples: a flagged step (:func:`_flagged`), else the batch's last step (unless checked
+    already, ``checked_to``); False where a check of a step before the last checked state
+    stops the run (the generic loop then goes on from it)."""
+    if code == L.FLAGGED:
+        return _flagged(kernel, b, ms, fixed, checked_to, y, t_now, after_step=after_step,
+                        sample=sample, te=te, every_step=every_step)
+    if b.ipar[L.I_STEPS] and b.hist[2, 0] > checked_to:  # the batch's last step
+        _, ok = _checked(after_step, _step(b, 1, 2), y.copy())
+        if not ok:
+            return False
+        _hand(b, ms, sample)
+    return True
+
+
+def _flagged(kernel, b, ms, fixed: bool, checked_to: float, y, t_now: float, *, after_step,
+             sample, te, every_step) -> bool:
+    """A step the loop flagged: the step before it checked (unless checked already; False
+    where that stops the run), the samples of the batch handed on, the flagged step
+    checked (a stop there is the run's) and its samples made as the generic loop makes
+    them."""
+    par, ipar, m = b.par, b.ipar, b.dims[4]
+    if ipar[L.I_PREV] >= 2 and b.hist[1, 0] > checked_to:
+        # the step before (unless checked already): the caller's last good state
+        ws_end = kernel.snapshot() if fixed else None
+        _, ok = _checked(after_step, _step(b, 0, 1), b.hist[1, 1:m + 1].copy())
+        if not ok:
+            return False
+        if fixed:
+            # the flagged step's end evaluated from the pose the loop left there, as in
+            # the Python stepper (whose check of the step before came first): the same
+            # numbers to round-off (DOP853's compiled runs stay as they were)
+            kernel.restore(ws_end)
+    _hand(b, ms, sample)
+    step = _step(b, 1, 2, None if fixed else (b.dns.copy(), float(par[L.P_TOLD]),
+                                              float(par[L.P_HOLD])))
+    y_new = y.copy()
+    ev = after_step(step, y_new)  # a stop here is the run's
+    _samples_of(step, y_new, ev, sample, te, ipar, every_step, t_now)
+    return True
 
 
 def _samples_of(step, y_new, ev, sample, te, ipar, every_step, t_now):
@@ -424,14 +468,7 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
     te = np.zeros(0)
     counted = [0, 0]
     o_ws = kept_offsets(m)[-1]  # the workspace at the row's end
-
-    def watch_window():
-        w = None if book is None else book.watch_window()
-        ipar[L.I_WATCH] = w is not None
-        if w is not None:
-            par[L.P_WC0], par[L.P_WC1] = w
-
-    watch_window()
+    _watch_window(book, par, ipar)
     ipar[L.I_MAXSTEPS] = min(KEEP_STEPS, b.kept.shape[0])
     call, fixed = _loop(kernel, b, integ, y, atol, te, t, t_end)
     while True:
@@ -448,16 +485,11 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
             kernel.restore(row[o_ws:])
             yield _kept_step(row, m, ni, fixed, kernel, stats)
         kernel.restore(ws_end)
-        if code == L.FAILED:  # SciPy's DOP853 goes on from the last step
+        # a kernel failure, or a branch chart built by the watch: SciPy's DOP853 goes on
+        # from the last step
+        if code == L.FAILED or not _watched(eqs, b):
             yield from scipy_from(float(par[L.P_T]), y.copy())
             return
-        if ipar[L.I_WPEND]:  # the watch of the branch charts
-            ipar[L.I_WPEND] = 0
-            if eqs.watching and book.watch(float(par[L.P_WS]), b.x_end[2 * b.dims[0]:].copy()) \
-                    is not None or book.charts:
-                yield from scipy_from(float(par[L.P_T]), y.copy())
-                return
-            watch_window()
         if code == L.DONE:
             return
 

@@ -50,13 +50,11 @@ from .dop853_numba import (
     N_PAR,
     P_T,
     WATCH,
-    _counted,
-    _put_back,
-    _watch,
     accept,
     samples,
     step_end,
 )
+from .dop853_steps import _counted, _put_back, _watch
 from .lagrange_numba import D_NI
 from .rows_numba import njit
 
@@ -156,7 +154,7 @@ def run(y, f, grid, par, ipar, K, ynew, ys, hist, t_eval, o_t, o_y, o_x, o_xd, o
     cap = o_t.size
     n_te = t_eval.size
     every = ipar[I_EVERY] != 0
-    off = ipar[I_FSAL] < 0  # False and True at run time (see dop853_numba._counted)
+    off = ipar[I_FSAL] < 0  # False and True at run time (see dop853_steps._counted)
     on = not off
     k = ipar[I_GRID]
     t = grid[k]

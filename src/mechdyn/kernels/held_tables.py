@@ -1,10 +1,13 @@
 """The loop's side of the held table pieces (:mod:`mechdyn.kernels.table_regions`): the
-table variables of an evaluation, the pieces held, and where a step leaves them.
+table variables of an evaluation, the pieces held, where a step leaves them, and what
+becomes of the step then.
 
-Used by :func:`mechdyn.kernels.dop853_numba.run`; every function reads the held tables'
+Used by :func:`mechdyn.kernels.dop853_numba.run`; the functions read the held tables'
 records (section ``S_LOCK`` of the packed loads, :mod:`mechdyn.kernels.loads_numba`) and
 the pieces held (``[region + 1, period count]`` per table, in the work array,
-:func:`mechdyn.kernels.lagrange_numba.held_pieces`).
+:func:`mechdyn.kernels.lagrange_numba.held_pieces`); :func:`again`, :func:`shortened` and
+:func:`switch_at` decide on a step from where it left them, and keep the bracket of the
+time of a point aimed at (see :func:`aim`).
 """
 
 from __future__ import annotations
@@ -14,9 +17,15 @@ import numpy as np
 from .lagrange_numba import D_NI, D_NQ, D_NV, table_inputs
 from .loads_numba import H_FOFF, H_IOFF, H_NB, H_NTAB, IR_LOCK, S_LOCK, S_TAB
 from .rows_numba import njit
-from .table_regions import region_bounds, region_of
+from .table_regions import ETA, region_bounds, region_of
 
-__all__ = ["table_vars", "hold", "left", "cut_back", "aim"]
+__all__ = ["table_vars", "hold", "left", "cut_back", "aim", "crossed", "again", "shortened",
+           "switch_at", "ATTEMPTS", "KEEP", "BACK_TO_STAGE", "NEXT_PIECE", "UP_TO_POINT"]
+
+#: attempts of a step taken again up to a table's point, at most
+ATTEMPTS = 8
+#: what becomes of a step at whose end a table variable has left its piece (:func:`again`)
+KEEP, BACK_TO_STAGE, NEXT_PIECE, UP_TO_POINT = range(4)
 
 
 @njit
@@ -138,3 +147,78 @@ def aim(br, t, s, eta):
     if (far - c) * (c - s) > 0.0:
         return (br[0] - t) * (c - s) / (far - s) * (1.0 + 0.5 * eta)
     return np.inf
+
+
+@njit
+def crossed(t, ip, fp, dims, sc, old, new, locks, br):
+    """``(theta, j, c, aiming)`` at the end ``t`` of a step (its table variables, as
+    evaluated, into ``new``): where a variable left its held piece (:func:`left`), and
+    whether that is the point of the bracket ``br`` (see :func:`aim`), which the step
+    then aimed at."""
+    table_vars(t, ip, fp, dims, sc, new)
+    th, jt, ct = left(ip, fp, old, new, locks)
+    # (a bracket of this point's time: the criteria relative to the first step past it,
+    # not to the short steps that aim at it)
+    aiming = br[0] < np.inf and jt == int(br[5]) and ct == br[4]
+    return th, jt, ct, aiming
+
+
+@njit
+def again(th, first, retried, aiming, h, hmin, old, jt, ct, br):
+    """What becomes of a step of size ``h`` whose variables left their pieces at the part
+    ``th`` of it (:func:`crossed`; at a stage, at the part ``first``; 2.0: none), taken
+    ``retried`` times already: KEEP it; BACK_TO_STAGE, a variable that left its piece and
+    came back within the step (a ram that, on the piece past its stop, would turn round
+    there): again, up to where the first stage past the point puts it; NEXT_PIECE, at the
+    point already (within ETA of the step, the smallest step, or ETA of the first step's
+    travel past a point aimed at): again on the next piece; UP_TO_POINT: again, up to the
+    point (just past it).  Past the point by at most ETA of the step it is kept."""
+    if retried >= ATTEMPTS:
+        return KEEP
+    if th > 1.0 and ETA < first < 1.0 - ETA:
+        return BACK_TO_STAGE
+    if not th <= 1.0:
+        return KEEP
+    if th <= ETA or th * h <= hmin or (aiming and abs(old[jt] - ct) <= ETA * br[3]):
+        return NEXT_PIECE
+    if th < 1.0 - ETA:
+        return UP_TO_POINT
+    return KEEP
+
+
+@njit
+def shortened(kind, h, hmin, first, t, over, aiming, old, new, jt, ct, br):
+    """``(h, over)``: the step ``h`` to ``t`` taken again shorter (``kind``, see
+    :func:`again`): BACK_TO_STAGE, up to where its first stage past the point put it
+    (``first``); UP_TO_POINT, up to the point ``ct`` of table ``jt`` (its variables went
+    from ``old`` to ``new``: :func:`cut_back`, just past it), the bracket ``br`` of the
+    point's time updated (see :func:`aim`) and ``over`` the attempts past it in a row."""
+    if kind == BACK_TO_STAGE:
+        return max(first * h * (1.0 + 0.5 * ETA), hmin), over
+    if not aiming:
+        br[3] = abs(new[jt] - old[jt])
+    if not aiming or t < br[0]:
+        br[0], br[1], br[2] = t, new[jt], 0.0
+    over = over + 1 if aiming else 1
+    br[4], br[5] = ct, jt
+    return cut_back(old[jt], new[jt], ct, over) * h * (1.0 + 0.5 * ETA), over
+
+
+@njit
+def switch_at(th, aiming, br, old, new):
+    """``(switch, ahead)`` for a step kept (:func:`crossed`): whether the next pieces are
+    held from its end -- past the point by at most ETA of the step, or short of the
+    bracket's point by ETA of the first step past it (``new`` then moved past it, for
+    :func:`hold`) -- and the part of the step's travel past its end at which a table
+    switches; the bracket dropped where the point is reached."""
+    switch = th <= 1.0
+    ahead = 2.0 * ETA
+    if switch and aiming:
+        br[0] = np.inf
+    jl = int(br[5])
+    if not switch and br[0] < np.inf and abs(new[jl] - br[4]) <= ETA * br[3]:
+        switch = True
+        ahead = min(1.0, max(ahead, 2.0 * ETA * br[3] / max(abs(new[jl] - old[jl]), 1e-300)))
+        new[jl] = br[4] + (br[1] - br[4]) * ETA  # (for hold: past it)
+        br[0] = np.inf
+    return switch, ahead

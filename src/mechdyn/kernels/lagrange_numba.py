@@ -298,6 +298,36 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
     for c in range(ni):
         qdl[c] = qdi[c]
     # declared coordinates, their rates, analogs G B and bias G b + quad_g
+    _declared(x, v, bb, Bl, ri, rf, dims, cs, q, qdot, G, GB, Gb, nb)
+    # mass matrix and c (the bodies', the drives' inertia)
+    _mass_matrix(v, bb, Bl, GB, Gb, ip, fp, cs, A, cc, bcx, bcy, nb, ni)
+    # forces
+    rows_values_cs(x, nb, ri[nc + ni + nq:], rf[nc + ni + nq:], cs, varv, 0)
+    forces(t, q, qdot, x, v, ip, fp, Fa, Fnc, Qd, varv, held_pieces(ws, nx, ni), cs)
+    P = _generalized_forces(v, qdot, Bl, GB, Fa, Fnc, Qd, cc, rhs, nx, ni, nq)
+    if not cholesky_solve(A, rhs, ni):
+        return 2
+    if full:
+        _reactions(x, v, bb, rhs, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, fac, piv, dims, ip, fp, nb,
+                   nc, ni, nq, ext, z, cs)
+    ok = P == P
+    for c in range(ni):
+        out[c] = qdi[c]
+        out[ni + c] = rhs[c]
+        ok = ok and (rhs[c] - rhs[c] == 0.0)
+    out[2 * ni] = P
+    if not ok:
+        return 3
+    return 0
+
+
+@njit
+def _declared(x, v, bb, Bl, ri, rf, dims, cs, q, qdot, G, GB, Gb, nb):
+    """The declared coordinates q = g(x) at the pose ``x`` (rates ``v``, analogs ``Bl``,
+    bias ``bb``), their rates, their Jacobian G, their analogs G B and their bias
+    G b + quad_g."""
+    nc, ni, nq = dims[D_NC], dims[D_NI], dims[D_NQ]
+    nx = 3 * nb
     gi, gf = ri[nc + ni:nc + ni + nq], rf[nc + ni:nc + ni + nq]
     for k in range(nq):
         qdot[k] = 0.0
@@ -316,7 +346,13 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
                 Gb[k] += g * bb[r]
                 for c in range(ni):
                     GB[k, c] += g * Bl[r * ni + c]
-    # mass matrix and c from the centre-of-mass analogs
+
+
+@njit
+def _mass_matrix(v, bb, Bl, GB, Gb, ip, fp, cs, A, cc, bcx, bcy, nb, ni):
+    """The mass matrix A (its upper triangle) and the bias c of the equations in q_I:
+    the bodies' from their centre-of-mass analogs (``bcx``, ``bcy``: scratch), the
+    drives' rotor and gear inertia on their (declared) coordinates."""
     for i in range(ni):
         cc[i] = 0.0
         for j in range(ni):
@@ -347,9 +383,12 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
                 cc[i] += je * GB[c, i] * Gb[c]
                 for j in range(i, ni):
                     A[i, j] += je * GB[c, i] * GB[c, j]
-    # forces
-    rows_values_cs(x, nb, ri[nc + ni + nq:], rf[nc + ni + nq:], cs, varv, 0)
-    forces(t, q, qdot, x, v, ip, fp, Fa, Fnc, Qd, varv, held_pieces(ws, nx, ni), cs)
+
+
+@njit
+def _generalized_forces(v, qdot, Bl, GB, Fa, Fnc, Qd, cc, rhs, nx, ni, nq):
+    """The right-hand side Q - c = B^T F + (G B)^T Q_drive - c of the solve for q_I''
+    (into ``rhs``); returns the power of the non-conservative forces."""
     P = 0.0
     for r in range(nx):
         P += Fnc[r] * v[r]
@@ -362,20 +401,7 @@ def evaluate_into(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full, sc, piv)
         for k in range(nq):
             s += GB[k, c] * Qd[k]
         rhs[c] = s
-    if not cholesky_solve(A, rhs, ni):
-        return 2
-    if full:
-        _reactions(x, v, bb, rhs, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, fac, piv, dims, ip, fp, nb,
-                   nc, ni, nq, ext, z, cs)
-    ok = P == P
-    for c in range(ni):
-        out[c] = qdi[c]
-        out[ni + c] = rhs[c]
-        ok = ok and (rhs[c] - rhs[c] == 0.0)
-    out[2 * ni] = P
-    if not ok:
-        return 3
-    return 0
+    return P
 
 
 @njit
