@@ -464,7 +464,6 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
     atol = _start(b, integ, t, t_end)
     par[L.P_PIVOT] = -np.inf  # every step is checked by the caller
     ipar[L.I_KEEP] = 1
-    ipar[L.I_CTRL] = 0  # fast_forward's step control: the same steps with or without events
     te = np.zeros(0)
     counted = [0, 0]
     o_ws = kept_offsets(m)[-1]  # the workspace at the row's end

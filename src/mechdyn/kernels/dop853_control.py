@@ -1,9 +1,9 @@
 """The step control of the compiled DOP853 loop (:mod:`mechdyn.kernels.dop853_numba`).
 
 Hairer's DOP853 (the error norm of orders 5 and 3, step factors within [1/6, 3] with
-safety 0.9, the starting step of order 8) and SciPy's variant of it (its starting step
-``select_initial_step``, step factors within [0.2, 10]), over the states y and rates f of
-the loop; no kernel evaluations here (the loop makes them).
+safety 0.9, the starting step of order 8), over the states y and rates f of the loop; no
+kernel evaluations here (the loop makes them).  It is the one step control of the loop,
+with and without event functions (SciPy's variant runs only as ``scipy-dop853``).
 """
 
 from __future__ import annotations
@@ -13,8 +13,7 @@ import numpy as np
 from ..integrate.dop853_tableau import E3, E5, N_STAGES
 from .rows_numba import njit
 
-__all__ = ["initial_guess", "initial_step", "scipy_guess", "scipy_step", "error_norm",
-           "too_large", "shrunk", "next_step"]
+__all__ = ["initial_guess", "initial_step", "error_norm", "too_large", "shrunk", "next_step"]
 
 
 @njit
@@ -58,27 +57,6 @@ def initial_step(y, f, f1, h, dnf, atol, rtol, hmax):
 
 
 @njit
-def scipy_guess(y, f, atol, rtol, span):
-    """SciPy's starting step (``select_initial_step``), first part: ``(h0, d1)``, RMS
-    norms."""
-    d0, d1 = _sizes2(y, f, atol, rtol)
-    d0, d1 = np.sqrt(d0 / y.size), np.sqrt(d1 / y.size)
-    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    return min(h0, span), d1
-
-
-@njit
-def scipy_step(y, f, f1, h0, d1, atol, rtol, hmax, span):
-    """SciPy's starting step, second part, from f1 = f(t + h0, y + h0 f)."""
-    d2 = np.sqrt(_change2(y, f, f1, atol, rtol) / y.size) / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
-    return min(100.0 * h0, h1, span, hmax)
-
-
-@njit
 def error_norm(y, ynew, K, atol, rtol, h):
     """The error of the step of size ``h`` from ``y`` to ``ynew`` with the stages ``K``:
     the embedded orders 5 and 3 combined as in DOP853, in the weights atol_i + rtol
@@ -103,28 +81,23 @@ def error_norm(y, ynew, K, atol, rtol, h):
 
 
 @njit
-def too_large(err, scipy_ctrl):
-    """Whether a step of error ``err`` is rejected (SciPy's control: also at 1 exactly)."""
-    return err > 1.0 or (scipy_ctrl and err == 1.0)
+def too_large(err):
+    """Whether a step of error ``err`` is rejected."""
+    return err > 1.0
 
 
 @njit
-def shrunk(h, err, fac11, scipy_ctrl):
+def shrunk(h, err, fac11):
     """The step to try after a rejected step ``h`` of error ``err`` (``fac11``: err to the
     power 1/8 - beta / 5)."""
-    if scipy_ctrl:
-        return h * max(0.2, 0.9 * err ** -0.125)
     return h / min(3.0, fac11 / 0.9)
 
 
 @njit
-def next_step(h, err, fac11, beta, err_old, scipy_ctrl):
+def next_step(h, err, fac11, beta, err_old):
     """``(h_next, err_kept)``: the step after an accepted step ``h`` of error ``err``
     (the PI control with ``beta`` over the error kept from the step before, ``err_old``;
     beta 0: from ``err`` alone) and the error to keep for the next one."""
     fac = fac11 / err_old ** beta if beta != 0.0 else fac11
     fac = max(1.0 / 6.0, min(3.0, fac / 0.9))
-    h_next = h / fac
-    if scipy_ctrl:
-        h_next = h * (10.0 if err == 0.0 else min(10.0, 0.9 * err ** -0.125))
-    return h_next, max(err, 1e-4)
+    return h / fac, max(err, 1e-4)

@@ -271,9 +271,8 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
     if not _pieces_at_start(t, y, f, ip, fp, ri, rf, dims, ws, ext, off, sc, piv, ipar, locks,
                             kv):
         return FAILED
-    scipy_ctrl = ipar[I_CTRL] != 0
     h = _step_at_start(t, y, f, K, atol, par, ip, fp, ri, rf, dims, ws, ext, off, sc, piv,
-                       ipar, scipy_ctrl)
+                       ipar)
     rejected = False
     # (the counters int64 from the start: a literal 0 would compile the helpers they go to
     # once more, for the literal)
@@ -291,8 +290,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
     ws0, wp0 = np.empty(ws.size), 0  # the workspace and watch at a step's start (put back)
     ipar[I_FLAGS] = 0
     while True:
-        code, h, hmin, t_new = _step_to_try(t, h, par, ipar, steps, scipy_ctrl, t_eval,
-                                            o_t.size)
+        code, h, hmin, t_new = _step_to_try(t, h, par, ipar, steps, t_eval, o_t.size)
         if code >= 0:
             return _stop(par, t, h, code)
         if not rejected and retried == 0:
@@ -305,7 +303,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
             return _stop(par, t, h, FAILED)
         err = error_norm(y, ynew, K, atol, rtol, h)
         fac11 = err ** (0.125 - 0.2 * par[P_BETA])
-        if too_large(err, scipy_ctrl):  # rejected
+        if too_large(err):  # rejected
             rejected = True
             retried = 0
             over = 0
@@ -313,7 +311,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
             # a retry starts its solves where the step started, not from the poses of the
             # rejected stages (a long trial step may have jumped to another assembly branch)
             _again(ws, ws0, ipar, wp0)
-            h = shrunk(h, err, fac11, scipy_ctrl)
+            h = shrunk(h, err, fac11)
             if h < hmin:
                 ipar[I_STATUS] = -1
                 return _stop(par, t, h, FAILED)
@@ -343,8 +341,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
         _watch(ynew[0], ws, nx, par, ipar, x_end)
         steps += 1
         ipar[I_STEPS] += 1
-        h_next, par[P_ERROLD] = next_step(h, err, fac11, par[P_BETA], par[P_ERROLD],
-                                          scipy_ctrl)
+        h_next, par[P_ERROLD] = next_step(h, err, fac11, par[P_BETA], par[P_ERROLD])
         h_next = _after_points(h_next, h, h_full, rejected, hmin, t_new, s_new, br)
         aimed = retried > 0  # (a step shortened to a table's point: no stall)
         rejected = False

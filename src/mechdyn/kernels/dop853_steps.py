@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..integrate.dop853_tableau import N_STAGES, C
-from .dop853_control import initial_guess, initial_step, scipy_guess, scipy_step
+from .dop853_control import initial_guess, initial_step
 from .dop853_dense import dense_coefficients, keep_step, kept_offsets, stage
 from .held_tables import aim, hold, left, table_vars
 from .lagrange_numba import D_NI, N_FLAGS, W_COUNT, evaluate_into, held_pieces
@@ -117,31 +117,24 @@ def _pieces_at_start(t, y, f, ip, fp, ri, rf, dims, ws, ext, off, sc, piv, ipar,
 
 
 @njit_inline
-def _step_at_start(t, y, f, K, atol, par, ip, fp, ri, rf, dims, ws, ext, off, sc, piv, ipar,
-                   scipy_ctrl):
-    """The first step of a call: ``par[P_H]``, or where it is not set the starting step
-    of Hairer (or SciPy) from one trial evaluation (in ``K[1]``, ``K[2]``)."""
+def _step_at_start(t, y, f, K, atol, par, ip, fp, ri, rf, dims, ws, ext, off, sc, piv, ipar):
+    """The first step of a call: ``par[P_H]``, or where it is not set Hairer's starting
+    step from one trial evaluation (in ``K[1]``, ``K[2]``)."""
     h = par[P_H]
     if h > 0.0:
         return h
-    t_end, rtol, hmax = par[P_TEND], par[P_RTOL], par[P_HMAX]
-    if scipy_ctrl:
-        h, dnf = scipy_guess(y, f, atol, rtol, t_end - t)
-    else:
-        h, dnf = initial_guess(y, f, atol, rtol, hmax)
+    rtol, hmax = par[P_RTOL], par[P_HMAX]
+    h, dnf = initial_guess(y, f, atol, rtol, hmax)
     for i in range(y.size):
         K[1, i] = y[i] + h * f[i]
     if _counted(t + h, K[1], K[2], dims[D_NI], ip, fp, ri, rf, dims, ws, ext, off, sc, piv,
                 ipar):
-        if scipy_ctrl:
-            h = scipy_step(y, f, K[2], h, dnf, atol, rtol, hmax, t_end - t)
-        else:
-            h = initial_step(y, f, K[2], h, dnf, atol, rtol, hmax)
+        h = initial_step(y, f, K[2], h, dnf, atol, rtol, hmax)
     return h
 
 
 @njit_inline
-def _step_to_try(t, h, par, ipar, steps, scipy_ctrl, t_eval, cap):
+def _step_to_try(t, h, par, ipar, steps, t_eval, cap):
     """``(code, h, hmin, t_new)``: DONE or BATCH where the call ends at ``t`` (``t_end``
     reached, ``steps`` the steps per call, or the buffers too full for the samples of the
     next step), else -1 and the step to try: ``h`` within the smallest step ``hmin`` and
@@ -154,7 +147,7 @@ def _step_to_try(t, h, par, ipar, steps, scipy_ctrl, t_eval, cap):
         return BATCH, h, 0.0, t
     hmin = 10.0 * abs(np.nextafter(t, np.inf) - t)
     h = min(max(h, hmin), par[P_HMAX])
-    last = t + (1.0 if scipy_ctrl else 1.01) * h >= t_end
+    last = t + 1.01 * h >= t_end
     if last:
         h = t_end - t
     # room in the buffers for the samples this step can give
