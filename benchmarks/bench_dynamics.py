@@ -20,7 +20,7 @@ import numpy as np
 from mechdyn.dynamics.compiled import numba_available
 from mechdyn.examples import andrews
 from mechdyn.examples.paper_case import motor_curve, press_idle
-from mechdyn.simulate import simulate
+from mechdyn.simulate.run import simulate
 
 
 def _andrews_error(model, tr, andrews):

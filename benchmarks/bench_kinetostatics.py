@@ -16,9 +16,9 @@ import time
 import numpy as np
 
 from mechdyn import examples
-from mechdyn.dynamics.kinetostatics import kinetostatics
-from mechdyn.dynamics.reactions import _inverse
+from mechdyn.dynamics.reactions import batched_inverse
 from mechdyn.kinematics.sweep import analyze
+from mechdyn.kinetostatics.inverse import kinetostatics
 
 N_POSITIONS = 3600
 OMEGA = 40 * 2 * np.pi / 60  # rad/s, 40 strokes per minute
@@ -42,7 +42,7 @@ def per_position_loop(model, values):
         pt = analyze(model, [values[k]], [OMEGA], x_guess=x)  # from the previous pose
         x, q = pt.x, pt.q[None, :]
         t = np.array([(values[k] - values[0]) / OMEGA])
-        tau[k] = _inverse(model, lay, didx, t, x[None], pt.xdot[None], pt.xddot[None], q,
+        tau[k] = batched_inverse(model, lay, didx, t, x[None], pt.xdot[None], pt.xddot[None], q,
                           q * 0 + OMEGA, skip=didx, reacting=(), point=np.zeros(2))["tau"][0, 0]
     return tau
 

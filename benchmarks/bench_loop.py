@@ -47,12 +47,12 @@ import numpy as np
 
 from mechdyn.dynamics.mode_equations import ModeEquations
 from mechdyn.dynamics.mode_system import ModeSystem
-from mechdyn.dynamics.modes import switched_model
 from mechdyn.examples import andrews, load
 from mechdyn.examples.paper_case import press_idle
 from mechdyn.kernels.rows_numba import NUMBA
+from mechdyn.model.switchable import switched_model
 from mechdyn.model.workspace import Workspace
-from mechdyn.simulate import simulate
+from mechdyn.simulate.run import simulate
 
 from .bench_dynamics import _best_of
 from .bench_switching import T_END, T_FIXED, _models

@@ -18,10 +18,10 @@ from ._version import __version__ as __version__
 #: name that is itself a submodule
 _WHERE: dict[str, str | None] = {
     "examples": None, "units": None,
-    "Kinetostatics": ".dynamics.kinetostatics", "kinetostatics": ".dynamics.kinetostatics",
+    "Kinetostatics": ".kinetostatics.inverse", "kinetostatics": ".kinetostatics.inverse",
     **dict.fromkeys(("FlywheelSizing", "Reduction", "SteadyCycle", "reduce_model",
                      "run_reduced", "size_flywheel", "startup", "steady_state"),
-                    ".dynamics.reduction"),
+                    ".reduction.reduce"),
     **dict.fromkeys(("AssemblyError", "BranchJumpError", "IntegrationError", "LockupError",
                      "MechdynError", "ModelError", "SingularPositionError", "Status",
                      "UnitError"), ".errors"),
@@ -41,8 +41,8 @@ _WHERE: dict[str, str | None] = {
     "Model": ".model", "Mode": ".model.state", "State": ".model.state",
     "load": ".modelfile", "loads": ".modelfile",
     "Trajectory": ".results.trajectory",
-    "simulate": ".simulate",
-    "SwitchEvent": ".simulate_events", "format_events": ".simulate_events",
+    "simulate": ".simulate.run",
+    "SwitchEvent": ".simulate.segments", "format_events": ".simulate.segments",
     "warmup": ".compiler",
 }
 

@@ -9,8 +9,8 @@
    (:func:`check_rank`, with :mod:`mechdyn.kinematics.assembly`);
 4. the loads, drives and every switchable element -- locks, stops, contacts and
    switches with their targets, variables and guards (:func:`check_loads`, by building
-   :func:`mechdyn.dynamics.forces.force_model` and
-   :func:`mechdyn.dynamics.modes.switched_model` once),
+   :func:`mechdyn.model.forces.force_model` and
+   :func:`mechdyn.model.switchable.switched_model` once),
 
 so that an analysis never discovers a bad name.  The module sits above the analyses
 it borrows from; :meth:`Mechanism.compile <mechdyn.mechanism.Mechanism.compile>` and
@@ -25,12 +25,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .dynamics.forces import force_model
-from .dynamics.modes import switched_model
 from .errors import MechdynError, ModelError
 from .kinematics.assembly import assemble, rank_report
-from .kinematics.constraints import coordinates
 from .model import Model
+from .model.constraints import coordinates
+from .model.forces import force_model
+from .model.switchable import switched_model
 
 __all__ = ["compile_mechanism", "check_rank", "check_loads", "warmup"]
 

@@ -161,6 +161,14 @@ class LockupError(_WhereError):
     """A mechanism cannot move on: no motion is consistent with the active constraints."""
 
 
+class ContactError(MechdynError):
+    """No contact force distribution satisfies the complementarity conditions."""
+
+    def __init__(self, message, *, t=None):
+        self.t = t
+        super().__init__(message + (f" (at t = {t:.9g} s)" if t is not None else ""))
+
+
 class IntegrationError(_WhereError):
     """Numerical integration failed (non-finite state, singular mass matrix, ...)."""
 

@@ -14,8 +14,8 @@ import numpy as np
 
 from .errors import ModelError, did_you_mean
 from .kinematics.assembly import assemble, solve_position
-from .kinematics.constraints import coordinates
 from .model import Model
+from .model.constraints import coordinates
 
 __all__ = ["initial_state"]
 

@@ -38,7 +38,7 @@ def test_other_packages_warnings_keep_their_format():
 
 
 def test_a_mechdyn_warning_class_is_in_the_cli_form_wherever_raised():
-    from mechdyn.dynamics.friction_ignored import FrictionIgnoredWarning
+    from mechdyn.friction.ignored import FrictionIgnoredWarning
 
     fmt = warning_format("flywheel")
     assert fmt(FrictionIgnoredWarning("left\n  out"), FrictionIgnoredWarning,

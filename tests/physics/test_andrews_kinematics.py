@@ -18,7 +18,7 @@ import pytest
 
 from mechdyn.examples import andrews
 from mechdyn.kinematics import assemble, solve_position
-from mechdyn.kinematics.constraints import point_velocity, residual
+from mechdyn.model.constraints import point_velocity, residual
 
 DEPENDENT = ("Theta", "gamma", "Phi", "delta", "Omega", "epsilon")
 

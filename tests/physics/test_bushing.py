@@ -8,8 +8,8 @@ import pytest
 
 import mechdyn
 from mechdyn import Bushing, Mechanism
-from mechdyn.dynamics.forces import force_model
 from mechdyn.errors import ModelError
+from mechdyn.model.forces import force_model
 
 M, KX, KY, CX, CY = 2.0, 8e3, 2e4, 4.0, 12.0  # kg, N/m, N s/m
 

@@ -14,7 +14,7 @@ from mechdyn.dynamics import compiled
 from mechdyn.dynamics.compiled import numba_available
 from mechdyn.examples import press_cycle
 from mechdyn.integrate.events import Event
-from mechdyn.simulate import simulate
+from mechdyn.simulate.run import simulate
 
 pytestmark = pytest.mark.skipif(not numba_available(), reason="numba not installed")
 

@@ -17,7 +17,7 @@ from mechdyn.dynamics.compiled import numba_available
 from mechdyn.dynamics.compiled_loop import PIVOT_FLAG
 from mechdyn.dynamics.mode_equations import PIVOT_CHECK
 from mechdyn.mechanism import RotarySpring
-from mechdyn.simulate import simulate
+from mechdyn.simulate.run import simulate
 
 pytestmark = pytest.mark.skipif(not numba_available(), reason="numba not installed")
 

@@ -4,7 +4,7 @@ supports against the closed forms of the indeterminate beam, with and without li
 import numpy as np
 import pytest
 
-from mechdyn.dynamics.compliance import (
+from mechdyn.contact.compliance import (
     beam_on_supports,
     check_compliance,
     share_by_compliance,

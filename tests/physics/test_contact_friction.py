@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from mechdyn.dynamics.contact import ContactError, solve_lcp
 from mechdyn.mechanism import Mechanism
 from mechdyn.mechanism.contact import Contact
 from mechdyn.mechanism.switch import add_element
-from mechdyn.simulate_events import simulate_events
+from mechdyn.simulate.gaps import ContactError, solve_lcp
+from mechdyn.simulate.segments import simulate_events
 
 G = 9.81
 

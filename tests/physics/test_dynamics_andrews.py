@@ -17,7 +17,7 @@ import pytest
 from mechdyn.dynamics.lagrange import EquationsOfMotion, kinetic_energy
 from mechdyn.examples import andrews
 from mechdyn.kinematics.analogs import velocity_analogs
-from mechdyn.simulate import simulate
+from mechdyn.simulate.run import simulate
 
 REF = andrews.REFERENCE_T003
 REF_RATES = andrews.REFERENCE_T003_RATES

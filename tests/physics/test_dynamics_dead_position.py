@@ -9,7 +9,7 @@ import pytest
 from dynamics_models import four_bar
 
 from mechdyn.mechanism import Drive
-from mechdyn.simulate import simulate
+from mechdyn.simulate.run import simulate
 
 
 def rocker_driven():

@@ -10,7 +10,7 @@ import pytest
 from dynamics_models import four_bar, slider_crank
 
 from mechdyn.mechanism import Drive, Force, RotarySpring, Spring, Table, Torque
-from mechdyn.simulate import simulate
+from mechdyn.simulate.run import simulate
 
 FOUR_BAR_PERIOD = 0.986  # s, measured for four_bar(phi0=0.3) (about 0.9862 s)
 

@@ -8,7 +8,7 @@ from test_dynamics_energy import loaded_slider_crank
 
 from mechdyn.dynamics.lagrange import EquationsOfMotion, potential_energy
 from mechdyn.examples.paper_case import press_idle
-from mechdyn.simulate import initial_state
+from mechdyn.simulate.run import initial_state
 
 D_DEG = np.array([0.4, 0.2, 0.1, 0.05])
 

@@ -13,7 +13,7 @@ from dynamics_models import pendulum
 from scipy.special import ellipj, ellipk
 
 from mechdyn.integrate import Event
-from mechdyn.simulate import simulate
+from mechdyn.simulate.run import simulate
 
 M, A, JC, G = 2.0, 0.5, 0.05, 9.81
 THETA0 = np.deg2rad(170.0)

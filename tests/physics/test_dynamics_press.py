@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from mechdyn.examples.paper_case import T_END, WILSON_STEPS, press_idle
-from mechdyn.simulate import simulate
+from mechdyn.simulate.run import simulate
 
 GRID = np.linspace(0.0, T_END, WILSON_STEPS + 1)
 

@@ -8,7 +8,7 @@ import pytest
 from mechdyn import examples
 from mechdyn.errors import ModelError
 from mechdyn.kinematics import solve_position
-from mechdyn.kinematics.constraints import point_position
+from mechdyn.model.constraints import point_position
 
 NAMES = ["andrews_squeezer", "bolt_buffer", "clutchless_press", "clutchless_press_lumped",
          "clutchless_press_paper",

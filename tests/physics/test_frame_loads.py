@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import mechdyn as md
-from mechdyn.dynamics.forces import com_arms
+from mechdyn.model.forces import com_arms
 
 
 @pytest.mark.parametrize("name", ["four_bar", "slider_crank", "toggle_press",

@@ -27,8 +27,8 @@ from scipy.integrate import cumulative_trapezoid
 from scipy.signal import find_peaks
 
 import mechdyn as md
-from mechdyn.dynamics.forces import com_arms
 from mechdyn.mechanism.load import Force
+from mechdyn.model.forces import com_arms
 from mechdyn.results import spectrum as sp
 
 T_END = 1.5  # s: three and a half work cycles (one every third turn, ~0.42 s)

@@ -8,7 +8,7 @@ import numpy as np
 from dynamics_models import pendulum
 
 import mechdyn
-from mechdyn.dynamics.friction_ignored import FrictionIgnoredWarning
+from mechdyn.friction.ignored import FrictionIgnoredWarning
 from mechdyn.mechanism.contact import Stop
 from mechdyn.mechanism.switch import add_element
 

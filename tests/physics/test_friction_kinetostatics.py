@@ -25,8 +25,8 @@ import numpy as np
 import pytest
 
 import mechdyn as md
-from mechdyn.dynamics.kinetostatics import kinetostatics
 from mechdyn.errors import Status
+from mechdyn.kinetostatics.inverse import kinetostatics
 from mechdyn.mechanism import Force
 
 OMEGA = 10.0  # rad/s

@@ -6,13 +6,13 @@ import warnings
 import numpy as np
 import pytest
 
-from mechdyn.dynamics.impact import impact
 from mechdyn.dynamics.mode_system import ModeSystem
-from mechdyn.dynamics.modes import switched_model
 from mechdyn.mechanism import Mechanism
 from mechdyn.mechanism.contact import Contact, Stop
 from mechdyn.mechanism.switch import add_element
+from mechdyn.model.switchable import switched_model
 from mechdyn.modelfile.switches import parse_switches
+from mechdyn.simulate.impact import impact
 
 M, L = 2.0, 0.8  # kg, m
 J = M * L * L / 12  # kg m^2, about the centre
@@ -170,7 +170,7 @@ def test_stop_friction_is_checked_and_read_from_the_model_file():
 def test_a_falling_rod_hits_the_floor_in_a_simulation(mu, e, state):
     # released at rest in its angle TH, moving sideways at 1 m/s, the centre at 0.5 m:
     # it falls without turning and A meets the floor after a free fall of h
-    from mechdyn.simulate_events import simulate_events
+    from mechdyn.simulate.segments import simulate_events
 
     m = _rod("stop", mu, e)
     m.gravity = (0.0, -9.81)

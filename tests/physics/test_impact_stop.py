@@ -6,7 +6,7 @@ import pytest
 from mechdyn.mechanism import Mechanism, Spring
 from mechdyn.mechanism.contact import Stop
 from mechdyn.mechanism.switch import CoordinateLock, Switch, add_element
-from mechdyn.simulate_events import format_events, simulate_events
+from mechdyn.simulate.segments import format_events, simulate_events
 
 K, M, D, X0 = 800.0, 2.0, 0.05, 0.1
 

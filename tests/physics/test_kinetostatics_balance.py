@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 
 import mechdyn as md
-from mechdyn.dynamics.forces import force_model
-from mechdyn.dynamics.kinetostatics import applied_forces, kinetostatics
-from mechdyn.kinematics.constraints import point_acceleration, point_position, point_velocity
+from mechdyn.kinetostatics.inverse import applied_forces, kinetostatics
 from mechdyn.mechanism import Force, RotarySpring, Spring, Table, Torque
 from mechdyn.mechanism.process import punch_load
+from mechdyn.model.constraints import point_acceleration, point_position, point_velocity
+from mechdyn.model.forces import force_model
 
 
 def _circle(P, rP, Q, rQ, sign):
@@ -172,7 +172,7 @@ def test_frame_receives_external_loads_minus_inertia(six_bar_result):
         ext_m += (rc[:, 0] * f[:, 1] - rc[:, 1] * f[:, 0]
                   - model.inertia[k] * res.xddot[:, 3 * k + 2])
     # Force loads (external, not carried by the frame here)
-    from mechdyn.dynamics.forces import LoadContext, evaluate
+    from mechdyn.model.forces import LoadContext, evaluate
 
     for ld in model.mechanism.loads:
         if not isinstance(ld, Force):

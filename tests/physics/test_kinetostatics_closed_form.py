@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import mechdyn as md
-from mechdyn.dynamics.kinetostatics import kinetostatics
+from mechdyn.kinetostatics.inverse import kinetostatics
 from mechdyn.mechanism import Force
 
 R_CRANK, L_ROD = 0.05, 0.20

@@ -8,7 +8,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import mechdyn as md
-from mechdyn.dynamics.kinetostatics import kinetostatics
+from mechdyn.kinetostatics.inverse import kinetostatics
 from mechdyn.mechanism import Drive
 
 M, JC, S = 2.0, 0.01, np.array([0.10, 0.03])  # kg, kg m^2, COM in the crank frame (m)

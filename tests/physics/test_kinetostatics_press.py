@@ -16,10 +16,10 @@ import numpy as np
 import pytest
 
 from mechdyn import examples
-from mechdyn.dynamics.kinetostatics import KinetostaticsWarning, dead_centres, kinetostatics
-from mechdyn.kinematics.constraints import point_position, point_velocity
+from mechdyn.kinetostatics.inverse import KinetostaticsWarning, dead_centres, kinetostatics
 from mechdyn.mechanism import Body, Lock, Mechanism
 from mechdyn.mechanism.process import punch_load
+from mechdyn.model.constraints import point_position, point_velocity
 
 OMEGA = 40 * 2 * np.pi / 60  # 40 strokes per minute
 PUNCH = 7500.0  # N, the working load of toggle_press.toml

@@ -18,7 +18,7 @@ import pytest
 from mechdyn.mechanism import Mechanism
 from mechdyn.mechanism.switch import CoordinateLock, Switch, add_element
 from mechdyn.modelfile.drives import drive_from_table
-from mechdyn.simulate import simulate
+from mechdyn.simulate.run import simulate
 
 J1, J2 = 0.02, 0.01  # kg m^2, both discs centred on the axis
 RTOL = 1e-12
@@ -86,7 +86,7 @@ def test_between_events_the_switched_run_equals_fixed_structure_runs():
     np.testing.assert_allclose(got[:, 1], ref2.qdot[:, 0], rtol=1e-9)  # they turn as one
     # the motor's rotor inertia shows: the plastic engagement conserves the momentum of
     # d1 with the rotor (reduced to th1) and d2
-    from mechdyn.dynamics.inertia import drive_inertia
+    from mechdyn.model.inertia import drive_inertia
 
     Jr = float(drive_inertia(_one_disc(False).compile())[0])
     assert Jr > 0

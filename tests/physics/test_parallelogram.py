@@ -41,12 +41,12 @@ from dynamics_models import parallelogram
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from mechdyn.dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
 from mechdyn.dynamics.lagrange import BranchEquations
 from mechdyn.kinematics.sweep import sweep
+from mechdyn.kinetostatics.inverse import KinetostaticsWarning, kinetostatics
 from mechdyn.mechanism import Drive
 from mechdyn.model import as_model
-from mechdyn.simulate import simulate
+from mechdyn.simulate.run import simulate
 
 G = 9.81
 PHI0, W0 = np.pi / 2, -1.0  # started vertical, turning clockwise at 1 rad/s

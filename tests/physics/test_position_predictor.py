@@ -16,7 +16,7 @@ import pytest
 from mechdyn import examples
 from mechdyn.dynamics.lagrange import EquationsOfMotion
 from mechdyn.kernels.lagrange_numba import N_FLAGS, W_ERR, W_ITER
-from mechdyn.simulate import simulate
+from mechdyn.simulate.run import simulate
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,7 @@ import pytest
 
 from mechdyn.examples import bolt_buffer, press_cycle
 from mechdyn.mechanism import Table
-from mechdyn.simulate_events import format_events
+from mechdyn.simulate.segments import format_events
 
 CYCLES = 4
 # chosen values of press_cycle.toml (SI)
@@ -107,7 +107,7 @@ def test_bolt_meets_the_buffer_separates_and_touches_again():
 
 @pytest.mark.slow
 def test_press_model_file_runs_to_the_first_work_stroke():
-    from mechdyn.simulate_events import simulate_events
+    from mechdyn.simulate.segments import simulate_events
 
     mech = press_cycle.load_model_file()
     assert {len(mech.extras[k]) for k in ("stops", "contacts", "coordinate_locks",

@@ -20,7 +20,9 @@ import numpy as np
 import pytest
 
 from mechdyn import Mechanism
-from mechdyn.dynamics.reduction import (
+from mechdyn.errors import ModelError
+from mechdyn.mechanism import Drive, TorqueSpeedCurve
+from mechdyn.reduction.reduce import (
     Member,
     MemberLoad,
     ReducedMachine,
@@ -29,8 +31,6 @@ from mechdyn.dynamics.reduction import (
     reduce_model,
     run_reduced,
 )
-from mechdyn.errors import ModelError
-from mechdyn.mechanism import Drive, TorqueSpeedCurve
 
 GEOM = dict(r=0.05, l=0.2, e=0.012, m1=2.0, J1=0.01, c1=0.02, m2=3.0, J2=0.02,
             c2=(0.08, 0.01), m3=5.0)

@@ -17,7 +17,11 @@ import math
 import numpy as np
 import pytest
 
-from mechdyn.dynamics.reduction import (
+from mechdyn.errors import IntegrationError, LockupError, ModelError
+from mechdyn.mechanism.catalogue import induction_motor
+from mechdyn.mechanism.motors import GearStage
+from mechdyn.modelfile.drives import drive_from_table
+from mechdyn.reduction.reduce import (
     ReducedMachine,
     mode_mechanism,
     reduce_model,
@@ -26,10 +30,6 @@ from mechdyn.dynamics.reduction import (
     startup,
     steady_state,
 )
-from mechdyn.errors import IntegrationError, LockupError, ModelError
-from mechdyn.mechanism.catalogue import induction_motor
-from mechdyn.mechanism.motors import GearStage
-from mechdyn.modelfile.drives import drive_from_table
 
 J0, T0, A = 0.05, 10.0, 4.0  # kg m^2, N m, N m
 

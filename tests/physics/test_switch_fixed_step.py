@@ -8,7 +8,7 @@ from test_impact_stop import X0, M, _closed_form, _oscillator
 from mechdyn.cli import main
 from mechdyn.integrate import RungeKutta4
 from mechdyn.integrate.base import IntegratorOptionError
-from mechdyn.simulate import simulate
+from mechdyn.simulate.run import simulate
 
 E = 0.6
 

@@ -3,13 +3,13 @@
 import numpy as np
 import pytest
 
-import mechdyn.dynamics.switching as switching
-from mechdyn.dynamics.contact import ContactError
 from mechdyn.errors import ModelError
 from mechdyn.mechanism import Mechanism, Spring
 from mechdyn.mechanism.contact import Stop
 from mechdyn.mechanism.switch import CoordinateLock, Switch, add_element
-from mechdyn.simulate_events import format_events, simulate_events
+from mechdyn.simulate import switching as switching
+from mechdyn.simulate.gaps import ContactError
+from mechdyn.simulate.segments import format_events, simulate_events
 
 
 def _oscillator():

@@ -18,7 +18,7 @@ import pytest
 from mechdyn.dynamics.compiled import numba_available
 from mechdyn.kernels.table_regions import region_bounds, region_of, region_value, sharp_breakpoints
 from mechdyn.mechanism import Drive, Force, Mechanism, Table, Torque, TorqueSpeedCurve
-from mechdyn.simulate import simulate
+from mechdyn.simulate.run import simulate
 
 needs_numba = pytest.mark.skipif(not numba_available(), reason="numba not installed")
 
@@ -164,8 +164,8 @@ def test_a_variable_held_at_a_point_stays_on_its_piece():
     # its spring table: round-off around the point must not flip the held piece
     from mechdyn.dynamics.mode_equations import ModeEquations
     from mechdyn.dynamics.mode_system import ModeSystem
-    from mechdyn.dynamics.modes import switched_model
     from mechdyn.kernels.held_tables import hold, left
+    from mechdyn.model.switchable import switched_model
     from mechdyn.model.workspace import Workspace
 
     model = _slider(Table([0.02, 0.022, 0.028], [0.0, 68.8e3, 70e3], "s")).compile()

@@ -10,9 +10,9 @@ import mechdyn
 from mechdyn.dynamics import dead_position as D
 from mechdyn.dynamics.compiled import numba_available
 from mechdyn.dynamics.mode_system import ModeSystem
-from mechdyn.dynamics.modes import switched_model
 from mechdyn.examples.paper_case import press_idle
 from mechdyn.kernels import rows_numpy as RN
+from mechdyn.model.switchable import switched_model
 
 
 def _systems():

@@ -6,7 +6,7 @@ from PIL import Image
 
 import mechdyn
 from mechdyn.errors import MechdynError, ModelError
-from mechdyn.kinematics.constraints import point_position
+from mechdyn.model.constraints import point_position
 from mechdyn.results.animate import (
     _Scene,
     animate,

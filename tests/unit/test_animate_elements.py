@@ -8,7 +8,7 @@ from matplotlib.text import Text
 from PIL import Image
 
 import mechdyn
-from mechdyn.kinematics.constraints import point_position
+from mechdyn.model.constraints import point_position
 from mechdyn.results.animate import _zigzag, animate, frame_geometry, snapshot
 
 

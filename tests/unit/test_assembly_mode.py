@@ -5,7 +5,7 @@ import pytest
 
 from mechdyn import Mechanism, ModelError
 from mechdyn.kinematics.assembly import solve_position, turn_signs
-from mechdyn.kinematics.constraints import point_position
+from mechdyn.model.constraints import point_position
 
 # crank 40 mm, coupler 120 mm, rocker 80 mm, frame 100 mm (Grashof crank-rocker)
 A_, B_, C_, D_ = 0.04, 0.12, 0.08, 0.10

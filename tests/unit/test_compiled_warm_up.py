@@ -5,7 +5,7 @@ position its run does not visit: a pendulum whose spring ends meet at the sketch
 import numpy as np
 
 from mechdyn.mechanism import Mechanism, Spring
-from mechdyn.simulate import simulate
+from mechdyn.simulate.run import simulate
 
 
 def _pendulum_with_spring():

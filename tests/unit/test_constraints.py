@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from mechdyn import Mechanism
-from mechdyn.kinematics.constraints import (
+from mechdyn.model.constraints import (
     coordinates,
     coordinates_gamma,
     coordinates_jacobian,

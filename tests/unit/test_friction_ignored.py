@@ -8,8 +8,8 @@ import pytest
 
 import mechdyn
 from mechdyn.cli import main
-from mechdyn.dynamics.friction_ignored import FrictionIgnoredWarning
-from mechdyn.dynamics.reduction import ReducedMachine, reduce_model
+from mechdyn.friction.ignored import FrictionIgnoredWarning
+from mechdyn.reduction.reduce import ReducedMachine, reduce_model
 
 JOINTS = ("A", "B", "C", "D", "E", "F", "slide")
 

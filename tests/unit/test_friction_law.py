@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from mechdyn import Mechanism
-from mechdyn.dynamics.friction import FrictionSet, friction_joints
 from mechdyn.errors import ModelError
+from mechdyn.friction.law import FrictionSet, friction_joints
 
 
 def _block(L=0.12, mu=0.2, c=3.0, smoothing=0.0):

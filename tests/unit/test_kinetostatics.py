@@ -1,4 +1,4 @@
-"""Unit tests of mechdyn.dynamics.kinetostatics and mechdyn.mechanism.process."""
+"""Unit tests of mechdyn.kinetostatics.inverse and mechdyn.mechanism.process."""
 
 import dataclasses
 import doctest
@@ -8,18 +8,18 @@ import numpy as np
 import pytest
 
 import mechdyn as md
-from mechdyn.dynamics import kinetostatics as ks_module
-from mechdyn.dynamics.forces import LoadContext, force_model
-from mechdyn.dynamics.kinetostatics import (
+from mechdyn.errors import ModelError
+from mechdyn.kinetostatics import inverse as ks_module
+from mechdyn.kinetostatics.inverse import (
     Kinetostatics,
     applied_forces,
     frame_mass_matrix,
     inertia_forces,
     kinetostatics,
 )
-from mechdyn.errors import ModelError
 from mechdyn.mechanism import Drive, Force, Spring, Table, TorqueSpeedCurve
 from mechdyn.mechanism.process import StrokeWindow, position_load, punch_load, time_pulse_load
+from mechdyn.model.forces import LoadContext, force_model
 
 G = 9.81
 

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 import mechdyn
-from mechdyn.dynamics import run_samples
 from mechdyn.examples.paper_case import press_idle
 from mechdyn.results.lazy_table import LazyDict
 from mechdyn.results.trajectory import SwitchedSamples
+from mechdyn.simulate import samples as run_samples
 
 
 @pytest.fixture(scope="module")

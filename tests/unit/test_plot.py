@@ -1,7 +1,7 @@
 """``mechdyn.results.plot.plot`` draws every kind of record it lists."""
 
 import mechdyn
-from mechdyn.dynamics.reduction import reduce_model
+from mechdyn.reduction.reduce import reduce_model
 from mechdyn.results.plot import PLOTTERS, plot, plot_trajectory  # noqa: F401
 
 

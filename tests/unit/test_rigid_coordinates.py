@@ -14,7 +14,7 @@ from mechdyn.foundation import Foundation, Isolator, mounted
 def _system(mech):
     """The mode system and pose of the first segment of a short run."""
     from mechdyn.dynamics.mode_system import ModeSystem
-    from mechdyn.dynamics.modes import SwitchedModel
+    from mechdyn.model.switchable import SwitchedModel
 
     model = mech.compile()
     sm = SwitchedModel(model)

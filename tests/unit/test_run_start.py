@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 import mechdyn
-from mechdyn.dynamics import run_start
 from mechdyn.examples.paper_case import press_idle
 from mechdyn.model.workspace import Workspace
+from mechdyn.simulate import run_start
 
 
 def _same(a, b):

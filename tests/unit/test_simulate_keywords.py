@@ -11,7 +11,7 @@ from mechdyn.integrate.base import DEFAULT_RTOL, IntegratorOptionError, Integrat
 from mechdyn.mechanism import Mechanism, Spring
 from mechdyn.mechanism.contact import Stop
 from mechdyn.mechanism.switch import add_element
-from mechdyn.simulate import simulate
+from mechdyn.simulate.run import simulate
 
 K, M, X0 = 400.0, 1.0, 0.05
 

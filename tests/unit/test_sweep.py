@@ -8,7 +8,6 @@ import pytest
 from mechdyn import Mechanism, ModelError, SingularPositionError
 from mechdyn.kernels import rows_numba
 from mechdyn.kinematics import branch_sign, residual
-from mechdyn.kinematics.constraints import coordinates
 from mechdyn.kinematics.continuation import Kernel
 from mechdyn.kinematics.sweep import (
     KinematicSweep,
@@ -19,6 +18,7 @@ from mechdyn.kinematics.sweep import (
     sweep,
 )
 from mechdyn.model import Model
+from mechdyn.model.constraints import coordinates
 
 A_, B_, C_, D_ = 0.02, 0.07, 0.05, 0.06
 

@@ -7,13 +7,13 @@ import pytest
 
 import mechdyn
 from mechdyn.dynamics.compiled import numba_available
-from mechdyn.dynamics.contact import gap_measures
 from mechdyn.dynamics.mode_equations import ModeEquations
 from mechdyn.dynamics.mode_system import ModeSystem, mode_system
-from mechdyn.dynamics.modes import switched_model
-from mechdyn.dynamics.switching import _PoseValues
 from mechdyn.kernels import rows_numpy
+from mechdyn.model.switchable import switched_model
 from mechdyn.model.workspace import Workspace
+from mechdyn.simulate.gaps import gap_measures
+from mechdyn.simulate.switching import _PoseValues
 
 
 @pytest.fixture(scope="module")

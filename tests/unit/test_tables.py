@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import mechdyn as md
-from mechdyn.dynamics.forces import LoadContext, evaluate
 from mechdyn.mechanism import Force, Table, Torque
 from mechdyn.mechanism.load import pulse
+from mechdyn.model.forces import LoadContext, evaluate
 
 TWO_PI = 2 * math.pi
 
@@ -152,7 +152,7 @@ def test_periodic_table_in_a_simulation_matches_the_compiled_kernel():
 
 def test_every_column_of_a_reduction_table_has_its_unit():
     import mechdyn
-    from mechdyn.dynamics.reduction import reduce_model
+    from mechdyn.reduction.reduce import reduce_model
     from mechdyn.results.table import unit_of_column
 
     red = reduce_model(mechdyn.examples.load("slider_crank").compile(), steps=5)

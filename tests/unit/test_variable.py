@@ -4,9 +4,9 @@ coordinate locks and load tables, checked against hand-made geometry."""
 import numpy as np
 import pytest
 
-from mechdyn.dynamics.forces import LoadContext
 from mechdyn.errors import ModelError
 from mechdyn.examples import press_cycle
+from mechdyn.model.forces import LoadContext
 from mechdyn.model.variable import Variable, parse, parse_variable, quantity
 from mechdyn.modelfile.switches import variable_kind
 

@@ -13,11 +13,11 @@ from pathlib import Path
 import numpy as np
 
 from .. import examples
-from ..dynamics.kinetostatics import kinetostatics
 from ..kinematics.sweep import sweep
+from ..kinetostatics.inverse import kinetostatics
 from ..results.plot import plot
 from ..results.table import write_csv
-from ..simulate import simulate
+from ..simulate.run import simulate
 
 __all__ = ["register", "run"]
 

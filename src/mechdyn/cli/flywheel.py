@@ -20,12 +20,12 @@ from __future__ import annotations
 
 import warnings
 
-from ..dynamics.flywheel import FLYWHEEL_METHODS, size_flywheel
-from ..dynamics.friction_ignored import FrictionIgnoredWarning
-from ..dynamics.reduced_machine import ReducedMachine
-from ..dynamics.reduction import reduce_model
 from ..errors import ModelError
+from ..friction.ignored import FrictionIgnoredWarning
 from ..progress import stage
+from ..reduction.flywheel import FLYWHEEL_METHODS, size_flywheel
+from ..reduction.machine import ReducedMachine
+from ..reduction.reduce import reduce_model
 from ..results.plot_reduction import plot_steady_cycle
 from ..results.table import rate_text
 from ..units import parse_quantity

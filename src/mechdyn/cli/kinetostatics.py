@@ -17,8 +17,8 @@ from __future__ import annotations
 import warnings
 from pathlib import Path
 
-from ..dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
 from ..errors import ModelError, Status
+from ..kinetostatics.inverse import KinetostaticsWarning, kinetostatics
 from ..progress import stage
 from ..results.plot_kinetostatics import plot_joint_force_polar, plot_kinetostatics
 from ..results.table import written

@@ -13,7 +13,6 @@ from pathlib import Path
 import numpy as np
 
 from .. import examples
-from ..dynamics.reduction import mode_mechanism
 from ..errors import ModelError, UnitError, did_you_mean
 from ..integrate.base import DEFAULT_RTOL
 from ..integrate.driver import INTEGRATORS
@@ -21,9 +20,10 @@ from ..kinematics.sweep import initial_coordinates
 from ..mechanism.joint import Lock
 from ..modelfile import load
 from ..modelfile.drives import drive_from_table
+from ..reduction.reduce import mode_mechanism
 from ..results.plot_columns import check_columns, plot_columns, table_of
 from ..results.table import rate_text, write_csv
-from ..simulate import simulate
+from ..simulate.run import simulate
 from ..units import parse_quantity, parse_vector
 
 __all__ = ["quantity", "vector", "add_model", "add_files", "add_range", "add_start",

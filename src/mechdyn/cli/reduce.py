@@ -16,10 +16,10 @@ import argparse
 
 import numpy as np
 
-from ..dynamics.reduction import reduce_model
 from ..errors import ModelError
 from ..kinematics.sweep import initial_coordinates
 from ..progress import stage
+from ..reduction.reduce import reduce_model
 from ..results.frame_geometry import trace_spec
 from ..results.plot_reduction import plot_reduction
 from .options import (

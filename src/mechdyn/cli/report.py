@@ -29,10 +29,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..dynamics.kinetostatics import KinetostaticsWarning, kinetostatics
 from ..errors import MechdynError, ModelError, Status
 from ..kinematics.sweep import initial_coordinates
 from ..kinematics.sweep import sweep as run_sweep
+from ..kinetostatics.inverse import KinetostaticsWarning, kinetostatics
 from ..model import as_model
 from ..progress import stage
 from ..results.report import report_trajectory, write_report

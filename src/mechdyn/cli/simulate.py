@@ -29,8 +29,8 @@ from ..results.frame_geometry import trace_spec
 from ..results.plot_dynamics import plot_trajectory
 from ..results.plot_spectrum import plot_spectrum
 from ..results.table import CsvStream, deg_or_mm, written
-from ..simulate import simulate
-from ..simulate_events import format_events
+from ..simulate.run import simulate
+from ..simulate.segments import format_events
 from ..units import parse_quantity
 from .options import (
     add_engage,

@@ -1,5 +1,5 @@
 """``mechdyn supports``: the forces of k supports by influence coefficients
-(:mod:`mechdyn.dynamics.compliance`), with supports that lift off: a beam (``--at``), or
+(:mod:`mechdyn.contact.compliance`), with supports that lift off: a beam (``--at``), or
 any body given by its compliance matrix and equilibrium equations as CSV files
 (``--compliance``)."""
 
@@ -112,7 +112,7 @@ def _beam(args):
     """The beam problem of ``--at``: (problem, positions, label of the body)."""
     import numpy as np
 
-    from ..dynamics.compliance import beam_on_supports
+    from ..contact.compliance import beam_on_supports
 
     x = _list(args.at, "length", "--at")
     k = len(x)
@@ -149,7 +149,7 @@ def _general(args):
     """The problem of ``--compliance``: (problem, None, label)."""
     import numpy as np
 
-    from ..dynamics.compliance import SupportProblem, check_compliance
+    from ..contact.compliance import SupportProblem, check_compliance
 
     for flag in ("load", "stiffness", "EI"):
         if getattr(args, flag):

@@ -35,11 +35,11 @@ from ..kernels.loads_numba import H_NTAB, LoadPacker, Unsupported
 from ..kernels.rows_numba import NUMBA, compiling
 from ..mechanism.mechanism import Mechanism
 from ..model import Model
+from ..model.forces import force_model
 from ..model.rows import concat
 from ..model.variable import lower, parse
 from ..model.workspace import Workspace
 from .compiled_loop import fast_forward, kept_steps, warm_up_loop
-from .forces import force_model
 
 __all__ = ["compile_mode_kernel", "CompiledKernel", "numba_available"]
 
@@ -255,7 +255,7 @@ def compile_mode_kernel(model, force_model, constraint_rows, independent, *, kep
     ----------
     model : Model
     force_model : ForceModel
-        The model's loads (:func:`mechdyn.dynamics.forces.force_model`).
+        The model's loads (:func:`mechdyn.model.forces.force_model`).
     constraint_rows : Rows
         The mode's independent constraint rows (joints, engaged locks, closed stops
         and contacts, sticking rows), n_c of them.

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..errors import (
     AssemblyError,
+    ContactError,
     IntegrationError,
     LockupError,
     SingularPositionError,
@@ -25,7 +26,6 @@ from ..kernels import rows_numpy as RN
 from ..kernels.rows_numba import NUMBA, rows_jacobian
 from ..kinematics.assembly import DEAD_RCOND
 from ..mechanism.coordinate import BODY_KINDS
-from .complementarity import ContactError
 from .mode_rows import held_key
 
 __all__ = ["turning_point", "rigid_coordinates", "diagnose", "status_of", "TURN_RCOND"]

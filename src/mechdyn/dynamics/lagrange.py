@@ -11,7 +11,7 @@ the last solution, so the assembly branch is kept by continuity).
 ``"exact"`` (default)
     With the exact velocity analogs B = dx/dq and the acceleration bias b
     (``xddot = B q'' + b``), and the frame mass matrix M_x(x) and centripetal
-    term h(x, xdot) of :mod:`mechdyn.dynamics.inertia` (the body-frame origins
+    term h(x, xdot) of :mod:`mechdyn.model.inertia` (the body-frame origins
     need not be the centres of mass), A = B^T M_x B, c = B^T (M_x b + h),
     Q = B^T F + Q_drive, plus the rotor and gear inertia of the drives on their
     coordinates; through bifurcation positions on the branch the motion is on.
@@ -33,11 +33,11 @@ import numpy as np
 from ..errors import ModelError
 from ..kinematics.assembly import assemble
 from ..model import Model
-from .forces import com_arms, force_model
-from .inertia import drive_inertia, frame_mass_matrix
+from ..model.forces import com_arms, force_model
+from ..model.inertia import drive_inertia, frame_mass_matrix
+from ..model.switchable import switched_model
 from .mode_equations import FORMULATIONS, PIVOT_CHECK, ModeEquations
 from .mode_system import ModeSystem
-from .modes import switched_model
 
 __all__ = ["EquationsOfMotion", "BranchEquations", "Terms", "FORMULATIONS", "PIVOT_CHECK",
            "equations_of_motion", "drive_inertia", "kinetic_energy", "potential_energy",
@@ -86,7 +86,7 @@ class Terms:
 
 def mass_matrix(model: Model, x, B) -> np.ndarray:
     """Generalized mass matrix A = B^T M_x B (M_x the frame mass matrix of
-    :mod:`mechdyn.dynamics.inertia`), shape (..., n_q, n_q)."""
+    :mod:`mechdyn.model.inertia`), shape (..., n_q, n_q)."""
     B = np.asarray(B, float)
     return np.swapaxes(B, -1, -2) @ frame_mass_matrix(model, x) @ B
 

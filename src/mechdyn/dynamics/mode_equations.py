@@ -9,7 +9,7 @@ run in one mode.  The right-hand side runs on the compiled kernel
 (:mod:`mechdyn.dynamics.compiled`) whenever the mode allows (numba installed,
 every load compiled, no sliding friction); otherwise, and to diagnose a failure,
 on the NumPy evaluation of the mode (:meth:`ModeSystem.evaluate`), which also
-gives every multiplier.  Friction in the joints (:mod:`mechdyn.dynamics.joint_friction`)
+gives every multiplier.  Friction in the joints (:mod:`mechdyn.friction.forward`)
 runs on the NumPy path: its force depends on the multipliers, and each evaluation
 solves the coupled system by Newton's method on them (the compiled kernel, whose
 signature frictionless runs keep, has no friction).
@@ -42,14 +42,14 @@ from functools import cached_property
 import numpy as np
 
 from ..errors import AssemblyError, ModelError, SingularPositionError
+from ..friction.law import friction_joints
 from ..kinematics.analogs import default_displacement
 from ..kinematics.assembly import SINGULAR_RCOND, solve_position
 from ..kinematics.branch_chart import BranchChart, ChartBook, PathProblem
-from ..kinematics.constraints import extend
+from ..model.constraints import extend
+from ..model.forces import com_arms
 from .compiled import compile_mode_kernel
 from .dead_position import _dependent, _where
-from .forces import com_arms
-from .friction import friction_joints
 from .mode_system import ModeEval, solve_mass
 
 __all__ = ["ModeEquations", "BACKENDS", "FORMULATIONS", "PIVOT_CHECK", "STAGE_FAILURES"]

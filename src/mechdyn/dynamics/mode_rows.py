@@ -5,7 +5,7 @@ rows followed by one row per active switchable element, their layout
 (:class:`~mechdyn.model.ConstraintLayout`) and the rows of each element, with their
 values and Jacobian.  :class:`~mechdyn.dynamics.mode_system.ModeSystem` adds what is
 chosen at a pose (independent rows and coordinates) and the dynamics; an impact's
-impulses on every element need the rows alone (:func:`mechdyn.dynamics.impact.impact`).
+impulses on every element need the rows alone (:func:`mechdyn.simulate.impact.impact`).
 """
 
 from __future__ import annotations
@@ -15,15 +15,15 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..friction.forward import split_mode, stick_row
 from ..kernels import rows_numpy as RN
 from ..model import ConstraintLayout
 from ..model.state import Mode
 from ..model.workspace import Workspace
-from .joint_friction import split_mode, stick_row
 from .reactions import ground_rows
 
 if TYPE_CHECKING:
-    from .modes import SwitchedModel
+    from ..model.switchable import SwitchedModel
 
 __all__ = ["ModeRows", "held_key"]
 
@@ -53,7 +53,7 @@ class ModeRows:
     Examples
     --------
     >>> import mechdyn
-    >>> from mechdyn.dynamics.modes import switched_model
+    >>> from mechdyn.model.switchable import switched_model
     >>> sm = switched_model(mechdyn.examples.load("press_cycle").compile())
     >>> mr = ModeRows(sm, frozenset({"ram_stop@upper"}), {})
     >>> mr.n_rows - mr.n_base, mr.row_labels()[-1]

@@ -1,7 +1,7 @@
 """Kinematics and dynamics of one *mode* of a variable-structure mechanism.
 
 A mode is the set of active switchable constraints (``State.mode``; see
-:mod:`mechdyn.dynamics.modes`).  Its constraint rows are ONE
+:mod:`mechdyn.model.switchable`).  Its constraint rows are ONE
 :class:`~mechdyn.model.rows.Rows`, :attr:`ModeSystem.rowset`: the model's joint
 rows (``Model.joint_rows``) followed by one row per active switchable element
 (:meth:`SwitchedModel.rows`, three for a weld lock), all evaluated by
@@ -35,6 +35,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import AssemblyError, IntegrationError, LockupError
+from ..friction.forward import JointFriction
+from ..friction.law import friction_joints
 from ..kernels import rows_numpy as RN
 from ..kinematics.assembly import (
     column_scale,
@@ -43,17 +45,16 @@ from ..kinematics.assembly import (
     scaled_by_columns,
     singular_report,
 )
+from ..model.inertia import mass_matrix_x
 from ..model.state import Mode
 from ..model.workspace import Workspace
-from .friction import friction_joints
-from .inertia import mass_matrix_x
-from .joint_friction import JointFriction
 from .mode_rows import ModeRows, held_key
 
 if TYPE_CHECKING:
-    from .modes import SwitchedModel
+    from ..model.switchable import SwitchedModel
 
 __all__ = ["ModeSystem", "ModeEval", "mass_matrix_x", "fmt_mode", "solve_mass", "held_key",
+           "independent_row_indices",
            "mode_system"]
 
 
@@ -152,7 +153,7 @@ class ModeSystem(ModeRows):
         kept = at.get((self.mode, held)) if held is not None else None
         if kept is None:
             Rs = scaled_by_columns(model, self.row_jacobian(self.x_ref), self.rowset.is_angle)
-            rows_i = _independent_rows(Rs)
+            rows_i = independent_row_indices(Rs)
             kept = {"rows": rows_i, "GN": self._coordinates_on_null_space(Rs[rows_i])}
             if held is not None:
                 at[self.mode, held] = kept
@@ -477,7 +478,7 @@ def mode_system(sm: SwitchedModel, mode, targets: dict, x, *, prefer=(), avoid=(
     Examples
     --------
     >>> import mechdyn
-    >>> from mechdyn.dynamics.modes import switched_model
+    >>> from mechdyn.model.switchable import switched_model
     >>> from mechdyn.model.workspace import Workspace
     >>> sm = switched_model(mechdyn.examples.load("press_cycle").compile())
     >>> ws, x = Workspace(), sm.model.x_sketch
@@ -500,7 +501,7 @@ def mode_system(sm: SwitchedModel, mode, targets: dict, x, *, prefer=(), avoid=(
     return ms
 
 
-def _independent_rows(Rs, tol=1e-9) -> np.ndarray:
+def independent_row_indices(Rs, tol=1e-9) -> np.ndarray:
     """Indices of a maximal set of linearly independent rows, earlier rows first."""
     keep = []
     basis = np.zeros((0, Rs.shape[1]))

@@ -1,7 +1,7 @@
 """Reactions of joints and locks from multipliers (the one reporter, for forward runs,
 impacts and kinetostatics: :func:`joint_reaction`), and the batched kinetostatic solve
 for the multipliers and driving torques, the frame loads and the redundancy check (the
-equation and sign conventions of :mod:`mechdyn.dynamics.kinetostatics`).
+equation and sign conventions of :mod:`mechdyn.kinetostatics.inverse`).
 """
 
 from __future__ import annotations
@@ -10,21 +10,21 @@ import warnings as _warnings
 
 import numpy as np
 
+from ..contact.compliance import share_by_compliance
 from ..errors import ModelError, Status
+from ..friction.forward import friction_set, joint_states
+from ..friction.kinetostatic import friction_solve, locking_note
+from ..friction.law import friction_joints
 from ..kernels import rows_numpy
 from ..kernels.planar import cross, perp, rotate
 from ..kinematics.assembly import SINGULAR_RCOND, column_scale, redundant_rows
-from ..kinematics.constraints import coordinates_jacobian, extend
 from ..model import ConstraintLayout, Model
-from .compliance import share_by_compliance
-from .forces import applied_forces
-from .friction import friction_joints
-from .inertia import inertia_forces
-from .joint_friction import friction_set, joint_states
-from .kinetostatics_friction import friction_solve, locking_note
+from ..model.constraints import coordinates_jacobian, extend
+from ..model.forces import applied_forces
+from ..model.inertia import inertia_forces
 
 __all__ = ["KinetostaticsWarning", "joint_reaction", "reaction_frame", "element_forces",
-           "element_width", "frame_forces", "touches_ground", "ground_rows"]
+           "element_width", "frame_forces", "touches_ground", "ground_rows", "batched_inverse"]
 
 #: relative singular value below which constraint equations count as dependent
 REDUNDANT_RCOND = 1e-9
@@ -86,7 +86,7 @@ def joint_reaction(model: Model, name: str, x, gen, friction=None):
         convention M xddot + h = F + Phi_x^T lambda.
     friction : array_like, shape (..., n_x), optional
         The generalized force of the pair's friction on the poses (the law's,
-        :meth:`~mechdyn.dynamics.friction.FrictionSet.by_pair`, or the constraint force
+        :meth:`~mechdyn.friction.law.FrictionSet.by_pair`, or the constraint force
         of the stick row of a sticking pair): part of the reaction.  A revolute joint's
         moment is then the moment of this friction about the pin (the friction moment
         on the child).
@@ -131,7 +131,7 @@ def element_forces(ms, x, lam, friction=None, R=None) -> dict:
         Multipliers of ``ms.rowset`` (forward convention); impulses give impulses.
     friction : dict, optional
         {joint: generalized force (..., n_x) of its friction} of the slipping pairs
-        (:meth:`~mechdyn.dynamics.joint_friction.JointFriction.by_pair`).
+        (:meth:`~mechdyn.friction.forward.JointFriction.by_pair`).
     R : ndarray, shape (..., n_rows, n_x), optional
         The row Jacobian at ``x`` (``ms.row_jacobian(x)``) when the caller has it.
 
@@ -145,7 +145,7 @@ def element_forces(ms, x, lam, friction=None, R=None) -> dict:
         multiplier of their (first) row, shape (...) (the normal force of a stop or
         contact, N or N m, the torque or force of a coordinate lock along its variable).
         The friction of a pair is part of its reaction: the law's (``friction``) or,
-        when it sticks, the force of its stick row (:mod:`~mechdyn.dynamics.joint_friction`),
+        when it sticks, the force of its stick row (:mod:`~mechdyn.friction.forward`),
         as :func:`mechdyn.kinetostatics` reports it.
     """
     model = ms.model
@@ -249,7 +249,7 @@ def _share_by_compliance(model: Model, lay: ConstraintLayout, red_joints, As, bs
     """Where every joint of the redundant set has a compliance (a pin's ``compliance``,
     m/N, on its two force rows), replace the minimum-norm solution ``z`` (scaled, (n, m))
     at the samples ``ok`` by the one of least complementary energy
-    (:func:`~mechdyn.dynamics.compliance.share_by_compliance`), in place.  Returns the
+    (:func:`~mechdyn.contact.compliance.share_by_compliance`), in place.  Returns the
     sentence for the warning ('' where the minimum norm stays)."""
     joints = model.mechanism.joints
     given = {j: float(getattr(joints.get(j), "compliance", 0.0) or 0.0) for j in red_joints}
@@ -277,7 +277,7 @@ def _share_by_compliance(model: Model, lay: ConstraintLayout, red_joints, As, bs
                                     "(minimum norm there)" if failed else ""))
 
 
-def _inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qdot, *,
+def batched_inverse(model: Model, lay: ConstraintLayout, didx, t, x, xdot, xddot, q, qdot, *,
              skip, reacting, point, charted=None) -> dict:
     """The batched inverse-dynamics solve and the reaction bookkeeping: the record fields
     it gives (as named in ``Kinetostatics``), ``tau`` (n, n_d), ``status``, ``warnings``

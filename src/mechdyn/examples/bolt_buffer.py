@@ -9,7 +9,7 @@ bundled ``bolt_buffer.toml``.  Use :func:`build` and :func:`run`.
 from __future__ import annotations
 
 from ..mechanism import Mechanism
-from ..simulate_events import simulate_events
+from ..simulate.segments import simulate_events
 from . import load
 
 __all__ = ["build", "run"]

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..mechanism import Mechanism
 from ..modelfile import load as load_file
-from ..simulate_events import simulate_events
+from ..simulate.segments import simulate_events
 from . import load
 
 __all__ = ["build", "run", "run_time", "load_model_file"]
@@ -63,7 +63,7 @@ def run(cycles: int = 4, t_end: float | None = None, **options):
     t_end : float, optional
         End time, s, instead.
     **options
-        Go to :func:`mechdyn.simulate_events.simulate_events`, the segment loop of
+        Go to :func:`mechdyn.simulate.segments.simulate_events`, the segment loop of
         :func:`mechdyn.simulate` (here rtol 1e-9 and output every 0.5 ms unless given).
 
     Returns

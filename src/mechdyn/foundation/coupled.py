@@ -166,7 +166,7 @@ def _reaction_loads(run, names, at) -> np.ndarray:
     """The reactions (Fx, Fy, M about the origin), shape (n, 3), that the frame of ``run``
     takes from the ``Force`` loads ``names`` (their point of application as it moves),
     at the samples of the times ``at`` (n,) of the run."""
-    from ..dynamics.forces import applied_forces
+    from ..model.forces import applied_forces
 
     ok = np.all(np.isfinite(run.q), axis=1)
     args = (run.model, run.t[ok], run.x[ok], run.xdot[ok], run.q[ok], run.qdot[ok])
@@ -234,7 +234,7 @@ def compare_mounting(mechanism: Mechanism, foundation: Foundation | None = None,
     >>> bool(abs(s["coupled"]["peak_N"] / s["one_way"]["peak_N"] - 1) < 1e-2)
     True
     """
-    from ..simulate import simulate
+    from ..simulate.run import simulate
 
     f = _foundation(mechanism, foundation)
     if samples < 2:

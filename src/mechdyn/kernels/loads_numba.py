@@ -1,4 +1,4 @@
-"""The compiled (Numba) twin of the load evaluation of :mod:`mechdyn.dynamics.forces`.
+"""The compiled (Numba) twin of the load evaluation of :mod:`mechdyn.model.forces`.
 
 Gravity, springs and dampers, bushings, rotary springs, forces and torques of constant or
 tabulated magnitude, and drives (constant, tabulated, torque-speed curves) are
@@ -66,7 +66,7 @@ class LoadPacker:
     ----------
     model : Model
     force_model : ForceModel
-        The model's parsed loads (:func:`mechdyn.dynamics.forces.force_model`).
+        The model's parsed loads (:func:`mechdyn.model.forces.force_model`).
     variable : callable, optional
         ``variable(name) -> (kind, ref)`` resolves a table variable: ``("t", None)``,
         ``("q", k)`` or ``("qdot", k)`` for a declared coordinate k or its rate,

@@ -2,7 +2,7 @@
 the rates and the kinetostatic solve, with a variant axis through the row data.
 
 The kinetostatic equations ``[-Phi_x^T, g_d,x^T] z = I - F`` of
-:func:`mechdyn.dynamics.reactions._inverse` have the transposed Jacobian of the
+:func:`mechdyn.dynamics.reactions.batched_inverse` have the transposed Jacobian of the
 position problem as their matrix: one factorization per position serves the rates,
 the accelerations and the multipliers.
 
@@ -376,8 +376,8 @@ def body_loads_variants(X, Xd, Xdd, mass, inertia, com, gravity, rhs):
     variant: the right-hand side of :func:`inverse_variants` when the bodies' weights
     are the only applied loads.
 
-    Per body (as :func:`mechdyn.dynamics.inertia.inertia_forces` and the weights of
-    :class:`mechdyn.dynamics.forces.ForceModel`): ``m a_c - m g`` (N) and
+    Per body (as :func:`mechdyn.model.inertia.inertia_forces` and the weights of
+    :class:`mechdyn.model.forces.ForceModel`): ``m a_c - m g`` (N) and
     ``J_c alpha + a x (m a_c - m g)`` (N m, about the frame origin), with the
     centre-of-mass arm ``a = A(theta) c`` and ``a_c = rddot + alpha perp(a) - omega^2 a``.
 

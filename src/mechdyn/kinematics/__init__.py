@@ -1,5 +1,13 @@
 """Kinematic analysis in absolute coordinates with exact Jacobians."""
 
+from ..model.constraints import (
+                      coordinates,
+                      jacobian,
+                      point_acceleration,
+                      point_position,
+                      point_velocity,
+                      residual,
+)
 from .analogs import (
                       acceleration_bias,
                       accelerations,
@@ -8,14 +16,6 @@ from .analogs import (
                       velocity_analogs,
 )
 from .assembly import assemble, branch_sign, joint_residuals, singularity, solve_position
-from .constraints import (
-                      coordinates,
-                      jacobian,
-                      point_acceleration,
-                      point_position,
-                      point_velocity,
-                      residual,
-)
 
 __all__ = ["accelerations", "acceleration_bias", "finite_difference_analogs", "velocities",
            "velocity_analogs", "assemble", "branch_sign", "joint_residuals", "singularity",

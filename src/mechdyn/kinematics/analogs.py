@@ -14,8 +14,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..model import ConstraintLayout, Model
+from ..model.constraints import full_gamma, full_jacobian
 from .assembly import solve_position
-from .constraints import full_gamma, full_jacobian
 
 __all__ = ["velocity_analogs", "acceleration_bias", "velocities", "accelerations",
            "finite_difference_analogs", "default_displacement", "DEFAULT_ANGLE_STEP"]

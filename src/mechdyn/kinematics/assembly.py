@@ -16,8 +16,8 @@ from ..kernels import rows_numpy
 from ..kernels.planar import rotate
 from ..mechanism.placement import describe_poses, initial_values, suggest_assembly_mode
 from ..model import ConstraintLayout, Model
+from ..model.constraints import coordinates, extend, full_jacobian, residual, system
 from ..model.rows import Rows
-from .constraints import coordinates, extend, full_jacobian, residual, system
 
 __all__ = ["newton", "solve_position", "assemble", "find_poses", "start_coordinates",
            "joint_residuals", "singularity", "rank_report",

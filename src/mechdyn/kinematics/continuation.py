@@ -8,7 +8,7 @@ gives the branch sign too), its Newton solve, the solved positions (:class:`_Nod
 their quintic Hermite predictor and the step-halving march through bifurcation
 positions (:mod:`mechdyn.kinematics.branch_chart`).  Used by
 :mod:`mechdyn.kinematics.sweep`, :mod:`mechdyn.kinematics.records` and
-:mod:`mechdyn.dynamics.prescribed_motion`.
+:mod:`mechdyn.kinetostatics.prescribed`.
 """
 
 from __future__ import annotations

@@ -17,8 +17,8 @@ import numpy as np
 from ..kernels import rows_numpy
 from ..mechanism.joint import Revolute
 from ..model import Model
+from ..model.constraints import point_kinematics, point_position, point_velocity, travel_rows
 from .assembly import position_tol
-from .constraints import point_kinematics, point_position, point_velocity, travel_rows
 from .continuation import path_newton, path_node, sweep_kernel
 
 __all__ = ["KinematicSweep", "KinematicPoint", "SweepSummary", "DeadCentre", "TransmissionAngle",

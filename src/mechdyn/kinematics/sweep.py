@@ -34,7 +34,7 @@ How it is computed (vectorized over the positions):
 
 The residual, Jacobian and acceleration right-hand side are the model's
 constraint and coordinate rows (:mod:`mechdyn.model.rows`), the equations of
-:mod:`mechdyn.kinematics.constraints`, evaluated by a private kernel
+:mod:`mechdyn.model.constraints`, evaluated by a private kernel
 (compiled when numba is installed) that also factors the Jacobians (sparse LU,
 which gives the branch sign too).
 
@@ -53,9 +53,9 @@ import numpy as np
 
 from ..errors import ModelError, SingularPositionError, Status, did_you_mean
 from ..model import Model, as_model
+from ..model.constraints import coordinates
 from .assembly import _least_squares, assemble, position_tol, singularity
 from .branch_chart import ChartBook, PathProblem
-from .constraints import coordinates
 from .continuation import (
     _MAX_NEWTON,
     _anchor_indices,

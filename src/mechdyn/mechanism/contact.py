@@ -46,7 +46,7 @@ class Stop:
         stays closed after the impact).
     friction : float
         Coulomb coefficient mu >= 0 of the tangential impulse in an impact on the stop
-        (:mod:`mechdyn.dynamics.impact`); only for a stop on a point coordinate
+        (:mod:`mechdyn.simulate.impact`); only for a stop on a point coordinate
         ``"body.point.x|y"``, whose tangent is the other ground axis.  It acts during
         impacts only: while the stop stays closed the point slides along it without
         friction (use a :class:`Contact` for lasting friction).

@@ -3,9 +3,9 @@
 A load's magnitude is a *value*: a constant (SI), a :class:`Table` interpolated in
 time, a coordinate, a coordinate rate or a point coordinate (optionally periodic in
 it, e.g. over the crank angle every revolution), or a callable that
-receives a :class:`mechdyn.dynamics.forces.LoadContext` (attributes ``t``, ``q``,
+receives a :class:`mechdyn.model.forces.LoadContext` (attributes ``t``, ``q``,
 ``qdot`` and methods ``coord``, ``rate``, ``point``, ``velocity``) and returns a
-float.  The elements are frozen data; ``mechdyn.dynamics.forces`` evaluates them.
+float.  The elements are frozen data; ``mechdyn.model.forces`` evaluates them.
 """
 
 from __future__ import annotations

@@ -2,13 +2,13 @@
 
 These helpers build ordinary :class:`~mechdyn.mechanism.load.Force` elements whose
 magnitude depends on the position of a point, on time, or on both; the dynamics
-(``mechdyn.dynamics.forces``) evaluates them like any other load, and the
+(``mechdyn.model.forces``) evaluates them like any other load, and the
 kinetostatic analysis evaluates them for a whole cycle at once (the magnitude
 objects here are *vectorized*: they accept a context whose attributes are arrays).
 
 Nothing here knows about solvers: a magnitude receives a context with the
 methods ``point(body, point)`` and ``velocity(body, point)`` (see
-:class:`mechdyn.dynamics.forces.LoadContext`) and returns a number, or an array
+:class:`mechdyn.model.forces.LoadContext`) and returns a number, or an array
 for a batch of positions.
 """
 

@@ -3,7 +3,7 @@
 A *variable-structure* mechanism keeps one set of bodies, joints and declared
 coordinates; what changes while it runs is the set of active constraints, the
 *mode* (``State.mode``): the names of the engaged locks and the closed stops
-and contacts.  The elements here are frozen data; ``mechdyn.simulate_events``
+and contacts.  The elements here are frozen data; ``mechdyn.simulate.segments``
 runs them.
 
 Variables

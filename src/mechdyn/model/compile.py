@@ -101,8 +101,8 @@ class Model:
     friction_joints : tuple of str
         The revolute and prismatic joints with friction, in joint order.
     forces, switchable
-        The loads and drives resolved (:class:`~mechdyn.dynamics.forces.ForceModel`)
-        and the switchable elements (:class:`~mechdyn.dynamics.modes.SwitchedModel`),
+        The loads and drives resolved (:class:`~mechdyn.model.forces.ForceModel`)
+        and the switchable elements (:class:`~mechdyn.model.switchable.SwitchedModel`),
         set by the compiler (:func:`mechdyn.compiler.check_loads`).
 
     A compiled model is constant: the compiler builds everything above, then freezes
@@ -196,8 +196,8 @@ class Model:
         self.friction_joints = tuple(
             n for n, j in mechanism.joints.items()
             if isinstance(j, Revolute | Prismatic) and has_friction(j))
-        #: the loads and drives resolved to indices (:class:`~mechdyn.dynamics.forces.
-        #: ForceModel`) and the switchable elements (:class:`~mechdyn.dynamics.modes.
+        #: the loads and drives resolved to indices (:class:`~mechdyn.model.forces.
+        #: ForceModel`) and the switchable elements (:class:`~mechdyn.model.switchable.
         #: SwitchedModel`): set by the compiler (:func:`mechdyn.compiler.check_loads`)
         self.forces = None
         self.switchable = None
@@ -338,7 +338,7 @@ class ConstraintLayout:
     mode : frozenset of str
     extra : list of Row, optional
         The switchable rows of a variable-structure mode (weld locks included,
-        :meth:`~mechdyn.dynamics.modes.SwitchedModel.rows`): they follow the joint rows
+        :meth:`~mechdyn.model.switchable.SwitchedModel.rows`): they follow the joint rows
         instead of the welds of the engaged locks.  ``rows`` then has the joints and weld
         locks, ``elements`` the others (a sticking contact's row on its own, by its label;
         ``element_rows`` groups every row by element), ``slip_rows`` and ``friction`` the

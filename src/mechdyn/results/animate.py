@@ -11,7 +11,7 @@
 What each frame shows (bodies through their points, joints, ground anchors, slider
 guides, an optional traced point, the time or swept value in the corner) is listed in
 ``docs/results.md``; :func:`frame_geometry` gives its coordinates, which the tests compare
-with :func:`mechdyn.kinematics.constraints.point_position`.  The axis limits are fixed
+with :func:`mechdyn.model.constraints.point_position`.  The axis limits are fixed
 from the whole motion and the aspect ratio is equal.  Figures are drawn on matplotlib's
 Agg canvas; pyplot is not used.
 """

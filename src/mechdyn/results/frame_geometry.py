@@ -1,7 +1,7 @@
 """What a frame of a mechanism's motion shows, as coordinates: bodies through their
 points, joints, ground anchors, slider guides, springs, stops, loads and joint forces, and
 a traced point (:func:`frame_geometry`), for :mod:`mechdyn.results.animate` to draw and
-for the tests to compare with :func:`mechdyn.kinematics.constraints.point_position`."""
+for the tests to compare with :func:`mechdyn.model.constraints.point_position`."""
 
 from __future__ import annotations
 
@@ -12,8 +12,8 @@ import numpy as np
 from ..errors import ModelError
 from ..kernels import rows_numpy
 from ..kernels.planar import rotate
-from ..kinematics.constraints import extend, point_position, travel_rows
 from ..mechanism.load import Force, Spring
+from ..model.constraints import extend, point_position, travel_rows
 from ..model.state import side_token
 from ..model.variable import parse as parse_variable
 from .table import deg_or_mm

@@ -1,5 +1,5 @@
 """The record of a kinetostatic analysis: :class:`Kinetostatics` (tables, summary,
-harmonics of the frame loads).  Computed by :func:`mechdyn.dynamics.kinetostatics.kinetostatics`."""
+harmonics of the frame loads).  Computed by :func:`mechdyn.kinetostatics.inverse.kinetostatics`."""
 
 from __future__ import annotations
 

@@ -2,7 +2,7 @@
 
 A run records its samples as it goes; the forces of every element, the loads on the
 frame and the energies are evaluated from them batched over each mode's samples (see
-:mod:`mechdyn.dynamics.run_samples`).  That evaluation costs about as much as a short
+:mod:`mechdyn.simulate.samples`).  That evaluation costs about as much as a short
 run itself, and many runs never read it (a study reading the end state, a benchmark):
 the :class:`~mechdyn.results.trajectory.Trajectory` of a run holds it as a
 :class:`LazyDict` (``energy``) and a lazily filled

@@ -22,7 +22,7 @@ def _title(record, what: str, sep: str = " ") -> str:
 
 def plot_kinetostatics(record, path=None, *, joints: Sequence[str] | None = None,
                        dpi: int = 120):
-    """Write a three-panel figure of a :class:`~mechdyn.dynamics.kinetostatics.Kinetostatics`.
+    """Write a three-panel figure of a :class:`~mechdyn.kinetostatics.inverse.Kinetostatics`.
 
     Panels: (1) driving torque of every driven angle (N m; driving forces of travels in N on
     a right-hand axis); (2) resultant reaction |R| of the chosen joints (N, or kN when

@@ -19,7 +19,7 @@ __all__ = ["plot_reduction", "plot_steady_cycle", "plot_startup", "plot_motor"]
 
 def plot_reduction(red, path, *, title: str | None = None, dpi: int = 120) -> Path:
     """J_red, dJ_red/dphi and M_red (drive and forces) over the positions of a
-    :class:`~mechdyn.dynamics.reduction.Reduction`.
+    :class:`~mechdyn.reduction.reduce.Reduction`.
 
     Parameters
     ----------
@@ -57,7 +57,7 @@ def plot_reduction(red, path, *, title: str | None = None, dpi: int = 120) -> Pa
 
 def plot_steady_cycle(cycle, path, *, title: str | None = None, dpi: int = 120) -> Path:
     """Speed and reduced torque over one steady cycle (a
-    :class:`~mechdyn.dynamics.flywheel.SteadyCycle`)."""
+    :class:`~mechdyn.reduction.flywheel.SteadyCycle`)."""
     x = np.degrees(cycle.phi)
     fig, ax = _figure(2, height=2.4)
     ax[0].plot(x, cycle.omega)
@@ -73,7 +73,7 @@ def plot_steady_cycle(cycle, path, *, title: str | None = None, dpi: int = 120) 
 
 
 def plot_startup(res, path, *, title: str | None = None, dpi: int = 120) -> Path:
-    """Speed and torques of a start-up (a :class:`~mechdyn.dynamics.reduced_run.StartupResult`)."""
+    """Speed and torques of a start-up (a :class:`~mechdyn.reduction.run.StartupResult`)."""
     run = res.run
     fig, ax = _figure(2, height=2.4)
     ax[0].plot(run.t, run.omega)

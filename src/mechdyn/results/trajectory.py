@@ -10,7 +10,7 @@ import numpy as np
 
 from ..errors import ModelError, did_you_mean
 from ..kinematics.analogs import accelerations
-from ..kinematics.constraints import point_acceleration, point_position, point_velocity
+from ..model.constraints import point_acceleration, point_position, point_velocity
 from .table import coordinate_columns, force_columns, mode_columns
 
 __all__ = ["Trajectory", "SwitchedSamples"]

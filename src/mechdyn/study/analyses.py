@@ -103,7 +103,7 @@ class KinetostaticExtremes:
 
     def record(self, model, warm=None):
         """The :class:`~mechdyn.Kinetostatics` record of a variant (from ``warm`` poses)."""
-        from ..dynamics.kinetostatics import kinetostatics
+        from ..kinetostatics.inverse import kinetostatics
 
         over, values = self.values(model)
         guess = warm if self.warm_start and warm is not None and \
@@ -244,8 +244,8 @@ class FlywheelSize:
             object.__setattr__(self, "speed", _si(self.speed, "angular_velocity", "speed"))
 
     def __call__(self, model, warm=None) -> Outcome:
-        from ..dynamics.flywheel import size_flywheel
-        from ..dynamics.reduction import reduce_model
+        from ..reduction.flywheel import size_flywheel
+        from ..reduction.reduce import reduce_model
 
         machine = reduce_model(model, steps=self.steps, omega=self.speed or 1.0).machine(model)
         key = "omega_guess" if machine.speed_dependent() else "omega_mean"
@@ -290,7 +290,7 @@ class SimulationMetrics:
         object.__setattr__(self, "t_end", _si(self.t_end, "time", "t_end"))
 
     def __call__(self, model, warm=None) -> Outcome:
-        from ..simulate import simulate
+        from ..simulate.run import simulate
 
         traj = simulate(model, self.t_end, progress=False, **self.options)
         out = {k: float(v) for k, v in dict(self.metrics(traj)).items()}

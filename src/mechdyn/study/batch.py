@@ -11,14 +11,14 @@ its own floats (:func:`mechdyn.kernels.rows_numpy.variant_rows`,
   the curvature), keeping each variant's assembly branch by the sign of det J; the
   rates and accelerations come from the factors of J at the solved poses;
 * the kinetostatic solve ``[-Phi_x^T, g_d,x^T] z = I - F`` of
-  :func:`mechdyn.dynamics.reactions._inverse`, whose matrix is J transposed (its
+  :func:`mechdyn.dynamics.reactions.batched_inverse`, whose matrix is J transposed (its
   balancing scales cancel in the solution), reuses those factors for every variant and
   position;
 * the inertia forces and weights are those of
-  :func:`~mechdyn.dynamics.inertia.inertia_forces` and
-  :class:`~mechdyn.dynamics.forces.ForceModel`, compiled over the variant axis
+  :func:`~mechdyn.model.inertia.inertia_forces` and
+  :class:`~mechdyn.model.forces.ForceModel`, compiled over the variant axis
   (:func:`~mechdyn.kernels.rows_variants.body_loads_variants`); other loads those of
-  :func:`~mechdyn.dynamics.forces.applied_forces`, one call per variant over its
+  :func:`~mechdyn.model.forces.applied_forces`, one call per variant over its
   positions (with the inertia forces of the bodies of all variants side by side); the
   joint reactions and frame loads those of :mod:`mechdyn.dynamics.reactions`
   (:func:`~mechdyn.dynamics.reactions.joint_reaction`,
@@ -46,9 +46,6 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..dynamics.forces import applied_forces
-from ..dynamics.inertia import inertia_forces
-from ..dynamics.prescribed_motion import independent_subset
 from ..dynamics.reactions import joint_reaction, reaction_frame
 from ..errors import Status
 from ..kernels import rows_numba, rows_numpy
@@ -59,8 +56,11 @@ from ..kernels.rows_variants import (
     path_variants,
 )
 from ..kinematics.sweep import DEFAULT_MAX_STEP
+from ..kinetostatics.prescribed import independent_subset
 from ..mechanism.joint import has_friction
 from ..model import Model
+from ..model.forces import applied_forces
+from ..model.inertia import inertia_forces
 from ..results.kinetostatics_record import Kinetostatics
 from .analyses import KinetostaticExtremes, Outcome, extremes
 
@@ -445,8 +445,8 @@ def _prescribed(q0, values, qd_dot, didx):
 def _rhs(vs: Variants, base, t, X, Xd, Xdd, q, qdot, didx):
     """Inertia forces minus applied forces, (V, N, n_x), and the loads on the frame
     (V, N, 3), of variants with loads besides the weights: the bodies of all variants
-    side by side as one model (:func:`~mechdyn.dynamics.inertia.inertia_forces`) and
-    each variant's loads (:func:`~mechdyn.dynamics.forces.applied_forces`)."""
+    side by side as one model (:func:`~mechdyn.model.inertia.inertia_forces`) and
+    each variant's loads (:func:`~mechdyn.model.forces.applied_forces`)."""
     V, N, n_x = X.shape
 
     def side(a):  # (V, N, n_x) -> (N, V n_x)
@@ -465,7 +465,7 @@ def _reaction_rows(base, lay, x, n_rows):
     """What :func:`~mechdyn.kernels.rows_variants.loads_variants` needs to give the joint
     reactions (on the child from the parent, as
     :func:`~mechdyn.dynamics.reactions.joint_reaction`) and what the frame receives
-    from the joints to the ground and from the drives' stators (as ``_inverse``'s frame
+    from the joints to the ground and from the drives' stators (as ``batched_inverse``'s frame
     loads; they are linear in the forces on the bodies, so their sum is taken once):
     the joints, the rows' weights and groups, each joint's two columns and sign; None
     when a joint's reaction is not two columns of its rows' force (the variants are then

@@ -16,22 +16,22 @@ the new constraint rows are C = Phi_new,x B:
 * unilateral rows with Newton's restitution e: the impulses P >= 0 and the
   rows' velocities after the impact v+ >= e max(0, -v-) are complementary
   (v+ = -e v- on every row that receives an impulse), a velocity-level LCP
-  solved by :func:`mechdyn.dynamics.complementarity.solve_lcp`;
+  solved by :func:`mechdyn.contact.complementarity.solve_lcp`;
 * Coulomb friction in the impact, on contacts and on point stops with ``friction``
   mu > 0: a tangential impulse P_t along the contact line (the other ground axis for
   a stop on ``body.point.y|x``) with |P_t| <= mu P_n.  The contact sticks (its
   tangential velocity after the impact is zero) when the impulse that stops the
   sliding lies in the cone, and otherwise slides with P_t = -mu P_n sgn(v_t+)
-  (:func:`mechdyn.dynamics.complementarity.solve_frictional_impact`: Newton's restitution on
+  (:func:`mechdyn.contact.complementarity.solve_frictional_impact`: Newton's restitution on
   the normal velocity with Coulomb's law at the impulse level, the friction impulse
   opposing the sliding after the impact; when the sliding keeps its direction through
   the impact this is Routh's result, sgn(v_t+) = sgn(v_t-)).
 
 The pairs' own friction (revolute and prismatic joints with ``friction``,
-:mod:`mechdyn.dynamics.friction`) is not part of the impulse problem: their impulsive
+:mod:`mechdyn.friction.law`) is not part of the impulse problem: their impulsive
 reactions would make impulsive friction, mu times the impulse, which is not modelled.
 The pairs are taken as frictionless during the impact, and a warning
-(:class:`~mechdyn.dynamics.friction_ignored.FrictionIgnoredWarning`) names, once per
+(:class:`~mechdyn.friction.ignored.FrictionIgnoredWarning`) names, once per
 event, the pairs with friction that carry an impulse (``docs/friction.md``).
 
 The kinetic energy lost is T- - T+; for a plastic impact it equals
@@ -50,16 +50,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..contact.complementarity import constrained_inverse, solve_frictional_impact, solve_lcp
+from ..dynamics.mode_rows import ModeRows
+from ..dynamics.mode_system import mass_matrix_x, mode_system
+from ..dynamics.reactions import element_forces, frame_forces
+from ..friction.ignored import FrictionIgnoredWarning
+from ..friction.law import friction_joints
 from ..kernels import rows_numpy
+from ..model.switchable import Row, SwitchedModel
 from ..model.variable import parse_variable
-from .complementarity import constrained_inverse, solve_frictional_impact, solve_lcp
-from .contact import row_terms
-from .friction import friction_joints
-from .friction_ignored import FrictionIgnoredWarning
-from .mode_rows import ModeRows
-from .mode_system import mass_matrix_x, mode_system
-from .modes import Row, SwitchedModel
-from .reactions import element_forces, frame_forces
+from .gaps import row_terms
 
 __all__ = ["ImpactResult", "impact", "element_forces", "frame_forces", "frame_impulse_key"]
 
@@ -80,7 +80,7 @@ def frame_impulse_key(sm: SwitchedModel) -> str:
     Examples
     --------
     >>> import mechdyn as md
-    >>> from mechdyn.dynamics.modes import switched_model
+    >>> from mechdyn.model.switchable import switched_model
     >>> frame_impulse_key(switched_model(md.examples.load("four_bar").compile()))
     'frame'
     """
@@ -168,7 +168,7 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     Parameters
     ----------
     sm : SwitchedModel
-        The switchable elements of the model (:func:`~mechdyn.dynamics.modes.
+        The switchable elements of the model (:func:`~mechdyn.model.switchable.
         switched_model`).
     x : ndarray, shape (n_x,)
         The pose at the switch (satisfies every row involved), m and rad.
@@ -225,8 +225,8 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     1/2 m (2^2 - 1^2) = 1.5 J:
 
     >>> import numpy as np
-    >>> from mechdyn.dynamics.contact import _drop
-    >>> from mechdyn.dynamics.modes import switched_model
+    >>> from mechdyn.simulate.gaps import _drop
+    >>> from mechdyn.model.switchable import switched_model
     >>> r = impact(switched_model(_drop(0.5)), np.zeros(3), np.array([0.0, -2.0, 0.0]),
     ...            frozenset(), frozenset(), {}, ["floor@lower"])
     >>> r.xdot_plus + 0.0, r.impulses["floor@lower"], r.energy_lost

@@ -1,6 +1,6 @@
 """Loads between two body points, evaluated together as arrays: linear springs and
 dampers (:class:`~mechdyn.mechanism.load.Spring`) and bushings
-(:class:`~mechdyn.mechanism.load.Bushing`), for :class:`mechdyn.dynamics.forces.ForceModel`
+(:class:`~mechdyn.mechanism.load.Bushing`), for :class:`mechdyn.model.forces.ForceModel`
 (one pose or a batch), with the planar rotation and cross product they use.
 
 A row of either set is ``(name, i, si, j, sj, ...)``: end 1 at ``si`` (body frame, m) on

@@ -14,8 +14,8 @@ import numpy as np
 from ..errors import ModelError
 from ..kernels import rows_numpy
 from ..kernels.planar import perp, rotate
-from ..model import ConstraintLayout, Model
-from ..model import rows as R
+from . import ConstraintLayout, Model
+from . import rows as R
 
 __all__ = ["full_jacobian", "full_gamma", "residual", "jacobian", "gamma", "coordinates",
            "coordinates_jacobian", "coordinates_gamma", "system", "travel_rows",

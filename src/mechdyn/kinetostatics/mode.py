@@ -1,8 +1,8 @@
 """The kinetostatic analysis in one mode: the motion prescribed on the driven
 coordinates, the multipliers of every row, the driving torques and frame loads
-(see :func:`mechdyn.dynamics.kinetostatics.kinetostatics`, the public entry, and
+(see :func:`mechdyn.kinetostatics.inverse.kinetostatics`, the public entry, and
 the sign conventions there).  Switched trajectories are analysed segment by segment
-with this function (:mod:`mechdyn.dynamics.kinetostatics_switched`).
+with this function (:mod:`mechdyn.kinetostatics.switched`).
 """
 
 from __future__ import annotations
@@ -12,13 +12,13 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..dynamics.reactions import batched_inverse
 from ..errors import ModelError, Status, did_you_mean
-from ..kinematics.constraints import coordinates, coordinates_gamma, coordinates_jacobian
+from ..friction.law import friction_joints
+from ..model.constraints import coordinates, coordinates_gamma, coordinates_jacobian
+from ..model.forces import force_model
 from ..results.kinetostatics_record import Kinetostatics
-from .forces import force_model
-from .friction import friction_joints
-from .prescribed_motion import _prescribed, independent_subset
-from .reactions import _inverse
+from .prescribed import _prescribed, independent_subset
 
 __all__ = ["_kinetostatics", "MESSAGES"]
 
@@ -192,7 +192,7 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
     # keep the prescribed values exactly (the poses satisfy them to round-off)
     q[:, didx], qdot[:, didx], qddot[:, didx] = qd, qd_dot, qd_ddot
 
-    core = _inverse(model, lay, didx, tt, x, xdot, xddot, q, qdot,
+    core = batched_inverse(model, lay, didx, tt, x, xdot, xddot, q, qdot,
                     skip=didx if model_drives == "replace" else (),
                     reacting=tuple(reacting_loads), point=np.asarray(point, dtype=float),
                     charted=charted)

@@ -29,14 +29,14 @@ import numpy as np
 
 from ..errors import ModelError, did_you_mean
 from ..kernels.planar import rotate_back
-from ..kinematics.constraints import extend
-from ..model import Model
-from ..model import rows as R
-from ..model.rows import Rows
-from ..model.state import Mode, friction_of, side_of, stick_key
-from ..model.variable import Measure, TimeMeasure, parse_variable
+from . import Model
+from . import rows as R
+from .constraints import extend
 from .forces import force_model
 from .inertia import drive_inertia
+from .rows import Rows
+from .state import Mode, friction_of, side_of, stick_key
+from .variable import Measure, TimeMeasure, parse_variable
 
 __all__ = ["Row", "SwitchedModel", "switched_model", "mode_locks", "mode_unilateral",
            "mode_friction",

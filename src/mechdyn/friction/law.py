@@ -33,8 +33,8 @@ import numpy as np
 from ..errors import ModelError
 from ..kernels import rows_numpy
 from ..kernels.planar import cross, perp, rotate
-from ..kinematics.constraints import extend
 from ..model import Model
+from ..model.constraints import extend
 
 __all__ = ["FrictionPair", "FrictionSet", "PreparedFriction", "friction_joints"]
 
@@ -146,7 +146,7 @@ class FrictionSet:
     0.2 W is lost.
 
     >>> import numpy as np, mechdyn as md
-    >>> from mechdyn.dynamics.friction import FrictionSet
+    >>> from mechdyn.friction.law import FrictionSet
     >>> m = md.Mechanism("pin")
     >>> _ = m.add_body("arm", mass=1.0, inertia=0.1)
     >>> _ = m.add_revolute("O", "ground", "arm", friction=0.1, pin_radius=0.01)

@@ -15,11 +15,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..dynamics.mode_system import independent_row_indices
 from ..errors import AssemblyError, ModelError, SingularPositionError
 from ..kernels import rows_numpy
 from ..kinematics.assembly import column_scale, joint_residuals
 from ..kinematics.branch_chart import ChartBook, PathProblem
-from ..kinematics.constraints import coordinates, coordinates_jacobian, point_kinematics
 from ..kinematics.continuation import Kernel, march_path, path_newton, path_node, sweep_kernel
 from ..kinematics.records import refine_root
 from ..kinematics.sweep import (
@@ -31,7 +31,7 @@ from ..kinematics.sweep import (
     sweep_motion,
 )
 from ..model import Model, as_model
-from .mode_system import _independent_rows
+from ..model.constraints import coordinates, coordinates_jacobian, point_kinematics
 
 __all__ = ["dead_centres"]
 
@@ -156,7 +156,7 @@ def independent_subset(model, lay, x0, first: list[int], candidates=None) -> lis
                      if k not in first]
     A = np.concatenate([rows_numpy.jacobian(lay.rowset, x0),
                         coordinates_jacobian(model, x0)[order]]) * column_scale(model)
-    keep = _independent_rows(A)
+    keep = independent_row_indices(A)
     dof = model.n_x - int(np.sum(keep < lay.n_rows))
     picked = [i - lay.n_rows for i in keep if i >= lay.n_rows]  # positions in order
     for i, k in enumerate(first):

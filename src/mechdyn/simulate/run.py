@@ -2,7 +2,7 @@
 
 ``simulate`` is the entry of every run: it checks the keywords (one set of defaults
 for every model) and hands the run to the one segment loop of
-:mod:`mechdyn.simulate_events`.  A fixed-structure model is a run in one mode, one
+:mod:`mechdyn.simulate.segments`.  A fixed-structure model is a run in one mode, one
 segment of that loop; a model with switches, stops, contacts or coordinate locks
 goes mode by mode.  In every mode the equations are those of
 :mod:`mechdyn.dynamics.mode_equations` (Lagrange II in the mode's independent
@@ -19,7 +19,7 @@ to the integrator's tolerance.
 
 Friction in the pairs (docs/friction.md) enters the equations of every mode with its
 dependence on the reactions (Newton on the multipliers at every evaluation,
-:mod:`mechdyn.dynamics.joint_friction`); true Coulomb pairs stick and slip as modes of
+:mod:`mechdyn.friction.forward`); true Coulomb pairs stick and slip as modes of
 the run, and the friction work is a second quadrature state (``energy["work_friction"]``).
 """
 
@@ -28,13 +28,13 @@ from __future__ import annotations
 import math
 import warnings
 
-from .dynamics.mode_equations import FORMULATIONS
-from .initial_state import initial_state
-from .integrate.base import DEFAULT_RTOL, IntegratorOptionError, IntegratorWarning
-from .integrate.driver import sample_times
-from .model import as_model
-from .results.trajectory import Trajectory
-from .simulate_events import needs_event_loop, simulate_events
+from ..dynamics.mode_equations import FORMULATIONS
+from ..initial_state import initial_state
+from ..integrate.base import DEFAULT_RTOL, IntegratorOptionError, IntegratorWarning
+from ..integrate.driver import sample_times
+from ..model import as_model
+from ..results.trajectory import Trajectory
+from .segments import needs_event_loop, simulate_events
 
 __all__ = ["simulate", "initial_state"]  # initial_state: re-exported from .initial_state
 

@@ -6,7 +6,7 @@ and the mode at a switching instant.
 their rows (rates, force directions, acceleration offsets).  :func:`resolve_mode`
 decides, at a switching instant, which touching constraints stay closed and whether
 frictional contacts stick or slip: the complementarity problem of their forces
-(:mod:`mechdyn.dynamics.complementarity`, where the LCP and the frictional impact are
+(:mod:`mechdyn.contact.complementarity`, where the LCP and the frictional impact are
 solved; their names are also importable from here).
 """
 
@@ -14,10 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernels import rows_numpy
-from ..model.rows import concat
-from ..model.state import contact_of, contact_token, friction_token, side_token, stick_key
-from .complementarity import (
+from ..contact.complementarity import (
     MAX_FRICTIONAL_ROWS,
     ContactError,
     FrictionalImpulse,
@@ -26,8 +23,11 @@ from .complementarity import (
     solve_frictional_impact,
     solve_lcp,
 )
-from .mode_system import ModeSystem, mode_system
-from .modes import Row, SwitchedModel
+from ..dynamics.mode_system import ModeSystem, mode_system
+from ..kernels import rows_numpy
+from ..model.rows import concat
+from ..model.state import contact_of, contact_token, friction_token, side_token, stick_key
+from ..model.switchable import Row, SwitchedModel
 
 __all__ = ["ContactError", "solve_lcp", "LCPResult", "resolve_mode", "constrained_inverse",
            "row_terms", "FrictionalImpulse", "solve_frictional_impact", "MAX_FRICTIONAL_ROWS",
@@ -81,7 +81,7 @@ def row_terms(ms: ModeSystem, rows: list[Row], x, xdot, B, b):
     The floor stop's row is the ball's height s, the mode's one coordinate:
 
     >>> import numpy as np
-    >>> from mechdyn.dynamics.modes import switched_model
+    >>> from mechdyn.model.switchable import switched_model
     >>> sm = switched_model(_drop())
     >>> from mechdyn.dynamics.mode_system import ModeSystem
     >>> x = np.zeros(3)
@@ -121,7 +121,7 @@ def gap_measures(sm: SwitchedModel):
     Examples
     --------
     >>> import numpy as np
-    >>> from mechdyn.dynamics.modes import switched_model
+    >>> from mechdyn.model.switchable import switched_model
     >>> sm = switched_model(_drop())
     >>> [(tok, sign, limit) for tok, _, sign, limit in gap_measures(sm)]
     [('floor@lower', 1.0, 0.0)]
@@ -154,7 +154,7 @@ def gaps(sm: SwitchedModel, x) -> dict:
     The ball 0.3 m above the floor:
 
     >>> import numpy as np
-    >>> from mechdyn.dynamics.modes import switched_model
+    >>> from mechdyn.model.switchable import switched_model
     >>> sm = switched_model(_drop())
     >>> g, is_angle = gaps(sm, np.array([0.0, 0.3, 0.0]))["floor@lower"]
     >>> float(g), is_angle
@@ -184,7 +184,7 @@ def touching(sm: SwitchedModel, x, *, gap_tol: float) -> list[str]:
     Examples
     --------
     >>> import numpy as np
-    >>> from mechdyn.dynamics.modes import switched_model
+    >>> from mechdyn.model.switchable import switched_model
     >>> sm = switched_model(_drop())
     >>> touching(sm, np.array([0.0, 1e-12, 0.0]), gap_tol=1e-9)
     ['floor@lower']

@@ -1,6 +1,6 @@
 """The samples of a run: recorded as it goes, evaluated and handed over as a Trajectory.
 
-Each sample of the segment loop (:func:`mechdyn.simulate_events.simulate_events`) is the
+Each sample of the segment loop (:func:`mechdyn.simulate.segments.simulate_events`) is the
 time, the mode system, the evaluation (poses, rates, every coordinate and multiplier),
 the integrated work and the impact losses so far (:class:`Samples`).  The forces of
 every element, the loads on the frame and the energies are evaluated from them batched
@@ -15,15 +15,15 @@ import time
 
 import numpy as np
 
+from ..dynamics.lagrange import kinetic_energy
+from ..dynamics.reactions import element_forces, element_width, frame_forces, net_on_ground
 from ..errors import ModelError, Status
+from ..friction.law import friction_joints
 from ..kernels import rows_numpy as RN
 from ..results.lazy_table import LazyDict
 from ..results.trajectory import SwitchedSamples, Trajectory
-from .contact import gaps
-from .friction import friction_joints
+from .gaps import gaps
 from .impact import frame_impulse_key
-from .lagrange import kinetic_energy
-from .reactions import element_forces, element_width, frame_forces, net_on_ground
 
 __all__ = ["Samples", "finish", "element_shapes"]
 

@@ -3,7 +3,7 @@
 ``ForceModel.loads`` returns the force vector F (..., n_x) conjugate to the body
 poses x: for each body the force (N) and the moment about the body-frame origin
 (N m).  It works on one pose (x of shape (n_x,)) or on a batch (leading
-dimensions, as in :mod:`mechdyn.kinematics.constraints`), so forward dynamics
+dimensions, as in :mod:`mechdyn.model.constraints`), so forward dynamics
 (one state per call) and kinetostatics (a whole cycle per call) evaluate the
 loads with the same code.  The generalized forces are then Q = B^T F + Q_drive
 by virtual work, exact.  Drives act on their coordinate directly (Q_drive).
@@ -20,17 +20,17 @@ import numpy as np
 from ..errors import ModelError, did_you_mean
 from ..kernels import rows_numpy
 from ..kernels.planar import cross, rotate
-from ..kinematics.constraints import (
+from ..mechanism.drive import Drive
+from ..mechanism.load import Bushing, Force, RotarySpring, Spring, Table, Torque
+from . import Model
+from .constraints import (
     coordinates_jacobian,
     extend,
     point_position,
     point_velocity,
 )
-from ..mechanism.drive import Drive
-from ..mechanism.load import Bushing, Force, RotarySpring, Spring, Table, Torque
-from ..model import Model
-from ..model.variable import lower, parse
 from .pair_loads import BushingSet, SpringSet
+from .variable import lower, parse
 
 __all__ = ["LoadContext", "ForceModel", "force_model", "evaluate", "applied_forces",
            "com_arms"]

@@ -6,7 +6,7 @@ matrix of the 1-DOF model) and ``dJ_red/dphi = 2 B^T (M_x b + h)``.
 
 Public name: :func:`reduced_kinematics`.  The private ``_ModelEvaluator`` (positions
 continued along the assembly branch, generalized forces of loads and drives) serves
-:func:`~mechdyn.dynamics.reduction.reduce_model` and ``ReducedMachine.from_model``.
+:func:`~mechdyn.reduction.reduce.reduce_model` and ``ReducedMachine.from_model``.
 """
 
 from __future__ import annotations
@@ -16,14 +16,14 @@ import math
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
+from ..friction.ignored import warn_friction_ignored
 from ..kernels.planar import perp
 from ..kinematics.analogs import acceleration_bias, velocity_analogs
-from ..kinematics.constraints import full_jacobian
 from ..kinematics.sweep import analyze, sweep
 from ..model import Model, as_model
-from .forces import com_arms, force_model
-from .friction_ignored import warn_friction_ignored
-from .inertia import frame_mass_matrix, inertia_forces
+from ..model.constraints import full_jacobian
+from ..model.forces import com_arms, force_model
+from ..model.inertia import frame_mass_matrix, inertia_forces
 
 __all__ = ["reduced_kinematics"]
 

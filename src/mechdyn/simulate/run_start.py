@@ -4,7 +4,7 @@
 projects the initial coordinates onto its constraints, takes the rates of its
 independent coordinates (with every touching stop and contact closed) and, in a
 variable-structure model, decides the mode the state is in
-(:func:`~mechdyn.dynamics.switching.apply_switch`: touching stops and contacts,
+(:func:`~mechdyn.simulate.switching.apply_switch`: touching stops and contacts,
 sticking pairs).  That is a function of the compiled model and the initial state
 alone, and costs about as much as a short run itself: where it records nothing but
 the state (no event, no warning, no friction in the pairs, nothing touching), it is
@@ -28,15 +28,15 @@ import copy
 
 import numpy as np
 
+from ..dynamics.mode_equations import ModeEquations
+from ..dynamics.mode_rows import held_key
+from ..dynamics.mode_system import ModeSystem
 from ..errors import LockupError, ModelError
+from ..friction.forward import stick_slip_joints
+from ..friction.law import friction_joints
 from ..model.state import side_of
 from ..model.workspace import KEPT, Workspace
-from .contact import gaps, touching
-from .friction import friction_joints
-from .joint_friction import stick_slip_joints
-from .mode_equations import ModeEquations
-from .mode_rows import held_key
-from .mode_system import ModeSystem
+from .gaps import gaps, touching
 from .switching import apply_switch
 
 __all__ = ["start_state", "start_equations", "give_back"]
@@ -63,7 +63,7 @@ def start_state(sm, t: float, locks: frozenset, q_init, qd_init, x_guess, ws: Wo
     events : list
         The run's events: the switching events of the start are appended.
     gap_tol, small_velocity, force_scale
-        As in :func:`mechdyn.simulate_events.simulate_events`.
+        As in :func:`mechdyn.simulate.segments.simulate_events`.
 
     Returns
     -------

@@ -6,7 +6,7 @@
 Public names
 ------------
 ReducedMachine, Member, MemberLoad
-    The reduced machine: from a model, from a :class:`~mechdyn.dynamics.reduction.Reduction`
+    The reduced machine: from a model, from a :class:`~mechdyn.reduction.reduce.Reduction`
     table, from a transmission of velocity ratios (belt drives, gear trains), or
     from plain functions.
 """
@@ -27,13 +27,13 @@ from ..errors import IntegrationError, ModelError
 from ..mechanism.drive import TorqueSpeedCurve
 from ..mechanism.load import Table
 from ..model import Model, as_model
-from .inertia import drive_inertia
-from .reduced_kinematics import _ModelEvaluator
+from ..model.inertia import drive_inertia
+from .kinematics import _ModelEvaluator
 
 
 class ReductionTable(Protocol):
     """What :meth:`ReducedMachine.from_reduction` reads of a
-    :class:`~mechdyn.dynamics.reduction.Reduction` (which imports this module)."""
+    :class:`~mechdyn.reduction.reduce.Reduction` (which imports this module)."""
 
     link: str | None
     coordinate: str
@@ -190,7 +190,7 @@ class ReducedMachine:
     drive : object, optional
         The drive on the link (an object with ``torque_at``; a
         :class:`~mechdyn.mechanism.motors.GearStage` also gives the motor-side
-        torque in :func:`~mechdyn.dynamics.reduced_run.startup`).  Informational: its
+        torque in :func:`~mechdyn.reduction.run.startup`).  Informational: its
         torque must already be part of ``torque``.
     period : float
         Angle of one cycle, rad (2 pi for a crank).
@@ -305,7 +305,7 @@ class ReducedMachine:
     def from_reduction(cls, red: ReductionTable, model: Model | None = None, *,
                        extra_inertia: float | None = None, drive=None) -> ReducedMachine:
         """A fast machine interpolating a one-cycle
-        :class:`~mechdyn.dynamics.reduction.Reduction` table.
+        :class:`~mechdyn.reduction.reduce.Reduction` table.
 
         J_red is a periodic cubic spline (its derivative the spline's), the
         applied-force torque M_forces is interpolated linearly (punch loads are

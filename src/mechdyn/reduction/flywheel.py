@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import IntegrationError, LockupError, ModelError
-from .reduced_machine import ReducedMachine, _Motion, _Record
+from .machine import ReducedMachine, _Motion, _Record
 
 __all__ = ["SteadyCycle", "steady_state", "FlywheelSizing", "size_flywheel", "FLYWHEEL_METHODS"]
 

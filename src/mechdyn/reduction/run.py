@@ -2,7 +2,7 @@
 and the start-up from rest.
 
 ``J(phi) domega/dt + 1/2 omega^2 dJ/dphi = M_red(phi, omega, t)`` of a
-:class:`~mechdyn.dynamics.reduced_machine.ReducedMachine` is integrated in time
+:class:`~mechdyn.reduction.machine.ReducedMachine` is integrated in time
 with :mod:`mechdyn.integrate`, or, when M_red depends on the position only,
 solved by its energy form ``J omega^2 / 2 = J_0 omega_0^2 / 2 + integral M_red dphi``.
 
@@ -25,7 +25,7 @@ import numpy as np
 from ..errors import ModelError, Status
 from ..integrate import solve
 from .flywheel import SteadyCycle, steady_state
-from .reduced_machine import ReducedMachine, _Motion, _Record
+from .machine import ReducedMachine, _Motion, _Record
 
 __all__ = ["ReducedRun", "run_reduced", "energy_speed", "StartupResult", "startup"]
 

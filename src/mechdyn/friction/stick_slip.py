@@ -1,7 +1,7 @@
 """The stick-slip state of every Coulomb pair at a switching instant.
 
 A pair with true Coulomb friction (``smoothing = 0``) carries a state token in the mode,
-``"B:stick"``, ``"B:slip+"`` or ``"B:slip-"`` (:mod:`mechdyn.dynamics.joint_friction`
+``"B:stick"``, ``"B:slip+"`` or ``"B:slip-"`` (:mod:`mechdyn.friction.forward`
 holds the states, the stick rows and the coupled solve of a mode); at every switching
 instant the segment loop decides the states again here (:func:`resolve_joints`).
 """
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from ..kernels import rows_numpy as RN
 from ..model.state import friction_token, stick_key
-from .joint_friction import _measure, capture_stick, stick_slip_joints
+from .forward import _measure, capture_stick, stick_slip_joints
 
 __all__ = ["state_tokens", "resolve_joints"]
 
@@ -90,10 +90,10 @@ def resolve_joints(system, sm, t, x, xdot, mode, targets: dict, *, before: dict,
     The block at rest in its horizontal guide needs no friction to stay (no force
     along the guide), so it sticks where it is; moving at 1 m/s it slips forward:
 
-    >>> from mechdyn.dynamics.joint_friction import _block
+    >>> from mechdyn.friction.forward import _block
     >>> model = _block()
     >>> import numpy as np
-    >>> from mechdyn.dynamics.modes import switched_model
+    >>> from mechdyn.model.switchable import switched_model
     >>> from mechdyn.dynamics.mode_system import ModeSystem
     >>> sm, x, targets = switched_model(model), np.zeros(3), {}
     >>> tols = {"velocity_tol": 1e-9, "force_tol": 1e-9}

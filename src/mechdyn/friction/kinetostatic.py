@@ -2,8 +2,8 @@
 solved by Newton with the exact Jacobian, batched over positions, and the detection of
 self-locking positions.
 
-With the friction of the pairs (:mod:`mechdyn.dynamics.friction`) the kinetostatic
-equations of :mod:`mechdyn.dynamics.kinetostatics` become, per position,
+With the friction of the pairs (:mod:`mechdyn.friction.law`) the kinetostatic
+equations of :mod:`mechdyn.kinetostatics.inverse` become, per position,
 
     r(z) = A z - (I - F) + F_f(-lambda) = 0,        z = [lambda; tau],
 
@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..kinematics.assembly import SINGULAR_RCOND
-from .friction import FrictionSet
+from .law import FrictionSet
 
 __all__ = ["friction_solve", "locking_note"]
 
@@ -64,7 +64,7 @@ def friction_solve(fs: FrictionSet, rows, n_rows: int, As, bs, rs, cs, x, xdot, 
     Parameters
     ----------
     fs : FrictionSet
-        The friction law of the pairs (:class:`~mechdyn.dynamics.friction.FrictionSet`).
+        The friction law of the pairs (:class:`~mechdyn.friction.law.FrictionSet`).
     rows : mapping
         {joint: indices of its rows among the multipliers}.
     n_rows : int
@@ -107,8 +107,8 @@ def friction_solve(fs: FrictionSet, rows, n_rows: int, As, bs, rs, cs, x, xdot, 
     A = I, is the solution, after no iteration and not locked:
 
     >>> import numpy as np
-    >>> from mechdyn.dynamics.friction import FrictionSet
-    >>> from mechdyn.dynamics.joint_friction import _block
+    >>> from mechdyn.friction.law import FrictionSet
+    >>> from mechdyn.friction.forward import _block
     >>> fs = FrictionSet(_block(), ())
     >>> b = np.array([[2.0, -1.0, 0.5]])
     >>> zs, Ff, locked, info = friction_solve(fs, {}, 2, np.eye(3)[None], b, np.ones(3),

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels.planar import cross, perp
-from ..model import Model
+from . import Model
 from .forces import com_arms
 
 __all__ = ["frame_mass_matrix", "inertia_forces", "mass_matrix_x", "drive_inertia"]

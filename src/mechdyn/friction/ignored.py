@@ -11,7 +11,7 @@ from __future__ import annotations
 import warnings
 
 from ..model import Model
-from .friction import friction_joints
+from .law import friction_joints
 
 __all__ = ["FrictionIgnoredWarning", "friction_text", "warn_friction_ignored"]
 

@@ -15,13 +15,13 @@ Reduction, reduce_model, mode_mechanism
     The reduced quantities of a model tabulated over a cycle, and a
     variable-structure mechanism in one mode as a 1-DOF mechanism (this module).
 reduced_kinematics
-    :mod:`mechdyn.dynamics.reduced_kinematics`.
+    :mod:`mechdyn.reduction.kinematics`.
 ReducedMachine, Member, MemberLoad
-    :mod:`mechdyn.dynamics.reduced_machine`.
+    :mod:`mechdyn.reduction.machine`.
 SteadyCycle, steady_state, FlywheelSizing, size_flywheel
-    :mod:`mechdyn.dynamics.flywheel`.
+    :mod:`mechdyn.reduction.flywheel`.
 ReducedRun, run_reduced, energy_speed, StartupResult, startup
-    :mod:`mechdyn.dynamics.reduced_run`.
+    :mod:`mechdyn.reduction.run`.
 
 All of them are importable from this module.
 """
@@ -38,8 +38,8 @@ from ..errors import ModelError, Status, did_you_mean
 from ..mechanism.joint import Lock
 from ..model import Model, as_model
 from .flywheel import FlywheelSizing, SteadyCycle, size_flywheel, steady_state
-from .reduced_kinematics import _inertia, _ModelEvaluator, reduced_kinematics
-from .reduced_machine import (
+from .kinematics import _inertia, _ModelEvaluator, reduced_kinematics
+from .machine import (
     TWO_PI,
     Member,
     MemberLoad,
@@ -47,7 +47,7 @@ from .reduced_machine import (
     _extra_inertia,
     _Record,
 )
-from .reduced_run import ReducedRun, StartupResult, energy_speed, run_reduced, startup
+from .run import ReducedRun, StartupResult, energy_speed, run_reduced, startup
 
 __all__ = ["Reduction", "reduce_model", "ReducedMachine", "Member", "MemberLoad",
            "ReducedRun", "run_reduced", "energy_speed", "SteadyCycle", "steady_state",
@@ -159,7 +159,7 @@ class Reduction(_Record):
 
     def machine(self, model: Model | None = None, **kwargs) -> ReducedMachine:
         """A fast :class:`ReducedMachine` interpolating this table (see
-        :meth:`~mechdyn.dynamics.reduced_machine.ReducedMachine.from_reduction`)."""
+        :meth:`~mechdyn.reduction.machine.ReducedMachine.from_reduction`)."""
         return ReducedMachine.from_reduction(self, model, **kwargs)
 
 
@@ -208,7 +208,7 @@ def reduce_model(model: Model, *, coordinate: str | None = None, link: str | Non
     -------
     Reduction
         ``stats["friction_ignored"]``: the joints with friction, which the reduction
-        leaves out (a :class:`~mechdyn.dynamics.friction_ignored.FrictionIgnoredWarning`
+        leaves out (a :class:`~mechdyn.friction.ignored.FrictionIgnoredWarning`
         names them).
     """
     model = as_model(model)  # a Mechanism is compiled (and validated) here

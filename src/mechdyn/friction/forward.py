@@ -1,7 +1,7 @@
 """Friction of the joints in forward dynamics: the coupled solve and the stick-slip states
-(which state each pair takes at a switching instant: :mod:`mechdyn.dynamics.stick_slip`).
+(which state each pair takes at a switching instant: :mod:`mechdyn.friction.stick_slip`).
 
-The friction of a revolute or prismatic pair (the law: :mod:`mechdyn.dynamics.friction`)
+The friction of a revolute or prismatic pair (the law: :mod:`mechdyn.friction.law`)
 depends on the pair's reaction, so on the multipliers lambda, which depend on the
 accelerations.  In a mode the equations of motion with friction
 
@@ -26,7 +26,7 @@ pair carries a state token in the mode, ``"B:stick"``, ``"B:slip+"`` or
 * slipping in direction s = +1 / -1, the law applies with sgn(v) = s for the whole
   segment (so that the right-hand side stays smooth up to the event).
 
-Events (:func:`mechdyn.dynamics.switching.event_functions`): slip -> stick when
+Events (:func:`mechdyn.simulate.switching.event_functions`): slip -> stick when
 s v falls to zero, and the pair sticks there if the friction needed to hold is at
 most mu S (else it slips the other way); stick -> slip when the needed friction
 |lambda_stick| exceeds the capacity mu S (mu r |R| for a pin), in the direction the
@@ -45,7 +45,7 @@ from ..errors import LockupError
 from ..kernels import rows_numpy as RN
 from ..model.state import Mode, friction_of, stick_key
 from ..model.variable import parse_variable
-from .friction import friction_joints
+from .law import friction_joints
 
 __all__ = ["SelfLockingError", "stick_slip_joints", "joint_states", "split_mode",
            "stick_row", "capture_stick", "JointFriction"]
@@ -99,7 +99,7 @@ def stick_slip_joints(model) -> tuple:
     ----------
     model : Model
         Compiled; its friction joints are
-        :func:`~mechdyn.dynamics.friction.friction_joints`.
+        :func:`~mechdyn.friction.law.friction_joints`.
 
     Returns
     -------
@@ -217,7 +217,7 @@ def capture_stick(model, joint: str, x, targets: dict) -> None:
 @dataclass(frozen=True)
 class StickRow:
     """The row holding a sticking pair: its travel or relative angle at ``target``; the
-    interface of :class:`mechdyn.dynamics.modes.Row` (kind ``"stick"``, element the
+    interface of :class:`mechdyn.model.switchable.Row` (kind ``"stick"``, element the
     joint), which this module cannot import (modes -> mode_system -> here)."""
 
     element: str
@@ -274,9 +274,9 @@ def stick_row(model, joint: str, targets: dict) -> StickRow:
 
 
 def friction_set(model, joints):
-    """The friction law (:class:`~mechdyn.dynamics.friction.FrictionSet`) of some joints of
+    """The friction law (:class:`~mechdyn.friction.law.FrictionSet`) of some joints of
     a model (a mode's :class:`JointFriction` keeps those of its sliding pairs)."""
-    from .friction import FrictionSet
+    from .law import FrictionSet
     return FrictionSet(model, joints)
 
 
@@ -309,7 +309,7 @@ class JointFriction:
 
     >>> model = _block()
     >>> import numpy as np
-    >>> from mechdyn.dynamics.modes import switched_model
+    >>> from mechdyn.model.switchable import switched_model
     >>> from mechdyn.dynamics.mode_system import ModeSystem
     >>> ms = ModeSystem(switched_model(model), frozenset(), {}, np.zeros(3))
     >>> jf = ms.friction
@@ -350,7 +350,7 @@ class JointFriction:
 
     def prepared(self, x, xdot):
         """The law of the sliding pairs at a pose and its rates, for any multipliers
-        (:class:`~mechdyn.dynamics.friction.PreparedFriction`), with the mode's slip
+        (:class:`~mechdyn.friction.law.PreparedFriction`), with the mode's slip
         directions."""
         return self.law.prepare(x, xdot, signs=self.signs)
 

@@ -12,12 +12,12 @@ constraints, :class:`~mechdyn.model.state.Mode`) at a time:
    the mode holds to round-off, and a singular position of the mode stops the
    run with its time and coordinates;
 2. after every accepted step the event functions of the mode
-   (:func:`mechdyn.dynamics.switching.event_functions`: switch conditions and
+   (:func:`mechdyn.simulate.switching.event_functions`: switch conditions and
    schedules, gaps of open stops and contacts, forces of closed ones, the friction
    cone of a sticking contact, the slip velocity of a slipping one) and the
    caller's events are evaluated; the first crossing is located by Brent's method
    on the step's dense output;
-3. at an event the switch is applied (:func:`mechdyn.dynamics.switching.apply_switch`:
+3. at an event the switch is applied (:func:`mechdyn.simulate.switching.apply_switch`:
    releases, engagements, the impact, the new mode by complementarity, its
    coordinates) and the next segment starts from the consistent state.
 
@@ -36,36 +36,36 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .dynamics.dead_position import diagnose, status_of, turning_point
-from .dynamics.friction import friction_joints
-from .dynamics.joint_friction import SelfLockingError
-from .dynamics.mode_equations import ModeEquations
-from .dynamics.modes import switched_model
-from .dynamics.run_samples import Samples, finish
-from .dynamics.run_start import give_back, start_equations, start_state
-from .dynamics.switching import apply_switch, event_functions
-from .errors import (
+from ..dynamics.dead_position import diagnose, status_of, turning_point
+from ..dynamics.mode_equations import ModeEquations
+from ..errors import (
     MechdynError,
     ModelError,
     Status,
     did_you_mean,
 )
-from .initial_state import initial_state
-from .integrate.base import DEFAULT_RTOL, IntegratorOptionError
-from .integrate.driver import segment_integrators
-from .integrate.events import EventRecord, as_events
-from .integrate.segment import (
+from ..friction.forward import SelfLockingError
+from ..friction.law import friction_joints
+from ..initial_state import initial_state
+from ..integrate.base import DEFAULT_RTOL, IntegratorOptionError
+from ..integrate.driver import segment_integrators
+from ..integrate.events import EventRecord, as_events
+from ..integrate.segment import (
     Stop,
     arm,
     run_segment,
     user_event_functions,
     user_event_records,
 )
-from .model import Model
-from .model.workspace import Workspace
-from .progress import Progress
-from .results.events import format_events
-from .results.trajectory import Trajectory
+from ..model import Model
+from ..model.switchable import switched_model
+from ..model.workspace import Workspace
+from ..progress import Progress
+from ..results.events import format_events
+from ..results.trajectory import Trajectory
+from .run_start import give_back, start_equations, start_state
+from .samples import Samples, finish
+from .switching import apply_switch, event_functions
 
 __all__ = ["simulate_events", "SwitchEvent", "format_events", "needs_event_loop",
            "LoopOptions", "loop_options", "output_times"]
@@ -206,7 +206,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     """The segment loop that runs every simulation: the keywords of
     :func:`mechdyn.simulate` (``method`` is its ``integrator``) and its ``**switching``
     options, without the checks of the keywords that :func:`mechdyn.simulate` makes.
-    ``sink``, ``chunk`` and ``keep``: see :class:`~mechdyn.dynamics.run_samples.Samples`;
+    ``sink``, ``chunk`` and ``keep``: see :class:`~mechdyn.simulate.samples.Samples`;
     ``workspace``: see :func:`mechdyn.simulate`.
 
     Returns

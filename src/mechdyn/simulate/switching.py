@@ -5,8 +5,8 @@ for it.
 schedules, gaps of open stops and contacts, forces of closed ones, the friction cone
 of a sticking contact, the slip velocity of a slipping one); :func:`apply_switch`
 applies the events fired at one instant: releases, engagements (the held value
-captured), the impact (:func:`mechdyn.dynamics.impact.impact`), the new mode by
-complementarity (:func:`mechdyn.dynamics.contact.resolve_mode`), its coordinates,
+captured), the impact (:func:`mechdyn.simulate.impact.impact`), the new mode by
+complementarity (:func:`mechdyn.simulate.gaps.resolve_mode`), its coordinates,
 and an :class:`~mechdyn.integrate.events.EventRecord` per thing that happened.
 """
 
@@ -17,18 +17,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..dynamics.mode_system import ModeSystem, held_key, mode_system
 from ..errors import AssemblyError
+from ..friction.forward import joint_states, stick_slip_joints
+from ..friction.stick_slip import resolve_joints, state_tokens
 from ..integrate.events import EventRecord
 from ..integrate.segment import EventFunction
 from ..kernels import rows_numpy
 from ..kernels.rows_numba import NUMBA, rows_values
 from ..model.rows import concat
 from ..model.state import contact_token
-from .contact import gap_measures, resolve_mode, touching
-from .impact import impact
-from .joint_friction import joint_states, stick_slip_joints
-from .mode_system import ModeSystem, held_key, mode_system
-from .modes import (
+from ..model.switchable import (
     Measure,
     SwitchedModel,
     TimeMeasure,
@@ -36,7 +35,8 @@ from .modes import (
     mode_locks,
     mode_unilateral,
 )
-from .stick_slip import resolve_joints, state_tokens
+from .gaps import gap_measures, resolve_mode, touching
+from .impact import impact
 
 __all__ = ["event_functions", "guard_holds", "apply_switch"]
 
@@ -145,7 +145,7 @@ def event_functions(sm: SwitchedModel, ms: ModeSystem, t, fired_once, force_scal
 
 
 def _joint_events(ms: ModeSystem, force_scale, L) -> list[EventFunction]:
-    """The events of the stick-slip pairs (:mod:`mechdyn.dynamics.joint_friction`): the
+    """The events of the stick-slip pairs (:mod:`mechdyn.friction.forward`): the
     friction needed to hold a sticking pair reaching its capacity mu S (``"cone"``), the
     sliding velocity of a slipping one falling to zero (``"slip"``)."""
     jf, out = ms.friction, []
@@ -273,7 +273,7 @@ def apply_switch(sm: SwitchedModel, t, ms: ModeSystem, x, xd, targets, events, *
 
     In order: the switches release and engage their locks (:func:`_requests`); an
     engaging lock or a touching row that closes makes an impact
-    (:func:`~mechdyn.dynamics.impact.impact`); the mode after is found by
+    (:func:`~mechdyn.simulate.impact.impact`); the mode after is found by
     complementarity (:func:`_mode_after`); its mode system is built and the state
     projected onto its constraints; the events of the instant are recorded
     (:func:`_record`)."""

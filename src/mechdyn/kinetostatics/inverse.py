@@ -10,16 +10,16 @@ Driving constraints ``g_d(x) - q_d(t) = 0`` are appended to the joint constraint
 (``I`` the inertia forces, ``F`` the applied forces).  With friction in the pairs
 ``F`` also holds their friction, which depends on the reactions: the system becomes
 nonlinear and is solved by Newton's method per position
-(:mod:`~mechdyn.dynamics.kinetostatics_friction`, ``docs/friction.md``), which also
+(:mod:`~mechdyn.friction.kinetostatic`, ``docs/friction.md``), which also
 finds the self-locking positions.  The sign conventions of
 reactions, driving torques and frame loads, and the two ways of treating ``Drive``
 elements (``model_drives``), are stated once, in ``docs/kinetostatics.md``, section
 "Reactions and driving torques".
 
 Where the parts live: :func:`kinetostatics` here; the analysis in one mode in
-:mod:`~mechdyn.dynamics.kinetostatics_mode`, of a switched trajectory in
-:mod:`~mechdyn.dynamics.kinetostatics_switched`; poses, rates and accelerations in
-:mod:`~mechdyn.dynamics.prescribed_motion`; the multiplier solve, reactions and frame
+:mod:`~mechdyn.kinetostatics.mode`, of a switched trajectory in
+:mod:`~mechdyn.kinetostatics.switched`; poses, rates and accelerations in
+:mod:`~mechdyn.kinetostatics.prescribed`; the multiplier solve, reactions and frame
 loads in :mod:`~mechdyn.dynamics.reactions`; the record
 :class:`~mechdyn.results.kinetostatics_record.Kinetostatics` in ``results``.
 """
@@ -28,14 +28,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 
+from ..dynamics.reactions import KinetostaticsWarning
 from ..model import as_model
+from ..model.forces import applied_forces
+from ..model.inertia import frame_mass_matrix, inertia_forces
 from ..results.kinetostatics_record import Kinetostatics
-from .forces import applied_forces
-from .inertia import frame_mass_matrix, inertia_forces
-from .kinetostatics_mode import _kinetostatics
-from .kinetostatics_switched import kinetostatics_switched
-from .prescribed_motion import dead_centres
-from .reactions import KinetostaticsWarning
+from .mode import _kinetostatics
+from .prescribed import dead_centres
+from .switched import kinetostatics_switched
 
 __all__ = ["Kinetostatics", "kinetostatics", "inertia_forces", "frame_mass_matrix",
            "applied_forces", "dead_centres", "KinetostaticsWarning"]

@@ -23,7 +23,7 @@ active sets, which is exact and cheap for the few contacts of a mechanism.
 The same solver handles impacts at the velocity level (impulses instead of
 forces, Newton's restitution law instead of a >= 0; with Coulomb friction
 :func:`solve_frictional_impact`).  What the mechanism's contacts are and which
-stay closed at a switching instant is :mod:`mechdyn.dynamics.contact`.
+stay closed at a switching instant is :mod:`mechdyn.simulate.gaps`.
 """
 
 from __future__ import annotations
@@ -33,18 +33,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import MechdynError
+from ..errors import ContactError
 
 __all__ = ["ContactError", "solve_lcp", "LCPResult", "constrained_inverse",
            "FrictionalImpulse", "solve_frictional_impact", "MAX_FRICTIONAL_ROWS"]
-
-
-class ContactError(MechdynError):
-    """No contact force distribution satisfies the complementarity conditions."""
-
-    def __init__(self, message, *, t=None):
-        self.t = t
-        super().__init__(message + (f" (at t = {t:.9g} s)" if t is not None else ""))
 
 
 @dataclass

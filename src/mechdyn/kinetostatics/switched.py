@@ -1,8 +1,8 @@
 """Kinetostatics of a switched (variable-structure) trajectory, segment by segment.
 
 The samples are split into segments of constant recorded mode; each segment is the
-kinetostatics of its mode (:func:`~mechdyn.dynamics.kinetostatics_mode._kinetostatics`
-on the rows of the forward dynamics, :meth:`~mechdyn.dynamics.modes.SwitchedModel.rows`,
+kinetostatics of its mode (:func:`~mechdyn.kinetostatics.mode._kinetostatics`
+on the rows of the forward dynamics, :meth:`~mechdyn.model.switchable.SwitchedModel.rows`,
 with the values the locks held in the run), driving the independent coordinates of the
 mode; the segments are concatenated into one record, NaN where a joint, drive or
 element is not part of a sample's mode.  The rules are stated in
@@ -16,15 +16,15 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from ..dynamics.mode_system import fmt_mode
 from ..errors import MechdynError, Status
+from ..friction.forward import capture_stick, split_mode, stick_row
 from ..model import ConstraintLayout, Model
+from ..model.forces import force_model
 from ..model.state import stick_key
+from ..model.switchable import SwitchedModel, mode_friction, mode_locks, switched_model
 from ..results.kinetostatics_record import Kinetostatics
-from .forces import force_model
-from .joint_friction import capture_stick, split_mode, stick_row
-from .kinetostatics_mode import MESSAGES, _kinetostatics
-from .mode_system import fmt_mode
-from .modes import SwitchedModel, mode_friction, mode_locks, switched_model
+from .mode import MESSAGES, _kinetostatics
 
 __all__ = ["kinetostatics_switched"]
 
@@ -32,7 +32,7 @@ __all__ = ["kinetostatics_switched"]
 def _mode_rows(model: Model, sm: SwitchedModel, mode: frozenset, x0, first):
     """(layout, candidates) of a mode whose first pose is ``x0``: the rows of
     the forward dynamics (:meth:`SwitchedModel.rows`, and the stick rows of the pairs
-    that stick, :func:`~mechdyn.dynamics.joint_friction.stick_row`), the locks and
+    that stick, :func:`~mechdyn.friction.forward.stick_row`), the locks and
     sticking pairs holding what they held, and the order in which coordinates are tried
     as driven (``first``, the others, and last those the mode's locks free)."""
     targets: dict = {}
@@ -55,7 +55,7 @@ def kinetostatics_switched(model: Model, trajectory, vs, *, over=None,
                            point=(0.0, 0.0), model_drives="replace",
                            reacting_loads=()) -> Kinetostatics:
     """Kinetostatics of a switched trajectory (called by
-    :func:`mechdyn.dynamics.kinetostatics.kinetostatics`; see the module docstring)."""
+    :func:`mechdyn.kinetostatics.inverse.kinetostatics`; see the module docstring)."""
     t_start = time.perf_counter()
     names = model.coordinate_names
     tt = np.asarray(trajectory.t, dtype=float).reshape(-1)

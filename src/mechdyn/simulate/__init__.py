@@ -1,0 +1,16 @@
+"""The segment loop of a run: integrate a mode, locate the event on the step's dense
+output, apply the switch or impact, go on.
+
+:mod:`~mechdyn.simulate.run` holds :func:`simulate`, the user's entry;
+:mod:`~mechdyn.simulate.segments` the loop over segments;
+:mod:`~mechdyn.simulate.run_start` the state a run starts from;
+:mod:`~mechdyn.simulate.switching` what happens at a switching instant, with
+:mod:`~mechdyn.simulate.gaps` (stops and contacts) and :mod:`~mechdyn.simulate.impact`;
+:mod:`~mechdyn.simulate.samples` the samples a run records and hands over;
+the compiled loop of one segment stays with the mode's kernel
+(:mod:`mechdyn.dynamics.compiled_loop`).
+"""
+
+from .run import simulate
+
+__all__ = ["simulate"]
