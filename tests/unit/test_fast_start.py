@@ -65,8 +65,9 @@ def test_all_and_dir_are_complete_and_unknown_names_fail():
 
 
 def test_a_submodule_imported_first_does_not_hide_the_public_name():
+    # the package mechdyn.simulate imported first: mechdyn.simulate is still the function
     assert _python("import mechdyn.simulate, mechdyn; print(mechdyn.simulate.__module__)") \
-        == "mechdyn.simulate"
+        == "mechdyn.simulate.run"
     assert mechdyn.simulate is sys.modules["mechdyn.simulate"].simulate
     assert mechdyn.examples is sys.modules["mechdyn.examples"]
 

@@ -24,13 +24,13 @@ def test_independent_rows_shortcut_agrees_with_gram_schmidt():
     rng = np.random.default_rng(3)
     for m, n in ((3, 6), (6, 6), (5, 9)):
         A = rng.normal(size=(m, n))
-        assert MS.independent_rows(A).tolist() == _greedy(A) == list(range(m))
+        assert MS.independent_row_indices(A).tolist() == _greedy(A) == list(range(m))
         B = np.vstack([A, A[0] + 2 * A[1]])  # a dependent row: the greedy path
         if B.shape[0] <= n:
-            assert MS.independent_rows(B).tolist() == _greedy(B) == list(range(m))
+            assert MS.independent_row_indices(B).tolist() == _greedy(B) == list(range(m))
         C = A.copy()
         C[1] = 3.0 * C[0]  # dependent among the first rows
-        assert MS.independent_rows(C).tolist() == _greedy(C)
+        assert MS.independent_row_indices(C).tolist() == _greedy(C)
 
 
 def test_mode_rows_kept_in_a_workspace_give_the_same_mode_system():

@@ -53,7 +53,7 @@ from .mode_rows import ModeRows, held_key
 if TYPE_CHECKING:
     from ..model.switchable import SwitchedModel
 
-__all__ = ["ModeSystem", "ModeEval", "mass_matrix_x", "fmt_mode", "solve_mass", "held_key",
+__all__ = ["ModeSystem", "ModeEval", "fmt_mode", "solve_mass", "held_key",
            "independent_row_indices",
            "mode_system"]
 

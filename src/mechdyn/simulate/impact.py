@@ -52,11 +52,12 @@ import numpy as np
 
 from ..contact.complementarity import constrained_inverse, solve_frictional_impact, solve_lcp
 from ..dynamics.mode_rows import ModeRows
-from ..dynamics.mode_system import mass_matrix_x, mode_system
+from ..dynamics.mode_system import mode_system
 from ..dynamics.reactions import element_forces, frame_forces
 from ..friction.ignored import FrictionIgnoredWarning
 from ..friction.law import friction_joints
 from ..kernels import rows_numpy
+from ..model.inertia import mass_matrix_x
 from ..model.switchable import Row, SwitchedModel
 from ..model.variable import parse_variable
 from .gaps import row_terms
