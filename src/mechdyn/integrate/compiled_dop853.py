@@ -1,20 +1,23 @@
 """DOP853 with a compiled loop: the default integrator of the package.
 
-:class:`DOP853` is the embedded Dormand-Prince 8(5,3) pair with step control and dense
-output of order 7 (coefficients: :mod:`mechdyn.integrate.dop853_tableau`).  Where the
-caller's equations run on a compiled kernel (a fixed-structure segment on the Numba
-backend, no event functions) :func:`mechdyn.integrate.segment.run_segment` hands the
-segment to the kernel's compiled loop (:mod:`mechdyn.kernels.dop853_numba`, driven by
+:class:`DOP853` is the embedded Dormand-Prince 8(5,3) pair with Hairer's step control and
+dense output of order 7 (coefficients: :mod:`mechdyn.integrate.dop853_tableau`), one
+method with one step control wherever it runs.  Where the caller's equations run on a
+compiled kernel (a fixed-structure segment on the Numba backend, no event functions)
+:func:`mechdyn.integrate.segment.run_segment` hands the segment to the kernel's compiled
+loop (:mod:`mechdyn.kernels.dop853_numba`, driven by
 :mod:`mechdyn.dynamics.compiled_loop`): every step, every stage, the position solves and
 the checks of the step run in machine code, and Python only records the output samples,
 looks at a flagged step (a coordinate rate changing sign, a nearly singular Jacobian)
 and reports a stop.  A segment with event functions (every mode of a variable-structure
-run, a caller's events) takes its steps from the same compiled loop, each
-with its dense output of order 7 and under SciPy's step control (so that its events fall
-where ``"scipy-dop853"`` finds them): only the checks of each step, the event functions
-and their location on that dense output stay in Python.  Everywhere else -- the NumPy
-path, :func:`mechdyn.integrate.solve` -- it steps with SciPy's implementation of the
-same method (``"scipy-dop853"`` asks for that everywhere).
+run, a caller's events) takes its steps from the same compiled loop, each with its dense
+output of order 7: only the checks of each step, the event functions and their location
+on that dense output stay in Python.  Everywhere else -- the NumPy path (friction in the
+joints, redundant constraints, ...), :func:`mechdyn.integrate.solve`, a segment from where
+the compiled loop stopped -- it steps from Python with the same tableau and the same step
+control (:mod:`mechdyn.integrate.dop853`).  It never calls SciPy's solvers:
+``"scipy-dop853"`` asks for SciPy's implementation of the method (its own step control)
+everywhere.
 
 Examples
 --------
@@ -28,14 +31,20 @@ False
 
 from __future__ import annotations
 
-from .base import DEFAULT_RTOL
+from collections.abc import Iterator
+
+import numpy as np
+
+from .base import DEFAULT_RTOL, IntegratorOptionError, Step
+from .dop853 import dop853_steps
 from .scipy_ivp import ScipyIntegrator
 
 __all__ = ["DOP853"]
 
 
 class DOP853(ScipyIntegrator):
-    """The Dormand-Prince 8(5,3) integrator, in the compiled loop where it can run.
+    """The Dormand-Prince 8(5,3) integrator, in the compiled loop where it can run and
+    stepped from Python (:func:`mechdyn.integrate.dop853.dop853_steps`) elsewhere.
 
     Parameters and errors: those of :class:`~mechdyn.integrate.scipy_ivp.ScipyIntegrator`
     (``rtol``, ``atol``, ``first_step``, ``max_step``), without its ``method``.
@@ -47,3 +56,45 @@ class DOP853(ScipyIntegrator):
     def __init__(self, rtol: float = DEFAULT_RTOL, atol=None, *,
                  first_step: float | None = None, max_step: float | None = None):
         super().__init__("dop853", rtol, atol, first_step=first_step, max_step=max_step)
+
+    def _steps(self, rhs, t0, q0, qdot0, w0, t_end, first_order=None) -> Iterator[Step]:
+        n = q0.size
+        if t_end == t0:
+            return
+        stats = self.stats
+        y0 = np.concatenate([q0, qdot0, w0])
+        if np.ndim(self.atol) and np.size(self.atol) != y0.size:
+            raise IntegratorOptionError(
+                f"`atol` has {np.size(self.atol)} components but the state (q, q', w) has "
+                f"{y0.size}")
+        if first_order is None:
+            def fun(t, y):
+                return np.concatenate([y[n:2 * n], *rhs(t, y[:n], y[n:2 * n])])
+
+            def count(k):  # rhs counts its own evaluations
+                return None
+        else:
+            fun = first_order
+
+            def count(k):
+                stats.evaluations += k
+
+        for t_old, t, y, f, dense, rejected in dop853_steps(
+                fun, t0, y0, t_end, rtol=self.rtol, atol=self.atol,
+                first_step=self.first_step, max_step=self.max_step, counter=count):
+            stats.steps += 1
+            stats.rejected += rejected
+            yield Step(t_old, float(t), y[:n].copy(), y[n:2 * n].copy(), f[n:2 * n].copy(),
+                       y[2 * n:].copy(), _Split(dense, n))
+
+
+class _Split:
+    """A step's dense output as ``(q, qdot, w)``."""
+
+    def __init__(self, dense, n: int):
+        self.dense, self.n = dense, n
+
+    def __call__(self, s):
+        y = self.dense(s)
+        n = self.n
+        return y[:n], y[n:2 * n], y[2 * n:]
