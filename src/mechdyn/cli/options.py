@@ -120,8 +120,8 @@ def add_run(p, *, required: bool) -> None:
                    help="end time of the run, e.g. 0.05s")
     p.add_argument("--integrator", default="dop853", metavar="NAME",
                    help=f"one of {', '.join(INTEGRATORS)} (default dop853: in the compiled "
-                        "loop on a fixed-structure run on the numba kernel without events, "
-                        "else SciPy's DOP853; scipy-dop853: SciPy's DOP853 everywhere)")
+                        "loop on the numba kernel, else the same method and step control "
+                        "stepped from Python; scipy-dop853: SciPy's DOP853 everywhere)")
     p.add_argument("--rtol", type=float,
                    help=f"relative tolerance of the adaptive integrators (default "
                         f"{DEFAULT_RTOL:g})")

@@ -17,8 +17,10 @@ only what the caller's callbacks of :func:`mechdyn.integrate.segment.run_segment
   evaluation past its window;
 * the progress bar and the wall-time limit, once per batch.
 
-It stops early -- the caller goes on with SciPy's DOP853 from the last state it checked,
-its checks after every step from there -- where the compiled loop cannot: a kernel
+It stops early -- the caller goes on with the same DOP853 stepped from Python
+(:mod:`mechdyn.integrate.dop853`: the tableau and step control of the loop, never SciPy's
+solvers) from the last state it checked, its checks after every step from there --
+where the compiled loop cannot: a kernel
 failure (the NumPy path then names the cause), a step too small, a branch chart built by
 the watch (bifurcation zones are evaluated in Python), or a check at the end of a batch
 that stops the run (the step budget: the generic loop then stops at the very step).
@@ -425,12 +427,13 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
     yielded one by one as :class:`~mechdyn.integrate.base.Step` records for
     :func:`mechdyn.integrate.segment.run_segment` to check (the caller's checks, the
     event functions and their location on that dense output, the output samples), as
-    it checks the steps of SciPy's DOP853.  Before a step is yielded the kernel's
+    it checks the steps of the Python stepper.  Before a step is yielded the kernel's
     workspace is put back as it was after the evaluation at the step's end, so that the
-    evaluations of the checks start where they would after SciPy's step; a generator
+    evaluations of the checks start where they would after a Python step; a generator
     closed at an event drops the later steps of its batch.  Where the loop cannot go on
     (a kernel failure, a step too small, a branch chart built by the watch) the steps
-    go on with SciPy's DOP853 (``integ.integrate``) from the last step yielded.  A
+    go on with the same DOP853 stepped from Python (``integ.integrate``,
+    :mod:`mechdyn.integrate.dop853`) from the last step yielded.  A
     fixed-step integrator's steps come from the fixed-step loop, each with the quintic
     Hermite interpolant of its ends (as its Python stepper's), and its Python stepper
     goes on where the loop cannot.
@@ -453,12 +456,12 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
     _, ni, _, _, m = b.dims
     y = np.array(y0, float)
 
-    def scipy_from(t_, y_):
+    def python_from(t_, y_):
         return integ.integrate(eqs.rhs, t_, y_[:ni], y_[ni:2 * ni], t_end, w0=y_[2 * ni:],
                                first_order=eqs.first_order_function())
 
     if book is not None and book.charts:
-        yield from scipy_from(t, y)
+        yield from python_from(t, y)
         return
     par, ipar = b.par, b.ipar
     atol = _start(b, integ, t, t_end)
@@ -484,10 +487,10 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
             kernel.restore(row[o_ws:])
             yield _kept_step(row, m, ni, fixed, kernel, stats)
         kernel.restore(ws_end)
-        # a kernel failure, or a branch chart built by the watch: SciPy's DOP853 goes on
-        # from the last step
+        # a kernel failure, or a branch chart built by the watch: the Python stepper
+        # of the same method goes on from the last step
         if code == L.FAILED or not _watched(eqs, b):
-            yield from scipy_from(float(par[L.P_T]), y.copy())
+            yield from python_from(float(par[L.P_T]), y.copy())
             return
         if code == L.DONE:
             return

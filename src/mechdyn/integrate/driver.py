@@ -46,7 +46,7 @@ def make_integrator(name: str | Integrator = "dop853", *, steps: int | None = No
     steps, dt
         Number of steps or step size (s) of the fixed-step integrators ``wilson``, ``rk4``.
     rtol, atol
-        Tolerances of the adaptive (SciPy) integrators; ignored by fixed-step ones.
+        Tolerances of the adaptive integrators; ignored by fixed-step ones.
     **options
         ``iterations``, ``tol``, ``theta`` for ``wilson``; ``first_step``, ``max_step``
         for the adaptive ones.

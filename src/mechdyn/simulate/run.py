@@ -67,8 +67,10 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
         Dormand-Prince 8(5,3) pair, in the compiled loop of
         :mod:`mechdyn.kernels.dop853_numba` where it can run -- a segment on the compiled
         (Numba) kernel without event functions: a fixed-structure model, no ``events``,
-        no redundant constraints, no friction in the joints -- and SciPy's DOP853
-        elsewhere: the NumPy backend, variable-structure modes, runs with ``events``);
+        no redundant constraints, no friction in the joints --, its steps checked from
+        Python in variable-structure modes and runs with ``events``, and elsewhere (the
+        NumPy backend) the same method and step control stepped from Python,
+        :mod:`mechdyn.integrate.dop853`; it never calls SciPy's solvers);
         ``"scipy-dop853"`` (SciPy's DOP853 everywhere, stepped from Python: the same
         method, for cross-checks); ``"rk45"``, ``"rk23"``, ``"radau"``, ``"bdf"``,
         ``"lsoda"`` (adaptive, SciPy); ``"rk4"`` or ``"wilson"`` (fixed step; the
