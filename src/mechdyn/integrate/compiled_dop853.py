@@ -33,11 +33,9 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 
-import numpy as np
-
-from .base import DEFAULT_RTOL, IntegratorOptionError, Step
+from .base import DEFAULT_RTOL, Step
 from .dop853 import dop853_steps
-from .scipy_ivp import ScipyIntegrator
+from .scipy_ivp import ScipyIntegrator, first_order_function, split_state
 
 __all__ = ["DOP853"]
 
@@ -62,14 +60,9 @@ class DOP853(ScipyIntegrator):
         if t_end == t0:
             return
         stats = self.stats
-        y0 = np.concatenate([q0, qdot0, w0])
-        if np.ndim(self.atol) and np.size(self.atol) != y0.size:
-            raise IntegratorOptionError(
-                f"`atol` has {np.size(self.atol)} components but the state (q, q', w) has "
-                f"{y0.size}")
+        y0 = self.start_vector(q0, qdot0, w0)
         if first_order is None:
-            def fun(t, y):
-                return np.concatenate([y[n:2 * n], *rhs(t, y[:n], y[n:2 * n])])
+            fun = first_order_function(rhs, n)
 
             def count(k):  # rhs counts its own evaluations
                 return None
@@ -95,6 +88,4 @@ class _Split:
         self.dense, self.n = dense, n
 
     def __call__(self, s):
-        y = self.dense(s)
-        n = self.n
-        return y[:n], y[n:2 * n], y[2 * n:]
+        return split_state(self.dense(s), self.n)

@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import IntegrationError
 from .base import DEFAULT_RTOL, Integrator, IntegratorOptionError, Step, check_positive
 
-__all__ = ["ScipyIntegrator", "SCIPY_METHODS"]
+__all__ = ["ScipyIntegrator", "SCIPY_METHODS", "first_order_function", "split_state"]
 
 #: our name -> scipy OdeSolver class name
 SCIPY_METHODS = {"dop853": "DOP853", "rk45": "RK45", "rk23": "RK23", "radau": "Radau",
@@ -68,6 +68,15 @@ class ScipyIntegrator(Integrator):
         self.first_step = check_positive("first_step", first_step, allow_none=True)
         self.max_step = check_positive("max_step", max_step, allow_none=True)
 
+    def start_vector(self, q0, qdot0, w0) -> np.ndarray:
+        """The first-order start (q, q', w), its size checked against ``atol``."""
+        y0 = np.concatenate([q0, qdot0, w0])
+        if np.ndim(self.atol) and np.size(self.atol) != y0.size:
+            raise IntegratorOptionError(
+                f"`atol` has {np.size(self.atol)} components but the state (q, q', w) has "
+                f"{y0.size}")
+        return y0
+
     def settings(self) -> dict:
         return {"method": self.method, "rtol": self.rtol, "atol": self.atol,
                 "first_step": self.first_step, "max_step": self.max_step}
@@ -77,17 +86,9 @@ class ScipyIntegrator(Integrator):
         if t_end == t0:
             return
         stats = self.stats
-
-        def wrapped(t, y):
-            return np.concatenate([y[n:2 * n], *rhs(t, y[:n], y[n:2 * n])])
-
-        fun = wrapped if first_order is None else first_order
-        y0 = np.concatenate([q0, qdot0, w0])
+        fun = first_order_function(rhs, n) if first_order is None else first_order
+        y0 = self.start_vector(q0, qdot0, w0)
         atol = self.atol
-        if np.ndim(atol) and np.size(atol) != y0.size:
-            raise IntegratorOptionError(
-                f"`atol` has {np.size(atol)} components but the state (q, q', w) has "
-                f"{y0.size}")
         kw = {k: v for k, v in (("first_step", self.first_step), ("max_step", self.max_step))
               if v is not None}
         import scipy.integrate as si
@@ -126,6 +127,31 @@ class _LazyDense:
     def __call__(self, s):
         if self.sol is None:
             self.sol = self.solver.dense_output()
-        y = self.sol(s)
-        n = self.n
-        return y[:n], y[n:2 * n], y[2 * n:]
+        return split_state(self.sol(s), self.n)
+
+
+def first_order_function(rhs, n: int):
+    """y' = f(t, y) of the first-order state y = (q, q', w) (n coordinates) from the
+    second-order ``rhs(t, q, qdot) -> (qddot, P_nc)``.
+
+    Examples
+    --------
+    >>> f = first_order_function(lambda t, q, qd: (-q, np.zeros(1)), 1)
+    >>> f(0.0, np.array([2.0, 3.0, 0.0])).tolist()
+    [3.0, -2.0, 0.0]
+    """
+    def fun(t, y):
+        return np.concatenate([y[n:2 * n], *rhs(t, y[:n], y[n:2 * n])])
+
+    return fun
+
+
+def split_state(y, n: int) -> tuple:
+    """``(q, q', w)`` of a first-order state y of n coordinates (views of y).
+
+    Examples
+    --------
+    >>> [a.tolist() for a in split_state(np.arange(5.0), 2)]
+    [[0.0, 1.0], [2.0, 3.0], [4.0]]
+    """
+    return y[:n], y[n:2 * n], y[2 * n:]
