@@ -162,7 +162,10 @@ def warmup() -> dict[str, float]:
         Wall time (s) of each group of kernels and ``"total"``: ``"dynamics"`` (the
         evaluations of the equations of motion of :func:`mechdyn.simulate`),
         ``"integration loop"`` (its compiled DOP853 loop, :mod:`mechdyn.kernels.dop853_numba`),
-        ``"kinematic sweep"`` (the position problem of :func:`mechdyn.sweep`) and
+        ``"fixed-step loop"`` (RK4 and Wilson's method, compiled), ``"first-order f"``
+        (the f SciPy's methods call), ``"turning check"`` (the position Jacobian of the
+        turning-point check; :data:`mechdyn.dynamics.compiled.GROUPS`; a run compiles only
+        the groups it uses), ``"kinematic sweep"`` (the position problem of :func:`mechdyn.sweep`) and
         ``"batched study"`` (the kinetostatics of many variants at once of
         :mod:`mechdyn.study`, :mod:`mechdyn.kernels.rows_variants`).  A group already
         compiled in this process counts 0 s.  Empty when Numba is not installed (the
@@ -171,8 +174,9 @@ def warmup() -> dict[str, float]:
     Examples
     --------
     >>> times = warmup()
-    >>> sorted(times) in ([], ["batched study", "dynamics", "integration loop",
-    ...                        "kinematic sweep", "total"])
+    >>> sorted(times) in ([], ["batched study", "dynamics", "first-order f", "fixed-step loop",
+    ...                        "integration loop", "kinematic sweep", "total",
+    ...                        "turning check"])
     True
     """
     import time

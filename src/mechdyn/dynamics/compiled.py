@@ -18,6 +18,7 @@ import time
 
 import numpy as np
 
+from ..integrate.base import FixedStep
 from ..kernels.block_lu import block_order
 from ..kernels.lagrange_numba import (
     D_NC,
@@ -39,9 +40,16 @@ from ..model.forces import force_model
 from ..model.rows import concat
 from ..model.variable import lower, parse
 from ..model.workspace import Workspace
-from .compiled_loop import fast_forward, kept_steps, warm_up_loop
+from .compiled_loop import (
+    fast_forward,
+    kept_steps,
+    warm_up_dop853,
+    warm_up_fixed_step,
+    warm_up_turning_check,
+)
 
-__all__ = ["compile_mode_kernel", "CompiledKernel", "numba_available"]
+__all__ = ["compile_mode_kernel", "CompiledKernel", "numba_available", "ensure_compiled",
+           "warm_up_groups", "GROUPS"]
 
 
 _NUMBA = NUMBA  # the switch the package reads (tests turn it off)
@@ -120,6 +128,7 @@ class CompiledKernel:
     def rhs(self, t, q, qdot):
         """(q_I'', array([P_nc])) or None on failure (see ``status``)."""
         n = self.n_i
+        self._ensure("first-order f")
         y = np.concatenate([q, qdot, [0.0]])
         if not self._run(first_order, t, y, *self._arrays, self.ws):
             return None
@@ -135,6 +144,12 @@ class CompiledKernel:
                          *self._arrays, self.ws, np.empty(2 * self.n_i + 1), ext):
             return None
         return (self.x.copy(), self.xdot.copy(), *(ext[a:b] for a, b in self._ext_parts))
+
+    def _ensure(self, group: str) -> None:
+        """Compile ``group`` (:data:`GROUPS`) on its first use in this process, its time
+        added to :attr:`compile_time`."""
+        if group not in _COMPILED:
+            self.compile_time += ensure_compiled(group)
 
     def snapshot(self) -> np.ndarray:
         """A copy of the workspace (last pose, analogs, flags), for :meth:`restore`."""
@@ -159,6 +174,7 @@ class CompiledKernel:
         ms = eqs.ms
         if len(ms.independent_rows) != ms.n_rows or y0.size != 2 * self.n_i + 1:
             return t, y0, callbacks["next_out"], False
+        self._ensure("fixed-step loop" if isinstance(integ, FixedStep) else "integration loop")
         return fast_forward(self, integ, eqs, t, y0, t_end, **callbacks)
 
     def kept_steps(self, integ, eqs, t, y0, t_end, stats):
@@ -167,12 +183,14 @@ class CompiledKernel:
         ms = eqs.ms
         if len(ms.independent_rows) != ms.n_rows or y0.size != 2 * self.n_i + 1:
             return None
+        self._ensure("fixed-step loop" if isinstance(integ, FixedStep) else "integration loop")
         return kept_steps(self, integ, eqs, t, y0, t_end, stats)
 
     def first_order_function(self, on_failure):
         """A function ``fun(t, y) -> y'`` for y = (q_I, q_I', w) calling the kernel directly
         (the path with the least Python per evaluation); ``on_failure(t, y)`` is called
         (and must return y' or raise) when the kernel reports a failure."""
+        self._ensure("first-order f")
         ip, fp, ri, rf, dims, ws, st = (self.ip, self.fp, self.ri, self.rf, self.dims,
                                         self.ws, self._st)
         kern = first_order
@@ -190,62 +208,92 @@ class CompiledKernel:
         return fun
 
 
-#: the first compilation (or load from the disk cache) of this process: done, and the
-#: seconds it took in all and per group ("dynamics": the kernel's evaluations,
-#: "integration loop": the compiled DOP853 loop of :mod:`mechdyn.kernels.dop853_numba`)
-_COMPILED: dict = {"done": False, "time": 0.0, "groups": {}}
+#: the groups of compiled functions, each compiled (or loaded from the disk cache) on its
+#: first use in a process: what it is called on stderr and what runs it on the warm-up
+#: pendulum (:func:`_pendulum_kernel`).  A run compiles only the groups it uses: a
+#: DOP853 run the dynamics and the DOP853 loop, not the fixed-step loop or SciPy's f.
+GROUPS = {
+    "dynamics": "numba kernels of the dynamics",
+    "integration loop": "compiled integration loop (DOP853) of the dynamics",
+    "fixed-step loop": "compiled fixed-step loop (RK4, Wilson) of the dynamics",
+    "first-order f": "compiled first-order f of the dynamics (SciPy's methods)",
+    "turning check": "compiled position Jacobian of the turning-point check",
+}
+
+#: the seconds each group took to compile (or load) in this process, once compiled
+_COMPILED: dict[str, float] = {}
 
 
-def _warm_up() -> float:
-    """Compile (or load from the disk cache) the kernels, once per process, on a small
-    pendulum (a bar pinned to the ground, its angle as coordinate, gravity): the kernels
-    are generic over their arrays, so compiling them on this model compiles them for
-    every model -- and never evaluates a user's model at a position its run does not
-    visit (a spring whose ends meet at the sketch ...).  The evaluations of the dynamics
-    and the compiled integration loop are compiled one after the other, each announced on
-    stderr when it takes longer than a few seconds (the first run of a fresh
-    installation); their times are kept in ``_COMPILED["groups"]``."""
-    if _COMPILED["done"]:
-        return 0.0
-    t0 = time.perf_counter()
-    with compiling("numba kernels of the dynamics"):
-        mech = Mechanism("warm-up pendulum", gravity=(0.0, -9.81))
-        mech.add_body("bar", mass=1.0, inertia=0.1, com=(0.5, 0.0), pose=(0.0, 0.0, 0.0))
-        mech.add_revolute("O", "ground", "bar")
-        mech.add_coordinate("theta", kind="angle", body="bar")
-        model = Model(mech)
-        ri, rf = concat(model.n_bodies, model.joint_rows, model.coordinate_rows,
-                        model.coordinate_rows).packed()
-        dims = np.array([len(model.joint_rows), 1, 1, 0], dtype=np.int64)
-        kernel = CompiledKernel(*LoadPacker(model, force_model(model)).pack(), ri, rf, dims,
-                                model.n_x, 0.0)
-        kernel.reset(model.x_sketch)
-        kernel.rhs(0.0, [0.3], [1.0])
+def _pendulum_kernel() -> CompiledKernel:
+    """The kernel of a small pendulum (a bar pinned to the ground, its angle as
+    coordinate, gravity) the groups are compiled on: the kernels are generic over their
+    arrays, so compiling them on this model compiles them for every model -- and never
+    evaluates a user's model at a position its run does not visit (a spring whose ends
+    meet at the sketch ...)."""
+    mech = Mechanism("warm-up pendulum", gravity=(0.0, -9.81))
+    mech.add_body("bar", mass=1.0, inertia=0.1, com=(0.5, 0.0), pose=(0.0, 0.0, 0.0))
+    mech.add_revolute("O", "ground", "bar")
+    mech.add_coordinate("theta", kind="angle", body="bar")
+    model = Model(mech)
+    ri, rf = concat(model.n_bodies, model.joint_rows, model.coordinate_rows,
+                    model.coordinate_rows).packed()
+    dims = np.array([len(model.joint_rows), 1, 1, 0], dtype=np.int64)
+    kernel = CompiledKernel(*LoadPacker(model, force_model(model)).pack(), ri, rf, dims,
+                            model.n_x, 0.0)
+    kernel.reset(model.x_sketch)
+    return kernel
+
+
+def _compile_group(group: str, kernel: CompiledKernel) -> None:
+    """Run the functions of ``group`` once on the pendulum ``kernel``."""
+    if group == "dynamics":
         kernel.evaluation(0.0, [0.3], [1.0])
-    t1 = time.perf_counter()
-    with compiling("compiled integration loop (DOP853) of the dynamics"):
-        warm_up_loop(kernel)
-    t2 = time.perf_counter()
-    _COMPILED.update(done=True, time=t2 - t0,
-                     groups={"dynamics": t1 - t0, "integration loop": t2 - t1})
-    return _COMPILED["time"]
+    elif group == "first-order f":  # (not through kernel.rhs, which would ask for it)
+        first_order(0.0, np.array([0.3, 1.0, 0.0]), *kernel._arrays, kernel.ws, kernel._st)
+    elif group == "integration loop":
+        warm_up_dop853(kernel)
+    elif group == "fixed-step loop":
+        warm_up_fixed_step(kernel)
+    else:
+        warm_up_turning_check(kernel)
 
 
-def warm_up_groups() -> dict[str, float]:
-    """Compile (or load) the kernels of the dynamics now (:func:`_warm_up`); returns the
-    wall time of each group, s: ``"dynamics"`` and ``"integration loop"`` (0 for groups
-    compiled earlier in this process).
+def ensure_compiled(*groups: str) -> float:
+    """Compile (or load from the disk cache) the ``groups`` (keys of :data:`GROUPS`) not
+    compiled yet in this process, each announced on stderr when it takes longer than a
+    few seconds (the first run of a fresh installation); returns the seconds it took.
 
     Examples
     --------
-    >>> sorted(warm_up_groups()) if numba_available() else ["dynamics", "integration loop"]
-    ['dynamics', 'integration loop']
+    >>> ensure_compiled("dynamics") >= 0.0
+    True
     """
-    fresh = not _COMPILED["done"]
-    _warm_up()
-    if fresh:
-        return dict(_COMPILED["groups"])
-    return {"dynamics": 0.0, "integration loop": 0.0}
+    todo = [g for g in groups if g not in _COMPILED]
+    if not todo or not _NUMBA:
+        return 0.0
+    t0 = time.perf_counter()
+    kernel = _pendulum_kernel()
+    for group in todo:
+        t1 = time.perf_counter()
+        with compiling(GROUPS[group]):
+            _compile_group(group, kernel)
+        _COMPILED[group] = time.perf_counter() - t1
+    return time.perf_counter() - t0
+
+
+def warm_up_groups() -> dict[str, float]:
+    """Compile (or load) every group of compiled functions of the dynamics now
+    (:data:`GROUPS`); returns the wall time of each, s (0 for groups compiled earlier in
+    this process).
+
+    Examples
+    --------
+    >>> sorted(warm_up_groups()) == sorted(GROUPS) if numba_available() else True
+    True
+    """
+    fresh = [g for g in GROUPS if g not in _COMPILED]
+    ensure_compiled(*GROUPS)
+    return {g: (_COMPILED.get(g, 0.0) if g in fresh else 0.0) for g in GROUPS}
 
 
 def compile_mode_kernel(model, force_model, constraint_rows, independent, *, kept=None):
@@ -305,7 +353,7 @@ def compile_mode_kernel(model, force_model, constraint_rows, independent, *, kep
             Workspace.keep(kept, key, packed)
     if isinstance(packed, str):
         return None, packed
-    return CompiledKernel(*packed, model.n_x, _warm_up()), ""
+    return CompiledKernel(*packed, model.n_x, ensure_compiled("dynamics")), ""
 
 
 def _variable(model, name: str):

@@ -45,7 +45,8 @@ from ..kernels.loads_numba import H_NTAB
 from ..kernels.rows_numba import rows_jacobian
 from .mode_system import ModeEval
 
-__all__ = ["fast_forward", "kept_steps", "warm_up_loop", "KEEP_STEPS", "PIVOT_FLAG",
+__all__ = ["fast_forward", "kept_steps", "warm_up_dop853", "warm_up_fixed_step",
+           "warm_up_turning_check", "KEEP_STEPS", "PIVOT_FLAG",
            "STALL_FLAG", "BATCH_SAMPLES", "BATCH_STEPS", "BETA"]
 
 #: pivot ratio of the kernel's LU below which a step is looked at (the value of
@@ -535,30 +536,44 @@ def _kept_step(row, m: int, ni: int, fixed: bool = False, kernel=None,
     return Step(t0, t1, y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni], y1[2 * ni:], dense)
 
 
-def warm_up_loop(kernel) -> None:
-    """Compile (or load) the loops on a kernel (DOP853, the fixed-step one): one short run
-    of each without output; and the compiled rows' Jacobian as the turning-point check
-    calls it (:func:`mechdyn.dynamics.dead_position.turning_point`)."""
-    _, _, ri, rf, _ = kernel._arrays
-    rows_jacobian(np.zeros(kernel.n_x), kernel.n_x // 3, ri, rf,
-                  np.zeros((len(ri), kernel.n_x)), 0)
+def _warm_up_buffers(kernel):
+    """The loop buffers of ``kernel`` and a start state (q_I = 0.3, q_I' = 1) for a warm-up
+    run of a compiled loop."""
     b = buffers(kernel)
     _, ni, _, _, m = b.dims
     y = np.zeros(m)
     y[:ni], y[ni:2 * ni] = 0.3, 1.0
     b.par[:], b.ipar[:] = 0.0, 0
-    b.par[L.P_TEND], b.par[L.P_RTOL], b.par[L.P_HMAX] = 1e-3, 1e-6, np.inf
     b.par[L.P_LAST] = -np.inf
     b.ipar[L.I_MAXSTEPS] = 10
+    return b, y
+
+
+def warm_up_dop853(kernel) -> None:
+    """Compile (or load) the DOP853 loop on a kernel: one short run without output."""
+    b, y = _warm_up_buffers(kernel)
+    m = y.size
+    b.par[L.P_TEND], b.par[L.P_RTOL], b.par[L.P_HMAX] = 1e-3, 1e-6, np.inf
     L.run(y, b.f, np.full(m, 1e-9), b.par, b.ipar, b.K, b.ynew, b.ys, b.hist, b.dns,
           np.zeros(0), b.o_t, b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end,
           *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept, b.kv)
-    for method in (F.RK4, F.WILSON):  # the fixed-step loop (one compilation for both)
-        y[:] = 0.0
-        y[:ni], y[ni:2 * ni] = 0.3, 1.0
-        b.par[:], b.ipar[:] = 0.0, 0
-        b.par[L.P_LAST], b.par[F.P_TOL], b.par[F.P_THETA] = -np.inf, 1e-12, 1.0
-        b.ipar[L.I_MAXSTEPS], b.ipar[F.I_METHOD], b.ipar[F.I_ITER] = 10, method, 2
+
+
+def warm_up_fixed_step(kernel) -> None:
+    """Compile (or load) the fixed-step loop on a kernel: a short run of RK4 and one of
+    Wilson's method (one compilation for both)."""
+    for method in (F.RK4, F.WILSON):
+        b, y = _warm_up_buffers(kernel)
+        b.par[F.P_TOL], b.par[F.P_THETA] = 1e-12, 1.0
+        b.ipar[F.I_METHOD], b.ipar[F.I_ITER] = method, 2
         F.run(y, b.f, np.linspace(0.0, 1e-3, 3), b.par, b.ipar, b.K, b.ynew, b.ys, b.hist,
               np.zeros(0), b.o_t, b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end,
               *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept)
+
+
+def warm_up_turning_check(kernel) -> None:
+    """Compile (or load) the rows' Jacobian as the turning-point check calls it
+    (:func:`mechdyn.dynamics.dead_position.turning_point`)."""
+    _, _, ri, rf, _ = kernel._arrays
+    rows_jacobian(np.zeros(kernel.n_x), kernel.n_x // 3, ri, rf,
+                  np.zeros((len(ri), kernel.n_x)), 0)

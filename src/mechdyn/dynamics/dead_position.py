@@ -26,6 +26,7 @@ from ..kernels import rows_numpy as RN
 from ..kernels.rows_numba import NUMBA, rows_jacobian
 from ..kinematics.assembly import DEAD_RCOND
 from ..mechanism.coordinate import BODY_KINDS
+from .compiled import ensure_compiled
 from .mode_rows import held_key
 
 __all__ = ["turning_point", "rigid_coordinates", "diagnose", "status_of", "TURN_RCOND"]
@@ -214,6 +215,7 @@ def _dead_at(ms, x, k: int, rep=None) -> bool:
         if packed is not None:
             nb, ints, flts = packed
             J = np.zeros((len(ints), len(x)))
+            ensure_compiled("turning check")
             rows_jacobian(np.asarray(x, float), nb, ints, flts, J, 0)
         rep = ms.singularity(x, jacobian=J)
     return bool(rep["rcond"] < TURN_RCOND and ms.coord_names[k] in rep["coordinates"])

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..integrate.dop853_tableau import N_STAGES, A, C, D
 from .lagrange_numba import D_NI, evaluate_into
-from .rows_numba import njit
+from .rows_numba import copy_into, copy_rows, njit
 
 __all__ = ["stage", "dense_at", "dense_coefficients", "keep_step", "dense_output",
            "kept_offsets", "kept_parts"]
@@ -81,14 +81,14 @@ def keep_step(row, t, h, t_new, y, ynew, fnew, dns, K, made):
     m = y.size
     o_y, o_yn, o_f, o_d, o_k, o_made, _ = kept_offsets(m)
     row[0], row[1], row[2] = t, h, t_new
-    row[o_y:o_y + m] = y
-    row[o_yn:o_yn + m] = ynew
-    row[o_f:o_f + m] = fnew
+    copy_into(row[o_y:o_y + m], y)
+    copy_into(row[o_yn:o_yn + m], ynew)
+    copy_into(row[o_f:o_f + m], fnew)
     for r in range(7):
-        row[o_d + r * m:o_d + (r + 1) * m] = dns[r]
+        copy_into(row[o_d + r * m:o_d + (r + 1) * m], dns[r])
     if not made:
         for r in range(N_STAGES + 1):
-            row[o_k + r * m:o_k + (r + 1) * m] = K[r]
+            copy_into(row[o_k + r * m:o_k + (r + 1) * m], K[r])
     row[o_made] = 1.0 if made else 0.0
 
 
@@ -110,7 +110,7 @@ def dense_output(y, ynew, stages, t, h, ip, fp, ri, rf, dims, ws, sc, piv, dns):
     m = y.size
     ni = dims[D_NI]
     K = np.empty((N_STAGES + 4, m))
-    K[:N_STAGES + 1] = stages
+    copy_rows(K[:N_STAGES + 1], stages)
     ys = np.empty(m)
     ext = np.empty(0)
     for s in range(N_STAGES + 1, N_STAGES + 4):

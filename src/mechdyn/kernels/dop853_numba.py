@@ -94,7 +94,7 @@ from .held_tables import KEEP, NEXT_PIECE, again, crossed, hold, shortened, swit
 from .hermite_numba import hermite_at
 from .lagrange_numba import D_NI, N_FLAGS, W_PIVOT, evaluate_into, held_pieces
 from .loads_numba import H_NB, H_NTAB
-from .rows_numba import njit, njit_inline
+from .rows_numba import copy_into, njit, njit_inline
 from .table_regions import ETA
 
 __all__ = ["run", "evaluate_states", "DONE", "BATCH", "FLAGGED", "FAILED", "WATCH",
@@ -125,18 +125,18 @@ def _switch(switch, ahead, t_new, ynew, fnew, s_old, s_new, ni, ip, fp, ri, rf, 
                         piv, ipar):
             return False
         table_vars(t_new, ip, fp, dims, sc, s_new)
-    s_old[:] = s_new
+    copy_into(s_old, s_new)
     return True
 
 
 @njit
 def _record(k, ts, y, ws, ext, nx, ni, o_t, o_y, o_x, o_xd, o_ext):
     o_t[k] = ts
-    o_y[k, :] = y
-    o_x[k, :] = ws[:nx]
+    copy_into(o_y[k, :], y)
+    copy_into(o_x[k, :], ws[:nx])
     o = nx + ni + nx * ni
-    o_xd[k, :] = ws[o:o + nx]
-    o_ext[k, :] = ext
+    copy_into(o_xd[k, :], ws[o:o + nx])
+    copy_into(o_ext[k, :], ext)
 
 
 @njit
@@ -159,13 +159,13 @@ def step_end(t, h, t_new, y, f, ynew, fnew, ws, x_end, hist, par, ni, turns):
     for i in range(nx):
         x_end[i] = ws[i]
         x_end[nx + i] = ws[o + i]
-    hist[0, :] = hist[1, :]
+    copy_into(hist[0, :], hist[1, :])
     hist[1, 0] = t
-    hist[1, 1:m + 1] = y
-    hist[1, m + 1:] = f
+    copy_into(hist[1, 1:m + 1], y)
+    copy_into(hist[1, m + 1:], f)
     hist[2, 0] = t_new
-    hist[2, 1:m + 1] = ynew
-    hist[2, m + 1:] = fnew
+    copy_into(hist[2, 1:m + 1], ynew)
+    copy_into(hist[2, m + 1:], fnew)
     par[P_TOLD], par[P_HOLD] = t, h
     return flags
 
@@ -213,10 +213,10 @@ def samples(hermite, t, h, t_new, y, f, ynew, fnew, dns, ys, fs, end_sample, t_e
     if end_sample and t_new > par[P_LAST]:
         k = ipar[I_NOUT]
         o_t[k] = t_new
-        o_y[k, :] = ynew
-        o_x[k, :] = x_end[:nx]
-        o_xd[k, :] = x_end[nx:2 * nx]
-        o_ext[k, :] = ext_end
+        copy_into(o_y[k, :], ynew)
+        copy_into(o_x[k, :], x_end[:nx])
+        copy_into(o_xd[k, :], x_end[nx:2 * nx])
+        copy_into(o_ext[k, :], ext_end)
         ipar[I_NOUT] += 1
         par[P_LAST] = t_new
     return True
@@ -233,12 +233,12 @@ def run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_
     nt = ip[H_NTAB]
     if nt > 0:
         locks = held_pieces(ws, 3 * ip[H_NB], dims[D_NI])
-        kv[2 * nt:4 * nt] = locks
+        copy_into(kv[2 * nt:4 * nt], locks)
         locks[:] = 0.0
     return code
 
 
-@njit
+@njit_inline
 def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o_xd, o_ext,
          ext, ext_end, x_end, ip, fp, ri, rf, dims, ws, sc, piv, kept, kv):
     """Integrate from ``par[P_T]`` (state ``y``, rates ``f`` when ``ipar[I_FSAL]``) towards
@@ -294,7 +294,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
         if code >= 0:
             return _stop(par, t, h, code)
         if not rejected and retried == 0:
-            ws0[:] = ws
+            copy_into(ws0, ws)
             wp0 = ipar[I_WPEND]  # a watch armed by an attempt that is not kept is dropped
         ok, first = _stages(t, h, y, f, K, ys, ynew, ip, fp, ri, rf, dims, ws, ext, off, sc,
                             piv, par, ipar, x_end, s_old, s_st, locks)

@@ -22,7 +22,7 @@ from .dop853_dense import dense_coefficients, keep_step, kept_offsets, stage
 from .held_tables import aim, hold, left, table_vars
 from .lagrange_numba import D_NI, N_FLAGS, W_COUNT, evaluate_into, held_pieces
 from .loads_numba import H_NB, H_NTAB
-from .rows_numba import njit, njit_inline
+from .rows_numba import copy_into, njit, njit_inline
 from .table_regions import ETA
 
 __all__ = ["DONE", "BATCH", "FLAGGED", "FAILED", "WATCH", "F_TURN", "F_PIVOT", "F_STALL",
@@ -54,7 +54,7 @@ I_EVALS, I_STEPS, I_REJ, I_NOUT, I_NEXT, I_FLAGS, I_FSAL, I_EVERY, I_WATCH, I_MA
 N_IPAR = 16
 
 
-@njit
+@njit_inline
 def _counted(ts, ys, fout, ni, ip, fp, ri, rf, dims, ws, ext, full, sc, piv, ipar):
     """One evaluation y' = (q_I', q_I'', P_nc) at (ts, ys), counted; False where the kernel
     failed (its status in ipar).  ``full`` must be a runtime boolean: a literal True or
@@ -79,7 +79,7 @@ def _again(ws, ws0, ipar, wp0):
 def _put_back(ws, ws0):
     """The workspace saved at the start of a step put back (the evaluation count goes on)."""
     cnt = ws[ws.size - N_FLAGS + W_COUNT]
-    ws[:] = ws0
+    copy_into(ws, ws0)
     ws[ws.size - N_FLAGS + W_COUNT] = cnt
 
 
@@ -102,7 +102,7 @@ def _pieces_at_start(t, y, f, ip, fp, ri, rf, dims, ws, ext, off, sc, piv, ipar,
     kernel failed."""
     nt = ip[H_NTAB]
     if ipar[I_FSAL] != 0:
-        locks[:] = kv[2 * nt:4 * nt]
+        copy_into(locks, kv[2 * nt:4 * nt])
         return True
     s_old, s_new = kv[:nt], kv[nt:2 * nt]
     locks[:] = 0.0
@@ -214,7 +214,7 @@ def _next_piece(t, y, f, jt, ip, fp, ri, rf, dims, ws, ws0, ext, off, sc, piv, i
     hold(ip, fp, s_old, s_new, locks, True, jt)
     if not _counted(t, y, f, dims[D_NI], ip, fp, ri, rf, dims, ws, ext, off, sc, piv, ipar):
         return False
-    ws0[:] = ws
+    copy_into(ws0, ws)
     return True
 
 
@@ -251,7 +251,7 @@ def _dense_kept(flags, t, h, t_new, y, f, ynew, fnew, K, ys, dns, t_eval, ip, fp
     interior = ipar[I_NEXT] < t_eval.size and t_eval[ipar[I_NEXT]] < t_new
     if keep:
         row_ws = kept[ipar[I_NKEPT], kept_offsets(m)[-1]:]
-        row_ws[:] = ws
+        copy_into(row_ws, ws)
         held_pieces(row_ws, nx, ni)[:] = 0.0  # (a kept workspace holds no pieces)
     made = flags != 0 or interior  # a kept step's is made when it is wanted
     if made:

@@ -56,7 +56,7 @@ from .dop853_numba import (
 )
 from .dop853_steps import _counted, _put_back, _watch
 from .lagrange_numba import D_NI
-from .rows_numba import njit
+from .rows_numba import copy_into, njit
 
 __all__ = ["run", "RK4", "WILSON", "I_GRID", "I_METHOD", "I_ITER", "P_TOL",
            "P_THETA", "N_PAR_FIXED", "N_IPAR_FIXED"]
@@ -187,7 +187,7 @@ def run(y, f, grid, par, ipar, K, ynew, ys, hist, t_eval, o_t, o_y, o_x, o_xd, o
                 return BATCH
             ipar[I_STATUS] = -2
             return FAILED
-        ws0[:] = ws
+        copy_into(ws0, ws)
         if wilson:
             ok = _wilson(t, h, y, f, K, ynew, ys, ni, ip, fp, ri, rf, dims, ws, ext, off, sc,
                          piv, par, ipar, nx, x_end)
@@ -209,8 +209,8 @@ def run(y, f, grid, par, ipar, K, ynew, ys, hist, t_eval, o_t, o_y, o_x, o_xd, o
                          ipar[I_KEEP] == 0)
         if ipar[I_KEEP] != 0:
             row = kept[ipar[I_NKEPT]]
-            row[row.size - ws.size:] = ws
-            K[6, :] = f
+            copy_into(row[row.size - ws.size:], ws)
+            copy_into(K[6, :], f)
             keep_step(row, t, h, t_new, y, ynew, fnew, K[6:13], K, True)
             ipar[I_NKEPT] += 1
         if flags != 0:

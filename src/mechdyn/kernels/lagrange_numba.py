@@ -42,7 +42,9 @@ from .loads_numba import (
 )
 from .rows_numba import (
     body_rotations,
+    copy_into,
     njit,
+    njit_inline,
     rows_jacobian_cs,
     rows_quad_cs,
     rows_values_cs,
@@ -224,7 +226,7 @@ def table_inputs(sc, nx, ni, nq, nv):
     return q, qdot, sc[o:o + nv]
 
 
-@njit
+@njit_inline
 def evaluate(t, qi, qdi, ip, fp, ri, rf, dims, ws, out, ext, full):
     """q_I'' and P_nc at (t, q_I, q_I'); out = [q_I' | q_I'' | P_nc].  Status: 0 ok,
     1 position solve failed, 2 mass matrix not positive definite, 3 non-finite.
@@ -417,8 +419,8 @@ def _reactions(x, v, bb, qdd, q, qdot, Bl, G, GB, Gb, Fa, Qd, J, fac, piv, dims,
             s += Bl[r * ni + c] * qdd[c]
         xdd[r] = s
     o = nx
-    ext[o:o + nq] = q
-    ext[o + nq:o + 2 * nq] = qdot
+    copy_into(ext[o:o + nq], q)
+    copy_into(ext[o + nq:o + 2 * nq], qdot)
     rows_a = ext[o + 2 * nq:o + 3 * nq]
     for k in range(nq):
         s = Gb[k]

@@ -17,7 +17,7 @@ from . import cache_dir
 
 __all__ = ["rows_values", "rows_jacobian", "rows_quad", "rows_values_cs",
            "rows_jacobian_cs", "rows_quad_cs", "body_rotations", "body_pose", "njit", "NUMBA",
-           "compiling", "ANNOUNCE_AFTER"]
+           "compiling", "ANNOUNCE_AFTER", "copy_into", "copy_rows"]
 
 #: seconds after which a compilation is announced on stderr
 ANNOUNCE_AFTER = 2.0
@@ -64,6 +64,39 @@ def njit_inline(fn):
     if NUMBA:
         return numba.njit(cache=True, fastmath=False, nogil=True, inline="always")(fn)
     return fn
+
+
+@njit_inline
+def copy_into(dst, src):
+    """``dst[:] = src`` for 1-D arrays of one size, as a loop: Numba's slice assignment
+    checks the shapes and builds its error message from them, and that string code
+    costs seconds of every first compile of a function using it.
+
+    Examples
+    --------
+    >>> a = np.zeros(3)
+    >>> copy_into(a, np.array([1.0, 2.0, 3.0]))
+    >>> a.tolist()
+    [1.0, 2.0, 3.0]
+    """
+    for i in range(dst.size):
+        dst[i] = src[i]
+
+
+@njit_inline
+def copy_rows(dst, src):
+    """``dst[:, :] = src`` for 2-D arrays of one shape (see :func:`copy_into`).
+
+    Examples
+    --------
+    >>> a = np.zeros((2, 2))
+    >>> copy_rows(a, np.eye(2))
+    >>> a.tolist()
+    [[1.0, 0.0], [0.0, 1.0]]
+    """
+    for i in range(dst.shape[0]):
+        for j in range(dst.shape[1]):
+            dst[i, j] = src[i, j]
 
 
 @njit

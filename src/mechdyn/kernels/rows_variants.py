@@ -22,6 +22,8 @@ import numpy as np
 from .linalg import lu_factor, lu_solve, lu_solve_transposed
 from .rows_numba import (
     body_rotations,
+    copy_into,
+    copy_rows,
     njit,
     njit_inline,
     rows_jacobian_cs,
@@ -69,7 +71,7 @@ def _at_solution(x, qdot, qddot, nb, ints, flts, n_rows, cs, J, fresh, lu, piv, 
     if not fresh:
         J[:, :] = 0.0
         rows_jacobian_cs(x, nb, ints, flts, cs, J, 0)
-    lu[:, :] = J
+    copy_rows(lu, J)
     rc = lu_factor(lu, piv, n)
     if rc == 0.0:
         return rc
@@ -87,7 +89,7 @@ def _at_solution(x, qdot, qddot, nb, ints, flts, n_rows, cs, J, fresh, lu, piv, 
     for c in range(qdot.shape[0]):
         b[n_rows + c] += qddot[c]
     lu_solve(lu, piv, b, n)
-    xdd[:] = b
+    copy_into(xdd, b)
     return rc
 
 
@@ -186,9 +188,9 @@ def path_variants(X0, Q, dQ, ddQ, keep, nb, ints, flts, n_rows, tol, max_iter, s
                 fail[v] = m
                 break
             if k >= 0:
-                X[v, k, :] = x
-                Xd[v, k, :] = xd
-                Xdd[v, k, :] = xdd
+                copy_into(X[v, k, :], x)
+                copy_into(Xd[v, k, :], xd)
+                copy_into(Xdd[v, k, :], xdd)
                 J[v, k] = Jw
                 LU[v, k] = lu
                 piv[v, k] = pv
@@ -226,7 +228,7 @@ def _short_step_error(x, b, nb, ints, flts, cs, Jw, J1):
         for j in range(n):
             r += (J1[i, j] - Jw[i, j]) * b[j]
         err = max(err, abs(0.5 * r))
-    Jw[:, :] = J1
+    copy_rows(Jw, J1)
     return err
 
 
@@ -263,10 +265,10 @@ def _newton(x, q, nb, ints, flts, n_rows, tol, max_iter, short, cs, F, Jw, J1, l
         if not fresh:
             Jw[:, :] = 0.0
             rows_jacobian_cs(x, nb, ints, flts, cs, Jw, 0)
-        lu[:, :] = Jw
+        copy_rows(lu, Jw)
         if lu_factor(lu, pv, n) == 0.0:
             return False, fresh
-        b[:] = F
+        copy_into(b, F)
         lu_solve(lu, pv, b, n)
         step = 0.0
         for i in range(n):
@@ -300,7 +302,7 @@ def inverse_variants(LU, piv, rhs, n_rows, Z):
     b = np.empty(n)
     for v in range(V):
         for k in range(N):
-            b[:] = rhs[v, k]
+            copy_into(b, rhs[v, k])
             lu_solve_transposed(LU[v, k], piv[v, k], b, n)
             for c in range(n):
                 Z[v, k, c] = -b[c] if c < n_rows else b[c]
