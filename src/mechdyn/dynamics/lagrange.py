@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from ..kernels.inertia import reduced_force, reduced_mass
 from ..kinematics.assembly import assemble
 from ..model import Model
 from ..model.forces import com_arms, force_model
@@ -87,8 +88,7 @@ class Terms:
 def mass_matrix(model: Model, x, B) -> np.ndarray:
     """Generalized mass matrix A = B^T M_x B (M_x the frame mass matrix of
     :mod:`mechdyn.model.inertia`), shape (..., n_q, n_q)."""
-    B = np.asarray(B, float)
-    return np.swapaxes(B, -1, -2) @ frame_mass_matrix(model, x) @ B
+    return reduced_mass(frame_mass_matrix(model, x), B)
 
 
 def kinetic_energy(model: Model, x, xdot) -> np.ndarray:
@@ -230,7 +230,8 @@ class EquationsOfMotion(ModeEquations):
         B, M = tm["B"], tm["M"]
         Qd = self.sm.fm.applied(t, ev.x, ev.xdot, q, qdot)[1]
         return Terms(t, q, qdot, ev.qddot, ev.x, ev.xdot, B, tm["A"],
-                     B.T @ (M @ tm["b"] + tm["h"]), B.T @ tm["F"], Qd, self._power(ev))
+                     reduced_force(B, M @ tm["b"] + tm["h"]), reduced_force(B, tm["F"]), Qd,
+                     self._power(ev))
 
     def energy(self, t: float, q, qdot) -> dict:
         """Kinetic and potential energy (J) and the non-conservative power (W) at one state."""

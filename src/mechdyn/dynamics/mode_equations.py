@@ -43,6 +43,7 @@ import numpy as np
 
 from ..errors import AssemblyError, ModelError, SingularPositionError
 from ..friction.law import friction_joints
+from ..kernels.inertia import analog_mass, reduced_force
 from ..kinematics.analogs import default_displacement
 from ..kinematics.assembly import SINGULAR_RCOND, solve_position
 from ..kinematics.branch_chart import BranchChart, ChartBook, PathProblem
@@ -417,24 +418,23 @@ class ModeEquations:
         q2 = q1[:, None, :] + pm[None, :, :]  # (2n, 2n, n)
         x2 = solve_position(model, q2, x1[:, None, :], layout=lay, t=t, check_singular=False)
 
-        def analog_mass(xs):
+        def partial_mass(xs):
             """A from the poses of the partial systems xs (..., 2n, n_x)."""
             rc = extend(model, xs)[..., :-1, :2] + com_arms(model, xs)  # (..., 2n, nb, 2)
             th = xs[..., 2::3]
             vc = (rc[..., :n, :, :] - rc[..., n:, :, :]) / (2 * d[:, None, None])
             w = (th[..., :n, :] - th[..., n:, :]) / (2 * d[:, None])  # (..., n, nb)
-            return (np.einsum("...ibk,...jbk,b->...ij", vc, vc, model.mass)
-                    + np.einsum("...ib,...jb,b->...ij", w, w, model.inertia))
+            return analog_mass(vc, w, model.mass, model.inertia)
 
-        A = analog_mass(x1) + np.diag(self.sm.drive_inertia)
-        A1 = analog_mass(x2)  # (2n, n, n): A at q + d e_k and q - d e_k
+        A = partial_mass(x1) + np.diag(self.sm.drive_inertia)
+        A1 = partial_mass(x2)  # (2n, n, n): A at q + d e_k and q - d e_k
         dA = (A1[:n] - A1[n:]) / (2 * d[:, None, None])  # dA[k, i, j] = A_ij,k
         c = np.einsum("ijk,j,k->i", np.transpose(dA, (1, 2, 0)) - 0.5 * dA, qdot, qdot)
         B = ((x1[:n] - x1[n:]) / (2 * d[:, None])).T  # (n_x, n) frame analogs
         xdot = B @ qdot
         fm = self.sm.fm
         F, Qd = fm.applied(t, x, xdot, q, qdot)
-        Q = B.T @ F + Qd
+        Q = reduced_force(B, F) + Qd
         qdd = solve_mass(model.coordinate_names, A, Q - c, t, q)
         p = fm.nonconservative_power(None, x, xdot, None, qdot, applied=(F, Qd))
         return dict(x=x, xdot=xdot, B=B, A=A, c=c, Q=Q, Q_drive=Qd, qddot=qdd, power_nc=p)

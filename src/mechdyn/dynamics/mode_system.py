@@ -38,6 +38,7 @@ from ..errors import AssemblyError, IntegrationError, LockupError
 from ..friction.forward import JointFriction
 from ..friction.law import friction_joints
 from ..kernels import rows_numpy as RN
+from ..kernels.inertia import reduced_force, reduced_mass
 from ..kinematics.assembly import (
     column_scale,
     newton,
@@ -327,7 +328,7 @@ class ModeSystem(ModeRows):
         rhs = F - h - M @ b_
         Ff = None if self.friction is None else np.zeros_like(F)
         if b is not None:
-            qddi = np.linalg.solve(B.T @ M @ B, B.T @ rhs)
+            qddi = np.linalg.solve(reduced_mass(M, B), reduced_force(B, rhs))
             lam = np.linalg.lstsq(R.T, M @ (B @ qddi) - rhs, rcond=None)[0]
         else:
             Reff = R
@@ -366,7 +367,7 @@ class ModeSystem(ModeRows):
                 except np.linalg.LinAlgError:
                     pass
             if self.n_i:  # a coordinate without inertia is named, not solved around
-                solve_mass(self.coord_names, B.T @ M @ B, np.zeros(self.n_i), None, None)
+                solve_mass(self.coord_names, reduced_mass(M, B), np.zeros(self.n_i), None, None)
             return self._redundant_solve(Ks, r)
 
         return lin
@@ -409,7 +410,7 @@ class ModeSystem(ModeRows):
         F, Qd = self.sm.fm.applied(t, x, xdot, q, G @ xdot)
         F = F + G.T @ Qd
         M, h = self.sm.with_drive_inertia(*mass_matrix_x(self.model, x, xdot), G, quad_g)
-        return dict(B=B, b=b, A=B.T @ M @ B, f=B.T @ (F - h - M @ b), M=M, F=F, h=h)
+        return dict(B=B, b=b, A=reduced_mass(M, B), f=reduced_force(B, F, h, M, b), M=M, F=F, h=h)
 
 
 def solve_mass(names, A, rhs, t, q) -> np.ndarray:

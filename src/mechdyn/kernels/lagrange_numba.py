@@ -354,7 +354,8 @@ def _declared(x, v, bb, Bl, ri, rf, dims, cs, q, qdot, G, GB, Gb, nb):
 def _mass_matrix(v, bb, Bl, GB, Gb, ip, fp, cs, A, cc, bcx, bcy, nb, ni):
     """The mass matrix A (its upper triangle) and the bias c of the equations in q_I:
     the bodies' from their centre-of-mass analogs (``bcx``, ``bcy``: scratch), the
-    drives' rotor and gear inertia on their (declared) coordinates."""
+    drives' rotor and gear inertia on their (declared) coordinates.  The NumPy twin of
+    the bodies' part: :func:`mechdyn.kernels.inertia.analog_mass`."""
     for i in range(ni):
         cc[i] = 0.0
         for j in range(ni):

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import ModelError, did_you_mean
 from ..friction.ignored import warn_friction_ignored
+from ..kernels.inertia import reduced_mass
 from ..kernels.planar import perp
 from ..kinematics.analogs import acceleration_bias, velocity_analogs
 from ..kinematics.sweep import analyze, sweep
@@ -30,7 +31,7 @@ __all__ = ["reduced_kinematics"]
 
 def _inertia(model: Model, x, B, b):
     """J_red = B^T M_x B and dJ_red/dphi = 2 B^T (M_x b + h) of the analogs B, b (..., n_x)."""
-    J = np.einsum("...i,...ij,...j->...", B, frame_mass_matrix(model, x), B)
+    J = reduced_mass(frame_mass_matrix(model, x), np.asarray(B, float)[..., None])[..., 0, 0]
     return J, 2.0 * np.sum(B * inertia_forces(model, x, B, b), axis=-1)
 
 

@@ -57,6 +57,7 @@ from ..dynamics.reactions import element_forces, frame_forces
 from ..friction.ignored import FrictionIgnoredWarning
 from ..friction.law import friction_joints
 from ..kernels import rows_numpy
+from ..kernels.inertia import reduced_mass
 from ..model.inertia import mass_matrix_x
 from ..model.switchable import Row, SwitchedModel
 from ..model.variable import parse_variable
@@ -240,7 +241,7 @@ def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets:
     G_all = base._coord_jac(x)
     # bodies, plus the rotors and gears of the drives reduced to their coordinates
     M, _ = sm.with_drive_inertia(*mass_matrix_x(model, x), G_all, np.zeros(model.n_q))
-    A = B.T @ M @ B
+    A = reduced_mass(M, B)
     G = G_all[base.coords]
     qd_minus = G @ xdot_minus
     new_locks = frozenset(locks_after) - frozenset(locks_before)
