@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..kernels.inertia import body_mass_block
 from ..kernels.planar import cross, perp
 from . import Model
 from .forces import com_arms
@@ -18,21 +19,15 @@ def frame_mass_matrix(model: Model, x) -> np.ndarray:
     With the centre of mass at ``a = A(theta) com`` from the frame origin, the
     kinetic energy ``1/2 m |v + omega perp(a)|^2 + 1/2 J_c omega^2`` gives, per
     body, the block ``[[m, 0, -m a_y], [0, m, m a_x], [-m a_y, m a_x, J_c + m |a|^2]]``
-    (kg, kg m, kg m^2).  The inertia forces are ``M_x xddot`` plus the
-    centripetal force ``-m omega^2 a`` (see :func:`inertia_forces`).
+    (kg, kg m, kg m^2; :func:`mechdyn.kernels.inertia.body_mass_block`).  The inertia
+    forces are ``M_x xddot`` plus the centripetal force ``-m omega^2 a`` (see
+    :func:`inertia_forces`).
     """
     x = np.asarray(x, dtype=float)
-    nb = model.n_bodies
-    a = com_arms(model, x)
-    m = model.mass
+    blocks = body_mass_block(model.mass, model.inertia, com_arms(model, x))  # (..., nb, 3, 3)
     M = np.zeros(x.shape[:-1] + (model.n_x, model.n_x))
-    for b in range(nb):
-        k = 3 * b
-        M[..., k, k] = m[b]
-        M[..., k + 1, k + 1] = m[b]
-        M[..., k, k + 2] = M[..., k + 2, k] = -m[b] * a[..., b, 1]
-        M[..., k + 1, k + 2] = M[..., k + 2, k + 1] = m[b] * a[..., b, 0]
-        M[..., k + 2, k + 2] = model.inertia[b] + m[b] * (a[..., b, 0] ** 2 + a[..., b, 1] ** 2)
+    for b in range(model.n_bodies):
+        M[..., 3 * b:3 * b + 3, 3 * b:3 * b + 3] = blocks[..., b, :, :]
     return M
 
 

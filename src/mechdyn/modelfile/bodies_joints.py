@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from ..kernels.inertia import centroidal_inertia
 from ..mechanism import GROUND, Body, Coordinate, Lock, Prismatic, Revolute
 from ..mechanism.body import unknown_point
 from ..mechanism.coordinate import LENGTH_KINDS, coordinate_problems
@@ -60,11 +61,11 @@ class _BodiesJoints(_Reader):
                 self.problem(f"{self.where(*P, 'inertia_about')}: "
                              + unknown_point(about, bname, ["com", *points]))
                 raise _Failed
-            d2 = (points[about][0] - com[0]) ** 2 + (points[about][1] - com[1]) ** 2
-            jc = inertia - mass * d2
+            d = (points[about][0] - com[0], points[about][1] - com[1])
+            jc = float(centroidal_inertia(inertia, mass, d))
             if jc < -1e-12 * max(inertia, 1e-30):
                 self.problem(f"{self.where(*P, 'inertia')}: {spec['inertia']!r} about point "
-                             f"{about!r} is less than mass * distance^2 = {mass * d2:.6g} "
+                             f"{about!r} is less than mass * distance^2 = {inertia - jc:.6g} "
                              "kg*m^2 from the centre of mass: the centroidal inertia would be "
                              "negative")
                 raise _Failed
