@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
-from ..kernels.planar import rotate
+from ..kernels.planar import cross, rotate
 from ..mechanism import Mechanism
 from .frame_loads import frame_loads
 from .mounting import _foundation, base_coordinates, isolator_forces, mounted, to_centre_of_mass
@@ -65,7 +65,7 @@ def floor_forces(trajectory, foundation: Foundation, base: str = "base",
     per = isolator_forces(foundation, u, v)  # (n, iso, 2) on the floor
     # where the base points are: the floor takes the forces there
     at = rotate(u[:, 2, None], foundation.positions()) + u[:, None, :2] - np.asarray(point, float)
-    m = np.sum(at[..., 0] * per[..., 1] - at[..., 1] * per[..., 0], axis=1)
+    m = np.sum(cross(at, per), axis=1)
     floor = np.column_stack([per.sum(axis=1), m])
     u, v = to_centre_of_mass(foundation, u, v)
     return MountedResponse(t=np.asarray(trajectory.t, float), u=u, v=v, floor=floor,

@@ -54,7 +54,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
-from ..kernels.planar import rotate
+from ..kernels.planar import cross, rotate
 from ..mechanism import (
     GROUND,
     AssemblyMode,
@@ -497,8 +497,8 @@ def static_equilibrium(mechanism: Mechanism, foundation: Foundation,
         F = isolator_forces(foundation, u, pivot=pivot)  # what the base pushes
         a = rotate(u[2], r_iso)
         r = rotate(u[2], r0)
-        m = np.sum(a[:, 0] * F[:, 1] - a[:, 1] * F[:, 0])
-        m_load = np.sum(r[:, 0] * F0[:, 1] - r[:, 1] * F0[:, 0]) + moment
+        m = np.sum(cross(a, F))
+        m_load = np.sum(cross(r, F0)) + moment
         return np.array([*(F.sum(axis=0) - F0.sum(axis=0)), m - m_load])
 
     K = foundation.stiffness_matrix(pivot)

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import AssemblyError, SingularPositionError
 from ..kernels import rows_numpy
-from ..kernels.planar import rotate
+from ..kernels.planar import cross, rotate
 from ..mechanism.placement import describe_poses, initial_values, suggest_assembly_mode
 from ..model import ConstraintLayout, Model
 from ..model.constraints import coordinates, extend, full_jacobian, residual, system
@@ -282,7 +282,7 @@ def turn_signs(model: Model, x) -> dict:
     for am, ((bp, sp), (bq, sq), (br, sr)) in model.assembly_modes:
         P, Q, R = _world(X, bp, sp), _world(X, bq, sq), _world(X, br, sr)
         a, b = Q - P, R - Q
-        out[am.name] = np.sign(a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0])
+        out[am.name] = np.sign(cross(a, b))
     return out
 
 

@@ -15,6 +15,7 @@ from functools import partial
 import numpy as np
 
 from ..kernels import rows_numpy
+from ..kernels.planar import cross
 from ..mechanism.joint import Revolute
 from ..model import Model
 from ..model.constraints import point_kinematics, point_position, point_velocity, travel_rows
@@ -415,7 +416,7 @@ def _summarize(sw: KinematicSweep) -> SweepSummary:
     for lp in four_bar_loops(m, sw.over):
         B_, C_, D_ = (_joint_point(m, j, sw.x) for j in lp.joints[1:])
         u, v = B_ - C_, D_ - C_
-        mu = np.arctan2(np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]),
+        mu = np.arctan2(np.abs(cross(u, v)),
                         u[:, 0] * v[:, 0] + u[:, 1] * v[:, 1])
         i0, i1 = int(np.argmin(mu)), int(np.argmax(mu))
         trans.append(TransmissionAngle(lp, float(mu[i0]), float(sw.values[i0]),

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import ModelError
 
-__all__ = ["AnchorBolt", "Isolator", "Foundation", "support_matrix", "shift_moment"]
+__all__ = ["AnchorBolt", "Isolator", "Foundation", "support_matrix"]
 
 
 def _problems(owner: str, strict: bool, unit: str, **values) -> list[str]:
@@ -44,21 +44,6 @@ def _finite(owner: str, **values) -> list[str]:
     return [f"{owner}: {key} must be a finite number, got {value!r}"
             for key, value in values.items()
             if not (isinstance(value, int | float) and math.isfinite(value))]
-
-
-def shift_moment(F, point, to) -> np.ndarray:
-    """Loads (..., 3) = (Fx, Fy, M about ``point``) with the moment taken about ``to``
-    (real, or complex amplitudes).
-
-    Examples
-    --------
-    >>> shift_moment([0.0, 10.0, 0.0], (1.0, 0.0), (0.0, 0.0)).tolist()
-    [0.0, 10.0, 10.0]
-    """
-    out = np.array(F, dtype=np.result_type(np.asarray(F), float))  # complex stays complex
-    d = np.asarray(point, float) - np.asarray(to, float)
-    out[..., 2] += d[0] * out[..., 1] - d[1] * out[..., 0]
-    return out
 
 
 @dataclass(frozen=True)

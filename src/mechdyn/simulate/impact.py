@@ -58,6 +58,7 @@ from ..friction.ignored import FrictionIgnoredWarning
 from ..friction.law import friction_joints
 from ..kernels import rows_numpy
 from ..kernels.inertia import reduced_mass
+from ..kernels.planar import cross
 from ..model.inertia import mass_matrix_x
 from ..model.switchable import Row, SwitchedModel
 from ..model.variable import parse_variable
@@ -159,7 +160,7 @@ def _momentum(x, Q):
     Q (n_x,) (forces and moments about each body's origin at poses x)."""
     F, pos = Q.reshape(-1, 3), np.asarray(x, float).reshape(-1, 3)
     return np.array([F[:, 0].sum(), F[:, 1].sum(),
-                     float(np.sum(F[:, 2] + pos[:, 0] * F[:, 1] - pos[:, 1] * F[:, 0]))])
+                     float(np.sum(F[:, 2] + cross(pos[:, :2], F[:, :2])))])
 
 
 def impact(sm: SwitchedModel, x, xdot_minus, locks_before, locks_after, targets: dict,

@@ -20,6 +20,7 @@ from ..dynamics.reactions import element_forces, element_width, frame_forces, ne
 from ..errors import ModelError, Status
 from ..friction.law import friction_joints
 from ..kernels import rows_numpy as RN
+from ..kernels.planar import cross
 from ..results.lazy_table import LazyDict
 from ..results.trajectory import SwitchedSamples, Trajectory
 from .gaps import gaps
@@ -124,7 +125,7 @@ def _block(model, sm, rec, point, modes: list, shapes=None) -> dict:
     # reactions) and the stators of the drives between it and the bodies: the loads do not
     # depend on the mode, so they are evaluated over every sample at once
     _, on_ground, Qd = sm.fm.loads(t, x, xd, q, qd)
-    on_ground[:, 2] -= point[0] * on_ground[:, 1] - point[1] * on_ground[:, 0]  # about P
+    on_ground[:, 2] -= cross(point, on_ground[:, :2])  # about P
     drives = np.einsum("nqx,nq->nx", RN.jacobian(model.coordinate_rows, x), Qd)
     stators = net_on_ground(model, x, drives, point)
     for a, b in zip(starts[:-1], starts[1:], strict=True):
@@ -234,7 +235,7 @@ def finish(model, rec: Samples, events, stats, wall0, status, message, sm,
     for ev in events:  # the frame's impulse of an impact: its angular part about the point
         if key in ev.impulses:
             f = np.array(ev.impulses[key], float)
-            f[2] -= point[0] * f[1] - point[1] * f[0]
+            f[2] -= cross(point, f[:2])
             ev.impulses[key] = f
     if rec.sink is None:  # forces, frame loads and energies: evaluated on first use
         stats["wall_time_s"] = time.perf_counter() - wall0
