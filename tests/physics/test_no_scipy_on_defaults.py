@@ -9,6 +9,14 @@ import scipy.integrate
 
 import mechdyn
 from mechdyn import examples
+from mechdyn.reduction.reduce import (
+    ReducedMachine,
+    energy_speed,
+    reduce_model,
+    run_reduced,
+    size_flywheel,
+    startup,
+)
 
 pytestmark = pytest.mark.timeout(120)
 
@@ -55,6 +63,30 @@ def test_solve_on_dop853_without_scipy(no_scipy_solvers):
                                   rtol=1e-10)
     assert sol.status == "success" and sol.t[-1] == np.pi
     assert sol.q[-1, 0] == pytest.approx(-1.0, abs=1e-8)
+
+
+def test_reduction_runs_without_scipy(no_scipy_solvers):
+    """The reduced slider-crank example on the defaults: its start-up from rest by the
+    motor, the steady cycle it approaches and a flywheel for it, and its run-down with
+    the motor off against a 2 N m brake, whose speeds the energy form (the work of the
+    reduced torque integrated along phi) gives again."""
+    model = examples.load("slider_crank").compile()
+    red = reduce_model(model, steps=181)
+    machine = red.machine(model)
+    res = startup(machine, 0.3, samples_per_second=200.0)
+    assert res.run.stats["integrator"] == "dop853"
+    assert res.run.t[-1] == pytest.approx(0.3, rel=1e-12)
+    assert np.all(np.diff(res.run.phi) > 0) and res.run.omega[-1] > 100.0
+    assert res.steady.omega_min < res.steady.omega_mean < res.steady.omega_max
+    fs = size_flywheel(machine, 0.5 * res.steady.delta, method="simulation", rtol=1e-3)
+    assert fs.J_fly > 0 and fs.delta_simulated == pytest.approx(0.5 * res.steady.delta,
+                                                                rel=1e-3)
+    coast = ReducedMachine.from_reduction(red).with_driving_torque(-2.0)
+    w0 = res.steady.omega_mean
+    run = run_reduced(coast, 0.1, omega0=w0, t_eval=np.linspace(0.0, 0.1, 11), rtol=1e-11,
+                      atol=1e-12)
+    assert run.status == "success" and run.omega[-1] < w0
+    np.testing.assert_allclose(energy_speed(coast, run.phi, omega0=w0), run.omega, rtol=1e-7)
 
 
 @pytest.mark.parametrize("name", ["slider_crank", "four_bar", "clutchless_press"])

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError, Status
-from ..integrate import solve
+from ..integrate import make_integrator, solve
 from .flywheel import SteadyCycle, steady_state
 from .machine import ReducedMachine, _Motion, _Record
 
@@ -94,7 +94,10 @@ def energy_speed(machine: ReducedMachine, phi, *, phi0: float = 0.0, omega0: flo
     """Speed from the energy form ``J omega^2/2 = J_0 omega_0^2/2 + int M dphi``.
 
     Valid when the reduced torque depends on the position only: it is evaluated
-    at time ``t`` and speed ``omega0``.
+    at time ``t`` and speed ``omega0``.  The work ``int M dphi`` is integrated by the
+    package's DOP853 (:mod:`mechdyn.integrate`, the default integrator, never SciPy's)
+    from ``phi0`` to the farthest target on each side, the targets read off its dense
+    output of order 7.
 
     Parameters
     ----------
@@ -102,32 +105,60 @@ def energy_speed(machine: ReducedMachine, phi, *, phi0: float = 0.0, omega0: flo
         Positions, rad (any order, on either side of ``phi0``).
     phi0, omega0 : float
         Reference position (rad) and speed there (rad/s).
+    t : float
+        Time at which the torque is evaluated, s.
+    rtol : float
+        Relative tolerance of the work integral; its absolute tolerance is
+        ``1e-12 max(1, J_0 omega_0^2)`` J.
 
     Returns
     -------
     ndarray, shape (n,)
         omega(phi), rad/s; NaN where the kinetic energy would be negative (the
         machine cannot reach that position).
-    """
-    from scipy.integrate import solve_ivp
 
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mechdyn.reduction.machine import ReducedMachine
+    >>> mach = ReducedMachine.constant(0.5, 1.0)  # J = 0.5 kg m^2, M = 1 N m
+    >>> w = energy_speed(mach, [0.0, 2.0, -0.5], omega0=2.0)  # w^2 = 4 + 4 phi
+    >>> np.round(w, 12).tolist()
+    [2.0, 3.464101615138, 1.414213562373]
+    """
     phi = np.asarray(phi, dtype=float).reshape(-1)
     j0, _ = machine.inertia(phi0)
+    atol = 1e-12 * max(1.0, j0 * omega0**2)
     out = np.empty_like(phi)
-    for sel in (phi >= phi0, phi < phi0):  # each side of phi0 from phi0 on
+    for sel, sign in ((phi >= phi0, 1.0), (phi < phi0, -1.0)):  # each side from phi0 on
         target = phi[sel]
-        end = target[np.argmax(np.abs(target - phi0))] if target.size else phi0
-        w = np.zeros(target.size)
-        if end != phi0:
-            sol = solve_ivp(lambda p, y: [machine.torque(t, p, omega0)], (phi0, end), [0.0],
-                            method="DOP853", rtol=rtol, atol=1e-12 * max(1.0, j0 * omega0**2),
-                            dense_output=True)
-            w = sol.sol(target)[0]
+        w = sign * _work(lambda u, sign=sign: machine.torque(t, phi0 + sign * u, omega0),
+                         sign * (target - phi0), rtol, atol)
         e2 = j0 * omega0**2 + 2.0 * w
         with np.errstate(invalid="ignore"):
             out[sel] = np.where(e2 >= 0, np.sqrt(np.maximum(e2, 0) / machine.inertia_along(target)),
                                 np.nan)
     return out
+
+
+def _work(integrand, s, rtol: float, atol: float) -> np.ndarray:
+    """``int_0^s integrand(u) du`` at the distances ``s >= 0`` (any order): the quadrature
+    state w of the package's DOP853 over [0, max s], each ``s`` read off the dense output
+    of the step that holds it."""
+    s = np.asarray(s, dtype=float)
+    w = np.zeros(s.size)
+    if not s.size or s.max() == 0.0:
+        return w
+    order = np.argsort(s)
+    k = int(np.searchsorted(s[order], 0.0, side="right"))  # s = 0: no work
+    integ = make_integrator("dop853", rtol=rtol, atol=atol)
+    for step in integ.integrate(lambda u, q, v: (np.zeros(0), [integrand(u)]), 0.0, [], [],
+                                float(s.max()), w0=[0.0]):
+        while k < s.size and s[order[k]] <= step.t:
+            sk = s[order[k]]
+            w[order[k]] = step.w[0] if sk == step.t else step.dense(sk)[2][0]
+            k += 1
+    return w
 
 
 @dataclass(frozen=True)
