@@ -6,8 +6,18 @@ Oracles: the harmonic oscillator q = cos(w t) and closed-form quadratures.
 import numpy as np
 import pytest
 
-from mechdyn.integrate import INTEGRATORS, Event, IntegratorOptionError, make_integrator, solve
+from mechdyn.integrate import (
+    INTEGRATORS,
+    AdaptiveIntegrator,
+    Event,
+    IntegratorOptionError,
+    ScipyIntegrator,
+    make_integrator,
+    solve,
+)
 from mechdyn.integrate.base import hermite_dense
+from mechdyn.integrate.compiled_dop853 import DOP853
+from mechdyn.integrate.driver import segment_integrators
 
 W = 2.0  # rad/s
 
@@ -156,3 +166,39 @@ def test_every_listed_integrator_runs():
         opts = {"steps": 50} if name in ("wilson", "rk4") else {"rtol": 1e-6}
         s = solve(name, oscillator, 0.0, [1.0], [0.0], 0.5, **opts)
         assert s.q[-1, 0] == pytest.approx(np.cos(W * 0.5), abs=1e-3), name
+
+
+@pytest.mark.parametrize("name", [n for n in INTEGRATORS if n not in ("wilson", "rk4")])
+def test_adaptive_integrators_share_one_base(name):
+    """The package's DOP853 and SciPy's solvers are adaptive integrators with the same
+    option checks; only the ``scipy-*`` names and SciPy's methods are SciPy's."""
+    integ = make_integrator(name, rtol=1e-7, max_step=0.5)
+    assert isinstance(integ, AdaptiveIntegrator) and integ.adaptive
+    assert isinstance(integ, ScipyIntegrator) == (name != "dop853")
+    assert isinstance(integ, DOP853) == (name == "dop853")
+    assert (integ.rtol, integ.atol, integ.first_step, integ.max_step) == (1e-7, 1e-10, None,
+                                                                          0.5)
+    for bad, match in (({"rtol": 0.0}, "`rtol`"), ({"atol": [1e-9, -1.0]}, "`atol`"),
+                       ({"first_step": -1e-3}, "`first_step`"), ({"max_step": 0}, "`max_step`")):
+        with pytest.raises(IntegratorOptionError, match=match):
+            make_integrator(name, **bad)
+
+
+def test_atol_per_state_must_fit_the_state():
+    for integ in (DOP853(atol=[1e-9, 1e-9, 1e-9]), ScipyIntegrator("rk45", atol=[1e-9] * 3)):
+        with pytest.raises(IntegratorOptionError, match="`atol` has 3 components"):
+            list(integ.integrate(oscillator, 0.0, [1.0], [0.0], 1.0))
+
+
+def test_an_adaptive_instance_keeps_its_tolerances_in_a_run():
+    """segment_integrators takes an instance's tolerances and step bounds, for the
+    package's DOP853 as for SciPy's solvers (both adaptive, one not SciPy's)."""
+    fixed = dict(dt=None, steps=None, iterations=None, tol=None, theta=None)
+    for inst in (DOP853(rtol=1e-6, atol=1e-8, max_step=0.01), ScipyIntegrator("radau", 1e-6,
+                                                                              1e-8)):
+        factory, name = segment_integrators(inst, 0.0, 1.0, rtol=1e-10, atol=1e-13,
+                                            first_step=None, max_step=None, **fixed)
+        integ = factory(np.ones(1), 1e-4)
+        assert name == inst.name and type(integ) is type(inst)
+        assert integ.rtol == 1e-6 and integ.max_step == inst.max_step
+        assert integ.atol.tolist() == [1e-8, 1e-7, 1e-5]

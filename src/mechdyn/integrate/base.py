@@ -19,7 +19,9 @@ How to write a new integrator:
 3. implement ``_steps(rhs, t0, q0, qdot0, w0, t_end)`` yielding :class:`Step`,
    calling ``rhs`` (which counts evaluations) and incrementing
    ``self.stats.steps`` / ``self.stats.rejected``; or, for a fixed-step method,
-   subclass :class:`FixedStep` and implement ``_advance`` over one step.
+   subclass :class:`FixedStep` and implement ``_advance`` over one step; for an
+   adaptive one, subclass :class:`AdaptiveIntegrator`, which holds and checks the
+   tolerances and step bounds (``isinstance(integ, AdaptiveIntegrator)``: "adaptive").
 """
 
 from __future__ import annotations
@@ -33,8 +35,9 @@ import numpy as np
 
 from ..errors import MechdynError
 
-__all__ = ["Integrator", "FixedStep", "IntegratorStats", "Step", "hermite_dense",
-           "check_positive", "IntegratorOptionError", "IntegratorWarning", "DEFAULT_RTOL"]
+__all__ = ["Integrator", "FixedStep", "AdaptiveIntegrator", "IntegratorStats", "Step",
+           "hermite_dense", "check_positive", "IntegratorOptionError", "IntegratorWarning",
+           "DEFAULT_RTOL", "first_order_function", "split_state"]
 
 
 class IntegratorOptionError(MechdynError, ValueError):
@@ -295,3 +298,103 @@ class FixedStep(Integrator):
             self.stats.steps += 1
             yield Step(t, float(t1), q1, v1, a1, w1, dense)
             t, q, v, w, a, p = float(t1), q1, v1, w1, a1, p1
+
+
+class AdaptiveIntegrator(Integrator):
+    """Base class of the adaptive integrators (the package's DOP853, SciPy's solvers):
+    the step size follows an error estimate against ``atol_i + rtol |y_i|`` over the
+    first-order state y = (q, q', w).
+
+    Parameters
+    ----------
+    rtol : float
+        Relative tolerance (> 0), default ``DEFAULT_RTOL`` (1e-10).
+    atol : float or array_like, optional
+        Absolute tolerance, SI units of each state component (> 0); a scalar, or an
+        array of length 2 n + n_w over (q, q', w), checked against the state by
+        :meth:`start_vector`.  Default ``1e-3 rtol``.
+    first_step, max_step : float, optional
+        Initial and largest step sizes, s (> 0; default: the method's starting step,
+        no bound).
+
+    Raises
+    ------
+    IntegratorOptionError
+        A tolerance or step bound that is not a positive finite number (the message
+        names it).
+
+    Examples
+    --------
+    >>> from mechdyn.integrate import AdaptiveIntegrator, make_integrator
+    >>> integ = make_integrator("dop853", rtol=1e-6, max_step=0.01)
+    >>> isinstance(integ, AdaptiveIntegrator), integ.atol, integ.max_step
+    (True, 1e-09, 0.01)
+    >>> make_integrator("dop853", atol=-1.0)
+    Traceback (most recent call last):
+    ...
+    mechdyn.integrate.base.IntegratorOptionError: `atol` must be positive, got -1.0
+    """
+
+    adaptive = True
+    #: whether a segment on a compiled kernel may run in a compiled loop (True for the
+    #: package's DOP853, :class:`mechdyn.integrate.compiled_dop853.DOP853`)
+    compiled = False
+
+    def __init__(self, rtol: float = DEFAULT_RTOL, atol=None, *,
+                 first_step: float | None = None, max_step: float | None = None):
+        super().__init__()
+        self.rtol = check_positive("rtol", rtol)
+        if atol is None:
+            atol = 1e-3 * self.rtol
+        at = np.asarray(atol, dtype=float)
+        if not np.all(np.isfinite(at)) or np.any(at <= 0):
+            raise IntegratorOptionError(f"`atol` must be positive, got {atol!r}")
+        self.atol = float(at) if at.ndim == 0 else at
+        self.first_step = check_positive("first_step", first_step, allow_none=True)
+        self.max_step = check_positive("max_step", max_step, allow_none=True)
+
+    def start_vector(self, q0, qdot0, w0) -> np.ndarray:
+        """The first-order start (q, q', w), its size checked against ``atol``.
+
+        Raises
+        ------
+        IntegratorOptionError
+            ``atol`` is an array whose length is not that of the state.
+        """
+        y0 = np.concatenate([q0, qdot0, w0])
+        if np.ndim(self.atol) and np.size(self.atol) != y0.size:
+            raise IntegratorOptionError(
+                f"`atol` has {np.size(self.atol)} components but the state (q, q', w) has "
+                f"{y0.size}")
+        return y0
+
+    def settings(self) -> dict:
+        return {"rtol": self.rtol, "atol": self.atol, "first_step": self.first_step,
+                "max_step": self.max_step}
+
+
+def first_order_function(rhs, n: int):
+    """y' = f(t, y) of the first-order state y = (q, q', w) (n coordinates) from the
+    second-order ``rhs(t, q, qdot) -> (qddot, P_nc)``.
+
+    Examples
+    --------
+    >>> f = first_order_function(lambda t, q, qd: (-q, np.zeros(1)), 1)
+    >>> f(0.0, np.array([2.0, 3.0, 0.0])).tolist()
+    [3.0, -2.0, 0.0]
+    """
+    def fun(t, y):
+        return np.concatenate([y[n:2 * n], *rhs(t, y[:n], y[n:2 * n])])
+
+    return fun
+
+
+def split_state(y, n: int) -> tuple:
+    """``(q, q', w)`` of a first-order state y of n coordinates (views of y).
+
+    Examples
+    --------
+    >>> [a.tolist() for a in split_state(np.arange(5.0), 2)]
+    [[0.0, 1.0], [2.0, 3.0], [4.0]]
+    """
+    return y[:n], y[n:2 * n], y[2 * n:]

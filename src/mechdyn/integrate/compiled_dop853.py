@@ -33,27 +33,30 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 
-from .base import DEFAULT_RTOL, Step
+from .base import DEFAULT_RTOL, AdaptiveIntegrator, Step, first_order_function, split_state
 from .dop853 import dop853_steps
-from .scipy_ivp import ScipyIntegrator, first_order_function, split_state
 
 __all__ = ["DOP853"]
 
 
-class DOP853(ScipyIntegrator):
+class DOP853(AdaptiveIntegrator):
     """The Dormand-Prince 8(5,3) integrator, in the compiled loop where it can run and
     stepped from Python (:func:`mechdyn.integrate.dop853.dop853_steps`) elsewhere.
 
-    Parameters and errors: those of :class:`~mechdyn.integrate.scipy_ivp.ScipyIntegrator`
-    (``rtol``, ``atol``, ``first_step``, ``max_step``), without its ``method``.
+    Parameters and errors: those of :class:`~mechdyn.integrate.base.AdaptiveIntegrator`
+    (``rtol``, ``atol``, ``first_step``, ``max_step``).
     """
 
+    name = "dop853"
+    order = 8
+    #: the method, spelt as SciPy's class of it (for reports)
+    method = "DOP853"
     #: segments on a compiled kernel run in the compiled loop
     compiled = True
 
     def __init__(self, rtol: float = DEFAULT_RTOL, atol=None, *,
                  first_step: float | None = None, max_step: float | None = None):
-        super().__init__("dop853", rtol, atol, first_step=first_step, max_step=max_step)
+        super().__init__(rtol, atol, first_step=first_step, max_step=max_step)
 
     def _steps(self, rhs, t0, q0, qdot0, w0, t_end, first_order=None) -> Iterator[Step]:
         n = q0.size

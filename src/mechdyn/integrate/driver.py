@@ -15,7 +15,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from .base import DEFAULT_RTOL, Integrator, IntegratorOptionError
+from .base import DEFAULT_RTOL, AdaptiveIntegrator, Integrator, IntegratorOptionError
 from .compiled_dop853 import DOP853
 from .events import as_events
 from .runge_kutta import RungeKutta4
@@ -128,7 +128,7 @@ def segment_integrators(method, t0: float, t_end: float, *, rtol, atol, dt, step
     if isinstance(method, Integrator):
         make_integrator(method, **fixed)  # refuses options beside an instance
         name = method.name
-        if isinstance(method, ScipyIntegrator):
+        if isinstance(method, AdaptiveIntegrator):
             rtol, atol = method.rtol, method.atol
             first_step = method.first_step if first_step is None else first_step
             max_step = method.max_step if max_step is None else max_step
