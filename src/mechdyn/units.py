@@ -10,6 +10,7 @@ Rules
   ``-1.11876...``).  A unit of the wrong dimension raises :class:`UnitError`
   naming where the value came from, the value, the expected dimension and an
   example.
+* A pint ``Quantity`` (of any registry) is converted the same way, by its unit.
 * A bare number (``0.015``, or a string without a unit such as ``"0.015"``) is
   taken as already being in SI units.  **This includes angles and angular
   speeds**: a bare ``1.2`` for an angle means 1.2 rad, not 1.2 deg, and a bare
@@ -54,7 +55,7 @@ from typing import Any
 from .errors import UnitError
 
 __all__ = ["KINDS", "Kind", "parse_quantity", "parse_vector", "format_quantity", "registry",
-           "MAX_TEXT"]
+           "is_quantity", "MAX_TEXT"]
 
 #: the longest quantity text accepted, characters
 MAX_TEXT = 100
@@ -137,10 +138,10 @@ def parse_quantity(value: Any, kind: str, *, where: str = "") -> float:
 
     Parameters
     ----------
-    value : str or float or int
+    value : str or float or int or pint.Quantity
         ``"15 mm"``, ``"-64.1 deg"``, ``"0.034 kg*m^2"``, ``"100 rpm"``, ``"1.5 kW"``,
-        ``"30 %"``, or a bare number, which is taken as SI (angles: rad; angular
-        speeds: rad/s).
+        ``"30 %"``, a scalar pint quantity, or a bare number, which is taken as SI
+        (angles: rad; angular speeds: rad/s).
     kind : str
         One of :data:`KINDS` (``"length"``, ``"angle"``, ``"mass"``, ...).
     where : str
@@ -159,6 +160,8 @@ def parse_quantity(value: Any, kind: str, *, where: str = "") -> float:
         is not finite.
     """
     k = _kind(kind)
+    if is_quantity(value):
+        return _from_quantity(value, kind, where)
     if isinstance(value, bool) or not isinstance(value, (str, int, float)):
         raise _problem(where, value, k, f"not a number or a quantity string "
                        f"(got {type(value).__name__})")
@@ -197,6 +200,34 @@ def parse_quantity(value: Any, kind: str, *, where: str = "") -> float:
     if why:
         raise _problem(where, value, k, why)
     out = float(m["num"]) * factor
+    if not math.isfinite(out):
+        raise _problem(where, value, k, "not a finite value")
+    return out
+
+
+def is_quantity(value: Any) -> bool:
+    """Whether ``value`` is a pint ``Quantity`` (of any registry; pint is not imported).
+
+    Examples
+    --------
+    >>> is_quantity(registry().Quantity(60.0, "rpm")), is_quantity("60 rpm"), is_quantity(1.0)
+    (True, False, False)
+    """
+    return hasattr(value, "magnitude") and hasattr(value, "units") and hasattr(value, "to")
+
+
+def _from_quantity(value: Any, kind: str, where: str) -> float:
+    """A scalar pint quantity in the SI unit of ``kind`` (the checks of a unit text)."""
+    k = KINDS[kind]
+    try:
+        mag = float(value.magnitude)
+    except (TypeError, ValueError):
+        raise _problem(where, value, k, "one quantity expected (its magnitude is not a "
+                       "number)") from None
+    factor, why = _unit_factor(str(value.units), kind)
+    if why:
+        raise _problem(where, value, k, why)
+    out = mag * factor
     if not math.isfinite(out):
         raise _problem(where, value, k, "not a finite value")
     return out

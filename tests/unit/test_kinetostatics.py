@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import mechdyn as md
-from mechdyn.errors import ModelError
+from mechdyn.errors import ModelError, UnitError
 from mechdyn.kinetostatics import inverse as ks_module
 from mechdyn.kinetostatics.inverse import (
     Kinetostatics,
@@ -20,6 +20,7 @@ from mechdyn.kinetostatics.inverse import (
 from mechdyn.mechanism import Drive, Force, Spring, Table, TorqueSpeedCurve
 from mechdyn.mechanism.process import StrokeWindow, position_load, punch_load, time_pulse_load
 from mechdyn.model.forces import LoadContext, force_model
+from mechdyn.units import registry
 
 G = 9.81
 
@@ -198,6 +199,35 @@ def test_motion_specs_and_errors():
     # the trajectory route, default over = first coordinate
     res = kinetostatics(mech, trajectory=traj)
     assert res.over == "phi" and res.driven == ("phi",)
+
+
+def test_speed_takes_units_of_its_coordinate():
+    """A speed in units (text, pint quantity, one per coordinate) is its SI number: the
+    same times and torques; a unit of the wrong dimension names speed and coordinate."""
+    rot = rotor(gravity=(0.0, -G)).compile()
+    phi = np.linspace(0.0, np.pi, 7)
+    ref = kinetostatics(rot, over="phi", speed=2 * np.pi, values=phi)
+    for speed in ("60 rpm", "1 turn/s", registry().Quantity(360.0, "deg/s"), ["60rpm"],
+                  (np.float64(2 * np.pi),)):
+        res = kinetostatics(rot, over="phi", speed=speed, values=phi)
+        np.testing.assert_allclose(res.t, ref.t, rtol=1e-14, atol=0.0)
+        np.testing.assert_allclose(res.driving["phi"], ref.driving["phi"], rtol=1e-12)
+    sl = slider().compile()
+    s = np.linspace(0.2, 0.3, 5)
+    ref = kinetostatics(sl, over="s", speed=0.5, values=s)
+    for speed in ("500 mm/s", registry().Quantity(1.8, "km/h")):
+        res = kinetostatics(sl, over="s", speed=speed, values=s)
+        np.testing.assert_allclose(res.t, ref.t, rtol=1e-14, atol=0.0)
+    with pytest.raises(UnitError, match=r"speed of 'phi' \(an angle coordinate\): '0.5 m/s'"
+                       r".*velocity unit.*expected an angular velocity"):
+        kinetostatics(rot, over="phi", speed="0.5 m/s", values=phi)
+    with pytest.raises(UnitError, match=r"speed of 'phi'.*no angle unit"):
+        kinetostatics(rot, over="phi", speed="1 Hz", values=phi)
+    with pytest.raises(UnitError, match=r"speed of 's' \(a length coordinate\).*expected a "
+                                        r"velocity"):
+        kinetostatics(sl, over="s", speed=registry().Quantity(60.0, "rpm"), values=s)
+    with pytest.raises(ValueError, match="expected 1 value"):
+        kinetostatics(rot, over="phi", speed=["60 rpm", "30 rpm"], values=phi)
 
 
 def test_model_drives_replace_or_load():

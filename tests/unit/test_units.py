@@ -131,3 +131,20 @@ def test_every_kind_example_parses_to_its_own_kind():
     for name, kind in KINDS.items():
         example = kind.example.split(" or ")[0].strip('"')
         parse_quantity(example, name, where=name)
+
+
+def test_pint_quantities_convert_as_their_unit_text():
+    pint = pytest.importorskip("pint")
+    for reg in (registry(), pint.UnitRegistry()):  # ours or the caller's registry
+        assert parse_quantity(reg.Quantity(60, "rpm"), "angular_velocity") == pytest.approx(
+            2 * math.pi, rel=1e-14)
+        assert parse_quantity(reg.Quantity(0.5, "mm/s"), "velocity") == pytest.approx(5e-4)
+        assert parse_quantity(reg.Quantity(30, "deg"), "angle") == pytest.approx(
+            math.pi / 6, rel=1e-14)
+    other = pint.UnitRegistry()
+    with pytest.raises(UnitError, match="speed: 10 hertz: .*no angle unit"):
+        parse_quantity(other.Quantity(10, "Hz"), "angular_velocity", where="speed")
+    with pytest.raises(UnitError, match="velocity unit; expected an angular velocity"):
+        parse_quantity(other.Quantity(1, "m/s"), "angular_velocity")
+    with pytest.raises(UnitError, match="one quantity expected"):
+        parse_quantity(other.Quantity([1.0, 2.0], "m/s"), "velocity")

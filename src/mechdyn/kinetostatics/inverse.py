@@ -50,7 +50,8 @@ def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
 
     Give the motion in one of three ways:
 
-    * ``speed`` (constant, rad/s or m/s; 0 for statics) and ``values`` of the
+    * ``speed`` (constant, 0 for statics: a number in rad/s or m/s, a unit text such as
+      ``"60 rpm"`` or ``"0.5 m/s"``, or a pint quantity) and ``values`` of the
       coordinate(s) ``over`` (default one full turn, ``linspace(0, 2 pi, 361)``);
       time is ``(values - values[0]) / speed``.
     * ``t`` with ``law`` (a callable q(t) giving the driven value(s), or a
@@ -73,7 +74,12 @@ def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
     mech_or_model : Mechanism or Model
     over : str or sequence of str, optional
         Driven coordinate(s); default the first independent coordinate.
-    speed : float, array_like or callable, optional
+    speed : float, str, pint.Quantity, sequence of them, or callable, optional
+        The constant speed of the driven coordinate(s), one for all or one per
+        coordinate: a bare number is SI (rad/s for an angle coordinate, m/s for a length
+        one); a unit text (``"60 rpm"``, ``"4.2 rad/s"``, ``"0.5 m/s"``) or a pint
+        quantity is converted, an angle rate for an angle coordinate and a length rate
+        for a length one.  A callable is a speed law omega(t), rad/s or m/s, with ``t``.
     values : array_like, shape (n,) or (n, k), optional
         Positions of the ``over`` coordinates, rad or m.
     t : array_like, shape (n,), optional
@@ -111,6 +117,9 @@ def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
     ModelError
         Unknown coordinate or load names, or a motion that does not fit the
         mechanism's degrees of freedom.
+    UnitError
+        A ``speed`` whose unit does not fit its coordinate (a length rate for an angle,
+        a frequency in Hz for an angle rate, ...); the message names the coordinate.
     AssemblyError
         A position cannot be assembled.
 
@@ -124,6 +133,13 @@ def kinetostatics(mech_or_model, *, over: str | Sequence[str] | None = None,
     >>> res = kinetostatics(m, over="phi", speed=0.0, values=[0.0])
     >>> round(float(res.driving["phi"][0]), 4)   # holds the weight: 1 kg x 9.81 x 0.1 m
     0.981
+    >>> res = kinetostatics(m, over="phi", speed="60 rpm", values=[0.0, np.pi / 2])
+    >>> res.t.round(6).tolist()   # a quarter turn at 1 turn/s
+    [0.0, 0.25]
+    >>> kinetostatics(m, over="phi", speed="0.5 m/s", values=[0.0])
+    Traceback (most recent call last):
+    ...
+    mechdyn.errors.UnitError: speed of 'phi' (an angle coordinate): '0.5 m/s': ... velocity unit...
     """
     model = as_model(mech_or_model)
     if model_drives not in ("replace", "load"):

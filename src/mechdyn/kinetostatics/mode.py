@@ -18,6 +18,7 @@ from ..friction.law import friction_joints
 from ..model.constraints import coordinates, coordinates_gamma, coordinates_jacobian
 from ..model.forces import force_model
 from ..results.kinetostatics_record import Kinetostatics
+from ..units import is_quantity, parse_quantity
 from .prescribed import _prescribed, independent_subset
 
 __all__ = ["_kinetostatics", "MESSAGES"]
@@ -87,6 +88,37 @@ def _to_array(v, n_d: int, what: str) -> np.ndarray:
     return a
 
 
+def _speeds(model, over_idx: list[int], speed) -> np.ndarray:
+    """The constant speeds of the driven coordinates ``over_idx``, SI (rad/s or m/s),
+    shape (n_o,): ``speed`` is one value for all or one per coordinate, each a number
+    (SI), a unit text (``"60 rpm"``, ``"0.5 m/s"``) or a pint quantity, an angle rate
+    for an angle coordinate and a length rate for a length one.
+
+    Raises
+    ------
+    UnitError
+        A unit of the wrong dimension for its coordinate (the message names the
+        argument and the coordinate) or a text that is not a quantity.
+    ValueError
+        Not one value per driven coordinate.
+    """
+    n_o = len(over_idx)
+    if isinstance(speed, (list, tuple)) or (is_quantity(speed) and np.ndim(speed.magnitude)):
+        items = list(speed)  # one per coordinate (a pint array quantity: its elements)
+    else:
+        items = [speed]
+    items = [v.item() if isinstance(v, np.generic) else v for v in items]
+    if not any(isinstance(v, str) or is_quantity(v) for v in items):
+        return _to_array(speed, n_o, "speed")  # SI numbers
+    if len(items) not in (1, n_o):
+        raise ValueError(f"speed: expected {n_o} value(s), got {len(items)}")
+    names, angle = model.coordinate_names, model.coord_is_angle
+    return np.array([parse_quantity(
+        v, "angular_velocity" if angle[k] else "velocity",
+        where=f"speed of {names[k]!r} ({'an angle' if angle[k] else 'a length'} coordinate)")
+        for v, k in zip(items * n_o if len(items) == 1 else items, over_idx, strict=True)])
+
+
 def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=None,
                    start=None, trajectory=None, hold=None, mode=None, point=(0.0, 0.0),
                    model_drives="replace", reacting_loads=(), x_guess=None, lay=None,
@@ -147,7 +179,7 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
             if t is not None:
                 raise ValueError("t= is used with law= or a callable speed, not with a "
                                  "constant speed (time follows from values and speed)")
-            w = _to_array(speed, n_o, "speed")
+            w = _speeds(model, over_idx, speed)
             if values is None:
                 if not all(model.coord_is_angle[k] for k in over_idx):
                     raise ValueError("values= is needed for a travel coordinate")
