@@ -165,7 +165,8 @@ def warmup() -> dict[str, float]:
         ``"fixed-step loop"`` (RK4 and Wilson's method, compiled), ``"first-order f"``
         (the f SciPy's methods call), ``"turning check"`` (the position Jacobian of the
         turning-point check; :data:`mechdyn.dynamics.compiled.GROUPS`; a run compiles only
-        the groups it uses), ``"kinematic sweep"`` (the position problem of :func:`mechdyn.sweep`) and
+        the groups it uses), ``"kinematic sweep"`` (the position problem of
+        :func:`mechdyn.sweep`) and
         ``"batched study"`` (the kinetostatics of many variants at once of
         :mod:`mechdyn.study`, :mod:`mechdyn.kernels.rows_variants`).  A group already
         compiled in this process counts 0 s.  Empty when Numba is not installed (the

@@ -169,11 +169,11 @@ class CompiledKernel:
 
     def fast_forward(self, integ, eqs, t, y0, t_end, **callbacks):
         """Run a segment in the compiled DOP853 loop as far as it can go: ``(t, y, next_out,
-        done)`` (see :func:`mechdyn.dynamics.compiled_loop.fast_forward`); a mode whose
+        done, h)`` (see :func:`mechdyn.dynamics.compiled_loop.fast_forward`); a mode whose
         multipliers are not all the kernel's (redundant rows) is not run there."""
         ms = eqs.ms
         if len(ms.independent_rows) != ms.n_rows or y0.size != 2 * self.n_i + 1:
-            return t, y0, callbacks["next_out"], False
+            return t, y0, callbacks["next_out"], False, None
         self._ensure("fixed-step loop" if isinstance(integ, FixedStep) else "integration loop")
         return fast_forward(self, integ, eqs, t, y0, t_end, **callbacks)
 

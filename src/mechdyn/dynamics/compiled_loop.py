@@ -215,7 +215,7 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
     ----------
     kernel : CompiledKernel
         The mode's kernel (``eqs.kernel``).
-    integ : ScipyIntegrator or FixedStep
+    integ : AdaptiveIntegrator or FixedStep
         Tolerances and step bounds (``rtol``, ``atol``, ``first_step``, ``max_step``), or
         the fixed-step integrator (its grid from ``t``, Wilson's settings).
     eqs : ModeEquations
@@ -235,6 +235,9 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
         The first output time not yet sampled.
     done : bool
         Whether ``t_end`` was reached.
+    h : float or None
+        The step to go on with from ``t`` (the one the loop had there), where the segment
+        is handed over; None where the loop took no step.
 
     Raises
     ------
@@ -242,7 +245,7 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
         From ``after_step`` (a dead position, the step budget) or the wall-time limit.
     """
     if isinstance(integ, FixedStep) and _fixed_method(integ) is None:
-        return t, np.asarray(y0, float), next_out, False
+        return t, np.asarray(y0, float), next_out, False, None
     ms = eqs.ms
     b = buffers(kernel)
     y = np.array(y0, float)
@@ -259,9 +262,10 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
     counted = [0, 0, 0]
     call, fixed = _loop(kernel, b, integ, y, atol, te, t, t_end)
     if book is not None and book.charts:
-        return t, y, next_out, False
+        return t, y, next_out, False, None
     _watch_window(book, par, ipar)
-    mark = (t, y.copy(), next_out, list(counted), kernel.snapshot())  # the last checked state
+    # the last checked state, and the step the loop had there
+    mark = (t, y.copy(), next_out, list(counted), kernel.snapshot(), None)
     checked_to = -np.inf  # the end of the last step checked
     while True:
         code = call()
@@ -277,11 +281,12 @@ def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, 
                       sample=sample, te=te, every_step=every_step):
             return _rewind(mark, counted, stats, kernel, ipar)
         checked_to = float(b.hist[2, 0]) if ipar[L.I_STEPS] else checked_to
-        mark = (t_now, y.copy(), int(ipar[L.I_NEXT]), list(counted), kernel.snapshot())
+        mark = (t_now, y.copy(), int(ipar[L.I_NEXT]), list(counted), kernel.snapshot(),
+                float(par[L.P_H]))
         if bar is not None:
             bar.update(t_now)
         if code == L.DONE:
-            return t_now, y.copy(), int(ipar[L.I_NEXT]), True
+            return t_now, y.copy(), int(ipar[L.I_NEXT]), True, None
         if deadline is not None and time.perf_counter() > deadline:
             raise Stop(Status.TIMEOUT, f"stopped on the wall-time limit at t = {t_now:.9g} s")
 
@@ -324,12 +329,12 @@ def _rewind(mark, counted: list, stats, kernel, ipar):
     """Back to the last checked state ``mark``: the generic loop takes the steps since then
     one by one, with the caller's checks after each (the exact step budget ...); returns
     what :func:`fast_forward` does."""
-    t0_, y0_, next0, (st, _, rej), ws0 = mark
+    t0_, y0_, next0, (st, _, rej), ws0, h = mark
     stats["steps"] -= counted[0] - st
     stats["rejected"] -= counted[2] - rej
     kernel.restore(ws0)
     ipar[L.I_NOUT] = 0
-    return t0_, y0_, next0, False
+    return t0_, y0_, next0, False, h
 
 
 def _hand(b, ms, sample) -> None:
@@ -405,7 +410,7 @@ def _samples_of(step, y_new, ev, sample, te, ipar, every_step, t_now):
         ipar[L.I_NEXT] += 1
     if every_step:
         sample(t_now, y_new, step, ev)
-    return t_now, y_new, int(ipar[L.I_NEXT]), False
+    return t_now, y_new, int(ipar[L.I_NEXT]), False, None
 
 
 def kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):

@@ -26,6 +26,7 @@ How to write a new integrator:
 
 from __future__ import annotations
 
+import copy
 import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterator
@@ -371,6 +372,25 @@ class AdaptiveIntegrator(Integrator):
     def settings(self) -> dict:
         return {"rtol": self.rtol, "atol": self.atol, "first_step": self.first_step,
                 "max_step": self.max_step}
+
+    def going_on(self, h: float | None) -> AdaptiveIntegrator:
+        """This integrator with its first step ``h`` (s), counters of its own: the method
+        going on from the middle of a segment with the step it had (a compiled loop
+        handing a segment over), rather than starting again with a guessed step; ``self``
+        where ``h`` is None or not positive.
+
+        Examples
+        --------
+        >>> from mechdyn.integrate import make_integrator
+        >>> make_integrator("dop853").going_on(1e-3).first_step
+        0.001
+        """
+        if h is None or not h > 0.0 or not np.isfinite(h):
+            return self
+        other = copy.copy(self)
+        other.stats = type(self.stats)()
+        other.first_step = float(h)
+        return other
 
 
 def first_order_function(rhs, n: int):

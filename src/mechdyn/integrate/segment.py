@@ -189,12 +189,14 @@ def run_segment(integ, eqs, t: float, y0, t_end: float, efns: list[EventFunction
     kernel = getattr(eqs, "kernel", None)
     steps = None
     if getattr(integ, "compiled", False) and kernel is not None and not efns:
-        # the compiled loop (mechdyn.dynamics.compiled_loop) as far as it can go
-        t, y0, next_out, done = kernel.fast_forward(
+        # the compiled loop (mechdyn.dynamics.compiled_loop) as far as it can go; where it
+        # hands the segment over, the method goes on with the step it had
+        t, y0, next_out, done, h = kernel.fast_forward(
             integ, eqs, t, y0, t_end, after_step=after_step, sample=sample, t_eval=t_eval,
             next_out=next_out, every_step=every_step, stats=stats, bar=bar, deadline=deadline)
         if done:
             return None, next_out
+        integ = integ.going_on(h) if integ.adaptive else integ
     elif getattr(integ, "compiled", False) and kernel is not None:
         # with event functions: the compiled loop's steps, each checked here
         steps = kernel.kept_steps(integ, eqs, t, y0, t_end, stats)
