@@ -43,6 +43,7 @@ from ..kernels.dop853_dense import dense_at, dense_output, kept_offsets, kept_pa
 from ..kernels.lagrange_numba import D_NC, D_NQ, scratch_size
 from ..kernels.loads_numba import H_NTAB
 from ..kernels.rows_numba import rows_jacobian
+from ..results.records import RunCounters
 from .mode_system import ModeEval
 
 __all__ = ["fast_forward", "kept_steps", "warm_up_dop853", "warm_up_fixed_step",
@@ -206,7 +207,7 @@ def _loop(kernel, b, integ, y, atol, te, t: float, t_end: float):
 
 
 def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, sample, t_eval,
-                 next_out: int, every_step: bool, stats: dict, bar=None,
+                 next_out: int, every_step: bool, stats: RunCounters, bar=None,
                  deadline: float | None = None):
     """Integrate a segment on ``kernel`` in the compiled loop of its integrator (DOP853,
     or RK4 and Wilson's method on their grid), as far as it can.
@@ -319,9 +320,9 @@ def _account(ipar, stats, counted: list) -> None:
     """The loop's steps, evaluations and rejected steps since they were last ``counted``
     added to the run's ``stats``."""
     steps, evals, rej = (int(ipar[i]) for i in (L.I_STEPS, L.I_EVALS, L.I_REJ))
-    stats["steps"] += steps - counted[0]
-    stats["evaluations"] += evals - counted[1]
-    stats["rejected"] += rej - counted[2]
+    stats.steps += steps - counted[0]
+    stats.evaluations += evals - counted[1]
+    stats.rejected += rej - counted[2]
     counted[:] = steps, evals, rej
 
 
@@ -330,8 +331,8 @@ def _rewind(mark, counted: list, stats, kernel, ipar):
     one by one, with the caller's checks after each (the exact step budget ...); returns
     what :func:`fast_forward` does."""
     t0_, y0_, next0, (st, _, rej), ws0, h = mark
-    stats["steps"] -= counted[0] - st
-    stats["rejected"] -= counted[2] - rej
+    stats.steps -= counted[0] - st
+    stats.rejected -= counted[2] - rej
     kernel.restore(ws0)
     ipar[L.I_NOUT] = 0
     return t0_, y0_, next0, False, h
@@ -413,7 +414,7 @@ def _samples_of(step, y_new, ev, sample, te, ipar, every_step, t_now):
     return t_now, y_new, int(ipar[L.I_NEXT]), False, None
 
 
-def kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
+def kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: RunCounters):
     """The steps of a segment with event functions from the compiled loop of the
     integrator (:func:`_kept_steps`), or None for a fixed-step method the loop does not
     have (its Python stepper takes them)."""
@@ -422,7 +423,7 @@ def kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
     return _kept_steps(kernel, integ, eqs, t, y0, t_end, stats)
 
 
-def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
+def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: RunCounters):
     """The steps of a segment with event functions, taken in the compiled loop.
 
     The loop takes :data:`KEEP_STEPS` steps per call (those after an event are taken in
@@ -448,7 +449,7 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
     ----------
     kernel, integ, eqs, t, y0, t_end
         As in :func:`fast_forward`; ``y0`` (q_I, q_I', w), shape (2 n_i + 1,).
-    stats : dict
+    stats : RunCounters
         The run's ``evaluations`` and ``rejected`` are counted in it (``steps`` by the
         caller); ``integ.stats`` is reset.
 
@@ -483,8 +484,8 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
         ipar[L.I_NKEPT] = 0
         code = call()
         evals, rej = int(ipar[L.I_EVALS]), int(ipar[L.I_REJ])
-        stats["evaluations"] += evals - counted[0]
-        stats["rejected"] += rej - counted[1]
+        stats.evaluations += evals - counted[0]
+        stats.rejected += rej - counted[1]
         counted[:] = evals, rej
         nk = int(ipar[L.I_NKEPT])
         rows = b.kept[:nk].copy()
@@ -503,7 +504,7 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: dict):
 
 
 def _kept_step(row, m: int, ni: int, fixed: bool = False, kernel=None,
-               stats: dict | None = None) -> Step:
+               stats: RunCounters | None = None) -> Step:
     """The :class:`Step` of a row of the loop's kept steps, with its dense output (a
     fixed-step loop's: the Python stepper's quintic Hermite interpolant of its ends).  A
     DOP853 step whose dense output the loop did not make gets it on first use
@@ -527,7 +528,7 @@ def _kept_step(row, m: int, ni: int, fixed: bool = False, kernel=None,
                               b.piv, d)
             kernel.restore(saved)
             if stats is not None:
-                stats["evaluations"] += 3
+                stats.evaluations += 3
             if st == 0:
                 coeffs.append(d)
             else:

@@ -15,7 +15,14 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from .base import DEFAULT_RTOL, AdaptiveIntegrator, Integrator, IntegratorOptionError
+from ..fieldmap import FieldMapping
+from .base import (
+    DEFAULT_RTOL,
+    AdaptiveIntegrator,
+    Integrator,
+    IntegratorOptionError,
+    IntegratorStats,
+)
 from .compiled_dop853 import DOP853
 from .events import as_events
 from .runge_kutta import RungeKutta4
@@ -24,7 +31,7 @@ from .segment import arm, run_segment, user_event_functions, user_event_records
 from .wilson import Wilson
 
 __all__ = ["INTEGRATORS", "make_integrator", "segment_integrators", "solve", "Solution",
-           "sample_times"]
+           "SolveStats", "sample_times"]
 
 #: valid integrator names: "dop853" runs in the compiled loop where it can
 #: (:mod:`mechdyn.integrate.compiled_dop853`), "scipy-dop853" is SciPy's everywhere
@@ -91,9 +98,38 @@ def make_integrator(name: str | Integrator = "dop853", *, steps: int | None = No
     return integ
 
 
+@dataclass(frozen=True)
+class SolveStats(FieldMapping):
+    """The counters of a :func:`solve` (also read as a mapping: ``stats["steps"]``).
+
+    Attributes
+    ----------
+    integrator : str
+        The integrator's name.
+    steps : int
+        Accepted steps.
+    rejected : int
+        Rejected steps (adaptive integrators).
+    evaluations : int
+        Right-hand-side evaluations f(t, q, qdot).
+
+    Examples
+    --------
+    >>> s = SolveStats("rk4", steps=10, evaluations=41)
+    >>> s.steps, s["evaluations"], list(s)
+    (10, 41, ['integrator', 'steps', 'rejected', 'evaluations'])
+    """
+
+    integrator: str
+    steps: int = 0
+    rejected: int = 0
+    evaluations: int = 0
+
+
 @dataclass
 class Solution:
-    """Result of :func:`solve`: samples (time-major), events, counters, status."""
+    """Result of :func:`solve`: samples (time-major), events, counters
+    (:class:`SolveStats`), status."""
 
     t: np.ndarray
     q: np.ndarray
@@ -101,7 +137,7 @@ class Solution:
     qddot: np.ndarray
     w: np.ndarray
     events: list = field(default_factory=list)
-    stats: dict = field(default_factory=dict)
+    stats: SolveStats = field(default_factory=lambda: SolveStats(""))
     status: str = "success"
 
 
@@ -218,7 +254,7 @@ def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end
         for _ in range(int(np.sum(te <= t0))):
             push(t0, y)
         te = te[te > t0]
-    counts = {"steps": 0, "rejected": 0, "evaluations": 0}
+    counts = IntegratorStats()
     t, fresh, next_out, records, status = t0, set(), 0, [], "success"
 
     def coordinates(t_, y_):  # what the caller's event functions read
@@ -246,4 +282,5 @@ def solve(integrator: Integrator | str, f: Callable, t0: float, q0, qdot0, t_end
             break
     Y = np.array(out_y).reshape(len(out_t), -1)
     return Solution(np.array(out_t), Y[:, :n], Y[:, n:2 * n], np.array(out_a).reshape(-1, n),
-                    Y[:, 2 * n:], records, {"integrator": integ.name, **counts}, status)
+                    Y[:, 2 * n:], records, SolveStats(integ.name, counts.steps, counts.rejected,
+                                          counts.evaluations), status)

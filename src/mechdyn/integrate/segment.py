@@ -144,7 +144,7 @@ def locate(cands, t_old: float, t_new: float, dense: Callable, evaluate: Callabl
 
 def run_segment(integ, eqs, t: float, y0, t_end: float, efns: list[EventFunction], *,
                 evaluate: Callable, after_step: Callable, sample: Callable, t_eval,
-                next_out: int, every_step: bool, stats: dict, bar=None,
+                next_out: int, every_step: bool, stats, bar=None,
                 deadline: float | None = None, n: int | None = None):
     """Integrate one segment from ``t`` until the first event or ``t_end``.
 
@@ -171,8 +171,10 @@ def run_segment(integ, eqs, t: float, y0, t_end: float, efns: list[EventFunction
     t_eval : ndarray
         Output times (``next_out`` is the first not yet sampled); with ``every_step``
         the end of every step is sampled too.
-    stats : dict
-        ``steps``, ``rejected``, ``evaluations`` are counted in it.
+    stats
+        Counters with the attributes ``steps``, ``rejected``, ``evaluations``, counted
+        in it (:class:`~mechdyn.integrate.base.IntegratorStats`, or the run's
+        :class:`~mechdyn.results.records.RunCounters`).
     deadline : float, optional
         ``time.perf_counter()`` value after which the run stops (status timeout).
     n : int, optional
@@ -214,7 +216,7 @@ def run_segment(integ, eqs, t: float, y0, t_end: float, efns: list[EventFunction
     try:
         for step in steps:
             anchor()
-            stats["steps"] += 1
+            stats.steps += 1
             t_old, t_new = step.t_old, step.t
             if bar is not None:
                 bar.update(t_new)
@@ -251,7 +253,7 @@ def run_segment(integ, eqs, t: float, y0, t_end: float, efns: list[EventFunction
                            f"t = {t_new:.9g} s")
     finally:
         steps.close()
-        stats["rejected"] += integ.stats.rejected
-        stats["evaluations"] += integ.stats.evaluations
+        stats.rejected += integ.stats.rejected
+        stats.evaluations += integ.stats.evaluations
     return hit, next_out
 

@@ -88,7 +88,7 @@ def plot_trajectory(traj, path=None, *, coordinates=None, degrees: bool = True,
     axes[-1].set_xlabel("t [s]")
     head = title or " ".join(filter(None, (
         f"{model_name(traj)}: simulation", speed_text(traj),
-        f"- {traj.stats.get('integrator', '')} ({traj.stats.get('formulation', '')})")))
+        f"- {traj.stats.integrator} ({traj.stats.formulation})")))
     if not traj.success:
         head += f" - stopped: {traj.status}"
     fig.suptitle(head)

@@ -384,12 +384,12 @@ def write_report(model, path, *, sweep=None, kinetostatics=None, title: str | No
 
 
 def _run_table(traj) -> str:
-    s = traj.stats or {}
-    run = {label: s.get(key) for label, key in (
-        ("integrator", "integrator"), ("formulation", "formulation"), ("backend", "backend"),
-        ("steps", "steps"), ("rejected steps", "rejected"), ("evaluations", "evaluations"))}
-    if s.get("wall_time_s") is not None:
-        run["wall time (s)"] = f"{float(s['wall_time_s']):.3g}"
+    s = traj.stats
+    run = {"integrator": s.integrator or None, "formulation": s.formulation or None,
+           "backend": s.backend or None, "steps": s.steps, "rejected steps": s.rejected,
+           "evaluations": s.evaluations}
+    if s.wall_time_s is not None:
+        run["wall time (s)"] = f"{float(s.wall_time_s):.3g}"
     run["samples"] = traj.n_samples
     if traj.t.size:
         run["t start (s)"], run["t end (s)"] = f"{traj.t[0]:.6g}", f"{traj.t[-1]:.6g}"

@@ -2,113 +2,20 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from functools import cached_property
 
 import numpy as np
 
 from ..errors import ModelError, did_you_mean
 from ..kinematics.analogs import accelerations
 from ..model.constraints import point_acceleration, point_position, point_velocity
+from .records import RunStats, SwitchedSamples
 from .table import coordinate_columns, force_columns, mode_columns
 
 __all__ = ["Trajectory", "SwitchedSamples"]
 
 #: statuses of a run that reached its end (or a terminal event)
 SUCCESS_STATUSES = ("success", "event")
-#: the keys of a :class:`SwitchedSamples` read as a mapping, in order
-SWITCHED_KEYS = ("mode", "modes", "mode_index", "frame_force", "forces", "impact_losses",
-                 "penetration", "frame_moment")
-
-
-@dataclass(frozen=True)
-class SwitchedSamples(Mapping):
-    """What a variable-structure run records per sample beyond the motion (typed; it also
-    reads as the mapping ``trajectory.stats["variable_structure"]`` it used to be).
-
-    The loads on the frame and in every element (``frame_force``, ``frame_moment``,
-    ``forces``) are computed from the run's samples when first read: ``loads`` is the
-    mapping of them or the function that computes it (an error of the function is raised
-    again by the next read).
-
-    Attributes
-    ----------
-    mode : list of Mode
-        The mode of every sample, shape (n,).
-    modes : list of Mode
-        The distinct modes in the order they appeared.
-    mode_index : ndarray of int, shape (n,)
-        Index of each sample's mode in ``modes``.
-    impact_losses : ndarray, shape (n,)
-        Kinetic energy lost in impacts up to each sample, J.
-    penetration : float
-        Largest penetration of a stop or contact seen, m.
-    frame_force : ndarray, shape (n, 2)
-        Force the frame receives (reactions and the ground ends of springs), N.
-    frame_moment : ndarray, shape (n,)
-        Moment the frame receives about the ground origin, N m.
-    forces : dict
-        Per joint, lock, stop and contact: its reaction per sample ((n, 2) or (n, 3):
-        force on the child from the parent at the joint point, N, and moment, N m;
-        (n,) normal force of a stop or contact, N).
-
-    Examples
-    --------
-    >>> s = SwitchedSamples([frozenset()], [frozenset()], np.zeros(1, int), np.zeros(1),
-    ...                     loads=lambda: {"frame_force": np.ones((1, 2)), "forces": {}})
-    >>> s["frame_force"].tolist(), s.frame_moment is None, len(s)
-    ([[1.0, 1.0]], True, 8)
-    """
-
-    mode: list
-    modes: list
-    mode_index: np.ndarray
-    impact_losses: np.ndarray
-    penetration: float = 0.0
-    loads: Callable[[], Mapping] | Mapping = field(default_factory=dict, repr=False,
-                                                   compare=False)
-
-    @classmethod
-    def lazy(cls, fill, **fields) -> SwitchedSamples:
-        """The record with its loads computed by ``fill()`` on first read."""
-        return cls(**fields, loads=fill)
-
-    @cached_property
-    def _loads(self) -> dict:
-        """The loads, computed once (see the class's text)."""
-        return dict(self.loads() if callable(self.loads) else self.loads)
-
-    @property
-    def frame_force(self) -> np.ndarray:
-        """Force the frame receives, N, shape (n, 2)."""
-        return self._loads.get("frame_force")
-
-    @property
-    def frame_moment(self) -> np.ndarray | None:
-        """Moment the frame receives about the ground origin, N m, shape (n,)."""
-        return self._loads.get("frame_moment")
-
-    @property
-    def forces(self) -> dict:
-        """The reaction of every joint, lock, stop and contact per sample, N (N m)."""
-        return self._loads.get("forces", {})
-
-    def __getstate__(self) -> dict:  # pickled and copied with the loads computed
-        state = {k: v for k, v in self.__dict__.items() if k != "_loads"}
-        state["loads"] = self._loads
-        return state
-
-    def __getitem__(self, key):
-        if key not in SWITCHED_KEYS:
-            raise KeyError(key)
-        return getattr(self, key)
-
-    def __iter__(self):
-        return iter(SWITCHED_KEYS)
-
-    def __len__(self) -> int:
-        return len(SWITCHED_KEYS)
 
 
 @dataclass(frozen=True)
@@ -133,14 +40,15 @@ class Trajectory:
         What happened, with the time and the coordinates when the run stopped early.
     events : list of EventRecord
         Occurrences of the requested events, in time order.
-    stats : dict
-        ``steps``, ``rejected``, ``evaluations`` (right-hand sides), ``wall_time_s``,
-        ``integrator``, ``formulation``, ``backend`` and the integrator's settings; for a
-        variable-structure run also ``segments`` and ``variable_structure``, a
-        :class:`SwitchedSamples` (see :attr:`switching`); for a run handed to a sink
-        without keeping its samples (``simulate(sink=..., keep=False)``, which holds the
-        last chunk) ``streamed``: the run's ``rows``, ``t_first``, ``energy_drift`` and
-        largest constraint ``residual``.
+    stats : RunStats
+        The run's counters and settings (:class:`~mechdyn.results.records.RunStats`:
+        ``steps``, ``rejected``, ``evaluations``, ``wall_time_s``, ``integrator``,
+        ``formulation``, ``backend``, the tolerances; ``segments``, ``bifurcations``;
+        ``variable_structure``, a :class:`SwitchedSamples`, see :attr:`switching`; for a
+        run handed to a sink without keeping its samples (``simulate(sink=...,
+        keep=False)``, which holds the last chunk) ``streamed``, a
+        :class:`~mechdyn.results.records.StreamedStats`).  It also reads as the mapping
+        it used to be: ``stats["steps"]``.
     energy : dict or None
         Arrays of shape (n,): ``kinetic`` T, ``potential`` U, ``work_nc`` (work of
         the non-conservative forces since t0: drives, applied forces and torques,
@@ -164,7 +72,7 @@ class Trajectory:
     status: str = "success"
     message: str = ""
     events: list = field(default_factory=list)
-    stats: dict = field(default_factory=dict)
+    stats: RunStats = field(default_factory=RunStats)
     energy: dict | None = None
     coordinate_names: tuple = ()
     body_names: tuple = ()
@@ -200,8 +108,8 @@ class Trajectory:
 
     def energy_drift(self) -> float:
         """Largest |balance - balance[0]| over the run, J (NaN without energy)."""
-        if "streamed" in self.stats:  # a run handed to a sink, of which this is the end
-            return float(self.stats["streamed"]["energy_drift"])
+        if self.stats.streamed is not None:  # a run handed to a sink, of which this is the end
+            return float(self.stats.streamed.energy_drift)
         if not self.energy or self.t.size == 0:
             return float("nan")
         b = self.energy["balance"]
@@ -211,18 +119,18 @@ class Trajectory:
         """Multi-line text: status, counters and the energy balance."""
         lines = [f"status: {self.status}" + (f" - {self.message}" if self.message else "")]
         s = self.stats
-        if s:
+        if s.integrator:
+            wall = float("nan") if s.wall_time_s is None else s.wall_time_s
             lines.append(
-                f"integrator {s.get('integrator')} ({s.get('formulation')}, backend "
-                f"{s.get('backend')}): {s.get('steps')} steps, {s.get('evaluations')} "
-                f"evaluations, wall time {s.get('wall_time_s', float('nan')):.4g} s")
-        streamed = s.get("streamed") if s else None
-        if streamed:
-            lines.append(f"samples: {streamed['rows']} (streamed), t = "
-                         f"{streamed['t_first']:.6g} .. {self.t[-1]:.6g} s")
+                f"integrator {s.integrator} ({s.formulation}, backend {s.backend}): "
+                f"{s.steps} steps, {s.evaluations} evaluations, wall time {wall:.4g} s")
+        streamed = s.streamed
+        if streamed is not None:
+            lines.append(f"samples: {streamed.rows} (streamed), t = "
+                         f"{streamed.t_first:.6g} .. {self.t[-1]:.6g} s")
         elif self.t.size:
             lines.append(f"samples: {self.t.size}, t = {self.t[0]:.6g} .. {self.t[-1]:.6g} s")
-        bif = s.get("bifurcations") if s else None
+        bif = s.bifurcations
         if bif:
             unit = " rad" if self.coordinate_is_angle[0] else " m"
             lines.append(f"went through {len(bif)} bifurcation position(s) on its branch, at "
@@ -235,7 +143,7 @@ class Trajectory:
                 f"energy at the end: T = {e['kinetic'][-1]:.9g} J, U = {e['potential'][-1]:.9g}"
                 f" J, W_nc = {e['work_nc'][-1]:.9g} J; balance T + U - W_nc drifts by "
                 f"{self.energy_drift():.3e} J; largest constraint residual "
-                f"{streamed['residual'] if streamed else np.max(e['residual']):.3e}")
+                f"{streamed.residual if streamed is not None else np.max(e['residual']):.3e}")
         return "\n".join(lines)
 
     # ------------------------------------------------------------------ tables
@@ -299,10 +207,9 @@ class Trajectory:
     @property
     def switching(self) -> SwitchedSamples | None:
         """The per-sample modes and element forces of a variable-structure run, else None."""
-        vs = self.stats.get("variable_structure")
-        return vs if isinstance(vs, SwitchedSamples) else None
+        return self.stats.variable_structure
 
     def xddot(self) -> np.ndarray:
         """Body frame accelerations xddot = B q'' + b, shape (n, n_x) (needs ``model``)."""
         return accelerations(self.model, self.x, self.xdot, self.qddot,
-                             layout=self.model.layout(self.stats.get("mode")))
+                             layout=self.model.layout(self.stats.mode))

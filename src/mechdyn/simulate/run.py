@@ -145,8 +145,9 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
     keep : bool
         With a ``sink``: also keep every sample for the Trajectory returned (default);
         ``False`` keeps only the last chunk, so memory does not grow with the run, and
-        ``stats["streamed"]`` gives the run's ``rows``, ``t_first``, ``energy_drift``
-        and largest constraint ``residual``.
+        ``stats.streamed`` (:class:`~mechdyn.results.records.StreamedStats`) gives the
+        run's ``rows``, ``t_first``, ``energy_drift`` and largest constraint
+        ``residual``.
     workspace : Workspace, optional
         The caches of the run (:class:`~mechdyn.model.workspace.Workspace`): pass the
         same one to many runs of one model from one initial state (a study, an
@@ -163,8 +164,9 @@ def simulate(mech_or_model, t_end: float, *, integrator="dop853", steps: int | N
         work_nc, balance = T + U - W_nc + impact losses, residual; with friction in the
         pairs also work_friction, the energy they dissipated, J, included in work_nc,
         and power_friction, W);
-        ``stats["variable_structure"]``
-        (:class:`~mechdyn.results.trajectory.SwitchedSamples`: the mode of each
+        ``stats`` (:class:`~mechdyn.results.records.RunStats`: the counters, and
+        ``variable_structure``, see ``switching``); ``switching``
+        (:class:`~mechdyn.results.records.SwitchedSamples`: the mode of each
         sample, the force on the frame, the force of every joint, lock, stop and
         contact, see :func:`mechdyn.dynamics.reactions.element_forces`).  Also when
         the run stopped early: then ``status`` and ``message`` say why and where,

@@ -12,6 +12,7 @@ chunk by chunk as they come -- into the run's
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -22,6 +23,7 @@ from ..friction.law import friction_joints
 from ..kernels import rows_numpy as RN
 from ..kernels.planar import cross
 from ..results.lazy_table import LazyDict
+from ..results.records import RunCounters, RunStats, StreamedStats
 from ..results.trajectory import SwitchedSamples, Trajectory
 from .gaps import gaps
 from .impact import frame_impulse_key
@@ -62,8 +64,8 @@ class Samples:
         Samples per chunk (>= 1).
     keep : bool
         Keep every chunk for the Trajectory returned (else it holds the last chunk, and
-        ``stats["streamed"]`` the run's row count, first time, energy drift and largest
-        constraint residual).
+        ``stats.streamed`` (:class:`~mechdyn.results.records.StreamedStats`) the run's
+        row count, first time, energy drift and largest constraint residual).
 
     Raises
     ------
@@ -81,33 +83,29 @@ class Samples:
         self.modes: list = []  # the modes in the order they appeared, over the whole run
         self.blocks: list = []
         self.shapes = element_shapes(model, sm) if sink is not None else None
-        self.streamed: dict = {}
+        self.streamed: StreamedStats | None = None
         self.penetration = 0.0
 
-    def append(self, sample, stats) -> None:
+    def append(self, sample, stats: RunCounters) -> None:
         """Record a sample; hand a full chunk to the sink."""
         self.state[1].append(sample)
         self.last = sample
         if self.sink is not None and len(self.state[1]) >= self.chunk:
             self.flush(stats)
 
-    def flush(self, stats) -> None:
+    def flush(self, stats: RunCounters) -> None:
         """Evaluate the waiting samples and hand them to the sink."""
         start, rows = self.state
         if not rows:
             return
         block = _block(self.model, self.sm, rows, self.point, self.modes, self.shapes)
-        self.sink(_trajectory(self.model, block, self.modes, [], {"mode": stats.get("mode")},
+        self.sink(_trajectory(self.model, block, self.modes, [], RunStats(mode=stats.mode),
                               Status.SUCCESS, ""), start)
         self.state = (start + len(rows), [])
         bal, res = block["balance"], block["residual"]
-        s = self.streamed
-        if not s:
-            s.update(rows=0, t_first=float(block["t"][0]), balance0=float(bal[0]),
-                     energy_drift=0.0, residual=0.0)
-        s["rows"] += len(rows)
-        s["energy_drift"] = max(s["energy_drift"], float(np.max(np.abs(bal - s["balance0"]))))
-        s["residual"] = max(s["residual"], float(np.max(res)))
+        s = self.streamed or StreamedStats(0, float(block["t"][0]), float(bal[0]), 0.0, 0.0)
+        self.streamed = s.joined(len(rows), float(np.max(np.abs(bal - s.balance0))),
+                                 float(np.max(res)))
         self.penetration = max(self.penetration, block["penetration"])
         self.blocks = [*self.blocks, block] if self.keep else [block]
 
@@ -201,16 +199,15 @@ def _joined(blocks: list) -> dict:
     return out
 
 
-def _trajectory(model, block, modes, events, stats, status, message) -> Trajectory:
+def _trajectory(model, block, modes, events, stats: RunStats, status,
+                message) -> Trajectory:
     """The Trajectory of an evaluated block of samples."""
     b = block
-    stats = dict(stats)
-    stats["penetration"] = b["penetration"]
-    stats["variable_structure"] = SwitchedSamples(
+    stats = replace(stats, penetration=b["penetration"], variable_structure=SwitchedSamples(
         mode=b["mode"], modes=list(modes), mode_index=b["mode_index"],
         impact_losses=b["impact_losses"], penetration=b["penetration"],
         loads=dict(frame_force=b["frame"][:, :2], frame_moment=b["frame"][:, 2],
-                   forces=b["forces"]))
+                   forces=b["forces"])))
     return Trajectory(b["t"], b["q"], b["qdot"], b["qddot"], b["x"], b["xdot"],
                       status=status, message=message, events=list(events), stats=stats,
                       energy=_energy(bool(friction_joints(model)), b),
@@ -219,18 +216,18 @@ def _trajectory(model, block, modes, events, stats, status, message) -> Trajecto
                       model=model)
 
 
-def finish(model, rec: Samples, events, stats, wall0, status, message, sm,
+def finish(model, rec: Samples, events, stats: RunCounters, wall0, status, message, sm,
             point=(0.0, 0.0)) -> Trajectory:
     """The Trajectory of a run from its samples: forces, frame loads and energies are
     evaluated here (or chunk by chunk as they were handed to the sink), batched over the
     samples of each mode segment."""
     point = np.asarray(point, float)
-    stats = dict(stats)
+    streamed = None
     if rec.sink is not None:
         rec.flush(stats)
         blocks = rec.blocks
-        if rec.streamed and not rec.keep:
-            stats["streamed"] = dict(rec.streamed)
+        if rec.streamed is not None and not rec.keep:
+            streamed = rec.streamed
     key = frame_impulse_key(sm)
     for ev in events:  # the frame's impulse of an impact: its angular part about the point
         if key in ev.impulses:
@@ -238,16 +235,16 @@ def finish(model, rec: Samples, events, stats, wall0, status, message, sm,
             f[2] -= cross(point, f[:2])
             ev.impulses[key] = f
     if rec.sink is None:  # forces, frame loads and energies: evaluated on first use
-        stats["wall_time_s"] = time.perf_counter() - wall0
-        return _lazy_trajectory(model, sm, rec.state[1], point, rec.modes, events, stats,
+        done = stats.freeze(wall_time_s=time.perf_counter() - wall0)
+        return _lazy_trajectory(model, sm, rec.state[1], point, rec.modes, events, done,
                                 status, message)
     if not blocks:  # nothing recorded
         blocks = [_block(model, sm, [], point, rec.modes)]
     block = _joined(blocks)
     if rec.sink is not None:
         block["penetration"] = max(rec.penetration, block["penetration"])
-    stats["wall_time_s"] = time.perf_counter() - wall0
-    return _trajectory(model, block, rec.modes, events, stats, status, message)
+    done = stats.freeze(wall_time_s=time.perf_counter() - wall0, streamed=streamed)
+    return _trajectory(model, block, rec.modes, events, done, status, message)
 
 
 class _Table:
@@ -282,17 +279,18 @@ def _energy(friction: bool, b: dict) -> dict:
     return energy
 
 
-def _lazy_trajectory(model, sm, rec, point, modes, events, stats, status, message):
+def _lazy_trajectory(model, sm, rec, point, modes, events, stats: RunStats, status,
+                     message) -> Trajectory:
     """The Trajectory of samples ``rec`` with its forces, frame loads and energies
     evaluated on first use (the numbers of :func:`_block`): the motion and the modes
     now."""
     t, _, _, lost, x, xd, q, qd, qdd = _motion(model, rec)
     mode_index = _modes(rec, modes)
     table = _Table(model, sm, rec, point, modes)
-    stats["penetration"] = pen = _penetration(sm, x)
-    stats["variable_structure"] = SwitchedSamples.lazy(
+    pen = _penetration(sm, x)
+    stats = replace(stats, penetration=pen, variable_structure=SwitchedSamples.lazy(
         table.frame_and_forces, mode=[r[1].mode for r in rec], modes=list(modes),
-        mode_index=mode_index, impact_losses=lost, penetration=pen)
+        mode_index=mode_index, impact_losses=lost, penetration=pen))
     return Trajectory(t, q, qd, qdd, x, xd, status=status, message=message,
                       events=list(events), stats=stats, energy=LazyDict.lazy(table.energy),
                       coordinate_names=model.coordinate_names, body_names=model.body_names,

@@ -25,7 +25,8 @@ All declared coordinates are recorded in every mode (dependent ones measured on
 the pose), so one :class:`~mechdyn.results.trajectory.Trajectory` covers the whole
 run; its ``events`` list holds an :class:`~mechdyn.integrate.events.EventRecord`
 per switching instant and per caller's event.  Per-sample mode, constraint forces
-and forces on the frame are in ``trajectory.stats["variable_structure"]``.
+and forces on the frame are in ``trajectory.switching``
+(``trajectory.stats.variable_structure``).
 """
 
 from __future__ import annotations
@@ -62,6 +63,7 @@ from ..model.switchable import switched_model
 from ..model.workspace import Workspace
 from ..progress import Progress
 from ..results.events import format_events
+from ..results.records import RunCounters
 from ..results.trajectory import Trajectory
 from .run_start import give_back, start_equations, start_state
 from .samples import Samples, finish
@@ -227,9 +229,8 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
         method, opts.t0, opts.t_end, rtol=rtol, atol=atol, dt=dt, steps=steps,
         iterations=iterations, tol=tol, theta=theta, first_step=first_step,
         max_step=max_step)
-    stats = dict(steps=0, rejected=0, evaluations=0, integrator=method_name,
-                 formulation=formulation, backend="numpy", rtol=rtol, atol=atol, segments=0,
-                 bifurcations=[])
+    stats = RunCounters(integrator=method_name, formulation=formulation, backend="numpy",
+                        rtol=rtol, atol=atol)
     # per sample: t, the mode system, the evaluation, the work (w_nc and, with friction in
     # the joints, the friction work w_f) and the impact losses so far;
     # forces and energies are computed at the end (with a sink: chunk by chunk), batched
@@ -242,7 +243,7 @@ def simulate_events(mech_or_model, t_end: float, *, q0=None, qdot0=None, t0: flo
     unknown = [n for n in locks if n not in sm.lock_names]
     if unknown:
         raise ModelError("mode: " + did_you_mean(unknown[0], sm.lock_names, "lock"))
-    stats["mode"] = sorted(locks)  # the engaged locks at the start
+    stats.mode = sorted(locks)  # the engaged locks at the start
     # the run's caches, shared by the mode systems of the run (the caller's, if given)
     ws = (Workspace() if workspace is None else workspace).begin()
     guess = loop.initial(locks, q0, qdot0, ws)
@@ -261,7 +262,7 @@ class _SegmentLoop:
     """One run of the segment loop: the state it advances from segment to segment and
     what it records (see the module's text)."""
 
-    def __init__(self, model, opts: LoopOptions, rec, stats, segment_integrator,
+    def __init__(self, model, opts: LoopOptions, rec, stats: RunCounters, segment_integrator,
                  user_events, t_eval, every_step, equations, wall0):
         self.model, self.sm, self.opts = model, switched_model(model), opts
         self.rec, self.stats, self.events = rec, stats, []
@@ -309,9 +310,9 @@ class _SegmentLoop:
         stats, o = self.stats, self.opts
         status, message = Status.SUCCESS, ""
         first_eqs = kept_eqs = None
-        while self.t < o.t_end or not stats["segments"]:
-            stats["segments"] += 1
-            if stats["segments"] == 1:  # kept with the run's start, if it was kept
+        while self.t < o.t_end or not stats.segments:
+            stats.segments += 1
+            if stats.segments == 1:  # kept with the run's start, if it was kept
                 eqs, kept_eqs = start_equations(self.sm, self.ms, *self.equations, start)
                 first_eqs = eqs
             else:
@@ -339,12 +340,12 @@ class _SegmentLoop:
                 status, message = _status(exc, self.good)
                 break
             finally:
-                stats["bifurcations"] += eqs.report()
+                stats.bifurcations += eqs.report()
                 self._note_compile(eqs)
         if self.after_event:  # the run ended before the next segment stored the state after
             self.store(self.t, self.ms, self.ms.evaluate_x(self.t, self.x, self.xd), self.w)
         b = self.backends
-        stats["backend"] = "numba" if b == {"numba"} else (
+        stats.backend = "numba" if b == {"numba"} else (
             "numpy" if b <= {"numpy"} else "numba+numpy")
         bar.close()
         give_back(ws, first_eqs, kept_eqs)  # for the next run from the same start
@@ -353,15 +354,15 @@ class _SegmentLoop:
     def _note_backend(self, eqs) -> None:
         self.backends.add(eqs.backend)
         if eqs.note:
-            self.stats["backend_note"] = eqs.note
+            self.stats.backend_note = eqs.note
         self._note_compile(eqs)
 
     def _note_compile(self, eqs) -> None:
         """The compile time of the run so far: the kernel's groups compiled on first use
         (the dynamics when the kernel was made, its loop when the segment ran it)."""
         if eqs.kernel is not None:
-            self.stats["compile_time_s"] = max(self.stats.get("compile_time_s", 0.0),
-                                               eqs.kernel.compile_time)
+            self.stats.compile_time_s = max(self.stats.compile_time_s or 0.0,
+                                            eqs.kernel.compile_time)
 
     def _segment(self, eqs, evaluate, efns, bar) -> bool:
         """Integrate one segment of the mode (its event functions ``efns``) and apply its
@@ -372,7 +373,7 @@ class _SegmentLoop:
         # the start of the run is an output sample with every_step (else when it is
         # one of t_eval); each segment after an event starts with one
         last = self.rec.last
-        if self.after_event or (self.every_step or stats["segments"] > 1 or t >= o.t_end) and (
+        if self.after_event or (self.every_step or stats.segments > 1 or t >= o.t_end) and (
                 last is None or last[0] != t or last[1].mode != ms.mode):
             self.store(t, ms, ev0, self.w)
         self.after_event = False
@@ -549,6 +550,6 @@ def _budget(step, ev, ms, stats, span, min_step, max_steps, fixed_step) -> None:
             raise Stop(Status.STEP_TOO_SMALL, (
                 f"step size fell below {min_step:.3g} s {where} (h = {h:.3g} s): the "
                 f"motion is too fast for the requested tolerance"))
-    if stats["steps"] > max_steps:  # the steps within the budget are all recorded
+    if stats.steps > max_steps:  # the steps within the budget are all recorded
         raise Stop(Status.BUDGET, f"step budget exhausted after t = {step.t_old:.9g} s "
                                   f"({max_steps} steps; raise max_steps to go on)")
