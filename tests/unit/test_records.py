@@ -73,3 +73,13 @@ def test_field_mapping_leaves_out_the_fields_that_are_none():
     assert s.keys() == ("a", "c") and "b" not in s and 1 not in s
     assert {**s}.keys() == {"a", "c"}
 
+
+def test_a_sweep_s_stats_are_typed():
+    from mechdyn.kinematics.records import SweepStats
+
+    sw = mechdyn.sweep(mechdyn.examples.load("slider_crank"), values=np.linspace(0, 1, 11))
+    s = sw.stats
+    assert isinstance(s, SweepStats) and s.n_points == s["n_points"] == 11
+    assert s.n_requested == 11 and s.bifurcations == [] and "mode" in s
+    assert s.time_s > 0 and s.positions_per_s == pytest.approx(11 / s.time_s)
+

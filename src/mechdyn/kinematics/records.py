@@ -14,6 +14,7 @@ from functools import partial
 
 import numpy as np
 
+from ..fieldmap import FieldMapping
 from ..kernels import rows_numpy
 from ..kernels.planar import cross
 from ..mechanism.joint import Revolute
@@ -22,8 +23,8 @@ from ..model.constraints import point_kinematics, point_position, point_velocity
 from .assembly import position_tol
 from .continuation import path_newton, path_node, sweep_kernel
 
-__all__ = ["KinematicSweep", "KinematicPoint", "SweepSummary", "DeadCentre", "TransmissionAngle",
-           "PointExtremes", "FourBarLoop", "four_bar_loops"]
+__all__ = ["SweepStats", "KinematicSweep", "KinematicPoint", "SweepSummary", "DeadCentre",
+           "TransmissionAngle", "PointExtremes", "FourBarLoop", "four_bar_loops"]
 
 
 def _ro(a):
@@ -66,6 +67,62 @@ class KinematicPoint:
 
 
 @dataclass(frozen=True)
+class SweepStats(FieldMapping):
+    """The counts and timings of a kinematic sweep (``KinematicSweep.stats``).
+
+    Typed like the stats of every record (:mod:`mechdyn.results.records`, which
+    re-exports it: it lives here, below the results, with the sweep); every field also
+    reads as a key (``stats["n_points"]``).
+
+    Attributes
+    ----------
+    n_points : int
+        Positions solved and kept.
+    n_requested : int
+        Positions requested.
+    anchors : int
+        Positions the path was anchored at (solved from the initial guess).
+    coarse_steps : int
+        Accepted steps of the continuation along the path.
+    rejected_steps : int
+        Rejected steps of the continuation.
+    fallback_segments : int
+        Segments the continuation had to redo with small steps.
+    time_s : float
+        Wall time of the sweep, s.
+    time_coarse_s : float
+        Wall time of the continuation, s.
+    positions_per_s : float
+        ``n_points / time_s``, 1/s.
+    bifurcations : list of dict
+        The bifurcation positions the sweep went through on its branch (``at``, the
+        swept coordinate there, rad or m; ``kind``).
+    mode : tuple of str
+        The locks engaged during the sweep.
+
+    Examples
+    --------
+    >>> s = SweepStats(n_points=3, n_requested=3, anchors=1, coarse_steps=2,
+    ...                rejected_steps=0, fallback_segments=0, time_s=0.5,
+    ...                time_coarse_s=0.25, positions_per_s=6.0)
+    >>> s.n_points, s["positions_per_s"], s.bifurcations
+    (3, 6.0, [])
+    """
+
+    n_points: int
+    n_requested: int
+    anchors: int
+    coarse_steps: int
+    rejected_steps: int
+    fallback_segments: int
+    time_s: float
+    time_coarse_s: float
+    positions_per_s: float
+    bifurcations: list = field(default_factory=list)
+    mode: tuple = ()
+
+
+@dataclass(frozen=True)
 class KinematicSweep:
     """Positions, velocities and accelerations of a mechanism over one coordinate.
 
@@ -86,9 +143,10 @@ class KinematicSweep:
         ``"success"``, or ``"singular-position"``: the sweep stopped at a dead or toggle
         position; the positions before it are kept and ``message`` says where.
     message : str
-    stats : dict
-        Counts and timings (``n_points``, ``n_requested``, ``coarse_steps``,
-        ``fallback_segments``, ``time_s``, ``positions_per_s``).
+    stats : SweepStats
+        Counts and timings (:class:`SweepStats`: ``n_points``, ``n_requested``,
+        ``coarse_steps``, ``fallback_segments``, ``time_s``, ``positions_per_s`` ...);
+        also read as the mapping it used to be (``stats["n_points"]``).
     events : tuple of dict
         ``{"kind": "dead-position", "at": value, "index": i, ...}`` when it stopped.
     error : SingularPositionError or None
@@ -106,7 +164,7 @@ class KinematicSweep:
     B: np.ndarray
     status: str
     message: str
-    stats: dict
+    stats: SweepStats
     events: tuple = ()
     error: Exception | None = field(default=None, repr=False, compare=False)
     model: Model = field(default=None, repr=False, compare=False)
@@ -436,7 +494,7 @@ def refine_root(sw: KinematicSweep, i: int, quantity) -> tuple[float, float]:
     gives the value and its first derivative (a travel, a point coordinate); returns
     (q there, value there)."""
     m, k = sw.model, sw.over_index
-    kern = sweep_kernel(m, m.layout(sw.stats.get("mode")))
+    kern = sweep_kernel(m, m.layout(sw.stats.mode))
     tol = position_tol(m)
     last = {"x": sw.x[i], "s": np.nan}
 

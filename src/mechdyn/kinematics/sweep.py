@@ -22,7 +22,7 @@ How it is computed (vectorized over the positions):
    lying flat), is gone through instead: every accepted position is watched for
    one ahead, and near it a branch chart (:mod:`mechdyn.kinematics.branch_chart`)
    gives the positions, expects the sign change and, in step 3, the analogs
-   (the limit from both sides).  ``stats["bifurcations"]`` lists the charts.
+   (the limit from both sides).  ``stats.bifurcations`` lists the charts.
 2. *Batched solve.*  Every value is predicted by quintic Hermite interpolation
    between the two coarse solutions around it (positions, first and second
    derivatives with respect to the swept coordinate), then polished by Newton's
@@ -72,6 +72,7 @@ from .records import (
     KinematicPoint,
     KinematicSweep,
     PointExtremes,
+    SweepStats,
     SweepSummary,
     TransmissionAngle,
     _ro,
@@ -252,14 +253,15 @@ def sweep(mech_or_model, over: str | None = None, values=None, *, speed=None, x_
         error, event = _dead_report(model, lay, k, stop, N, n_req)
         events = (event,)
     elapsed = time.perf_counter() - t_start
-    stats = {"n_points": int(N), "n_requested": int(n_req), "anchors": counter["anchors"],
-             "coarse_steps": int(counter.get("coarse_steps", 0)),
-             "rejected_steps": int(counter.get("rejected_steps", 0)),
-             "fallback_segments": counter["fallback"], "time_s": elapsed,
-             "time_coarse_s": counter["time_coarse"],
-             "positions_per_s": N / elapsed if elapsed > 0 else np.inf,
-             "bifurcations": book.report() if book is not None else [],
-             "mode": tuple(sorted(lay.mode))}
+    stats = SweepStats(
+        n_points=int(N), n_requested=int(n_req), anchors=counter["anchors"],
+        coarse_steps=int(counter.get("coarse_steps", 0)),
+        rejected_steps=int(counter.get("rejected_steps", 0)),
+        fallback_segments=counter["fallback"], time_s=elapsed,
+        time_coarse_s=counter["time_coarse"],
+        positions_per_s=N / elapsed if elapsed > 0 else np.inf,
+        bifurcations=book.report() if book is not None else [],
+        mode=tuple(sorted(lay.mode)))
     return KinematicSweep(
         over=over, values=_ro(values[:N].copy()), q=_ro(Q), qdot=_ro(qdot), qddot=_ro(qddot),
         x=_ro(X), xdot=_ro(xdot), xddot=_ro(xddot), B=_ro(B), stats=stats, events=events,

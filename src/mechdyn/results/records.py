@@ -8,7 +8,10 @@ also reads as the read-only mapping it used to be (``stats["evaluations"]``,
 :class:`~mechdyn.fieldmap.FieldMapping`): the keys are its fields that are not None.
 
 The record classes themselves stay in their modules
-(:mod:`mechdyn.results.trajectory` ...); only their stats are here.
+(:mod:`mechdyn.results.trajectory` ...); only their stats are here.  The stats of a
+kinematic sweep, :class:`~mechdyn.kinematics.records.SweepStats`, are defined with the
+sweep in :mod:`mechdyn.kinematics.records` (the kinematics are a layer below the
+results and may not import them) and re-exported here.
 """
 
 from __future__ import annotations
@@ -20,8 +23,9 @@ from functools import cached_property
 import numpy as np
 
 from ..fieldmap import FieldMapping
+from ..kinematics.records import SweepStats
 
-__all__ = ["RunStats", "RunCounters", "StreamedStats", "SwitchedSamples"]
+__all__ = ["RunStats", "RunCounters", "StreamedStats", "SwitchedSamples", "SweepStats"]
 
 #: the keys of a :class:`SwitchedSamples` read as a mapping, in order
 SWITCHED_KEYS = ("mode", "modes", "mode_index", "frame_force", "forces", "impact_losses",
