@@ -83,3 +83,15 @@ def test_a_sweep_s_stats_are_typed():
     assert s.n_requested == 11 and s.bifurcations == [] and "mode" in s
     assert s.time_s > 0 and s.positions_per_s == pytest.approx(11 / s.time_s)
 
+
+def test_a_kinetostatic_analysis_s_stats_are_typed():
+    from mechdyn.results.records import KinetostaticsStats
+
+    res = mechdyn.kinetostatics(mechdyn.examples.load("slider_crank"), speed=10.0,
+                                values=np.linspace(0, 1, 11))
+    s = res.stats
+    assert isinstance(s, KinetostaticsStats) and s.positions == s["positions"] == 11
+    assert s.power_balance_rel < 1e-9 and s.seconds > 0
+    assert s.redundant_equations == 0 and "redundant_shared_by" not in s
+    assert s.segments is None and "segments" not in s and "friction_iterations" not in s
+

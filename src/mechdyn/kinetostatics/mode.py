@@ -18,6 +18,7 @@ from ..friction.law import friction_joints
 from ..model.constraints import coordinates, coordinates_gamma, coordinates_jacobian
 from ..model.forces import force_model
 from ..results.kinetostatics_record import Kinetostatics
+from ..results.records import KinetostaticsStats
 from ..units import is_quantity, parse_quantity
 from .prescribed import _prescribed, independent_subset
 
@@ -230,10 +231,10 @@ def _kinetostatics(model, *, over=None, speed=None, values=None, t=None, law=Non
                     charted=charted)
     tau, status = core.pop("tau"), core.pop("status")
     warn.extend(core.pop("warnings"))
-    stats = core.pop("stats")
-    stats.update(positions=n, **pos_stats, seconds=time.perf_counter() - t_start)
+    stats = KinetostaticsStats(**core.pop("stats"), positions=n, **pos_stats,
+                               seconds=time.perf_counter() - t_start)
     message = MESSAGES[status]
-    if status == Status.SINGULAR_POSITION and not stats.get("singular_positions"):
+    if status == Status.SINGULAR_POSITION and not stats.singular_positions:
         message = ("completed through bifurcation position(s): the mechanism stays on its "
                    "branch, the driving torques are the limits along it; the reactions are "
                    "unbounded there")

@@ -24,6 +24,7 @@ from ..model.forces import force_model
 from ..model.state import stick_key
 from ..model.switchable import SwitchedModel, mode_friction, mode_locks, switched_model
 from ..results.kinetostatics_record import Kinetostatics
+from ..results.records import KinetostaticsStats, SegmentStats
 from .mode import MESSAGES, _kinetostatics
 
 __all__ = ["kinetostatics_switched"]
@@ -134,10 +135,9 @@ def kinetostatics_switched(model: Model, trajectory, vs, *, over=None,
     notes: list[str] = []
     seg_stats = []
     for a, b, mode, r, exc in parts:
-        info = dict(mode=mode, start=a, stop=b, t_start=float(tt[a]), t_end=float(tt[b - 1]))
-        seg_stats.append(info)
+        span = dict(mode=mode, start=a, stop=b, t_start=float(tt[a]), t_end=float(tt[b - 1]))
         if r is None:
-            info.update(driven=(), status=f"not analysed: {exc}")
+            seg_stats.append(SegmentStats(**span, driven=(), status=f"not analysed: {exc}"))
             warn.append(f"samples {a}..{b - 1} (t = {tt[a]:.6g} .. {tt[b - 1]:.6g} s, mode "
                         f"{fmt_mode(mode)}) could not be analysed ({type(exc).__name__}: {exc}); "
                         f"their forces are NaN")
@@ -148,8 +148,9 @@ def kinetostatics_switched(model: Model, trajectory, vs, *, over=None,
         multipliers[a:b, :r.multipliers.shape[1]] = r.multipliers
         warn.extend(w for w in (f"mode {fmt_mode(mode)}: {w}" for w in r.warnings) if w not in warn)
         notes.extend(nt for nt in r.message.split("; ")[1:] if nt not in notes)
-        info.update(driven=r.driven, status=r.status,
-                    **{k: r.stats[k] for k in ("power_balance_rel", "rcond_min")})
+        seg_stats.append(SegmentStats(**span, driven=r.driven, status=r.status,
+                                      power_balance_rel=r.stats.power_balance_rel,
+                                      rcond_min=r.stats.rcond_min))
 
     statuses = {Status.PARTIAL if r is None else r.status for *_, r, _ in parts}
     status = next((s for s in (Status.PARTIAL, Status.SELF_LOCKING, Status.SINGULAR_POSITION,
@@ -157,11 +158,13 @@ def kinetostatics_switched(model: Model, trajectory, vs, *, over=None,
                    if s in statuses), Status.SUCCESS)
     head = (f"{MESSAGES[status]} for a switched trajectory: {len(parts)} segment(s) in "
             f"{len(modes)} mode(s)")
-    stats = dict(positions=n, segments=seg_stats, seconds=time.perf_counter() - t_start)
-    for key, agg, empty in (("position_solves", sum, 0), ("power_balance_rel", max, np.nan),
-                            ("rcond_min", min, np.nan), ("redundant_equations", max, 0),
-                            ("singular_positions", sum, 0)):
-        stats[key] = agg([r.stats[key] for r in done] or [empty])
+    over_done = {key: agg([getattr(r.stats, key) for r in done] or [empty])
+                 for key, agg, empty in (
+                     ("position_solves", sum, 0), ("power_balance_rel", max, np.nan),
+                     ("rcond_min", min, np.nan), ("redundant_equations", max, 0),
+                     ("singular_positions", sum, 0))}
+    stats = KinetostaticsStats(positions=n, segments=tuple(seg_stats),
+                               seconds=time.perf_counter() - t_start, **over_done)
     return Kinetostatics(
         over=names[over_k], t=tt, values=arrays["q"][:, over_k].copy(), **arrays, **series,
         multipliers=multipliers, coordinate_names=tuple(names), driven=tuple(driven),

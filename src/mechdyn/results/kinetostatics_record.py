@@ -9,6 +9,7 @@ import numpy as np
 
 from ..errors import ModelError, did_you_mean
 from ..model import Model
+from .records import KinetostaticsStats
 from .table import coordinate_columns, force_columns, mode_columns
 
 __all__ = ["Kinetostatics"]
@@ -70,7 +71,7 @@ class Kinetostatics:
     redundant_joints : tuple of str
         Joints whose equations are linearly dependent (their reactions are not
         unique to rigid-body statics): shared by the joints' compliances where every
-        one of them has a ``compliance`` (``stats["redundant_shared_by"]`` is
+        one of them has a ``compliance`` (``stats.redundant_shared_by`` is
         ``"compliance"``, ``docs/indeterminacy.md``), else the minimum-norm solution.
     status : str
         "success", "redundant" (dependent joint equations, see ``redundant_joints``) or
@@ -78,11 +79,13 @@ class Kinetostatics:
         mechanism).
     message : str
     warnings : tuple of str
-    stats : dict
-        Run figures: positions, seconds, position (Newton) solves, power-balance
-        residual (relative), smallest rcond, ...; for a switched trajectory also
-        ``segments`` (one dict per segment: mode, sample range, times, driven
-        coordinates, status, power-balance residual).
+    stats : KinetostaticsStats
+        Run figures (:class:`~mechdyn.results.records.KinetostaticsStats`): positions,
+        seconds, position (Newton) solves, power-balance residual (relative), smallest
+        rcond, ...; for a switched trajectory also ``segments`` (a
+        :class:`~mechdyn.results.records.SegmentStats` per segment: mode, sample range,
+        times, driven coordinates, status, power-balance residual).  Also read as the
+        mapping it used to be (``stats["power_balance_rel"]``).
     element_forces : dict str -> ndarray, shape (n,)
         Switchable elements other than weld locks (coordinate locks, closed stops
         and contacts, ``"<contact>.tangent"`` for a sticking contact): the
@@ -140,7 +143,7 @@ class Kinetostatics:
     status: str
     message: str
     warnings: tuple
-    stats: dict
+    stats: KinetostaticsStats
     model: Model | None = field(default=None, compare=False)
     element_forces: dict = field(default_factory=dict)
     element_units: dict = field(default_factory=dict)
@@ -376,15 +379,15 @@ class Kinetostatics:
             return f"{d[key + '_at'] * f:.4g} {unit}{t}"
 
         if self.switched:
-            segs = self.stats.get("segments", [])
+            segs = self.stats.segments or ()
             lines.append(f"  switched trajectory: {len(segs)} segment(s) in {len(self.modes)} "
                          f"mode(s); the quantities of a joint, drive or element that is not "
                          f"part of a sample's mode are NaN there")
             for sg in segs:
-                lines.append(f"    t = {sg['t_start']:.6g} .. {sg['t_end']:.6g} s, samples "
-                             f"{sg['start']}..{sg['stop'] - 1}, mode "
-                             f"{{{', '.join(sorted(sg['mode']))}}}: driven "
-                             f"{', '.join(sg['driven']) or '-'}; {sg['status']}")
+                lines.append(f"    t = {sg.t_start:.6g} .. {sg.t_end:.6g} s, samples "
+                             f"{sg.start}..{sg.stop - 1}, mode "
+                             f"{{{', '.join(sorted(sg.mode))}}}: driven "
+                             f"{', '.join(sg.driven) or '-'}; {sg.status}")
         for c, d in p["driving"].items():
             u = "N m" if self._drive_unit(c)[1] == "Nm" else "N"
             lines.append(

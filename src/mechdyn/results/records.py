@@ -3,7 +3,10 @@
 Every record's ``stats`` is a typed dataclass (no free dict): :class:`RunStats` of a
 simulation (:class:`~mechdyn.results.trajectory.Trajectory`), with
 :class:`StreamedStats` of a run handed to a sink and :class:`RunCounters`, the
-builder the segment loop counts into and freezes at the end.  Each
+builder the segment loop counts into and freezes at the end;
+:class:`KinetostaticsStats` (with a :class:`SegmentStats` per segment of a switched
+trajectory) of a kinetostatic analysis
+(:class:`~mechdyn.results.kinetostatics_record.Kinetostatics`).  Each
 also reads as the read-only mapping it used to be (``stats["evaluations"]``,
 :class:`~mechdyn.fieldmap.FieldMapping`): the keys are its fields that are not None.
 
@@ -25,7 +28,8 @@ import numpy as np
 from ..fieldmap import FieldMapping
 from ..kinematics.records import SweepStats
 
-__all__ = ["RunStats", "RunCounters", "StreamedStats", "SwitchedSamples", "SweepStats"]
+__all__ = ["RunStats", "RunCounters", "StreamedStats", "SwitchedSamples", "SweepStats",
+           "KinetostaticsStats", "SegmentStats"]
 
 #: the keys of a :class:`SwitchedSamples` read as a mapping, in order
 SWITCHED_KEYS = ("mode", "modes", "mode_index", "frame_force", "forces", "impact_losses",
@@ -271,4 +275,105 @@ class RunCounters:
         now = {f.name: getattr(self, f.name) for f in fields(self)}
         now["bifurcations"] = list(self.bifurcations)
         return RunStats(**now, **more)
+
+
+@dataclass(frozen=True)
+class SegmentStats(FieldMapping):
+    """One segment of the kinetostatics of a switched trajectory (the samples of one
+    mode in a row), an entry of ``KinetostaticsStats.segments``.
+
+    Attributes
+    ----------
+    mode : frozenset of str
+        The engaged locks of the segment.
+    start, stop : int
+        Its sample range ``start .. stop - 1``.
+    t_start, t_end : float
+        The times of its first and last samples, s.
+    driven : tuple of str
+        The coordinates driven in it (none when it was not analysed).
+    status : str
+        The status of its analysis, or ``"not analysed: <why>"``.
+    power_balance_rel : float or None
+        Largest power-balance residual, relative to the largest power (1).
+    rcond_min : float or None
+        Smallest reciprocal condition number of its equations (1).
+
+    Examples
+    --------
+    >>> s = SegmentStats(frozenset({"clutch"}), 0, 50, 0.0, 0.49, ("th1",), "success")
+    >>> s.stop - s.start, s["driven"], "rcond_min" in s
+    (50, ('th1',), False)
+    """
+
+    mode: frozenset
+    start: int
+    stop: int
+    t_start: float
+    t_end: float
+    driven: tuple = ()
+    status: str = ""
+    power_balance_rel: float | None = None
+    rcond_min: float | None = None
+
+
+@dataclass(frozen=True)
+class KinetostaticsStats(FieldMapping):
+    """The figures of a kinetostatic analysis (``Kinetostatics.stats``).
+
+    A field that is None does not apply to the analysis (and is not among its keys:
+    ``friction_iterations`` only with friction in the pairs, ``segments`` only for a
+    switched trajectory ...).
+
+    Attributes
+    ----------
+    positions : int or None
+        Positions analysed.
+    seconds : float or None
+        Wall time of the analysis, s.
+    position_solves : int or None
+        Newton solves of the positions (continuation steps and batched solves).
+    power_balance_rel : float or None
+        Largest |driving power - rate of kinetic energy - losses|, relative to the
+        largest power of the run (1): a self-check, round-off small.
+    rcond_min : float or None
+        Smallest reciprocal condition number of the equations over the positions (1).
+    redundant_equations : int or None
+        Linearly dependent joint equations.
+    redundant_shared_by : str or None
+        With redundant equations: ``"compliance"`` (shared by the joints'
+        compliances) or ``"minimum norm"``.
+    singular_positions : int or None
+        Positions where the driven coordinates lose control of the mechanism.
+    bifurcation_positions : int or None
+        Positions at a bifurcation the analysis went through on its branch.
+    bifurcations : list of dict or None
+        The bifurcations charted on the way (``at``, ``kind``).
+    self_locked_positions : int or None
+        With friction: the self-locked positions.
+    friction_iterations : int or None
+        With friction: iterations of the friction solve.
+    segments : tuple of SegmentStats or None
+        For a switched trajectory: one entry per segment.
+
+    Examples
+    --------
+    >>> s = KinetostaticsStats(positions=361, seconds=0.02, power_balance_rel=3e-15)
+    >>> s.positions, s["power_balance_rel"] < 1e-9, "segments" in s
+    (361, True, False)
+    """
+
+    positions: int | None = None
+    seconds: float | None = None
+    position_solves: int | None = None
+    power_balance_rel: float | None = None
+    rcond_min: float | None = None
+    redundant_equations: int | None = None
+    redundant_shared_by: str | None = None
+    singular_positions: int | None = None
+    bifurcation_positions: int | None = None
+    bifurcations: list | None = None
+    self_locked_positions: int | None = None
+    friction_iterations: int | None = None
+    segments: tuple | None = None
 

@@ -62,6 +62,7 @@ from ..model import Model
 from ..model.forces import applied_forces
 from ..model.inertia import inertia_forces
 from ..results.kinetostatics_record import Kinetostatics
+from ..results.records import KinetostaticsStats
 from .analyses import KinetostaticExtremes, Outcome, extremes
 
 __all__ = ["batched", "batch_reason", "kinetostatic_batch", "Variants"]
@@ -411,7 +412,8 @@ def _cycle(vs: Variants, analysis: KinetostaticExtremes, work: dict) -> list[Out
         power={c: tau * qdot[..., names.index(c)] for c, tau in driven.items()},
         frame_force=frame[..., :2], frame_moment=frame[..., 2], frame_point=np.zeros(2),
         frame_loads={}, multipliers=Z[..., :n_rows], joint_kinds={}, mode=lay0.mode,
-        redundant_joints=(), status=Status.SUCCESS, message="", warnings=(), stats={},
+        redundant_joints=(), status=Status.SUCCESS, message="", warnings=(),
+        stats=KinetostaticsStats(),
         model=base)
 
     def rms(y):  # the record's rule (Kinetostatics.rms): time-weighted, here at once
