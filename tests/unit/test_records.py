@@ -95,3 +95,30 @@ def test_a_kinetostatic_analysis_s_stats_are_typed():
     assert s.redundant_equations == 0 and "redundant_shared_by" not in s
     assert s.segments is None and "segments" not in s and "friction_iterations" not in s
 
+
+def test_the_reduction_records_stats_are_typed():
+    from mechdyn.reduction.reduce import (
+        ReducedMachine,
+        reduce_model,
+        run_reduced,
+        size_flywheel,
+        steady_state,
+    )
+    from mechdyn.results.records import (
+        FlywheelStats,
+        ReductionStats,
+        SteadyCycleStats,
+    )
+
+    red = reduce_model(mechdyn.examples.load("slider_crank"), steps=37)
+    assert isinstance(red.stats, ReductionStats) and red.stats.positions == 37
+    assert red.stats["friction_ignored"] == red.stats.friction_ignored == ()
+    machine = ReducedMachine.constant(0.05, lambda t, p, w: -4.0 * np.sin(2 * p))
+    cycle = steady_state(machine, omega_mean=30.0)
+    assert isinstance(cycle.stats, SteadyCycleStats) and cycle.stats.steps > 0
+    assert cycle.stats["cycles_integrated"] == cycle.stats.cycles_integrated >= 1
+    fs = size_flywheel(machine, 0.02, omega_mean=30.0, method="energy")
+    assert isinstance(fs.stats, FlywheelStats)
+    assert fs.stats["mean_torque_removed_Nm"] == fs.stats.mean_torque_removed_Nm
+    run = run_reduced(machine, 0.1, omega0=30.0)
+    assert isinstance(run.stats, SolveStats) and run.stats.steps == run.stats["steps"] > 0

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import IntegrationError, LockupError, ModelError
+from ..results.records import FlywheelStats, SteadyCycleStats
 from .machine import ReducedMachine, _Motion, _Record
 
 __all__ = ["SteadyCycle", "steady_state", "FlywheelSizing", "size_flywheel", "FLYWHEEL_METHODS"]
@@ -288,8 +289,8 @@ def _finish(machine, ph, calls, w0, t0, iters) -> SteadyCycle:
         omega_min=float(wmin), omega_mean=float(wmean), omega_avg=float(machine.period / T_cyc),
         delta=float((wmax - wmin) / wmean), cycle_time=float(T_cyc), phi_at_max=float(pmax),
         phi_at_min=float(pmin), extra_inertia=machine.extra_inertia,
-        stats={"cycles_integrated": iters + 1, "evaluations": calls[0],
-               "omega0": float(w0), "steps": ph.size - 1})
+        stats=SteadyCycleStats(cycles_integrated=iters + 1, evaluations=calls[0],
+                               omega0=float(w0), steps=ph.size - 1))
 
 
 # ============================================================================ flywheel
@@ -527,4 +528,4 @@ def size_flywheel(machine: ReducedMachine, delta: float, *, omega_mean: float | 
         J_fly_energy=float(j_basic), J_fly_refined=float(j_ref), J_fly=float(j_fly),
         J_fly_motor=j_motor, gear_ratio=None if gear_ratio is None else float(gear_ratio),
         delta_simulated=d_sim, delta_without=d0, method=method, cycle=cycle,
-        message="; ".join(msgs), stats={"mean_torque_removed_Nm": imbalance})
+        message="; ".join(msgs), stats=FlywheelStats(mean_torque_removed_Nm=imbalance))

@@ -17,17 +17,19 @@ import bisect
 import copy
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
 from types import SimpleNamespace
 from typing import Protocol
 
 import numpy as np
 
 from ..errors import IntegrationError, ModelError
+from ..fieldmap import FieldMapping
 from ..mechanism.drive import TorqueSpeedCurve
 from ..mechanism.load import Table
 from ..model import Model, as_model
 from ..model.inertia import drive_inertia
+from ..results.records import ReductionStats
 from .kinematics import _ModelEvaluator
 
 
@@ -40,6 +42,7 @@ class ReductionTable(Protocol):
     phi: np.ndarray
     J_red: np.ndarray
     M_forces: np.ndarray
+    stats: ReductionStats
 
 __all__ = ["ReducedMachine", "Member", "MemberLoad"]
 
@@ -48,13 +51,14 @@ TWO_PI = 2.0 * math.pi
 
 @dataclass(frozen=True, kw_only=True)
 class _Record:
-    """The fields every record has: ``status``, ``message``, ``events``, ``stats``; its
-    array fields are kept as read-only float copies."""
+    """The fields every record has: ``status``, ``message``, ``events``, ``stats`` (the
+    typed stats of the record, :mod:`mechdyn.results.records`); its array fields are kept
+    as read-only float copies."""
 
     status: str = "success"
     message: str = ""
     events: tuple = ()
-    stats: dict = field(default_factory=dict)
+    stats: FieldMapping
 
     def __post_init__(self):
         for f in fields(self):
@@ -350,7 +354,7 @@ class ReducedMachine:
             return m + _drive_torque(drive, w)
 
         if extra_inertia is None:
-            extra_inertia = float(red.stats.get("extra_inertia_coordinate", 0.0))
+            extra_inertia = float(red.stats.extra_inertia_coordinate)
         return cls(inertia, torque, extra_inertia=extra_inertia, drive=drive, period=period,
                    coordinate=red.coordinate)
 

@@ -37,6 +37,7 @@ import numpy as np
 from ..errors import ModelError, Status, did_you_mean
 from ..mechanism.joint import Lock
 from ..model import Model, as_model
+from ..results.records import ReductionStats
 from .flywheel import FlywheelSizing, SteadyCycle, size_flywheel, steady_state
 from .kinematics import _inertia, _ModelEvaluator, reduced_kinematics
 from .machine import (
@@ -207,7 +208,7 @@ def reduce_model(model: Model, *, coordinate: str | None = None, link: str | Non
     Returns
     -------
     Reduction
-        ``stats["friction_ignored"]``: the joints with friction, which the reduction
+        ``stats.friction_ignored``: the joints with friction, which the reduction
         leaves out (a :class:`~mechdyn.friction.ignored.FrictionIgnoredWarning`
         names them).
     """
@@ -265,8 +266,8 @@ def reduce_model(model: Model, *, coordinate: str | None = None, link: str | Non
         link_angle=link_angle, ratio=ratio, J_red=J_link, dJ_red_dphi=dJ_link, J_extra=J_extra,
         M_red=M_f + M_d, M_drive=M_d, M_forces=M_f, omega=np.full(n, float(omega)), t=float(t),
         point=point, m_red=m_red, v_ratio=v_ratio, status=status, message=message,
-        stats={"positions": n, "extra_inertia_coordinate": j_extra,
-               "friction_ignored": ev.friction})
+        stats=ReductionStats(positions=n, extra_inertia_coordinate=j_extra,
+                             friction_ignored=ev.friction))
 
 
 def mode_mechanism(mechanism, *, engage: Sequence[str] = (), offsets: dict | None = None,

@@ -86,7 +86,7 @@ def run_reduced(machine: ReducedMachine, t_end: float, *, phi0: float = 0.0,
     mm = None if machine.drive is None else np.array([machine.motor_torque(w) for w in omega])
     eps = (M - 0.5 * dJ * omega**2) / J
     return ReducedRun(t, phi, omega, eps, J, M, md, mm, status=sol.status,
-                      events=tuple(sol.events), stats=dict(sol.stats))
+                      events=tuple(sol.events), stats=sol.stats)
 
 
 def energy_speed(machine: ReducedMachine, phi, *, phi0: float = 0.0, omega0: float,
@@ -271,4 +271,4 @@ def startup(machine: ReducedMachine, t_end: float, *, phi0: float = 0.0, omega0:
                          speed_dip=float(dip), phi_dip=float(phi_dip),
                          omega_mean=steady.omega_mean, tol=float(tol),
                          status=Status.SUCCESS if t_steady is not None else Status.NOT_SETTLED,
-                         message=msg, stats=dict(run.stats))
+                         message=msg, stats=run.stats)

@@ -6,7 +6,10 @@ simulation (:class:`~mechdyn.results.trajectory.Trajectory`), with
 builder the segment loop counts into and freezes at the end;
 :class:`KinetostaticsStats` (with a :class:`SegmentStats` per segment of a switched
 trajectory) of a kinetostatic analysis
-(:class:`~mechdyn.results.kinetostatics_record.Kinetostatics`).  Each
+(:class:`~mechdyn.results.kinetostatics_record.Kinetostatics`);
+:class:`ReductionStats`, :class:`SteadyCycleStats` and :class:`FlywheelStats` of the
+records of :mod:`mechdyn.reduction` (whose runs, ``ReducedRun`` and ``StartupResult``,
+carry the :class:`~mechdyn.integrate.driver.SolveStats` of their integration).  Each
 also reads as the read-only mapping it used to be (``stats["evaluations"]``,
 :class:`~mechdyn.fieldmap.FieldMapping`): the keys are its fields that are not None.
 
@@ -29,7 +32,8 @@ from ..fieldmap import FieldMapping
 from ..kinematics.records import SweepStats
 
 __all__ = ["RunStats", "RunCounters", "StreamedStats", "SwitchedSamples", "SweepStats",
-           "KinetostaticsStats", "SegmentStats"]
+           "KinetostaticsStats", "SegmentStats", "ReductionStats", "SteadyCycleStats",
+           "FlywheelStats"]
 
 #: the keys of a :class:`SwitchedSamples` read as a mapping, in order
 SWITCHED_KEYS = ("mode", "modes", "mode_index", "frame_force", "forces", "impact_losses",
@@ -377,3 +381,75 @@ class KinetostaticsStats(FieldMapping):
     friction_iterations: int | None = None
     segments: tuple | None = None
 
+
+@dataclass(frozen=True)
+class ReductionStats(FieldMapping):
+    """The figures of a reduction to one coordinate (``Reduction.stats``).
+
+    Attributes
+    ----------
+    positions : int
+        Positions the reduced quantities were evaluated at.
+    extra_inertia_coordinate : float
+        The inertia of the rotors and gears of the drives reduced to the coordinate,
+        kg m^2 (kg for a travel).
+    friction_ignored : tuple of str
+        The joints with friction, which the reduction leaves out.
+
+    Examples
+    --------
+    >>> s = ReductionStats(positions=361, extra_inertia_coordinate=0.0, friction_ignored=())
+    >>> s.positions, s["friction_ignored"]
+    (361, ())
+    """
+
+    positions: int
+    extra_inertia_coordinate: float
+    friction_ignored: tuple = ()
+
+
+@dataclass(frozen=True)
+class SteadyCycleStats(FieldMapping):
+    """How the steady cycle of a reduced machine was found (``SteadyCycle.stats``).
+
+    Attributes
+    ----------
+    cycles_integrated : int
+        Cycles integrated until the speed repeated.
+    evaluations : int
+        Right-hand-side evaluations.
+    omega0 : float
+        The speed the steady cycle starts with, rad/s (m/s for a travel).
+    steps : int
+        Steps of the cycle kept.
+
+    Examples
+    --------
+    >>> s = SteadyCycleStats(cycles_integrated=3, evaluations=5000, omega0=10.0, steps=720)
+    >>> s.omega0, s["steps"]
+    (10.0, 720)
+    """
+
+    cycles_integrated: int
+    evaluations: int
+    omega0: float
+    steps: int
+
+
+@dataclass(frozen=True)
+class FlywheelStats(FieldMapping):
+    """A figure of the sizing of a flywheel (``FlywheelSizing.stats``).
+
+    Attributes
+    ----------
+    mean_torque_removed_Nm : float
+        The mean of the reduced torque over the cycle, removed before sizing (a
+        machine out of balance), N m (N for a travel).
+
+    Examples
+    --------
+    >>> FlywheelStats(mean_torque_removed_Nm=0.25)["mean_torque_removed_Nm"]
+    0.25
+    """
+
+    mean_torque_removed_Nm: float
