@@ -71,7 +71,7 @@ def kernel_cost(model, tr, passes: int = 40) -> float:
     """Seconds per evaluation of the mode's compiled kernel, timed in a compiled loop over
     the states of the run ``tr`` (in order): the best of many short passes (the machine
     is shared; a pass is about 2000 evaluations)."""
-    from mechdyn.dynamics.compiled_loop import buffers
+    from mechdyn.dynamics.loop_buffers import buffers
     from mechdyn.kernels.dop853_numba import evaluate_states
 
     sm = switched_model(model)
@@ -86,7 +86,7 @@ def kernel_cost(model, tr, passes: int = 40) -> float:
         reps = max(1, 2000 // len(Y[chunk]))
         k.reset(tr.x[chunk.start])
         t0 = time.perf_counter()
-        evaluate_states(tr.t[chunk], Y[chunk], reps, *k._arrays, k.ws, b.sc, b.piv)
+        evaluate_states(tr.t[chunk], Y[chunk], reps, *k.arrays, k.ws, b.sc, b.piv)
         best = min(best, (time.perf_counter() - t0) / (reps * len(Y[chunk])))
     return best
 

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 from test_compiled_loop import A0, OMEGA, oscillator
 
-from mechdyn.dynamics import compiled
 from mechdyn.dynamics.compiled import numba_available
 from mechdyn.examples import press_cycle
 from mechdyn.integrate.events import Event
+from mechdyn.simulate import compiled_loop as compiled
 from mechdyn.simulate.run import simulate
 
 pytestmark = pytest.mark.skipif(not numba_available(), reason="numba not installed")

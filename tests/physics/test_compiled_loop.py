@@ -12,11 +12,11 @@ import pytest
 from dynamics_models import four_bar, pendulum
 
 from mechdyn import Mechanism, examples
-from mechdyn.dynamics import compiled
 from mechdyn.dynamics.compiled import numba_available
-from mechdyn.dynamics.compiled_loop import PIVOT_FLAG
 from mechdyn.dynamics.mode_equations import PIVOT_CHECK
 from mechdyn.mechanism import RotarySpring
+from mechdyn.simulate import compiled_loop as compiled
+from mechdyn.simulate.compiled_loop import PIVOT_FLAG
 from mechdyn.simulate.run import simulate
 
 pytestmark = pytest.mark.skipif(not numba_available(), reason="numba not installed")

@@ -18,7 +18,6 @@ import time
 
 import numpy as np
 
-from ..integrate.base import FixedStep
 from ..kernels.block_lu import block_order
 from ..kernels.lagrange_numba import (
     D_NC,
@@ -33,20 +32,14 @@ from ..kernels.lagrange_numba import (
     work_size,
 )
 from ..kernels.loads_numba import H_NTAB, LoadPacker, Unsupported
-from ..kernels.rows_numba import NUMBA, compiling
+from ..kernels.rows_numba import NUMBA, compiling, rows_jacobian
 from ..mechanism.mechanism import Mechanism
 from ..model import Model
 from ..model.forces import force_model
 from ..model.rows import concat
 from ..model.variable import lower, parse
 from ..model.workspace import Workspace
-from .compiled_loop import (
-    fast_forward,
-    kept_steps,
-    warm_up_dop853,
-    warm_up_fixed_step,
-    warm_up_turning_check,
-)
+from .loop_buffers import warm_up_dop853, warm_up_fixed_step
 
 __all__ = ["compile_mode_kernel", "CompiledKernel", "numba_available", "ensure_compiled",
            "warm_up_groups", "GROUPS"]
@@ -86,6 +79,11 @@ class CompiledKernel:
         ends = np.cumsum([0, n_x, nq, nq, nq, nc, n_x]).tolist()
         self._ext_size = ends[-1]
         self._ext_parts = tuple(zip(ends[:-1], ends[1:], strict=True))
+
+    @property
+    def arrays(self) -> tuple:
+        """The packed arrays ``(ip, fp, ri, rf, dims)`` the compiled functions take."""
+        return self._arrays
 
     @property
     def x(self) -> np.ndarray:
@@ -128,7 +126,7 @@ class CompiledKernel:
     def rhs(self, t, q, qdot):
         """(q_I'', array([P_nc])) or None on failure (see ``status``)."""
         n = self.n_i
-        self._ensure("first-order f")
+        self.ensure("first-order f")
         y = np.concatenate([q, qdot, [0.0]])
         if not self._run(first_order, t, y, *self._arrays, self.ws):
             return None
@@ -145,9 +143,10 @@ class CompiledKernel:
             return None
         return (self.x.copy(), self.xdot.copy(), *(ext[a:b] for a, b in self._ext_parts))
 
-    def _ensure(self, group: str) -> None:
+    def ensure(self, group: str) -> None:
         """Compile ``group`` (:data:`GROUPS`) on its first use in this process, its time
-        added to :attr:`compile_time`."""
+        added to :attr:`compile_time` (the segment loop asks for the group of its
+        compiled loop, :mod:`mechdyn.simulate.compiled_loop`)."""
         if group not in _COMPILED:
             self.compile_time += ensure_compiled(group)
 
@@ -167,30 +166,11 @@ class CompiledKernel:
         """Evaluations of the equations by this kernel so far."""
         return int(self.ws[-N_FLAGS + W_COUNT])
 
-    def fast_forward(self, integ, eqs, t, y0, t_end, **callbacks):
-        """Run a segment in the compiled DOP853 loop as far as it can go: ``(t, y, next_out,
-        done, h)`` (see :func:`mechdyn.dynamics.compiled_loop.fast_forward`); a mode whose
-        multipliers are not all the kernel's (redundant rows) is not run there."""
-        ms = eqs.ms
-        if len(ms.independent_rows) != ms.n_rows or y0.size != 2 * self.n_i + 1:
-            return t, y0, callbacks["next_out"], False, None
-        self._ensure("fixed-step loop" if isinstance(integ, FixedStep) else "integration loop")
-        return fast_forward(self, integ, eqs, t, y0, t_end, **callbacks)
-
-    def kept_steps(self, integ, eqs, t, y0, t_end, stats):
-        """The steps of a segment with event functions from the compiled loop, or None
-        where it cannot run them (see :func:`mechdyn.dynamics.compiled_loop.kept_steps`)."""
-        ms = eqs.ms
-        if len(ms.independent_rows) != ms.n_rows or y0.size != 2 * self.n_i + 1:
-            return None
-        self._ensure("fixed-step loop" if isinstance(integ, FixedStep) else "integration loop")
-        return kept_steps(self, integ, eqs, t, y0, t_end, stats)
-
     def first_order_function(self, on_failure):
         """A function ``fun(t, y) -> y'`` for y = (q_I, q_I', w) calling the kernel directly
         (the path with the least Python per evaluation); ``on_failure(t, y)`` is called
         (and must return y' or raise) when the kernel reports a failure."""
-        self._ensure("first-order f")
+        self.ensure("first-order f")
         ip, fp, ri, rf, dims, ws, st = (self.ip, self.fp, self.ri, self.rf, self.dims,
                                         self.ws, self._st)
         kern = first_order
@@ -254,8 +234,10 @@ def _compile_group(group: str, kernel: CompiledKernel) -> None:
         warm_up_dop853(kernel)
     elif group == "fixed-step loop":
         warm_up_fixed_step(kernel)
-    else:
-        warm_up_turning_check(kernel)
+    else:  # the rows' Jacobian as the turning-point check calls it (dead_position)
+        _, _, ri, rf, _ = kernel.arrays
+        rows_jacobian(np.zeros(kernel.n_x), kernel.n_x // 3, ri, rf,
+                      np.zeros((len(ri), kernel.n_x)), 0)
 
 
 def ensure_compiled(*groups: str) -> float:

@@ -4,9 +4,9 @@
 dense output of order 7 (coefficients: :mod:`mechdyn.integrate.dop853_tableau`), one
 method with one step control wherever it runs.  Where the caller's equations run on a
 compiled kernel (a fixed-structure segment on the Numba backend, no event functions)
-:func:`mechdyn.integrate.segment.run_segment` hands the segment to the kernel's compiled
+the segment loop hands the segment to the kernel's compiled
 loop (:mod:`mechdyn.kernels.dop853_numba`, driven by
-:mod:`mechdyn.dynamics.compiled_loop`): every step, every stage, the position solves and
+:mod:`mechdyn.simulate.compiled_loop`): every step, every stage, the position solves and
 the checks of the step run in machine code, and Python only records the output samples,
 looks at a flagged step (a coordinate rate changing sign, a nearly singular Jacobian)
 and reports a stop.  A segment with event functions (every mode of a variable-structure

@@ -145,7 +145,7 @@ def locate(cands, t_old: float, t_new: float, dense: Callable, evaluate: Callabl
 def run_segment(integ, eqs, t: float, y0, t_end: float, efns: list[EventFunction], *,
                 evaluate: Callable, after_step: Callable, sample: Callable, t_eval,
                 next_out: int, every_step: bool, stats, bar=None,
-                deadline: float | None = None, n: int | None = None):
+                deadline: float | None = None, n: int | None = None, steps=None):
     """Integrate one segment from ``t`` until the first event or ``t_end``.
 
     Parameters
@@ -179,6 +179,10 @@ def run_segment(integ, eqs, t: float, y0, t_end: float, efns: list[EventFunction
         ``time.perf_counter()`` value after which the run stops (status timeout).
     n : int, optional
         Number of coordinates q (default: one quadrature state w, n = (len(y0) - 1) / 2).
+    steps : iterator of Step, optional
+        The segment's steps taken elsewhere (a generator with ``close``: the compiled
+        loop of a mode's kernel, :func:`mechdyn.simulate.compiled_loop.integrate_segment`),
+        checked here as the integrator's; by default ``integ.integrate`` takes them.
 
     Returns
     -------
@@ -188,20 +192,6 @@ def run_segment(integ, eqs, t: float, y0, t_end: float, efns: list[EventFunction
     """
     n = (np.size(y0) - 1) // 2 if n is None else n
     y0 = np.asarray(y0, float)
-    kernel = getattr(eqs, "kernel", None)
-    steps = None
-    if getattr(integ, "compiled", False) and kernel is not None and not efns:
-        # the compiled loop (mechdyn.dynamics.compiled_loop) as far as it can go; where it
-        # hands the segment over, the method goes on with the step it had
-        t, y0, next_out, done, h = kernel.fast_forward(
-            integ, eqs, t, y0, t_end, after_step=after_step, sample=sample, t_eval=t_eval,
-            next_out=next_out, every_step=every_step, stats=stats, bar=bar, deadline=deadline)
-        if done:
-            return None, next_out
-        integ = integ.going_on(h) if integ.adaptive else integ
-    elif getattr(integ, "compiled", False) and kernel is not None:
-        # with event functions: the compiled loop's steps, each checked here
-        steps = kernel.kept_steps(integ, eqs, t, y0, t_end, stats)
     if steps is None:
         steps = integ.integrate(eqs.rhs, t, y0[:n], y0[n:2 * n], t_end, w0=y0[2 * n:],
                                 first_order=eqs.first_order_function())

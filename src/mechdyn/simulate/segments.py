@@ -7,7 +7,9 @@ constraints, :class:`~mechdyn.model.state.Mode`) at a time:
    coordinates) are integrated by one segment of
    :func:`mechdyn.integrate.segment.run_segment`, with any integrator of the
    package (DOP853 by default, rtol 1e-10 as every run), the right-hand side on
-   the compiled kernel of the mode (:mod:`mechdyn.dynamics.mode_equations`);
+   the compiled kernel of the mode (:mod:`mechdyn.dynamics.mode_equations`), in
+   the kernel's compiled loop where it can run
+   (:func:`mechdyn.simulate.compiled_loop.integrate_segment`);
    positions are re-solved from q_I at every evaluation, so every constraint of
    the mode holds to round-off, and a singular position of the mode stops the
    run with its time and coordinates;
@@ -54,7 +56,6 @@ from ..integrate.events import EventRecord, as_events
 from ..integrate.segment import (
     Stop,
     arm,
-    run_segment,
     user_event_functions,
     user_event_records,
 )
@@ -65,6 +66,7 @@ from ..progress import Progress
 from ..results.events import format_events
 from ..results.records import RunCounters
 from ..results.trajectory import Trajectory
+from .compiled_loop import integrate_segment
 from .run_start import give_back, start_equations, start_state
 from .samples import Samples, finish
 from .switching import apply_switch, event_functions
@@ -385,7 +387,7 @@ class _SegmentLoop:
         integ = self.segment_integrator(self.model.tolerance_scale[ms.coords], first)
         if self.w.size > 1 and np.ndim(getattr(integ, "atol", None)):
             integ.atol = np.append(integ.atol, integ.atol[-1])  # W_f: as W_nc
-        hit, self.next_out = run_segment(
+        hit, self.next_out = integrate_segment(
             integ, eqs, t, y0, o.t_end, efns, evaluate=evaluate,
             after_step=self._after_step(eqs, evaluate), sample=self._sampler(evaluate),
             t_eval=self.t_eval, next_out=self.next_out, every_step=self.every_step,

@@ -1,5 +1,13 @@
 """A segment of a run in the compiled loop: the Python side of :mod:`mechdyn.kernels.dop853_numba`.
 
+:func:`integrate_segment` is the segment of the segment loop
+(:mod:`mechdyn.simulate.segments`): it decides which path runs it -- the compiled loop
+of the mode's kernel, or :func:`mechdyn.integrate.segment.run_segment` stepping from
+Python -- and hands the compiled loop's steps (:func:`kept_steps`) or what is left of
+the segment (after :func:`fast_forward`) to ``run_segment``, which knows no kernel.  The
+loop's arrays and its warm-up runs are the kernel's
+(:mod:`mechdyn.dynamics.loop_buffers`).
+
 :func:`fast_forward` runs a segment on a mode's compiled kernel (fixed structure, no
 event functions) in the compiled DOP853 loop, batch after batch, and does in Python
 only what the caller's callbacks of :func:`mechdyn.integrate.segment.run_segment` need:
@@ -32,80 +40,32 @@ import time
 
 import numpy as np
 
+from ..dynamics.loop_buffers import KEEP_STEPS, buffers
+from ..dynamics.mode_system import ModeEval
 from ..errors import Status
 from ..integrate.base import FixedStep, Step, hermite_dense
 from ..integrate.runge_kutta import RungeKutta4
-from ..integrate.segment import Stop
+from ..integrate.segment import Stop, run_segment
 from ..integrate.wilson import Wilson
 from ..kernels import dop853_numba as L
 from ..kernels import fixed_step_numba as F
 from ..kernels.dop853_dense import dense_at, dense_output, kept_offsets, kept_parts
-from ..kernels.lagrange_numba import D_NC, D_NQ, scratch_size
-from ..kernels.loads_numba import H_NTAB
-from ..kernels.rows_numba import rows_jacobian
 from ..results.records import RunCounters
-from .mode_system import ModeEval
 
-__all__ = ["fast_forward", "kept_steps", "warm_up_dop853", "warm_up_fixed_step",
-           "warm_up_turning_check", "KEEP_STEPS", "PIVOT_FLAG",
-           "STALL_FLAG", "BATCH_SAMPLES", "BATCH_STEPS", "BETA"]
+__all__ = ["integrate_segment", "fast_forward", "kept_steps", "PIVOT_FLAG", "STALL_FLAG",
+           "BATCH_STEPS", "BETA"]
 
 #: pivot ratio of the kernel's LU below which a step is looked at (the value of
 #: :data:`mechdyn.dynamics.mode_equations.PIVOT_CHECK`; a test keeps them equal)
 PIVOT_FLAG = 1e-5
 #: steps below this fraction of the segment are looked at (the stall check of the run)
 STALL_FLAG = 1e-7
-#: output samples and steps per call of the compiled loop
-BATCH_SAMPLES, BATCH_STEPS = 1024, 2048
-#: steps per call of the compiled loop in a segment with event functions: the steps of a
-#: call after an event are taken in vain, and a call costs little beside the Python checks
-#: of a step (press_cycle 0.4 s: 1 -> 9228 evaluations and 0.10 s in the loop, 4 -> 9844,
-#: 64 -> 12307 and 0.15 s)
-KEEP_STEPS = 1
+#: steps per call of the compiled loop (its output samples per call:
+#: :data:`mechdyn.dynamics.loop_buffers.BATCH_SAMPLES`)
+BATCH_STEPS = 2048
 #: exponent of the PI step control (0: Hairer's DOP853 and SciPy's, a step from the last
 #: error alone; 0.04 gave 4-10 % fewer evaluations on some runs, more on others)
 BETA = 0.0
-
-
-class _Buffers:
-    """The arrays of one kernel's loop (allocated once per kernel and reused)."""
-
-    def __init__(self, kernel):
-        nx, ni = kernel.n_x, kernel.n_i
-        nq, nc = int(kernel.dims[D_NQ]), int(kernel.dims[D_NC])
-        m = 2 * ni + 1
-        n_ext = nx + 3 * nq + nc + nx
-        cap = BATCH_SAMPLES
-        self.dims = (nx, ni, nq, nc, m)
-        self.f, self.ynew, self.ys = np.empty(m), np.empty(m), np.empty(m)
-        self.K = np.empty((16, m))
-        self.hist = np.zeros((3, 2 * m + 1))
-        self.dns = np.zeros((7, m))
-        self.o_t, self.o_y = np.empty(cap), np.empty((cap, m))
-        self.o_x, self.o_xd, self.o_ext = np.empty((cap, nx)), np.empty((cap, nx)), \
-            np.empty((cap, n_ext))
-        self.ext, self.ext_end, self.x_end = np.empty(n_ext), np.empty(n_ext), np.empty(3 * nx)
-        self.sc = np.empty(scratch_size(nx, ni, nq, int(kernel.dims[3])))
-        self.piv = np.empty(nx + 1, dtype=np.int64)
-        self.par = np.zeros(F.N_PAR_FIXED)  # the DOP853 loop's scalars, then the fixed-step's
-        self.ipar = np.zeros(F.N_IPAR_FIXED, dtype=np.int64)
-        self.kept = np.empty((KEEP_STEPS, kept_offsets(m)[-1] + kernel.ws.size))
-        self.kv = np.zeros(4 * int(kernel.ip[H_NTAB]))  # held table pieces
-
-    def restart(self) -> None:
-        """Clear what a new set of buffers has cleared (for a kernel used again)."""
-        self.hist[:] = 0.0
-        self.dns[:] = 0.0
-        self.par[:] = 0.0
-        self.ipar[:] = 0
-
-
-def buffers(kernel) -> _Buffers:
-    """The loop's arrays of ``kernel`` (made on first use)."""
-    b = getattr(kernel, "_loop_buffers", None)
-    if b is None:
-        b = kernel._loop_buffers = _Buffers(kernel)
-    return b
 
 
 def _evals(b, ms, n) -> list:
@@ -200,10 +160,71 @@ def _loop(kernel, b, integ, y, atol, te, t: float, t_end: float):
         b.ipar[F.I_GRID] = 0
         return (lambda: F.run(y, b.f, grid, b.par, b.ipar, b.K, b.ynew, b.ys, b.hist, te,
                               b.o_t, b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end,
-                              *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept)), True
+                              *kernel.arrays, kernel.ws, b.sc, b.piv, b.kept)), True
     return (lambda: L.run(y, b.f, atol, b.par, b.ipar, b.K, b.ynew, b.ys, b.hist, b.dns, te,
                           b.o_t, b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end,
-                          *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept, b.kv)), False
+                          *kernel.arrays, kernel.ws, b.sc, b.piv, b.kept, b.kv)), False
+
+
+def integrate_segment(integ, eqs, t: float, y0, t_end: float, efns: list, *,
+                      evaluate, after_step, sample, t_eval, next_out: int, every_step: bool,
+                      stats: RunCounters, bar=None, deadline: float | None = None,
+                      n: int | None = None):
+    """Integrate one segment of a mode (:func:`mechdyn.integrate.segment.run_segment`), in
+    the compiled loop of its kernel where it can run there.
+
+    A segment without event functions runs in the loop as far as it can go
+    (:func:`fast_forward`); where the loop hands it over, the method goes on from there
+    with the step it had (``integ.going_on(h)``).  A segment with event functions takes
+    its steps from the loop (:func:`kept_steps`), each checked by ``run_segment``.  A
+    mode whose multipliers are not all the kernel's (redundant rows), an integrator
+    without a compiled loop or equations without a kernel step from Python.  The loop's
+    group of compiled functions is compiled on first use (:meth:`CompiledKernel.ensure
+    <mechdyn.dynamics.compiled.CompiledKernel.ensure>`).
+
+    Parameters
+    ----------
+    integ, eqs, t, y0, t_end, efns
+        As in :func:`mechdyn.integrate.segment.run_segment`; ``eqs`` a
+        :class:`~mechdyn.dynamics.mode_equations.ModeEquations` (its ``kernel``).
+    evaluate, after_step, sample, t_eval, next_out, every_step, stats, bar, deadline, n
+        As in :func:`mechdyn.integrate.segment.run_segment`.
+
+    Returns
+    -------
+    hit : tuple or None
+        ``(t_hit, fired event functions, dense)``; None at ``t_end``.
+    next_out : int
+    """
+    y0 = np.asarray(y0, float)
+    kernel, steps = eqs.kernel, None
+    if getattr(integ, "compiled", False) and _ready(kernel, integ, eqs, y0):
+        if not efns:
+            t, y0, next_out, done, h = fast_forward(
+                kernel, integ, eqs, t, y0, t_end, after_step=after_step, sample=sample,
+                t_eval=t_eval, next_out=next_out, every_step=every_step, stats=stats,
+                bar=bar, deadline=deadline)
+            if done:
+                return None, next_out
+            integ = integ.going_on(h) if integ.adaptive else integ
+        else:
+            steps = kept_steps(kernel, integ, eqs, t, y0, t_end, stats)
+    return run_segment(integ, eqs, t, y0, t_end, efns, evaluate=evaluate,
+                       after_step=after_step, sample=sample, t_eval=t_eval,
+                       next_out=next_out, every_step=every_step, stats=stats, bar=bar,
+                       deadline=deadline, n=n, steps=steps)
+
+
+def _ready(kernel, integ, eqs, y0) -> bool:
+    """Whether the compiled loop of ``integ`` can run a segment of ``eqs`` from ``y0`` on
+    ``kernel`` (a kernel, every multiplier of the mode its own, one quadrature state);
+    where it can, the loop's group is compiled (on first use, its time added to the
+    kernel's ``compile_time``)."""
+    ms = eqs.ms
+    if kernel is None or len(ms.independent_rows) != ms.n_rows or y0.size != 2 * kernel.n_i + 1:
+        return False
+    kernel.ensure("fixed-step loop" if isinstance(integ, FixedStep) else "integration loop")
+    return True
 
 
 def fast_forward(kernel, integ, eqs, t: float, y0, t_end: float, *, after_step, sample, t_eval,
@@ -524,7 +545,7 @@ def _kept_step(row, m: int, ni: int, fixed: bool = False, kernel=None,
             kernel.restore(ws)
             b = buffers(kernel)
             d = np.empty((7, m))
-            st = dense_output(y0, y1, stages, t0, h, *kernel._arrays, kernel.ws, b.sc,
+            st = dense_output(y0, y1, stages, t0, h, *kernel.arrays, kernel.ws, b.sc,
                               b.piv, d)
             kernel.restore(saved)
             if stats is not None:
@@ -540,46 +561,3 @@ def _kept_step(row, m: int, ni: int, fixed: bool = False, kernel=None,
         return out[:ni], out[ni:2 * ni], out[2 * ni:]
 
     return Step(t0, t1, y1[:ni], y1[ni:2 * ni], f1[ni:2 * ni], y1[2 * ni:], dense)
-
-
-def _warm_up_buffers(kernel):
-    """The loop buffers of ``kernel`` and a start state (q_I = 0.3, q_I' = 1) for a warm-up
-    run of a compiled loop."""
-    b = buffers(kernel)
-    _, ni, _, _, m = b.dims
-    y = np.zeros(m)
-    y[:ni], y[ni:2 * ni] = 0.3, 1.0
-    b.par[:], b.ipar[:] = 0.0, 0
-    b.par[L.P_LAST] = -np.inf
-    b.ipar[L.I_MAXSTEPS] = 10
-    return b, y
-
-
-def warm_up_dop853(kernel) -> None:
-    """Compile (or load) the DOP853 loop on a kernel: one short run without output."""
-    b, y = _warm_up_buffers(kernel)
-    m = y.size
-    b.par[L.P_TEND], b.par[L.P_RTOL], b.par[L.P_HMAX] = 1e-3, 1e-6, np.inf
-    L.run(y, b.f, np.full(m, 1e-9), b.par, b.ipar, b.K, b.ynew, b.ys, b.hist, b.dns,
-          np.zeros(0), b.o_t, b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end,
-          *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept, b.kv)
-
-
-def warm_up_fixed_step(kernel) -> None:
-    """Compile (or load) the fixed-step loop on a kernel: a short run of RK4 and one of
-    Wilson's method (one compilation for both)."""
-    for method in (F.RK4, F.WILSON):
-        b, y = _warm_up_buffers(kernel)
-        b.par[F.P_TOL], b.par[F.P_THETA] = 1e-12, 1.0
-        b.ipar[F.I_METHOD], b.ipar[F.I_ITER] = method, 2
-        F.run(y, b.f, np.linspace(0.0, 1e-3, 3), b.par, b.ipar, b.K, b.ynew, b.ys, b.hist,
-              np.zeros(0), b.o_t, b.o_y, b.o_x, b.o_xd, b.o_ext, b.ext, b.ext_end, b.x_end,
-              *kernel._arrays, kernel.ws, b.sc, b.piv, b.kept)
-
-
-def warm_up_turning_check(kernel) -> None:
-    """Compile (or load) the rows' Jacobian as the turning-point check calls it
-    (:func:`mechdyn.dynamics.dead_position.turning_point`)."""
-    _, _, ri, rf, _ = kernel._arrays
-    rows_jacobian(np.zeros(kernel.n_x), kernel.n_x // 3, ri, rf,
-                  np.zeros((len(ri), kernel.n_x)), 0)
