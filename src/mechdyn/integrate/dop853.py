@@ -1,15 +1,17 @@
-"""DOP853 stepped from Python: the method and step control of the compiled loop, in NumPy.
+"""DOP853 stepped from Python: the method and step control of the compiled loop.
 
 The embedded Dormand-Prince 8(5,3) pair (:mod:`mechdyn.integrate.dop853_tableau`) with
 Hairer's step control as in his code DOP853 and as the compiled loop
-(:mod:`mechdyn.kernels.dop853_numba`, its control :mod:`mechdyn.kernels.dop853_control`)
-has it: the starting step of order 8 from one trial evaluation, the error norm of the
-embedded orders 5 and 3 in the weights ``atol_i + rtol max(|y_i|, |y_new_i|)``, step
-factors within [1/6, 3] with safety 0.9, no increase right after a rejection, a last
-step stretched by up to 1 % to land on ``t_end``, and the dense output of order 7 (three
-more evaluations, made on first use).  It steps a segment wherever the compiled loop does
-not (the NumPy path, :func:`mechdyn.integrate.solve`, a segment from where the compiled
-loop stopped), so that the default integrator is one method with one step control
+(:mod:`mechdyn.kernels.dop853_numba`) has it: the starting step of order 8 from one trial
+evaluation, the error norm of the embedded orders 5 and 3 in the weights ``atol_i + rtol
+max(|y_i|, |y_new_i|)``, step factors within [1/6, 3] with safety 0.9, no increase right
+after a rejection, a last step stretched by up to 1 % to land on ``t_end``, and the dense
+output of order 7 (three more evaluations, made on first use).  The formulas of the step
+control (:mod:`mechdyn.integrate.dop853_control`) and of the dense output
+(:mod:`mechdyn.integrate.dop853_dense`) are the very functions the compiled loop compiles;
+here they run as Python over the step's arrays.  It steps a segment wherever the compiled
+loop does not (the NumPy path, :func:`mechdyn.integrate.solve`, a segment from where the
+compiled loop stopped), so that the default integrator is one method with one step control
 everywhere; SciPy's solvers run only where the caller names one.
 
 A step whose evaluations give non-finite rates is rejected (its error is infinite) and
@@ -35,16 +37,22 @@ from collections.abc import Callable, Iterator
 import numpy as np
 
 from ..errors import IntegrationError
-from .dop853_tableau import E3, E5, N_STAGES, A, B, C, D
+from . import dop853_control as ctl
+from .dop853_dense import dense_at, dense_coefficients
+from .dop853_tableau import N_STAGES, A, B, C
 
-__all__ = ["dop853_steps", "initial_step", "error_norm", "next_step", "DenseDOP853"]
+__all__ = ["dop853_steps", "initial_step", "DenseDOP853", "BETA"]
 
-#: Hairer's safety factor and the bounds of the step factor
-SAFETY, FAC_MIN, FAC_MAX = 0.9, 1.0 / 6.0, 3.0
+#: exponent of the PI step control: 0, Hairer's DOP853 (a step from the last error alone),
+#: as in the compiled loop by default (:data:`mechdyn.dynamics.compiled_loop.BETA`)
+BETA = 0.0
 
 
 def initial_step(fun: Callable, t: float, y, f, atol, rtol: float, hmax: float) -> tuple:
-    """Hairer's starting step of order 8 from one trial evaluation.
+    """Hairer's starting step of order 8 from one trial evaluation
+    (:func:`~mechdyn.integrate.dop853_control.initial_guess`, then
+    :func:`~mechdyn.integrate.dop853_control.initial_step` where the trial rates are
+    finite; else the guess, as in the compiled loop).
 
     Parameters
     ----------
@@ -53,11 +61,10 @@ def initial_step(fun: Callable, t: float, y, f, atol, rtol: float, hmax: float) 
     t : float
         Start time, s.
     y, f : ndarray, shape (m,)
-        State and rates at ``t``.
-    atol : ndarray, shape (m,)
-        Absolute tolerances.
-    rtol, hmax : float
-        Relative tolerance; largest step, s.
+        State and rates at ``t`` (units of y, and of y per second).
+    atol, rtol, hmax
+        The tolerances (absolute: shape (m,), units of y) and the largest step, s, as
+        for :func:`~mechdyn.integrate.dop853_control.initial_guess`.
 
     Returns
     -------
@@ -65,65 +72,20 @@ def initial_step(fun: Callable, t: float, y, f, atol, rtol: float, hmax: float) 
         The starting step, s.
     evaluations : int
         Evaluations spent (1).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> h, k = initial_step(lambda t, y: -y, 0.0, np.ones(1), -np.ones(1), np.full(1, 1e-8),
+    ...                     1e-6, np.inf)
+    >>> round(float(h), 4), k  # y' = -y from 1, tolerance 1e-6
+    (0.1001, 1)
     """
-    sk = atol + rtol * np.abs(y)
-    dnf = float(np.sum((f / sk) ** 2))
-    dny = float(np.sum((y / sk) ** 2))
-    h = 1e-6 if (dnf <= 1e-10 or dny <= 1e-10) else 0.01 * np.sqrt(dny / dnf)
-    h = min(h, hmax)
+    h, dnf = ctl.initial_guess(y, f, atol, rtol, hmax)
     f1 = np.asarray(fun(t + h, y + h * f), float)
     if not np.all(np.isfinite(f1)):  # the compiled loop keeps the guess where it fails
         return h, 1
-    der2 = np.sqrt(float(np.sum(((f1 - f) / sk) ** 2))) / h
-    der12 = max(der2, np.sqrt(dnf))
-    h1 = max(1e-6, h * 1e-3) if der12 <= 1e-15 else (0.01 / der12) ** (1.0 / 8.0)
-    return min(100.0 * h, h1, hmax), 1
-
-
-def error_norm(y, ynew, K, atol, rtol: float, h: float) -> float:
-    """The error of a step ``h`` from ``y`` to ``ynew`` with the stages ``K`` (12, m):
-    the embedded orders 5 and 3 combined as in DOP853; inf where it is not finite.
-
-    Parameters
-    ----------
-    y, ynew : ndarray, shape (m,)
-        The step's start and end.
-    K : ndarray, shape (>= 12, m)
-        The rates at the stages.
-    atol : ndarray, shape (m,)
-    rtol, h : float
-
-    Returns
-    -------
-    float
-        The error in units of the tolerance (the step is rejected above 1).
-    """
-    sk = atol + rtol * np.maximum(np.abs(y), np.abs(ynew))
-    k = K[:N_STAGES]
-    e5n = float(np.sum((E5[:N_STAGES] @ k / sk) ** 2))
-    e3n = float(np.sum((E3[:N_STAGES] @ k / sk) ** 2))
-    deno = e5n + 0.01 * e3n
-    err = abs(h) * e5n / np.sqrt(y.size * (deno if deno > 0.0 else 1.0))
-    return err if np.isfinite(err) else np.inf
-
-
-def next_step(h: float, err: float, rejected: bool) -> float:
-    """The step after an accepted step ``h`` of error ``err`` (no longer than ``h`` right
-    after a rejection).
-
-    Parameters
-    ----------
-    h, err : float
-    rejected : bool
-        Whether an attempt of this step was rejected.
-
-    Returns
-    -------
-    float
-    """
-    fac = max(FAC_MIN, min(FAC_MAX, err ** 0.125 / SAFETY))
-    h_next = h / fac
-    return min(h_next, h) if rejected else h_next
+    return ctl.initial_step(y, f, f1, h, dnf, atol, rtol, hmax), 1
 
 
 class DenseDOP853:
@@ -153,19 +115,17 @@ class DenseDOP853:
         for s in range(N_STAGES + 1, N_STAGES + 4):
             K[s] = self.fun(t + C[s] * h, y + h * (A[s, :s] @ K[:s]))
         self.counter(3)
-        dy = self.ynew - y
-        f, fnew = K[0], K[N_STAGES]
-        return np.vstack([dy, h * f - dy, 2.0 * dy - h * (f + fnew), h * (D @ K)])
+        dns = np.empty((7, y.size))
+        dense_coefficients(y, self.ynew, K[0], K[N_STAGES], K, h, dns)
+        return dns
 
     def __call__(self, ts: float) -> np.ndarray:
         """The state at ``ts`` within the step, shape (m,)."""
         if self.coeffs is None:
             self.coeffs = self._make()
-        d = self.coeffs
-        s = (ts - self.t) / self.h if self.h != 0.0 else 1.0
-        s1 = 1.0 - s
-        return self.y + s * (d[0] + s1 * (d[1] + s * (d[2] + s1 * (d[3] + s * (
-            d[4] + s1 * (d[5] + s * d[6]))))))
+        out = np.empty(self.y.size)
+        dense_at(self.coeffs, self.y, self.t, self.h, ts, out)
+        return out
 
 
 def _stages(fun, t: float, h: float, y, K) -> np.ndarray:
@@ -242,18 +202,21 @@ def _one_step(fun, t, y, f, h, t_end, atol, rtol, hmax, count) -> tuple:
         with np.errstate(all="ignore"):
             ynew = _stages(fun, t, h, y, K)
             count(N_STAGES - 1)
-            err = error_norm(y, ynew, K, atol, rtol, h)
-            if err <= 1.0:
+            err = ctl.error_norm(y, ynew, K, atol, rtol, h)
+            if not ctl.too_large(err):
                 K[N_STAGES] = fun(t_new, ynew)
                 count(1)
                 if not np.all(np.isfinite(K[N_STAGES])):
                     err = np.inf
-        if err <= 1.0:
-            h_next = next_step(h, err, rejected > 0)
+        fac11 = ctl.error_factor(err, BETA)
+        if not ctl.too_large(err):
+            h_next = ctl.next_step(h, err, fac11, BETA, ctl.ERR_MIN)[0]
+            if rejected:  # no increase right after a rejection
+                h_next = min(h_next, h)
             dense = DenseDOP853(fun, t, h, y, ynew, K, count)
             return h_next, t_new, ynew, K[N_STAGES].copy(), dense, rejected
         rejected += 1
-        h = h / min(FAC_MAX, err ** 0.125 / SAFETY)
+        h = ctl.shrunk(h, err, fac11)
         if h < hmin:
             raise IntegrationError(
                 f"DOP853 failed: the step fell below {hmin:.3g} s (error {err:.3g} of "

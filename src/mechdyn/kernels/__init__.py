@@ -6,8 +6,11 @@ The Numba kernels are compiled once per machine and kept in the user's cache fol
 ``~/.cache/mechdyn`` on Linux) rather than next to the installed sources, which may be
 read-only, in a subfolder named after a digest of the kernels' sources: Numba checks a
 cached function against its own file only, so a kernel that inlines a changed helper of
-another file (the linear algebra, the rows) would otherwise keep the old code.  A
-``NUMBA_CACHE_DIR`` the user has set is respected.
+another file (the linear algebra, the rows) would otherwise keep the old code.  The digest
+covers this package's files and the modules of :mod:`mechdyn.integrate` the kernels
+compile (:data:`COMPILED_INTEGRATE`: the DOP853 tableau, step control and dense output,
+written there once for the Python stepper and the compiled loop).  A ``NUMBA_CACHE_DIR``
+the user has set is respected.
 """
 
 from __future__ import annotations
@@ -17,12 +20,31 @@ import os
 import sys
 from pathlib import Path
 
-__all__ = ["cache_dir", "sources_digest"]
+__all__ = ["cache_dir", "sources_digest", "digested_sources", "COMPILED_INTEGRATE"]
+
+#: the modules of :mod:`mechdyn.integrate` whose functions and constants the kernels
+#: compile into their code (every one a kernel imports; a test keeps the list complete)
+COMPILED_INTEGRATE = ("dop853_control.py", "dop853_dense.py", "dop853_tableau.py")
+
+
+def digested_sources() -> list[Path]:
+    """The files :func:`sources_digest` covers: this package's ``*.py`` files, then
+    :data:`COMPILED_INTEGRATE` of :mod:`mechdyn.integrate`.
+
+    Examples
+    --------
+    >>> [f.name for f in digested_sources()][-3:]
+    ['dop853_control.py', 'dop853_dense.py', 'dop853_tableau.py']
+    """
+    here = Path(__file__).parent
+    integrate = here.parent / "integrate"
+    return sorted(here.glob("*.py")) + [integrate / name for name in COMPILED_INTEGRATE]
 
 
 def sources_digest() -> str:
-    """A short digest (12 hex digits) of the sources of the kernels (this package's
-    ``*.py`` files): the name of the cache subfolder their compiled code is valid for.
+    """A short digest (12 hex digits) of the sources of the kernels
+    (:func:`digested_sources`): the name of the cache subfolder their compiled code is
+    valid for.
 
     Examples
     --------
@@ -31,8 +53,8 @@ def sources_digest() -> str:
     (12, True)
     """
     h = hashlib.sha1()
-    for f in sorted(Path(__file__).parent.glob("*.py")):
-        h.update(f.name.encode() + b"\0" + f.read_bytes())
+    for f in digested_sources():
+        h.update(f.parent.name.encode() + b"/" + f.name.encode() + b"\0" + f.read_bytes())
     return h.hexdigest()[:12]
 
 

@@ -19,12 +19,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..integrate.dop853_tableau import N_STAGES, A, C, D
+from ..integrate import dop853_dense as _plain
+from ..integrate.dop853_tableau import N_STAGES, A, C
 from .lagrange_numba import D_NI, evaluate_into
 from .rows_numba import copy_into, copy_rows, njit
 
 __all__ = ["stage", "dense_at", "dense_coefficients", "keep_step", "dense_output",
            "kept_offsets", "kept_parts"]
+
+#: the dense output at a time of the step, and its coefficients: the plain functions of
+#: :mod:`mechdyn.integrate.dop853_dense`, compiled
+dense_at = njit(_plain.dense_at)
+dense_coefficients = njit(_plain.dense_coefficients)
 
 
 @njit
@@ -38,32 +44,6 @@ def stage(y, K, s, h, ys):
             if a != 0.0:
                 acc += a * K[j, i]
         ys[i] = y[i] + h * acc
-
-
-@njit
-def dense_at(dns, y_old, t_old, h, ts, out):
-    """The dense output of order 7 of a step at ``ts`` into ``out``."""
-    s = (ts - t_old) / h
-    s1 = 1.0 - s
-    for i in range(y_old.size):
-        out[i] = y_old[i] + s * (dns[0, i] + s1 * (dns[1, i] + s * (dns[2, i] + s1 * (
-            dns[3, i] + s * (dns[4, i] + s1 * (dns[5, i] + s * dns[6, i]))))))
-
-
-@njit
-def dense_coefficients(y, ynew, f, fnew, K, h, dns):
-    """The coefficients of the dense output, the three extra stages in K."""
-    m = y.size
-    for i in range(m):
-        dy = ynew[i] - y[i]
-        dns[0, i] = dy
-        dns[1, i] = h * f[i] - dy
-        dns[2, i] = 2.0 * dy - h * (f[i] + fnew[i])
-        for k in range(4):
-            acc = 0.0
-            for j in range(N_STAGES + 4):
-                acc += D[k, j] * K[j, i]
-            dns[3 + k, i] = h * acc
 
 
 @njit

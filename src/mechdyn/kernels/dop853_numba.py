@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..integrate.dop853_tableau import N_STAGES
-from .dop853_control import error_norm, next_step, shrunk, too_large
+from .dop853_control import error_factor, error_norm, next_step, shrunk, too_large
 from .dop853_dense import dense_at
 from .dop853_steps import (
     BATCH,
@@ -302,7 +302,7 @@ def _run(y, f, atol, par, ipar, K, ynew, ys, hist, dns, t_eval, o_t, o_y, o_x, o
             _put_back(ws, ws0)
             return _stop(par, t, h, FAILED)
         err = error_norm(y, ynew, K, atol, rtol, h)
-        fac11 = err ** (0.125 - 0.2 * par[P_BETA])
+        fac11 = error_factor(err, par[P_BETA])
         if too_large(err):  # rejected
             rejected = True
             retried = 0
