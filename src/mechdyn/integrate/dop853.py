@@ -44,7 +44,7 @@ from .dop853_tableau import N_STAGES, A, B, C
 __all__ = ["dop853_steps", "initial_step", "DenseDOP853", "BETA"]
 
 #: exponent of the PI step control: 0, Hairer's DOP853 (a step from the last error alone),
-#: as in the compiled loop by default (:data:`mechdyn.dynamics.compiled_loop.BETA`)
+#: as in the compiled loop by default (:data:`mechdyn.simulate.compiled_loop.BETA`)
 BETA = 0.0
 
 

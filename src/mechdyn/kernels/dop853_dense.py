@@ -3,7 +3,7 @@ its steps in.
 
 The dense output of order 7 of a DOP853 step needs three evaluations beyond the step's
 own twelve.  A segment with event functions keeps every step of the compiled loop for
-Python to check (:func:`mechdyn.dynamics.compiled_loop.kept_steps`), but only the steps
+Python to check (:func:`mechdyn.simulate.compiled_loop.kept_steps`), but only the steps
 in which an event function changes sign, a coordinate rate turns or an output time
 falls need their dense output; the loop keeps the stages of the others
 (:func:`keep_step`) and :func:`dense_output` finishes them on demand: the same three

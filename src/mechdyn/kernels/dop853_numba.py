@@ -21,7 +21,7 @@ allocating and without going back to Python.  It returns only
   the state is the last accepted one.
 
 The arrays of a call (all preallocated by the caller, see
-:class:`mechdyn.dynamics.compiled_loop.LoopBuffers`): ``par`` (float) and ``ipar`` (int)
+:class:`mechdyn.dynamics.loop_buffers.LoopBuffers`): ``par`` (float) and ``ipar`` (int)
 hold the scalars named by the ``P_*`` and ``I_*`` indices (of
 :mod:`mechdyn.kernels.dop853_steps`, which has the parts of a step; the step control is in
 :mod:`mechdyn.kernels.dop853_control`).
@@ -42,7 +42,6 @@ from .dop853_steps import (
     F_TURN,
     FAILED,
     FLAGGED,
-    I_CTRL,
     I_EVALS,
     I_EVERY,
     I_FLAGS,
@@ -102,7 +101,7 @@ __all__ = ["run", "evaluate_states", "DONE", "BATCH", "FLAGGED", "FAILED", "WATC
            "P_HMAX", "P_STALL", "P_PIVOT", "P_WC0", "P_WC1", "P_LAST", "P_TOLD", "P_HOLD",
            "I_EVALS", "I_STEPS", "I_REJ", "I_NOUT", "I_NEXT", "I_FLAGS", "I_FSAL",
            "I_EVERY", "I_WATCH", "I_MAXSTEPS", "I_STATUS", "I_PREV", "I_WPEND", "P_WS",
-           "I_KEEP", "I_NKEPT", "I_CTRL", "P_BRACKET", "step_end", "accept", "samples",
+           "I_KEEP", "I_NKEPT", "P_BRACKET", "step_end", "accept", "samples",
            "N_PAR", "N_IPAR"]
 
 @njit

@@ -30,7 +30,7 @@ __all__ = ["DONE", "BATCH", "FLAGGED", "FAILED", "WATCH", "F_TURN", "F_PIVOT", "
            "P_WC1", "P_LAST", "P_TOLD", "P_HOLD", "P_WS", "P_BETA", "P_ERROLD", "P_BRACKET",
            "I_EVALS", "I_STEPS", "I_REJ", "I_NOUT", "I_NEXT", "I_FLAGS", "I_FSAL", "I_EVERY",
            "I_WATCH", "I_MAXSTEPS", "I_STATUS", "I_PREV", "I_WPEND", "I_KEEP", "I_NKEPT",
-           "I_CTRL", "N_PAR", "N_IPAR"]
+           "N_PAR", "N_IPAR"]
 
 # return codes of run
 DONE, BATCH, FLAGGED, FAILED, WATCH = 0, 1, 2, 3, 4
@@ -46,12 +46,10 @@ P_T, P_TEND, P_H, P_RTOL, P_HMAX, P_STALL, P_PIVOT, P_WC0, P_WC1, P_LAST, P_TOLD
 N_PAR = P_BRACKET + 6
 # ipar: evaluations, accepted and rejected steps, samples in the buffers, next t_eval,
 # flags, f valid, every step sampled, watch on, steps per call, kernel status, history,
-# a watch due, every step kept (with its dense output) in ``kept``, steps kept, SciPy's
-# step control (its starting step, step factors within [0.2, 10], a step accepted below an
-# error of 1, no stretch of the last step) instead of Hairer's
+# a watch due, every step kept (with its dense output) in ``kept``, steps kept
 I_EVALS, I_STEPS, I_REJ, I_NOUT, I_NEXT, I_FLAGS, I_FSAL, I_EVERY, I_WATCH, I_MAXSTEPS, \
-    I_STATUS, I_PREV, I_WPEND, I_KEEP, I_NKEPT, I_CTRL = range(16)
-N_IPAR = 16
+    I_STATUS, I_PREV, I_WPEND, I_KEEP, I_NKEPT = range(15)
+N_IPAR = 15
 
 
 @njit_inline

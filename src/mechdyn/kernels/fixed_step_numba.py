@@ -6,7 +6,7 @@ a mode's kernel.
 ``ipar[I_METHOD]``, every evaluation made by
 :func:`mechdyn.kernels.lagrange_numba.evaluate_into` as in the DOP853 loop
 (:mod:`mechdyn.kernels.dop853_numba`, whose return codes, flags, scalars and buffers it
-shares, so that one Python side drives both: :mod:`mechdyn.dynamics.compiled_loop`):
+shares, so that one Python side drives both: :mod:`mechdyn.simulate.compiled_loop`):
 
 * ``RK4`` (:class:`mechdyn.integrate.runge_kutta.RungeKutta4`): the classical
   fourth-order Runge-Kutta method, four evaluations per step, the one at the end of a step
