@@ -198,8 +198,13 @@ def main(argv: list[str] | None = None) -> int:
     from ..errors import MechdynError
 
     terminated = []
+    owner = os.getpid()
 
     def on_term(signum, frame):  # SIGTERM ends a run as Ctrl-C does: the data is kept
+        if os.getpid() != owner:  # a child forked with this handler: ends as by default
+            signal.signal(signum, signal.SIG_DFL)
+            os.kill(os.getpid(), signum)
+            return
         terminated.append(signum)
         raise KeyboardInterrupt
 

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
 import os
@@ -27,6 +28,8 @@ MAX_BATCH = 50
 #: default largest batch of variants analysed as one (:mod:`.batch`): its probes and
 #: compiled kernels are shared by more variants
 MAX_BATCHED = 2000
+#: longest wait (s) for a batch before the study's process looks at its signals again
+_WAIT = 0.25
 
 
 def variant_table(base: BaseModel, variants):
@@ -74,22 +77,90 @@ def _bar(total: int, initial: int, progress):
                 delay=0.0 if progress else _progress.PROGRESS_AFTER)
 
 
+#: the signals that stop a study: Ctrl-C and SIGTERM
+_STOP = (signal.SIGINT, signal.SIGTERM)
+
+
 def _quiet_worker() -> None:
-    """A worker process ignores Ctrl-C: the study's process stops them all."""
+    """Signals of a local worker process: Ctrl-C ignored (the study's process stops them
+    all), SIGTERM the system's default, which ends the worker at once wherever it is (a
+    Python handler inherited from the parent, such as the command line's, would raise
+    in the middle of the pool's own locking, or never run while the worker waits on a
+    lock); then the signals blocked while it was started (:func:`_start_pool`) are let
+    through."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOP)
+
+
+def _start_pool(workers: int):
+    """A pool of ``workers`` processes whose signals are :func:`_quiet_worker`'s from
+    their first instruction: SIGINT and SIGTERM are blocked in this thread while the
+    pool forks its workers and starts its threads (which keep them blocked, so that
+    this process's handlers run in its main thread only)."""
+    import multiprocessing
+
+    if not hasattr(signal, "pthread_sigmask"):
+        return multiprocessing.Pool(workers, initializer=_quiet_worker)
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, _STOP)
+    try:
+        return multiprocessing.Pool(workers, initializer=_quiet_worker)
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+@contextlib.contextmanager
+def _signals_held():
+    """SIGINT and SIGTERM held while the block runs (the pool is stopped, the table
+    gathered), then the first one that came is raised again for this process's own
+    handler; a no-op outside the main thread."""
+    got: list[int] = []
+    try:
+        previous = {s: signal.signal(s, lambda signum, frame: got.append(signum))
+                    for s in _STOP}
+    except ValueError:  # not the main thread: signals cannot be handled here
+        yield
+        return
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        if got:
+            signal.raise_signal(got[0])
 
 
 def _local(task, batches, workers: int):
     """Results of the batches as they finish, in this process (workers <= 1) or in a
-    pool of worker processes (terminated when the study is interrupted)."""
+    pool of worker processes: closed and joined when every batch is done, terminated
+    (pending batches dropped, running ones stopped) when the study is interrupted or
+    the generator closed early; joined either way."""
     if workers <= 1:
         for b in batches:
             yield evaluate_batch(task, b)
         return
     import multiprocessing
 
-    with multiprocessing.Pool(workers, initializer=_quiet_worker) as pool:  # exit: terminate
-        yield from pool.imap_unordered(functools.partial(evaluate_batch, task), batches)
+    pool = _start_pool(workers)
+    done = False
+    try:
+        results = pool.imap_unordered(functools.partial(evaluate_batch, task), batches)
+        while True:
+            try:  # in short waits: a signal is acted on within _WAIT s
+                rows = results.next(timeout=_WAIT)
+            except multiprocessing.TimeoutError:
+                continue
+            except StopIteration:
+                break
+            yield rows
+        done = True
+    finally:
+        if done:  # the workers leave by the pool's sentinel: no signal sent
+            pool.close()
+        else:
+            pool.terminate()
+        pool.join()
 
 
 def _dask(task, batches, client, retries: int):
@@ -229,11 +300,12 @@ def run_study(model, variants, analysis, *, output: str | Path | None = None,
             if bar is not None:
                 bar.update(len(batch_rows))
     finally:
-        results.close()
-        if bar is not None:
-            bar.close()
-        if out is not None:
-            table = out.finish()
+        with _signals_held():  # a second Ctrl-C or a SIGTERM waits for the table
+            results.close()
+            if bar is not None:
+                bar.close()
+            if out is not None:
+                table = out.finish()
     if out is None:
         table = pd.DataFrame(rows)
         if len(table):
