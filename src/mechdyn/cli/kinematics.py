@@ -27,6 +27,7 @@ from .options import (
     check_plot_columns,
     finish,
     open_model,
+    preview_record,
     speed_from_args,
     speed_line,
     sweep_values,
@@ -68,6 +69,9 @@ def run(args) -> int:
     trace_spec(model, args.trace)
     over, values, _ = sweep_values(model, args, only=True)
     speed, why = speed_from_args(model, over, args)
+    if args.plot_columns is not None:  # the columns before the sweep
+        check_plot_columns(args, preview_record(lambda: sweep(model, over, values[:2],
+                                                              speed=speed)))
     with stage(f"kinematics: sweeping {over} over {values.size} positions", args.progress):
         sw = sweep(model, over, values, speed=speed)
     ends, unit = deg_or_mm(values[[0, -1]], sw.over_is_angle)

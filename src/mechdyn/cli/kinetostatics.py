@@ -37,6 +37,7 @@ from .options import (
     finish,
     load_model,
     moment_point,
+    preview_record,
     speed_from_args,
     speed_line,
     sweep_values,
@@ -95,6 +96,10 @@ def run(args) -> int:
     over, values, _ = sweep_values(model, args)
     speed, why = speed_from_args(model, over, args)
     point = moment_point(args)
+    if args.plot_columns is not None:  # the columns before the analysis
+        check_plot_columns(args, preview_record(lambda: kinetostatics(
+            model, over=over, speed=speed, values=values[:2], point=point, mode=engaged,
+            reacting_loads=tuple(args.bed))))
     with (warnings.catch_warnings(),
           stage(f"kinetostatics: {values.size} positions of {over}", args.progress)):
         warnings.simplefilter("ignore", KinetostaticsWarning)  # printed below

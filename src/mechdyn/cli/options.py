@@ -7,6 +7,7 @@ import argparse
 import dataclasses
 import re
 import sys
+import warnings
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -32,7 +33,8 @@ __all__ = ["quantity", "vector", "add_model", "add_files", "add_range", "add_sta
            "add_model_arguments", "add_run",
            "load_model", "open_model", "prepare_model", "sweep_values", "model_speed",
            "speed_from_args", "speed_line", "simulate_from_args", "write_files", "finish",
-           "add_plot_columns", "check_plot_columns", "draw_plot", "SPEED_DEFAULT"]
+           "add_plot_columns", "check_plot_columns", "draw_plot", "SPEED_DEFAULT",
+           "numeric_columns", "preview_record"]
 
 
 #: kinds whose bare numbers are SI radians, easily mistaken for degrees or rpm
@@ -449,17 +451,36 @@ def add_plot_columns(p) -> None:
 
 
 def check_plot_columns(args, record=None) -> None:
-    """Before the run: ``--plot-columns`` needs ``--plot``; with the record: every column
-    exists (else the error lists the valid columns)."""
+    """``--plot-columns`` needs ``--plot``; every column it names is one of the numeric
+    columns of ``record``'s table (else the error lists the valid columns).
+
+    ``record`` is the result, or before the run a preview of it (the same analysis over
+    two positions, :func:`preview_record`): its table has the columns of the run's.
+    """
     columns = getattr(args, "plot_columns", None)
     if columns is None:
         return
     if not args.plot:
         raise ModelError("--plot-columns needs --plot FILE (the image to draw them in)")
     if record is not None:
-        table = table_of(record)
-        check_columns(columns, [c for c in table.columns if table[c].dtype.kind in "iuf"],
-                      "--plot-columns")
+        check_columns(columns, numeric_columns(table_of(record)), "--plot-columns")
+
+
+def numeric_columns(table) -> list[str]:
+    """The names of the numeric columns of a table (a pandas DataFrame)."""
+    return [c for c in table.columns if table[c].dtype.kind in "iuf"]
+
+
+def preview_record(run):
+    """The record of ``run()``, the command's analysis over two positions or samples, whose
+    table names the columns of the full run's; None when ``run`` raises (the full run then
+    says why)."""
+    try:
+        with warnings.catch_warnings():  # the full run warns
+            warnings.simplefilter("ignore")
+            return run()
+    except (ModelError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+        return None
 
 
 def draw_plot(args, record, plot, **kwargs):

@@ -26,6 +26,7 @@ from ..mechanism import Drive
 from ..results import spectrum
 from ..results.events import events_table
 from ..results.frame_geometry import trace_spec
+from ..results.plot_columns import check_columns
 from ..results.plot_dynamics import plot_trajectory
 from ..results.plot_spectrum import plot_spectrum
 from ..results.table import CsvStream, deg_or_mm, written
@@ -46,6 +47,8 @@ from .options import (
     engage_from_args,
     load_model,
     moment_point,
+    numeric_columns,
+    preview_record,
     quantity,
     with_lock_poses,
 )
@@ -141,8 +144,13 @@ def run(args) -> int:
     model = mech.compile()
     for point in args.points or ():  # unknown names before the run
         trace_spec(model, point, "--points")
-    t_eval = None
     fixed = args.integrator.lower() in ("wilson", "rk4")
+    run = dict(t0=t0, integrator=args.integrator, rtol=args.rtol, atol=args.atol, q0=q0,
+               qdot0=qdot0, formulation=args.formulation, d=d, backend=args.backend,
+               theta=args.theta, iterations=args.iterations if fixed else None,
+               mode=engaged, **_moment_point(args))
+    _check_columns(args, model, run, fixed)
+    t_eval = None
     if args.samples is None and not (fixed or args.every_step):
         args.samples = 1001
     if args.samples is not None:
@@ -154,13 +162,9 @@ def run(args) -> int:
         stream = CsvStream(args.output, table=lambda part: _with_points(
             part, args.points).to_dataframe(points=args.points is not None))
     try:
-        traj = simulate(model, t_end, t0=t0, integrator=args.integrator,
-                        steps=args.fixed_steps, dt=dt, rtol=args.rtol, atol=args.atol, q0=q0,
-                        qdot0=qdot0, t_eval=t_eval, formulation=args.formulation, d=d,
-                        progress=args.progress, backend=args.backend, theta=args.theta,
-                        iterations=args.iterations if fixed else None, mode=engaged,
-                        sink=stream, chunk=args.chunk,
-                        keep=bool(args.plot or args.spectrum), **_moment_point(args))
+        traj = simulate(model, t_end, steps=args.fixed_steps, dt=dt, t_eval=t_eval,
+                        progress=args.progress, sink=stream, chunk=args.chunk,
+                        keep=bool(args.plot or args.spectrum), **run)
     except BaseException:
         if stream is not None:
             stream.abort()  # NAME.csv.partial stays as written so far
@@ -189,6 +193,22 @@ def run(args) -> int:
         print(f"mechdyn simulate: stopped early: {traj.status}: {traj.message}", file=sys.stderr)
         return 130 if traj.status == Status.INTERRUPTED else 1
     return 0
+
+
+def _check_columns(args, model, run: dict, fixed: bool) -> None:
+    """``--plot-columns`` and ``--spectrum`` name columns of the table: checked before the
+    run against a preview of it (the same run over 1 us, two samples)."""
+    if args.plot_columns is None and args.spectrum is None:
+        return
+    t0 = run["t0"]
+    traj = preview_record(lambda: simulate(
+        model, t0 + 1e-6, steps=1 if fixed else None, progress=False,
+        t_eval=None if fixed else np.array([t0, t0 + 1e-6]), **run))
+    if traj is None or traj.t.size == 0:
+        return  # the run itself says why it cannot start
+    check_plot_columns(args, traj)
+    if args.spectrum is not None:
+        check_columns([args.spectrum], numeric_columns(traj.to_dataframe()), "--spectrum")
 
 
 def _moment_point(args) -> dict:

@@ -32,6 +32,7 @@ from ..study.analyses import (
     FlywheelSize,
     KinematicSummary,
     KinetostaticExtremes,
+    check_figures,
 )
 from ..study.designs import DESIGNS, design, parse_range
 from ..study.execute import run_study
@@ -179,10 +180,15 @@ def run(args) -> int:
     base = BaseModel(args.model)
     ranges = [parse_range(base, spec) for spec in args.vary]
     analysis = _analysis(args, base)
+    constraints = [parse_constraint(c) for c in args.constraint]
+    check_figures(analysis, base.compile({}),  # the names, before the first variant
+                  {"--minimise": args.minimise, "--figure": args.figure,
+                   **{f"--constraint {c.column}": c.column for c in constraints}},
+                  [r.parameter.column for r in ranges])
     t0 = time.perf_counter()
     if args.minimise:
         best = optimise(base, ranges, analysis, args.minimise, method=args.method,
-                        constraints=[parse_constraint(c) for c in args.constraint],
+                        constraints=constraints,
                         seed=args.seed, output=args.output)
         _summary(best.table, args, ranges, time.perf_counter() - t0)
         print(f"  optimum ({args.method}, {best.evaluations} evaluations, "

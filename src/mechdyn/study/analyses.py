@@ -10,7 +10,7 @@ and what the next variant may start from (``warm``, e.g. this variant's poses).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -18,7 +18,7 @@ from ..errors import ModelError, Status
 from ..units import parse_quantity
 
 __all__ = ["Outcome", "KinetostaticExtremes", "extremes", "KinematicSummary", "FlywheelSize",
-           "SimulationMetrics", "Combined", "ANALYSES"]
+           "SimulationMetrics", "Combined", "ANALYSES", "check_figures"]
 
 _DEG = 180.0 / np.pi
 
@@ -113,6 +113,11 @@ class KinetostaticExtremes:
     def __call__(self, model, warm=None) -> Outcome:
         return self.figures(self.record(model, warm))
 
+    def columns(self, model) -> tuple[str, ...]:
+        """The names of the figures of ``model``'s variants (the analysis over four
+        positions: the drives and joints name them)."""
+        return tuple(replace(self, steps=4, warm_start=False)(model).figures)
+
     @staticmethod
     def figures(rec) -> Outcome:
         """The figures of a kinetostatics record (also for a plain loop's records)."""
@@ -191,6 +196,20 @@ class KinematicSummary:
     def __post_init__(self):
         object.__setattr__(self, "start", _si(self.start, "angle", "start"))
 
+    def columns(self, model) -> tuple[str, ...]:
+        """The names of the figures of ``model``'s variants: per slider its stroke and
+        dead centres, per four-bar loop its transmission-angle range."""
+        from ..kinematics.records import four_bar_loops
+
+        over = _cycle(model, self.over, self.start, 2)[0]
+        out = [f"stroke_{j}_m" for j in model.pri.names]
+        out += [f"{label}_{j}_{what}" for j in model.pri.names for label in ("TDC", "BDC")
+                for what in ("at_deg", "travel_m")]
+        for lp in four_bar_loops(model, over):
+            tag = f"{lp.coupler}_{lp.rocker}"
+            out += [f"mu_min_{tag}_deg", f"mu_max_{tag}_deg", f"mu_min_{tag}_at_deg"]
+        return tuple(out)
+
     def __call__(self, model, warm=None) -> Outcome:
         from ..kinematics.sweep import sweep
 
@@ -243,6 +262,12 @@ class FlywheelSize:
         if self.speed is not None:
             object.__setattr__(self, "speed", _si(self.speed, "angular_velocity", "speed"))
 
+    def columns(self, model) -> tuple[str, ...]:
+        """The names of the figures (the same for every model)."""
+        out = ("J_fly_kg_m2", "delta_E_max_J", "omega_mean_rpm", "J_red_mean_kg_m2",
+               "J_fly_motor_kg_m2")
+        return out + (("delta_simulated",) if self.method == "simulation" else ())
+
     def __call__(self, model, warm=None) -> Outcome:
         from ..reduction.flywheel import size_flywheel
         from ..reduction.reduce import reduce_model
@@ -289,6 +314,10 @@ class SimulationMetrics:
     def __post_init__(self):
         object.__setattr__(self, "t_end", _si(self.t_end, "time", "t_end"))
 
+    def columns(self, model) -> None:
+        """None: the names are those ``metrics`` gives, known after a run."""
+        return None
+
     def __call__(self, model, warm=None) -> Outcome:
         from ..simulate.run import simulate
 
@@ -318,12 +347,58 @@ class Combined:
     def name(self) -> str:
         return "+".join(p.name for p in self.parts)
 
+    def columns(self, model) -> tuple[str, ...] | None:
+        """The names of the figures of all the parts (None if one part's are unknown)."""
+        names = [p.columns(model) for p in self.parts]
+        return None if None in names else tuple(c for n in names for c in n)
+
     def __call__(self, model, warm=None) -> Outcome:
         outs = [p(model, warm if k == 0 else None) for k, p in enumerate(self.parts)]
         figures = {k: v for oc in outs for k, v in oc.figures.items()}
         bad = [oc for oc in outs if oc.status not in (Status.SUCCESS, Status.REDUNDANT)]
         head = bad[0] if bad else outs[0]
         return Outcome(figures, head.status, head.message, outs[0].warm)
+
+
+def check_figures(analysis, model, names: dict, extra=()) -> None:
+    """Check, before a study runs, that every figure it names is a column of the table.
+
+    Parameters
+    ----------
+    analysis : KinetostaticExtremes, KinematicSummary, FlywheelSize, Combined ...
+        Its ``columns(model)`` names the figures (None, or no such method: unknown
+        before a run, nothing is checked).
+    model : Model
+        The compiled base model.
+    names : dict of str to str or None
+        The option or argument (``"--minimise"``) -> the column it names (None: not
+        given).
+    extra : sequence of str
+        More valid names (the parameters' columns).
+
+    Raises
+    ------
+    ModelError
+        An unknown name: the message names the option and the value and lists the
+        valid names.
+
+    Examples
+    --------
+    >>> check_figures(FlywheelSize(0.05), None, {"--minimise": "J_fly_kg_m2"})
+    >>> check_figures(FlywheelSize(0.05), None, {"--minimise": "J_fly"})
+    Traceback (most recent call last):
+    ...
+    mechdyn.errors.ModelError: --minimise: unknown column 'J_fly'; valid column names: ...
+    """
+    from ..results.plot_columns import check_columns
+
+    given = {flag: name for flag, name in names.items() if name is not None}
+    columns = getattr(analysis, "columns", None)  # a plain callable names none
+    valid = columns(model) if given and columns is not None else None
+    if valid is None:
+        return
+    for flag, name in given.items():
+        check_columns([name], [*valid, *extra], flag)
 
 
 #: the analyses by their CLI name

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError, Status
+from .analyses import check_figures
 from .designs import Range
 from .evaluate import Task, evaluate_variant
 from .output import StudyOutput, order_columns
@@ -215,6 +216,10 @@ def optimise(model, ranges: list[Range], analysis, objective: str, *,
     from scipy import optimize
 
     base = model if isinstance(model, BaseModel) else BaseModel(model)
+    names = {"objective": objective, **{f"constraints[{k}]": c.column
+                                        for k, c in enumerate(constraints)}}
+    check_figures(analysis, base.compile({}), names,  # before the first evaluation
+                  [r.parameter.column for r in ranges])
     out = None if output is None else StudyOutput(output)
     if out is not None:
         out.clear()
