@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..brief import brief, number
 from ..errors import ModelError
 from ..kernels.planar import cross, rotate
 from ..mechanism import Mechanism
@@ -84,7 +85,7 @@ def _stats(F) -> dict:
             "rms_dFy_N": float(np.sqrt(np.mean(dyn[:, 1] ** 2)))}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class MountingComparison:
     """Rigid frame, one-way linear prediction and coupled mounting, on one time grid.
 
@@ -111,6 +112,13 @@ class MountingComparison:
     rigid_run: object
     coupled_run: object
     point: np.ndarray
+
+    def __repr__(self) -> str:
+        s = self.statistics()
+        return brief(self, f"{self.t.size} samples", "peak |F| to the floor: " + ", ".join(
+            f"{k} {number(s[k]['peak_N'], 'N')}" for k in ("rigid", "one_way", "coupled")),
+            model=getattr(getattr(getattr(self.rigid_run, "model", None), "mechanism", None),
+                          "name", None))
 
     def statistics(self) -> dict:
         """Peak force magnitude, peak |Fx|, |Fy| and RMS of the fluctuation of Fx, Fy about

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..brief import brief, number
 from ..errors import ModelError
 from .supports import Foundation
 
@@ -22,7 +23,7 @@ __all__ = ["Modes", "natural_frequencies", "ExcitationWarning", "excitation_warn
 _DOF = ("x", "y", "theta")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Modes:
     """The natural frequencies and mode shapes of the mounted base (undamped).
 
@@ -42,6 +43,10 @@ class Modes:
     omega: np.ndarray
     shapes: np.ndarray
     labels: tuple
+
+    def __repr__(self) -> str:
+        return brief(self, "frequencies " + ", ".join(number(f) for f in self.frequencies)
+                     + " Hz", f"labels={list(self.labels)}")
 
 
 def natural_frequencies(foundation: Foundation) -> Modes:

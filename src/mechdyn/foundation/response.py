@@ -7,13 +7,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..brief import brief, number
 from ..errors import ModelError
 from .supports import Foundation, shift_moment, support_matrix
 
 __all__ = ["MountedResponse", "mounted_response"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class MountedResponse:
     """The base's motion and the load it passes to the floor over a load history.
 
@@ -39,6 +40,12 @@ class MountedResponse:
     floor: np.ndarray
     supports: dict
     point: np.ndarray
+
+    def __repr__(self) -> str:
+        ok = self.floor[np.all(np.isfinite(self.floor), axis=1)]
+        peak = float(np.max(np.hypot(ok[:, 0], ok[:, 1]))) if len(ok) else None
+        return brief(self, f"{self.t.size} samples", f"supports={list(self.supports)[:6]}",
+                     f"peak |F| to the floor {number(peak, 'N')}")
 
     def to_dataframe(self):
         """A pandas DataFrame: ``t_s``, ``x_base_m``, ``y_base_m``, ``theta_base_rad``,

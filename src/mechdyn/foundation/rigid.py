@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..brief import brief, number
 from ..errors import ModelError
 from .frame_loads import frame_loads
 from .supports import AnchorBolt, Foundation, shift_moment, support_matrix
@@ -25,7 +26,7 @@ from .supports import AnchorBolt, Foundation, shift_moment, support_matrix
 __all__ = ["SupportLoads", "distribute", "bolt_forces", "support_loads"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class SupportLoads:
     """The loads of every support over a load history of ``n`` samples.
 
@@ -54,6 +55,14 @@ class SupportLoads:
     clamp: dict
     applied: np.ndarray
     point: np.ndarray
+
+    def __repr__(self) -> str:
+        peak = np.hypot(self.applied[:, 0], self.applied[:, 1]) if self.t.size else []
+        opening = self.first_opening
+        return brief(self, f"{self.t.size} samples", f"supports={list(self.names)[:6]}",
+                     f"peak |F| on the base {number(np.max(peak) if len(peak) else None, 'N')}",
+                     "" if not self.tension else "no bolt opens" if opening is None else
+                     f"{opening[0]!r} opens at {number(opening[1], 's')}")
 
     @property
     def first_opening(self) -> tuple[str, float] | None:

@@ -14,6 +14,7 @@ from functools import partial
 
 import numpy as np
 
+from ..brief import brief, number, span, status_text
 from ..fieldmap import FieldMapping
 from ..kernels import rows_numpy
 from ..kernels.planar import cross
@@ -33,7 +34,7 @@ def _ro(a):
     return a
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class KinematicPoint:
     """Kinematics of one position (see :func:`~mechdyn.kinematics.sweep.analyze`).
 
@@ -55,6 +56,11 @@ class KinematicPoint:
     xddot: np.ndarray
     B: np.ndarray
     model: Model = field(repr=False, compare=False)
+
+    def __repr__(self) -> str:
+        names = self.model.coordinate_names if self.model is not None else ()
+        at = ", ".join(f"{n} = {number(v)}" for n, v in zip(names[:4], self.q, strict=False))
+        return brief(self, at, f"{self.q.size} coordinates, {self.x.size // 3} bodies")
 
     def point(self, body: str, name) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position (m), velocity (m/s) and acceleration (m/s^2) of a body point, each (2,)."""
@@ -122,7 +128,7 @@ class SweepStats(FieldMapping):
     mode: tuple = ()
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class KinematicSweep:
     """Positions, velocities and accelerations of a mechanism over one coordinate.
 
@@ -168,6 +174,15 @@ class KinematicSweep:
     events: tuple = ()
     error: Exception | None = field(default=None, repr=False, compare=False)
     model: Model = field(default=None, repr=False, compare=False)
+
+    def __repr__(self) -> str:
+        n_req = getattr(self.stats, "n_requested", None)
+        of = f" of {n_req}" if n_req is not None and n_req != len(self) else ""
+        unit = "rad" if self.model is None or self.over_is_angle else "m"
+        return brief(self, f"{len(self)}{of} positions over {self.over!r}",
+                     span(self.values, unit) if len(self) else "",
+                     f"{self.q.shape[-1]} coordinates, {self.x.shape[-1] // 3} bodies",
+                     status_text(self))
 
     # ------------------------------------------------------------------ access
     def __len__(self) -> int:
@@ -334,7 +349,7 @@ class PointExtremes:
     a_max_at: float
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class SweepSummary:
     """Derived figures of a :class:`~mechdyn.kinematics.records.KinematicSweep`.
 
@@ -355,6 +370,13 @@ class SweepSummary:
     dead_centres: list
     transmission: list
     extremes: list
+
+    def __repr__(self) -> str:
+        strokes = ", ".join(f"{j} {number(s, 'm')}" for j, s in list(self.strokes.items())[:3])
+        return brief(self, f"over {self.over!r}", f"stroke {strokes}" if strokes else "",
+                     f"{len(self.dead_centres)} dead centres",
+                     f"{len(self.transmission)} transmission angles",
+                     f"{len(self.extremes)} points", model="")
 
     def as_dict(self) -> dict:
         """Plain nested dict (for JSON)."""

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..brief import brief, number, status_text
 from ..errors import IntegrationError, LockupError, ModelError
 from ..results.records import FlywheelStats, SteadyCycleStats
 from .machine import ReducedMachine, _Motion, _Record
@@ -29,7 +30,7 @@ CYCLE_STEPS = 720
 
 
 # ============================================================================ steady cycle
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class SteadyCycle(_Motion):
     """One cycle of the periodic steady motion of a reduced machine.
 
@@ -63,6 +64,10 @@ class SteadyCycle(_Motion):
     phi_at_max: float
     phi_at_min: float
     extra_inertia: float = 0.0
+
+    def _figures(self) -> tuple[str, ...]:
+        return (f"omega_mean {number(self.omega_mean, 'rad/s')}",
+                f"delta {number(self.delta)}", f"cycle {number(self.cycle_time, 's')}")
 
     @property
     def delta_avg(self) -> float:
@@ -294,7 +299,7 @@ def _finish(machine, ph, calls, w0, t0, iters) -> SteadyCycle:
 
 
 # ============================================================================ flywheel
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class FlywheelSizing(_Record):
     """A flywheel for a target coefficient of speed fluctuation.
 
@@ -346,6 +351,15 @@ class FlywheelSizing(_Record):
     delta_without: float | None
     method: str
     cycle: SteadyCycle | None = None
+
+    def __repr__(self) -> str:
+        motor = f"J_fly_motor {number(self.J_fly_motor, 'kg m^2')}" \
+            if self.J_fly_motor is not None else ""
+        return brief(self, f"method {self.method!r}", status_text(self),
+                     f"delta {number(self.delta_target)}",
+                     f"omega_mean {number(self.omega_mean, 'rad/s')}",
+                     f"J_fly {number(self.J_fly, 'kg m^2')}", motor,
+                     f"delta_E_max {number(self.delta_E_max, 'J')}")
 
     def to_dataframe(self):
         """One row of the sizing figures with unit-suffixed columns."""

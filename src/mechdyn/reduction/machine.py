@@ -23,6 +23,7 @@ from typing import Protocol
 
 import numpy as np
 
+from ..brief import brief, span, status_text
 from ..errors import IntegrationError, ModelError
 from ..fieldmap import FieldMapping
 from ..mechanism.drive import TorqueSpeedCurve
@@ -78,6 +79,16 @@ class _Motion(_Record):
     epsilon: np.ndarray
     J: np.ndarray
     M: np.ndarray
+
+    def __repr__(self) -> str:
+        times = span(self.t[[0, -1]], "s") if self.t.size else ""
+        return brief(self, f"{self.t.size} samples" + (f", t = {times}" if times else ""),
+                     f"omega = {span(self.omega, 'rad/s')}" if self.t.size else "",
+                     status_text(self), *self._figures())
+
+    def _figures(self) -> tuple[str, ...]:
+        """The key figures of the repr (after the sizes and the status)."""
+        return ()
 
     def to_dataframe(self):
         """Columns ``t_s, phi_deg, phi_rad, omega_rad_s, epsilon_rad_s2, J_total_kgm2,

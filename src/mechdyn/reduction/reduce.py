@@ -34,6 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..brief import brief, span, status_text
 from ..errors import ModelError, Status, did_you_mean
 from ..mechanism.joint import Lock
 from ..model import Model, as_model
@@ -57,7 +58,7 @@ __all__ = ["Reduction", "reduce_model", "ReducedMachine", "Member", "MemberLoad"
 
 
 # ============================================================================ the table
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Reduction(_Record):
     """Reduced quantities of a 1-DOF mechanism over a range of positions.
 
@@ -120,6 +121,12 @@ class Reduction(_Record):
     point: tuple | None = None
     m_red: np.ndarray | None = None
     v_ratio: np.ndarray | None = None
+
+    def __repr__(self) -> str:
+        link = f"link {self.link!r}" if self.link is not None else ""
+        return brief(self, f"{self.phi.size} positions of {self.coordinate!r}", link,
+                     status_text(self), f"J_red = {span(self.J_red, 'kg m^2')}",
+                     f"M_red = {span(self.M_red, 'N m' if self.is_angle else 'N')}")
 
     @property
     def J_total(self) -> np.ndarray:

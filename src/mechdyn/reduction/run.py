@@ -22,15 +22,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..brief import brief, number, status_text
 from ..errors import ModelError, Status
+from ..fieldmap import FieldMapping
 from ..integrate import make_integrator, solve
 from .flywheel import SteadyCycle, steady_state
 from .machine import ReducedMachine, _Motion, _Record
 
-__all__ = ["ReducedRun", "run_reduced", "energy_speed", "StartupResult", "startup"]
+__all__ = ["ReducedRun", "run_reduced", "energy_speed", "StartupResult", "StartupSummary",
+           "startup"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class ReducedRun(_Motion):
     """A time history of the reduced machine.
 
@@ -46,6 +49,10 @@ class ReducedRun(_Motion):
 
     M_drive: np.ndarray
     M_motor: np.ndarray | None = None
+
+    def _figures(self) -> tuple[str, ...]:
+        peak = float(np.max(np.abs(self.M_drive))) if self.M_drive.size else None
+        return (f"peak M_drive {number(peak, 'N m')}",)
 
 
 def run_reduced(machine: ReducedMachine, t_end: float, *, phi0: float = 0.0,
@@ -161,7 +168,7 @@ def _work(integrand, s, rtol: float, atol: float) -> np.ndarray:
     return w
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class StartupResult(_Record):
     """Start-up of a machine from rest by its motor, and its steady regime.
 
@@ -197,16 +204,75 @@ class StartupResult(_Record):
     omega_mean: float
     tol: float
 
+    def __repr__(self) -> str:
+        return brief(self, f"{self.run.t.size} samples", status_text(self),
+                     f"t_steady {number(self.t_steady, 's')}",
+                     f"omega_mean {number(self.omega_mean, 'rad/s')}",
+                     f"peak_motor_torque {number(self.peak_motor_torque, 'N m')}",
+                     f"speed_dip {number(self.speed_dip, 'rad/s')}")
+
     def to_dataframe(self):
         """The run's time history (see :meth:`ReducedRun.to_dataframe`)."""
         return self.run.to_dataframe()
 
-    def summary(self) -> dict:
-        """The headline figures in SI units."""
-        return {"t_steady_s": self.t_steady, "peak_drive_torque_Nm": self.peak_drive_torque,
-                "peak_motor_torque_Nm": self.peak_motor_torque,
-                "omega_mean_rad_s": self.omega_mean, "speed_dip_rad_s": self.speed_dip,
-                "phi_dip_deg": math.degrees(self.phi_dip), "delta": self.steady.delta}
+    def summary(self) -> StartupSummary:
+        """The headline figures in SI units (a :class:`StartupSummary`, which also reads
+        as the dict it used to be: ``summary()["t_steady_s"]``)."""
+        return StartupSummary(self.t_steady, self.peak_drive_torque, self.peak_motor_torque,
+                              self.omega_mean, self.speed_dip, math.degrees(self.phi_dip),
+                              self.steady.delta)
+
+
+@dataclass(frozen=True, repr=False)
+class StartupSummary(FieldMapping):
+    """The headline figures of a :class:`StartupResult` (:meth:`StartupResult.summary`).
+
+    Read as a mapping it has the keys of the dict it used to be, but for the figures
+    that are None (``t_steady_s`` of a run that does not settle, ``peak_motor_torque_Nm``
+    without a gear stage).
+
+    Attributes
+    ----------
+    t_steady_s : float or None
+        Time to the steady regime, s.
+    peak_drive_torque_Nm, peak_motor_torque_Nm : float (or None)
+        Largest drive torque on the link, and on the motor shaft, N m.
+    omega_mean_rad_s, speed_dip_rad_s : float
+        Mean speed and speed dip of the steady cycle, rad/s.
+    phi_dip_deg : float
+        Where the speed is least, deg.
+    delta : float
+        Coefficient of speed fluctuation of the steady cycle.
+
+    Examples
+    --------
+    >>> s = StartupSummary(0.065, 72.0, 22.3, 45.46, 5.15, 170.0, 0.113)
+    >>> s["t_steady_s"], s.delta
+    (0.065, 0.113)
+    >>> print(s)  # doctest: +NORMALIZE_WHITESPACE
+    t_steady 0.065 s, peak drive torque 72 N m, peak motor torque 22.3 N m,
+    omega_mean 45.46 rad/s, speed dip 5.15 rad/s at 170 deg, delta 0.113
+    """
+
+    t_steady_s: float | None
+    peak_drive_torque_Nm: float
+    peak_motor_torque_Nm: float | None
+    omega_mean_rad_s: float
+    speed_dip_rad_s: float
+    phi_dip_deg: float
+    delta: float
+
+    def __str__(self) -> str:
+        motor = f", peak motor torque {number(self.peak_motor_torque_Nm, 'N m')}" \
+            if self.peak_motor_torque_Nm is not None else ""
+        return (f"t_steady {number(self.t_steady_s, 's')}, peak drive torque "
+                f"{number(self.peak_drive_torque_Nm, 'N m')}{motor}, omega_mean "
+                f"{number(self.omega_mean_rad_s, 'rad/s')}, speed dip "
+                f"{number(self.speed_dip_rad_s, 'rad/s')} at {number(self.phi_dip_deg, 'deg')}"
+                f", delta {number(self.delta)}")
+
+    def __repr__(self) -> str:
+        return brief(self, str(self))
 
 
 def startup(machine: ReducedMachine, t_end: float, *, phi0: float = 0.0, omega0: float = 0.0,

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..brief import brief, number, status_text
 from ..errors import ModelError, did_you_mean
 from ..model import Model
 from .records import KinetostaticsStats
@@ -155,10 +156,16 @@ class Kinetostatics:
     locked: np.ndarray | None = None
 
     def __repr__(self) -> str:
-        sw = f", {len(self.modes)} modes" if self.sample_modes is not None else ""
-        return (f"Kinetostatics(status={self.status!r}, {len(self.t)} positions over "
-                f"{self.over!r}, driven={list(self.driven)}, joints={list(self.reactions)}"
-                f"{sw})")
+        peaks = []
+        for c in self.driven[:2]:
+            sym, unit = self._drive_unit(c)
+            tau = np.asarray(self.driving[c], float)
+            peak = float(np.nanmax(np.abs(tau))) if np.isfinite(tau).any() else None
+            peaks.append(f"peak {sym}_drive_{c} {number(peak, 'N m' if sym == 'M' else 'N')}")
+        return brief(self, f"{self.n} positions over {self.over!r}",
+                     f"driven={list(self.driven)}", f"{len(self.reactions)} joints",
+                     f"{len(self.modes)} modes" if self.switched else "",
+                     status_text(self), *peaks)
 
     @property
     def switched(self) -> bool:

@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..brief import brief, number, span, status_text
 from ..errors import ModelError, did_you_mean
 from ..kinematics.analogs import accelerations
 from ..model.constraints import point_acceleration, point_position, point_velocity
@@ -18,7 +19,7 @@ __all__ = ["Trajectory", "SwitchedSamples"]
 SUCCESS_STATUSES = ("success", "event")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Trajectory:
     """Samples of a simulated motion, time-major.
 
@@ -78,6 +79,18 @@ class Trajectory:
     body_names: tuple = ()
     coordinate_is_angle: tuple = ()
     model: object = field(default=None, repr=False, compare=False)
+
+    def __repr__(self) -> str:
+        s = self.stats
+        rows = s.streamed.rows if s.streamed is not None else self.n_samples
+        first = s.streamed.t_first if s.streamed is not None else self.t[:1]
+        times = span([*np.ravel(first), self.t[-1]], "s") if self.t.size else ""
+        drift = self.energy_drift()
+        return brief(self, f"{rows} samples" + (f", t = {times}" if times else ""),
+                     f"{len(self.coordinate_names)} coordinates, {len(self.body_names)} bodies",
+                     status_text(self), f"integrator {s.integrator!r}" if s.integrator else "",
+                     f"energy drift {number(drift, 'J')}" if drift == drift else "",
+                     f"{len(self.events)} events" if self.events else "")
 
     @property
     def success(self) -> bool:

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..brief import brief, number
 from ..errors import ModelError, Status
 from .analyses import check_figures
 from .designs import Range
@@ -67,7 +68,7 @@ def parse_constraint(text: str) -> Constraint:
     return Constraint(col, v if op != "<=" else None, v if op != ">=" else None)
 
 
-@dataclass
+@dataclass(repr=False)
 class Optimum:
     """The result of :func:`optimise`.
 
@@ -94,6 +95,12 @@ class Optimum:
     success: bool
     message: str
     evaluations: int = field(default=0)
+
+    def __repr__(self) -> str:
+        at = ", ".join(f"{k} = {number(v)}" for k, v in list(self.values.items())[:3])
+        return brief(self, f"objective {number(self.objective)}", at,
+                     f"{self.evaluations} evaluations",
+                     "converged" if self.success else "not converged")
 
 
 class _Problem:
