@@ -185,9 +185,20 @@ def warning_format(command: str, fallback=None):
     return format_warning
 
 
+def _quiet_stdout() -> None:
+    """Point stdout at the null device: its reader has gone, and Python's flush of it at
+    exit would otherwise print an ignored ``BrokenPipeError``."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):  # no real stdout (captured, closed)
+        pass
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code (0 ok, 1 analysis stopped, 2 bad input,
-    130 interrupted by Ctrl-C, 143 by SIGTERM; an interrupted run writes its data)."""
+    130 interrupted by Ctrl-C, 143 by SIGTERM; an interrupted run writes its data; 141,
+    silently, where the reader of the output stopped reading, as ``| head`` does)."""
     argv = negative_values(sys.argv[1:] if argv is None else list(argv))
     command = _command(argv)
     parser = build_parser(load=() if command is None else (command,))
@@ -221,6 +232,9 @@ def main(argv: list[str] | None = None) -> int:
     except (MechdynError, FileNotFoundError, IsADirectoryError, PermissionError) as exc:
         print(f"mechdyn {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # the reader of the output stopped (``| head``): no message
+        _quiet_stdout()
+        return 141  # as a command ended by SIGPIPE
     except OSError as exc:  # a full disk, a device that refuses the data ...
         print(f"mechdyn {args.command}: error: cannot write the output: {exc}",
               file=sys.stderr)
