@@ -484,9 +484,14 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: RunCounte
     _, ni, _, _, m = b.dims
     y = np.array(y0, float)
 
-    def python_from(t_, y_):
-        return integ.integrate(eqs.rhs, t_, y_[:ni], y_[ni:2 * ni], t_end, w0=y_[2 * ni:],
+    def python_from(t_, y_, h=None):
+        # the same method from (t_, y_), with the step the loop had there (as a segment
+        # handed over by fast_forward); its counters are integ's, which the caller reads
+        cont = integ.going_on(h) if integ.adaptive else integ
+        steps = cont.integrate(eqs.rhs, t_, y_[:ni], y_[ni:2 * ni], t_end, w0=y_[2 * ni:],
                                first_order=eqs.first_order_function())
+        integ.stats = cont.stats
+        return steps
 
     if book is not None and book.charts:
         yield from python_from(t, y)
@@ -518,7 +523,7 @@ def _kept_steps(kernel, integ, eqs, t: float, y0, t_end: float, stats: RunCounte
         # a kernel failure, or a branch chart built by the watch: the Python stepper
         # of the same method goes on from the last step
         if code == L.FAILED or not _watched(eqs, b):
-            yield from python_from(float(par[L.P_T]), y.copy())
+            yield from python_from(float(par[L.P_T]), y.copy(), float(par[L.P_H]))
             return
         if code == L.DONE:
             return
